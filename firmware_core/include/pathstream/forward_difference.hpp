@@ -1,0 +1,129 @@
+// Exact forward differencing of a tick cubic with no division per tick.
+//
+// Each difference level i (0: position, 1: velocity, 2: acceleration, 3: jerk, all per tick)
+// is kept as a quotient q_i and a remainder r_i in [0, D): value_i = q_i + r_i / D. One tick
+// adds level i+1 into level i for i = 0, 1, 2: add the remainders, carry into the quotient.
+// Level 0 starts offset by floor(D/2), so q_0 is round(Q(k)/D) at every tick, exactly.
+//
+// The carry costs no compare: remainders are stored biased, level i by B_i with
+// B_0 = B_2 = K, B_1 = B_3 = 0 and K = 2^W - D (W = 32 or 64 bits). Then adding the stored
+// words of levels i and i+1 gives r_i + r_{i+1} + K, which overflows the word exactly when
+// r_i + r_{i+1} >= D; the hardware carry is the quotient's carry, and one conditional add
+// or subtract of K restores the bias (details and proof: docs/exact-math.md).
+// W = 32 when D < 2^32 ("narrow" spans: n <= 894 for B-splines, 1290 for Catmull-Rom,
+// 1625 for Bezier/Hermite), else W = 64.
+#pragma once
+
+#include <cstdint>
+
+#include "pathstream/status.hpp"
+#include "pathstream/tick_cubic.hpp"
+#include "pathstream/units.hpp"
+
+namespace pathstream {
+
+/// Forward-differencing state of one axis with W-bit remainders (Word = uint32_t or uint64_t).
+/// The constant jerk level comes first and the three changing levels after it, so that on
+/// Thumb-2 one LDMIA loads a narrow state and one STMDB stores the changed part back.
+template <typename Word>
+struct DifferenceState {
+    Word jerk_remainder;        ///< level 3 remainder (bias 0), constant in a span
+    std::uint32_t jerk_quotient;  ///< level 3 quotient, constant in a span
+    Word remainder[3];          ///< levels 0..2, biased by K, 0, K
+    std::uint32_t quotient[3];  ///< levels 0..2 as two's complement int32
+
+    /// Current setpoint: the exact curve at the current tick, rounded once.
+    constexpr Lsb position() const { return static_cast<Lsb>(quotient[0]); }
+
+    /// Advances one tick in portable C++. `bias` is K = 2^W - D of the span. Compiles to
+    /// four instructions per level on Thumb-2 (add, add-with-carry, IT, conditional fix-up).
+    /// Interrupt-safe: touches only this object.
+    constexpr void step(Word bias) {
+        Word sum;
+        bool carry = __builtin_add_overflow(remainder[0], remainder[1], &sum);
+        quotient[0] += quotient[1] + (carry ? 1u : 0u);
+        remainder[0] = carry ? static_cast<Word>(sum + bias) : sum;
+
+        carry = __builtin_add_overflow(remainder[1], remainder[2], &sum);
+        quotient[1] += quotient[2] + (carry ? 1u : 0u);
+        remainder[1] = carry ? sum : static_cast<Word>(sum - bias);
+
+        carry = __builtin_add_overflow(remainder[2], jerk_remainder, &sum);
+        quotient[2] += jerk_quotient + (carry ? 1u : 0u);
+        remainder[2] = carry ? static_cast<Word>(sum + bias) : sum;
+    }
+};
+
+using NarrowDifferences = DifferenceState<std::uint32_t>;
+using WideDifferences = DifferenceState<std::uint64_t>;
+
+/// Writes each axis's current setpoint to `out`, then advances every axis one tick.
+/// This is the tick interrupt's whole per-axis work. On Thumb-2 (Cortex-M3/M4/M7) the narrow
+/// case is one LDMIA, one store, twelve ALU/IT instructions and one STMDB per axis, the
+/// same arithmetic as DifferenceState::step written so the loads and stores coalesce (GCC
+/// emits five loads and three stores for the C++). Define PATHSTREAM_PORTABLE_STEP to force
+/// the C++ everywhere; tests compare both builds' checksums bit for bit.
+template <unsigned Axes, typename Word>
+inline void emit_and_step(DifferenceState<Word> (&state)[Axes], Lsb (&out)[Axes], Word bias) {
+#if defined(__thumb2__) && !defined(PATHSTREAM_PORTABLE_STEP)
+    if constexpr (sizeof(Word) == 4) {
+        static_assert(sizeof(DifferenceState<Word>) == 32, "LDMIA of eight words");
+        DifferenceState<Word>* p = state;
+        Lsb* o = out;
+#pragma GCC unroll 8
+        for (unsigned a = 0; a < Axes; ++a) {
+            // r4 jerk remainder, r5 jerk quotient, r6..r8 remainders 0..2, r9..r11 quotients.
+            asm volatile(
+                "ldmia %[p]!, {r4-r11}\n\t"
+                "str   r9, [%[o]], #4\n\t"
+                "adds  r6, r6, r7\n\t"
+                "adc   r9, r9, r10\n\t"
+                "it    cs\n\t"
+                "addcs r6, r6, %[k]\n\t"
+                "adds  r7, r7, r8\n\t"
+                "adc   r10, r10, r11\n\t"
+                "it    cc\n\t"
+                "subcc r7, r7, %[k]\n\t"
+                "adds  r8, r8, r4\n\t"
+                "adc   r11, r11, r5\n\t"
+                "it    cs\n\t"
+                "addcs r8, r8, %[k]\n\t"
+                "stmdb %[p], {r6-r11}"
+                : [p] "+r"(p), [o] "+r"(o)
+                : [k] "r"(bias)
+                : "r4", "r5", "r6", "r7", "r8", "r9", "r10", "r11", "cc", "memory");
+        }
+        return;
+    }
+#endif
+    for (unsigned a = 0; a < Axes; ++a) {
+        out[a] = state[a].position();
+        state[a].step(bias);
+    }
+}
+
+/// True when a span with this timing uses 32-bit remainders.
+constexpr bool is_narrow(const SpanTiming& timing) {
+    return timing.denominator < (std::uint64_t{1} << 32);
+}
+
+/// K = 2^W - D for the word width the span uses (returned in 64 bits for both widths).
+constexpr std::uint64_t difference_bias(const SpanTiming& timing) {
+    return is_narrow(timing) ? (std::uint64_t{1} << 32) - timing.denominator
+                             : 0 - timing.denominator;
+}
+
+/// Sets `out` to the state at tick k0 of the span (0 <= k0 <= ticks). Requires a cubic built
+/// by make_tick_cubic with this timing (its bounds keep every quotient in int32), and Word
+/// wide enough for D (uint32_t only when is_narrow). Cost: four 128/64 floor divisions and a
+/// dozen 128-bit multiplies. Task context.
+template <typename Word>
+[[nodiscard]] Status start_differences(const TickCubic& cubic, const SpanTiming& timing,
+                                       std::uint32_t k0, DifferenceState<Word>& out);
+
+extern template Status start_differences<std::uint32_t>(const TickCubic&, const SpanTiming&,
+                                                        std::uint32_t, NarrowDifferences&);
+extern template Status start_differences<std::uint64_t>(const TickCubic&, const SpanTiming&,
+                                                        std::uint32_t, WideDifferences&);
+
+}  // namespace pathstream

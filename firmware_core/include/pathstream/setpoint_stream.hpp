@@ -1,0 +1,117 @@
+// The span queue plus the per-tick consumer: spans in (task), one setpoint per axis per
+// tick out (timer interrupt).
+#pragma once
+
+#include <cstdint>
+
+#include "pathstream/span.hpp"
+#include "pathstream/span_queue.hpp"
+#include "pathstream/status.hpp"
+#include "pathstream/units.hpp"
+
+namespace pathstream {
+
+/// What tick() produced.
+enum class TickState : std::uint8_t {
+    kMoving = 0,  ///< a span supplied this tick's setpoints
+    kIdle = 1,    ///< no span queued: setpoints hold the last end point (or the start)
+};
+
+/// Spans of `Axes` axes queued `Capacity` deep, consumed one tick at a time by forward
+/// differencing. Consecutive spans join without a gap or a repeated tick: a span of n ticks
+/// supplies its ticks 0..n-1, and its end point (tick n) is the next span's tick 0.
+/// Storage is inline (about Capacity * (16 + 40 * Axes) bytes); no allocation ever.
+template <unsigned Axes, std::uint32_t Capacity>
+class SetpointStream {
+public:
+    /// Starts idle, holding `start` (LSB per axis). Init context.
+    explicit SetpointStream(const Lsb (&start)[Axes]) {
+        for (unsigned a = 0; a < Axes; ++a) hold_[a] = start[a];
+    }
+    SetpointStream() = default;
+
+    /// Producer (task): validates and prepares `span` straight into a free queue slot.
+    /// Returns kQueueFull with nothing written when no slot is free, or the span's validation
+    /// error with the queue unchanged. Cost: prepare_span. Never call from the tick interrupt.
+    [[nodiscard]] Status push(const Span<Axes>& span) {
+        PreparedSpan<Axes>* slot = queue_.claim();
+        if (slot == nullptr) return Status::kQueueFull;
+        if (Status s = prepare_span(span, *slot); s != Status::kOk) return s;
+        queue_.publish();
+        return Status::kOk;
+    }
+
+    /// Consumer (tick interrupt): writes this tick's setpoint for every axis to `out`.
+    /// Steady state costs one forward-differencing step per axis; at a span boundary the
+    /// next span is taken from the queue (a pointer swap, no copy).
+    TickState tick(Lsb (&out)[Axes]) {
+        PreparedSpan<Axes>* span = active_;
+        if (span == nullptr) {
+            span = begin_next_span();
+            if (span == nullptr) return hold(out);
+        }
+        if (!span->wide) {
+            emit_and_step(span->narrow, out, static_cast<std::uint32_t>(span->bias));
+        } else {
+            step_wide(*span, out);
+        }
+        if (--remaining_ == 0) finish_span();
+        return TickState::kMoving;
+    }
+
+    /// Spans queued, the active one included. Either context.
+    std::uint32_t queued_spans() const { return queue_.size(); }
+    /// Free queue slots as seen by the producer.
+    std::uint32_t free_slots() const { return queue_.free_slots(); }
+    static constexpr std::uint32_t capacity() { return Capacity; }
+    /// Ticks supplied by spans since construction (idle ticks excluded). Consumer context.
+    std::uint64_t ticks_executed() const {
+        return completed_ticks_ + (active_ != nullptr ? active_->ticks - remaining_ : 0u);
+    }
+    /// Tag of the last span whose every tick was supplied; 0 before the first. Consumer.
+    std::uint32_t last_completed_tag() const { return last_completed_tag_; }
+    /// Spans completed since construction. Consumer context.
+    std::uint32_t spans_completed() const { return spans_completed_; }
+
+private:
+    // Wide spans (D >= 2^32: long spans) are kept out of line so the common narrow path
+    // needs no stack frame of its own.
+    [[gnu::noinline]] static void step_wide(PreparedSpan<Axes>& span, Lsb (&out)[Axes]) {
+        emit_and_step(span.wide_state, out, span.bias);
+    }
+
+    [[gnu::noinline, gnu::cold]] TickState hold(Lsb (&out)[Axes]) const {
+        for (unsigned a = 0; a < Axes; ++a) out[a] = hold_[a];
+        return TickState::kIdle;
+    }
+
+    // Span boundaries are rare (every n ticks): kept out of line so tick() stays small.
+    [[gnu::noinline]] PreparedSpan<Axes>* begin_next_span() {
+        active_ = queue_.front();
+        if (active_ != nullptr) remaining_ = active_->ticks;
+        return active_;
+    }
+
+    [[gnu::noinline]] void finish_span() {
+        // The state has stepped once past the last tick: it now holds the end point.
+        for (unsigned a = 0; a < Axes; ++a) {
+            hold_[a] = active_->wide ? active_->wide_state[a].position()
+                                     : active_->narrow[a].position();
+        }
+        last_completed_tag_ = active_->tag;
+        completed_ticks_ += active_->ticks;
+        ++spans_completed_;
+        active_ = nullptr;
+        queue_.release();
+    }
+
+    SpanQueue<PreparedSpan<Axes>, Capacity> queue_;
+    PreparedSpan<Axes>* active_ = nullptr;
+    std::uint32_t remaining_ = 0;
+    std::uint64_t completed_ticks_ = 0;
+    std::uint32_t last_completed_tag_ = 0;
+    std::uint32_t spans_completed_ = 0;
+    Lsb hold_[Axes] = {};
+};
+
+}  // namespace pathstream

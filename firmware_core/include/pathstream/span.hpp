@@ -1,0 +1,72 @@
+// A span as the host sends it, and the same span prepared for the per-tick loop.
+#pragma once
+
+#include <cstdint>
+
+#include "pathstream/basis.hpp"
+#include "pathstream/forward_difference.hpp"
+#include "pathstream/status.hpp"
+#include "pathstream/tick_cubic.hpp"
+
+namespace pathstream {
+
+/// Upper bound on axes per span; a build picks its own Axes (1..kMaxAxes) at compile time.
+inline constexpr unsigned kMaxAxes = 8;
+
+/// One cubic piece of the path on all axes, lasting `ticks` ticks. Plain value, 16 bytes per
+/// axis plus a header; what the wire protocols carry.
+template <unsigned Axes>
+struct Span {
+    static_assert(Axes >= 1 && Axes <= kMaxAxes, "1 to 8 axes");
+    Basis basis = Basis::kUniformBSpline;
+    std::uint32_t ticks = 1;               ///< n, 1..kMaxSpanTicks
+    std::uint32_t tag = 0;                 ///< caller's label (e.g. a sequence number), kept
+    std::int32_t control[Axes][4] = {};    ///< per axis: P0..P3 (Hermite: P0, P1, T0, T1)
+};
+
+/// A span validated and converted to forward-differencing state at its first tick.
+/// Holds either narrow or wide state for all axes (they share D). ~40 or ~48 bytes per axis.
+template <unsigned Axes>
+struct PreparedSpan {
+    // The states come first so the tick loop addresses them from the span pointer itself.
+    union {
+        NarrowDifferences narrow[Axes];
+        WideDifferences wide_state[Axes];
+    };
+    std::uint32_t ticks = 0;
+    std::uint32_t tag = 0;
+    std::uint64_t bias = 0;  ///< K = 2^W - D (its low 32 bits when narrow)
+    bool wide = false;
+    PreparedSpan() : narrow{} {}
+};
+
+/// Validates `span` on every axis and writes its prepared form to `out`. Either every axis
+/// passes and `out` is fully written, or the first failure is returned and `out` is left as
+/// it was on all axes. Cost: per axis, one make_tick_cubic and one start_differences
+/// (a few thousand instructions on Cortex-M4). Task context, never the tick interrupt.
+template <unsigned Axes>
+[[nodiscard]] Status prepare_span(const Span<Axes>& span, PreparedSpan<Axes>& out) {
+    SpanTiming timing;
+    if (Status s = make_span_timing(span.basis, span.ticks, timing); s != Status::kOk) return s;
+    TickCubic cubic[Axes];
+    for (unsigned axis = 0; axis < Axes; ++axis) {
+        if (Status s = make_tick_cubic(span.basis, span.control[axis], timing, cubic[axis]);
+            s != Status::kOk) {
+            return s;
+        }
+    }
+    // Bounds are proven; from here nothing can fail, so `out` is only written now.
+    const bool narrow = is_narrow(timing);
+    for (unsigned axis = 0; axis < Axes; ++axis) {
+        const Status s = narrow ? start_differences(cubic[axis], timing, 0, out.narrow[axis])
+                                : start_differences(cubic[axis], timing, 0, out.wide_state[axis]);
+        (void)s;  // cannot fail: tick 0 is inside every span
+    }
+    out.ticks = span.ticks;
+    out.tag = span.tag;
+    out.wide = !narrow;
+    out.bias = difference_bias(timing);
+    return Status::kOk;
+}
+
+}  // namespace pathstream

@@ -1,0 +1,30 @@
+#!/usr/bin/env bash
+# Installs every Debian package pathstream needs to build, test and benchmark.
+# Idempotent: packages already present are skipped, so it is cheap to run again.
+set -euo pipefail
+
+packages=(
+  # host toolchain and test framework
+  build-essential cmake ninja-build pkg-config catch2
+  # host libraries (CLI, data, math baseline for the bench)
+  libcli11-dev nlohmann-json3-dev libeigen3-dev
+  # Cortex-M proof: cross toolchain, C++ headers, emulator with TCG plugin support
+  gcc-arm-none-eabi binutils-arm-none-eabi libstdc++-arm-none-eabi-newlib
+  libnewlib-arm-none-eabi qemu-system-arm libglib2.0-dev
+)
+
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "setup: all ${#packages[@]} packages already installed"
+  exit 0
+fi
+
+echo "setup: installing ${missing[*]}"
+if [ "$(id -u)" -ne 0 ]; then sudo=sudo; else sudo=; fi
+export DEBIAN_FRONTEND=noninteractive
+$sudo apt-get update -q
+$sudo apt-get install -y -q --no-install-recommends "${missing[@]}"
