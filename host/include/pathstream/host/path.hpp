@@ -1,0 +1,45 @@
+// A geometric path as the user describes it, before timing: subpaths of control points in
+// the path's units (millimetres after loading).
+#pragma once
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+namespace pathstream::host {
+
+/// How a subpath's points define the curve.
+enum class PathBasis {
+    kBSpline,     ///< uniform cubic B-spline; open ends clamped with phantom points 2P0 - P1
+    kCatmullRom,  ///< uniform Catmull-Rom through every point
+    kBezier,      ///< cubic Bezier chain: P0 C C P1 C C P2 ... (3k + 1 points open, 3k closed)
+    kPolyline,    ///< straight segments between points
+};
+
+/// Where a value came from in its input file (1-based), for error messages.
+struct SourceLocation {
+    std::size_t line = 0;
+    std::size_t column = 0;
+};
+
+/// One point: one coordinate per axis, in millimetres.
+using PathPoint = std::vector<double>;
+
+/// A connected piece of the path, drawn pen-down.
+struct Subpath {
+    PathBasis basis = PathBasis::kBSpline;
+    bool closed = false;
+    std::vector<PathPoint> points;
+    SourceLocation location;  ///< where the subpath starts in the file
+};
+
+/// A whole path. Every point of every subpath has `axes` coordinates.
+struct Path {
+    std::size_t axes = 2;
+    std::vector<Subpath> subpaths;
+};
+
+/// Name used in files and messages ("bspline", "catmull-rom", "bezier", "polyline").
+const char* basis_name(PathBasis basis);
+
+}  // namespace pathstream::host

@@ -1,0 +1,36 @@
+#!/usr/bin/env bash
+# End-to-end checks of the pathstream command as a user runs it: exit codes, messages, and
+# that a failed run leaves no output file behind.
+#   cli_test.sh PATHSTREAM_BINARY SOURCE_DIR WORK_DIR
+set -u
+bin=$1 src=$2 work=$3
+rm -rf "$work" && mkdir -p "$work"
+failures=0 passed=0
+expect() {  # expect NAME EXIT_CODE MESSAGE_SUBSTRING -- command...
+  local name=$1 code=$2 needle=$3; shift 4
+  local out rc
+  out=$("$@" 2>&1); rc=$?
+  if [ "$rc" -ne "$code" ] || [[ "$out" != *"$needle"* ]]; then
+    echo "FAIL $name: exit $rc (want $code), output: $out"; failures=$((failures + 1))
+  else
+    passed=$((passed + 1))
+  fi
+}
+
+expect example 0 "every setpoint (6720) equals" -- "$bin" setpoints "$src/examples/rose.json" --out "$work/rose.csv"
+rows=$(wc -l < "$work/rose.csv")
+# 105 spans x 32 ticks + the end point + the header
+if [ "$rows" -ne $((105 * 32 + 2)) ]; then echo "FAIL rows: $rows"; failures=$((failures + 1)); else passed=$((passed + 1)); fi
+if [ "$(head -1 "$work/rose.csv")" != "tick,span,subpath,pen,x,y" ]; then echo "FAIL header"; failures=$((failures + 1)); else passed=$((passed + 1)); fi
+
+printf '{\n  "points": [[0, 0],\n    [1, "x"]]\n}\n' > "$work/bad.json"
+expect bad-file 1 "bad.json:3:9: coordinate must be a number" -- "$bin" setpoints "$work/bad.json" --out "$work/bad.csv"
+if ls "$work"/bad.csv* >/dev/null 2>&1; then echo "FAIL bad-file left output behind"; failures=$((failures + 1)); else passed=$((passed + 1)); fi
+expect bad-option 2 "--ticks-per-span" -- "$bin" setpoints "$src/examples/rose.json" --ticks-per-span 70000
+expect missing-file 2 "File does not exist" -- "$bin" setpoints "$work/nope.json"
+expect no-subcommand 2 "A subcommand is required" -- "$bin"
+expect unwritable 3 "cannot create output file" -- "$bin" setpoints "$src/examples/rose.json" --out "$work/no/such/dir/x.csv"
+expect help 0 "--ticks-per-span" -- "$bin" setpoints --help
+
+echo "cli: $passed passed, $failures failed"
+[ "$failures" -eq 0 ]
