@@ -35,22 +35,22 @@ struct DifferenceState {
     /// Current setpoint: the exact curve at the current tick, rounded once.
     constexpr Lsb position() const { return static_cast<Lsb>(quotient[0]); }
 
-    /// Advances one tick in portable C++. `bias` is K = 2^W - D of the span. Compiles to
-    /// four instructions per level on Thumb-2 (add, add-with-carry, IT, conditional fix-up).
+    /// Advances one tick in portable C++. `bias` is K = 2^W - D of the span. Branch-free:
+    /// each carry becomes a 0/1 and an all-zeros/all-ones mask selecting the K fix-up, so
+    /// no data-dependent jump can mispredict (x86 compiles a ternary here to jumps).
     /// Interrupt-safe: touches only this object.
     constexpr void step(Word bias) {
-        Word sum;
-        bool carry = __builtin_add_overflow(remainder[0], remainder[1], &sum);
-        quotient[0] += quotient[1] + (carry ? 1u : 0u);
-        remainder[0] = carry ? static_cast<Word>(sum + bias) : sum;
-
-        carry = __builtin_add_overflow(remainder[1], remainder[2], &sum);
-        quotient[1] += quotient[2] + (carry ? 1u : 0u);
-        remainder[1] = carry ? sum : static_cast<Word>(sum - bias);
-
-        carry = __builtin_add_overflow(remainder[2], jerk_remainder, &sum);
-        quotient[2] += jerk_quotient + (carry ? 1u : 0u);
-        remainder[2] = carry ? static_cast<Word>(sum + bias) : sum;
+        Word r0 = remainder[0], r1 = remainder[1], r2 = remainder[2];
+        const Word sum0 = r0 + r1, sum1 = r1 + r2, sum2 = r2 + jerk_remainder;
+        const Word c0 = sum0 < r1 ? 1u : 0u;
+        const Word c1 = sum1 < r2 ? 1u : 0u;
+        const Word c2 = sum2 < jerk_remainder ? 1u : 0u;
+        quotient[0] += quotient[1] + static_cast<std::uint32_t>(c0);
+        quotient[1] += quotient[2] + static_cast<std::uint32_t>(c1);
+        quotient[2] += jerk_quotient + static_cast<std::uint32_t>(c2);
+        remainder[0] = static_cast<Word>(sum0 + (bias & (0 - c0)));
+        remainder[1] = static_cast<Word>(sum1 - (bias & (c1 - 1)));
+        remainder[2] = static_cast<Word>(sum2 + (bias & (0 - c2)));
     }
 };
 
@@ -97,8 +97,12 @@ inline void emit_and_step(DifferenceState<Word> (&state)[Axes], Lsb (&out)[Axes]
     }
 #endif
     for (unsigned a = 0; a < Axes; ++a) {
-        out[a] = state[a].position();
-        state[a].step(bias);
+        // A local copy: `out` (int32) may alias the quotients (uint32) as far as the compiler
+        // knows, which would otherwise force every field through memory.
+        DifferenceState<Word> s = state[a];
+        out[a] = s.position();
+        s.step(bias);
+        state[a] = s;
     }
 }
 
