@@ -1,0 +1,223 @@
+// Bare-metal image for the instruction budgets, run under qemu with the insn_count plugin
+// (plugin/insn_count.c) and read by host/budget_report.cpp.
+//
+// For A = 1, 2, 3, 4, 8 axes it streams spans through SetpointStream<A, 16> in phases:
+//   narrow: spans of n = 64 ticks (the typical streaming case, 32-bit remainders), S = 16
+//   wide:   spans of n = 2048 ticks (D >= 2^32, 64-bit remainders), S = 4
+// and for each width three phases on the same control values: (n, S spans), (2n, S spans),
+// (n, 2S spans), plus a phase of push() alone. Differences between phases cancel everything
+// that does not scale with the tick count:
+//   (2n, S) - (n, S): the steady per-tick cost (same number of span switches);
+//   (n, 2S) - (n, S): S more spans of n ticks, each with its switch and its push.
+// Every phase is bracketed by calls to budget_mark(), whose address the plugin watches: it
+// snapshots its counters there. tick() is measured through budget_tick_<A>, an out-of-line
+// function whose body is exactly SetpointStream::tick inlined (same arguments: the stream and
+// the output array), so its address range is tick()'s code.
+// It ends with Horner phases (evaluate_at per call, n = 64 and n = 65536) and a calibration loop whose exact
+// instruction count is known, which checks the counting method itself.
+#include <cstdint>
+#include <new>
+
+#include "pathstream/setpoint_stream.hpp"
+#include "pathstream/tick_cubic.hpp"
+#include "semihosting.hpp"
+#include "workload.hpp"
+
+namespace {
+
+using pathstream::Lsb;
+using pathstream::Status;
+using pathstream::TickState;
+
+constexpr std::uint32_t kCapacity = 16;
+template <unsigned A>
+using Stream = pathstream::SetpointStream<A, kCapacity>;
+
+// One stream at a time lives here (the micro:bit has 16 KiB of RAM).
+alignas(8) unsigned char g_arena[sizeof(Stream<8>)];
+Lsb g_out[8];
+bool g_failed = false;
+
+}  // namespace
+
+/// The plugin snapshots its counters whenever this function's first instruction executes.
+extern "C" [[gnu::noinline, gnu::used]] void budget_mark(std::uint32_t id) {
+    asm volatile("" : : "r"(id) : "memory");
+}
+
+/// Exactly 2 * iterations + 1 instructions (iterations >= 1): the plugin's self-check.
+extern "C" [[gnu::naked, gnu::noinline, gnu::used]] void budget_calibrate(std::uint32_t) {
+    // GCC hands Thumb-1 inline asm to the assembler in divided syntax; ask for unified (GCC
+    // re-emits .syntax unified after every asm statement itself).
+    asm volatile(
+        ".syntax unified\n\t"
+        "1: subs r0, r0, #1\n\t"
+        "   bne 1b\n\t"
+        "   bx lr\n\t");
+}
+
+// tick() as an out-of-line function per axis count: budget_tick_<A>.
+#define PATHSTREAM_BUDGET_TICK(A)                                                           \
+    extern "C" [[gnu::noinline, gnu::used]] TickState budget_tick_##A(Stream<A>& s,         \
+                                                                      Lsb(&out)[A]) {       \
+        return s.tick(out);                                                                 \
+    }
+PATHSTREAM_BUDGET_TICK(1)
+PATHSTREAM_BUDGET_TICK(2)
+PATHSTREAM_BUDGET_TICK(3)
+PATHSTREAM_BUDGET_TICK(4)
+PATHSTREAM_BUDGET_TICK(8)
+
+namespace {
+
+template <unsigned A>
+TickState tick_of(Stream<A>& s, Lsb (&out)[A]);
+template <> TickState tick_of<1>(Stream<1>& s, Lsb (&out)[1]) { return budget_tick_1(s, out); }
+template <> TickState tick_of<2>(Stream<2>& s, Lsb (&out)[2]) { return budget_tick_2(s, out); }
+template <> TickState tick_of<3>(Stream<3>& s, Lsb (&out)[3]) { return budget_tick_3(s, out); }
+template <> TickState tick_of<4>(Stream<4>& s, Lsb (&out)[4]) { return budget_tick_4(s, out); }
+template <> TickState tick_of<8>(Stream<8>& s, Lsb (&out)[8]) { return budget_tick_8(s, out); }
+
+constexpr int kPoolSize = 4;
+
+/// Four spans of `n` ticks, one per basis, gentle random control values.
+template <unsigned A>
+void make_pool(pathstream::workload::SplitMix64& rng, std::uint32_t n,
+               pathstream::Span<A> (&pool)[kPoolSize]) {
+    for (int i = 0; i < kPoolSize; ++i) {
+        pool[i].basis = static_cast<pathstream::Basis>(i);
+        pool[i].ticks = n;
+        pool[i].tag = static_cast<std::uint32_t>(i + 1);
+        for (unsigned a = 0; a < A; ++a) {
+            const std::int32_t base = rng.between(-1000000, 1000000);
+            for (int j = 0; j < 4; ++j) {
+                const bool tangent = pool[i].basis == pathstream::Basis::kHermite && j >= 2;
+                pool[i].control[a][j] =
+                    tangent ? rng.between(-300000, 300000) : base + rng.between(-100000, 100000);
+            }
+        }
+    }
+}
+
+std::uint32_t g_phase = 0;
+
+void report_phase(const char* kind, unsigned axes, std::uint32_t n, std::uint32_t spans,
+                  std::uint64_t ticks, std::uint64_t calls, bool ok) {
+    cortex_m::Line line;
+    line.text("phase id=").dec(g_phase).text(" kind=").text(kind).text(" axes=").dec(axes)
+        .text(" n=").dec(n).text(" spans=").dec(spans).text(" ticks=").dec(ticks)
+        .text(" calls=").dec(calls).text(" ok=").dec(ok ? 1 : 0).end();
+    if (!ok) g_failed = true;
+    ++g_phase;
+}
+
+/// One streaming phase: a fresh stream, `spans` spans of `n` ticks pushed as room appears
+/// (the producer runs between ticks, as a task would), ticked until all are consumed.
+template <unsigned A>
+[[gnu::noinline]] void stream_phase(const char* kind, const pathstream::Span<A> (&pool)[kPoolSize],
+                                    std::uint32_t n, std::uint32_t spans) {
+    const Lsb start[A] = {};
+    budget_mark(2 * g_phase);
+    Stream<A>& s = *new (g_arena) Stream<A>(start);
+    std::uint32_t pushed = 0;
+    bool ok = true;
+    while (pushed < spans && s.free_slots() != 0) {
+        ok &= s.push(pool[pushed % kPoolSize]) == Status::kOk;
+        ++pushed;
+    }
+    const std::uint64_t ticks = std::uint64_t{spans} * n;
+    for (std::uint64_t t = 0; t < ticks; ++t) {
+        (void)tick_of<A>(s, reinterpret_cast<Lsb(&)[A]>(g_out));
+        if (pushed < spans && s.free_slots() != 0) {
+            ok &= s.push(pool[pushed % kPoolSize]) == Status::kOk;
+            ++pushed;
+        }
+    }
+    budget_mark(2 * g_phase + 1);
+    ok &= s.spans_completed() == spans && s.queued_spans() == 0 && s.ticks_executed() == ticks;
+    report_phase(kind, A, n, spans, ticks, 0, ok);
+}
+
+/// push() alone: a fresh stream filled with kCapacity spans; cost per push (validation and
+/// prepare_span, i.e. make_tick_cubic and start_differences on every axis).
+template <unsigned A>
+[[gnu::noinline]] void push_phase(const char* kind, const pathstream::Span<A> (&pool)[kPoolSize]) {
+    const Lsb start[A] = {};
+    Stream<A>& s = *new (g_arena) Stream<A>(start);
+    bool ok = true;
+    budget_mark(2 * g_phase);
+    for (std::uint32_t i = 0; i < kCapacity; ++i) {
+        ok &= s.push(pool[i % kPoolSize]) == Status::kOk;
+    }
+    budget_mark(2 * g_phase + 1);
+    report_phase(kind, A, pool[0].ticks, kCapacity, 0, kCapacity, ok);
+}
+
+/// The phases of one span width: (n, S), (2n, S), (n, 2S) on the same control values (only
+/// the tick count changes, and S is a multiple of the pool size, so the (n, 2S) phase runs
+/// the (n, S) phase's spans twice), then push() alone.
+template <unsigned A>
+void width_phases(pathstream::workload::SplitMix64& rng, const char* kind, const char* push_kind,
+                  std::uint32_t n, std::uint32_t spans) {
+    pathstream::Span<A> pool[kPoolSize];
+    make_pool<A>(rng, n, pool);
+    stream_phase<A>(kind, pool, n, spans);
+    for (auto& span : pool) span.ticks = 2 * n;
+    stream_phase<A>(kind, pool, 2 * n, spans);
+    for (auto& span : pool) span.ticks = n;
+    stream_phase<A>(kind, pool, n, 2 * spans);
+    push_phase<A>(push_kind, pool);
+}
+
+template <unsigned A>
+void stream_phases(pathstream::workload::SplitMix64& rng) {
+    // Narrow: n = 64 (D = scale * 2^18 < 2^32 for every basis).
+    width_phases<A>(rng, "narrow", "push_narrow", 64, 16);
+    // Wide: n = 2048 (D >= 2^33 for every basis).
+    width_phases<A>(rng, "wide", "push_wide", 2048, 4);
+}
+
+/// evaluate_at at `calls` ticks spread over a span of n ticks; cost per call.
+[[gnu::noinline]] void horner_phase(pathstream::workload::SplitMix64& rng, std::uint32_t n,
+                                    std::uint32_t calls) {
+    pathstream::SpanTiming timing;
+    pathstream::TickCubic cubic;
+    std::int32_t control[4];
+    for (int j = 0; j < 4; ++j) control[j] = rng.between(-50000000, 50000000);
+    bool ok = pathstream::make_span_timing(pathstream::Basis::kUniformBSpline, n, timing) ==
+              Status::kOk;
+    ok &= pathstream::make_tick_cubic(pathstream::Basis::kUniformBSpline, control, timing,
+                                      cubic) == Status::kOk;
+    budget_mark(2 * g_phase);
+    for (std::uint32_t i = 0; i < calls; ++i) {
+        ok &= pathstream::evaluate_at(cubic, timing, (i * 7919u) % (n + 1), g_out[0]) ==
+              Status::kOk;
+    }
+    budget_mark(2 * g_phase + 1);
+    report_phase("horner", 1, n, 1, 0, calls, ok);
+}
+
+[[gnu::noinline]] void calibration_phase(std::uint32_t iterations) {
+    budget_mark(2 * g_phase);
+    budget_calibrate(iterations);
+    budget_mark(2 * g_phase + 1);
+    report_phase("calibrate", 0, iterations, 0, 0, 1, true);
+}
+
+}  // namespace
+
+int main() {
+    pathstream::workload::SplitMix64 rng(0xb0d6e7u);
+    cortex_m::write("budget image: SetpointStream<A, 16>, narrow n=64, wide n=2048\n");
+    calibration_phase(1000);
+    stream_phases<1>(rng);
+    stream_phases<2>(rng);
+    stream_phases<3>(rng);
+    stream_phases<4>(rng);
+    stream_phases<8>(rng);
+    horner_phase(rng, 64, 64);      // |Q| < 2^64: one 64-bit division
+    horner_phase(rng, 65536, 64);   // |Q| >= 2^64: the bit-serial 128/64 division
+    cortex_m::Line line;
+    line.text("budget done phases=").dec(g_phase).text(g_failed ? " FAILED" : " ok").end();
+    return g_failed ? 1 : 0;
+}
