@@ -5,7 +5,7 @@
 //   cortex_m_budget --qemu qemu-system-arm --plugin libpathstream_insn_count.so
 //                   --nm arm-none-eabi-nm --board mps2-an386 --label "Cortex-M4"
 //                   --image budget.elf [--budget 20] [--assert-axes 4,8]
-//                   [--assert-marginal] [--timeout 60] [--keep DIR]
+//                   [--assert-marginal] [--no-legend] [--timeout 60] [--keep DIR]
 //
 // Method (docs/cortex-m.md): the address ranges of budget_tick_<A> (SetpointStream::tick
 // inlined into an out-of-line function), SetpointStream<A,16>::step_wide (the wide per-tick
@@ -44,6 +44,7 @@ struct Options {
     std::optional<double> budget;
     std::set<unsigned> assert_axes;
     bool assert_marginal = false;
+    bool legend = true;
     int timeout = 60;
 };
 
@@ -174,6 +175,7 @@ Options parse_options(int argc, char** argv) {
         else if (arg == "--budget") o.budget = std::stod(value());
         else if (arg == "--timeout") o.timeout = std::stoi(value());
         else if (arg == "--assert-marginal") o.assert_marginal = true;
+        else if (arg == "--no-legend") o.legend = false;
         else if (arg == "--assert-axes") {
             std::istringstream in(value());
             for (std::string item; std::getline(in, item, ',');) {
@@ -298,8 +300,8 @@ int main(int argc, char** argv) {
         return sum;
     };
 
-    std::cout << "\n## " << o.label << " (qemu -M " << o.board
-              << "): SetpointStream<A, 16>, executed instructions\n\n";
+    std::cout << "\n## " << o.label << ": SetpointStream<A, 16>, executed instructions (qemu -M "
+              << o.board << ", TCG plugin counts)\n\n";
 
     // Self-check of the counting method: the calibration loop's exact count.
     for (const Phase& p : phases) {
@@ -427,7 +429,7 @@ int main(int argc, char** argv) {
                   << " instructions per call (whole call, 128-bit arithmetic and libgcc helpers"
                      " included)\n";
     }
-    std::cout << "\nColumns (docs/cortex-m.md):\n"
+    if (o.legend) std::cout << "\nColumns (docs/cortex-m.md):\n"
                  "- tick() per tick: steady state, instructions executed inside tick() (and"
                  " step_wide for wide spans) per tick, from two runs with the same spans and n vs"
                  " 2n ticks each; the setpoint output (exact, rounded) included.\n"
