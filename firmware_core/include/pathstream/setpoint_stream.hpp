@@ -24,20 +24,36 @@ enum class TickState : std::uint8_t {
 template <unsigned Axes, std::uint32_t Capacity>
 class SetpointStream {
 public:
-    /// Starts idle, holding `start` (LSB per axis). Init context.
+    /// Starts idle, holding `start` (LSB per axis); the first span must begin there.
+    /// Init context. The default constructor starts at 0 on every axis.
     explicit SetpointStream(const Lsb (&start)[Axes]) {
-        for (unsigned a = 0; a < Axes; ++a) hold_[a] = start[a];
+        for (unsigned a = 0; a < Axes; ++a) hold_[a] = pushed_end_[a] = start[a];
     }
     SetpointStream() = default;
 
-    /// Producer (task): validates and prepares `span` straight into a free queue slot.
-    /// Returns kQueueFull with nothing written when no slot is free, or the span's validation
-    /// error with the queue unchanged. Cost: prepare_span. Never call from the tick interrupt.
+    /// Producer (task): validates `span`, checks that it starts exactly where the previously
+    /// pushed span ends (or at the start position, for the first), and prepares it straight
+    /// into a free queue slot. Errors, in this order, each leaving queue and stream unchanged:
+    /// the span's own validation error; kDiscontinuousSpan (a jump no axis could execute);
+    /// kQueueFull (retry later: the span itself is fine). Cost: validation, one Horner end
+    /// point per axis, preparation. Never call from the tick interrupt.
     [[nodiscard]] Status push(const Span<Axes>& span) {
+        ValidatedSpan<Axes> v;
+        if (Status s = validate_span(span, v); s != Status::kOk) return s;
+        Lsb end[Axes];
+        for (unsigned a = 0; a < Axes; ++a) {
+            Lsb start = 0;
+            if (evaluate_at(v.cubic[a], v.timing, 0, start) != Status::kOk ||
+                evaluate_at(v.cubic[a], v.timing, v.timing.ticks, end[a]) != Status::kOk) {
+                return Status::kTickOutsideSpan;  // unreachable: ticks 0 and n are in the span
+            }
+            if (start != pushed_end_[a]) return Status::kDiscontinuousSpan;
+        }
         PreparedSpan<Axes>* slot = queue_.claim();
         if (slot == nullptr) return Status::kQueueFull;
-        if (Status s = prepare_span(span, *slot); s != Status::kOk) return s;
+        prepare_validated(v, *slot);
         queue_.publish();
+        for (unsigned a = 0; a < Axes; ++a) pushed_end_[a] = end[a];
         return Status::kOk;
     }
 
@@ -111,7 +127,8 @@ private:
     std::uint64_t completed_ticks_ = 0;
     std::uint32_t last_completed_tag_ = 0;
     std::uint32_t spans_completed_ = 0;
-    Lsb hold_[Axes] = {};
+    Lsb hold_[Axes] = {};        // consumer side: where the axes rest when idle
+    Lsb pushed_end_[Axes] = {};  // producer side: end point of the last pushed span
 };
 
 }  // namespace pathstream

@@ -16,6 +16,7 @@ enum class [[nodiscard]] Status : std::uint8_t {
     kUnknownBasis = 5,             ///< basis id not one of the Basis enumerators
     kTickOutsideSpan = 6,          ///< evaluation or start tick beyond the span's end
     kQueueFull = 7,                ///< span queue has no free slot; nothing was written
+    kDiscontinuousSpan = 8,        ///< span does not start where the previous one ends
 };
 
 /// Short stable name of a status, for logs and host messages. Never null.
@@ -29,6 +30,7 @@ constexpr const char* status_name(Status s) {
         case Status::kUnknownBasis: return "unknown basis";
         case Status::kTickOutsideSpan: return "tick outside span";
         case Status::kQueueFull: return "span queue full";
+        case Status::kDiscontinuousSpan: return "span does not start where the previous one ends";
     }
     return "unknown status";
 }

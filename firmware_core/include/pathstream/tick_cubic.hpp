@@ -31,9 +31,14 @@ struct TickCubic {
 /// invalid basis. Cost: a few multiplies. Any context.
 [[nodiscard]] Status make_span_timing(Basis basis, std::uint32_t ticks, SpanTiming& out);
 
-/// Converts four control values into the axis's tick cubic and proves, for every tick of the
-/// span (0..n inclusive, so the end point too), that the curve stays within kMaxCurveLsb and
-/// that velocity, acceleration and jerk per tick stay within kMaxDifferenceLsb.
+/// Converts four control values into the axis's tick cubic and proves that the curve stays
+/// within kMaxCurveLsb for u in [0, 1], and that the forward differences Delta1(k) (velocity),
+/// Delta2(k) (acceleration) and Delta3 (jerk) per tick stay within kMaxDifferenceLsb for every
+/// k in 0..n. That is the whole state the differencer holds, up to and including the state at
+/// tick n after the last step, so Delta1(n) and Delta2(n) reach one and two ticks past the
+/// span's end: a one-tick span whose cubic swings hard just after u = 1 can be rejected
+/// though its one real step is small. With today's input ranges the curve bound cannot be
+/// exceeded (the hull stays below 2^28.3); it guards the proof should the ranges change.
 /// On any error `out` is left untouched. Cost: a few dozen 128-bit operations. Task context.
 [[nodiscard]] Status make_tick_cubic(Basis basis, const std::int32_t (&control)[4],
                                      const SpanTiming& timing, TickCubic& out);
