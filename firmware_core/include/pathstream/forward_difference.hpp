@@ -35,22 +35,33 @@ struct DifferenceState {
     /// Current setpoint: the exact curve at the current tick, rounded once.
     constexpr Lsb position() const { return static_cast<Lsb>(quotient[0]); }
 
-    /// Advances one tick in portable C++. `bias` is K = 2^W - D of the span. Branch-free:
-    /// each carry becomes a 0/1 and an all-zeros/all-ones mask selecting the K fix-up, so
-    /// no data-dependent jump can mispredict (x86 compiles a ternary here to jumps).
+    /// Advances one tick in portable C++. `bias` is K = 2^W - D of the span.
+    /// Two spellings of the same arithmetic, chosen for what each compiler makes of them:
+    /// on ARM a carry-select (GCC emits IT blocks on Thumb-2 and one short forward branch per
+    /// level on ARMv6-M, half the instructions of mask arithmetic there); elsewhere an
+    /// all-zeros/all-ones mask, because x86 compilers turn the select into data-dependent
+    /// jumps that mispredict. Both builds are cross-checked by the Cortex-M checksum tests.
     /// Interrupt-safe: touches only this object.
     constexpr void step(Word bias) {
-        Word r0 = remainder[0], r1 = remainder[1], r2 = remainder[2];
-        const Word sum0 = r0 + r1, sum1 = r1 + r2, sum2 = r2 + jerk_remainder;
-        const Word c0 = sum0 < r1 ? 1u : 0u;
-        const Word c1 = sum1 < r2 ? 1u : 0u;
-        const Word c2 = sum2 < jerk_remainder ? 1u : 0u;
-        quotient[0] += quotient[1] + static_cast<std::uint32_t>(c0);
-        quotient[1] += quotient[2] + static_cast<std::uint32_t>(c1);
-        quotient[2] += jerk_quotient + static_cast<std::uint32_t>(c2);
-        remainder[0] = static_cast<Word>(sum0 + (bias & (0 - c0)));
-        remainder[1] = static_cast<Word>(sum1 - (bias & (c1 - 1)));
-        remainder[2] = static_cast<Word>(sum2 + (bias & (0 - c2)));
+        const Word r0 = remainder[0], r1 = remainder[1], r2 = remainder[2];
+        Word sum0, sum1, sum2;
+        const bool c0 = __builtin_add_overflow(r0, r1, &sum0);
+        const bool c1 = __builtin_add_overflow(r1, r2, &sum1);
+        const bool c2 = __builtin_add_overflow(r2, jerk_remainder, &sum2);
+        quotient[0] += quotient[1] + (c0 ? 1u : 0u);
+        quotient[1] += quotient[2] + (c1 ? 1u : 0u);
+        quotient[2] += jerk_quotient + (c2 ? 1u : 0u);
+#if defined(__arm__)
+        remainder[0] = c0 ? static_cast<Word>(sum0 + bias) : sum0;
+        remainder[1] = c1 ? sum1 : static_cast<Word>(sum1 - bias);
+        remainder[2] = c2 ? static_cast<Word>(sum2 + bias) : sum2;
+#else
+        const Word m0 = 0 - static_cast<Word>(c0), m2 = 0 - static_cast<Word>(c2);
+        const Word keep1 = static_cast<Word>(c1) - 1;  // all ones when there was no carry
+        remainder[0] = static_cast<Word>(sum0 + (bias & m0));
+        remainder[1] = static_cast<Word>(sum1 - (bias & keep1));
+        remainder[2] = static_cast<Word>(sum2 + (bias & m2));
+#endif
     }
 };
 

@@ -58,19 +58,12 @@ public:
     }
 
     /// Consumer (tick interrupt): writes this tick's setpoint for every axis to `out`.
-    /// Steady state costs one forward-differencing step per axis; at a span boundary the
-    /// next span is taken from the queue (a pointer swap, no copy).
+    /// Steady state on a narrow span tests one pointer and runs one forward-differencing step
+    /// per axis; everything else (a span boundary, a wide span, an empty queue) is out of line.
     TickState tick(Lsb (&out)[Axes]) {
-        PreparedSpan<Axes>* span = active_;
-        if (span == nullptr) {
-            span = begin_next_span();
-            if (span == nullptr) return hold(out);
-        }
-        if (!span->wide) {
-            emit_and_step(span->narrow, out, static_cast<std::uint32_t>(span->bias));
-        } else {
-            step_wide(*span, out);
-        }
+        PreparedSpan<Axes>* const span = narrow_active_;
+        if (span == nullptr) return tick_slow(out);
+        emit_and_step(span->narrow, out, static_cast<std::uint32_t>(span->bias));
         if (--remaining_ == 0) finish_span();
         return TickState::kMoving;
     }
@@ -90,22 +83,24 @@ public:
     std::uint32_t spans_completed() const { return spans_completed_; }
 
 private:
-    // Wide spans (D >= 2^32: long spans) are kept out of line so the common narrow path
-    // needs no stack frame of its own.
-    [[gnu::noinline]] static void step_wide(PreparedSpan<Axes>& span, Lsb (&out)[Axes]) {
-        emit_and_step(span.wide_state, out, span.bias);
-    }
-
-    [[gnu::noinline, gnu::cold]] TickState hold(Lsb (&out)[Axes]) const {
-        for (unsigned a = 0; a < Axes; ++a) out[a] = hold_[a];
-        return TickState::kIdle;
-    }
-
-    // Span boundaries are rare (every n ticks): kept out of line so tick() stays small.
-    [[gnu::noinline]] PreparedSpan<Axes>* begin_next_span() {
-        active_ = queue_.front();
-        if (active_ != nullptr) remaining_ = active_->ticks;
-        return active_;
+    // Everything but a narrow span in progress: taking the next span from the queue, wide
+    // spans (D >= 2^32: long spans) and holding when the queue is empty.
+    [[gnu::noinline]] TickState tick_slow(Lsb (&out)[Axes]) {
+        if (active_ == nullptr) {
+            active_ = queue_.front();
+            if (active_ == nullptr) {
+                for (unsigned a = 0; a < Axes; ++a) out[a] = hold_[a];
+                return TickState::kIdle;
+            }
+            remaining_ = active_->ticks;
+            if (!active_->wide) {
+                narrow_active_ = active_;
+                return tick(out);
+            }
+        }
+        emit_and_step(active_->wide_state, out, active_->bias);
+        if (--remaining_ == 0) finish_span();
+        return TickState::kMoving;
     }
 
     [[gnu::noinline]] void finish_span() {
@@ -114,6 +109,7 @@ private:
             hold_[a] = active_->wide ? active_->wide_state[a].position()
                                      : active_->narrow[a].position();
         }
+        narrow_active_ = nullptr;
         last_completed_tag_ = active_->tag;
         completed_ticks_ += active_->ticks;
         ++spans_completed_;
@@ -122,7 +118,8 @@ private:
     }
 
     SpanQueue<PreparedSpan<Axes>, Capacity> queue_;
-    PreparedSpan<Axes>* active_ = nullptr;
+    PreparedSpan<Axes>* active_ = nullptr;         // span being played, narrow or wide
+    PreparedSpan<Axes>* narrow_active_ = nullptr;  // == active_ when it is narrow, else null
     std::uint32_t remaining_ = 0;
     std::uint64_t completed_ticks_ = 0;
     std::uint32_t last_completed_tag_ = 0;
