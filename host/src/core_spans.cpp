@@ -89,14 +89,14 @@ public:
                 c[i] = static_cast<std::int32_t>(v);
             }
             span.control.push_back(c);
-            SpanTiming timing;
             TickCubic cubic;
-            if (const Status s = to_core(span, a, timing, cubic); s != Status::kOk) {
+            if (const Status s = to_core(span, a, span.timing, cubic); s != Status::kOk) {
                 std::ostringstream m;
                 m << "subpath " << subpath_ << ", span " << spans_.size() << ", axis " << a
                   << ": the core rejects it: " << status_name(s);
                 throw InputError(file_, at_, m.str());
             }
+            span.cubic.push_back(cubic);
         }
         spans_.push_back(std::move(span));
     }
@@ -153,12 +153,9 @@ std::vector<CoreSpan> subpath_spans(const Path& path, std::size_t s, const std::
 }  // namespace
 
 Lsb core_value_at(const CoreSpan& span, std::size_t axis, std::uint32_t k) {
-    SpanTiming timing;
-    TickCubic cubic;
     Lsb v = 0;
-    if (to_core(span, axis, timing, cubic) != Status::kOk ||
-        evaluate_at(cubic, timing, k, v) != Status::kOk) {
-        throw std::logic_error("core_value_at: span was not validated by uniform_core_spans");
+    if (axis >= span.cubic.size() || evaluate_at(span.cubic[axis], span.timing, k, v) != Status::kOk) {
+        throw std::logic_error("core_value_at: span not validated by uniform_core_spans, or tick beyond it");
     }
     return v;
 }
