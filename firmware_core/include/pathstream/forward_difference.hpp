@@ -43,6 +43,20 @@ struct DifferenceState {
     /// jumps that mispredict. Both builds are cross-checked by the Cortex-M checksum tests.
     /// Interrupt-safe: touches only this object.
     constexpr void step(Word bias) {
+#if defined(__arm__)
+        // Level by level, in place: few values live at once (ARMv6-M has eight low registers).
+        // Level i reads level i+1 before level i+1 is updated, as the recurrence requires.
+        Word sum;
+        bool carry = __builtin_add_overflow(remainder[0], remainder[1], &sum);
+        quotient[0] += quotient[1] + (carry ? 1u : 0u);
+        remainder[0] = carry ? static_cast<Word>(sum + bias) : sum;
+        carry = __builtin_add_overflow(remainder[1], remainder[2], &sum);
+        quotient[1] += quotient[2] + (carry ? 1u : 0u);
+        remainder[1] = carry ? sum : static_cast<Word>(sum - bias);
+        carry = __builtin_add_overflow(remainder[2], jerk_remainder, &sum);
+        quotient[2] += jerk_quotient + (carry ? 1u : 0u);
+        remainder[2] = carry ? static_cast<Word>(sum + bias) : sum;
+#else
         const Word r0 = remainder[0], r1 = remainder[1], r2 = remainder[2];
         Word sum0, sum1, sum2;
         const bool c0 = __builtin_add_overflow(r0, r1, &sum0);
@@ -51,11 +65,6 @@ struct DifferenceState {
         quotient[0] += quotient[1] + (c0 ? 1u : 0u);
         quotient[1] += quotient[2] + (c1 ? 1u : 0u);
         quotient[2] += jerk_quotient + (c2 ? 1u : 0u);
-#if defined(__arm__)
-        remainder[0] = c0 ? static_cast<Word>(sum0 + bias) : sum0;
-        remainder[1] = c1 ? sum1 : static_cast<Word>(sum1 - bias);
-        remainder[2] = c2 ? static_cast<Word>(sum2 + bias) : sum2;
-#else
         const Word m0 = 0 - static_cast<Word>(c0), m2 = 0 - static_cast<Word>(c2);
         const Word keep1 = static_cast<Word>(c1) - 1;  // all ones when there was no carry
         remainder[0] = static_cast<Word>(sum0 + (bias & m0));
@@ -108,12 +117,19 @@ inline void emit_and_step(DifferenceState<Word> (&state)[Axes], Lsb (&out)[Axes]
     }
 #endif
     for (unsigned a = 0; a < Axes; ++a) {
+#if defined(__arm__)
+        // In place: the setpoint is stored before the step, so aliasing costs nothing, and
+        // the constant jerk level is never written back (a copy would store all eight words).
+        out[a] = state[a].position();
+        state[a].step(bias);
+#else
         // A local copy: `out` (int32) may alias the quotients (uint32) as far as the compiler
-        // knows, which would otherwise force every field through memory.
+        // knows, which would otherwise force every field through memory on x86.
         DifferenceState<Word> s = state[a];
         out[a] = s.position();
         s.step(bias);
         state[a] = s;
+#endif
     }
 }
 
