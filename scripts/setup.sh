@@ -10,7 +10,7 @@ packages=(
   libcli11-dev nlohmann-json3-dev libeigen3-dev
   # Cortex-M proof: cross toolchain, C++ headers, emulator with TCG plugin support
   gcc-arm-none-eabi binutils-arm-none-eabi libstdc++-arm-none-eabi-newlib
-  libnewlib-arm-none-eabi qemu-system-arm libglib2.0-dev
+  libnewlib-arm-none-eabi qemu-system-arm
 )
 
 missing=()
