@@ -646,8 +646,18 @@ bool run_case(const Config& cfg, std::uint32_t n, std::uint64_t& grand_checksum)
     const std::vector<DoubleCoefficients> coef = double_coefficients(path);
     const std::vector<FloatStart> starts = float_starts(path, coef);
     const EigenSpline spline = eigen_spline(path);
-    auto queued = std::make_unique<QueuedStream>();
-    auto fed = std::make_unique<FedStream>();
+    // Both streams start where the path starts (span 0's tick-0 value): push() accepts only a
+    // continuous chain from the stream's start position. The path is closed (span N-1 ends
+    // where span 0 starts), so every pass continues the chain of the one before.
+    Lsb start[kAxes];
+    for (unsigned a = 0; a < kAxes; ++a) {
+        if (pathstream::evaluate_at(path.cubics[0][a], path.timing, 0, start[a]) != Status::kOk) {
+            fail("evaluate_at(0) of span 0 failed");
+            return false;
+        }
+    }
+    auto queued = std::make_unique<QueuedStream>(start);
+    auto fed = std::make_unique<FedStream>(start);
 
     // Verification pass: every method's outputs checked against the exact values as they come.
     std::vector<Row> rows;

@@ -123,6 +123,44 @@ struct ExactSpan {
 
 i128 abs128(i128 v) { return v < 0 ? -v : v; }
 
+/// The core's tick-0 (`start`) and tick-n (`end`) values of a valid span, every axis: what
+/// SetpointStream::push compares with the end of the chain.
+template <unsigned Axes>
+void core_ends(const Span<Axes>& span, Lsb (&start)[Axes], Lsb (&end)[Axes]) {
+    for (unsigned a = 0; a < Axes; ++a) {
+        SpanTiming timing;
+        TickCubic cubic;
+        REQUIRE(build(span.basis, span.control[a], span.ticks, timing, cubic) == Status::kOk);
+        REQUIRE(pathstream::evaluate_at(cubic, timing, 0, start[a]) == Status::kOk);
+        REQUIRE(pathstream::evaluate_at(cubic, timing, span.ticks, end[a]) == Status::kOk);
+    }
+}
+
+/// Translates the valid `span` so that it starts exactly at `at` (the end of the chain so
+/// far): the same offset per axis on every position control value (Hermite: P0, P1, not the
+/// tangents), exact in the core. Writes the span's new end point to `end` (which may be `at`).
+template <unsigned Axes>
+void chain_after(Span<Axes>& span, const Lsb (&at)[Axes], Lsb (&end)[Axes]) {
+    Lsb target[Axes], start[Axes], old_end[Axes], new_start[Axes];
+    for (unsigned a = 0; a < Axes; ++a) target[a] = at[a];
+    core_ends(span, start, old_end);
+    const int positions = span.basis == Basis::kHermite ? 2 : 4;
+    for (unsigned a = 0; a < Axes; ++a) {
+        const std::int64_t offset = std::int64_t{target[a]} - start[a];
+        for (int j = 0; j < positions; ++j) {
+            const std::int64_t v = span.control[a][j] + offset;
+            REQUIRE(v <= kMaxPositionLsb);
+            REQUIRE(v >= -kMaxPositionLsb);
+            span.control[a][j] = static_cast<std::int32_t>(v);
+        }
+    }
+    core_ends(span, new_start, end);
+    for (unsigned a = 0; a < Axes; ++a) {
+        REQUIRE(new_start[a] == target[a]);
+        REQUIRE(std::int64_t{end[a]} - old_end[a] == std::int64_t{target[a]} - start[a]);
+    }
+}
+
 /// Integers of [0, n] next to the real roots of q2 k^2 + q1 k + q0 (long double, +/-2 ticks).
 void ticks_near_roots(long double q2, long double q1, long double q0, std::int64_t n,
                       std::vector<std::int64_t>& out) {
@@ -483,13 +521,18 @@ TEST_CASE("A rejected span leaves the prepared span, the tick cubic and the stre
     }
 
     SECTION("SetpointStream::push") {
-        const Lsb start[3] = {0, 1000, 2000};
+        // A continuous chain (push() accepts nothing else): good starts at the stream's start
+        // position, and each later span is moved by translation to start where the previous
+        // one ends.
+        Lsb start[3], end[3];
+        core_ends(good, start, end);
         SetpointStream<3, 4> stream(start);
         Span<3> second = good;
         second.tag = 8;
         for (int a = 0; a < 3; ++a) {
             for (int j = 0; j < 4; ++j) second.control[a][j] = good.control[a][3] - 17 * j;
         }
+        chain_after(second, end, end);
         REQUIRE(stream.push(good) == Status::kOk);
         REQUIRE(stream.push(second) == Status::kOk);
         Lsb out[3];
@@ -499,42 +542,64 @@ TEST_CASE("A rejected span leaves the prepared span, the tick cubic and the stre
                 REQUIRE(out[a] == reference_setpoint(s.basis, s.control[a], s.ticks, k));
             }
         };
-        for (std::uint32_t k = 0; k < 5; ++k) expect_tick(good, k);
-        // Failures with free slots (the slot claimed for them must not become visible).
-        for (const Bad& b : bad) {
-            INFO(b.what);
+        // Each refused push returns the span's own status (validation before continuity
+        // before room: these bad spans do not continue the chain either) and changes nothing.
+        auto expect_refused = [&](const Bad& b, std::uint32_t queued) {
+            INFO(b.what << " with " << queued << " queued");
             const Status s = stream.push(b.span);
-            CHECK(name(s) != name(Status::kOk));
-            CHECK(stream.queued_spans() == 2);
-            CHECK(stream.free_slots() == 2);
+            if (b.expected == Status::kDifferenceOutOfRange) {
+                CHECK((name(s) == name(Status::kDifferenceOutOfRange) ||
+                       name(s) == name(Status::kCurveOutOfRange)));
+            } else {
+                CHECK(name(s) == name(b.expected));
+            }
+            CHECK(stream.queued_spans() == queued);
+            CHECK(stream.free_slots() == 4 - queued);
             CHECK(stream.ticks_executed() == 5);
             CHECK(stream.spans_completed() == 0);
-        }
-        // Fill the queue, then fail once more with no free slot.
-        Span<3> third = second, fourth = second;
+        };
+        for (std::uint32_t k = 0; k < 5; ++k) expect_tick(good, k);
+        // Failures with free slots (the slot claimed for them must not become visible).
+        Span<3> third = second, fourth = second, fifth = good;
         third.tag = 9;
         fourth.tag = 10;
+        fifth.tag = 11;
         for (int a = 0; a < 3; ++a) third.control[a][0] += 1;
         for (int a = 0; a < 3; ++a) fourth.control[a][1] -= 1;
+        chain_after(third, end, end);
+        // A valid span that does not continue the chain: third, 1 LSB off on axis 2.
+        Span<3> third_off = third;
+        for (int j = 0; j < 4; ++j) third_off.control[2][j] += 1;
+        for (const Bad& b : bad) expect_refused(b, 2);
+        expect_refused(Bad{"third, 1 LSB off", third_off, Status::kDiscontinuousSpan}, 2);
+        // Fill the queue, then fail once more with no free slot: still each span's own status,
+        // never kQueueFull.
         REQUIRE(stream.push(third) == Status::kOk);
+        chain_after(fourth, end, end);
         REQUIRE(stream.push(fourth) == Status::kOk);
-        for (const Bad& b : bad) {
-            const Status s = stream.push(b.span);
-            CHECK(name(s) != name(Status::kOk));
-        }
-        const Status full = stream.push(good);
+        chain_after(fifth, end, end);
+        Span<3> fifth_off = fifth;
+        for (int j = 0; j < 4; ++j) fifth_off.control[0][j] -= 1;
+        for (const Bad& b : bad) expect_refused(b, 4);
+        expect_refused(Bad{"fifth, 1 LSB off", fifth_off, Status::kDiscontinuousSpan}, 4);
+        // The valid continuous fifth span only waits for room.
+        const Status full = stream.push(fifth);
         CHECK(name(full) == name(Status::kQueueFull));
         CHECK(stream.queued_spans() == 4);
-        // Playback is exactly good (from tick 5), second, third, fourth; none of the bad.
+        // Playback is exactly good (from tick 5), second, third, fourth; none of the refused.
         for (std::uint32_t k = 5; k < good.ticks; ++k) expect_tick(good, k);
         CHECK(stream.last_completed_tag() == 7);
-        for (const Span<3>* s : {&second, &third, &fourth}) {
+        // good's slot is free now: fifth is accepted.
+        const Status late = stream.push(fifth);
+        REQUIRE(name(late) == name(Status::kOk));
+        for (const Span<3>* s : {&second, &third, &fourth, &fifth}) {
             for (std::uint32_t k = 0; k < s->ticks; ++k) expect_tick(*s, k);
             CHECK(stream.last_completed_tag() == s->tag);
         }
-        CHECK(stream.spans_completed() == 4);
-        CHECK(stream.ticks_executed() == 4u * good.ticks);
+        CHECK(stream.spans_completed() == 5);
+        CHECK(stream.ticks_executed() == 5u * good.ticks);
         CHECK(stream.tick(out) == TickState::kIdle);
+        for (int a = 0; a < 3; ++a) CHECK(out[a] == end[a]);
     }
 }
 

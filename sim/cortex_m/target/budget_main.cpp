@@ -80,10 +80,17 @@ template <> TickState tick_of<8>(Stream<8>& s, Lsb (&out)[8]) { return budget_ti
 
 constexpr int kPoolSize = 4;
 
-/// Four spans of `n` ticks, one per basis, gentle random control values.
+/// Four spans of `n` ticks, one per basis, gentle random control values, chained into a
+/// closed loop: push() accepts only a span that starts where the previous one ends, and the
+/// phases push the pool round and round from `start` (pool[0]'s tick-0 value). Each span is
+/// translated (the same offset on its position control values) to start at the previous
+/// one's end; the last, a Hermite span, then ends at pool[0]'s start (its P1). The end points
+/// (u = 0 and u = 1) do not depend on n, so the loop stays closed when n changes.
+/// Returns false if the core refuses a span (it cannot: the values are gentle).
 template <unsigned A>
-void make_pool(pathstream::workload::SplitMix64& rng, std::uint32_t n,
-               pathstream::Span<A> (&pool)[kPoolSize]) {
+bool make_pool(pathstream::workload::SplitMix64& rng, std::uint32_t n,
+               pathstream::Span<A> (&pool)[kPoolSize], Lsb (&start)[A]) {
+    static_assert(kPoolSize == 4, "one span per basis; the last one is the Hermite span");
     for (int i = 0; i < kPoolSize; ++i) {
         pool[i].basis = static_cast<pathstream::Basis>(i);
         pool[i].ticks = n;
@@ -97,6 +104,27 @@ void make_pool(pathstream::workload::SplitMix64& rng, std::uint32_t n,
             }
         }
     }
+    using pathstream::workload::span_start;
+    if (span_start(pool[0], start) != Status::kOk) return false;
+    Lsb end[A];  // pool[i - 1]'s end point
+    for (int i = 1; i < kPoolSize; ++i) {
+        Lsb own_start[A];
+        pathstream::SpanTiming timing;
+        if (pathstream::make_span_timing(pool[i - 1].basis, n, timing) != Status::kOk) return false;
+        for (unsigned a = 0; a < A; ++a) {
+            pathstream::TickCubic cubic;
+            if (pathstream::make_tick_cubic(pool[i - 1].basis, pool[i - 1].control[a], timing,
+                                            cubic) != Status::kOk ||
+                pathstream::evaluate_at(cubic, timing, n, end[a]) != Status::kOk) {
+                return false;
+            }
+        }
+        if (span_start(pool[i], own_start) != Status::kOk) return false;
+        if (!pathstream::workload::translate(pool[i], own_start, end)) return false;
+    }
+    // Close the loop: the Hermite span ends at its P1.
+    for (unsigned a = 0; a < A; ++a) pool[kPoolSize - 1].control[a][1] = start[a];
+    return pool[kPoolSize - 1].basis == pathstream::Basis::kHermite;
 }
 
 std::uint32_t g_phase = 0;
@@ -115,8 +143,7 @@ void report_phase(const char* kind, unsigned axes, std::uint32_t n, std::uint32_
 /// (the producer runs between ticks, as a task would), ticked until all are consumed.
 template <unsigned A>
 [[gnu::noinline]] void stream_phase(const char* kind, const pathstream::Span<A> (&pool)[kPoolSize],
-                                    std::uint32_t n, std::uint32_t spans) {
-    const Lsb start[A] = {};
+                                    const Lsb (&start)[A], std::uint32_t n, std::uint32_t spans) {
     budget_mark(2 * g_phase);
     Stream<A>& s = *new (g_arena) Stream<A>(start);
     std::uint32_t pushed = 0;
@@ -141,8 +168,8 @@ template <unsigned A>
 /// push() alone: a fresh stream filled with kCapacity spans; cost per push (validation and
 /// prepare_span, i.e. make_tick_cubic and start_differences on every axis).
 template <unsigned A>
-[[gnu::noinline]] void push_phase(const char* kind, const pathstream::Span<A> (&pool)[kPoolSize]) {
-    const Lsb start[A] = {};
+[[gnu::noinline]] void push_phase(const char* kind, const pathstream::Span<A> (&pool)[kPoolSize],
+                                  const Lsb (&start)[A]) {
     Stream<A>& s = *new (g_arena) Stream<A>(start);
     bool ok = true;
     budget_mark(2 * g_phase);
@@ -160,13 +187,17 @@ template <unsigned A>
 void width_phases(pathstream::workload::SplitMix64& rng, const char* kind, const char* push_kind,
                   std::uint32_t n, std::uint32_t spans) {
     pathstream::Span<A> pool[kPoolSize];
-    make_pool<A>(rng, n, pool);
-    stream_phase<A>(kind, pool, n, spans);
+    Lsb start[A];
+    if (!make_pool<A>(rng, n, pool, start)) {
+        cortex_m::write("budget image: make_pool failed\n");
+        g_failed = true;
+    }
+    stream_phase<A>(kind, pool, start, n, spans);
     for (auto& span : pool) span.ticks = 2 * n;
-    stream_phase<A>(kind, pool, 2 * n, spans);
+    stream_phase<A>(kind, pool, start, 2 * n, spans);
     for (auto& span : pool) span.ticks = n;
-    stream_phase<A>(kind, pool, n, 2 * spans);
-    push_phase<A>(push_kind, pool);
+    stream_phase<A>(kind, pool, start, n, 2 * spans);
+    push_phase<A>(push_kind, pool, start);
 }
 
 template <unsigned A>

@@ -8,6 +8,13 @@
 // every Horner value (pathstream::evaluate_at at pseudo-random ticks of each span) is folded
 // into a 64-bit FNV-1a checksum. The checksum must be identical on every target.
 //
+// push() accepts only a continuous chain (a span's tick-0 value must equal the previous
+// span's tick-n value, or the stream's start position), so every drawn span is moved onto the
+// chain by translation, which is exact in the core: the same integer offset on every position
+// control value of an axis (Hermite: P0 and P1, not the tangents). Once per section a copy of
+// the next span, 1 LSB off on one axis, is pushed first and must be refused with
+// kDiscontinuousSpan.
+//
 // It also checks itself: the stream's setpoint at two pseudo-random ticks of each span, and
 // the held end point when the queue runs dry, must equal evaluate_at computed independently
 // (make_span_timing + make_tick_cubic + Horner); differences are counted as mismatches.
@@ -74,7 +81,7 @@ struct Summary {
     std::uint64_t checksum = 0;
     std::uint32_t ticks = 0;               ///< tick() calls, idle ones included
     std::uint32_t spans_accepted = 0;      ///< push() == kOk
-    std::uint32_t spans_rejected = 0;      ///< push() returned a validation error
+    std::uint32_t spans_rejected = 0;      ///< push() refused: validation error or discontinuity
     std::uint32_t horner_evaluations = 0;  ///< evaluate_at() calls
     std::uint32_t mismatches = 0;          ///< self-check failures; must be 0
 };
@@ -115,6 +122,88 @@ inline void draw_control(SplitMix64& rng, Basis basis, std::int32_t (&p)[4]) {
     }
 }
 
+/// The core's tick-0 value of `span` on every axis (make_span_timing, make_tick_cubic,
+/// evaluate_at): where the chain must stand for push() to accept it. Returns the span's
+/// validation error, if any (`start` is then unspecified). Axes evaluate_at calls.
+template <unsigned Axes>
+Status span_start(const Span<Axes>& span, Lsb (&start)[Axes]) {
+    SpanTiming timing;
+    if (Status s = make_span_timing(span.basis, span.ticks, timing); s != Status::kOk) return s;
+    for (unsigned a = 0; a < Axes; ++a) {
+        TickCubic cubic;
+        if (Status s = make_tick_cubic(span.basis, span.control[a], timing, cubic);
+            s != Status::kOk) {
+            return s;
+        }
+        if (Status s = evaluate_at(cubic, timing, 0, start[a]); s != Status::kOk) return s;
+    }
+    return Status::kOk;
+}
+
+/// Translates one axis whose tick-0 value is `start` so that it starts at `at`: adds
+/// at - start to each position control value (Hermite: P0, P1; not the tangents). Returns
+/// false, leaving `control` unchanged, if a value would leave +/-kMaxPositionLsb.
+inline bool translate_axis(Basis basis, std::int32_t (&control)[4], Lsb start, Lsb at) {
+    const int positions = basis == Basis::kHermite ? 2 : 4;
+    const std::int64_t offset = std::int64_t{at} - start;
+    for (int j = 0; j < positions; ++j) {
+        const std::int64_t v = control[j] + offset;
+        if (v > kMaxPositionLsb || v < -kMaxPositionLsb) return false;
+    }
+    for (int j = 0; j < positions; ++j) control[j] = static_cast<std::int32_t>(control[j] + offset);
+    return true;
+}
+
+/// Translates `span`, whose tick-0 values are `start`, so that it starts at `at` on every
+/// axis (translate_axis). Returns false, leaving `span` unchanged, if any axis cannot move.
+template <unsigned Axes>
+bool translate(Span<Axes>& span, const Lsb (&start)[Axes], const Lsb (&at)[Axes]) {
+    Span<Axes> moved = span;
+    for (unsigned a = 0; a < Axes; ++a) {
+        if (!translate_axis(moved.basis, moved.control[a], start[a], at[a])) return false;
+    }
+    span = moved;
+    return true;
+}
+
+/// Draws the next span of a chain that stands at `at`: basis and tick count as drawn, then per
+/// axis control values as drawn, translated to start at `at[axis]`. An axis the core rejects
+/// (too steep) is left as drawn, so push() refuses the span with that error. An axis that
+/// cannot be moved that far within the position range is drawn again, up to 16 times; then
+/// it is flat at `at[axis]`. `longest`: the span lasts kMaxSpanTicks ticks.
+template <unsigned Axes>
+void draw_span(Context& ctx, Width width, bool longest, std::uint32_t tag, const Lsb (&at)[Axes],
+               Span<Axes>& span) {
+    SplitMix64& rng = ctx.rng;
+    span.tag = tag;
+    span.basis = static_cast<Basis>(rng.below(kBasisCount));
+    span.ticks = longest ? kMaxSpanTicks : draw_ticks(rng, width);
+    SpanTiming timing;
+    if (make_span_timing(span.basis, span.ticks, timing) != Status::kOk) {
+        ++ctx.summary.mismatches;  // every basis and tick count drawn here is valid
+        return;
+    }
+    for (unsigned a = 0; a < Axes; ++a) {
+        bool placed = false;
+        for (int attempt = 0; attempt < 16 && !placed; ++attempt) {
+            draw_control(rng, span.basis, span.control[a]);
+            TickCubic cubic;
+            Lsb start = 0;
+            const Status s = make_tick_cubic(span.basis, span.control[a], timing, cubic);
+            ctx.hash.byte(static_cast<std::uint8_t>(s));
+            if (s != Status::kOk) return;  // rejected by the core anyway: left as drawn
+            if (evaluate_at(cubic, timing, 0, start) != Status::kOk) ++ctx.summary.mismatches;
+            ++ctx.summary.horner_evaluations;
+            placed = translate_axis(span.basis, span.control[a], start, at[a]);
+        }
+        if (!placed) {
+            for (int j = 0; j < 4; ++j) {
+                span.control[a][j] = span.basis == Basis::kHermite && j >= 2 ? 0 : at[a];
+            }
+        }
+    }
+}
+
 /// Makes every fourth-teenth span invalid in one of four ways; returns true if it did.
 template <unsigned Axes>
 bool maybe_break(SplitMix64& rng, Span<Axes>& span) {
@@ -131,13 +220,14 @@ bool maybe_break(SplitMix64& rng, Span<Axes>& span) {
     return true;
 }
 
-/// The independent expectation for one accepted span: Horner values at two ticks inside it
-/// and at its end point.
+/// The independent expectation for one accepted span: Horner values at its start, at two
+/// ticks inside it and at its end point.
 template <unsigned Axes>
 struct Expectation {
     std::uint32_t ticks = 0;
     std::uint32_t sample[2] = {0, 0};
     Lsb at_sample[2][Axes] = {};
+    Lsb start[Axes] = {};
     Lsb end[Axes] = {};
 };
 
@@ -162,10 +252,13 @@ Status expect(Context& ctx, const Span<Axes>& span, Expectation<Axes>& e) {
             ctx.hash.byte(static_cast<std::uint8_t>(s));
             ctx.hash.lsb(e.at_sample[j][a]);
         }
+        const Status s0 = evaluate_at(cubic[a], timing, 0, e.start[a]);
+        ctx.hash.byte(static_cast<std::uint8_t>(s0));
+        ctx.hash.lsb(e.start[a]);
         const Status s = evaluate_at(cubic[a], timing, span.ticks, e.end[a]);
         ctx.hash.byte(static_cast<std::uint8_t>(s));
         ctx.hash.lsb(e.end[a]);
-        ctx.summary.horner_evaluations += 3;
+        ctx.summary.horner_evaluations += 4;
     }
     // One evaluation past the end must be refused.
     Lsb ignored = 0;
@@ -174,16 +267,53 @@ Status expect(Context& ctx, const Span<Axes>& span, Expectation<Axes>& e) {
     return Status::kOk;
 }
 
+/// True when `a` and `b` agree on every axis.
+template <unsigned Axes>
+bool same_point(const Lsb (&a)[Axes], const Lsb (&b)[Axes]) {
+    for (unsigned i = 0; i < Axes; ++i) {
+        if (a[i] != b[i]) return false;
+    }
+    return true;
+}
+
+/// Pushes a copy of the valid span `span` (which continues the chain), 1 LSB off on one
+/// pseudo-random axis: push() must refuse it with kDiscontinuousSpan and change nothing.
+/// Returns false (nothing pushed) if that copy would leave the position range.
+template <unsigned Axes, std::uint32_t Capacity>
+bool push_discontinuous(Context& ctx, SetpointStream<Axes, Capacity>& stream,
+                        const Span<Axes>& span) {
+    const unsigned axis = ctx.rng.below(Axes);
+    Span<Axes> off = span;
+    Lsb start[Axes], at[Axes];
+    if (span_start(span, start) != Status::kOk) return false;
+    ctx.summary.horner_evaluations += Axes;
+    for (unsigned a = 0; a < Axes; ++a) at[a] = start[a];
+    at[axis] = start[axis] + (start[axis] < 0 ? 1 : -1);
+    if (!translate(off, start, at)) return false;
+    const std::uint32_t queued = stream.queued_spans();
+    const Status got = stream.push(off);
+    ctx.hash.byte(static_cast<std::uint8_t>(got));
+    if (got != Status::kDiscontinuousSpan || stream.queued_spans() != queued) {
+        ++ctx.summary.mismatches;
+    }
+    ++ctx.summary.spans_rejected;
+    return true;
+}
+
 /// One section: `attempts` pushes (valid and invalid) into a fresh stream of Axes axes and
 /// Capacity slots, ticked until every accepted span has been consumed. The producer pushes at
-/// pseudo-random moments, so the queue sometimes runs dry and the stream idles.
-/// `longest_first`: the first span lasts kMaxSpanTicks ticks.
+/// pseudo-random moments, so the queue sometimes runs dry and the stream idles. The spans
+/// form a continuous chain from the stream's start position; once, half-way, a span 1 LSB
+/// off the chain is refused first. `longest_first`: the first span lasts kMaxSpanTicks ticks.
 template <unsigned Axes, std::uint32_t Capacity>
 void run_section(Context& ctx, Width width, std::uint32_t attempts, bool longest_first) {
     SplitMix64& rng = ctx.rng;
     Lsb hold[Axes];
     for (unsigned a = 0; a < Axes; ++a) hold[a] = rng.between(-5000, 5000);
     SetpointStream<Axes, Capacity> stream(hold);
+    Lsb chain_end[Axes];  // producer side: where the next span must start
+    for (unsigned a = 0; a < Axes; ++a) chain_end[a] = hold[a];
+    bool discontinuity_checked = false;
 
     Expectation<Axes> mirror[Capacity];
     std::uint32_t head = 0, tail = 0;  // free-running indices into mirror
@@ -196,15 +326,19 @@ void run_section(Context& ctx, Width width, std::uint32_t attempts, bool longest
         // Producer: when there is room, push now or later (never later when idle for long).
         if (made < attempts && head - tail < Capacity && rng.below(4) != 0) {
             Span<Axes> span;
-            span.basis = static_cast<Basis>(rng.below(kBasisCount));
-            span.ticks = (longest_first && made == 0) ? kMaxSpanTicks : draw_ticks(rng, width);
-            span.tag = made + 1;
-            for (unsigned a = 0; a < Axes; ++a) draw_control(rng, span.basis, span.control[a]);
+            draw_span(ctx, width, longest_first && made == 0, made + 1, chain_end, span);
+            if (!discontinuity_checked && made >= attempts / 2) {
+                discontinuity_checked = push_discontinuous(ctx, stream, span);
+            }
             const bool broken = maybe_break(rng, span);
             ++made;
 
             Expectation<Axes>& e = mirror[head % Capacity];
-            const Status expected = expect(ctx, span, e);
+            Status expected = expect(ctx, span, e);
+            if (expected == Status::kOk && !same_point(e.start, chain_end)) {
+                expected = Status::kDiscontinuousSpan;
+                ++ctx.summary.mismatches;  // draw_span put a valid span off the chain
+            }
             const Status got = stream.push(span);
             ctx.hash.byte(static_cast<std::uint8_t>(got));
             if (got != expected || (broken && got == Status::kOk)) ++ctx.summary.mismatches;
@@ -212,6 +346,7 @@ void run_section(Context& ctx, Width width, std::uint32_t attempts, bool longest
                 ++head;
                 ++ctx.summary.spans_accepted;
                 last_tag = span.tag;
+                for (unsigned a = 0; a < Axes; ++a) chain_end[a] = e.end[a];
             } else {
                 ++ctx.summary.spans_rejected;
             }
@@ -263,6 +398,8 @@ void run_section(Context& ctx, Width width, std::uint32_t attempts, bool longest
     if (stream.ticks_executed() != moving_ticks) ++ctx.summary.mismatches;
     if (stream.last_completed_tag() != last_tag) ++ctx.summary.mismatches;
     if (stream.queued_spans() != 0) ++ctx.summary.mismatches;
+    if (!same_point(chain_end, hold)) ++ctx.summary.mismatches;
+    if (!discontinuity_checked) ++ctx.summary.mismatches;  // the refusal was never exercised
     ctx.hash.u64(stream.ticks_executed());
     ctx.hash.u32(stream.spans_completed());
     ctx.hash.u32(stream.last_completed_tag());
