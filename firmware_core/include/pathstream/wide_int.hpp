@@ -60,15 +60,9 @@ constexpr Int128 multiply_unsigned(std::uint64_t a, std::uint64_t b) {
 }
 
 /// Signed 128 x signed 64 product, truncated to 128 bits. Exact whenever |a| * |b| < 2^127;
-/// span setup bounds every operand so that it is (see docs/exact-math.md).
-constexpr Int128 operator*(Int128 a, std::int64_t b) {
-    const bool negate = a.negative() != (b < 0);
-    const Int128 m = magnitude(a);
-    const std::uint64_t bm = b < 0 ? 0 - static_cast<std::uint64_t>(b) : static_cast<std::uint64_t>(b);
-    Int128 p = multiply_unsigned(m.lo, bm);
-    p.hi += m.hi * bm;
-    return negate ? -p : p;
-}
+/// span setup bounds every operand so that it is (see docs/exact-math.md). Out of line:
+/// setup code is called rarely and kept small.
+Int128 operator*(Int128 a, std::int64_t b);
 
 /// Quotient and remainder of a floor division.
 struct FloorDivision {
@@ -77,33 +71,8 @@ struct FloorDivision {
 };
 
 /// floor(a / d) and a - d * floor(a / d) for a divisor d > 0.
-/// Cost: one hardware 64-bit division when |a| < 2^64, otherwise a shift-subtract loop over
-/// the bits of the high word (at most 64 rounds). Setup and Horner only.
-constexpr FloorDivision floor_divide(Int128 a, std::uint64_t d) {
-    const Int128 m = magnitude(a);
-    Int128 q{};
-    std::uint64_t r = 0;
-    if (m.hi == 0) {
-        q.lo = m.lo / d;
-        r = m.lo % d;
-    } else {
-        // Long division, one bit at a time, of the 128-bit magnitude. The running remainder
-        // stays below d < 2^64, so a 65th bit only appears transiently (tracked by carry).
-        for (int bit = 127; bit >= 0; --bit) {
-            const bool carry = (r >> 63) != 0;
-            const std::uint64_t word = bit >= 64 ? m.hi : m.lo;
-            r = (r << 1) | ((word >> (bit & 63)) & 1u);
-            if (carry || r >= d) {
-                r -= d;
-                if (bit >= 64) q.hi |= std::uint64_t{1} << (bit - 64);
-                else q.lo |= std::uint64_t{1} << bit;
-            }
-        }
-    }
-    if (!a.negative()) return FloorDivision{q, r};
-    // floor(-m / d) = -(q + 1) with remainder d - r, unless the division was exact.
-    if (r == 0) return FloorDivision{-q, 0};
-    return FloorDivision{-(q + Int128::from(1)), d - r};
-}
+/// Cost: one 64-bit division when |a| < 2^64, otherwise a shift-subtract loop over 128 bits.
+/// Setup and Horner only; out of line, one copy in the image.
+FloorDivision floor_divide(Int128 a, std::uint64_t d);
 
 }  // namespace pathstream

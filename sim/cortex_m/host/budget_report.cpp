@@ -8,8 +8,8 @@
 //                   [--assert-marginal] [--no-legend] [--timeout 60] [--keep DIR]
 //
 // Method (docs/cortex-m.md): the address ranges of budget_tick_<A> (SetpointStream::tick
-// inlined into an out-of-line function), SetpointStream<A,16>::step_wide (the wide per-tick
-// step, called from tick), begin_next_span, finish_span and hold come from `nm -S`. The
+// inlined into an out-of-line function), SetpointStream<A,16>::tick_slow (span start, wide
+// spans and the empty queue, called from tick) and finish_span come from `nm -S`. The
 // plugin counts the instructions executed in each range and snapshots all counters at every
 // budget_mark() call, which brackets each phase. For each axis count and span width the
 // image runs three phases, (n, S spans), (2n, S), (n, 2S); differences between them cancel
@@ -143,7 +143,7 @@ std::vector<Phase> parse_phases(const std::string& output) {
 }
 
 /// Range roles inside tick()'s world, per axis count.
-enum class Role { kTick, kStepWide, kBeginNextSpan, kFinishSpan, kHold, kCalibrate };
+enum class Role { kTick, kSlowPath, kFinishSpan, kCalibrate };
 
 struct Range {
     Symbol symbol;
@@ -198,7 +198,7 @@ int main(int argc, char** argv) {
     std::optional<std::uint64_t> mark;
     const std::regex tick_re(R"(^budget_tick_(\d+)(\..*| .*)?$)");
     const std::regex member_re(
-        R"(SetpointStream<(\d+)u?l?, 16u?l?>::(step_wide|begin_next_span|finish_span|hold)\()");
+        R"(SetpointStream<(\d+)u?l?, 16u?l?>::(tick_slow|finish_span)\()");
     for (const Symbol& s : symbols) {
         std::smatch m;
         if (s.name == "budget_mark") mark = s.address;
@@ -207,10 +207,7 @@ int main(int argc, char** argv) {
             ranges.push_back({s, Role::kTick, static_cast<unsigned>(std::stoul(m[1]))});
         } else if (std::regex_search(s.name, m, member_re)) {
             const std::string f = m[2];
-            const Role role = f == "step_wide"         ? Role::kStepWide
-                              : f == "begin_next_span" ? Role::kBeginNextSpan
-                              : f == "finish_span"     ? Role::kFinishSpan
-                                                       : Role::kHold;
+            const Role role = f == "tick_slow" ? Role::kSlowPath : Role::kFinishSpan;
             ranges.push_back({s, role, static_cast<unsigned>(std::stoul(m[1]))});
         }
     }
@@ -334,13 +331,10 @@ int main(int argc, char** argv) {
             const Phase &p1 = ps[0], &p2 = ps[1], &p3 = ps[2];  // (n,S) (2n,S) (n,2S)
             const unsigned a = axes;
             auto in_tick = [a](const Range& r) {
-                return r.axes == a && (r.role == Role::kTick || r.role == Role::kStepWide);
+                return r.axes == a && (r.role == Role::kTick || r.role == Role::kSlowPath);
             };
             auto in_consumer = [a](const Range& r) {
                 return r.axes == a && r.role != Role::kCalibrate;
-            };
-            auto in_switch = [a](const Range& r) {
-                return r.axes == a && (r.role == Role::kBeginNextSpan || r.role == Role::kFinishSpan);
             };
             bool have_tick = false;
             for (const Range& r : ranges) have_tick |= r.axes == a && r.role == Role::kTick;
@@ -357,7 +351,12 @@ int main(int argc, char** argv) {
                          static_cast<double>(p2.ticks - p1.ticks);
             row.consumer = range_sum(p1, in_consumer) / t1;
             row.whole = (delta(p3, 0) - delta(p1, 0)) / static_cast<double>(p3.ticks - p1.ticks);
-            row.switch_per_span = range_sum(p1, in_switch) / static_cast<double>(p1.spans);
+            // (n, 2S) has S more spans and S n more ticks than (n, S): what it executes beyond
+            // those ticks' steady cost is the span switches, whatever functions they live in.
+            row.switch_per_span =
+                (range_sum(p3, in_consumer) - range_sum(p1, in_consumer) -
+                 row.steady * static_cast<double>(p3.ticks - p1.ticks)) /
+                static_cast<double>(p3.spans - p1.spans);
             const Phase& push = push_of.at(a);
             row.push_per_span = delta(push, 0) / static_cast<double>(push.calls);
             rows.push_back(row);
@@ -385,7 +384,7 @@ int main(int argc, char** argv) {
     const std::string budget_text = o.budget ? fmt(*o.budget, 0) : "-";
     std::cout << "| spans | axes A | tick() per tick | per axis per setpoint | marginal per extra axis"
                  " | amortized tick() incl. span switches, per axis | whole run incl. push(), per axis"
-                 " | begin_next_span + finish_span per span | push() per span | <= "
+                 " | span switch per span | push() per span | <= "
               << budget_text << " per axis |\n";
     std::cout << "|---|---|---|---|---|---|---|---|---|---|\n";
     for (std::size_t i = 0; i < rows.size(); ++i) {
@@ -431,11 +430,11 @@ int main(int argc, char** argv) {
     }
     if (o.legend) std::cout << "\nColumns (docs/cortex-m.md):\n"
                  "- tick() per tick: steady state, instructions executed inside tick() (and"
-                 " step_wide for wide spans) per tick, from two runs with the same spans and n vs"
+                 " tick_slow for wide spans) per tick, from two runs with the same spans and n vs"
                  " 2n ticks each; the setpoint output (exact, rounded) included.\n"
                  "- per axis per setpoint: that divided by A; the budget applies to it.\n"
                  "- marginal: extra instructions per tick for each added axis.\n"
-                 "- amortized: everything tick() executes (begin_next_span, finish_span"
+                 "- amortized: everything tick() executes (tick_slow, finish_span"
                  " included) over a run of spans of n ticks, per tick, per axis.\n"
                  "- whole run: difference of runs with S and 2S spans of n ticks: the driver"
                  " loop, push() (validation, prepare_span) and tick(), per tick, per axis.\n";
