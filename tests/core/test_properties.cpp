@@ -11,6 +11,8 @@
 // long span), so the default CI size (--spans 100000 under ASan) stays within a few seconds.
 #include <catch2/catch.hpp>
 
+#include <utility>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -525,12 +527,15 @@ TEST_CASE("Catmull-Rom spans pass through P1 and P2 and join C1", "[properties]"
 
 // ---- Bezier and Hermite end conditions --------------------------------------------------
 
-TEST_CASE("Bezier ends at P0 and P3 with tangents 3(P1-P0) and 3(P3-P2)", "[properties]") {
+/// End points and end tangents (in u) of a basis that interpolates its ends: the span must
+/// start at p[0], end at p[end_index], and have the tangents `tangents(p)` gives at u = 0, 1.
+template <typename Tangents>
+void check_end_conditions(Basis b, std::uint64_t seed_offset, int end_index, Tangents tangents,
+                          std::uint64_t min_accepted_divisor) {
     const auto seed = pathstream::test::property_seed();
     INFO("seed " << seed);
-    SpanGenerator gen(seed + 3);
+    SpanGenerator gen(seed + seed_offset);
     const std::uint64_t count = spans_for(1);
-    const Basis b = Basis::kBezier;
     std::uint64_t accepted = 0;
     for (std::uint64_t i = 0; i < count; ++i) {
         std::int32_t p[4];
@@ -541,48 +546,30 @@ TEST_CASE("Bezier ends at P0 and P3 with tangents 3(P1-P0) and 3(P3-P2)", "[prop
         ++accepted;
         const auto ctx = [&] { return describe(b, p, n); };
         EXPECT(core_at(s, 0) == p[0], ctx());
-        EXPECT(core_at(s, n) == p[3], ctx());
+        EXPECT(core_at(s, n) == p[end_index], ctx());
         std::int64_t last = 0;
         emit(s, n, 1, &last);
-        EXPECT(last == p[3], ctx());
-        const Rational t0{3 * (i128{p[1]} - p[0]), 1}, t1{3 * (i128{p[3]} - p[2]), 1};
+        EXPECT(last == p[end_index], ctx());
+        const auto [t0, t1] = tangents(p);
         EXPECT(same_value(reference_derivatives(b, p, n, 0).d1, t0), ctx());
         EXPECT(same_value(reference_derivatives(b, p, n, n).d1, t1), ctx());
         EXPECT(same_value(core_d1(s, b, false), t0), ctx());
         EXPECT(same_value(core_d1(s, b, true), t1), ctx());
     }
     INFO("accepted " << accepted << " of " << count);
-    REQUIRE(accepted > count / 3);
+    REQUIRE(accepted > count / min_accepted_divisor);
+}
+
+TEST_CASE("Bezier ends at P0 and P3 with tangents 3(P1-P0) and 3(P3-P2)", "[properties]") {
+    check_end_conditions(Basis::kBezier, 3, 3, [](const std::int32_t (&p)[4]) {
+        return std::pair{Rational{3 * (i128{p[1]} - p[0]), 1}, Rational{3 * (i128{p[3]} - p[2]), 1}};
+    }, 3);
 }
 
 TEST_CASE("Hermite ends at P0 and P1 with tangents T0 and T1", "[properties]") {
-    const auto seed = pathstream::test::property_seed();
-    INFO("seed " << seed);
-    SpanGenerator gen(seed + 4);
-    const std::uint64_t count = spans_for(1);
-    const Basis b = Basis::kHermite;
-    std::uint64_t accepted = 0;
-    for (std::uint64_t i = 0; i < count; ++i) {
-        std::int32_t p[4];
-        gen.control(b, p);
-        const std::uint32_t n = gen.ticks();
-        Axis s;
-        if (build(b, p, n, s) != Status::kOk) continue;
-        ++accepted;
-        const auto ctx = [&] { return describe(b, p, n); };
-        EXPECT(core_at(s, 0) == p[0], ctx());
-        EXPECT(core_at(s, n) == p[1], ctx());
-        std::int64_t last = 0;
-        emit(s, n, 1, &last);
-        EXPECT(last == p[1], ctx());
-        const Rational t0{p[2], 1}, t1{p[3], 1};
-        EXPECT(same_value(reference_derivatives(b, p, n, 0).d1, t0), ctx());
-        EXPECT(same_value(reference_derivatives(b, p, n, n).d1, t1), ctx());
-        EXPECT(same_value(core_d1(s, b, false), t0), ctx());
-        EXPECT(same_value(core_d1(s, b, true), t1), ctx());
-    }
-    INFO("accepted " << accepted << " of " << count);
-    REQUIRE(accepted > count / 4);
+    check_end_conditions(Basis::kHermite, 4, 1, [](const std::int32_t (&p)[4]) {
+        return std::pair{Rational{p[2], 1}, Rational{p[3], 1}};
+    }, 4);
 }
 
 // ---- Convex hull ------------------------------------------------------------------------
