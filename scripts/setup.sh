@@ -7,7 +7,7 @@ packages=(
   # host toolchain and test framework
   build-essential cmake ninja-build pkg-config catch2
   # host libraries (CLI, data, math baseline for the bench)
-  libcli11-dev nlohmann-json3-dev libeigen3-dev
+  libcli11-dev nlohmann-json3-dev libeigen3-dev libpugixml-dev
   # Cortex-M proof: cross toolchain, C++ headers, emulator with TCG plugin support
   gcc-arm-none-eabi binutils-arm-none-eabi libstdc++-arm-none-eabi-newlib
   libnewlib-arm-none-eabi qemu-system-arm

@@ -6,7 +6,7 @@
 #include <iostream>
 
 #include "pathstream/host/input_error.hpp"
-#include "setpoints_command.hpp"
+#include "cli/setpoints_command.hpp"
 
 namespace {
 constexpr int kExitInput = 1;
