@@ -11,6 +11,8 @@ packages=(
   # Cortex-M proof: cross toolchain, C++ headers, emulator with TCG plugin support
   gcc-arm-none-eabi binutils-arm-none-eabi libstdc++-arm-none-eabi-newlib
   libnewlib-arm-none-eabi qemu-system-arm
+  # plots: SVG to PNG
+  librsvg2-bin
 )
 
 missing=()

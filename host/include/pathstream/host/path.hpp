@@ -30,6 +30,7 @@ struct Subpath {
     PathBasis basis = PathBasis::kBSpline;
     bool closed = false;
     std::vector<PathPoint> points;
+    double feed = 0;          ///< requested speed along it, mm/s; 0: the machine profile's feed
     SourceLocation location;  ///< where the subpath starts in the file
 };
 

@@ -1,0 +1,32 @@
+// The geometric path as one list of cubic Bezier segments in millimetres: the form the
+// planner works on, whatever the input format was.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <vector>
+
+#include "pathstream/host/path.hpp"
+
+namespace pathstream::host {
+
+/// One cubic Bezier piece, control points in mm (each PathPoint has Path::axes coordinates).
+struct BezierSegment {
+    std::array<PathPoint, 4> p;
+    bool pen_down = true;     ///< false: pen-up travel between subpaths
+    std::size_t subpath = 0;  ///< index into Path::subpaths (travel: the subpath it leads to)
+};
+
+/// Converts every subpath to Bezier segments (B-spline and Catmull-Rom spans exactly, with the
+/// same clamped open ends as the core spans; polylines as straight segments) and inserts a
+/// straight pen-up travel segment between consecutive subpaths. Consecutive segments share
+/// end points exactly.
+std::vector<BezierSegment> to_bezier_segments(const Path& path);
+
+/// Point of a segment at parameter u in [0, 1] (de Casteljau), and its first and second
+/// derivatives with respect to u.
+PathPoint bezier_point(const BezierSegment& s, double u);
+PathPoint bezier_d1(const BezierSegment& s, double u);
+PathPoint bezier_d2(const BezierSegment& s, double u);
+
+}  // namespace pathstream::host

@@ -1,0 +1,41 @@
+// The machine profile: what the axes can do and how the device ticks (docs/formats.md).
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace pathstream::host {
+
+/// Limits of one axis, in millimetres and seconds.
+struct AxisLimits {
+    std::string name;                  ///< "x", "y", ...
+    double max_velocity = 0;           ///< mm/s, > 0
+    double max_acceleration = 0;       ///< mm/s^2, > 0
+};
+
+/// Everything the planner and the simulated device need to know about the machine.
+struct MachineProfile {
+    std::vector<AxisLimits> axes;      ///< one per path axis, in path order
+    double mm_per_lsb = 0.001;         ///< position resolution
+    double tick_hz = 1000;             ///< device tick rate
+    std::uint32_t ticks_per_span = 8;  ///< span length the planner emits (device streaming unit)
+    double feed = 50;                  ///< requested pen-down speed along the path, mm/s
+    double travel_feed = 150;          ///< requested pen-up speed, mm/s
+    double pen_down_delay = 0.05;      ///< s the pen needs to settle after going down
+    double pen_up_delay = 0.05;        ///< s the pen needs to lift
+    double chord_tolerance = 0.005;    ///< mm: max distance of executed ticks from the path
+    std::string source;                ///< file it came from, for messages
+
+    double tick_seconds() const { return 1.0 / tick_hz; }
+};
+
+/// Parses a machine profile JSON document. Throws InputError ("file:line:col: ...") on
+/// malformed JSON, unknown keys, wrong types, non-finite or impossible values (zero or
+/// negative limits, tick rate outside 10 Hz..100 kHz, ...).
+MachineProfile parse_machine_profile(const std::string& text, const std::string& file);
+
+/// Reads and parses a machine profile file. Throws InputError.
+MachineProfile load_machine_profile(const std::string& file);
+
+}  // namespace pathstream::host

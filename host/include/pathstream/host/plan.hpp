@@ -1,0 +1,41 @@
+// The planner's result: the spans the device executes, tick by tick, and how they were checked.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "pathstream/host/core_spans.hpp"
+#include "pathstream/host/geometry.hpp"
+#include "pathstream/host/machine.hpp"
+
+namespace pathstream::host {
+
+/// The pen changes state at the start of `tick` (the device switches its output then).
+struct PenEvent {
+    std::uint64_t tick = 0;
+    bool down = false;
+};
+
+/// What `plan` produces and what every target executes: spans of whole ticks for the core.
+struct Plan {
+    std::vector<CoreSpan> spans;    ///< consecutive, continuous (each starts where the last ends)
+    std::vector<PenEvent> pen;      ///< in tick order; the pen starts up
+    std::uint64_t total_ticks = 0;  ///< sum of span ticks
+    double duration = 0;            ///< s = total_ticks / tick_hz
+    double path_length = 0;         ///< mm, pen-down length of the geometric path
+    double travel_length = 0;       ///< mm, pen-up travel
+};
+
+/// Per-tick check of a plan against the machine and the geometry (every tick executed).
+struct PlanCheck {
+    double max_velocity_fraction = 0;      ///< max over axes and ticks of |v| / v_max
+    double max_acceleration_fraction = 0;  ///< max over axes and ticks of |a| / a_max
+    std::vector<double> axis_velocity_fraction;      ///< per axis
+    std::vector<double> axis_acceleration_fraction;  ///< per axis
+    double max_deviation = 0;              ///< mm, worst distance of a pen-down setpoint from the path
+    std::uint64_t worst_deviation_tick = 0;
+    bool within_limits = false;            ///< every fraction <= 1 (after the quantisation allowance)
+    bool drawing_while_pen_moves = false;  ///< true if any tick moves while the pen settles
+};
+
+}  // namespace pathstream::host
