@@ -79,6 +79,9 @@ public:
     }
     /// Tag of the last span whose every tick was supplied; 0 before the first. Consumer.
     std::uint32_t last_completed_tag() const { return last_completed_tag_; }
+    /// Discrete outputs (Span::outputs) in force: those of the span that supplied the last
+    /// tick, kept while idle. Consumer context; read it right after tick().
+    std::uint8_t outputs() const { return outputs_; }
     /// Spans completed since construction. Consumer context.
     std::uint32_t spans_completed() const { return spans_completed_; }
 
@@ -93,6 +96,7 @@ private:
                 return TickState::kIdle;
             }
             remaining_ = active_->ticks;
+            outputs_ = active_->outputs;
             if (!active_->wide) {
                 narrow_active_ = active_;
                 return tick(out);
@@ -124,6 +128,7 @@ private:
     std::uint64_t completed_ticks_ = 0;
     std::uint32_t last_completed_tag_ = 0;
     std::uint32_t spans_completed_ = 0;
+    std::uint8_t outputs_ = 0;
     Lsb hold_[Axes] = {};        // consumer side: where the axes rest when idle
     Lsb pushed_end_[Axes] = {};  // producer side: end point of the last pushed span
 };

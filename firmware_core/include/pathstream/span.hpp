@@ -21,8 +21,13 @@ struct Span {
     Basis basis = Basis::kUniformBSpline;
     std::uint32_t ticks = 1;               ///< n, 1..kMaxSpanTicks
     std::uint32_t tag = 0;                 ///< caller's label (e.g. a sequence number), kept
+    std::uint8_t outputs = 0;              ///< discrete outputs while it plays (kOutputPenDown...)
     std::int32_t control[Axes][4] = {};    ///< per axis: P0..P3 (Hermite: P0, P1, T0, T1)
 };
+
+/// Bits of Span::outputs. The device applies a span's outputs at its first tick, so a pen
+/// change happens exactly at a span boundary (the planner puts a dwell span there).
+inline constexpr std::uint8_t kOutputPenDown = 1u << 0;
 
 /// A span validated and converted to forward-differencing state at its first tick.
 /// Holds either narrow or wide state for all axes (they share D). ~40 or ~48 bytes per axis.
@@ -37,6 +42,7 @@ struct PreparedSpan {
     std::uint32_t tag = 0;
     std::uint64_t bias = 0;  ///< K = 2^W - D (its low 32 bits when narrow)
     bool wide = false;
+    std::uint8_t outputs = 0;  ///< Span::outputs, applied while the span plays
     PreparedSpan() : narrow{} {}
 };
 
@@ -46,6 +52,7 @@ struct ValidatedSpan {
     SpanTiming timing;
     TickCubic cubic[Axes];
     std::uint32_t tag = 0;
+    std::uint8_t outputs = 0;
 };
 
 /// Checks `span` on every axis (make_span_timing, make_tick_cubic) into `out`. Returns the
@@ -61,6 +68,7 @@ template <unsigned Axes>
         }
     }
     out.tag = span.tag;
+    out.outputs = span.outputs;
     return Status::kOk;
 }
 
@@ -76,6 +84,7 @@ void prepare_validated(const ValidatedSpan<Axes>& v, PreparedSpan<Axes>& out) {
     }
     out.ticks = v.timing.ticks;
     out.tag = v.tag;
+    out.outputs = v.outputs;
     out.wide = !narrow;
     out.bias = difference_bias(v.timing);
 }
