@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "pathstream/host/input_error.hpp"
+#include "pathstream/host/json_document.hpp"
 #include "pathstream/host/json_locate.hpp"
 
 namespace pathstream::host {
@@ -28,24 +29,9 @@ using nlohmann::json;
 constexpr std::size_t kMaxAxes = 8;
 constexpr double kMaxCoordinateMm = 1e6;  // 1 km: beyond any plotter; catches unit mix-ups
 
-class Reader {
+class Reader : public JsonChecker {
 public:
-    Reader(const std::string& text, const std::string& file) : text_(text), file_(file) {}
-
-    [[noreturn]] void fail(const std::string& pointer, const std::string& message) const {
-        throw InputError(file_, locate_json_pointer(text_, pointer), message);
-    }
-
-    void only_keys(const json& object, const std::string& pointer,
-                   const std::set<std::string>& allowed) const {
-        for (const auto& [key, value] : object.items()) {
-            if (!allowed.count(key)) {
-                std::string list;
-                for (const auto& k : allowed) list += (list.empty() ? "" : ", ") + k;
-                fail(pointer + "/" + key, "unknown key \"" + key + "\" (expected one of: " + list + ")");
-            }
-        }
-    }
+    using JsonChecker::JsonChecker;
 
     PathBasis basis(const json& v, const std::string& pointer) const {
         if (!v.is_string()) fail(pointer, "basis must be a string");
@@ -81,7 +67,7 @@ public:
         Subpath sp;
         sp.basis = default_basis;
         sp.closed = default_closed;
-        sp.location = locate_json_pointer(text_, pointer);
+        sp.location = locate_json_pointer(text(), pointer);
         if (!v.is_object()) fail(pointer, "subpath must be an object with \"points\"");
         only_keys(v, pointer, {"basis", "closed", "points"});
         if (v.contains("basis")) sp.basis = basis(v["basis"], pointer + "/basis");
@@ -163,7 +149,7 @@ public:
             Subpath sp;
             sp.basis = default_basis;
             sp.closed = default_closed;
-            sp.location = locate_json_pointer(text_, "/points");
+            sp.location = locate_json_pointer(text(), "/points");
             sp.points = points(root["points"], "/points", scale, axes);
             check_count(sp, "/points");
             path.subpaths.push_back(std::move(sp));
@@ -178,39 +164,12 @@ public:
         path.axes = axes;
         return path;
     }
-
-private:
-    const std::string& text_;
-    const std::string& file_;
 };
 
 }  // namespace
 
 Path parse_json_path(const std::string& text, const std::string& file) {
-    json root;
-    try {
-        root = json::parse(text);
-    } catch (const json::parse_error& e) {
-        // nlohmann reports the byte just past the offending token; point at that token.
-        const std::size_t offset = e.byte > 0 ? e.byte - 1 : 0;
-        std::string message = e.what();
-        if (const auto colon = message.find("syntax error"); colon != std::string::npos) {
-            message = message.substr(colon);
-        }
-        throw InputError(file, locate_offset(text, offset), "invalid JSON: " + message);
-    } catch (const json::out_of_range& e) {
-        // A number too large for a double (e.g. 1e400): nlohmann names the token, not where.
-        std::string message = e.what();
-        const auto open = message.find('\''), close = message.rfind('\'');
-        if (open != std::string::npos && close > open) {
-            const std::string token = message.substr(open + 1, close - open - 1);
-            const auto at = text.find(token);
-            throw InputError(file, at == std::string::npos ? SourceLocation{} : locate_offset(text, at),
-                             "number " + token + " is out of range (not finite as a double)");
-        }
-        throw InputError(file, {}, "invalid JSON: " + message);
-    }
-    return Reader(text, file).path(root);
+    return Reader(text, file).path(parse_json_document(text, file));
 }
 
 Path load_json_path(const std::string& file) {
