@@ -162,6 +162,10 @@ public:
             }
         }
         path.axes = axes;
+        if (scale != 1.0) {
+            path.units = "in";
+            path.mm_per_unit = scale;
+        }
         return path;
     }
 };

@@ -6,6 +6,7 @@
 #include <iostream>
 
 #include "pathstream/host/input_error.hpp"
+#include "cli/eval_command.hpp"
 #include "cli/setpoints_command.hpp"
 
 namespace {
@@ -21,6 +22,8 @@ int main(int argc, char** argv) {
     app.set_version_flag("--version", "pathstream 0.1.0");
     pathstream::host::SetpointsOptions setpoints;
     pathstream::host::add_setpoints_command(app, setpoints);
+    pathstream::host::EvalOptions eval;
+    pathstream::host::add_eval_command(app, eval);
 
     try {
         app.parse(argc, argv);
@@ -35,6 +38,7 @@ int main(int argc, char** argv) {
 
     try {
         if (app.got_subcommand("setpoints")) return pathstream::host::run_setpoints(setpoints);
+        if (app.got_subcommand("eval")) return pathstream::host::run_eval(eval);
     } catch (const pathstream::host::InputError& e) {
         std::cerr << e.what() << '\n';
         return kExitInput;

@@ -32,5 +32,18 @@ expect no-subcommand 2 "A subcommand is required" -- "$bin"
 expect unwritable 3 "cannot create output file" -- "$bin" setpoints "$src/examples/rose.json" --out "$work/no/such/dir/x.csv"
 expect help 0 "--ticks-per-span" -- "$bin" setpoints --help
 
+# eval: N samples per span plus the end point, header span,u,x,y, values exact to one LSB
+expect eval 0 "25 samples of 1 subpath(s) in mm" -- "$bin" eval "$src/examples/wave.json" --samples-per-span 4 --out "$work/wave.csv"
+if [ "$(head -1 "$work/wave.csv")" != "span,u,x,y" ] || [ "$(sed -n 3p "$work/wave.csv")" != "0,0.25,2.5,2.375" ] ||
+   [ "$(tail -1 "$work/wave.csv")" != "5,1,60,0" ]; then
+  echo "FAIL eval output: $(head -3 "$work/wave.csv" | tr '\n' ' ') ... $(tail -1 "$work/wave.csv")"; failures=$((failures + 1))
+else
+  passed=$((passed + 1))
+fi
+printf '{"units": "in", "basis": "polyline", "points": [[0, 0], [1, 0.5]]}' > "$work/inch.json"
+out=$("$bin" eval "$work/inch.json" --samples-per-span 2 2>/dev/null | tail -1)
+if [ "$out" != "0,1,1,0.5" ]; then echo "FAIL eval-inches: $out"; failures=$((failures + 1)); else passed=$((passed + 1)); fi
+expect eval-unknown-type 1 "unknown file type" -- "$bin" eval "$src/README.md"
+
 echo "cli: $passed passed, $failures failed"
 [ "$failures" -eq 0 ]

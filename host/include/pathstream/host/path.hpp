@@ -38,6 +38,8 @@ struct Subpath {
 struct Path {
     std::size_t axes = 2;
     std::vector<Subpath> subpaths;
+    std::string units = "mm";  ///< the file's own unit, for output in it ("mm" or "in")
+    double mm_per_unit = 1.0;  ///< coordinates above are already in mm; this converts back
 };
 
 /// Name used in files and messages ("bspline", "catmull-rom", "bezier", "polyline").
