@@ -17,7 +17,7 @@ expect() {  # expect NAME EXIT_CODE MESSAGE_SUBSTRING -- command...
   fi
 }
 
-expect example 0 "every setpoint (6720) equals" -- "$bin" setpoints "$src/examples/rose.json" --out "$work/rose.csv"
+expect example 0 "every setpoint (6722) equals" -- "$bin" setpoints "$src/examples/rose.json" --out "$work/rose.csv"
 rows=$(wc -l < "$work/rose.csv")
 # 105 spans x 32 ticks + the end point + the header
 if [ "$rows" -ne $((105 * 32 + 2)) ]; then echo "FAIL rows: $rows"; failures=$((failures + 1)); else passed=$((passed + 1)); fi
