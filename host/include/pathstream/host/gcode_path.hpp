@@ -1,0 +1,39 @@
+// Reader of G-code (RS274/NGC as LinuxCNC reads it, the subset a pen plotter needs):
+// docs/formats-gcode.md.
+#pragma once
+
+#include <string>
+
+#include "pathstream/host/path.hpp"
+
+namespace pathstream::host {
+
+/// What lowers the pen.
+enum class PenControl {
+    kZ,        ///< down during G1/G2/G3/G5/G5.1 moves made at Z <= GcodeOptions::z_down_max
+    kSpindle,  ///< down during G1/G2/G3/G5/G5.1 moves made between M3 (or M4) and M5
+};
+
+/// How to read a G-code program.
+struct GcodeOptions {
+    PenControl pen = PenControl::kZ;  ///< what lowers the pen
+    double z_down_max = 0.0;          ///< kZ: highest Z (mm) at which the pen is down; finite
+    double arc_tolerance_mm = 0.01;   ///< largest distance of an arc's Beziers from the arc; >= 1e-6
+};
+
+/// Parses a G-code program into a 2-axis path (X, Y in mm): one subpath (basis kBezier, open,
+/// points P0 C C P1 C C ... of 3k + 1) per maximal run of pen-down moves with one feed; G0 and
+/// pen-up moves are travel between subpaths. Subpath::feed is the F word in mm/s (0 until the
+/// program gives F). `file` names the source in error messages.
+/// Throws InputError ("file:line:col: what is wrong") at the offending word for syntax errors,
+/// unsupported words and codes, missing or repeated words, out-of-range numbers (> 1e6 mm) and
+/// impossible arcs; and ("file: no pen-down moves ...") when nothing is drawn.
+/// Throws std::invalid_argument when `options` is out of range.
+Path parse_gcode_path(const std::string& text, const std::string& file,
+                      const GcodeOptions& options = {});
+
+/// Reads and parses a G-code file. Throws as parse_gcode_path, and InputError when the file
+/// cannot be read.
+Path load_gcode_path(const std::string& file, const GcodeOptions& options = {});
+
+}  // namespace pathstream::host

@@ -1,0 +1,113 @@
+// G2/G3: the arc's center from I J (offsets, or absolute under G90.1) or from R, LinuxCNC's
+// checks on it, then Bezier pieces (docs/formats-gcode.md, "Arcs").
+#include <cmath>
+#include <cstdio>
+#include <numbers>
+
+#include "arc.hpp"
+#include "interpreter.hpp"
+
+namespace pathstream::host::gcode {
+
+namespace {
+
+// LinuxCNC's defaults (interp_internal.hh): radii below this are zero; an R arc may be this
+// much too short for its chord.
+constexpr double kRadiusToleranceMm = 0.00005 * 25.4;
+// LinuxCNC's defaults for how far the end may be off the start's circle: the end point's
+// radius may differ from the start point's by at most this much (in the program's units) and
+// by at most 0.1 %.
+constexpr double kSpiralToleranceMm = 2 * 0.01 * std::numbers::sqrt2;
+constexpr double kSpiralToleranceInch = 2 * 0.001 * std::numbers::sqrt2;
+constexpr double kSpiralRelativeTolerance = 0.001;
+constexpr int kMaxTurns = 100;
+
+std::string fixed(double v, int decimals) {
+    char buffer[64];
+    std::snprintf(buffer, sizeof buffer, "%.*f", decimals, v);
+    return buffer;
+}
+
+}  // namespace
+
+void Interpreter::arc(const Command& c, Motion move, Vec2 to, SourceLocation at) {
+    const char* name = move == Motion::kArcCw ? "G2" : "G3";
+    const Word *i = c.value('I'), *j = c.value('J'), *r = c.value('R'), *p = c.value('P');
+    const Vec2 from = position_;
+    if (r && (i || j)) fail(r->at, "give either I and J (the center) or R (the radius), not both");
+    if (!r && !i && !j) fail(at, std::string(name) + " needs I and J (the center) or R (the radius)");
+
+    int turns = 1;
+    if (p) {
+        if (p->value != std::floor(p->value) || p->value < 1 || p->value > kMaxTurns) {
+            fail(p->at, "P (number of turns) must be a whole number from 1 to " +
+                            std::to_string(kMaxTurns));
+        }
+        turns = static_cast<int>(p->value);
+    }
+
+    Vec2 center;
+    if (r) {
+        const double radius = length(*r);
+        if (to == from) {
+            fail(r->at, "R arc with the end point equal to the start point (use I and J for a "
+                        "full circle)");
+        }
+        // As LinuxCNC's arc_data_r: the center lies on the chord's perpendicular bisector; R < 0
+        // asks for the arc of more than 180 degrees.
+        const double abs_radius = std::fabs(radius);
+        if (abs_radius < kRadiusToleranceMm) fail(r->at, "zero-radius arc (R" + r->text + ")");
+        const Vec2 mid = 0.5 * (from + to);
+        double half = std::hypot(to.x - mid.x, to.y - mid.y);
+        if (half - abs_radius > kRadiusToleranceMm) {
+            fail(r->at, "arc radius R" + r->text + " is too small to reach the end point (" +
+                            "half the chord is " + fixed(half, 4) + " mm)");
+        }
+        if (half / abs_radius > 1 - 1e-12) half = abs_radius;
+        const bool right = (move == Motion::kArcCw) == (radius > 0);
+        const double theta = std::atan2(to.y - from.y, to.x - from.x) +
+                             (right ? -std::numbers::pi / 2 : std::numbers::pi / 2);
+        const double offset = abs_radius * std::cos(std::asin(half / abs_radius));
+        center = mid + offset * Vec2{std::cos(theta), std::sin(theta)};
+    } else {
+        if (arc_incremental_) {
+            center = from + Vec2{i ? length(*i) : 0.0, j ? length(*j) : 0.0};
+        } else {
+            if (!i || !j) {
+                fail(i ? i->at : j->at, std::string(name) +
+                                            " with absolute centers (G90.1) needs both I and J");
+            }
+            center = Vec2{length(*i), length(*j)};
+        }
+        const double r0 = std::hypot(from.x - center.x, from.y - center.y);
+        const double r1 = std::hypot(to.x - center.x, to.y - center.y);
+        if (r0 < kRadiusToleranceMm || r1 < kRadiusToleranceMm) {
+            fail(at, "zero-radius arc (the center is at the start or end point)");
+        }
+        const double abs_err = std::fabs(r0 - r1);
+        const double rel_err = abs_err / std::max(r0, r1);
+        const double abs_tolerance = inch_ ? kSpiralToleranceInch * 25.4 : kSpiralToleranceMm;
+        if (abs_err > abs_tolerance || rel_err > kSpiralRelativeTolerance) {
+            fail(at, "radius to end of arc differs from radius to start: " + fixed(r0, 4) + " mm vs " +
+                         fixed(r1, 4) + " mm (allowed: " + fixed(abs_tolerance, 4) + " mm and 0.1%)");
+        }
+    }
+
+    const bool ccw = move == Motion::kArcCcw;
+    double sweep = 0;
+    if (to == from) {
+        sweep = ccw ? 2 * std::numbers::pi : -2 * std::numbers::pi;
+    } else {
+        sweep = std::atan2(to.y - center.y, to.x - center.x) -
+                std::atan2(from.y - center.y, from.x - center.x);
+        if (ccw && sweep <= 0) sweep += 2 * std::numbers::pi;
+        if (!ccw && sweep >= 0) sweep -= 2 * std::numbers::pi;
+    }
+    sweep += (ccw ? 2 : -2) * std::numbers::pi * (turns - 1);
+
+    check_point(center, at);
+    follow(arc_to_cubics(Arc{from, to, center, sweep}, options_.arc_tolerance_mm),
+           pen_down(z_, z_), to, at);
+}
+
+}  // namespace pathstream::host::gcode

@@ -1,0 +1,38 @@
+// Pen-down runs -> Bezier-chain subpaths.
+#include "runs.hpp"
+
+#include <stdexcept>
+
+namespace pathstream::host::gcode {
+
+namespace {
+PathPoint point(Vec2 v) { return PathPoint{v.x, v.y}; }
+}  // namespace
+
+void RunBuilder::draw(const Cubic& piece, double feed_mm_s, SourceLocation at) {
+    const Vec2 p0 = piece.p[0];
+    if (piece.p[1] == p0 && piece.p[2] == p0 && piece.p[3] == p0) return;  // zero length
+    if (open_ && done_.back().feed != feed_mm_s) open_ = false;            // one feed per subpath
+    if (!open_) {
+        Subpath sp;
+        sp.basis = PathBasis::kBezier;
+        sp.closed = false;
+        sp.feed = feed_mm_s;
+        sp.location = at;
+        sp.points.push_back(point(p0));
+        done_.push_back(std::move(sp));
+        open_ = true;
+    } else if (done_.back().points.back() != point(p0)) {
+        throw std::logic_error("RunBuilder::draw: piece does not start where the run ends");
+    }
+    for (std::size_t k = 1; k < piece.p.size(); ++k) done_.back().points.push_back(point(piece.p[k]));
+}
+
+void RunBuilder::lift() { open_ = false; }
+
+std::vector<Subpath> RunBuilder::finish() {
+    open_ = false;
+    return std::move(done_);
+}
+
+}  // namespace pathstream::host::gcode
