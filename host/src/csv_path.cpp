@@ -18,7 +18,9 @@ namespace {
 constexpr std::size_t kMaxAxes = 8;
 constexpr double kMaxCoordinateMm = 1e6;  // as the JSON reader: catches unit mix-ups
 
-bool is_blank(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\f' || c == '\v'; }
+bool is_blank(char c) {
+    return c == ' ' || c == '\t' || c == '\r' || c == '\f' || c == '\v';
+}
 
 std::string_view trim(std::string_view s) {
     while (!s.empty() && is_blank(s.front())) s.remove_prefix(1);
@@ -36,7 +38,8 @@ std::vector<Field> split(std::string_view line) {
     std::size_t begin = 0;
     while (true) {
         const std::size_t comma = line.find(',', begin);
-        const std::string_view raw = line.substr(begin, comma == std::string_view::npos ? line.npos : comma - begin);
+        const std::string_view raw =
+            line.substr(begin, comma == std::string_view::npos ? line.npos : comma - begin);
         std::size_t lead = 0;
         while (lead < raw.size() && is_blank(raw[lead])) ++lead;
         fields.push_back({trim(raw), begin + lead + 1});
@@ -55,7 +58,8 @@ bool overflows(std::string_view s) {
     long exponent = 0;
     if (e != std::string_view::npos) {
         const std::string digits(s.substr(e + 1));
-        exponent = std::clamp(std::strtol(digits.c_str(), nullptr, 10), -1'000'000'000L, 1'000'000'000L);
+        exponent =
+            std::clamp(std::strtol(digits.c_str(), nullptr, 10), -1'000'000'000L, 1'000'000'000L);
     }
     long integer_digits = 0, index = 0, first_significant = -1;
     bool after_point = false;
@@ -75,7 +79,8 @@ Parsed parse_number(std::string_view s, double& value) {
     std::string_view body = s;
     if (!body.empty() && body.front() == '+') {
         body.remove_prefix(1);
-        if (!body.empty() && (body.front() == '+' || body.front() == '-')) return Parsed::kNotANumber;
+        if (!body.empty() && (body.front() == '+' || body.front() == '-'))
+            return Parsed::kNotANumber;
     }
     const auto result = std::from_chars(body.data(), body.data() + body.size(), value);
     if (body.empty() || result.ptr != body.data() + body.size()) return Parsed::kNotANumber;
@@ -99,16 +104,19 @@ public:
         if (f.text.empty()) fail(line, f.column, "empty field (expected a number)");
         double value = 0;
         switch (parse_number(f.text, value)) {
-            case Parsed::kNotANumber: fail(line, f.column, "\"" + std::string(f.text) + "\" is not a number");
+            case Parsed::kNotANumber:
+                fail(line, f.column, "\"" + std::string(f.text) + "\" is not a number");
             case Parsed::kOverflow:
                 fail(line, f.column,
                      "number " + std::string(f.text) + " is out of range (not finite as a double)");
-            case Parsed::kNumber: break;
+            case Parsed::kNumber:
+                break;
         }
         if (!std::isfinite(value)) fail(line, f.column, "coordinate is not finite");
         if (std::fabs(value) > kMaxCoordinateMm) {
             std::ostringstream m;
-            m << "coordinate " << value << " is out of range (|value| <= " << kMaxCoordinateMm << " mm)";
+            m << "coordinate " << value << " is out of range (|value| <= " << kMaxCoordinateMm
+              << " mm)";
             fail(line, f.column, m.str());
         }
         return value;
@@ -117,7 +125,8 @@ public:
     static bool is_header(const std::vector<Field>& fields) {
         for (const Field& f : fields) {
             double ignored = 0;
-            if (!f.text.empty() && parse_number(f.text, ignored) != Parsed::kNotANumber) return false;
+            if (!f.text.empty() && parse_number(f.text, ignored) != Parsed::kNotANumber)
+                return false;
         }
         return true;
     }
@@ -172,8 +181,9 @@ public:
             if (axes == 0) axes = fields.size();
             if (fields.size() != axes) {
                 const Field& at = fields.size() > axes ? fields[axes] : fields.back();
-                fail(line, at.column, "point has " + std::to_string(fields.size()) +
-                                          " coordinates, expected " + std::to_string(axes));
+                fail(line, at.column,
+                     "point has " + std::to_string(fields.size()) + " coordinates, expected " +
+                         std::to_string(axes));
             }
             PathPoint point;
             for (const Field& f : fields) point.push_back(coordinate(f, line));
@@ -193,7 +203,8 @@ private:
 
 }  // namespace
 
-Path parse_csv_path(const std::string& text, const std::string& file, PathBasis basis, bool closed) {
+Path parse_csv_path(const std::string& text, const std::string& file, PathBasis basis,
+                    bool closed) {
     return Reader(file).path(text, basis, closed);
 }
 

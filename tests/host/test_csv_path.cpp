@@ -1,7 +1,6 @@
 // The CSV point reader: headers, comments, whitespace, and each broken file with its exact
 // message.
 #include <catch2/catch.hpp>
-
 #include <string>
 
 #include "pathstream/host/csv_path.hpp"
@@ -58,9 +57,9 @@ TEST_CASE("CSV: one point per line after an optional header", "[host][csv]") {
 
 TEST_CASE("CSV: comments, blank lines, whitespace, CRLF, a BOM, signs and exponents",
           "[host][csv]") {
-    const Path p = csv(
-        "\xEF\xBB\xBF# a comment\r\n\r\n   \t\r\n  x , y , z\r\n  1 , 2 ,3\r\n  # another\r\n"
-        "+4,\t5e-1, -6E2\r\n.5,7.,1e-400\r\n");
+    const Path p =
+        csv("\xEF\xBB\xBF# a comment\r\n\r\n   \t\r\n  x , y , z\r\n  1 , 2 ,3\r\n  # another\r\n"
+            "+4,\t5e-1, -6E2\r\n.5,7.,1e-400\r\n");
     REQUIRE(p.axes == 3);
     const Subpath& sp = p.subpaths[0];
     REQUIRE(sp.points.size() == 3);
@@ -101,10 +100,12 @@ TEST_CASE("CSV: bad fields name line, column and the problem", "[host][csv]") {
     CHECK(error_of("0,0\n ,1\n") == "t.csv:2:2: empty field (expected a number)");
     CHECK(error_of("0,0\n1, inf\n") == "t.csv:2:4: coordinate is not finite");
     CHECK(error_of("0,0\nnan,1\n") == "t.csv:2:1: coordinate is not finite");
-    CHECK(error_of("0,0\n1,1e400\n") == "t.csv:2:3: number 1e400 is out of range (not finite as a double)");
+    CHECK(error_of("0,0\n1,1e400\n") ==
+          "t.csv:2:3: number 1e400 is out of range (not finite as a double)");
     CHECK(error_of("0,0\n1,-0.000001e999999999999\n") ==
           "t.csv:2:3: number -0.000001e999999999999 is out of range (not finite as a double)");
-    CHECK(error_of("0,0\n2e6,0\n") == "t.csv:2:1: coordinate 2e+06 is out of range (|value| <= 1e+06 mm)");
+    CHECK(error_of("0,0\n2e6,0\n") ==
+          "t.csv:2:1: coordinate 2e+06 is out of range (|value| <= 1e+06 mm)");
     CHECK(error_of("0,0\n0,-1000000.5\n") ==
           "t.csv:2:3: coordinate -1e+06 is out of range (|value| <= 1e+06 mm)");
 }

@@ -1,7 +1,6 @@
 // The G-code reader: syntax, modal state, exact geometry of lines, arcs and splines, pen
 // control, feeds, and each error with its exact message.
 #include <catch2/catch.hpp>
-
 #include <cmath>
 #include <numbers>
 #include <stdexcept>
@@ -223,7 +222,8 @@ TEST_CASE("G-code: incremental distances (G91) and back to absolute (G90)", "[ho
 TEST_CASE("G-code: feeds in mm/s; a new F in a pen-down run starts a new subpath",
           "[host][gcode]") {
     const Path p = gcode(
-        "G0 Z-1\nG1 X10 F600\nX20\nX30 F1200\nX40 F1200\nF600\nX50\nG0 Z1\nF300\nG0 X60\nG1 Z-1\nX70\n");
+        "G0 Z-1\nG1 X10 F600\nX20\nX30 F1200\nX40 F1200\nF600\nX50\nG0 Z1\nF300\nG0 X60\nG1 "
+        "Z-1\nX70\n");
     REQUIRE(p.subpaths.size() == 4);
     check_points(p.subpaths[0], line_chain({{0, 0}, {10, 0}, {20, 0}}));
     check_points(p.subpaths[1], line_chain({{20, 0}, {30, 0}, {40, 0}}));
@@ -246,7 +246,8 @@ TEST_CASE("G-code: feeds in mm/s; a new F in a pen-down run starts a new subpath
 }
 
 TEST_CASE("G-code: zero-length pieces are dropped and empty runs skipped", "[host][gcode]") {
-    const Path p = gcode("G0 Z-1\nG1 X0 Y0\nG1 Z-2\nG1\nG0 Z5\nG0 X10\nG1 Z-1\nG1 X10\nX20\nX20 Y0\n");
+    const Path p =
+        gcode("G0 Z-1\nG1 X0 Y0\nG1 Z-2\nG1\nG0 Z5\nG0 X10\nG1 Z-1\nG1 X10\nX20\nX20 Y0\n");
     REQUIRE(p.subpaths.size() == 1);
     check_points(p.subpaths[0], line_chain({{10, 0}, {20, 0}}));
     CHECK(p.subpaths[0].location.line == 9);
@@ -272,8 +273,13 @@ TEST_CASE("G-code: a quarter circle (G3, I J) is one cubic with the standard con
     check_arc(p.subpaths[0], 0, 1, {0, 0}, 10, 10, kPi / 2, 0.01);
     // The same arc with an absolute center (G90.1), and clockwise back (G2).
     const Path q = gcode("G90.1 G0 X10 Y0 Z-1\nG3 X0 Y10 I0 J0\nG2 X10 Y0 I0 J0\n");
-    check_points(q.subpaths[0], {{10, 0}, {10, 10 * kQuarter}, {10 * kQuarter, 10}, {0, 10},
-                                 {10 * kQuarter, 10}, {10, 10 * kQuarter}, {10, 0}});
+    check_points(q.subpaths[0], {{10, 0},
+                                 {10, 10 * kQuarter},
+                                 {10 * kQuarter, 10},
+                                 {0, 10},
+                                 {10 * kQuarter, 10},
+                                 {10, 10 * kQuarter},
+                                 {10, 0}});
 }
 
 TEST_CASE("G-code: arcs split into pieces of at most 90 degrees within the tolerance",
@@ -357,7 +363,8 @@ TEST_CASE("G-code: an end point slightly off the circle gives a spiral through b
 
 TEST_CASE("G-code: G5 cubics; I J omitted after a G5 reflect the previous control point",
           "[host][gcode]") {
-    const Path p = gcode("G0 X0 Y0 Z-1\nG5 X10 Y0 I2 J3 P-2 Q3\nG5 X20 Y0 P-2 Q-3\nF60\nX30 Y5 P0 Q1\n");
+    const Path p =
+        gcode("G0 X0 Y0 Z-1\nG5 X10 Y0 I2 J3 P-2 Q3\nG5 X20 Y0 P-2 Q-3\nF60\nX30 Y5 P0 Q1\n");
     REQUIRE(p.subpaths.size() == 2);
     check_points(p.subpaths[0], {{0, 0}, {2, 3}, {8, 3}, {10, 0}, {12, -3}, {18, -3}, {20, 0}});
     check_points(p.subpaths[1], {{20, 0}, {22, 3}, {30, 6}, {30, 5}});
@@ -368,8 +375,13 @@ TEST_CASE("G-code: G5 cubics; I J omitted after a G5 reflect the previous contro
 
 TEST_CASE("G-code: G5.1 quadratics become their exact cubics", "[host][gcode]") {
     const Path p = gcode("G0 Z-1\nG5.1 X10 Y0 I5 J5\nG5.1 X20 J-3\n");
-    check_points(p.subpaths[0], {{0, 0}, {10.0 / 3, 10.0 / 3}, {20.0 / 3, 10.0 / 3}, {10, 0},
-                                 {10, -2}, {40.0 / 3, -2}, {20, 0}});
+    check_points(p.subpaths[0], {{0, 0},
+                                 {10.0 / 3, 10.0 / 3},
+                                 {20.0 / 3, 10.0 / 3},
+                                 {10, 0},
+                                 {10, -2},
+                                 {40.0 / 3, -2},
+                                 {20, 0}});
 }
 
 TEST_CASE("G-code: the example drawing uses G1, G2, G3 and G5", "[host][gcode]") {
@@ -387,14 +399,17 @@ TEST_CASE("G-code: the example drawing uses G1, G2, G3 and G5", "[host][gcode]")
     check_arc(frame, 0, (frame.points.size() - 1) / 3, {50, 50}, 45, 45, -2 * kPi, 0.01);
     // The outline: two G5 pieces, 20 mm/s.
     CHECK(p.subpaths[1].feed == 20.0);
-    check_points(p.subpaths[1], {{50, 85}, {15, 70}, {25, 50}, {50, 25}, {75, 50}, {85, 70}, {50, 85}});
+    check_points(p.subpaths[1],
+                 {{50, 85}, {15, 70}, {25, 50}, {50, 25}, {75, 50}, {85, 70}, {50, 85}});
     // Midrib and stem: a line, then a quarter circle about (50, 8).
     const Subpath& rib = p.subpaths[2];
     REQUIRE(rib.points.size() == 7);
     check_arc(rib, 1, 1, {50, 8}, 6, 6, kPi / 2, 0.01);
     // The veins continue smoothly through the midrib.
-    check_points(p.subpaths[3], {{32, 55}, {40, 49}, {42, 45}, {50, 45}, {58, 45}, {60, 49}, {68, 55}});
-    check_points(p.subpaths[4], {{36, 70}, {42, 65}, {44, 62}, {50, 62}, {56, 62}, {58, 65}, {64, 70}});
+    check_points(p.subpaths[3],
+                 {{32, 55}, {40, 49}, {42, 45}, {50, 45}, {58, 45}, {60, 49}, {68, 55}});
+    check_points(p.subpaths[4],
+                 {{36, 70}, {42, 65}, {44, 62}, {50, 62}, {56, 62}, {58, 65}, {64, 70}});
 }
 
 // ---- errors -------------------------------------------------------------------------------
@@ -411,7 +426,8 @@ TEST_CASE("G-code: syntax errors name line, column and the problem", "[host][gco
     CHECK(error_of("G1 X1.2.3") == "t.ngc:1:4: malformed number \"1.2.3\" after X");
     CHECK(error_of("G1 X-") == "t.ngc:1:4: malformed number \"-\" after X");
     CHECK(error_of("G1 X1-2") == "t.ngc:1:4: malformed number \"1-2\" after X");
-    CHECK(error_of("G1 X1e3") == "t.ngc:1:6: unsupported word letter 'E' (supported: F G I J M N P Q R S T X Y Z)");
+    CHECK(error_of("G1 X1e3") ==
+          "t.ngc:1:6: unsupported word letter 'E' (supported: F G I J M N P Q R S T X Y Z)");
     CHECK(error_of("G1 X Y2") == "t.ngc:1:4: missing number after X");
     CHECK(error_of("G1 X" + std::string(400, '9')) ==
           "t.ngc:1:4: number after X is out of range (not finite as a double)");
@@ -419,7 +435,8 @@ TEST_CASE("G-code: syntax errors name line, column and the problem", "[host][gco
     CHECK(error_of("G1 (oops X1") == "t.ngc:1:4: unclosed comment '('");
     CHECK(error_of("#1=5") == "t.ngc:1:1: parameters (#) are not supported");
     CHECK(error_of("G1 [1]") == "t.ngc:1:4: expressions ([ ]) are not supported");
-    CHECK(error_of("o100 sub") == "t.ngc:1:1: O-words (subroutines and control flow) are not supported");
+    CHECK(error_of("o100 sub") ==
+          "t.ngc:1:1: O-words (subroutines and control flow) are not supported");
     CHECK(error_of("G1 N10 X1") == "t.ngc:1:4: line number N must start the block");
     CHECK(error_of("G1 X1\xC3\xA9") ==
           "t.ngc:1:6: unexpected character byte \\xC3 (expected a word: letter and number)");
@@ -427,8 +444,10 @@ TEST_CASE("G-code: syntax errors name line, column and the problem", "[host][gco
 
 TEST_CASE("G-code: code and word errors", "[host][gcode]") {
     CHECK(error_of("G1 X1 X2") == "t.ngc:1:7: repeated word X in one block");
-    CHECK(error_of("G0 G1 X1") == "t.ngc:1:4: G0 and G1 are in the same modal group (one per block)");
-    CHECK(error_of("G20 G21") == "t.ngc:1:5: G20 and G21 are in the same modal group (one per block)");
+    CHECK(error_of("G0 G1 X1") ==
+          "t.ngc:1:4: G0 and G1 are in the same modal group (one per block)");
+    CHECK(error_of("G20 G21") ==
+          "t.ngc:1:5: G20 and G21 are in the same modal group (one per block)");
     CHECK(error_of("M3 M5") == "t.ngc:1:4: M3 and M5 are in the same modal group (one per block)");
     CHECK(error_of("G41") == "t.ngc:1:1: unsupported G code G41");
     CHECK(error_of("G0 Z0\nG92 X0") == "t.ngc:2:1: unsupported G code G92");
@@ -467,8 +486,10 @@ TEST_CASE("G-code: out-of-range coordinates", "[host][gcode]") {
 }
 
 TEST_CASE("G-code: arc errors", "[host][gcode]") {
-    CHECK(error_of("G0 Z-1\nG2 X10") == "t.ngc:2:1: G2 needs I and J (the center) or R (the radius)");
-    CHECK(error_of("G0 Z-1\nG3 X10\n") == "t.ngc:2:1: G3 needs I and J (the center) or R (the radius)");
+    CHECK(error_of("G0 Z-1\nG2 X10") ==
+          "t.ngc:2:1: G2 needs I and J (the center) or R (the radius)");
+    CHECK(error_of("G0 Z-1\nG3 X10\n") ==
+          "t.ngc:2:1: G3 needs I and J (the center) or R (the radius)");
     CHECK(error_of("G2 X10 I5 R5") ==
           "t.ngc:1:11: give either I and J (the center) or R (the radius), not both");
     CHECK(error_of("G0 X10 Y0\nG3 X0 Y11 I-10") ==
@@ -477,24 +498,31 @@ TEST_CASE("G-code: arc errors", "[host][gcode]") {
     CHECK(error_of("G0 X1 Y0\nG3 X0 Y1.002 I-1") ==
           "t.ngc:2:1: radius to end of arc differs from radius to start: 1.0000 mm vs 1.0020 mm "
           "(allowed: 0.0283 mm and 0.1%)");
-    CHECK(error_of("G20 G0 X10 Y0\nG3 X0 Y10.005 I-10") ==
-          "t.ngc:2:1: radius to end of arc differs from radius to start: 254.0000 mm vs 254.1270 mm "
-          "(allowed: 0.0718 mm and 0.1%)");
+    CHECK(
+        error_of("G20 G0 X10 Y0\nG3 X0 Y10.005 I-10") ==
+        "t.ngc:2:1: radius to end of arc differs from radius to start: 254.0000 mm vs 254.1270 mm "
+        "(allowed: 0.0718 mm and 0.1%)");
     CHECK(error_of("G0 X5 Y5\nG2 X5 Y5 R3") ==
           "t.ngc:2:10: R arc with the end point equal to the start point (use I and J for a full "
           "circle)");
     CHECK(error_of("G2 X10 R4") ==
-          "t.ngc:1:8: arc radius R4 is too small to reach the end point (half the chord is 5.0000 mm)");
+          "t.ngc:1:8: arc radius R4 is too small to reach the end point (half the chord is 5.0000 "
+          "mm)");
     CHECK(error_of("G2 X0.001 R0") == "t.ngc:1:11: zero-radius arc (R0)");
-    CHECK(error_of("G2 X10 I0 J0") == "t.ngc:1:1: zero-radius arc (the center is at the start or end point)");
-    CHECK(error_of("G2 X10 I10") == "t.ngc:1:1: zero-radius arc (the center is at the start or end point)");
+    CHECK(error_of("G2 X10 I0 J0") ==
+          "t.ngc:1:1: zero-radius arc (the center is at the start or end point)");
+    CHECK(error_of("G2 X10 I10") ==
+          "t.ngc:1:1: zero-radius arc (the center is at the start or end point)");
     CHECK(error_of("G0 Z-1\nG2 X10 I5 Z-2") ==
           "t.ngc:2:11: helical arcs are not supported (Z changes during G2/G3)");
-    CHECK(error_of("G3 X10 I5 Z0") == "t.ngc:1:11: helical arcs are not supported (Z changes during G2/G3)");
+    CHECK(error_of("G3 X10 I5 Z0") ==
+          "t.ngc:1:11: helical arcs are not supported (Z changes during G2/G3)");
     CHECK(error_of("G90.1 G2 X10 I5") ==
           "t.ngc:1:14: G2 with absolute centers (G90.1) needs both I and J");
-    CHECK(error_of("G2 I5 P0") == "t.ngc:1:7: P (number of turns) must be a whole number from 1 to 100");
-    CHECK(error_of("G2 I5 P1.5") == "t.ngc:1:7: P (number of turns) must be a whole number from 1 to 100");
+    CHECK(error_of("G2 I5 P0") ==
+          "t.ngc:1:7: P (number of turns) must be a whole number from 1 to 100");
+    CHECK(error_of("G2 I5 P1.5") ==
+          "t.ngc:1:7: P (number of turns) must be a whole number from 1 to 100");
     // A Z word that does not change Z is fine.
     CHECK(gcode("G0 Z-1\nG2 X10 I5 Z-1\n").subpaths.size() == 1);
 }
@@ -511,24 +539,32 @@ TEST_CASE("G-code: spline errors", "[host][gcode]") {
           "point)");
     CHECK(error_of("G5 X10 I1 P1 Q1") ==
           "t.ngc:1:8: G5 needs both I and J, or neither right after another G5");
-    CHECK(error_of("G5 X1 I1 J1 P1") == "t.ngc:1:13: G5 needs both P and Q (the second control point)");
+    CHECK(error_of("G5 X1 I1 J1 P1") ==
+          "t.ngc:1:13: G5 needs both P and Q (the second control point)");
     CHECK(error_of("G5 X1 I1 J1") == "t.ngc:1:1: G5 needs both P and Q (the second control point)");
-    CHECK(error_of("G5 X1 Z1 I1 J1 P1 Q1") == "t.ngc:1:7: Z is not allowed with G5 (XY plane only)");
+    CHECK(error_of("G5 X1 Z1 I1 J1 P1 Q1") ==
+          "t.ngc:1:7: Z is not allowed with G5 (XY plane only)");
     CHECK(error_of("G5 I1 J1 P1 Q1") == "t.ngc:1:1: G5 needs X or Y (the end point)");
-    CHECK(error_of("G5.1 X1 I0 J0") == "t.ngc:1:1: G5.1 needs a nonzero I or J (the control point)");
-    CHECK(error_of("G5.1 X1 I1 P1") == "t.ngc:1:12: word P is not used by any command in this block");
+    CHECK(error_of("G5.1 X1 I0 J0") ==
+          "t.ngc:1:1: G5.1 needs a nonzero I or J (the control point)");
+    CHECK(error_of("G5.1 X1 I1 P1") ==
+          "t.ngc:1:12: word P is not used by any command in this block");
     CHECK(error_of("G5.1 X1 Z0 I1") == "t.ngc:1:9: Z is not allowed with G5.1 (XY plane only)");
 }
 
 TEST_CASE("G-code: a program that draws nothing is an error", "[host][gcode]") {
     CHECK(error_of("G0 X10\nG1 X20\nM2\n") ==
-          "t.ngc: no pen-down moves (the pen is down during G1, G2, G3, G5 and G5.1 moves at Z <= 0 mm)");
+          "t.ngc: no pen-down moves (the pen is down during G1, G2, G3, G5 and G5.1 moves at Z <= "
+          "0 mm)");
     CHECK(error_of("") ==
-          "t.ngc: no pen-down moves (the pen is down during G1, G2, G3, G5 and G5.1 moves at Z <= 0 mm)");
-    CHECK(error_of("G0 Z-1\nG1 X10\n", spindle()) ==
-          "t.ngc: no pen-down moves (the pen is down during G1, G2, G3, G5 and G5.1 moves between M3 "
-          "or M4 and M5)");
-    CHECK(error_of("M3\nG0 X10\nM2\nG1 X20\n", spindle()).rfind("t.ngc: no pen-down moves", 0) == 0);
+          "t.ngc: no pen-down moves (the pen is down during G1, G2, G3, G5 and G5.1 moves at Z <= "
+          "0 mm)");
+    CHECK(
+        error_of("G0 Z-1\nG1 X10\n", spindle()) ==
+        "t.ngc: no pen-down moves (the pen is down during G1, G2, G3, G5 and G5.1 moves between M3 "
+        "or M4 and M5)");
+    CHECK(error_of("M3\nG0 X10\nM2\nG1 X20\n", spindle()).rfind("t.ngc: no pen-down moves", 0) ==
+          0);
 }
 
 TEST_CASE("G-code: bad options and missing files", "[host][gcode]") {
@@ -540,5 +576,6 @@ TEST_CASE("G-code: bad options and missing files", "[host][gcode]") {
     GcodeOptions z;
     z.z_down_max = INFINITY;
     CHECK_THROWS_AS(gcode("G0 Z-1\nG1 X1", z), std::invalid_argument);
-    CHECK_THROWS_WITH(load_gcode_path("/nonexistent/p.ngc"), "/nonexistent/p.ngc: cannot open file");
+    CHECK_THROWS_WITH(load_gcode_path("/nonexistent/p.ngc"),
+                      "/nonexistent/p.ngc: cannot open file");
 }

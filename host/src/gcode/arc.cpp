@@ -18,7 +18,9 @@ double circle_error(double radius, double theta) {
     return radius * 2.0 / 27.0 * std::pow(s, 6) / (c * c);
 }
 
-Vec2 unit(double a) { return {std::cos(a), std::sin(a)}; }
+Vec2 unit(double a) {
+    return {std::cos(a), std::sin(a)};
+}
 
 Vec2 bezier(const Cubic& b, double t) {
     const double u = 1 - t;
@@ -87,9 +89,11 @@ private:
 std::vector<Cubic> arc_to_cubics(const Arc& arc, double tolerance_mm) {
     const ArcPieces geometry(arc);
     const double turn = std::fabs(arc.sweep);
-    auto n = static_cast<std::size_t>(std::max(1.0, std::ceil(turn / (std::numbers::pi / 2) - 1e-9)));
+    auto n =
+        static_cast<std::size_t>(std::max(1.0, std::ceil(turn / (std::numbers::pi / 2) - 1e-9)));
     // The closed form for a circle, with half the tolerance left for a spiral's extra error.
-    while (circle_error(geometry.largest_radius(), turn / static_cast<double>(n)) > tolerance_mm / 2) {
+    while (circle_error(geometry.largest_radius(), turn / static_cast<double>(n)) >
+           tolerance_mm / 2) {
         ++n;
     }
     while (n <= kMaxPieces) {

@@ -35,7 +35,8 @@ void Interpreter::arc(const Command& c, Motion move, Vec2 to, SourceLocation at)
     const Word *i = c.value('I'), *j = c.value('J'), *r = c.value('R'), *p = c.value('P');
     const Vec2 from = position_;
     if (r && (i || j)) fail(r->at, "give either I and J (the center) or R (the radius), not both");
-    if (!r && !i && !j) fail(at, std::string(name) + " needs I and J (the center) or R (the radius)");
+    if (!r && !i && !j)
+        fail(at, std::string(name) + " needs I and J (the center) or R (the radius)");
 
     int turns = 1;
     if (p) {
@@ -50,8 +51,9 @@ void Interpreter::arc(const Command& c, Motion move, Vec2 to, SourceLocation at)
     if (r) {
         const double radius = length(*r);
         if (to == from) {
-            fail(r->at, "R arc with the end point equal to the start point (use I and J for a "
-                        "full circle)");
+            fail(r->at,
+                 "R arc with the end point equal to the start point (use I and J for a "
+                 "full circle)");
         }
         // As LinuxCNC's arc_data_r: the center lies on the chord's perpendicular bisector; R < 0
         // asks for the arc of more than 180 degrees.
@@ -74,8 +76,8 @@ void Interpreter::arc(const Command& c, Motion move, Vec2 to, SourceLocation at)
             center = from + Vec2{i ? length(*i) : 0.0, j ? length(*j) : 0.0};
         } else {
             if (!i || !j) {
-                fail(i ? i->at : j->at, std::string(name) +
-                                            " with absolute centers (G90.1) needs both I and J");
+                fail(i ? i->at : j->at,
+                     std::string(name) + " with absolute centers (G90.1) needs both I and J");
             }
             center = Vec2{length(*i), length(*j)};
         }
@@ -88,8 +90,9 @@ void Interpreter::arc(const Command& c, Motion move, Vec2 to, SourceLocation at)
         const double rel_err = abs_err / std::max(r0, r1);
         const double abs_tolerance = inch_ ? kSpiralToleranceInch * 25.4 : kSpiralToleranceMm;
         if (abs_err > abs_tolerance || rel_err > kSpiralRelativeTolerance) {
-            fail(at, "radius to end of arc differs from radius to start: " + fixed(r0, 4) + " mm vs " +
-                         fixed(r1, 4) + " mm (allowed: " + fixed(abs_tolerance, 4) + " mm and 0.1%)");
+            fail(at, "radius to end of arc differs from radius to start: " + fixed(r0, 4) +
+                         " mm vs " + fixed(r1, 4) + " mm (allowed: " + fixed(abs_tolerance, 4) +
+                         " mm and 0.1%)");
         }
     }
 
@@ -106,8 +109,8 @@ void Interpreter::arc(const Command& c, Motion move, Vec2 to, SourceLocation at)
     sweep += (ccw ? 2 : -2) * std::numbers::pi * (turns - 1);
 
     check_point(center, at);
-    follow(arc_to_cubics(Arc{from, to, center, sweep}, options_.arc_tolerance_mm),
-           pen_down(z_, z_), to, at);
+    follow(arc_to_cubics(Arc{from, to, center, sweep}, options_.arc_tolerance_mm), pen_down(z_, z_),
+           to, at);
 }
 
 }  // namespace pathstream::host::gcode

@@ -11,8 +11,20 @@ namespace {
 
 // Modal groups, as LinuxCNC numbers them where it matters for "one per block".
 enum Group {
-    kNonModal, kMotionGroup, kPlane, kDistance, kArcDistance, kFeedMode, kUnits, kCutterComp,
-    kToolLength, kCoordinateSystem, kPathControl, kStopping, kSpindle, kGroupCount
+    kNonModal,
+    kMotionGroup,
+    kPlane,
+    kDistance,
+    kArcDistance,
+    kFeedMode,
+    kUnits,
+    kCutterComp,
+    kToolLength,
+    kCoordinateSystem,
+    kPathControl,
+    kStopping,
+    kSpindle,
+    kGroupCount
 };
 
 struct Seen {
@@ -28,9 +40,12 @@ public:
         Command c;
         c.start = block.start;
         for (const Word& w : block.words) {
-            if (w.letter == 'G') g_word(w, c);
-            else if (w.letter == 'M') m_word(w, c);
-            else value_word(w, c);
+            if (w.letter == 'G')
+                g_word(w, c);
+            else if (w.letter == 'M')
+                m_word(w, c);
+            else
+                value_word(w, c);
         }
         return c;
     }
@@ -42,7 +57,8 @@ private:
 
     void claim(Group g, const Word& w, const std::string& name) {
         if (groups_[g].given) {
-            fail(w, groups_[g].name + " and " + name + " are in the same modal group (one per block)");
+            fail(w,
+                 groups_[g].name + " and " + name + " are in the same modal group (one per block)");
         }
         groups_[g] = {true, name};
     }
@@ -60,35 +76,84 @@ private:
             c.motion_at = w.at;
         };
         switch (tenths) {
-            case 0: motion(Motion::kRapid); break;
-            case 10: motion(Motion::kLine); break;
-            case 20: motion(Motion::kArcCw); break;
-            case 30: motion(Motion::kArcCcw); break;
-            case 50: motion(Motion::kCubic); break;
-            case 51: motion(Motion::kQuadratic); break;
-            case 800: motion(Motion::kNone); break;
+            case 0:
+                motion(Motion::kRapid);
+                break;
+            case 10:
+                motion(Motion::kLine);
+                break;
+            case 20:
+                motion(Motion::kArcCw);
+                break;
+            case 30:
+                motion(Motion::kArcCcw);
+                break;
+            case 50:
+                motion(Motion::kCubic);
+                break;
+            case 51:
+                motion(Motion::kQuadratic);
+                break;
+            case 800:
+                motion(Motion::kNone);
+                break;
             case 40:
                 claim(kNonModal, w, name);
                 c.dwell = true;
                 c.dwell_at = w.at;
                 break;
-            case 170: claim(kPlane, w, name); break;
+            case 170:
+                claim(kPlane, w, name);
+                break;
             case 180:
-            case 190: fail(w, "only the XY plane (G17) is supported");
-            case 200: claim(kUnits, w, name); c.inch = true; break;
-            case 210: claim(kUnits, w, name); c.inch = false; break;
-            case 400: claim(kCutterComp, w, name); break;
-            case 490: claim(kToolLength, w, name); break;
-            case 540: claim(kCoordinateSystem, w, name); break;
+            case 190:
+                fail(w, "only the XY plane (G17) is supported");
+            case 200:
+                claim(kUnits, w, name);
+                c.inch = true;
+                break;
+            case 210:
+                claim(kUnits, w, name);
+                c.inch = false;
+                break;
+            case 400:
+                claim(kCutterComp, w, name);
+                break;
+            case 490:
+                claim(kToolLength, w, name);
+                break;
+            case 540:
+                claim(kCoordinateSystem, w, name);
+                break;
             case 610:
-            case 611: claim(kPathControl, w, name); break;
-            case 640: claim(kPathControl, w, name); c.path_control = true; break;
-            case 900: claim(kDistance, w, name); c.incremental = false; break;
-            case 910: claim(kDistance, w, name); c.incremental = true; break;
-            case 901: claim(kArcDistance, w, name); c.arc_incremental = false; break;
-            case 911: claim(kArcDistance, w, name); c.arc_incremental = true; break;
-            case 940: claim(kFeedMode, w, name); break;
-            default: fail(w, "unsupported G code " + name);
+            case 611:
+                claim(kPathControl, w, name);
+                break;
+            case 640:
+                claim(kPathControl, w, name);
+                c.path_control = true;
+                break;
+            case 900:
+                claim(kDistance, w, name);
+                c.incremental = false;
+                break;
+            case 910:
+                claim(kDistance, w, name);
+                c.incremental = true;
+                break;
+            case 901:
+                claim(kArcDistance, w, name);
+                c.arc_incremental = false;
+                break;
+            case 911:
+                claim(kArcDistance, w, name);
+                c.arc_incremental = true;
+                break;
+            case 940:
+                claim(kFeedMode, w, name);
+                break;
+            default:
+                fail(w, "unsupported G code " + name);
         }
     }
 
@@ -100,11 +165,21 @@ private:
         const std::string name = "M" + std::to_string(code);
         switch (code) {
             case 2:
-            case 30: claim(kStopping, w, name); c.end_program = true; break;
+            case 30:
+                claim(kStopping, w, name);
+                c.end_program = true;
+                break;
             case 3:
-            case 4: claim(kSpindle, w, name); c.spindle_on = true; break;
-            case 5: claim(kSpindle, w, name); c.spindle_on = false; break;
-            default: fail(w, "unsupported M code " + name);
+            case 4:
+                claim(kSpindle, w, name);
+                c.spindle_on = true;
+                break;
+            case 5:
+                claim(kSpindle, w, name);
+                c.spindle_on = false;
+                break;
+            default:
+                fail(w, "unsupported M code " + name);
         }
     }
 

@@ -18,18 +18,19 @@ enum class Motion { kNone, kRapid, kLine, kArcCw, kArcCcw, kCubic, kQuadratic };
 /// One block, decoded. Codes the reader accepts and ignores (G17, G40, G49, G54, G61, G61.1,
 /// G64, G94, S, T) leave no trace here apart from `path_control` (G64 may carry P and Q).
 struct Command {
-    SourceLocation start;                ///< the block's first word
-    std::optional<Motion> motion;        ///< G0 G1 G2 G3 G5 G5.1 G80
-    SourceLocation motion_at;            ///< where that G word is
-    std::optional<bool> inch;            ///< G20 (true) / G21 (false)
-    std::optional<bool> incremental;     ///< G91 (true) / G90 (false)
-    std::optional<bool> arc_incremental; ///< G91.1 (true) / G90.1 (false)
-    bool dwell = false;                  ///< G4 (takes P)
-    SourceLocation dwell_at;             ///< where the G4 word is
-    bool path_control = false;           ///< G64 (may take P and Q)
-    std::optional<bool> spindle_on;      ///< M3, M4 (true) / M5 (false)
-    bool end_program = false;            ///< M2, M30
-    std::array<std::optional<Word>, 26> values;  ///< the value words by letter (F I J P Q R S T X Y Z)
+    SourceLocation start;                 ///< the block's first word
+    std::optional<Motion> motion;         ///< G0 G1 G2 G3 G5 G5.1 G80
+    SourceLocation motion_at;             ///< where that G word is
+    std::optional<bool> inch;             ///< G20 (true) / G21 (false)
+    std::optional<bool> incremental;      ///< G91 (true) / G90 (false)
+    std::optional<bool> arc_incremental;  ///< G91.1 (true) / G90.1 (false)
+    bool dwell = false;                   ///< G4 (takes P)
+    SourceLocation dwell_at;              ///< where the G4 word is
+    bool path_control = false;            ///< G64 (may take P and Q)
+    std::optional<bool> spindle_on;       ///< M3, M4 (true) / M5 (false)
+    bool end_program = false;             ///< M2, M30
+    /// The value words (F I J P Q R S T X Y Z), indexed by letter - 'A'.
+    std::array<std::optional<Word>, 26> values;
 
     /// The value word for `letter` ('A'..'Z'), or nullptr.
     const Word* value(char letter) const {

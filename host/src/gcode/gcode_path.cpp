@@ -14,7 +14,8 @@
 
 namespace pathstream::host {
 
-Path parse_gcode_path(const std::string& text, const std::string& file, const GcodeOptions& options) {
+Path parse_gcode_path(const std::string& text, const std::string& file,
+                      const GcodeOptions& options) {
     if (!std::isfinite(options.z_down_max)) {
         throw std::invalid_argument("GcodeOptions::z_down_max must be finite");
     }

@@ -31,8 +31,8 @@ void Interpreter::fail(SourceLocation at, const std::string& message) const {
 double Interpreter::length(const Word& w) const {
     const double mm = w.value * scale();
     if (std::fabs(mm) > kMaxCoordinateMm) {
-        fail(w.at, std::string(1, w.letter) + " " + number(mm) + " mm is out of range (|value| <= " +
-                       number(kMaxCoordinateMm) + " mm)");
+        fail(w.at, std::string(1, w.letter) + " " + number(mm) +
+                       " mm is out of range (|value| <= " + number(kMaxCoordinateMm) + " mm)");
     }
     return mm;
 }
@@ -56,8 +56,8 @@ bool Interpreter::execute(const Command& c) {
     if (const Word* f = c.value('F')) {
         const double mm_per_min = f->value * scale();
         if (!(mm_per_min > 0) || mm_per_min > kMaxFeedMmPerMin) {
-            fail(f->at, "feed F" + f->text + " is out of range (0 < F <= " +
-                            number(kMaxFeedMmPerMin) + " mm/min)");
+            fail(f->at, "feed F" + f->text +
+                            " is out of range (0 < F <= " + number(kMaxFeedMmPerMin) + " mm/min)");
         }
         feed_ = mm_per_min / 60.0;
     }
@@ -75,8 +75,8 @@ bool Interpreter::execute(const Command& c) {
     const bool axis_words = c.value('X') || c.value('Y') || c.value('Z');
     const bool arc_words = c.value('I') || c.value('J') || c.value('R');
     const bool arc_mode = motion_ == Motion::kArcCw || motion_ == Motion::kArcCcw;
-    const bool moving = (c.motion && *c.motion != Motion::kNone) || axis_words ||
-                        (arc_words && arc_mode);
+    const bool moving =
+        (c.motion && *c.motion != Motion::kNone) || axis_words || (arc_words && arc_mode);
     if (axis_words && motion_ == Motion::kNone) {
         const Word* w = c.value('X') ? c.value('X') : c.value('Y') ? c.value('Y') : c.value('Z');
         fail(w->at, c.motion ? "axis words cannot be used with G80"
@@ -109,7 +109,8 @@ void Interpreter::check_words_used(const Command& c, Motion move, bool moving) c
     };
     for (const auto& u : uses) {
         if (const Word* w = c.value(u.letter); w && !u.used) {
-            fail(w->at, std::string("word ") + u.letter + " is not used by any command in this block");
+            fail(w->at,
+                 std::string("word ") + u.letter + " is not used by any command in this block");
         }
     }
 }
@@ -132,12 +133,15 @@ void Interpreter::move(const Command& c, Motion move, SourceLocation at) {
     z_to = axis('Z', z_);
 
     switch (move) {
-        case Motion::kNone: break;  // not reached: execute() rejects axis words without a mode
+        case Motion::kNone:
+            break;  // not reached: execute() rejects axis words without a mode
         case Motion::kRapid:
             runs_.lift();
             position_ = to;
             break;
-        case Motion::kLine: line(to, z_to, at); break;
+        case Motion::kLine:
+            line(to, z_to, at);
+            break;
         case Motion::kArcCw:
         case Motion::kArcCcw: {
             const Word* z = c.value('Z');
@@ -147,8 +151,12 @@ void Interpreter::move(const Command& c, Motion move, SourceLocation at) {
             arc(c, move, to, at);
             break;
         }
-        case Motion::kCubic: cubic(c, to, at); break;
-        case Motion::kQuadratic: quadratic(c, to, at); break;
+        case Motion::kCubic:
+            cubic(c, to, at);
+            break;
+        case Motion::kQuadratic:
+            quadratic(c, to, at);
+            break;
     }
     if (c.value('Z')) {
         z_ = z_to;
@@ -171,7 +179,8 @@ void Interpreter::follow(const std::vector<Cubic>& pieces, bool down, Vec2 to, S
 
 void Interpreter::line(Vec2 to, double z_to, SourceLocation at) {
     const Vec2 from = position_;
-    const Cubic piece{{from, from + (1.0 / 3.0) * (to - from), from + (2.0 / 3.0) * (to - from), to}};
+    const Cubic piece{
+        {from, from + (1.0 / 3.0) * (to - from), from + (2.0 / 3.0) * (to - from), to}};
     follow({piece}, pen_down(z_, z_to), to, at);
 }
 
@@ -183,7 +192,8 @@ Path Interpreter::finish() {
         throw InputError(
             file_, {},
             options_.pen == PenControl::kZ
-                ? "no pen-down moves (the pen is down during G1, G2, G3, G5 and G5.1 moves at Z <= " +
+                ? "no pen-down moves (the pen is down during G1, G2, G3, G5 and G5.1 moves at Z "
+                  "<= " +
                       number(options_.z_down_max) + " mm)"
                 : "no pen-down moves (the pen is down during G1, G2, G3, G5 and G5.1 moves between "
                   "M3 or M4 and M5)");

@@ -50,15 +50,15 @@ private:
     GcodeOptions options_;
     RunBuilder runs_;
 
-    Vec2 position_;               ///< mm; X0 Y0 at the start
-    double z_ = 0;                ///< mm
-    bool z_known_ = false;        ///< false until a Z word: the pen counts as up (kZ)
+    Vec2 position_;         ///< mm; X0 Y0 at the start
+    double z_ = 0;          ///< mm
+    bool z_known_ = false;  ///< false until a Z word: the pen counts as up (kZ)
     Motion motion_ = Motion::kNone;
-    bool inch_ = false;           ///< G20
-    bool incremental_ = false;    ///< G91
-    bool arc_incremental_ = true; ///< G91.1 (LinuxCNC's default)
-    double feed_ = 0;             ///< mm/s; 0 until F
-    bool spindle_ = false;        ///< M3/M4 given, no M5 since
+    bool inch_ = false;                       ///< G20
+    bool incremental_ = false;                ///< G91
+    bool arc_incremental_ = true;             ///< G91.1 (LinuxCNC's default)
+    double feed_ = 0;                         ///< mm/s; 0 until F
+    bool spindle_ = false;                    ///< M3/M4 given, no M5 since
     std::optional<Vec2> last_cubic_control_;  ///< second control point of the last move, if G5
 };
 

@@ -12,8 +12,12 @@ namespace pathstream::host::gcode {
 
 namespace {
 
-bool is_blank(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\f' || c == '\v'; }
-bool is_digit(char c) { return c >= '0' && c <= '9'; }
+bool is_blank(char c) {
+    return c == ' ' || c == '\t' || c == '\r' || c == '\f' || c == '\v';
+}
+bool is_digit(char c) {
+    return c >= '0' && c <= '9';
+}
 
 std::string describe(char c) {
     const auto u = static_cast<unsigned char>(c);
@@ -79,7 +83,8 @@ private:
         if (c == '#') fail(at, "parameters (#) are not supported");
         if (c == '[') fail(at, "expressions ([ ]) are not supported");
         if (!std::isalpha(static_cast<unsigned char>(c))) {
-            fail(at, "unexpected character " + describe(c) + " (expected a word: letter and number)");
+            fail(at,
+                 "unexpected character " + describe(c) + " (expected a word: letter and number)");
         }
         const char letter = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
         if (letter == 'O') fail(at, "O-words (subroutines and control flow) are not supported");
@@ -90,8 +95,8 @@ private:
         ++i_;
         skip_blanks();
         const std::size_t begin = i_;
-        while (i_ < text_.size() && (is_digit(text_[i_]) || text_[i_] == '.' || text_[i_] == '+' ||
-                                     text_[i_] == '-')) {
+        while (i_ < text_.size() &&
+               (is_digit(text_[i_]) || text_[i_] == '.' || text_[i_] == '+' || text_[i_] == '-')) {
             ++i_;
         }
         const std::string_view token = text_.substr(begin, i_ - begin);

@@ -14,10 +14,10 @@ namespace pathstream::host::gcode {
 
 /// One word: an upper-case letter and its number.
 struct Word {
-    char letter = 0;       ///< 'A'..'Z', upper case
-    double value = 0;      ///< the number as written (file units), finite
-    std::string text;      ///< the number exactly as written, for messages ("01", "90.1")
-    SourceLocation at;     ///< where the letter is
+    char letter = 0;    ///< 'A'..'Z', upper case
+    double value = 0;   ///< the number as written (file units), finite
+    std::string text;   ///< the number exactly as written, for messages ("01", "90.1")
+    SourceLocation at;  ///< where the letter is
 };
 
 /// The words of one line (a block), line number word N removed.

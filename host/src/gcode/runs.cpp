@@ -6,7 +6,9 @@
 namespace pathstream::host::gcode {
 
 namespace {
-PathPoint point(Vec2 v) { return PathPoint{v.x, v.y}; }
+PathPoint point(Vec2 v) {
+    return PathPoint{v.x, v.y};
+}
 }  // namespace
 
 void RunBuilder::draw(const Cubic& piece, double feed_mm_s, SourceLocation at) {
@@ -25,10 +27,13 @@ void RunBuilder::draw(const Cubic& piece, double feed_mm_s, SourceLocation at) {
     } else if (done_.back().points.back() != point(p0)) {
         throw std::logic_error("RunBuilder::draw: piece does not start where the run ends");
     }
-    for (std::size_t k = 1; k < piece.p.size(); ++k) done_.back().points.push_back(point(piece.p[k]));
+    for (std::size_t k = 1; k < piece.p.size(); ++k)
+        done_.back().points.push_back(point(piece.p[k]));
 }
 
-void RunBuilder::lift() { open_ = false; }
+void RunBuilder::lift() {
+    open_ = false;
+}
 
 std::vector<Subpath> RunBuilder::finish() {
     open_ = false;

@@ -11,7 +11,8 @@ void Interpreter::cubic(const Command& c, Vec2 to, SourceLocation at) {
     if ((i != nullptr) != (j != nullptr)) {
         fail(i ? i->at : j->at, "G5 needs both I and J, or neither right after another G5");
     }
-    if (!p || !q) fail(p ? p->at : q ? q->at : at, "G5 needs both P and Q (the second control point)");
+    if (!p || !q)
+        fail(p ? p->at : q ? q->at : at, "G5 needs both P and Q (the second control point)");
     const Vec2 from = position_;
     Vec2 first;
     if (i) {
@@ -19,7 +20,8 @@ void Interpreter::cubic(const Command& c, Vec2 to, SourceLocation at) {
     } else if (last_cubic_control_) {
         first = 2.0 * from - *last_cubic_control_;  // reflection through the current point
     } else {
-        fail(at, "G5 without I and J must follow another G5 (I and J give the first control point)");
+        fail(at,
+             "G5 without I and J must follow another G5 (I and J give the first control point)");
     }
     const Vec2 second = to + Vec2{length(*p), length(*q)};
     follow({Cubic{{from, first, second, to}}}, pen_down(z_, z_), to, at);
@@ -35,7 +37,8 @@ void Interpreter::quadratic(const Command& c, Vec2 to, SourceLocation at) {
     const Vec2 from = position_;
     const Vec2 control = from + offset;
     // The quadratic's exact cubic form: control points 2/3 of the way to its control point.
-    const Cubic piece{{from, from + (2.0 / 3.0) * (control - from), to + (2.0 / 3.0) * (control - to), to}};
+    const Cubic piece{
+        {from, from + (2.0 / 3.0) * (control - from), to + (2.0 / 3.0) * (control - to), to}};
     follow({piece}, pen_down(z_, z_), to, at);
 }
 

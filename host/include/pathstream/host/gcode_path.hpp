@@ -18,7 +18,7 @@ enum class PenControl {
 struct GcodeOptions {
     PenControl pen = PenControl::kZ;  ///< what lowers the pen
     double z_down_max = 0.0;          ///< kZ: highest Z (mm) at which the pen is down; finite
-    double arc_tolerance_mm = 0.01;   ///< largest distance of an arc's Beziers from the arc; >= 1e-6
+    double arc_tolerance_mm = 0.01;  ///< largest distance of an arc's Beziers from the arc; >= 1e-6
 };
 
 /// Parses a G-code program into a 2-axis path (X, Y in mm): one subpath (basis kBezier, open,
