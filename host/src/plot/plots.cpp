@@ -1,0 +1,485 @@
+// path.svg, speed.svg, acceleration.svg: drawing and the series behind them.
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+#include "pathstream/host/plot.hpp"
+#include "svg_canvas.hpp"
+
+namespace pathstream::host::plot {
+namespace {
+
+using detail::Canvas;
+using detail::LegendEntry;
+
+constexpr double kMarginLeft = 74, kMarginRight = 22, kMarginTop = 56, kMarginBottom = 66;
+constexpr const char* kPenUpDash = "6 4";
+constexpr const char* kTravelDash = "10 6";
+
+std::string axis_name(const MachineProfile& profile, std::size_t axis) {
+    if (axis < profile.axes.size() && !profile.axes[axis].name.empty())
+        return profile.axes[axis].name;
+    static const char* const names[] = {"x", "y", "z", "a", "b", "c", "u", "v"};
+    return axis < 8 ? names[axis] : "axis " + std::to_string(axis);
+}
+
+/// Point of a cubic Bezier at u (de Casteljau), two coordinates.
+Point bezier_xy(const BezierSegment& s, std::size_t ax, std::size_t ay, double u) {
+    const auto coord = [&](std::size_t a) {
+        const double p0 = s.p[0][a], p1 = s.p[1][a], p2 = s.p[2][a], p3 = s.p[3][a];
+        const double q0 = p0 + (p1 - p0) * u, q1 = p1 + (p2 - p1) * u, q2 = p2 + (p3 - p2) * u;
+        const double r0 = q0 + (q1 - q0) * u, r1 = q1 + (q2 - q1) * u;
+        return r0 + (r1 - r0) * u;
+    };
+    return {coord(ax), coord(ay)};
+}
+
+double polygon_length(const BezierSegment& s, std::size_t ax, std::size_t ay) {
+    double len = 0;
+    for (int i = 0; i < 3; ++i)
+        len += std::hypot(s.p[i + 1][ax] - s.p[i][ax], s.p[i + 1][ay] - s.p[i][ay]);
+    return len;
+}
+
+struct Bounds {
+    double x0 = std::numeric_limits<double>::infinity(), x1 = -x0, y0 = x0, y1 = -x0;
+    void add(double x, double y) {
+        if (!std::isfinite(x) || !std::isfinite(y)) return;
+        x0 = std::min(x0, x);
+        x1 = std::max(x1, x);
+        y0 = std::min(y0, y);
+        y1 = std::max(y1, y);
+    }
+    bool empty() const { return !(x1 >= x0); }
+};
+
+/// Appends a pixel point unless it is within `min_px` of the last one kept.
+void add_px(std::vector<Point>& run, Point p, double min_px = 0.4) {
+    if (!run.empty() && std::hypot(p.x - run.back().x, p.y - run.back().y) < min_px) return;
+    run.push_back(p);
+}
+
+/// Draws a TickSeries' two axes as pen-down (solid) and pen-up (dashed) runs, in pixels,
+/// thinned to points at least 0.75 px apart (the last point of every run kept).
+void draw_executed(Canvas& c, const TickSeries& s, std::size_t ax, std::size_t ay,
+                   const std::string& colour, double width) {
+    const std::size_t n = s.ticks();
+    std::size_t k = 0;
+    while (k < n) {
+        const bool down = k < s.pen_down.size() && s.pen_down[k] != 0;
+        std::vector<Point> run;
+        std::size_t j = k;
+        for (; j < n && ((j < s.pen_down.size() && s.pen_down[j] != 0) == down); ++j) {
+            add_px(run, {c.px(s.at(j, ax)), c.py(s.at(j, ay))}, 0.75);
+        }
+        const std::size_t last = j < n ? j : n - 1;  // share the boundary point with the next run
+        const Point end{c.px(s.at(last, ax)), c.py(s.at(last, ay))};
+        if (run.empty() || run.back().x != end.x || run.back().y != end.y) run.push_back(end);
+        c.polyline_px(run, colour, width, down ? "" : kPenUpDash, down ? "pen-down" : "pen-up");
+        k = j;
+    }
+}
+
+constexpr const char* kPenUpShade = "#eceef0";
+
+LegendEntry pen_up_legend() {
+    return {"pen up", kPenUpShade, "", 10};
+}
+
+/// Shades the pen-up intervals of a series (merging ones closer than a pixel).
+void shade_pen_up(Canvas& c, const TickSeries& s) {
+    const double t = 1.0 / s.tick_hz;
+    const double merge = 1.0 / std::max(1e-12, c.px(1) - c.px(0));  // one pixel in seconds
+    double from = -1, to = -1;
+    c.body() << "<g id=\"pen-up-intervals\">\n";
+    for (std::size_t k = 0; k < s.pen_down.size(); ++k) {
+        if (s.pen_down[k] != 0) continue;
+        const double a = static_cast<double>(k) * t, b = a + t;
+        if (from >= 0 && a - to <= merge) {
+            to = b;
+            continue;
+        }
+        if (from >= 0) c.band(from, to, kPenUpShade, "pen-up");
+        from = a;
+        to = b;
+    }
+    if (from >= 0) c.band(from, to, kPenUpShade, "pen-up");
+    c.body() << "</g>\n";
+}
+
+std::vector<double> times(std::size_t n, double tick_hz) {
+    std::vector<double> t(n);
+    for (std::size_t k = 0; k < n; ++k) t[k] = static_cast<double>(k) / tick_hz;
+    return t;
+}
+
+std::vector<double> column(const std::vector<double>& rows, std::size_t axes, std::size_t axis) {
+    std::vector<double> out;
+    out.reserve(rows.size() / std::max<std::size_t>(1, axes));
+    for (std::size_t i = axis; i < rows.size(); i += axes) out.push_back(rows[i]);
+    return out;
+}
+
+std::string title_of(const Options& o, const std::string& what) {
+    return o.title.empty() ? what : what + " \xe2\x80\x94 " + o.title;
+}
+
+double width_of(const Options& o) {
+    return std::max(400.0, static_cast<double>(o.width_px));
+}
+
+std::size_t columns_of(const Canvas& c) {
+    return static_cast<std::size_t>(std::max(50.0, std::ceil(c.plot_width())));
+}
+
+/// One axis: position against time for the executed series (and plant).
+std::string position_time_svg(const TickSeries& executed, const TickSeries* plant,
+                              const MachineProfile& profile, const Options& options) {
+    const double w = width_of(options);
+    Canvas c(w, std::round(w * 0.5), kMarginLeft, kMarginTop, kMarginRight, kMarginBottom);
+    c.title(title_of(options, "Path (one axis)"));
+    const std::size_t n = executed.ticks();
+    const double t_end = n > 1 ? static_cast<double>(n - 1) / executed.tick_hz : 1;
+    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+    for (const TickSeries* s : {&executed, plant}) {
+        if (s == nullptr) continue;
+        for (double v : s->position) lo = std::min(lo, v), hi = std::max(hi, v);
+    }
+    if (!(hi >= lo)) lo = 0, hi = 1;
+    const double pad = std::max(1e-6, (hi - lo) * 0.05);
+    c.set_range(0, t_end, lo - pad, hi + pad, false);
+    c.axes("time (s)", axis_name(profile, 0) + " (mm)");
+    shade_pen_up(c, executed);
+    std::vector<LegendEntry> legend;
+    const auto draw = [&](const TickSeries& s, const char* id, const char* colour, double width) {
+        c.begin_series(id);
+        c.polyline(decimate_min_max(times(s.ticks(), s.tick_hz), column(s.position, s.axes, 0), 0,
+                                    t_end, columns_of(c)),
+                   colour, width);
+        c.end_group();
+        legend.push_back({s.name, colour, "", width});
+    };
+    draw(executed, "setpoints", detail::kSetpointColour, 2.5);
+    if (plant != nullptr) draw(*plant, "plant", detail::kPlantColour, 1.2);
+    legend.push_back(pen_up_legend());
+    c.legend(legend);
+    c.note("One axis: position against time (no ideal path drawn). Pen-up time shaded.");
+    return c.finish();
+}
+
+/// Axes sharing one limit value are drawn as one line (labels would overprint otherwise).
+struct LimitGroup {
+    double value = 0;
+    std::vector<std::size_t> axes;
+    std::string names(const MachineProfile& profile, const char* separator) const {
+        std::string out;
+        for (std::size_t i = 0; i < axes.size(); ++i)
+            out += (i ? separator : "") + axis_name(profile, axes[i]);
+        return out;
+    }
+    std::string colour() const { return axes.size() == 1 ? detail::axis_colour(axes[0]) : "#555"; }
+};
+
+std::vector<LimitGroup> limit_groups(const MachineProfile& profile, std::size_t axes,
+                                     bool acceleration) {
+    std::vector<LimitGroup> groups;
+    for (std::size_t a = 0; a < axes && a < profile.axes.size(); ++a) {
+        const double v =
+            acceleration ? profile.axes[a].max_acceleration : profile.axes[a].max_velocity;
+        auto it = std::find_if(groups.begin(), groups.end(),
+                               [&](const LimitGroup& g) { return g.value == v; });
+        if (it == groups.end()) {
+            groups.push_back({v, {a}});
+        } else {
+            it->axes.push_back(a);
+        }
+    }
+    return groups;
+}
+
+}  // namespace
+
+Derivatives differentiate(const TickSeries& s, const MachineProfile& profile,
+                          unsigned half_window) {
+    Derivatives d;
+    const std::size_t n = s.ticks(), axes = s.axes;
+    const double t = 1.0 / s.tick_hz;
+    unsigned h = half_window;
+    if (h == 0) {
+        h = 1;
+        double a_min = std::numeric_limits<double>::infinity();
+        for (const AxisLimits& l : profile.axes) {
+            if (l.max_acceleration > 0) a_min = std::min(a_min, l.max_acceleration);
+        }
+        if (s.quantum_mm > 0 && std::isfinite(a_min)) {
+            const double seconds = std::sqrt(2 * s.quantum_mm / (0.05 * a_min));
+            h = static_cast<unsigned>(std::clamp(std::ceil(seconds / t), 1.0, 64.0));
+        }
+    }
+    if (n >= 3) h = std::min<unsigned>(h, static_cast<unsigned>((n - 1) / 2));
+    h = std::max(1u, h);
+    d.half_window = h;
+    const double ht = h * t;
+    d.acceleration_noise = 2 * s.quantum_mm / (ht * ht);
+    d.velocity.assign(n * axes, 0.0);
+    d.acceleration.assign(n * axes, 0.0);
+    d.speed.assign(n, 0.0);
+    if (n < 2) return d;
+    for (std::size_t k = 0; k < n; ++k) {
+        const std::size_t lo = k >= h ? k - h : 0, hi = std::min(n - 1, k + h);
+        // Acceleration: the nearest k with a full window on both sides.
+        const std::size_t kc = n > 2 * h ? std::clamp<std::size_t>(k, h, n - 1 - h) : 0;
+        double sq = 0;
+        for (std::size_t a = 0; a < axes; ++a) {
+            const double v = (s.at(hi, a) - s.at(lo, a)) / (static_cast<double>(hi - lo) * t);
+            d.velocity[k * axes + a] = v;
+            sq += v * v;
+            if (n > 2 * h) {
+                d.acceleration[k * axes + a] =
+                    (s.at(kc + h, a) - 2 * s.at(kc, a) + s.at(kc - h, a)) / (ht * ht);
+            }
+        }
+        d.speed[k] = std::sqrt(sq);
+    }
+    return d;
+}
+
+std::vector<Point> decimate_min_max(const std::vector<double>& x, const std::vector<double>& y,
+                                    double x_min, double x_max, std::size_t columns) {
+    const std::size_t n = std::min(x.size(), y.size());
+    std::vector<Point> out;
+    if (n <= 2 * columns || columns == 0 || !(x_max > x_min)) {
+        out.reserve(n);
+        for (std::size_t i = 0; i < n; ++i) {
+            if (!std::isnan(y[i])) out.push_back({x[i], y[i]});
+        }
+        return out;
+    }
+    out.reserve(2 * columns + 2);
+    const double scale = static_cast<double>(columns) / (x_max - x_min);
+    std::size_t i = 0;
+    const auto emit = [&](std::size_t idx) {
+        if (out.empty() || out.back().x != x[idx] || out.back().y != y[idx])
+            out.push_back({x[idx], y[idx]});
+    };
+    // The first sample always (even a NaN-free start is what a reader expects at t = 0).
+    while (i < n && std::isnan(y[i])) ++i;
+    if (i == n) return out;
+    const std::size_t first = i;
+    std::size_t last = first;
+    emit(first);
+    while (i < n) {
+        const double cx = std::floor((x[i] - x_min) * scale);
+        std::size_t lo = n, hi = n;
+        for (; i < n && std::floor((x[i] - x_min) * scale) == cx; ++i) {
+            if (std::isnan(y[i])) continue;
+            if (lo == n || y[i] < y[lo]) lo = i;
+            if (hi == n || y[i] > y[hi]) hi = i;
+            last = i;
+        }
+        if (lo == n) continue;
+        if (lo <= hi) {
+            emit(lo);
+            emit(hi);
+        } else {
+            emit(hi);
+            emit(lo);
+        }
+    }
+    emit(last);
+    return out;
+}
+
+std::string path_svg(const std::vector<BezierSegment>& path, const TickSeries& executed,
+                     const TickSeries* plant, const MachineProfile& profile,
+                     const Options& options) {
+    if (executed.axes == 1) return position_time_svg(executed, plant, profile, options);
+    if (executed.axes == 0)
+        throw std::invalid_argument("path_svg: the executed series has no axes");
+    const std::size_t ax = 0, ay = 1;
+
+    // Bounds: the executed series and the ideal path (16 samples per segment suffice).
+    Bounds b;
+    for (const TickSeries* s : {&executed, plant}) {
+        if (s == nullptr) continue;
+        for (std::size_t k = 0; k < s->ticks(); ++k) b.add(s->at(k, ax), s->at(k, ay));
+    }
+    for (const BezierSegment& seg : path) {
+        if (seg.p[0].size() <= ay) continue;
+        for (int i = 0; i <= 16; ++i) {
+            const Point p = bezier_xy(seg, ax, ay, i / 16.0);
+            b.add(p.x, p.y);
+        }
+    }
+    if (b.empty()) b.add(0, 0);
+    double dx = b.x1 - b.x0, dy = b.y1 - b.y0;
+    const double extent = std::max({dx, dy, 1e-3});
+    dx = std::max(dx, extent * 0.05);
+    dy = std::max(dy, extent * 0.05);
+    const double pad = 0.04 * std::max(dx, dy);
+    dx += 2 * pad;
+    dy += 2 * pad;
+    const double cx = (b.x0 + b.x1) / 2, cy = (b.y0 + b.y1) / 2;
+
+    // Equal scale on both axes: the plot area takes the data's aspect within [0.4, 1.1] x width.
+    const double w = width_of(options);
+    const double pw = w - kMarginLeft - kMarginRight;
+    const double ph = std::clamp(pw * dy / dx, pw * 0.4, pw * 1.1);
+    const double scale = std::min(pw / dx, ph / dy);
+    const double hx = pw / scale / 2, hy = ph / scale / 2;
+    Canvas c(w, std::round(ph + kMarginTop + kMarginBottom), kMarginLeft, kMarginTop, kMarginRight,
+             kMarginBottom);
+    c.set_range(cx - hx, cx + hx, cy - hy, cy + hy, !options.y_up);
+    c.title(title_of(options, "Path"));
+    c.axes(axis_name(profile, ax) + " (mm)",
+           axis_name(profile, ay) + (options.y_up ? " (mm), up" : " (mm), down"));
+
+    // Ideal path: consecutive segments of the same pen state form one polyline.
+    c.begin_series("ideal-path");
+    std::vector<Point> run;
+    bool run_down = true;
+    const auto flush = [&] {
+        c.polyline_px(run, detail::kIdealColour, run_down ? 5 : 2, run_down ? "" : kTravelDash,
+                      run_down ? "pen-down" : "pen-up");
+        run.clear();
+    };
+    for (const BezierSegment& seg : path) {
+        if (seg.p[0].size() <= ay) continue;
+        if (!run.empty() && seg.pen_down != run_down) {
+            const Point joint = run.back();
+            flush();
+            run.push_back(joint);
+        }
+        run_down = seg.pen_down;
+        const double len_px = polygon_length(seg, ax, ay) * scale;
+        const int samples = static_cast<int>(std::clamp(std::ceil(len_px / 1.5), 2.0, 4000.0));
+        for (int i = run.empty() ? 0 : 1; i <= samples; ++i) {
+            const Point p = bezier_xy(seg, ax, ay, static_cast<double>(i) / samples);
+            add_px(run, {c.px(p.x), c.py(p.y)}, 0.25);
+        }
+        const Point end = bezier_xy(seg, ax, ay, 1.0);
+        const Point end_px{c.px(end.x), c.py(end.y)};
+        if (run.back().x != end_px.x || run.back().y != end_px.y) run.push_back(end_px);
+    }
+    if (!run.empty()) flush();
+    c.end_group();
+
+    c.begin_series("setpoints");
+    draw_executed(c, executed, ax, ay, detail::kSetpointColour, 1.6);
+    c.end_group();
+    std::vector<LegendEntry> legend;
+    if (!path.empty()) {
+        legend.push_back({"ideal path", detail::kIdealColour, "", 5});
+        legend.push_back({"ideal travel (pen up)", detail::kIdealColour, kTravelDash, 2});
+    }
+    legend.push_back(
+        {executed.name.empty() ? "setpoints" : executed.name, detail::kSetpointColour, "", 1.6});
+    if (plant != nullptr && plant->axes == executed.axes) {
+        c.begin_series("plant");
+        draw_executed(c, *plant, ax, ay, detail::kPlantColour, 1);
+        c.end_group();
+        legend.push_back(
+            {plant->name.empty() ? "plant" : plant->name, detail::kPlantColour, "", 1});
+    }
+    c.legend(legend);
+    std::string note =
+        "Equal scale; +" + axis_name(profile, ay) +
+        (options.y_up ? " points up." : " points down (SVG / plotter coordinates).") +
+        " Executed pen-up moves dashed.";
+    if (executed.axes > 2)
+        note += " Axes " + axis_name(profile, ax) + ", " + axis_name(profile, ay) + " of " +
+                std::to_string(executed.axes) + ".";
+    c.note(note);
+    return c.finish();
+}
+
+std::string speed_svg(const TickSeries& executed, const MachineProfile& profile,
+                      const Options& options) {
+    const Derivatives d = differentiate(executed, profile, options.half_window_ticks);
+    const double w = width_of(options);
+    Canvas c(w, std::round(w * 0.5), kMarginLeft, kMarginTop, kMarginRight, kMarginBottom);
+    c.title(title_of(options, "Path speed"));
+    const std::size_t n = executed.ticks();
+    const double t_end = n > 1 ? static_cast<double>(n - 1) / executed.tick_hz : 1;
+    double top = std::max(profile.feed, profile.travel_feed);
+    for (double v : d.speed) top = std::max(top, v);
+    for (const AxisLimits& l : profile.axes) top = std::max(top, l.max_velocity);
+    c.set_range(0, t_end, 0, std::max(top, 1e-6) * 1.08, false);
+    c.axes("time (s)", "speed (mm/s)");
+    shade_pen_up(c, executed);
+    const std::vector<LimitGroup> limits = limit_groups(profile, executed.axes, false);
+    c.body() << "<g id=\"velocity-limits\">\n";
+    for (const LimitGroup& g : limits) {
+        c.hline(g.value, g.colour(), "4 3", "velocity-limit-" + g.names(profile, "-"),
+                g.names(profile, ", ") + " limit " + detail::format_number(g.value, 0) + " mm/s");
+    }
+    c.body() << "</g>\n";
+    c.hline(profile.feed, detail::kFeedColour, "", "feed",
+            "feed " + detail::format_number(profile.feed, 0) + " mm/s");
+    c.hline(profile.travel_feed, detail::kFeedColour, "2 3", "travel-feed",
+            "travel feed " + detail::format_number(profile.travel_feed, 0) + " mm/s");
+    c.begin_series("speed");
+    c.polyline(decimate_min_max(times(n, executed.tick_hz), d.speed, 0, t_end, columns_of(c)),
+               "#000", 1.3);
+    c.end_group();
+    std::vector<LegendEntry> legend = {{"path speed", "#000", "", 1.5},
+                                       {"feed", detail::kFeedColour, "", 1.5},
+                                       {"travel feed", detail::kFeedColour, "2 3", 1.5}};
+    for (const LimitGroup& g : limits)
+        legend.push_back({g.names(profile, ", ") + " limit", g.colour(), "4 3", 1.5});
+    legend.push_back(pen_up_legend());
+    c.legend(legend);
+    c.note("Speed = |v| of the " + executed.name + " over all axes, central differences over +/-" +
+           std::to_string(d.half_window) +
+           " tick(s); pen-up time shaded. An axis limit bounds that axis' own speed, not |v|.");
+    return c.finish();
+}
+
+std::string acceleration_svg(const TickSeries& executed, const MachineProfile& profile,
+                             const Options& options) {
+    const Derivatives d = differentiate(executed, profile, options.half_window_ticks);
+    const double w = width_of(options);
+    Canvas c(w, std::round(w * 0.55), kMarginLeft, kMarginTop, kMarginRight, kMarginBottom);
+    c.title(title_of(options, "Axis acceleration"));
+    const std::size_t n = executed.ticks();
+    const double t_end = n > 1 ? static_cast<double>(n - 1) / executed.tick_hz : 1;
+    double top = 0;
+    for (double a : d.acceleration) top = std::max(top, std::fabs(a));
+    for (std::size_t a = 0; a < executed.axes && a < profile.axes.size(); ++a) {
+        top = std::max(top, profile.axes[a].max_acceleration);
+    }
+    top = std::max(top, 1e-6) * 1.08;
+    c.set_range(0, t_end, -top, top, false);
+    c.axes("time (s)", "acceleration (mm/s\xc2\xb2)");
+    shade_pen_up(c, executed);
+    c.body() << "<g id=\"acceleration-limits\">\n";
+    for (const LimitGroup& g : limit_groups(profile, executed.axes, true)) {
+        const std::string id = "acceleration-limit-" + g.names(profile, "-"),
+                          names = g.names(profile, ", ");
+        c.hline(g.value, g.colour(), "4 3", id, names + " +" + detail::format_number(g.value, 0));
+        c.hline(-g.value, g.colour(), "4 3", id + "-negative",
+                names + " \xe2\x88\x92" + detail::format_number(g.value, 0));
+    }
+    c.body() << "</g>\n";
+    const std::vector<double> t = times(n, executed.tick_hz);
+    std::vector<LegendEntry> legend;
+    for (std::size_t a = 0; a < executed.axes; ++a) {
+        const std::string name = axis_name(profile, a);
+        c.begin_series("acceleration-" + name);
+        c.polyline(
+            decimate_min_max(t, column(d.acceleration, executed.axes, a), 0, t_end, columns_of(c)),
+            detail::axis_colour(a), 1.2);
+        c.end_group();
+        legend.push_back({name, detail::axis_colour(a), "", 1.5});
+    }
+    legend.push_back({"limits", "#555", "4 3", 1.5});
+    legend.push_back(pen_up_legend());
+    c.legend(legend);
+    c.note("Second differences of the " + executed.name + " over +/-" +
+           std::to_string(d.half_window) + " tick(s): rounding noise up to " +
+           detail::format_number(d.acceleration_noise, 0) + " mm/s\xc2\xb2. Pen-up time shaded.");
+    return c.finish();
+}
+
+}  // namespace pathstream::host::plot

@@ -1,0 +1,118 @@
+// The one-screen text report of a run.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+
+#include "pathstream/host/plot.hpp"
+
+namespace pathstream::host::plot {
+namespace {
+
+std::string fmt(const char* format, double v) {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, format, v);
+    return buf;
+}
+
+std::string percent(double fraction) {
+    if (!std::isfinite(fraction)) return "-";
+    return fmt("%.1f", 100 * fraction);
+}
+
+std::string pad(std::string s, std::size_t width) {
+    if (s.size() < width) s.insert(0, width - s.size(), ' ');
+    return s;
+}
+
+std::string name_of(const MachineProfile& profile, std::size_t axis) {
+    if (axis < profile.axes.size() && !profile.axes[axis].name.empty())
+        return profile.axes[axis].name;
+    return "axis" + std::to_string(axis);
+}
+
+}  // namespace
+
+std::string text_report(const Plan& plan, const PlanCheck* check, const MachineProfile& profile,
+                        const TickSeries& executed, const RunSummary& run) {
+    std::ostringstream o;
+    const std::size_t axes = executed.axes;
+    std::string names;
+    for (std::size_t a = 0; a < axes; ++a) names += (a ? ", " : "") + name_of(profile, a);
+
+    o << "pathstream run on the " << run.target << "\n";
+    o << "  machine    " << axes << " axes (" << names << "), " << fmt("%.6g", profile.tick_hz)
+      << " Hz tick, " << fmt("%.6g", profile.mm_per_lsb) << " mm/LSB\n";
+    o << "  plant      " << run.plant << "\n";
+    const double duration =
+        plan.duration > 0 ? plan.duration : static_cast<double>(plan.total_ticks) / profile.tick_hz;
+    o << "  duration   " << fmt("%.3f", duration) << " s planned; "
+      << fmt("%.3f", run.simulated_seconds) << " s simulated in " << fmt("%.3f", run.wall_seconds)
+      << " s wall";
+    if (run.wall_seconds > 0)
+        o << " (" << fmt("%.3g", run.simulated_seconds / run.wall_seconds) << "x)";
+    o << (run.realtime ? ", paced" : "") << "\n";
+    o << "  path       " << fmt("%.2f", plan.path_length) << " mm pen-down, "
+      << fmt("%.2f", plan.travel_length) << " mm travel, " << run.pen_switches << " pen switches\n";
+    o << "  device     " << run.ticks << " ticks, " << run.spans << " spans, " << run.underruns
+      << " underruns";
+    if (run.realtime) o << ", " << run.late_ticks << " late ticks";
+    o << "\n";
+    if (check != nullptr) {
+        o << "  deviation  " << fmt("%.2f", check->max_deviation * 1000) << " um max (tick "
+          << check->worst_deviation_tick << "), tolerance "
+          << fmt("%.2f", profile.chord_tolerance * 1000) << " um (planner check)\n";
+        o << "  limits     "
+          << (check->within_limits ? "within the axis limits" : "LIMITS EXCEEDED")
+          << " (planner check: v " << percent(check->max_velocity_fraction) << " %, a "
+          << percent(check->max_acceleration_fraction) << " %)\n";
+    } else {
+        o << "  deviation  not checked (no planner check given)\n";
+    }
+
+    // Per axis: peak fractions of the limits (planner, executed setpoints) and following error.
+    const Derivatives d = differentiate(executed, profile);
+    const bool following = !run.max_following_error_mm.empty();
+    o << "\n  axis      v peak % of limit     a peak % of limit";
+    if (following) o << "   following error um";
+    o << "\n            planner  executed     planner  executed";
+    if (following) o << "       max       rms";
+    o << "\n";
+    for (std::size_t a = 0; a < axes; ++a) {
+        double v = 0, acc = 0;
+        for (std::size_t k = 0; k < executed.ticks(); ++k) {
+            v = std::max(v, std::fabs(d.velocity[k * axes + a]));
+            acc = std::max(acc, std::fabs(d.acceleration[k * axes + a]));
+        }
+        const double v_lim = a < profile.axes.size() ? profile.axes[a].max_velocity : 0;
+        const double a_lim = a < profile.axes.size() ? profile.axes[a].max_acceleration : 0;
+        const auto planned = [&](const std::vector<double>& f) {
+            return check != nullptr && a < f.size() ? percent(f[a]) : std::string("-");
+        };
+        std::string name = name_of(profile, a);
+        name.resize(std::max<std::size_t>(name.size(), 6), ' ');
+        o << "  " << name
+          << pad(planned(check ? check->axis_velocity_fraction : std::vector<double>{}), 9)
+          << pad(v_lim > 0 ? percent(v / v_lim) : "-", 10)
+          << pad(planned(check ? check->axis_acceleration_fraction : std::vector<double>{}), 12)
+          << pad(a_lim > 0 ? percent(acc / a_lim) : "-", 10);
+        if (following && a < run.max_following_error_mm.size()) {
+            o << pad(fmt("%.1f", run.max_following_error_mm[a] * 1000), 13)
+              << pad(a < run.rms_following_error_mm.size()
+                         ? fmt("%.1f", run.rms_following_error_mm[a] * 1000)
+                         : "-",
+                     10);
+        }
+        o << "\n";
+    }
+    o << "  executed: setpoint differences over +/-" << d.half_window
+      << " ticks (a noise <= " << fmt("%.0f", d.acceleration_noise) << " mm/s^2)\n";
+    if (!following) o << "  following error: 0 (ideal plant: position = setpoint)\n";
+    if (run.underruns > 0) {
+        o << "  WARNING: the span queue ran dry " << run.underruns
+          << " times before the end of the plan\n";
+    }
+    return o.str();
+}
+
+}  // namespace pathstream::host::plot

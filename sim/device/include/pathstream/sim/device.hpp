@@ -1,0 +1,117 @@
+// The simulated device: the firmware core's SetpointStream fed with a plan's spans and ticked
+// by a clock, driving a pen output and a plant per axis, with everything recorded per tick.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "pathstream/hal/clock.hpp"
+#include "pathstream/host/machine.hpp"
+#include "pathstream/host/plan.hpp"
+#include "pathstream/host/plot.hpp"
+#include "pathstream/sim/plant.hpp"
+#include "pathstream/units.hpp"
+
+namespace pathstream::sim {
+
+/// Span queue depth of the simulated device (SetpointStream<Axes, kQueueCapacity>).
+inline constexpr std::uint32_t kQueueCapacity = 32;
+
+/// How to run.
+struct SimOptions {
+    PlantModel plant = PlantModel::kIdeal;
+    ServoParameters servo;           ///< used when plant == kServo
+    bool realtime = false;           ///< pace ticks with the Linux monotonic clock
+    std::uint64_t settle_ticks = 0;  ///< idle ticks run after the end point (plant settling)
+    /// The producer task runs before every `producer_interval_ticks`-th tick and pushes up to
+    /// `max_pushes_per_run` spans (0: until the queue is full). Defaults keep the queue full;
+    /// larger intervals or small batches model a slow link (and can starve the queue).
+    std::uint32_t producer_interval_ticks = 1;
+    std::uint32_t max_pushes_per_run = 0;
+};
+
+/// Following error of one axis, |setpoint - plant position| over every recorded tick.
+struct FollowingError {
+    double max_mm = 0;
+    double rms_mm = 0;
+    std::uint64_t max_tick = 0;  ///< tick of the maximum
+};
+
+/// The stream's own counters at the end of the run, plus what the producer saw.
+struct StreamCounters {
+    std::uint64_t ticks_executed = 0;      ///< SetpointStream::ticks_executed()
+    std::uint32_t spans_completed = 0;     ///< SetpointStream::spans_completed()
+    std::uint32_t last_completed_tag = 0;  ///< tag = span index + 1
+    std::uint64_t idle_ticks = 0;          ///< ticks that returned TickState::kIdle
+    std::uint64_t queue_full = 0;          ///< pushes answered kQueueFull (retried later)
+    std::uint32_t max_queued = 0;          ///< deepest the queue got (<= kQueueCapacity)
+};
+
+/// Everything one run produced. Per-tick records are row-major, row k = tick k: ticks 0 to
+/// plan ticks - 1 come from spans, then one tick holding the end point, then settle_ticks
+/// (more rows if the queue ran dry: see underruns).
+struct SimulationResult {
+    std::size_t axes = 0;
+    double tick_hz = 0;
+    double mm_per_lsb = 0;
+    PlantModel plant = PlantModel::kIdeal;
+    ServoParameters servo;
+
+    std::uint64_t ticks = 0;         ///< ticks run = rows recorded
+    std::uint64_t plan_ticks = 0;    ///< sum of the plan's span ticks
+    std::uint64_t spans_pushed = 0;  ///< accepted by push()
+    StreamCounters stream;
+    std::vector<std::uint64_t> pen_switch_ticks;  ///< ticks at which the pen output changed
+    std::uint64_t underruns = 0;   ///< idle ticks before the last span finished (0 expected)
+    bool paced = false;            ///< ticks were paced by a clock (realtime, or injected)
+    std::uint64_t late_ticks = 0;  ///< paced runs: ticks that began a whole tick late
+    double simulated_seconds = 0;  ///< ticks / tick_hz
+    double wall_seconds = 0;       ///< host time the run took
+
+    std::vector<Lsb> setpoints;             ///< LSB, from the core, [tick * axes + axis]
+    std::vector<double> positions;          ///< mm, the plant's position at the tick's instant
+    std::vector<std::uint8_t> pen;          ///< pen output after the tick (1: down)
+    std::vector<FollowingError> following;  ///< per axis
+
+    Lsb setpoint(std::uint64_t tick, std::size_t axis) const {
+        return setpoints[tick * axes + axis];
+    }
+    double position(std::uint64_t tick, std::size_t axis) const {
+        return positions[tick * axes + axis];
+    }
+};
+
+/// Called now and then (about every 1 % of the ticks, and with 1.0 at the end) with the
+/// fraction done.
+using Progress = std::function<void(double fraction)>;
+
+/// Runs `plan` on the simulated device: a SetpointStream<axes, kQueueCapacity> (axes = the
+/// spans' axis count, 1..8) starting at the first span's start point, a producer pushing the
+/// plan's spans (Span::tag = index + 1, outputs = kOutputPenDown on pen-down spans) whenever
+/// there is room, one tick() per clock tick, the pen output set from outputs() after each
+/// tick, and the plant stepped with the tick's setpoint. Virtual time (as fast as possible)
+/// unless options.realtime (hal::LinuxClock at profile.tick_hz).
+/// Throws std::invalid_argument for an empty plan, spans whose axis count differs from the
+/// profile's, or bad servo parameters; std::runtime_error ("span I (tag T): the device
+/// refused it: <status name>") when push() answers anything but kOk or kQueueFull.
+SimulationResult simulate(const host::Plan& plan, const host::MachineProfile& profile,
+                          const SimOptions& options, const Progress& progress = {});
+
+/// The same run paced by `pacing` (options.realtime is ignored): before tick k the device
+/// calls pacing.wait_until(k), and counts the tick late when pacing.now() > k afterwards.
+/// Tests inject a clock here to check the pacing without measuring wall time.
+SimulationResult simulate_paced(const host::Plan& plan, const host::MachineProfile& profile,
+                                const SimOptions& options, hal::Clock& pacing,
+                                const Progress& progress = {});
+
+/// The setpoints in mm as a plot series ("setpoints", quantum = mm_per_lsb).
+host::plot::TickSeries setpoint_series(const SimulationResult& result);
+/// The plant positions as a plot series ("ideal plant" or "servo plant", continuous).
+host::plot::TickSeries plant_series(const SimulationResult& result);
+/// The run's figures for host::plot::text_report.
+host::plot::RunSummary run_summary(const SimulationResult& result);
+
+}  // namespace pathstream::sim

@@ -1,0 +1,292 @@
+#include "pathstream/sim/device.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <memory>
+#include <optional>
+#include <sstream>
+#include <stdexcept>
+
+#include "pathstream/hal/linux_clock.hpp"
+#include "pathstream/setpoint_stream.hpp"
+#include "pathstream/sim/simulated_output.hpp"
+#include "pathstream/sim/virtual_clock.hpp"
+#include "pathstream/span.hpp"
+#include "pathstream/status.hpp"
+#include "pathstream/tick_cubic.hpp"
+
+namespace pathstream::sim {
+namespace {
+
+using host::CoreSpan;
+
+std::string span_error(std::size_t index, Status s) {
+    std::ostringstream m;
+    m << "span " << index << " (tag " << index + 1
+      << "): the device refused it: " << status_name(s);
+    return m.str();
+}
+
+template <unsigned Axes>
+Span<Axes> to_core_span(const CoreSpan& in, std::size_t index) {
+    Span<Axes> s;
+    s.basis = in.basis;
+    s.ticks = in.ticks;
+    s.tag = static_cast<std::uint32_t>(index + 1);
+    s.outputs = in.pen_down ? kOutputPenDown : std::uint8_t{0};
+    for (unsigned a = 0; a < Axes; ++a) {
+        for (unsigned i = 0; i < 4; ++i) s.control[a][i] = in.control[a][i];
+    }
+    return s;
+}
+
+/// Where the first span starts, by the core's own evaluation (independent of the CoreSpan's
+/// cached cubic, which a hand-made plan may lack).
+template <unsigned Axes>
+void start_point(const CoreSpan& first, Lsb (&start)[Axes]) {
+    const Span<Axes> s = to_core_span<Axes>(first, 0);
+    ValidatedSpan<Axes> v;
+    if (const Status st = validate_span(s, v); st != Status::kOk) {
+        throw std::runtime_error(span_error(0, st));
+    }
+    for (unsigned a = 0; a < Axes; ++a) {
+        if (const Status st = evaluate_at(v.cubic[a], v.timing, 0, start[a]); st != Status::kOk) {
+            throw std::runtime_error(span_error(0, st));
+        }
+    }
+}
+
+template <unsigned Axes>
+SimulationResult run(const host::Plan& plan, const host::MachineProfile& profile,
+                     const SimOptions& options, hal::Clock* pacing, const Progress& progress) {
+    using Stream = SetpointStream<Axes, kQueueCapacity>;
+    const auto wall_start = std::chrono::steady_clock::now();
+    const std::size_t span_count = plan.spans.size();
+
+    SimulationResult r;
+    r.axes = Axes;
+    r.tick_hz = profile.tick_hz;
+    r.mm_per_lsb = profile.mm_per_lsb;
+    r.plant = options.plant;
+    r.servo = options.servo;
+    r.paced = pacing != nullptr;
+    for (const CoreSpan& s : plan.spans) r.plan_ticks += s.ticks;
+
+    Lsb start[Axes];
+    start_point<Axes>(plan.spans.front(), start);
+    auto stream = std::make_unique<Stream>(start);  // ~13 KB at 8 axes: heap on the host
+
+    VirtualClock device_time;          // the device's tick counter
+    SimulatedOutput pen(device_time);  // the pen lift, stamped in device ticks
+
+    std::vector<ServoAxis> servo;
+    if (options.plant == PlantModel::kServo) {
+        for (unsigned a = 0; a < Axes; ++a) {
+            servo.emplace_back(options.servo, profile.tick_seconds(),
+                               start[a] * profile.mm_per_lsb);
+        }
+    }
+
+    const std::uint64_t expected_rows = r.plan_ticks + 1 + options.settle_ticks;
+    r.setpoints.reserve(expected_rows * Axes);
+    r.positions.reserve(expected_rows * Axes);
+    r.pen.reserve(expected_rows);
+    std::vector<double> sum_sq(Axes, 0.0);
+    r.following.assign(Axes, FollowingError{});
+
+    std::size_t next = 0;  // next span to push
+    const auto produce = [&] {
+        std::uint32_t pushed = 0;
+        while (next < span_count &&
+               (options.max_pushes_per_run == 0 || pushed < options.max_pushes_per_run)) {
+            const Status s = stream->push(to_core_span<Axes>(plan.spans[next], next));
+            if (s == Status::kQueueFull) {
+                ++r.stream.queue_full;
+                break;
+            }
+            if (s != Status::kOk) throw std::runtime_error(span_error(next, s));
+            ++next;
+            ++pushed;
+            ++r.spans_pushed;
+        }
+        r.stream.max_queued = std::max(r.stream.max_queued, stream->queued_spans());
+    };
+
+    const std::uint32_t interval = std::max<std::uint32_t>(1, options.producer_interval_ticks);
+    const std::uint64_t progress_stride = std::max<std::uint64_t>(1, expected_rows / 100);
+    std::uint64_t rows_after_end = 1 + options.settle_ticks;  // end point + settling
+    Lsb out[Axes];
+    for (std::uint64_t k = 0;; ++k) {
+        if (k % interval == 0) produce();  // the producer task, between two tick interrupts
+        if (pacing != nullptr) {
+            pacing->wait_until(k);
+            if (pacing->now() > k) ++r.late_ticks;
+        }
+        device_time.wait_until(k);
+        const bool finished = stream->spans_completed() == span_count;
+
+        // --- the tick interrupt ---
+        const TickState state = stream->tick(out);
+        pen.set((stream->outputs() & kOutputPenDown) != 0);
+        // ---
+
+        if (state == TickState::kIdle) {
+            ++r.stream.idle_ticks;
+            if (!finished) ++r.underruns;
+        }
+        r.pen.push_back(pen.state() ? 1 : 0);
+        for (unsigned a = 0; a < Axes; ++a) {
+            const double setpoint_mm = out[a] * profile.mm_per_lsb;
+            double position = setpoint_mm;
+            if (!servo.empty()) {
+                position = servo[a].position();  // at this tick's instant, before its hold
+                servo[a].step(setpoint_mm);
+            }
+            r.setpoints.push_back(out[a]);
+            r.positions.push_back(position);
+            const double e = std::fabs(setpoint_mm - position);
+            sum_sq[a] += e * e;
+            if (e > r.following[a].max_mm) {
+                r.following[a].max_mm = e;
+                r.following[a].max_tick = k;
+            }
+        }
+        r.ticks = k + 1;
+        if (progress && r.ticks % progress_stride == 0) {
+            progress(
+                std::min(1.0, static_cast<double>(r.ticks) / static_cast<double>(expected_rows)));
+        }
+        if (finished && --rows_after_end == 0) break;
+    }
+
+    for (unsigned a = 0; a < Axes; ++a) {
+        r.following[a].rms_mm = std::sqrt(sum_sq[a] / static_cast<double>(r.ticks));
+    }
+    r.stream.ticks_executed = stream->ticks_executed();
+    r.stream.spans_completed = stream->spans_completed();
+    r.stream.last_completed_tag = stream->last_completed_tag();
+    r.pen_switch_ticks = pen.switch_ticks();
+    r.simulated_seconds = static_cast<double>(r.ticks) / profile.tick_hz;
+    r.wall_seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+    if (progress) progress(1.0);
+    return r;
+}
+
+SimulationResult dispatch(const host::Plan& plan, const host::MachineProfile& profile,
+                          const SimOptions& options, hal::Clock* pacing, const Progress& progress) {
+    if (plan.spans.empty())
+        throw std::invalid_argument("the plan has no spans: nothing to simulate");
+    const std::size_t axes = plan.spans.front().control.size();
+    if (axes < 1 || axes > kMaxAxes) {
+        throw std::invalid_argument("the plan has " + std::to_string(axes) +
+                                    " axes; the device supports 1 to 8");
+    }
+    for (std::size_t i = 0; i < plan.spans.size(); ++i) {
+        if (plan.spans[i].control.size() != axes) {
+            throw std::invalid_argument("span " + std::to_string(i) + " has " +
+                                        std::to_string(plan.spans[i].control.size()) +
+                                        " axes, the first span " + std::to_string(axes));
+        }
+    }
+    if (profile.axes.size() != axes) {
+        throw std::invalid_argument("the plan has " + std::to_string(axes) +
+                                    " axes but the machine profile " +
+                                    std::to_string(profile.axes.size()));
+    }
+    if (!(profile.tick_hz > 0) || !(profile.mm_per_lsb > 0)) {
+        throw std::invalid_argument(
+            "the machine profile needs a positive tick rate and mm per LSB");
+    }
+    switch (axes) {
+        case 1:
+            return run<1>(plan, profile, options, pacing, progress);
+        case 2:
+            return run<2>(plan, profile, options, pacing, progress);
+        case 3:
+            return run<3>(plan, profile, options, pacing, progress);
+        case 4:
+            return run<4>(plan, profile, options, pacing, progress);
+        case 5:
+            return run<5>(plan, profile, options, pacing, progress);
+        case 6:
+            return run<6>(plan, profile, options, pacing, progress);
+        case 7:
+            return run<7>(plan, profile, options, pacing, progress);
+        default:
+            return run<8>(plan, profile, options, pacing, progress);
+    }
+}
+
+host::plot::TickSeries series_base(const SimulationResult& r, std::string name) {
+    host::plot::TickSeries s;
+    s.name = std::move(name);
+    s.tick_hz = r.tick_hz;
+    s.axes = r.axes;
+    s.pen_down = r.pen;
+    return s;
+}
+
+std::string plant_description(const SimulationResult& r) {
+    if (r.plant == PlantModel::kIdeal) return "ideal (position = setpoint)";
+    char text[96];
+    std::snprintf(text, sizeof text, "servo, 2nd order, f_n %.4g Hz, zeta %.3g",
+                  r.servo.bandwidth_hz, r.servo.damping);
+    return text;
+}
+
+}  // namespace
+
+SimulationResult simulate(const host::Plan& plan, const host::MachineProfile& profile,
+                          const SimOptions& options, const Progress& progress) {
+    if (!options.realtime) return dispatch(plan, profile, options, nullptr, progress);
+    hal::LinuxClock clock(profile.tick_hz);
+    return dispatch(plan, profile, options, &clock, progress);
+}
+
+SimulationResult simulate_paced(const host::Plan& plan, const host::MachineProfile& profile,
+                                const SimOptions& options, hal::Clock& pacing,
+                                const Progress& progress) {
+    return dispatch(plan, profile, options, &pacing, progress);
+}
+
+host::plot::TickSeries setpoint_series(const SimulationResult& r) {
+    host::plot::TickSeries s = series_base(r, "setpoints");
+    s.quantum_mm = r.mm_per_lsb;
+    s.position.reserve(r.setpoints.size());
+    for (Lsb v : r.setpoints) s.position.push_back(v * r.mm_per_lsb);
+    return s;
+}
+
+host::plot::TickSeries plant_series(const SimulationResult& r) {
+    host::plot::TickSeries s =
+        series_base(r, r.plant == PlantModel::kServo ? "servo plant" : "ideal plant");
+    s.quantum_mm = r.plant == PlantModel::kServo ? 0 : r.mm_per_lsb;
+    s.position = r.positions;
+    return s;
+}
+
+host::plot::RunSummary run_summary(const SimulationResult& r) {
+    host::plot::RunSummary s;
+    s.target = "simulated device";
+    s.plant = plant_description(r);
+    s.ticks = r.ticks;
+    s.spans = r.spans_pushed;
+    s.pen_switches = r.pen_switch_ticks.size();
+    s.underruns = r.underruns;
+    s.late_ticks = r.late_ticks;
+    s.realtime = r.paced;
+    s.simulated_seconds = r.simulated_seconds;
+    s.wall_seconds = r.wall_seconds;
+    if (r.plant == PlantModel::kServo) {
+        for (const FollowingError& f : r.following) {
+            s.max_following_error_mm.push_back(f.max_mm);
+            s.rms_following_error_mm.push_back(f.rms_mm);
+        }
+    }
+    return s;
+}
+
+}  // namespace pathstream::sim
