@@ -131,26 +131,10 @@ public:
         return true;
     }
 
-    // Same rules as the JSON reader's point counts (json_path.cpp, check_count).
     void check_count(const Subpath& sp) const {
-        const std::size_t n = sp.points.size();
-        const std::string name = basis_name(sp.basis);
-        const std::string kind = sp.closed ? "closed " : "open ";
-        std::string problem;
-        if (sp.basis == PathBasis::kBezier) {
-            const bool ok = sp.closed ? (n >= 3 && n % 3 == 0) : (n >= 4 && n % 3 == 1);
-            if (!ok) {
-                problem = kind + "bezier needs " + (sp.closed ? "3k" : "3k + 1") +
-                          " points (k >= 1), got " + std::to_string(n);
-            }
-        } else {
-            const std::size_t needed = sp.closed ? 3 : 2;
-            if (n < needed) {
-                problem = kind + name + " needs at least " + std::to_string(needed) +
-                          " points, got " + std::to_string(n);
-            }
+        if (const std::string problem = point_count_problem(sp); !problem.empty()) {
+            throw InputError(file_, sp.location, problem);
         }
-        if (!problem.empty()) throw InputError(file_, sp.location, problem);
     }
 
     Path path(std::string_view text, PathBasis basis, bool closed) const {

@@ -12,16 +12,6 @@
 
 namespace pathstream::host {
 
-const char* basis_name(PathBasis basis) {
-    switch (basis) {
-        case PathBasis::kBSpline: return "bspline";
-        case PathBasis::kCatmullRom: return "catmull-rom";
-        case PathBasis::kBezier: return "bezier";
-        case PathBasis::kPolyline: return "polyline";
-    }
-    return "?";
-}
-
 namespace {
 
 using nlohmann::json;
@@ -105,22 +95,7 @@ public:
     }
 
     void check_count(const Subpath& sp, const std::string& pointer) const {
-        const std::size_t n = sp.points.size();
-        const std::string name = basis_name(sp.basis);
-        const std::string kind = sp.closed ? "closed " : "open ";
-        if (sp.basis == PathBasis::kBezier) {
-            const bool ok = sp.closed ? (n >= 3 && n % 3 == 0) : (n >= 4 && n % 3 == 1);
-            if (!ok) {
-                fail(pointer, kind + "bezier needs " + (sp.closed ? "3k" : "3k + 1") +
-                                  " points (k >= 1), got " + std::to_string(n));
-            }
-            return;
-        }
-        const std::size_t needed = sp.closed ? 3 : 2;
-        if (n < needed) {
-            fail(pointer, kind + name + " needs at least " + std::to_string(needed) +
-                              " points, got " + std::to_string(n));
-        }
+        if (const std::string problem = point_count_problem(sp); !problem.empty()) fail(pointer, problem);
     }
 
     Path path(const json& root) const {

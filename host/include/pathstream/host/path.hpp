@@ -45,4 +45,9 @@ struct Path {
 /// Name used in files and messages ("bspline", "catmull-rom", "bezier", "polyline").
 const char* basis_name(PathBasis basis);
 
+/// Empty when the subpath has a usable number of points for its basis (bezier: 3k + 1 open,
+/// 3k closed, k >= 1; others: at least 2 open, 3 closed); else the message every reader uses,
+/// e.g. "open bezier needs 3k + 1 points (k >= 1), got 3".
+std::string point_count_problem(const Subpath& subpath);
+
 }  // namespace pathstream::host
