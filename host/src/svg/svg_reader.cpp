@@ -1,0 +1,557 @@
+// The SVG document walk: XML, elements, attributes and their places, units and transforms.
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <fstream>
+#include <limits>
+#include <optional>
+#include <pugixml.hpp>
+#include <sstream>
+#include <unordered_map>
+
+#include "pathstream/host/input_error.hpp"
+#include "pathstream/host/svg_path.hpp"
+
+namespace pathstream::host {
+namespace {
+
+using svg::Affine;
+using svg::CubicSubpaths;
+using svg::Point;
+
+constexpr double kMaxCoordinateMm = 1e6;  // as the JSON reader: catches unit mix-ups
+constexpr double kDegenerateMm = 1e-9;    // pieces smaller than this are dropped
+constexpr std::size_t kMaxUses = 100000;  // <use> copies per document: stops exponential nesting
+constexpr double kMmPerPx = 25.4 / 96.0;
+constexpr double kNoBase = std::numeric_limits<double>::quiet_NaN();
+constexpr const char* kSvgNamespace = "http://www.w3.org/2000/svg";
+
+bool is_space(char c) {
+    return c == ' ' || c == '\t' || c == '\r' || c == '\n' || c == '\f';
+}
+
+std::string trim(std::string_view s) {
+    while (!s.empty() && is_space(s.front())) s.remove_prefix(1);
+    while (!s.empty() && is_space(s.back())) s.remove_suffix(1);
+    return std::string(s);
+}
+
+std::string lower(std::string s) {
+    for (char& c : s) {
+        if (c >= 'A' && c <= 'Z') c = static_cast<char>(c - 'A' + 'a');
+    }
+    return s;
+}
+
+std::string number_text(double v, int precision = 6) {
+    std::ostringstream o;
+    o.precision(precision);
+    o << v;
+    return o.str();
+}
+
+// What the walk carries down the tree.
+struct State {
+    Affine to_mm;            // user units of this element -> mm
+    double width = kNoBase;  // viewport size in user units, for percentages
+    double height = kNoBase;
+    bool visible = true;  // inherited 'visibility'
+};
+
+class Reader {
+public:
+    Reader(const std::string& text, const std::string& file, double tolerance_mm)
+        : text_(text), file_(file), tolerance_mm_(tolerance_mm) {}
+
+    Path read() {
+        const pugi::xml_parse_result result =
+            doc_.load_buffer(text_.data(), text_.size(), pugi::parse_default, pugi::encoding_utf8);
+        if (!result) {
+            std::string what = result.description();
+            if (!what.empty() && what[0] >= 'A' && what[0] <= 'Z')
+                what[0] = static_cast<char>(what[0] - 'A' + 'a');
+            throw InputError(file_, locate(static_cast<std::size_t>(result.offset)),
+                             "invalid XML: " + what);
+        }
+        const pugi::xml_node root = doc_.document_element();
+        if (svg_name(root) != "svg") {
+            throw InputError(file_, element_location(root),
+                             "root element is <" + std::string(root.name()) + ">, expected <svg>");
+        }
+        root_svg(root);
+        if (path_.subpaths.empty())
+            throw InputError(file_, element_location(root), "no drawable paths");
+        path_.axes = 2;
+        return std::move(path_);
+    }
+
+private:
+    // ---- places ----------------------------------------------------------------------------
+
+    // Line and column (1-based, columns in characters of UTF-8) of a byte offset.
+    SourceLocation locate(std::size_t offset) const {
+        SourceLocation at{1, 1};
+        std::size_t i = text_.compare(0, 3, "\xEF\xBB\xBF") == 0 ? 3 : 0;  // a byte order mark
+        for (; i < offset && i < text_.size(); ++i) {
+            const auto c = static_cast<unsigned char>(text_[i]);
+            if (c == '\n') {
+                ++at.line;
+                at.column = 1;
+            } else if ((c & 0xC0) != 0x80) {
+                ++at.column;
+            }
+        }
+        return at;
+    }
+
+    // Byte offset of an element's '<' (pugixml gives the offset of its name).
+    std::size_t element_offset(pugi::xml_node n) const {
+        const std::ptrdiff_t name = n.offset_debug();
+        return name > 0 ? static_cast<std::size_t>(name - 1) : 0;
+    }
+
+    SourceLocation element_location(pugi::xml_node n) const { return locate(element_offset(n)); }
+
+    // Where an attribute's name starts in the element's start tag; the element if not found.
+    SourceLocation attribute_location(pugi::xml_node n, const char* name) const {
+        const std::string_view t = text_;
+        const std::size_t start = element_offset(n);
+        std::size_t i = start + 1;
+        const auto stop = [&](char c) { return is_space(c) || c == '>' || c == '/' || c == '='; };
+        while (i < t.size() && !stop(t[i])) ++i;  // the element's name
+        for (;;) {
+            while (i < t.size() && is_space(t[i])) ++i;
+            if (i >= t.size() || t[i] == '>' || t[i] == '/') break;
+            const std::size_t name_at = i;
+            while (i < t.size() && !stop(t[i])) ++i;
+            const std::string_view attribute = t.substr(name_at, i - name_at);
+            while (i < t.size() && is_space(t[i])) ++i;
+            if (i < t.size() && t[i] == '=') {
+                ++i;
+                while (i < t.size() && is_space(t[i])) ++i;
+                if (i < t.size() && (t[i] == '"' || t[i] == '\'')) {
+                    const char quote = t[i++];
+                    while (i < t.size() && t[i] != quote) ++i;
+                    ++i;
+                }
+            }
+            if (attribute == name) return locate(name_at);
+            if (i == name_at) break;  // cannot happen in a document pugixml accepted
+        }
+        return locate(start);
+    }
+
+    [[noreturn]] void fail_at(pugi::xml_node n, const char* attribute,
+                              const std::string& message) const {
+        throw InputError(file_, attribute ? attribute_location(n, attribute) : element_location(n),
+                         message);
+    }
+
+    // Runs parse(value of attribute) and gives its ValueError the attribute's place.
+    template <class F>
+    auto with_attribute(pugi::xml_node n, const char* attribute, F&& parse) const {
+        try {
+            return parse(std::string_view(n.attribute(attribute).value()));
+        } catch (const svg::ValueError& e) {
+            fail_at(n, attribute, e.what());
+        }
+    }
+
+    // ---- names, styles -----------------------------------------------------------------------
+
+    // The local name of an element in the SVG namespace ("" for others, e.g. sodipodi:namedview).
+    // Unprefixed names count as SVG; a prefix counts when some ancestor binds it to SVG.
+    static std::string svg_name(pugi::xml_node n) {
+        const std::string name = n.name();
+        const auto colon = name.find(':');
+        if (colon == std::string::npos) return name;
+        const std::string binding = "xmlns:" + name.substr(0, colon);
+        for (pugi::xml_node a = n; a; a = a.parent()) {
+            if (const pugi::xml_attribute ns = a.attribute(binding.c_str())) {
+                return std::string(ns.value()) == kSvgNamespace ? name.substr(colon + 1) : "";
+            }
+        }
+        return "";
+    }
+
+    // A property from the style attribute (the last declaration wins), else the presentation
+    // attribute of the same name; trimmed and lower-cased, without "!important".
+    static std::string property(pugi::xml_node n, const std::string& name) {
+        std::string value;
+        bool found = false;
+        std::istringstream style{std::string(n.attribute("style").value())};
+        std::string declaration;
+        while (std::getline(style, declaration, ';')) {
+            const auto colon = declaration.find(':');
+            if (colon == std::string::npos) continue;
+            if (lower(trim(std::string_view(declaration).substr(0, colon))) != name) continue;
+            value = lower(trim(std::string_view(declaration).substr(colon + 1)));
+            found = true;
+        }
+        if (!found) value = lower(trim(n.attribute(name.c_str()).value()));
+        if (const auto bang = value.find("!important"); bang != std::string::npos)
+            value = trim(value.substr(0, bang));
+        return value;
+    }
+
+    // ---- values -----------------------------------------------------------------------------
+
+    Affine transform(pugi::xml_node n) const {
+        if (!n.attribute("transform")) return {};
+        return with_attribute(n, "transform",
+                              [](std::string_view v) { return svg::parse_transform(v); });
+    }
+
+    // A length attribute in user units; `fallback` when absent.
+    double length(pugi::xml_node n, const char* attribute, double percent_base,
+                  double fallback) const {
+        if (!n.attribute(attribute)) return fallback;
+        return with_attribute(n, attribute, [&](std::string_view v) {
+            return svg::parse_length(v, attribute, percent_base);
+        });
+    }
+
+    // A size (width, r, ...) that must not be negative.
+    double size(pugi::xml_node n, const char* attribute, double percent_base,
+                double fallback) const {
+        const double v = length(n, attribute, percent_base, fallback);
+        if (v < 0) {
+            fail_at(n, attribute,
+                    "<" + svg_name(n) + "> " + attribute + " must not be negative (got " +
+                        trim(n.attribute(attribute).value()) + ")");
+        }
+        return v;
+    }
+
+    // rx / ry of rect and ellipse: NaN for "auto" or absent.
+    double radius(pugi::xml_node n, const char* attribute, double percent_base) const {
+        if (trim(n.attribute(attribute).value()) == "auto") return kNoBase;
+        return size(n, attribute, percent_base, kNoBase);
+    }
+
+    std::optional<std::array<double, 4>> view_box(pugi::xml_node n) const {
+        if (!n.attribute("viewBox")) return std::nullopt;
+        return with_attribute(n, "viewBox", [](std::string_view v) {
+            const std::vector<double> numbers = svg::parse_number_list(v, "viewBox");
+            if (numbers.size() != 4) {
+                throw svg::ValueError(
+                    "viewBox: expected 4 numbers (min-x min-y width height), got " +
+                    std::to_string(numbers.size()));
+            }
+            if (!(numbers[2] > 0) || !(numbers[3] > 0)) {
+                throw svg::ValueError("viewBox: width and height must be positive (got " +
+                                      number_text(numbers[2]) + " x " + number_text(numbers[3]) +
+                                      ")");
+            }
+            return std::array<double, 4>{numbers[0], numbers[1], numbers[2], numbers[3]};
+        });
+    }
+
+    Affine viewbox_map(pugi::xml_node n, const std::array<double, 4>& box, double width,
+                       double height) const {
+        return with_attribute(n, "preserveAspectRatio", [&](std::string_view v) {
+            return svg::viewbox_transform(box, width, height, v);
+        });
+    }
+
+    // ---- the walk ---------------------------------------------------------------------------
+
+    void root_svg(pugi::xml_node n) {
+        State state;
+        state.visible =
+            property(n, "visibility") != "hidden" && property(n, "visibility") != "collapse";
+        if (property(n, "display") == "none") return;
+        // Width and height in px; percentages mean "no size given" for the outermost <svg>.
+        const auto given = [&](const char* attribute) {
+            const std::string v = trim(n.attribute(attribute).value());
+            return !v.empty() && v.back() != '%';
+        };
+        double width = given("width") ? size(n, "width", kNoBase, 0) : kNoBase;
+        double height = given("height") ? size(n, "height", kNoBase, 0) : kNoBase;
+        Affine view;
+        if (const auto box = view_box(n)) {
+            const double w = (*box)[2], h = (*box)[3];
+            if (std::isnan(width) && std::isnan(height)) {
+                width = w;  // no size: one user unit is one px
+                height = h;
+            } else if (std::isnan(width)) {
+                width = height * w / h;
+            } else if (std::isnan(height)) {
+                height = width * h / w;
+            }
+            view = viewbox_map(n, *box, width, height);
+            state.width = w;
+            state.height = h;
+        } else {
+            state.width = width;
+            state.height = height;
+        }
+        if (width == 0 || height == 0) return;  // a zero-sized drawing draws nothing
+        state.to_mm = Affine::scale(kMmPerPx, kMmPerPx) * transform(n) * view;
+        if (state.to_mm.determinant() == 0) return;
+        children(n, state);
+    }
+
+    void children(pugi::xml_node n, const State& state) {
+        for (pugi::xml_node child = n.first_child(); child; child = child.next_sibling()) {
+            if (child.type() == pugi::node_element) element(child, state);
+        }
+    }
+
+    static bool conditions_hold(pugi::xml_node n) {
+        // <switch>: we know no extensions or languages, so any such test fails.
+        return !n.attribute("requiredExtensions") && !n.attribute("systemLanguage");
+    }
+
+    void element(pugi::xml_node n, const State& parent) {
+        const std::string name = svg_name(n);
+        if (name.empty() || property(n, "display") == "none") return;
+        State state = parent;
+        const std::string visibility = property(n, "visibility");
+        if (visibility == "hidden" || visibility == "collapse") state.visible = false;
+        if (visibility == "visible") state.visible = true;
+
+        if (name == "g" || name == "a" || name == "switch") {
+            state.to_mm = parent.to_mm * transform(n);
+            if (state.to_mm.determinant() == 0) return;
+            if (name != "switch") return children(n, state);
+            for (pugi::xml_node child = n.first_child(); child; child = child.next_sibling()) {
+                if (child.type() == pugi::node_element && !svg_name(child).empty() &&
+                    conditions_hold(child)) {
+                    return element(child, state);
+                }
+            }
+            return;
+        }
+        if (name == "svg") return nested_svg(n, parent, state);
+        if (name == "use") return use(n, parent, state);
+        static const char* const kShapes[] = {"path", "rect",     "circle", "ellipse",
+                                              "line", "polyline", "polygon"};
+        bool shape = false;
+        for (const char* s : kShapes) shape = shape || name == s;
+        if (!shape) return;  // defs, symbol, text, image, metadata, title, style, ...
+        state.to_mm = parent.to_mm * transform(n);
+        if (state.to_mm.determinant() == 0 || !state.visible) return;
+        geometry(n, name, state);
+    }
+
+    void nested_svg(pugi::xml_node n, const State& parent, State state) {
+        const double x = length(n, "x", parent.width, 0), y = length(n, "y", parent.height, 0);
+        const double width = size(n, "width", parent.width, parent.width);
+        const double height = size(n, "height", parent.height, parent.height);
+        viewport(n, parent.to_mm * transform(n) * Affine::translate(x, y), width, height, state);
+    }
+
+    // Enters the viewport of a nested <svg> or of a <symbol> drawn by <use>: `n`'s viewBox and
+    // preserveAspectRatio map its user units onto width x height at the origin of `to_mm`.
+    void viewport(pugi::xml_node n, const Affine& to_mm, double width, double height, State state) {
+        if (width == 0 || height == 0) return;  // a zero-sized viewport draws nothing
+        state.width = width;
+        state.height = height;
+        state.to_mm = to_mm;
+        if (const auto box = view_box(n)) {
+            if (std::isnan(width) || std::isnan(height)) {
+                fail_at(n, "viewBox",
+                        "a viewBox needs a viewport size (give <" + svg_name(n) +
+                            "> a width and height, or the root <svg> a size)");
+            }
+            state.to_mm = to_mm * viewbox_map(n, *box, width, height);
+            state.width = (*box)[2];
+            state.height = (*box)[3];
+        }
+        if (state.to_mm.determinant() == 0) return;
+        children(n, state);
+    }
+
+    // <use href="#id">: the element with that id, drawn here, moved by x and y. A <symbol>
+    // gets a viewport of the use's width and height. Other files' content is not drawn.
+    void use(pugi::xml_node n, const State& parent, State state) {
+        const char* const href_name = n.attribute("href") ? "href" : "xlink:href";
+        const std::string href = trim(n.attribute(href_name).value());
+        if (href.size() < 2 || href[0] != '#') return;
+        const pugi::xml_node target = element_by_id(href.substr(1));
+        if (!target) return;  // SVG: a reference to nothing draws nothing
+        for (const pugi::xml_node& active : use_stack_) {
+            if (active == target) {
+                fail_at(
+                    n, href_name,
+                    "<use> refers to " + href + ", which contains this <use> (circular reference)");
+            }
+        }
+        if (++use_count_ > kMaxUses) {
+            fail_at(n, nullptr,
+                    "too many <use> copies (more than " + std::to_string(kMaxUses) + ")");
+        }
+        const double x = length(n, "x", parent.width, 0), y = length(n, "y", parent.height, 0);
+        const Affine to_mm = parent.to_mm * transform(n) * Affine::translate(x, y);
+        if (to_mm.determinant() == 0) return;
+        use_stack_.push_back(target);
+        if (svg_name(target) == "symbol") {
+            if (property(target, "display") != "none") {
+                const std::string visibility = property(target, "visibility");
+                if (visibility == "hidden" || visibility == "collapse") state.visible = false;
+                if (visibility == "visible") state.visible = true;
+                const auto side = [&](const char* attribute, double base) {
+                    if (n.attribute(attribute)) return size(n, attribute, base, base);
+                    return size(target, attribute, base, base);
+                };
+                viewport(target, to_mm * transform(target), side("width", parent.width),
+                         side("height", parent.height), state);
+            }
+        } else {
+            state.to_mm = to_mm;
+            element(target, state);
+        }
+        use_stack_.pop_back();
+    }
+
+    pugi::xml_node element_by_id(const std::string& id) {
+        if (!ids_built_) {
+            ids_built_ = true;
+            std::vector<pugi::xml_node> todo{doc_.document_element()};
+            while (!todo.empty()) {
+                const pugi::xml_node e = todo.back();
+                todo.pop_back();
+                if (const pugi::xml_attribute a = e.attribute("id"))
+                    ids_.emplace(a.value(), e);  // first one wins
+                for (pugi::xml_node c = e.last_child(); c; c = c.previous_sibling()) {
+                    if (c.type() == pugi::node_element) todo.push_back(c);
+                }
+            }
+        }
+        const auto it = ids_.find(id);
+        return it == ids_.end() ? pugi::xml_node() : it->second;
+    }
+
+    void geometry(pugi::xml_node n, const std::string& name, const State& state) {
+        const double w = state.width, h = state.height;
+        const double diagonal = std::sqrt((w * w + h * h) / 2);  // what 100% of r is
+        const Affine& m = state.to_mm;
+        if (name == "path") {
+            if (!n.attribute("d")) return;
+            const CubicSubpaths pieces = with_attribute(n, "d", [&](std::string_view d) {
+                return svg::parse_path_data(d, m, tolerance_mm_);
+            });
+            return emit(pieces, m, attribute_location(n, "d"));
+        }
+        if (name == "polyline" || name == "polygon") {
+            const std::vector<Point> points = with_attribute(n, "points", [](std::string_view v) {
+                const std::vector<double> numbers = svg::parse_number_list(v, "points");
+                if (numbers.size() % 2 != 0) {
+                    throw svg::ValueError("points: odd number of coordinates (" +
+                                          std::to_string(numbers.size()) + ")");
+                }
+                std::vector<Point> out;
+                for (std::size_t i = 0; i < numbers.size(); i += 2)
+                    out.push_back({numbers[i], numbers[i + 1]});
+                return out;
+            });
+            return emit(CubicSubpaths{svg::polyline_cubics(points, name == "polygon")}, m,
+                        attribute_location(n, "points"));
+        }
+        const SourceLocation at = element_location(n);
+        if (name == "line") {
+            const Point a{length(n, "x1", w, 0), length(n, "y1", h, 0)};
+            const Point b{length(n, "x2", w, 0), length(n, "y2", h, 0)};
+            return emit(CubicSubpaths{std::vector<svg::Cubic>{svg::line_cubic(a, b)}}, m, at);
+        }
+        if (name == "rect") {
+            const double x = length(n, "x", w, 0), y = length(n, "y", h, 0);
+            const double width = size(n, "width", w, 0), height = size(n, "height", h, 0);
+            double rx = radius(n, "rx", w), ry = radius(n, "ry", h);
+            if (width == 0 || height == 0) return;
+            if (std::isnan(rx) && std::isnan(ry))
+                rx = ry = 0;
+            else if (std::isnan(rx))
+                rx = ry;
+            else if (std::isnan(ry))
+                ry = rx;
+            rx = std::min(rx, width / 2);
+            ry = std::min(ry, height / 2);
+            return emit(
+                CubicSubpaths{svg::rect_cubics(x, y, width, height, rx, ry, m, tolerance_mm_)}, m,
+                at);
+        }
+        const Point center{length(n, "cx", w, 0), length(n, "cy", h, 0)};
+        double rx = 0, ry = 0;
+        if (name == "circle") {
+            rx = ry = size(n, "r", diagonal, 0);
+        } else {  // ellipse
+            rx = radius(n, "rx", w);
+            ry = radius(n, "ry", h);
+            if (std::isnan(rx)) rx = std::isnan(ry) ? 0 : ry;
+            if (std::isnan(ry)) ry = rx;
+        }
+        if (rx == 0 || ry == 0) return;
+        emit(CubicSubpaths{svg::ellipse_cubics(center, rx, ry, m, tolerance_mm_)}, m, at);
+    }
+
+    // Maps pieces to mm and appends them as Bezier subpaths.
+    void emit(const CubicSubpaths& subpaths, const Affine& to_mm, SourceLocation at) {
+        for (const auto& pieces : subpaths) {
+            Subpath sp;
+            sp.basis = PathBasis::kBezier;
+            sp.closed = false;
+            sp.location = at;
+            for (const svg::Cubic& c : pieces) {
+                Point mm[4];
+                bool degenerate = true;
+                for (int k = 0; k < 4; ++k) {
+                    mm[k] = to_mm(c[k]);
+                    degenerate = degenerate &&
+                                 std::hypot(mm[k].x - mm[0].x, mm[k].y - mm[0].y) <= kDegenerateMm;
+                }
+                if (degenerate) continue;
+                for (int k = sp.points.empty() ? 0 : 1; k < 4; ++k) {
+                    check(mm[k].x, at);
+                    check(mm[k].y, at);
+                    sp.points.push_back({mm[k].x, mm[k].y});
+                }
+            }
+            if (!sp.points.empty()) path_.subpaths.push_back(std::move(sp));
+        }
+    }
+
+    void check(double mm, SourceLocation at) const {
+        if (!std::isfinite(mm))
+            throw InputError(file_, at, "coordinate is not finite after units and transforms");
+        if (std::fabs(mm) > kMaxCoordinateMm) {
+            throw InputError(file_, at,
+                             "coordinate " + number_text(mm, 10) +
+                                 " mm is out of range (|value| <= " +
+                                 number_text(kMaxCoordinateMm) + " mm after units and transforms)");
+        }
+    }
+
+    const std::string& text_;
+    const std::string& file_;
+    double tolerance_mm_;
+    pugi::xml_document doc_;
+    Path path_;
+    std::unordered_map<std::string, pugi::xml_node> ids_;
+    bool ids_built_ = false;
+    std::vector<pugi::xml_node> use_stack_;  // targets of the <use> elements being drawn
+    std::size_t use_count_ = 0;
+};
+
+}  // namespace
+
+Path parse_svg_path(const std::string& text, const std::string& file, double tolerance_mm) {
+    if (!(tolerance_mm > 0) || !std::isfinite(tolerance_mm)) {
+        throw InputError(
+            file, {},
+            "tolerance must be positive and finite (got " + number_text(tolerance_mm) + " mm)");
+    }
+    return Reader(text, file, tolerance_mm).read();
+}
+
+Path load_svg_path(const std::string& file, double tolerance_mm) {
+    std::ifstream in(file, std::ios::binary);
+    if (!in) throw InputError(file, {}, "cannot open file");
+    std::ostringstream buffer;
+    buffer << in.rdbuf();
+    if (in.bad()) throw InputError(file, {}, "cannot read file");
+    return parse_svg_path(buffer.str(), file, tolerance_mm);
+}
+
+}  // namespace pathstream::host
