@@ -8,6 +8,7 @@
 #include "pathstream/host/gcode_path.hpp"
 #include "pathstream/host/input_error.hpp"
 #include "pathstream/host/json_path.hpp"
+#include "pathstream/host/svg_path.hpp"
 
 namespace pathstream::host {
 
@@ -42,6 +43,7 @@ Path load_path(const PathOptions& o) {
                                                                                  : o.file.find_last_of('.'));
     std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
     if (ext == ".json") return load_json_path(o.file);
+    if (ext == ".svg") return load_svg_path(o.file, o.tolerance);
     if (ext == ".csv") return load_csv_path(o.file, basis_from_name(o.csv_basis), o.csv_closed);
     if (ext == ".gcode" || ext == ".ngc" || ext == ".nc" || ext == ".gc") {
         GcodeOptions g;
