@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
-# The main job: build pathstream (incrementally) and run a path through the exact core.
-#   scripts/main.sh                      # examples/rose.json -> out/rose.csv
-#   scripts/main.sh setpoints FILE ...   # any pathstream command line
+# The main job: build pathstream (incrementally), plan an example drawing for a pen plotter
+# and run it on the simulated plotter: a report on screen, plots in out/rose/.
+#   scripts/main.sh                  # examples/rose.json on examples/machines/pen_plotter.json
+#   scripts/main.sh COMMAND ARGS...  # any pathstream command line (pathstream --help)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/setup.sh >/dev/null
@@ -11,6 +12,6 @@ fi
 cmake --build --preset default --target pathstream >/dev/null
 if [ $# -eq 0 ]; then
   mkdir -p out
-  set -- setpoints examples/rose.json --ticks-per-span 32 --out out/rose.csv
+  set -- sim examples/rose.json --machine examples/machines/pen_plotter.json --plot out/rose
 fi
 exec build/default/host/pathstream "$@"

@@ -1,25 +1,36 @@
 // pathstream: the command-line tool. Exit codes (docs/cli.md): 0 success, 1 bad input file,
-// 2 bad command line, 3 output could not be written, 4 internal error.
+// 2 bad command line, 3 output could not be written, 4 internal error, 5 planning failed.
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <exception>
 #include <iostream>
 
 #include "pathstream/host/input_error.hpp"
+#include "pathstream/host/planner.hpp"
+#include "cli/check_command.hpp"
 #include "cli/eval_command.hpp"
+#include "cli/plan_command.hpp"
 #include "cli/setpoints_command.hpp"
+#include "cli/sim_command.hpp"
 
 namespace {
 constexpr int kExitInput = 1;
 constexpr int kExitUsage = 2;
 constexpr int kExitOutput = 3;
 constexpr int kExitInternal = 4;
+constexpr int kExitPlanning = 5;
 }  // namespace
 
 int main(int argc, char** argv) {
     CLI::App app{"pathstream: exact spline paths to timed setpoints for plotters and servo axes"};
     app.require_subcommand(1);
     app.set_version_flag("--version", "pathstream 0.1.0");
+    pathstream::host::CheckOptions check;
+    pathstream::host::add_check_command(app, check);
+    pathstream::host::PlanCommandOptions plan;
+    pathstream::host::add_plan_command(app, plan);
+    pathstream::host::SimCommandOptions sim;
+    pathstream::host::add_sim_command(app, sim);
     pathstream::host::SetpointsOptions setpoints;
     pathstream::host::add_setpoints_command(app, setpoints);
     pathstream::host::EvalOptions eval;
@@ -39,9 +50,15 @@ int main(int argc, char** argv) {
     try {
         if (app.got_subcommand("setpoints")) return pathstream::host::run_setpoints(setpoints);
         if (app.got_subcommand("eval")) return pathstream::host::run_eval(eval);
+        if (app.got_subcommand("check")) return pathstream::host::run_check(check);
+        if (app.got_subcommand("plan")) return pathstream::host::run_plan(plan);
+        if (app.got_subcommand("sim")) return pathstream::host::run_sim(sim);
     } catch (const pathstream::host::InputError& e) {
         std::cerr << e.what() << '\n';
         return kExitInput;
+    } catch (const pathstream::host::PlanError& e) {
+        std::cerr << "pathstream: planning failed: " << e.what() << '\n';
+        return kExitPlanning;
     } catch (const std::runtime_error& e) {
         std::cerr << "pathstream: " << e.what() << '\n';
         return kExitOutput;

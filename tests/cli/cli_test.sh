@@ -45,5 +45,24 @@ out=$("$bin" eval "$work/inch.json" --samples-per-span 2 2>/dev/null | tail -1)
 if [ "$out" != "0,1,1,0.5" ]; then echo "FAIL eval-inches: $out"; failures=$((failures + 1)); else passed=$((passed + 1)); fi
 expect eval-unknown-type 1 "unknown file type" -- "$bin" eval "$src/README.md"
 
+# check, plan and sim on the example drawing and machine
+machine="$src/examples/machines/pen_plotter.json"
+expect check 0 "subpaths: 2" -- "$bin" check "$src/examples/rose.json"
+expect check-gcode 0 "valid" -- "$bin" check "$src/examples/leaf.ngc"
+expect plan 0 "within limits; no motion while the pen moves" -- "$bin" plan "$src/examples/rose.json" -m "$machine" --out "$work/plan.csv"
+if [ "$(head -1 "$work/plan.csv")" != "tick,t,x,y,pen" ] || [ "$(sed -n 2p "$work/plan.csv" | cut -d, -f1-2)" != "0,0" ]; then
+  echo "FAIL plan csv: $(head -2 "$work/plan.csv" | tr '\n' ' ')"; failures=$((failures + 1))
+else
+  passed=$((passed + 1))
+fi
+expect sim 0 "0 underruns" -- "$bin" sim "$src/examples/rose.json" -m "$machine" --plot "$work/plots"
+for f in path.svg speed.svg acceleration.svg; do
+  if [ -s "$work/plots/$f" ]; then passed=$((passed + 1)); else echo "FAIL sim did not write $f"; failures=$((failures + 1)); fi
+done
+printf '{"axes": [{"name": "x", "max_velocity": 100, "max_acceleration": 1000}]}' > "$work/one_axis.json"
+expect axes-mismatch 1 "the machine has 1 axes but" -- "$bin" plan "$src/examples/rose.json" -m "$work/one_axis.json"
+printf '{"axes": [{"name": "x", "max_velocity": -1, "max_acceleration": 1000}]}' > "$work/bad_machine.json"
+expect bad-machine 1 "bad_machine.json:1:41: max_velocity -1 mm/s is impossible" -- "$bin" plan "$src/examples/rose.json" -m "$work/bad_machine.json"
+
 echo "cli: $passed passed, $failures failed"
 [ "$failures" -eq 0 ]

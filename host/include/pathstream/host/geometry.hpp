@@ -15,6 +15,8 @@ struct BezierSegment {
     std::array<PathPoint, 4> p;
     bool pen_down = true;     ///< false: pen-up travel between subpaths
     std::size_t subpath = 0;  ///< index into Path::subpaths (travel: the subpath it leads to)
+    double feed = 0;          ///< requested speed, mm/s (Subpath::feed); 0: the machine profile's
+                              ///< feed (travel_feed for pen-up travel)
 };
 
 /// Converts every subpath to Bezier segments (B-spline and Catmull-Rom spans exactly, with the

@@ -36,6 +36,18 @@ struct PlanCheck {
     std::uint64_t worst_deviation_tick = 0;
     bool within_limits = false;            ///< every fraction <= 1 (after the quantisation allowance)
     bool drawing_while_pen_moves = false;  ///< true if any tick moves while the pen settles
+
+    // The same fractions without the rounding allowance: `raw` from the integer setpoints,
+    // `exact` from the core's exact cubic before its one rounding (docs/planner.md).
+    double max_velocity_fraction_raw = 0;
+    double max_acceleration_fraction_raw = 0;
+    double max_velocity_fraction_exact = 0;
+    double max_acceleration_fraction_exact = 0;
+    /// Max over moving ticks of the per-tick speed along the path over the requested feed
+    /// (pen-down: the subpath's feed; pen-up: travel_feed), after an allowance of
+    /// 2 sqrt(axes) LSB per tick for the rounding of setpoints and span end points.
+    double max_feed_fraction = 0;
+    std::uint64_t ticks_checked = 0;       ///< setpoints examined (the end point included)
 };
 
 }  // namespace pathstream::host

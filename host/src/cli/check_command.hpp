@@ -1,0 +1,17 @@
+// `pathstream check`: validate a path file and summarise it.
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+#include "path_options.hpp"
+
+namespace pathstream::host {
+
+struct CheckOptions {
+    PathOptions path;
+};
+
+void add_check_command(CLI::App& app, CheckOptions& options);
+int run_check(const CheckOptions& options);
+
+}  // namespace pathstream::host

@@ -1,0 +1,101 @@
+#include "plan_command.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <iostream>
+#include <stdexcept>
+
+#include "pathstream/host/atomic_file.hpp"
+#include "pathstream/host/core_playback.hpp"
+#include "pathstream/host/input_error.hpp"
+#include "pathstream/host/planner.hpp"
+#include "pathstream/host/progress.hpp"
+
+namespace pathstream::host {
+
+void add_plan_command(CLI::App& app, PlanCommandOptions& o) {
+    CLI::App* cmd = app.add_subcommand(
+        "plan", "Plan the path for a machine (near time-optimal under its limits) and write the executed setpoints as "
+                "CSV tick,t,x,y,...,pen in mm");
+    add_path_options(*cmd, o.path);
+    cmd->add_option("--machine,-m", o.machine, "machine profile (JSON, docs/formats.md)")->required()->check(CLI::ExistingFile);
+    cmd->add_option("--out,-o", o.output, "CSV output file (default: only the summary)");
+}
+
+PlannedJob plan_job(const PathOptions& path_options, const std::string& machine_file) {
+    PlannedJob job;
+    job.path = load_path(path_options);
+    job.machine = load_machine_profile(machine_file);
+    if (job.machine.axes.size() != job.path.axes) {
+        throw InputError(machine_file, {}, "the machine has " + std::to_string(job.machine.axes.size()) +
+                                               " axes but " + path_options.file + " has " +
+                                               std::to_string(job.path.axes));
+    }
+    job.segments = to_bezier_segments(job.path);
+    const auto t0 = std::chrono::steady_clock::now();
+    {
+        ProgressBar bar("planning");
+        job.plan = plan_path(job.segments, job.machine, [&](double f) { bar.update(f); });
+    }
+    job.planning_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    job.check = check_plan(job.plan, job.segments, job.machine);
+    return job;
+}
+
+std::string lsb_to_mm_text(Lsb value, double mm_per_lsb) {
+    double lsb_per_mm = 1.0 / mm_per_lsb;
+    if (std::fabs(lsb_per_mm - std::round(lsb_per_mm)) < 1e-9 * lsb_per_mm) lsb_per_mm = std::round(lsb_per_mm);
+    return exact_decimal(value / lsb_per_mm);
+}
+
+void print_plan_summary(const PlannedJob& job, std::ostream& out) {
+    const PlanCheck& c = job.check;
+    char line[256];
+    std::snprintf(line, sizeof line, "  motion: %.3f s (%llu ticks at %g Hz), %zu spans, %zu pen changes\n",
+                  job.plan.duration, static_cast<unsigned long long>(job.plan.total_ticks), job.machine.tick_hz,
+                  job.plan.spans.size(), job.plan.pen.size());
+    out << line;
+    std::snprintf(line, sizeof line, "  path: %.3f mm drawn, %.3f mm travel; planned in %.3f s\n", job.plan.path_length,
+                  job.plan.travel_length, job.planning_seconds);
+    out << line;
+    std::snprintf(line, sizeof line, "  max deviation from the path: %.2f um (tolerance %.2f um) at tick %llu\n",
+                  c.max_deviation * 1000, job.machine.chord_tolerance * 1000,
+                  static_cast<unsigned long long>(c.worst_deviation_tick));
+    out << line;
+    for (std::size_t a = 0; a < job.machine.axes.size(); ++a) {
+        std::snprintf(line, sizeof line, "  axis %s: peak %.1f %% of max velocity, %.1f %% of max acceleration\n",
+                      job.machine.axes[a].name.c_str(), 100 * c.axis_velocity_fraction.at(a),
+                      100 * c.axis_acceleration_fraction.at(a));
+        out << line;
+    }
+    std::snprintf(line, sizeof line, "  every tick checked (%llu): %s%s\n", static_cast<unsigned long long>(c.ticks_checked),
+                  c.within_limits ? "within limits" : "LIMITS EXCEEDED",
+                  c.drawing_while_pen_moves ? "; MOTION WHILE THE PEN MOVES" : "; no motion while the pen moves");
+    out << line;
+}
+
+int run_plan(const PlanCommandOptions& o) {
+    const PlannedJob job = plan_job(o.path, o.machine);
+    if (!o.output.empty()) {
+        AtomicFile file(o.output);
+        std::ostream& csv = file.stream();
+        csv << "tick,t";
+        for (std::size_t a = 0; a < job.path.axes; ++a) csv << ',' << axis_column_name(a);
+        csv << ",pen\n";
+        play_through_core(job.plan.spans, job.path.axes, [&](const PlayedTick& t) {
+            csv << t.tick << ',' << exact_decimal(static_cast<double>(t.tick) / job.machine.tick_hz);
+            for (std::size_t a = 0; a < job.path.axes; ++a) csv << ',' << lsb_to_mm_text(t.setpoint[a], job.machine.mm_per_lsb);
+            csv << ',' << (t.pen_down ? 1 : 0) << '\n';
+        });
+        file.commit();
+    }
+    std::cout << "pathstream plan: " << o.path.file << " on " << o.machine
+              << (o.output.empty() ? "" : " -> " + o.output) << '\n';
+    print_plan_summary(job, std::cout);
+    if (!job.check.within_limits || job.check.drawing_while_pen_moves) {
+        throw PlanError("the plan failed its per-tick check (a planner bug): see the summary above");
+    }
+    return 0;
+}
+
+}  // namespace pathstream::host

@@ -1,0 +1,43 @@
+// `pathstream plan`: time a path for a machine and write the setpoints the device executes.
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <string>
+
+#include "path_options.hpp"
+#include "pathstream/host/geometry.hpp"
+#include "pathstream/host/machine.hpp"
+#include "pathstream/host/plan.hpp"
+
+namespace pathstream::host {
+
+struct PlanCommandOptions {
+    PathOptions path;
+    std::string machine;
+    std::string output;
+};
+
+void add_plan_command(CLI::App& app, PlanCommandOptions& options);
+int run_plan(const PlanCommandOptions& options);
+
+/// What plan and sim share: the path, the machine, the geometry, the plan and its check.
+struct PlannedJob {
+    Path path;
+    MachineProfile machine;
+    std::vector<BezierSegment> segments;
+    Plan plan;
+    PlanCheck check;
+    double planning_seconds = 0;
+};
+
+/// Loads both files, checks they agree (axis count), plans with a progress bar and checks
+/// every tick. Throws InputError for bad files, PlanError when planning fails.
+PlannedJob plan_job(const PathOptions& path, const std::string& machine_file);
+
+/// The summary lines both commands print (duration, lengths, deviation, limit fractions).
+void print_plan_summary(const PlannedJob& job, std::ostream& out);
+
+/// Millimetres of an LSB count, as the shortest exact decimal (one division, see eval).
+std::string lsb_to_mm_text(Lsb value, double mm_per_lsb);
+
+}  // namespace pathstream::host

@@ -1,0 +1,25 @@
+// `pathstream sim`: plan, then run the plan on the simulated plotter; plots and a report.
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <string>
+
+#include "path_options.hpp"
+
+namespace pathstream::host {
+
+struct SimCommandOptions {
+    PathOptions path;
+    std::string machine;
+    std::string plot_dir;
+    bool realtime = false;
+    std::string plant = "servo";
+    double bandwidth_hz = 50;
+    double damping = 1.0;
+    bool y_up = false;
+};
+
+void add_sim_command(CLI::App& app, SimCommandOptions& options);
+int run_sim(const SimCommandOptions& options);
+
+}  // namespace pathstream::host

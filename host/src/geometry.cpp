@@ -1,0 +1,181 @@
+// Path -> cubic Bezier segments in millimetres (the planner's input), and Bezier evaluation.
+#include "pathstream/host/geometry.hpp"
+
+#include <stdexcept>
+#include <string>
+
+namespace pathstream::host {
+namespace {
+
+using Window = std::array<const PathPoint*, 4>;
+
+PathPoint combine(const PathPoint& a, double wa, const PathPoint& b, double wb) {
+    PathPoint r(a.size());
+    for (std::size_t i = 0; i < a.size(); ++i) r[i] = wa * a[i] + wb * b[i];
+    return r;
+}
+
+PathPoint reflect(const PathPoint& end, const PathPoint& next) {  // phantom point 2 end - next
+    return combine(end, 2.0, next, -1.0);
+}
+
+/// Four-point windows of a uniform B-spline or Catmull-Rom subpath, as core_spans.cpp makes
+/// them: open ends get phantom points 2 P0 - P1 and 2 Pm - Pm-1; closed subpaths are periodic.
+std::vector<Window> windows(const std::vector<PathPoint>& pts, bool closed,
+                            std::vector<PathPoint>& storage) {
+    const std::size_t m = pts.size();
+    std::vector<Window> out;
+    if (closed) {
+        for (std::size_t i = 0; i < m; ++i) {
+            out.push_back({&pts[(i + m - 1) % m], &pts[i], &pts[(i + 1) % m], &pts[(i + 2) % m]});
+        }
+        return out;
+    }
+    storage.clear();
+    storage.push_back(reflect(pts[0], pts[1]));
+    storage.push_back(reflect(pts[m - 1], pts[m - 2]));
+    std::vector<const PathPoint*> ext;
+    ext.push_back(&storage[0]);
+    for (const auto& p : pts) ext.push_back(&p);
+    ext.push_back(&storage[1]);
+    for (std::size_t i = 0; i + 3 < ext.size(); ++i) out.push_back({ext[i], ext[i + 1], ext[i + 2], ext[i + 3]});
+    return out;
+}
+
+/// Weighted sum w0 Q0 + w1 Q1 + w2 Q2 + w3 Q3 of a window.
+PathPoint weigh(const Window& q, double w0, double w1, double w2, double w3) {
+    PathPoint r(q[0]->size());
+    for (std::size_t i = 0; i < r.size(); ++i) {
+        r[i] = w0 * (*q[0])[i] + w1 * (*q[1])[i] + w2 * (*q[2])[i] + w3 * (*q[3])[i];
+    }
+    return r;
+}
+
+/// Bezier control points of a uniform cubic B-spline window: rows [1 4 1 0]/6, [0 4 2 0]/6,
+/// [0 2 4 0]/6, [0 1 4 1]/6.
+std::array<PathPoint, 4> bspline_to_bezier(const Window& q) {
+    return {weigh(q, 1.0 / 6, 4.0 / 6, 1.0 / 6, 0), weigh(q, 0, 4.0 / 6, 2.0 / 6, 0),
+            weigh(q, 0, 2.0 / 6, 4.0 / 6, 0), weigh(q, 0, 1.0 / 6, 4.0 / 6, 1.0 / 6)};
+}
+
+/// Bezier control points of a uniform Catmull-Rom window (P0..P3, curve from P1 to P2):
+/// (P1, P1 + (P2 - P0)/6, P2 - (P3 - P1)/6, P2).
+std::array<PathPoint, 4> catmull_rom_to_bezier(const Window& q) {
+    return {*q[1], weigh(q, -1.0 / 6, 1, 1.0 / 6, 0), weigh(q, 0, 1.0 / 6, 1, -1.0 / 6), *q[2]};
+}
+
+/// A straight cubic from a to b with its handles at the thirds (uniform speed in u).
+std::array<PathPoint, 4> straight(const PathPoint& a, const PathPoint& b) {
+    return {a, combine(a, 2.0 / 3, b, 1.0 / 3), combine(a, 1.0 / 3, b, 2.0 / 3), b};
+}
+
+std::vector<std::array<PathPoint, 4>> subpath_segments(const Subpath& sp, std::size_t index) {
+    const auto& pts = sp.points;
+    const std::size_t m = pts.size();
+    std::vector<std::array<PathPoint, 4>> out;
+    const auto too_few = [&](const char* need) {
+        throw std::invalid_argument("subpath " + std::to_string(index) + ": " + basis_name(sp.basis) +
+                                    " needs " + need + " points, got " + std::to_string(m));
+    };
+    switch (sp.basis) {
+        case PathBasis::kBSpline:
+        case PathBasis::kCatmullRom: {
+            if (m < (sp.closed ? 3u : 2u)) too_few(sp.closed ? "at least 3" : "at least 2");
+            std::vector<PathPoint> storage;
+            for (const Window& w : windows(pts, sp.closed, storage)) {
+                out.push_back(sp.basis == PathBasis::kBSpline ? bspline_to_bezier(w) : catmull_rom_to_bezier(w));
+            }
+            if (!sp.closed) {  // the clamped ends are exactly the first and last points
+                out.front()[0] = pts.front();
+                out.back()[3] = pts.back();
+            }
+            break;
+        }
+        case PathBasis::kBezier: {
+            if (sp.closed ? (m < 3 || m % 3 != 0) : (m < 4 || m % 3 != 1)) too_few(sp.closed ? "3k" : "3k + 1");
+            const std::size_t count = sp.closed ? m / 3 : (m - 1) / 3;
+            for (std::size_t i = 0; i < count; ++i) {
+                out.push_back({pts[3 * i], pts[3 * i + 1], pts[3 * i + 2], pts[(3 * i + 3) % m]});
+            }
+            break;
+        }
+        case PathBasis::kPolyline: {
+            if (m < (sp.closed ? 3u : 2u)) too_few(sp.closed ? "at least 3" : "at least 2");
+            const std::size_t count = sp.closed ? m : m - 1;
+            for (std::size_t i = 0; i < count; ++i) out.push_back(straight(pts[i], pts[(i + 1) % m]));
+            break;
+        }
+    }
+    // Joints are shared exactly (not merely to rounding), and a closed subpath ends where it starts.
+    for (std::size_t i = 1; i < out.size(); ++i) out[i][0] = out[i - 1][3];
+    if (sp.closed && !out.empty()) out.back()[3] = out.front()[0];
+    return out;
+}
+
+}  // namespace
+
+std::vector<BezierSegment> to_bezier_segments(const Path& path) {
+    std::vector<BezierSegment> out;
+    for (std::size_t s = 0; s < path.subpaths.size(); ++s) {
+        const Subpath& sp = path.subpaths[s];
+        for (const auto& p : sp.points) {
+            if (p.size() != path.axes) {
+                throw std::invalid_argument("subpath " + std::to_string(s) + ": a point has " +
+                                            std::to_string(p.size()) + " coordinates, expected " +
+                                            std::to_string(path.axes));
+            }
+        }
+        auto segments = subpath_segments(sp, s);
+        if (segments.empty()) continue;
+        if (!out.empty()) {  // straight pen-up travel from the last end point to this start
+            BezierSegment travel;
+            travel.p = straight(out.back().p[3], segments.front()[0]);
+            travel.pen_down = false;
+            travel.subpath = s;
+            out.push_back(std::move(travel));
+        }
+        for (auto& p : segments) {
+            BezierSegment seg;
+            seg.p = std::move(p);
+            seg.pen_down = true;
+            seg.subpath = s;
+            seg.feed = sp.feed;
+            out.push_back(std::move(seg));
+        }
+    }
+    return out;
+}
+
+PathPoint bezier_point(const BezierSegment& s, double u) {
+    const double v = 1 - u;
+    PathPoint r(s.p[0].size());
+    for (std::size_t i = 0; i < r.size(); ++i) {  // de Casteljau, each lerp exact at u = 0 and 1
+        const double a = v * s.p[0][i] + u * s.p[1][i];
+        const double b = v * s.p[1][i] + u * s.p[2][i];
+        const double c = v * s.p[2][i] + u * s.p[3][i];
+        const double ab = v * a + u * b, bc = v * b + u * c;
+        r[i] = v * ab + u * bc;
+    }
+    return r;
+}
+
+PathPoint bezier_d1(const BezierSegment& s, double u) {
+    const double v = 1 - u;
+    PathPoint r(s.p[0].size());
+    for (std::size_t i = 0; i < r.size(); ++i) {
+        r[i] = 3 * (v * v * (s.p[1][i] - s.p[0][i]) + 2 * u * v * (s.p[2][i] - s.p[1][i]) +
+                    u * u * (s.p[3][i] - s.p[2][i]));
+    }
+    return r;
+}
+
+PathPoint bezier_d2(const BezierSegment& s, double u) {
+    const double v = 1 - u;
+    PathPoint r(s.p[0].size());
+    for (std::size_t i = 0; i < r.size(); ++i) {
+        r[i] = 6 * (v * (s.p[2][i] - 2 * s.p[1][i] + s.p[0][i]) + u * (s.p[3][i] - 2 * s.p[2][i] + s.p[1][i]));
+    }
+    return r;
+}
+
+}  // namespace pathstream::host

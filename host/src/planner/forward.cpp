@@ -1,0 +1,501 @@
+// The forward pass in whole ticks: from rest at the start of a piece, one span of
+// ticks_per_span ticks at a time, each with constant acceleration along the path, as fast as
+// the executed Hermite span allows and never above the lookahead's controllable speed (beta);
+// then one final span of at most ticks_per_span ticks that ends at rest exactly at the piece's
+// end. What is checked is the cubic the device will run between two knots (positions and
+// velocities at both ends), not the continuous profile, so acceleration switches inside a span
+// cannot overshoot the limits.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+
+#include "internal.hpp"
+
+namespace pathstream::host::planner_detail {
+namespace {
+
+class PieceTimer {
+public:
+    PieceTimer(const PathGrid& pg, const Piece& piece, const Limits& limits, const std::vector<double>& caps,
+               const std::vector<double>& beta, const MachineProfile& profile, const PlanOptions& options)
+        : pg_(pg), g_(pg.grid), piece_(piece), caps_(caps), beta_(beta), axes_(pg.grid.axes),
+          tick_(1.0 / profile.tick_hz), n_(profile.ticks_per_span) {
+        for (std::size_t i = 0; i < axes_; ++i) {
+            acc_[i] = limits.acceleration[i] * options.acceleration_margin;
+            vel_[i] = limits.velocity[i] * options.velocity_margin;
+            acc_norm_ += acc_[i] * acc_[i];
+        }
+        acc_norm_ = std::sqrt(acc_norm_);
+        feed_ = piece.feed * options.feed_margin;
+        delta_ = profile.chord_tolerance;
+        end_lambda_ = g_.lambda[piece.last];
+        end_q_ = g_.q[piece.last];
+    }
+
+    PieceMotion run(const PieceMotion* resume, double resume_lambda, bool short_spans) {
+        PieceMotion out;
+        Knot k;
+        k.lambda = g_.lambda[piece_.first];
+        k.q = g_.q[piece_.first];
+        out.start = k;
+        if (piece_.first == piece_.last || !(end_lambda_ - k.lambda > 1e-12)) return out;
+        if (resume != nullptr) {  // keep the knots (and the spans ending there) before resume_lambda
+            for (const MotionSpan& s : resume->spans) {
+                if (!(s.end.lambda < resume_lambda) || s.end.lambda >= end_lambda_) break;
+                out.spans.push_back(s);
+                k = s.end;
+            }
+        }
+        const std::size_t limit = 50'000'000;
+        while (out.spans.size() < limit) {
+            if (const std::uint32_t f = finish(k); f > 0) {
+                out.spans.push_back({f, end_knot()});
+                return out;
+            }
+            if (Knot mid; const std::uint32_t f = land(k, mid)) {
+                out.spans.push_back({n_, mid});
+                out.spans.push_back({f, end_knot()});
+                return out;
+            }
+            Knot next;
+            std::uint32_t ticks = 0;
+            for (std::uint32_t m = n_; m >= (short_spans ? 1u : n_) && ticks == 0; --m) {
+                if (step(k, m, next)) ticks = m;
+            }
+            if (ticks == 0 || (!(next.lambda > k.lambda) && next.speed <= 0 && k.speed <= 0)) {
+                out.ok = false;
+                out.fail_lambda = k.lambda;
+                out.fail_speed = k.speed;
+                return out;
+            }
+            out.spans.push_back({ticks, next});
+            k = next;
+        }
+        out.ok = false;
+        out.fail_lambda = k.lambda;
+        out.fail_speed = k.speed;
+        return out;
+    }
+
+private:
+    Knot end_knot() const {
+        Knot e;
+        e.lambda = end_lambda_;
+        e.q = end_q_;
+        return e;
+    }
+
+    /// The last two spans at once, when the end is near: a span of ticks_per_span ticks with
+    /// constant path acceleration A, then a final span of f ticks (1..ticks_per_span) to rest at
+    /// the end. Along the path both spans' end accelerations are affine in A, so for each f the
+    /// A that keep them within the path acceleration limit L (the smallest a_i / |t_i| at the
+    /// end) form an exact interval; its middle, then its ends, are checked on the executed
+    /// spans. Returns the smallest f that works (0: none) and the knot between the two spans.
+    std::uint32_t land(const Knot& k, Knot& mid) {
+        const double tau = n_ * tick_;
+        const double d = end_lambda_ - k.lambda, v = k.speed;
+        // Reachable only if the end is within two spans at the current speed plus full
+        // acceleration; cheap test first.
+        if (d > v * 2 * tau + acc_norm_ * 2 * tau * tau) return 0;
+        double lim = acc_norm_;
+        std::size_t h = hint_;
+        const Vec t_end = path_at(pg_, piece_, end_lambda_, h).t;
+        for (std::size_t i = 0; i < axes_; ++i) {
+            if (std::fabs(t_end[i]) > 1e-12) lim = std::min(lim, acc_[i] / std::fabs(t_end[i]));
+        }
+        for (std::uint32_t f = 1; f <= n_; ++f) {
+            const double tf = f * tick_;
+            double lo = std::max(-lim, -v / tau), hi = lim;  // the first span, and V' >= 0
+            hi = std::min(hi, 2 * (d - v * tau) / (tau * tau));  // d' >= 0
+            // Final span along the path: a0 = 6 d'/tf^2 - 4 V'/tf, a1 = -6 d'/tf^2 + 2 V'/tf.
+            const double base = 6 * (d - v * tau) / (tf * tf);
+            const double a0c = base - 4 * v / tf, a0s = -(3 * tau * tau / (tf * tf) + 4 * tau / tf);
+            const double a1c = -base + 2 * v / tf, a1s = 3 * tau * tau / (tf * tf) + 2 * tau / tf;
+            for (const auto& [c, sl] : {std::pair{a0c, a0s}, std::pair{a1c, a1s}}) {
+                double x = (-lim - c) / sl, y = (lim - c) / sl;
+                if (x > y) std::swap(x, y);
+                lo = std::max(lo, x);
+                hi = std::min(hi, y);
+            }
+            if (lo > hi) continue;
+            for (const double a : {0.5 * (lo + hi), hi, lo, lo + 0.75 * (hi - lo), lo + 0.25 * (hi - lo)}) {
+                if (!under_beta(k, a, tau)) continue;
+                Candidate c = evaluate(k, a, tau);
+                if (c.f > 0 || !finish_ok(c.end, f)) continue;
+                mid = c.end;
+                return f;
+            }
+        }
+        return 0;
+    }
+
+    /// Node index of the interval holding lambda (lambda[i] <= lambda < lambda[i+1]).
+    std::size_t interval(double lambda) const {
+        const auto b = g_.lambda.begin();
+        auto it = std::upper_bound(b + static_cast<std::ptrdiff_t>(piece_.first),
+                                   b + static_cast<std::ptrdiff_t>(piece_.last) + 1, lambda);
+        std::size_t i = static_cast<std::size_t>(it - b);
+        i = i == 0 ? 0 : i - 1;
+        return std::clamp(i, piece_.first, piece_.last == piece_.first ? piece_.first : piece_.last - 1);
+    }
+
+    double interpolate(const std::vector<double>& v, double lambda) const {
+        const std::size_t i = interval(lambda);
+        const double l0 = g_.lambda[i], l1 = g_.lambda[i + 1];
+        if (!(l1 > l0)) return std::min(v[i], v[i + 1]);
+        const double w = std::clamp((lambda - l0) / (l1 - l0), 0.0, 1.0);
+        return (1 - w) * v[i] + w * v[i + 1];
+    }
+
+    /// True when constant path acceleration A for tau seconds from k keeps x = s^2 under beta
+    /// at every node passed and at the end.
+    bool under_beta(const Knot& k, double a, double tau) const {
+        double v1 = k.speed + a * tau;
+        if (v1 < -1e-9 * (1 + k.speed)) return false;
+        v1 = std::max(v1, 0.0);
+        const double l1 = k.lambda + k.speed * tau + 0.5 * a * tau * tau;
+        if (l1 > end_lambda_ + 1e-12) return false;
+        const double x0 = k.speed * k.speed;
+        const auto tol = [](double b) { return b * 1e-9 + 1e-12; };
+        for (std::size_t i = interval(k.lambda) + 1; i <= piece_.last && g_.lambda[i] <= l1; ++i) {
+            if (!(g_.lambda[i] > k.lambda)) continue;
+            if (x0 + 2 * a * (g_.lambda[i] - k.lambda) > beta_[i] + tol(beta_[i])) return false;
+        }
+        const double b1 = interpolate(beta_, l1);
+        return v1 * v1 <= b1 + tol(b1);
+    }
+
+    /// Largest A in [a_lo, a_hi] keeping the speed under beta, or false if even a_lo fails.
+    bool max_under_beta(const Knot& k, double tau, double a_lo, double a_hi, double& a) const {
+        if (!under_beta(k, a_lo, tau)) return false;
+        if (under_beta(k, a_hi, tau)) {
+            a = a_hi;
+            return true;
+        }
+        double lo = a_lo, hi = a_hi;
+        for (int it = 0; it < 64 && hi - lo > 1e-12 * (1 + std::fabs(lo)); ++it) {
+            const double m = 0.5 * (lo + hi);
+            (under_beta(k, m, tau) ? lo : hi) = m;
+        }
+        a = lo;
+        return true;
+    }
+
+    /// How far the Hermite span from (q0, v0) to (q1, v1) over tau seconds exceeds the limits:
+    /// max over axes of |acceleration| / limit (at both ends: it is linear in a cubic) and
+    /// peak |velocity| / limit, and the speed at mid-span over the feed and the speed cap.
+    /// <= 0 means within the limits.
+    double violation(const Knot& k0, const Knot& k1, double tau) const {
+        const Vec &q0 = k0.q, &v0 = k0.v, &q1 = k1.q, &v1 = k1.v;
+        double worst = 0;
+        constexpr int kSamples = 7;
+        Vec at[kSamples] = {};
+        static constexpr double kW[kSamples] = {0.125, 0.25, 0.375, 0.5, 0.625, 0.75, 0.875};
+        for (std::size_t i = 0; i < axes_; ++i) {
+            const double d = q1[i] - q0[i];
+            const double a0 = 6 * d / (tau * tau) - (4 * v0[i] + 2 * v1[i]) / tau;
+            const double a1 = -6 * d / (tau * tau) + (2 * v0[i] + 4 * v1[i]) / tau;
+            worst = std::max(worst, std::max(std::fabs(a0), std::fabs(a1)) / acc_[i]);
+            double peak = std::max(std::fabs(v0[i]), std::fabs(v1[i]));
+            if (a0 * a1 < 0) {
+                const double t = tau * a0 / (a0 - a1);
+                peak = std::max(peak, std::fabs(v0[i] + 0.5 * a0 * t));
+            }
+            worst = std::max(worst, peak / vel_[i]);
+            for (int s = 0; s < kSamples; ++s) {  // velocity at t = w tau: v0 + a0 w tau + (a1 - a0) w^2 tau / 2
+                at[s][i] = v0[i] + tau * (a0 * kW[s] + (a1 - a0) * kW[s] * kW[s] / 2);
+            }
+        }
+        // Speed along the path at every eighth of the span, against the feed and the speed cap
+        // where the path profile (constant acceleration) is then.
+        const double acc = (k1.speed - k0.speed) / tau;
+        for (int s = 0; s < kSamples; ++s) {
+            const double t = kW[s] * tau;
+            const double speed = norm(at[s]);
+            const double cap = interpolate(caps_, std::clamp(k0.lambda + k0.speed * t + 0.5 * acc * t * t,
+                                                             k0.lambda, std::max(k0.lambda, k1.lambda)));
+            worst = std::max(worst, speed / feed_);
+            if (cap > 0) worst = std::max(worst, speed / std::sqrt(cap));
+            else if (speed > 0) worst = std::max(worst, 2.0);
+        }
+        return worst - 1;
+    }
+
+    struct Candidate {
+        double a = 0;
+        Knot end;
+        double f = 0;
+    };
+
+    /// The span of tau seconds from k with constant path acceleration a: end speed
+    /// V1 = V0 + a tau at arc length l1 = l0 + V0 tau + a tau^2 / 2 + offset. The offset (a few
+    /// tenths of a micrometre) lets the end accelerations of the executed cubic, which are very
+    /// sensitive to the end point (6 / tau^2 per mm), absorb the difference between the cubic and
+    /// the path there (curvature changing along the span): it is the one nearest 0 that the
+    /// linearised end accelerations allow. f <= 0 means within the limits.
+    Candidate evaluate(const Knot& k, double a, double tau) {
+        Candidate c;
+        c.a = a;
+        c.end.speed = std::max(0.0, k.speed + a * tau);
+        const double l1 = std::min(end_lambda_, k.lambda + k.speed * tau + 0.5 * a * tau * tau);
+        c.end.lambda = l1;
+        PathAt p = path_at(pg_, piece_, l1, hint_);
+        const double v1 = c.end.speed;
+        // d(a0)/d(offset) and d(a1)/d(offset) per axis: the end point moves along the tangent,
+        // the end velocity turns with the curvature.
+        const Vec kappa = curvature_at(l1);
+        double off_lo = -0.1 * acc_norm_ * tau * tau, off_hi = -off_lo;
+        off_lo = std::max(off_lo, k.lambda - l1);
+        off_hi = std::min(off_hi, end_lambda_ - l1);
+        for (std::size_t i = 0; i < axes_ && off_lo <= off_hi; ++i) {
+            const double d = p.q[i] - k.q[i];
+            const double a0 = 6 * d / (tau * tau) - (4 * k.v[i] + 2 * v1 * p.t[i]) / tau;
+            const double a1 = -6 * d / (tau * tau) + (2 * k.v[i] + 4 * v1 * p.t[i]) / tau;
+            const double s0 = 6 * p.t[i] / (tau * tau) - 2 * v1 * kappa[i] / tau;
+            const double s1 = -6 * p.t[i] / (tau * tau) + 4 * v1 * kappa[i] / tau;
+            for (const auto& [val, slope] : {std::pair{a0, s0}, std::pair{a1, s1}}) {
+                if (std::fabs(slope) < 1e-300) continue;
+                double x = (-acc_[i] - val) / slope, y = (acc_[i] - val) / slope;
+                if (x > y) std::swap(x, y);
+                off_lo = std::max(off_lo, x);
+                off_hi = std::min(off_hi, y);
+            }
+        }
+        if (off_lo <= off_hi && !(off_lo <= 0 && off_hi >= 0)) {
+            // Nearest to 0, a tenth of the window inside it (the linearisation is not exact).
+            const double w = 0.1 * (off_hi - off_lo);
+            const double off = off_lo > 0 ? off_lo + w : off_hi - w;
+            c.end.lambda = std::clamp(l1 + off, k.lambda, end_lambda_);
+            p = path_at(pg_, piece_, c.end.lambda, hint_);
+        }
+        c.end.q = p.q;
+        c.end.v = scaled(p.t, v1);
+        c.f = violation(k, c.end, tau);
+        c.f = std::max(c.f, span_deviation(k, c.end, tau) / (0.5 * delta_) - 1);
+        const double b1 = interpolate(beta_, c.end.lambda);
+        if (v1 * v1 > b1 * (1 + 1e-6) + 1e-9) c.f = std::max(c.f, 1e-3);
+        return c;
+    }
+
+    /// Largest distance of the executed cubic from the path at sixths of the span, measured
+    /// across the path at the arc length where the cubic's point projects onto the chord.
+    /// Skipped (0) where the span is too short for the curvature it passes to matter:
+    /// chord^2 kappa / 8 < delta / 64.
+    double span_deviation(const Knot& k, const Knot& end, double tau) {
+        const double len = end.lambda - k.lambda;
+        double kappa = 0;
+        bool corner = false;
+        for (std::size_t i = interval(k.lambda); i <= piece_.last && g_.lambda[i] <= end.lambda + 1e-12; ++i) {
+            kappa = std::max(kappa, norm(g_.curvature[i]));
+            if (i + 1 <= piece_.last) kappa = std::max(kappa, norm(g_.curvature[i + 1]));
+            corner = corner || norm(g_.corner_jump[i]) > 0;
+        }
+        if (!corner && len * len * kappa / 8 < delta_ / 64) return 0;
+        const Vec chord = sub(end.q, k.q);
+        const double c2 = dot(chord, chord);
+        double worst = 0;
+        std::size_t h = hint_;
+        for (int s = 1; s < 6; ++s) {
+            const double w = s / 6.0, w2 = w * w, w3 = w2 * w;
+            const double h00 = 2 * w3 - 3 * w2 + 1, h10 = w3 - 2 * w2 + w, h01 = -2 * w3 + 3 * w2, h11 = w3 - w2;
+            Vec x{};
+            for (std::size_t i = 0; i < axes_; ++i) {
+                x[i] = h00 * k.q[i] + h10 * k.v[i] * tau + h01 * end.q[i] + h11 * end.v[i] * tau;
+            }
+            const double along = c2 > 0 ? std::clamp(dot(sub(x, k.q), chord) / c2, 0.0, 1.0) : w;
+            const PathAt p = path_at(pg_, piece_, k.lambda + along * len, h);
+            const Vec off = sub(x, p.q);
+            worst = std::max(worst, norm(sub(off, scaled(p.t, dot(off, p.t)))));
+        }
+        return worst;
+    }
+
+    /// Curvature vector at arc length l, interpolated between grid nodes.
+    Vec curvature_at(double l) const {
+        const std::size_t i = interval(l);
+        const double l0 = g_.lambda[i], l1 = g_.lambda[i + 1];
+        const double w = l1 > l0 ? std::clamp((l - l0) / (l1 - l0), 0.0, 1.0) : 1.0;
+        Vec r{};
+        for (std::size_t a = 0; a < kAxesMax; ++a) r[a] = (1 - w) * g_.curvature[i][a] + w * g_.curvature[i + 1][a];
+        return r;
+    }
+
+    /// One span of m ticks from k: the largest constant path acceleration (end speed) under
+    /// beta whose executed span, with its end point moved by the allowed offset (evaluate), is
+    /// within the limits.
+    bool step(const Knot& k, std::uint32_t m, Knot& next) {
+        const double tau = m * tick_;
+        const double a_lo = -k.speed / tau;
+        double a_hi;
+        if (!max_under_beta(k, tau, a_lo, acc_norm_, a_hi)) {
+            if (std::getenv("PS_DEBUG")) fprintf(stderr, "step m=%u l=%.4f V=%.3f: beta fails at a_lo (end %.5f, d %.6f)\n", m, k.lambda, k.speed, end_lambda_, end_lambda_ - k.lambda);
+            return false;
+        }
+        Candidate hi = evaluate(k, a_hi, tau);
+        if (hi.f <= 0) {
+            next = hi.end;
+            return true;
+        }
+        // No feasible span accelerates harder than the axes allow: search from there.
+        const double a_floor = std::min(a_hi, std::max(a_lo, -1.5 * acc_norm_));
+        Candidate lo = evaluate(k, a_floor, tau);
+        if (lo.f > 0) {
+            // The violation is (nearly) a maximum of affine functions of the acceleration, so
+            // convex: golden-section search for its minimum, a feasible span if any exists.
+            constexpr double kGolden = 0.6180339887498949;
+            double x0 = a_floor, x3 = a_hi;
+            double x1 = x3 - kGolden * (x3 - x0), x2 = x0 + kGolden * (x3 - x0);
+            Candidate c1 = evaluate(k, x1, tau), c2 = evaluate(k, x2, tau);
+            for (int it = 0; it < 48 && c1.f > 0 && c2.f > 0; ++it) {
+                if (c1.f <= c2.f) {
+                    x3 = x2;
+                    x2 = x1;
+                    c2 = c1;
+                    x1 = x3 - kGolden * (x3 - x0);
+                    c1 = evaluate(k, x1, tau);
+                } else {
+                    x0 = x1;
+                    x1 = x2;
+                    c1 = c2;
+                    x2 = x0 + kGolden * (x3 - x0);
+                    c2 = evaluate(k, x2, tau);
+                }
+            }
+            const Candidate& best = c1.f <= c2.f ? c1 : c2;
+            if (best.f > 0) {
+                if (std::getenv("PS_DEBUG")) fprintf(stderr, "step m=%u l=%.4f V=%.3f: exact fails best f=%.4f a_hi=%.1f lo.f=%.4f hi.f=%.4f\n", m, k.lambda, k.speed, best.f, a_hi, lo.f, hi.f);
+                return false;
+            }
+            lo = best;
+        }
+        // Illinois (regula falsi) for the boundary between feasible lo and infeasible hi.
+        int side = 0;
+        double flo = lo.f, fhi = hi.f;
+        for (int it = 0; it < 40; ++it) {
+            if (hi.a - lo.a <= 1e-7 * acc_norm_) break;
+            double a = lo.a - flo * (hi.a - lo.a) / (fhi - flo);
+            if (!(a > lo.a && a < hi.a)) a = 0.5 * (lo.a + hi.a);
+            Candidate c = evaluate(k, a, tau);
+            if (c.f <= 0) {
+                lo = c;
+                flo = c.f;
+                if (side == -1) fhi *= 0.5;
+                side = -1;
+            } else {
+                hi = c;
+                fhi = c.f;
+                if (side == +1) flo *= 0.5;
+                side = +1;
+            }
+        }
+        next = lo.end;
+        return true;
+    }
+
+    /// Hermite value at theta in [0, 1] on one axis (positions p0, p1, tangents m0, m1 per span).
+    static double hermite(double p0, double p1, double m0, double m1, double t) {
+        const double t2 = t * t, t3 = t2 * t;
+        return (2 * t3 - 3 * t2 + 1) * p0 + (t3 - 2 * t2 + t) * m0 + (-2 * t3 + 3 * t2) * p1 + (t3 - t2) * m1;
+    }
+
+    /// True when the final span of `ticks` ticks from k to rest at the end is within the limits
+    /// and never passes the end point at a tick.
+    bool finish_ok(const Knot& k, std::uint32_t ticks) {
+        const double tau = ticks * tick_;
+        if (violation(k, end_knot(), tau) > 0) return false;
+        if (span_deviation(k, end_knot(), tau) > 0.5 * delta_) return false;
+        // Under the speed caps along the way (corners, feed, chord tolerance): the cubic's speed
+        // at eighths of the span against the cap where its point projects onto the chord. (Its
+        // accelerations, the bends included, were checked above on the cubic itself.)
+        const Vec chord = sub(end_q_, k.q);
+        const double c2 = dot(chord, chord), d = end_lambda_ - k.lambda;
+        for (int s = 1; s < 8 && c2 > 0; ++s) {
+            const double w = s / 8.0, w2 = w * w;
+            double along = 0, speed2 = 0;
+            for (std::size_t i = 0; i < axes_; ++i) {
+                const double x = (2 * w2 * w - 3 * w2 + 1) * k.q[i] + (w2 * w - 2 * w2 + w) * k.v[i] * tau +
+                                 (-2 * w2 * w + 3 * w2) * end_q_[i];
+                const double v = ((6 * w2 - 6 * w) * k.q[i] + (3 * w2 - 4 * w + 1) * k.v[i] * tau +
+                                  (-6 * w2 + 6 * w) * end_q_[i]) / tau;
+                along += (x - k.q[i]) * chord[i];
+                speed2 += v * v;
+            }
+            const double l = k.lambda + d * std::clamp(along / c2, 0.0, 1.0);
+            if (speed2 > interpolate(caps_, l) * (1 + 1e-6) + 1e-9) return false;
+        }
+        const double len2 = c2;
+        if (ticks < 2 || len2 <= 0) return true;
+        const std::uint32_t samples = std::min<std::uint32_t>(ticks - 1, 64);
+        for (std::uint32_t j = 1; j <= samples; ++j) {
+            const double t = static_cast<double>(j) / (samples + 1);
+            double along = 0;
+            for (std::size_t i = 0; i < axes_; ++i) {
+                const double p = hermite(k.q[i], end_q_[i], k.v[i] * tau, 0, t);
+                along += (p - end_q_[i]) * chord[i];
+            }
+            if (along > 1e-9 * len2) return false;
+        }
+        return true;
+    }
+
+    /// Ticks of a final span from k to rest at the piece's end, or 0 if none of at most
+    /// ticks_per_span ticks is within the limits from here.
+    std::uint32_t finish(const Knot& k) {
+        const double d = end_lambda_ - k.lambda;
+        double lo_f, hi_f;
+        if (d > (k.speed * tick_ + acc_norm_ * tick_ * tick_) * n_ * n_) return 0;  // far away
+        if (k.speed > 0) {
+            const double kc = 2 * d / (k.speed * tick_);  // ticks at constant deceleration
+            lo_f = std::floor(0.75 * kc);
+            hi_f = std::ceil(1.5 * kc) + 1;
+        } else {
+            double t = 0;
+            for (std::size_t i = 0; i < axes_; ++i) {
+                t = std::max(t, std::sqrt(6 * std::fabs(end_q_[i] - k.q[i]) / acc_[i]));
+            }
+            t = std::max(t, std::sqrt(6 * d / acc_norm_));
+            lo_f = std::ceil(t / tick_ - 1e-9);
+            hi_f = n_;
+        }
+        if (lo_f > n_) return 0;
+        const std::uint32_t lo = static_cast<std::uint32_t>(std::max(1.0, lo_f));
+        const std::uint32_t hi = static_cast<std::uint32_t>(std::min<double>(n_, std::max(hi_f, lo_f)));
+        const std::uint32_t stride = std::max<std::uint32_t>(1, (hi - lo) / 64);
+        for (std::uint32_t t = lo; t <= hi; t += stride) {
+            if (!finish_ok(k, t)) continue;
+            std::uint32_t best = t;  // with a coarse stride, look for a shorter one just below
+            while (stride > 1 && best > lo && best + stride > t + 1 && finish_ok(k, best - 1)) --best;
+            return best;
+        }
+        return 0;
+    }
+
+    const PathGrid& pg_;
+    const Grid& g_;
+    const Piece& piece_;
+    const std::vector<double>& caps_;
+    const std::vector<double>& beta_;
+    std::size_t axes_;
+    double tick_;
+    std::uint32_t n_;
+    Vec acc_{}, vel_{};
+    double acc_norm_ = 0;
+    double feed_ = 0;
+    double delta_ = 0;
+    double end_lambda_ = 0;
+    Vec end_q_{};
+    std::size_t hint_ = 0;
+};
+
+}  // namespace
+
+PieceMotion forward_pass(const PathGrid& g, const Piece& piece, const Limits& limits,
+                         const std::vector<double>& caps, const std::vector<double>& beta,
+                         const MachineProfile& profile, const PlanOptions& options, const PieceMotion* resume,
+                         double resume_lambda, bool short_spans) {
+    PieceTimer timer(g, piece, limits, caps, beta, profile, options);
+    return timer.run(resume, resume_lambda, short_spans);
+}
+
+}  // namespace pathstream::host::planner_detail

@@ -1,0 +1,330 @@
+// The lookahead grid: nodes along the path at known arc length, with tangent and curvature;
+// stops at sharp corners, cusps and pen changes; the arc length -> point lookup.
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+#include "internal.hpp"
+
+namespace pathstream::host::planner_detail {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kDegenerateMm = 1e-9;  // a segment with every control point this close is a point
+
+double angle_between(const Vec& a, const Vec& b) {
+    return std::acos(std::clamp(dot(a, b), -1.0, 1.0));
+}
+
+/// Unit tangent at u, well defined where q'(u) vanishes (degenerate handles, cusps): then the
+/// tangent is taken a little towards `side` (+1: larger u).
+Vec unit_tangent(const Cubic& c, double u, double size, int side) {
+    Vec d = c.d1(u);
+    double n = norm(d);
+    if (n <= 1e-9 * size) {
+        const double v = std::clamp(u + side * 1e-4, 0.0, 1.0);
+        d = c.d1(v);
+        n = norm(d);
+        if (n <= 1e-12 * size) {  // still flat: the chord
+            d = sub(c.p[3], c.p[0]);
+            n = norm(d);
+        }
+    }
+    return n > 0 ? scaled(d, 1 / n) : Vec{};
+}
+
+/// Curvature vector d2q/dl2 at u (evaluated slightly inside the segment where q' vanishes).
+Vec curvature(const Cubic& c, double u, double size, int side) {
+    double w = u;
+    Vec d = c.d1(w);
+    if (norm(d) <= 1e-7 * size) {
+        w = std::clamp(u + side * 1e-3, 0.0, 1.0);
+        d = c.d1(w);
+    }
+    const double n2 = dot(d, d);
+    if (n2 <= 0) return Vec{};
+    const Vec dd = c.d2(w);
+    const double along = dot(dd, d) / n2;
+    Vec k{};
+    for (std::size_t i = 0; i < kAxesMax; ++i) k[i] = (dd[i] - along * d[i]) / n2;
+    return k;
+}
+
+/// Parameters of the grid nodes along one segment: uniform in u, then bisected wherever the
+/// tangent turns by more than max_turn between neighbours. A turn above 90 degrees inside an
+/// interval shorter than 1e-7 in u is a cusp: its parameter goes to `cusps`.
+std::vector<double> segment_nodes(const Cubic& c, double length, const PlanOptions& o,
+                                  std::vector<double>& cusps) {
+    const double size = c.size();
+    std::size_t k = std::max<std::size_t>(o.min_nodes_per_segment, 1);
+    if (o.grid_step > 0) {
+        k = std::max<std::size_t>(k, static_cast<std::size_t>(std::ceil(std::min(length / o.grid_step, 1e6))));
+    }
+    std::vector<double> out;
+    std::vector<std::pair<double, double>> stack;  // intervals still to examine, last first
+    for (std::size_t i = k; i-- > 0;) {
+        stack.emplace_back(static_cast<double>(i) / static_cast<double>(k),
+                           i + 1 == k ? 1.0 : static_cast<double>(i + 1) / static_cast<double>(k));
+    }
+    out.push_back(0.0);
+    while (!stack.empty()) {
+        const auto [a, b] = stack.back();
+        stack.pop_back();
+        const double turn = angle_between(unit_tangent(c, a, size, +1), unit_tangent(c, b, size, -1));
+        if (turn > o.max_turn) {
+            if (b - a > 1e-7) {
+                const double m = 0.5 * (a + b);
+                stack.emplace_back(m, b);
+                stack.emplace_back(a, m);
+                continue;
+            }
+            if (turn > 0.5 * kPi) cusps.push_back(norm(c.d1(a)) < norm(c.d1(b)) ? a : b);
+        }
+        out.push_back(b);
+    }
+    return out;
+}
+
+struct Builder {
+    const std::vector<BezierSegment>& segments;
+    const MachineProfile& profile;
+    const PlanOptions& options;
+    PathGrid out;
+    double lambda = 0;
+    double kappa_stop_ = 0;
+
+    void add_node(std::uint32_t seg, double u, double lam, const Vec& q, const Vec& t, const Vec& k,
+                  double feed) {
+        Grid& g = out.grid;
+        g.lambda.push_back(lam);
+        g.u.push_back(u);
+        g.seg.push_back(seg);
+        g.q.push_back(q);
+        g.tangent.push_back(t);
+        g.curvature.push_back(k);
+        g.feed.push_back(feed);
+        g.corner_jump.push_back(Vec{});
+    }
+
+    void close_piece(Run& run, std::size_t first, std::size_t last, double feed) {
+        Piece p;
+        p.first = first;
+        p.last = last;
+        p.run = out.runs.size();
+        p.feed = feed;
+        run.pieces.push_back(out.pieces.size());
+        out.pieces.push_back(p);
+    }
+
+    void build_run(std::size_t first_seg, std::size_t last_seg) {
+        Grid& g = out.grid;
+        Run run;
+        run.pen_down = segments[first_seg].pen_down;
+        run.subpath = segments[first_seg].subpath;
+        run.first_segment = first_seg;
+        run.last_segment = last_seg;
+        run.start = out.cubics[first_seg].p[0];
+        run.end = out.cubics[last_seg].p[3];
+        const double feed = run.pen_down ? (segments[first_seg].feed > 0 ? segments[first_seg].feed : profile.feed)
+                                         : (segments[first_seg].feed > 0 ? segments[first_seg].feed
+                                                                          : profile.travel_feed);
+        std::size_t piece_first = g.size();
+        bool any = false;
+        for (std::size_t s = first_seg; s <= last_seg; ++s) {
+            const Cubic& c = out.cubics[s];
+            const double size = c.size();
+            if (size < kDegenerateMm) continue;
+            const double length = arc_length(c, 0, 0.5) + arc_length(c, 0.5, 1);
+            if (length < kDegenerateMm) continue;
+            (run.pen_down ? out.pen_down_length : out.travel_length) += length;
+            std::vector<double> cusps;
+            const std::vector<double> us = segment_nodes(c, length, options, cusps);
+            const std::size_t seg_first = g.size();
+            double lam = lambda;
+            for (std::size_t i = 0; i < us.size(); ++i) {
+                if (i > 0) lam += arc_length(c, us[i - 1], us[i]);
+                const int side = i + 1 == us.size() ? -1 : +1;
+                Vec q = c.point(us[i]);
+                add_node(static_cast<std::uint32_t>(s), us[i], lam, q, unit_tangent(c, us[i], size, side),
+                         curvature(c, us[i], size, side), feed);
+            }
+            if (any) {  // the joint with the previous segment of this run
+                const std::size_t a = seg_first - 1, b = seg_first;
+                const double turn = angle_between(g.tangent[a], g.tangent[b]);
+                const bool sharp = norm(g.curvature[a]) > kappa_stop_ || norm(g.curvature[b]) > kappa_stop_;
+                if (turn > options.corner_stop_angle || sharp) {
+                    close_piece(run, piece_first, a, feed);
+                    piece_first = b;
+                } else if (turn > 1e-9) {
+                    g.corner_jump[a] = g.corner_jump[b] = sub(g.tangent[b], g.tangent[a]);
+                }
+            }
+            // Curvature peaks too sharp to cross: where the speed cap sqrt(a / kappa) is below
+            // one tick of acceleration (kappa > 1 / (a T^2), smallest axis), the motion stops, as
+            // at a cusp.
+            for (std::size_t n = seg_first + 1; n + 1 < g.size(); ++n) {
+                const double kn = norm(g.curvature[n]);
+                if (kn > kappa_stop_ && kn >= norm(g.curvature[n - 1]) && kn >= norm(g.curvature[n + 1])) {
+                    cusps.push_back(g.u[n]);
+                }
+            }
+            std::sort(cusps.begin(), cusps.end());
+            // Cusps inside the segment: the piece ends at the node nearest the cusp and the
+            // next one starts there.
+            for (double cu : cusps) {
+                std::size_t best = seg_first;
+                for (std::size_t n = seg_first; n < g.size(); ++n) {
+                    if (std::fabs(g.u[n] - cu) < std::fabs(g.u[best] - cu)) best = n;
+                }
+                if (best > piece_first && best + 1 < g.size() && (out.pieces.empty() || run.pieces.empty() ||
+                                                                  out.pieces.back().last != best)) {
+                    g.curvature[best] = Vec{};
+                    close_piece(run, piece_first, best, feed);
+                    piece_first = best;
+                }
+            }
+            lambda = lam;
+            any = true;
+        }
+        if (!any) {  // nothing but points: a piece of zero length where the run is
+            add_node(static_cast<std::uint32_t>(first_seg), 0, lambda, run.start, Vec{}, Vec{}, feed);
+        }
+        close_piece(run, piece_first, g.size() - 1, feed);
+        out.runs.push_back(std::move(run));
+    }
+};
+
+}  // namespace
+
+Cubic to_cubic(const BezierSegment& s) {
+    Cubic c;
+    for (std::size_t k = 0; k < 4; ++k) {
+        for (std::size_t i = 0; i < s.p[k].size() && i < kAxesMax; ++i) c.p[k][i] = s.p[k][i];
+    }
+    return c;
+}
+
+double arc_length(const Cubic& c, double u0, double u1) {
+    static constexpr double x[5] = {0.0, -0.5384693101056831, 0.5384693101056831, -0.9061798459386640,
+                                    0.9061798459386640};
+    static constexpr double w[5] = {0.5688888888888889, 0.4786286704993665, 0.4786286704993665,
+                                    0.2369268850561891, 0.2369268850561891};
+    const double h = 0.5 * (u1 - u0), m = 0.5 * (u0 + u1);
+    double s = 0;
+    for (int i = 0; i < 5; ++i) s += w[i] * norm(c.d1(m + h * x[i]));
+    return s * h;
+}
+
+PathGrid build_grid(const std::vector<BezierSegment>& segments, const MachineProfile& profile,
+                    const PlanOptions& options) {
+    const std::size_t axes = profile.axes.size();
+    Builder b{segments, profile, options, {}, 0, 0};
+    double a_min = 0;
+    for (const auto& a : profile.axes) a_min = a_min == 0 ? a.max_acceleration : std::min(a_min, a.max_acceleration);
+    const double tick = 1 / profile.tick_hz;
+    b.kappa_stop_ = a_min > 0 ? 1 / (a_min * tick * tick) : std::numeric_limits<double>::infinity();
+    b.out.grid.axes = axes;
+    for (VecArray* v : {&b.out.grid.q, &b.out.grid.tangent, &b.out.grid.curvature, &b.out.grid.corner_jump}) {
+        v->set_axes(axes);
+    }
+    for (std::size_t s = 0; s < segments.size(); ++s) {
+        for (const auto& p : segments[s].p) {
+            if (p.size() != axes) {
+                std::ostringstream m;
+                m << "segment " << s << " (subpath " << segments[s].subpath << ") has " << p.size()
+                  << " coordinates but the machine has " << axes << " axes";
+                throw PlanError(m.str());
+            }
+            for (double x : p) {
+                if (!std::isfinite(x)) throw PlanError("segment " + std::to_string(s) + " has a non-finite coordinate");
+            }
+        }
+        if (s == 0) b.out.cubics.reserve(segments.size());
+        b.out.cubics.push_back(to_cubic(segments[s]));
+        if (s > 0) {
+            const double gap = norm(sub(b.out.cubics[s].p[0], b.out.cubics[s - 1].p[3]));
+            if (gap > 1e-6) {
+                std::ostringstream m;
+                m << "segment " << s << " (subpath " << segments[s].subpath << ") starts " << gap
+                  << " mm away from where segment " << s - 1 << " ends: the path must be continuous";
+                throw PlanError(m.str());
+            }
+        }
+    }
+    for (std::size_t s = 0; s < segments.size();) {
+        std::size_t e = s;
+        while (e + 1 < segments.size() && segments[e + 1].pen_down == segments[s].pen_down &&
+               segments[e + 1].subpath == segments[s].subpath) {
+            ++e;
+        }
+        b.build_run(s, e);
+        s = e + 1;
+    }
+    return std::move(b.out);
+}
+
+PathAt path_at(const PathGrid& pg, const Piece& piece, double lambda, std::size_t& hint) {
+    const Grid& g = pg.grid;
+    PathAt r;
+    if (piece.first == piece.last) {
+        r.q = g.q[piece.first];
+        r.t = g.tangent[piece.first];
+        return r;
+    }
+    // Interval [k, k+1] of positive length with lambda[k] <= lambda < lambda[k+1].
+    std::size_t k = std::clamp(hint, piece.first, piece.last - 1);
+    if (g.lambda[k] > lambda) {
+        const auto it = std::upper_bound(g.lambda.begin() + static_cast<std::ptrdiff_t>(piece.first),
+                                         g.lambda.begin() + static_cast<std::ptrdiff_t>(piece.last) + 1, lambda);
+        k = static_cast<std::size_t>(it - g.lambda.begin());
+        k = k == 0 ? 0 : k - 1;
+    } else {
+        std::size_t steps = 0;
+        while (k + 1 < piece.last && g.lambda[k + 1] <= lambda && ++steps < 64) ++k;
+        if (k + 1 < piece.last && g.lambda[k + 1] <= lambda) {
+            const auto it = std::upper_bound(g.lambda.begin() + static_cast<std::ptrdiff_t>(k),
+                                             g.lambda.begin() + static_cast<std::ptrdiff_t>(piece.last) + 1, lambda);
+            k = static_cast<std::size_t>(it - g.lambda.begin()) - 1;
+        }
+    }
+    k = std::clamp(k, piece.first, piece.last - 1);
+    while (k > piece.first && g.lambda[k + 1] <= g.lambda[k]) --k;  // skip a zero-length joint link
+    hint = k;
+    const double l0 = g.lambda[k], l1 = g.lambda[k + 1];
+    if (!(l1 > l0) || g.seg[k] != g.seg[k + 1]) {
+        r.q = g.q[k + 1];
+        r.t = g.tangent[k + 1];
+        return r;
+    }
+    const Cubic& c = pg.cubics[g.seg[k]];
+    const double u0 = g.u[k], u1 = g.u[k + 1];
+    const double target = std::clamp(lambda - l0, 0.0, l1 - l0);
+    // Newton on the arc length, kept inside [lo, hi] by bisection.
+    double lo = u0, hi = u1;
+    double u = u0 + (u1 - u0) * target / (l1 - l0);
+    for (int it = 0; it < 12; ++it) {
+        const double f = arc_length(c, u0, u) - target;
+        if (std::fabs(f) < 1e-12 * (1 + l1)) break;
+        if (f > 0) hi = u;
+        else lo = u;
+        const double speed = norm(c.d1(u));
+        double next = speed > 0 ? u - f / speed : 0.5 * (lo + hi);
+        if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);
+        u = next;
+    }
+    r.q = c.point(u);
+    const Vec d = c.d1(u);
+    const double n = norm(d);
+    if (n > 1e-9 * c.size()) {
+        r.t = scaled(d, 1 / n);
+    } else {  // at a degenerate point: interpolate the node tangents
+        const double w = (lambda - l0) / (l1 - l0);
+        for (std::size_t i = 0; i < kAxesMax; ++i) r.t[i] = (1 - w) * g.tangent[k][i] + w * g.tangent[k + 1][i];
+        const double m = norm(r.t);
+        if (m > 0) r.t = scaled(r.t, 1 / m);
+    }
+    return r;
+}
+
+}  // namespace pathstream::host::planner_detail

@@ -1,0 +1,281 @@
+// Internals of the planner shared by its source files (not installed, not an API).
+#pragma once
+
+#include <array>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "pathstream/host/geometry.hpp"
+#include "pathstream/host/machine.hpp"
+#include "pathstream/host/plan.hpp"
+#include "pathstream/host/planner.hpp"
+
+namespace pathstream::host::planner_detail {
+
+inline constexpr std::size_t kAxesMax = 8;
+using Vec = std::array<double, kAxesMax>;  // the first `axes` entries are used, the rest stay 0
+
+inline double dot(const Vec& a, const Vec& b) {
+    double s = 0;
+    for (std::size_t i = 0; i < kAxesMax; ++i) s += a[i] * b[i];
+    return s;
+}
+inline double norm(const Vec& a) { return std::sqrt(dot(a, a)); }
+inline Vec sub(const Vec& a, const Vec& b) {
+    Vec r{};
+    for (std::size_t i = 0; i < kAxesMax; ++i) r[i] = a[i] - b[i];
+    return r;
+}
+inline Vec scaled(const Vec& a, double s) {
+    Vec r{};
+    for (std::size_t i = 0; i < kAxesMax; ++i) r[i] = a[i] * s;
+    return r;
+}
+
+/// A Bezier segment in flat form.
+struct Cubic {
+    std::array<Vec, 4> p{};
+
+    Vec point(double u) const {
+        const double v = 1 - u;
+        Vec r{};
+        for (std::size_t i = 0; i < kAxesMax; ++i) {
+            const double a = v * p[0][i] + u * p[1][i], b = v * p[1][i] + u * p[2][i],
+                         c = v * p[2][i] + u * p[3][i];
+            r[i] = v * (v * a + u * b) + u * (v * b + u * c);
+        }
+        return r;
+    }
+    Vec d1(double u) const {
+        const double v = 1 - u;
+        Vec r{};
+        for (std::size_t i = 0; i < kAxesMax; ++i) {
+            r[i] = 3 * (v * v * (p[1][i] - p[0][i]) + 2 * u * v * (p[2][i] - p[1][i]) + u * u * (p[3][i] - p[2][i]));
+        }
+        return r;
+    }
+    Vec d2(double u) const {
+        const double v = 1 - u;
+        Vec r{};
+        for (std::size_t i = 0; i < kAxesMax; ++i) {
+            r[i] = 6 * (v * (p[2][i] - 2 * p[1][i] + p[0][i]) + u * (p[3][i] - 2 * p[2][i] + p[1][i]));
+        }
+        return r;
+    }
+    /// Largest distance of a control point from P0: the segment's size.
+    double size() const {
+        double s = 0;
+        for (std::size_t k = 1; k < 4; ++k) s = std::fmax(s, norm(sub(p[k], p[0])));
+        return s;
+    }
+};
+
+Cubic to_cubic(const BezierSegment& s);
+
+/// Arc length of `c` over [u0, u1] by 5-point Gauss-Legendre quadrature of |q'(u)|.
+double arc_length(const Cubic& c, double u0, double u1);
+
+/// Per-axis limits of one planning attempt (mm/s, mm/s^2): the profile's, possibly lowered by
+/// a replan.
+struct Limits {
+    std::vector<double> velocity, acceleration;
+};
+
+/// Per-node vectors stored flat, `axes` doubles each (a Vec per node would be 64 bytes).
+class VecArray {
+public:
+    struct ConstRow {
+        const double* p;
+        std::size_t n;
+        double operator[](std::size_t i) const { return i < n ? p[i] : 0.0; }
+        operator Vec() const {
+            Vec v{};
+            for (std::size_t i = 0; i < n; ++i) v[i] = p[i];
+            return v;
+        }
+    };
+    struct Row {
+        double* p;
+        std::size_t n;
+        double& operator[](std::size_t i) const { return p[i]; }
+        operator Vec() const { return ConstRow{p, n}; }
+        const Row& operator=(const Vec& v) const {
+            for (std::size_t i = 0; i < n; ++i) p[i] = v[i];
+            return *this;
+        }
+        const Row& operator=(const Row& o) const { return *this = Vec(o); }
+    };
+
+    void set_axes(std::size_t axes) { axes_ = axes; }
+    void reserve(std::size_t n) { data_.reserve(n * axes_); }
+    void push_back(const Vec& v) { data_.insert(data_.end(), v.begin(), v.begin() + static_cast<std::ptrdiff_t>(axes_)); }
+    std::size_t size() const { return axes_ == 0 ? 0 : data_.size() / axes_; }
+    ConstRow operator[](std::size_t k) const { return {data_.data() + k * axes_, axes_}; }
+    Row operator[](std::size_t k) { return {data_.data() + k * axes_, axes_}; }
+
+private:
+    std::size_t axes_ = 0;
+    std::vector<double> data_;
+};
+
+/// The lookahead grid of the whole path: nodes along every non-degenerate segment at
+/// increasing arc length `lambda` (mm from the start of the path). Where two segments meet
+/// there are two nodes at the same lambda (end of one, start of the next).
+struct Grid {
+    std::size_t axes = 0;
+    std::vector<double> lambda, u;
+    std::vector<std::uint32_t> seg;
+    VecArray q, tangent, curvature;  ///< point, unit tangent dq/dl, curvature d2q/dl2
+    std::vector<double> feed;        ///< requested speed along the path at the node
+    VecArray corner_jump;            ///< tangent jump at a crossed corner (0 elsewhere)
+
+    std::size_t size() const { return lambda.size(); }
+};
+
+/// A stretch of the path between two stops: nodes first..last of the grid, started and ended
+/// at rest. A piece of zero length has first == last.
+struct Piece {
+    std::size_t first = 0, last = 0;
+    std::size_t run = 0;
+    double feed = 0;  ///< requested speed along it (mm/s)
+};
+
+/// Consecutive segments with the same pen state and subpath: drawn (or travelled) without a
+/// pen change. Holds its pieces in order.
+struct Run {
+    bool pen_down = true;
+    std::size_t subpath = 0;
+    std::size_t first_segment = 0, last_segment = 0;
+    std::vector<std::size_t> pieces;
+    Vec start{}, end{};  ///< mm
+};
+
+struct PathGrid {
+    Grid grid;
+    std::vector<Cubic> cubics;
+    std::vector<Piece> pieces;
+    std::vector<Run> runs;
+    double pen_down_length = 0, travel_length = 0;
+};
+
+/// Builds the grid, the stops (sharp corners, cusps, pen changes, ends) and the runs.
+/// `profile` gives the feeds. Throws PlanError on unusable input.
+PathGrid build_grid(const std::vector<BezierSegment>& segments, const MachineProfile& profile,
+                    const PlanOptions& options);
+
+/// Point and unit tangent at arc length `lambda` inside `piece`. `hint` is a node index to
+/// start searching from (updated), for the monotone walk of the forward pass.
+struct PathAt {
+    Vec q{}, t{};
+};
+PathAt path_at(const PathGrid& g, const Piece& piece, double lambda, std::size_t& hint);
+
+/// Max x in [0, x_max] such that some y in [y_lo, y_hi] satisfies lo_m <= c_m x + d_m y <= hi_m
+/// for every row (each row must contain the origin: lo_m <= 0 <= hi_m, and y_lo <= 0 <= y_hi).
+struct LpRow {
+    double c, d, lo, hi;
+};
+double lp_max_x(const LpRow* rows, std::size_t count, double x_max, double y_lo, double y_hi);
+/// Max y in [y_lo, y_hi] for a given x; returns false (and y = the least violating value) when
+/// no y satisfies the rows.
+bool lp_max_y(const LpRow* rows, std::size_t count, double x, double y_lo, double y_hi, double& y);
+
+/// Per-node squared-speed caps: per-axis velocity, feed, chord tolerance, corner rule, with
+/// the velocity and feed margins of `options`.
+std::vector<double> speed_caps(const PathGrid& g, const Limits& limits, const MachineProfile& profile,
+                               const PlanOptions& options);
+
+/// TOPP-RA backward pass over one piece: beta[k] (k = first..last, indexed by node) is the
+/// largest squared speed at node k from which the rest of the piece can still be run to a stop
+/// at its end with accelerations limits * accel_factor[k], speed changes costing
+/// 1 / tangential_margin times their acceleration. beta[last] = 0.
+/// With span_time > 0, dips of the speed caps (dip[k]: speed, scratch of the same size) are
+/// also approached no faster than spans of that duration can slow down (1 / span_time per mm).
+/// Incremental use: only nodes below `top` are recomputed (beta[top] must be valid), and the
+/// pass stops at the first node below `unchanged_below` whose value does not change. Returns
+/// the lowest node recomputed.
+std::size_t backward_pass(const PathGrid& g, const Piece& piece, const Limits& limits,
+                          const std::vector<double>& accel_factor, double tangential_margin,
+                          const std::vector<double>& caps, double span_time, std::vector<double>& dip,
+                          std::vector<double>& beta, std::size_t top = static_cast<std::size_t>(-1),
+                          std::size_t unchanged_below = 0);
+
+/// TOPP-RA forward pass of one piece on its own grid (continuous time, piecewise constant path
+/// acceleration between nodes): the optimum's motion time in seconds.
+double topp_piece_time(const PathGrid& g, const Piece& piece, const Limits& limits,
+                       const std::vector<double>& accel_factor, const std::vector<double>& beta);
+
+/// A knot of the executed motion: arc length, speed, point and velocity vector (mm, mm/s).
+struct Knot {
+    double lambda = 0, speed = 0;
+    Vec q{}, v{};
+};
+/// A span of the executed motion: `ticks` ticks ending at `end` (it starts at the previous end).
+struct MotionSpan {
+    std::uint32_t ticks = 0;
+    Knot end;
+};
+struct PieceMotion {
+    Knot start;
+    std::vector<MotionSpan> spans;
+    bool ok = true;
+    double fail_lambda = 0;  ///< where the forward pass got stuck (when !ok)
+    double fail_speed = 0;   ///< and how fast it was going there
+};
+
+/// The executed motion of one piece in whole ticks: knots every ticks_per_span ticks with
+/// constant acceleration along the path in each span, the Hermite span between two knots
+/// checked against the limits, the speed kept under beta, and the final span ending at rest
+/// exactly at the piece's end.
+/// `resume` (optional): a previous attempt whose knots before `resume_lambda` are kept.
+/// `short_spans`: allow spans shorter than ticks_per_span where a full one cannot be found
+/// (the last resort: their tangents are rounded on a different scale).
+PieceMotion forward_pass(const PathGrid& g, const Piece& piece, const Limits& limits,
+                         const std::vector<double>& caps, const std::vector<double>& beta,
+                         const MachineProfile& profile, const PlanOptions& options,
+                         const PieceMotion* resume = nullptr, double resume_lambda = 0,
+                         bool short_spans = false);
+
+/// Distance from points to a set of Bezier segments (the pen-down path), for the plan check.
+/// Queries are expected to move along the path: each one first searches the segments around
+/// the previous answer (both ways, a window that grows with the step; closed runs wrap), then,
+/// only if that finds nothing within `global_below` mm, every segment (pruned by control-point
+/// boxes), so that a distance above `global_below` is always the true one. Each candidate
+/// segment: branch and bound over de Casteljau halves (a half is dropped when the box of its
+/// control points is farther than the best distance so far), pieces flat to 1 um projected on
+/// their chord and refined by Newton on (q(u) - p) . q'(u) = 0: the global nearest point, exact
+/// to rounding.
+class PathProjector {
+public:
+    PathProjector(std::vector<Cubic> segments, std::vector<std::size_t> index, double global_below);
+    /// Distance (mm) from p to the nearest segment; `segment` gets its index (as given).
+    double distance(const Vec& p, std::size_t& segment);
+    bool empty() const { return segs_.empty(); }
+
+private:
+    double segment_distance(std::size_t i, const Vec& p) const;
+    double box_distance(std::size_t i, const Vec& p) const;
+
+    std::vector<Cubic> segs_;
+    std::vector<std::size_t> index_;
+    std::vector<double> length_;
+    std::vector<Vec> lo_, hi_;
+    std::vector<std::size_t> run_first_, run_last_;
+    double global_below_;
+    std::size_t cursor_ = 0;
+    Vec last_p_{};
+    double last_d_ = 0;
+    bool started_ = false;
+};
+
+/// check_plan, with the deviation part optional (the planner's own verification skips it).
+PlanCheck check_plan_impl(const Plan& plan, const std::vector<BezierSegment>& segments,
+                          const MachineProfile& profile, bool deviation);
+
+/// Turns the motion of every piece plus the pen dwells into the plan's core spans.
+Plan emit_plan(const PathGrid& g, const std::vector<PieceMotion>& motion, const MachineProfile& profile,
+               PlanStats* stats);
+
+}  // namespace pathstream::host::planner_detail

@@ -1,0 +1,154 @@
+// The lookahead: per-node speed caps and the TOPP-RA backward pass (controllable sets), plus
+// the TOPP-RA forward pass used as the time-optimal reference.
+//
+// Along the path with arc length l, speed s = dl/dt and x = s^2, the acceleration of axis i is
+// q_i'(l) dds + q_i''(l) x (q' the unit tangent, q'' the curvature vector), and between two
+// nodes TOPP-RA takes dds constant, so x is linear in l: dds = (x[k+1] - x[k]) / (2 dl). The
+// limit |q_i' dds + q_i'' x| <= a_i at both ends of the interval is linear in (x[k], x[k+1]).
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "internal.hpp"
+
+namespace pathstream::host::planner_detail {
+namespace {
+
+constexpr double kNoCap = 1e20;  // (mm/s)^2: effectively unlimited, still finite
+
+/// Rows of the interval k..k+1. The path acceleration's coefficient (the unit tangent) is
+/// divided by `tangential_margin` (<= 1): the lookahead assumes speed changes cost that much
+/// more acceleration than they do, while the curvature terms (the speed cap of a bend) keep
+/// the full budget.
+std::size_t interval_rows(const Grid& g, std::size_t k, double dl, const Limits& limits,
+                          const std::vector<double>& accel_factor, double tangential_margin, LpRow* rows) {
+    std::size_t n = 0;
+    for (std::size_t i = 0; i < g.axes; ++i) {
+        const double a0 = limits.acceleration[i] * accel_factor[k];
+        const double a1 = limits.acceleration[i] * accel_factor[k + 1];
+        const double g0 = g.tangent[k][i] / tangential_margin, h0 = g.curvature[k][i];
+        const double g1 = g.tangent[k + 1][i] / tangential_margin, h1 = g.curvature[k + 1][i];
+        rows[n++] = {h0 - g0 / (2 * dl), g0 / (2 * dl), -a0, a0};
+        rows[n++] = {-g1 / (2 * dl), h1 + g1 / (2 * dl), -a1, a1};
+    }
+    return n;
+}
+
+/// Largest x at node k for which some path acceleration keeps every axis within its limit.
+double acceleration_cap(const Grid& g, std::size_t k, const Limits& limits, double factor, double x_max) {
+    LpRow rows[kAxesMax];
+    for (std::size_t i = 0; i < g.axes; ++i) {
+        const double a = limits.acceleration[i] * factor;
+        rows[i] = {g.curvature[k][i], g.tangent[k][i], -a, a};
+    }
+    return lp_max_x(rows, g.axes, x_max, -kNoCap, kNoCap);
+}
+
+}  // namespace
+
+std::vector<double> speed_caps(const PathGrid& pg, const Limits& limits, const MachineProfile& profile,
+                               const PlanOptions& options) {
+    const Grid& g = pg.grid;
+    const double tick = 1.0 / profile.tick_hz;
+    const double span = tick * profile.ticks_per_span;
+    const double delta = profile.chord_tolerance;
+    std::vector<double> caps(g.size(), kNoCap);
+    for (std::size_t k = 0; k < g.size(); ++k) {
+        double s = g.feed[k] * options.feed_margin;
+        for (std::size_t i = 0; i < g.axes; ++i) {
+            const double t = std::fabs(g.tangent[k][i]);
+            if (t > 0) s = std::min(s, limits.velocity[i] * options.velocity_margin / t);
+        }
+        // Chord tolerance: the chord between two ticks at speed s on radius rho stays within
+        // delta of the arc when s <= (2/T) sqrt(2 rho delta - delta^2) (no cap for rho <= delta).
+        const double kappa = norm(g.curvature[k]);
+        if (kappa > 0 && 1 / kappa > delta) {
+            const double rho = 1 / kappa;
+            s = std::min(s, (2 / tick) * std::sqrt(2 * rho * delta - delta * delta));
+        }
+        // Spans: the cubic through two knots an arc theta apart on radius rho leaves the arc by
+        // rho theta^4 / 384; keep that within delta / 2 (with 10 % to spare on theta).
+        if (kappa > 0) {
+            const double theta = 0.9 * std::pow(192 * delta * kappa, 0.25);
+            s = std::min(s, theta / (kappa * span));
+        }
+        // Corner rule (docs/planner.md): a tangent jump J crossed at speed s changes axis i's
+        // velocity by s |J_i|; keep that within one tick of its acceleration (and, for spans of
+        // fewer than 4 ticks, within a quarter span of it: the span that crosses the corner
+        // turns at up to 4 s |J_i| / T_span), and keep the cut of the corner by that span
+        // (s T_span |J| / 8) within delta / 2.
+        const double jump = norm(g.corner_jump[k]);
+        if (jump > 0) {
+            const double window = std::min(tick, span / 4);
+            for (std::size_t i = 0; i < g.axes; ++i) {
+                const double j = std::fabs(g.corner_jump[k][i]);
+                if (j > 0) s = std::min(s, limits.acceleration[i] * window / j);
+            }
+            s = std::min(s, 4 * delta / (span * jump));
+        }
+        caps[k] = std::min(kNoCap, s * s);
+    }
+    return caps;
+}
+
+std::size_t backward_pass(const PathGrid& pg, const Piece& piece, const Limits& limits,
+                          const std::vector<double>& accel_factor, double tangential_margin,
+                          const std::vector<double>& caps, double span_time, std::vector<double>& dip,
+                          std::vector<double>& beta, std::size_t top, std::size_t unchanged_below) {
+    const Grid& g = pg.grid;
+    if (beta.size() < g.size()) beta.resize(g.size(), 0);
+    if (dip.size() < g.size()) dip.resize(g.size(), kNoCap);
+    top = std::min(top, piece.last);
+    if (top == piece.last) {
+        beta[piece.last] = 0;
+        dip[piece.last] = kNoCap;
+    }
+    LpRow rows[4 * kAxesMax];
+    std::size_t lowest = top;
+    for (std::size_t k = top; k-- > piece.first;) {
+        const double dl = g.lambda[k + 1] - g.lambda[k];
+        const double bend = acceleration_cap(g, k, limits, accel_factor[k], caps[k]);
+        // A span from speed s can at most stop at its end (constant deceleration s / span_time,
+        // s span_time / 2 further on), so along it the speed cannot fall faster than by
+        // 1 / span_time per mm at first: a dip in the speed caps (a tight bend, a corner) is
+        // approached with the speed falling no faster than that.
+        double d = std::sqrt(bend);
+        if (span_time > 0) d = std::min(d, dip[k + 1] + 0.95 * std::max(dl, 0.0) / span_time);
+        double x;
+        if (!(dl > 1e-12)) {  // a joint: the speed is the same on both sides
+            x = std::min(beta[k + 1], bend);
+        } else {
+            const std::size_t n = interval_rows(g, k, dl, limits, accel_factor, tangential_margin, rows);
+            x = lp_max_x(rows, n, caps[k], 0, beta[k + 1]);
+        }
+        if (span_time > 0) x = std::min(x, d * d);
+        if (k < unchanged_below && x == beta[k] && d == dip[k]) break;  // nothing below changes either
+        beta[k] = x;
+        dip[k] = d;
+        lowest = k;
+    }
+    return lowest;
+}
+
+double topp_piece_time(const PathGrid& pg, const Piece& piece, const Limits& limits,
+                       const std::vector<double>& accel_factor, const std::vector<double>& beta) {
+    const Grid& g = pg.grid;
+    LpRow rows[4 * kAxesMax];
+    double x = 0, time = 0;
+    for (std::size_t k = piece.first; k < piece.last; ++k) {
+        const double dl = g.lambda[k + 1] - g.lambda[k];
+        double y;
+        if (!(dl > 1e-12)) {
+            y = std::min(x, beta[k + 1]);
+        } else {
+            const std::size_t n = interval_rows(g, k, dl, limits, accel_factor, 1.0, rows);
+            (void)lp_max_y(rows, n, x, 0, beta[k + 1], y);
+            const double sum = std::sqrt(x) + std::sqrt(y);
+            time += sum > 0 ? 2 * dl / sum : std::numeric_limits<double>::infinity();
+        }
+        x = y;
+    }
+    return time;
+}
+
+}  // namespace pathstream::host::planner_detail

@@ -1,0 +1,202 @@
+// Distance from a point to the geometric path (nearest point on the Bezier segments).
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "internal.hpp"
+
+namespace pathstream::host::planner_detail {
+
+PathProjector::PathProjector(std::vector<Cubic> segments, std::vector<std::size_t> index, double global_below)
+    : segs_(std::move(segments)), index_(std::move(index)), global_below_(global_below) {
+    for (const Cubic& c : segs_) {
+        length_.push_back(arc_length(c, 0, 0.5) + arc_length(c, 0.5, 1));
+        Vec lo = c.p[0], hi = c.p[0];
+        for (const Vec& p : c.p) {
+            for (std::size_t i = 0; i < kAxesMax; ++i) {
+                lo[i] = std::min(lo[i], p[i]);
+                hi[i] = std::max(hi[i], p[i]);
+            }
+        }
+        lo_.push_back(lo);
+        hi_.push_back(hi);
+    }
+    // Runs of segments that join end to start; a closed run (ending where it starts) wraps
+    // around in the search window.
+    run_first_.resize(segs_.size());
+    run_last_.resize(segs_.size());
+    for (std::size_t i = 0; i < segs_.size();) {
+        std::size_t e = i;
+        while (e + 1 < segs_.size() && segs_[e + 1].p[0] == segs_[e].p[3]) ++e;
+        for (std::size_t k = i; k <= e; ++k) {
+            run_first_[k] = i;
+            run_last_[k] = e;
+        }
+        i = e + 1;
+    }
+}
+
+double PathProjector::box_distance(std::size_t i, const Vec& p) const {
+    double s = 0;
+    for (std::size_t a = 0; a < kAxesMax; ++a) {
+        const double d = p[a] < lo_[i][a] ? lo_[i][a] - p[a] : (p[a] > hi_[i][a] ? p[a] - hi_[i][a] : 0.0);
+        s += d * d;
+    }
+    return std::sqrt(s);
+}
+
+namespace {
+
+/// Squared distance from p to the box of the control points (a lower bound for the curve).
+double box_distance2(const Cubic& c, const Vec& p) {
+    double s = 0;
+    for (std::size_t a = 0; a < kAxesMax; ++a) {
+        const double lo = std::min(std::min(c.p[0][a], c.p[1][a]), std::min(c.p[2][a], c.p[3][a]));
+        const double hi = std::max(std::max(c.p[0][a], c.p[1][a]), std::max(c.p[2][a], c.p[3][a]));
+        const double d = p[a] < lo ? lo - p[a] : (p[a] > hi ? p[a] - hi : 0.0);
+        s += d * d;
+    }
+    return s;
+}
+
+/// de Casteljau split at the middle.
+void split(const Cubic& c, Cubic& left, Cubic& right) {
+    for (std::size_t a = 0; a < kAxesMax; ++a) {
+        const double p01 = 0.5 * (c.p[0][a] + c.p[1][a]), p12 = 0.5 * (c.p[1][a] + c.p[2][a]),
+                     p23 = 0.5 * (c.p[2][a] + c.p[3][a]);
+        const double p012 = 0.5 * (p01 + p12), p123 = 0.5 * (p12 + p23), mid = 0.5 * (p012 + p123);
+        left.p[0][a] = c.p[0][a];
+        left.p[1][a] = p01;
+        left.p[2][a] = p012;
+        left.p[3][a] = mid;
+        right.p[0][a] = mid;
+        right.p[1][a] = p123;
+        right.p[2][a] = p23;
+        right.p[3][a] = c.p[3][a];
+    }
+}
+
+/// Largest distance of the inner control points from the chord: how far from straight. A
+/// piece whose control polygon turns back along the chord (a cusp) is not straight at all.
+double flatness(const Cubic& c) {
+    const Vec chord = sub(c.p[3], c.p[0]);
+    const double len2 = dot(chord, chord);
+    double worst = 0;
+    for (int k = 1; k <= 2; ++k) {
+        const Vec off = sub(c.p[k], c.p[0]);
+        const double w = len2 > 0 ? dot(off, chord) / len2 : 0;
+        worst = std::max(worst, norm(sub(off, scaled(chord, w))));
+    }
+    for (int k = 0; k < 3; ++k) {
+        if (dot(sub(c.p[k + 1], c.p[k]), chord) < 0) return std::numeric_limits<double>::infinity();
+    }
+    return worst;
+}
+
+}  // namespace
+
+double PathProjector::segment_distance(std::size_t i, const Vec& p) const {
+    // Branch and bound: a piece of the curve lies in the box of its control points, so a piece
+    // whose box is farther than the best distance so far is dropped; nearly straight pieces
+    // are projected on their chord and the parameter refined by Newton on the whole segment.
+    const Cubic& whole = segs_[i];
+    struct Item {
+        Cubic c;
+        double u0, u1;
+        int depth;
+    };
+    Item stack[64];
+    std::size_t n = 0;
+    stack[n++] = {whole, 0.0, 1.0, 0};
+    double best = std::numeric_limits<double>::infinity();
+    while (n > 0) {
+        const Item it = stack[--n];
+        if (box_distance2(it.c, p) >= best) continue;
+        if (it.depth >= 30 || flatness(it.c) <= 1e-3 || n + 2 > 64) {
+            // On a nearly straight piece the nearest point is where the curve passes p's
+            // projection on the chord: (q(u) - p) . chord = 0, found by Illinois regula falsi
+            // (robust where q' vanishes, e.g. handles on the end points).
+            const Vec chord = sub(it.c.p[3], it.c.p[0]);
+            const auto g = [&](double v) { return dot(sub(whole.point(v), p), chord); };
+            double lo = it.u0, hi = it.u1, glo = g(lo), ghi = g(hi);
+            double u = glo >= 0 ? lo : (ghi <= 0 ? hi : 0.5 * (lo + hi));
+            int side = 0;
+            for (int k = 0; k < 200 && glo < 0 && ghi > 0 && hi - lo > 1e-15; ++k) {
+                u = lo - glo * (hi - lo) / (ghi - glo);
+                if (!(u > lo && u < hi)) u = 0.5 * (lo + hi);
+                const double gu = g(u);
+                if (gu == 0) break;
+                if (gu < 0) {
+                    lo = u;
+                    glo = gu;
+                    if (side == -1) ghi *= 0.5;
+                    side = -1;
+                } else {
+                    hi = u;
+                    ghi = gu;
+                    if (side == +1) glo *= 0.5;
+                    side = +1;
+                }
+            }
+            for (const double v : {u, it.u0, it.u1}) {
+                const Vec d = sub(whole.point(v), p);
+                best = std::min(best, dot(d, d));
+            }
+            continue;
+        }
+        Item left{{}, it.u0, 0.5 * (it.u0 + it.u1), it.depth + 1}, right{{}, left.u1, it.u1, it.depth + 1};
+        split(it.c, left.c, right.c);
+        // The nearer half is examined first (pushed last): it tightens the bound sooner.
+        if (box_distance2(left.c, p) <= box_distance2(right.c, p)) {
+            stack[n++] = right;
+            stack[n++] = left;
+        } else {
+            stack[n++] = left;
+            stack[n++] = right;
+        }
+    }
+    return std::sqrt(best);
+}
+
+double PathProjector::distance(const Vec& p, std::size_t& segment) {
+    const std::size_t n = segs_.size();
+    const double step = started_ ? norm(sub(p, last_p_)) : 0;
+    const double reach = 2 * (step + last_d_) + 0.01;  // mm of path to search ahead
+    double best = std::numeric_limits<double>::infinity();
+    std::size_t best_i = cursor_;
+    // Around the cursor, both ways, until `reach` mm of path (at least two segments each way).
+    std::size_t from = cursor_;
+    for (double behind = 0; from > 0 && (from + 2 > cursor_ || behind <= reach);) behind += length_[--from];
+    const auto consider = [&](std::size_t i) {
+        if (box_distance(i, p) >= best) return;
+        const double d = segment_distance(i, p);
+        if (d < best) {
+            best = d;
+            best_i = i;
+        }
+    };
+    if (n > 0) consider(std::min(cursor_, n - 1));  // the cursor's own segment wins ties
+    double ahead = 0;
+    for (std::size_t i = from; i < n && i < from + 10000; ++i) {
+        if (i > cursor_ + 2 && ahead > reach) break;
+        if (i > cursor_) ahead += length_[i - 1];
+        consider(i);
+    }
+    if (n > 0 && segs_[run_last_[cursor_]].p[3] == segs_[run_first_[cursor_]].p[0]) {  // closed: wrap
+        for (const std::size_t i : {run_first_[cursor_], run_first_[cursor_] + 1, run_last_[cursor_],
+                                    run_last_[cursor_] - 1}) {
+            if (i >= run_first_[cursor_] && i <= run_last_[cursor_]) consider(i);
+        }
+    }
+    if (!(best <= global_below_) || !started_) {  // not close around the cursor: every segment
+        for (std::size_t i = 0; i < n; ++i) consider(i);
+    }
+    cursor_ = best_i;
+    last_p_ = p;
+    last_d_ = best;
+    started_ = true;
+    segment = n > 0 ? index_[best_i] : 0;
+    return best;
+}
+
+}  // namespace pathstream::host::planner_detail
