@@ -86,7 +86,7 @@ TEST_CASE("eval's core values equal an independent double evaluation to half an 
                 for (std::size_t a = 0; a < 2; ++a) {
                     const auto p = window(sp, i, a, lsb);
                     for (std::uint32_t k = 0; k <= n; ++k) {
-                        double w[4];
+                        double w[4] = {0, 0, 0, 0};
                         weights(sp.basis, static_cast<double>(k) / n, w);
                         const double expected = w[0] * p[0] + w[1] * p[1] + w[2] * p[2] + w[3] * p[3];
                         const double got = core_value_at(spans[i], a, k) * lsb;
