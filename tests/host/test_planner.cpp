@@ -345,6 +345,28 @@ TEST_CASE("degenerate input: repeated points, a point subpath, zero-length trave
     stream_all(r.plan);
 }
 
+TEST_CASE("one and three axes: a line and a helix", "[planner]") {
+    SECTION("one axis") {
+        MachineProfile p = profile(100, 2000, 1);
+        Subpath s = polyline({{0}, {30}, {10}});  // a reversal: a sharp corner, a stop
+        const Planned r = plan_and_check(path_of({s}, 1), p);
+        const double optimum = (30 / 80.0 + 80 / 2000.0) + (20 / 80.0 + 80 / 2000.0);  // two trapezoids
+        CHECK(motion_time(r, p) >= optimum * 0.999);
+        CHECK(motion_time(r, p) <= optimum * 1.02);
+    }
+    SECTION("three axes") {
+        const MachineProfile p = profile(250, 3000, 3);
+        Subpath helix;
+        helix.basis = PathBasis::kBSpline;
+        for (int i = 0; i <= 120; ++i) {
+            const double t = 2 * kPi * i / 40.0;
+            helix.points.push_back({10 * std::cos(t), 10 * std::sin(t), 0.5 * t});
+        }
+        const Planned r = plan_and_check(path_of({helix}, 3), p);
+        CHECK(motion_time(r, p) <= r.stats.reference_motion_time * 1.02);
+    }
+}
+
 TEST_CASE("progress is reported, non-decreasing, up to 1", "[planner]") {
     std::vector<double> seen;
     const auto segs = to_bezier_segments(path_of({circle(10, 100)}));

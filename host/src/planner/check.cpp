@@ -12,8 +12,6 @@
 #include <cmath>
 #include <map>
 #include <memory>
-#include <cstdio>
-#include <cstdlib>
 #include <sstream>
 
 #include "internal.hpp"
@@ -217,7 +215,6 @@ private:
                 for (std::size_t a = 0; a < axes_; ++a) q[a] = static_cast<double>(p[a]) * profile_.mm_per_lsb;
                 std::size_t seg = 0;
                 distance_ = projector_->distance(q, seg);
-                if (std::getenv("PS_DEBUG3") && distance_ > 0.004) fprintf(stderr, "tick %llu q (%.5f, %.5f) d %.5f seg %zu\n", (unsigned long long)k, q[0], q[1], distance_, seg);
                 have_distance_ = true;
             }
             if (distance_ > out_.max_deviation) {

@@ -1,14 +1,12 @@
 // The forward pass in whole ticks: from rest at the start of a piece, one span of
 // ticks_per_span ticks at a time, each with constant acceleration along the path, as fast as
 // the executed Hermite span allows and never above the lookahead's controllable speed (beta);
-// then one final span of at most ticks_per_span ticks that ends at rest exactly at the piece's
-// end. What is checked is the cubic the device will run between two knots (positions and
-// velocities at both ends), not the continuous profile, so acceleration switches inside a span
-// cannot overshoot the limits.
+// then a final span of at most ticks_per_span ticks (alone, or with the span before it chosen
+// for it) that ends at rest exactly at the piece's end. What is checked is the cubic the
+// device will run between two knots (positions and velocities at both ends), not the
+// continuous profile, so acceleration switches inside a span cannot overshoot the limits.
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 
 #include "internal.hpp"
 
@@ -148,8 +146,12 @@ private:
         return (1 - w) * v[i] + w * v[i + 1];
     }
 
-    /// True when constant path acceleration A for tau seconds from k keeps x = s^2 under beta
-    /// at every node passed and at the end.
+    /// The lookahead's bound on x = s^2 at arc length l: beta interpolated linearly in x, as
+    /// TOPP-RA's constant path acceleration between nodes has it.
+    double beta_at(double l) const { return interpolate(beta_, l); }
+
+    /// True when constant path acceleration A for tau seconds from k keeps x = s^2 under the
+    /// lookahead at every node passed and at the end (x and beta are both linear in between).
     bool under_beta(const Knot& k, double a, double tau) const {
         double v1 = k.speed + a * tau;
         if (v1 < -1e-9 * (1 + k.speed)) return false;
@@ -162,7 +164,7 @@ private:
             if (!(g_.lambda[i] > k.lambda)) continue;
             if (x0 + 2 * a * (g_.lambda[i] - k.lambda) > beta_[i] + tol(beta_[i])) return false;
         }
-        const double b1 = interpolate(beta_, l1);
+        const double b1 = beta_at(l1);
         return v1 * v1 <= b1 + tol(b1);
     }
 
@@ -182,10 +184,11 @@ private:
         return true;
     }
 
-    /// How far the Hermite span from (q0, v0) to (q1, v1) over tau seconds exceeds the limits:
-    /// max over axes of |acceleration| / limit (at both ends: it is linear in a cubic) and
-    /// peak |velocity| / limit, and the speed at mid-span over the feed and the speed cap.
-    /// <= 0 means within the limits.
+    /// How far the Hermite span between two knots over tau seconds exceeds the limits: max over
+    /// axes of |acceleration| / limit (exact: it is linear in a cubic, so its ends bound it) and
+    /// peak |velocity| / limit (exact: at the ends or where the acceleration crosses 0), and the
+    /// speed at eighths of the span over the feed and the speed cap there. <= 0: within.
+    /// Relative: the check is ratio - 1.
     double violation(const Knot& k0, const Knot& k1, double tau) const {
         const Vec &q0 = k0.q, &v0 = k0.v, &q1 = k1.q, &v1 = k1.v;
         double worst = 0;
@@ -229,11 +232,13 @@ private:
     };
 
     /// The span of tau seconds from k with constant path acceleration a: end speed
-    /// V1 = V0 + a tau at arc length l1 = l0 + V0 tau + a tau^2 / 2 + offset. The offset (a few
-    /// tenths of a micrometre) lets the end accelerations of the executed cubic, which are very
-    /// sensitive to the end point (6 / tau^2 per mm), absorb the difference between the cubic and
-    /// the path there (curvature changing along the span): it is the one nearest 0 that the
-    /// linearised end accelerations allow. f <= 0 means within the limits.
+    /// V1 = V0 + a tau at arc length l1 = l0 + V0 tau + a tau^2 / 2 + offset. The end
+    /// accelerations of the executed cubic are very sensitive to the end point (6 / tau^2 per
+    /// mm), so a small offset along the path (at most a tenth of a full-acceleration span's
+    /// distance, typically micrometres) lets them absorb what a constant path acceleration gets
+    /// wrong where the curvature changes along the span: the offset nearest 0 that the
+    /// linearised end accelerations allow. f <= 0 means the span is within the limits and its
+    /// end under beta.
     Candidate evaluate(const Knot& k, double a, double tau) {
         Candidate c;
         c.a = a;
@@ -273,7 +278,7 @@ private:
         c.end.v = scaled(p.t, v1);
         c.f = violation(k, c.end, tau);
         c.f = std::max(c.f, span_deviation(k, c.end, tau) / (0.5 * delta_) - 1);
-        const double b1 = interpolate(beta_, c.end.lambda);
+        const double b1 = beta_at(c.end.lambda);
         if (v1 * v1 > b1 * (1 + 1e-6) + 1e-9) c.f = std::max(c.f, 1e-3);
         return c;
     }
@@ -328,10 +333,7 @@ private:
         const double tau = m * tick_;
         const double a_lo = -k.speed / tau;
         double a_hi;
-        if (!max_under_beta(k, tau, a_lo, acc_norm_, a_hi)) {
-            if (std::getenv("PS_DEBUG")) fprintf(stderr, "step m=%u l=%.4f V=%.3f: beta fails at a_lo (end %.5f, d %.6f)\n", m, k.lambda, k.speed, end_lambda_, end_lambda_ - k.lambda);
-            return false;
-        }
+        if (!max_under_beta(k, tau, a_lo, acc_norm_, a_hi)) return false;
         Candidate hi = evaluate(k, a_hi, tau);
         if (hi.f <= 0) {
             next = hi.end;
@@ -363,10 +365,7 @@ private:
                 }
             }
             const Candidate& best = c1.f <= c2.f ? c1 : c2;
-            if (best.f > 0) {
-                if (std::getenv("PS_DEBUG")) fprintf(stderr, "step m=%u l=%.4f V=%.3f: exact fails best f=%.4f a_hi=%.1f lo.f=%.4f hi.f=%.4f\n", m, k.lambda, k.speed, best.f, a_hi, lo.f, hi.f);
-                return false;
-            }
+            if (best.f > 0) return false;
             lo = best;
         }
         // Illinois (regula falsi) for the boundary between feasible lo and infeasible hi.

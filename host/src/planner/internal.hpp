@@ -187,12 +187,20 @@ bool lp_max_y(const LpRow* rows, std::size_t count, double x, double y_lo, doubl
 std::vector<double> speed_caps(const PathGrid& g, const Limits& limits, const MachineProfile& profile,
                                const PlanOptions& options);
 
+/// A span that crosses a corner at speed v turns on axis i at up to 4 v |J_i| / span_time:
+/// caps the lookahead's acceleration factor within two spans' travel of every crossed corner
+/// to 1 minus that share (at most half), so that the deceleration into it leaves room for it.
+/// `caps` are the squared-speed caps (the corner speed is the corner node's cap).
+void reserve_for_corners(const PathGrid& g, const Limits& limits, const std::vector<double>& caps,
+                         double span_time, std::vector<double>& factor);
+
 /// TOPP-RA backward pass over one piece: beta[k] (k = first..last, indexed by node) is the
 /// largest squared speed at node k from which the rest of the piece can still be run to a stop
 /// at its end with accelerations limits * accel_factor[k], speed changes costing
 /// 1 / tangential_margin times their acceleration. beta[last] = 0.
-/// With span_time > 0, dips of the speed caps (dip[k]: speed, scratch of the same size) are
-/// also approached no faster than spans of that duration can slow down (1 / span_time per mm).
+/// With span_time > 0, dips of the speed caps (dip[k]: squared speed, scratch of the same size)
+/// are also approached no faster than spans of that duration can slow down from a knot
+/// (x = s^2 falling by at most 1.9 s / span_time per mm).
 /// Incremental use: only nodes below `top` are recomputed (beta[top] must be valid), and the
 /// pass stops at the first node below `unchanged_below` whose value does not change. Returns
 /// the lowest node recomputed.

@@ -76,7 +76,9 @@ std::vector<double> speed_caps(const PathGrid& pg, const Limits& limits, const M
         // velocity by s |J_i|; keep that within one tick of its acceleration (and, for spans of
         // fewer than 4 ticks, within a quarter span of it: the span that crosses the corner
         // turns at up to 4 s |J_i| / T_span), and keep the cut of the corner by that span
-        // (s T_span |J| / 8) within delta / 2.
+        // within 0.45 delta: the cubic through knots on both sides leaves the two straight
+        // pieces by up to 0.1407 s T_span |J| (worst with the corner at the span's start,
+        // 1/8 mid-span).
         const double jump = norm(g.corner_jump[k]);
         if (jump > 0) {
             const double window = std::min(tick, span / 4);
@@ -84,11 +86,34 @@ std::vector<double> speed_caps(const PathGrid& pg, const Limits& limits, const M
                 const double j = std::fabs(g.corner_jump[k][i]);
                 if (j > 0) s = std::min(s, limits.acceleration[i] * window / j);
             }
-            s = std::min(s, 4 * delta / (span * jump));
+            s = std::min(s, 0.45 * delta / (0.1407 * span * jump));
         }
         caps[k] = std::min(kNoCap, s * s);
     }
     return caps;
+}
+
+void reserve_for_corners(const PathGrid& pg, const Limits& limits, const std::vector<double>& caps,
+                         double span_time, std::vector<double>& factor) {
+    const Grid& g = pg.grid;
+    for (std::size_t k = 0; k < g.size(); ++k) {
+        const double jump = norm(g.corner_jump[k]);
+        if (jump <= 0 || span_time <= 0) continue;
+        const double v = std::sqrt(caps[k]);
+        double share = 0;
+        for (std::size_t i = 0; i < g.axes; ++i) {
+            share = std::max(share, 4 * v * std::fabs(g.corner_jump[k][i]) / (span_time * limits.acceleration[i]));
+        }
+        share = std::min(share, 0.5);
+        // Every node within two spans' travel at the corner speed (and at least the neighbours).
+        const double reach = 2 * v * span_time;
+        for (std::size_t j = k; j-- > 0 && g.lambda[k] - g.lambda[j] <= reach;) factor[j] = std::min(factor[j], 1 - share);
+        for (std::size_t j = k; j < g.size() && g.lambda[j] - g.lambda[k] <= reach; ++j) {
+            factor[j] = std::min(factor[j], 1 - share);
+        }
+        if (k > 0) factor[k - 1] = std::min(factor[k - 1], 1 - share);
+        if (k + 1 < g.size()) factor[k + 1] = std::min(factor[k + 1], 1 - share);
+    }
 }
 
 std::size_t backward_pass(const PathGrid& pg, const Piece& piece, const Limits& limits,
@@ -108,12 +133,16 @@ std::size_t backward_pass(const PathGrid& pg, const Piece& piece, const Limits& 
     for (std::size_t k = top; k-- > piece.first;) {
         const double dl = g.lambda[k + 1] - g.lambda[k];
         const double bend = acceleration_cap(g, k, limits, accel_factor[k], caps[k]);
-        // A span from speed s can at most stop at its end (constant deceleration s / span_time,
-        // s span_time / 2 further on), so along it the speed cannot fall faster than by
-        // 1 / span_time per mm at first: a dip in the speed caps (a tight bend, a corner) is
-        // approached with the speed falling no faster than that.
-        double d = std::sqrt(bend);
-        if (span_time > 0) d = std::min(d, dip[k + 1] + 0.95 * std::max(dl, 0.0) / span_time);
+        // A span from speed s can at most stop at its end (constant deceleration s / span_time),
+        // so from a knot at speed s, x = s^2 can fall no faster than by 2 s / span_time per mm:
+        // a dip in the speed caps (a tight bend, a corner) is approached with beta falling no
+        // faster than that at the lower end of each interval (x linear between nodes, as the
+        // forward pass interpolates it), 5 % to spare.
+        double d = bend;
+        if (span_time > 0) {
+            const double below = dip[k + 1];
+            d = std::min(d, below + 1.9 * std::sqrt(below) * std::max(dl, 0.0) / span_time);
+        }
         double x;
         if (!(dl > 1e-12)) {  // a joint: the speed is the same on both sides
             x = std::min(beta[k + 1], bend);
@@ -121,7 +150,7 @@ std::size_t backward_pass(const PathGrid& pg, const Piece& piece, const Limits& 
             const std::size_t n = interval_rows(g, k, dl, limits, accel_factor, tangential_margin, rows);
             x = lp_max_x(rows, n, caps[k], 0, beta[k + 1]);
         }
-        if (span_time > 0) x = std::min(x, d * d);
+        if (span_time > 0) x = std::min(x, d);
         if (k < unchanged_below && x == beta[k] && d == dip[k]) break;  // nothing below changes either
         beta[k] = x;
         dip[k] = d;

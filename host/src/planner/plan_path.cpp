@@ -2,8 +2,6 @@
 // re-planned with lowered limits if the check finds a tick over a limit.
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 #include <sstream>
 
 #include "internal.hpp"
@@ -59,8 +57,7 @@ private:
 
 std::string where(const PathGrid& g, const Piece& piece, double lambda) {
     const Run& run = g.runs[piece.run];
-    const double from = g.grid.lambda[g.runs[piece.run].pieces.empty() ? piece.first
-                                                                       : g.pieces[run.pieces.front()].first];
+    const double from = g.grid.lambda[g.pieces[run.pieces.front()].first];
     std::ostringstream m;
     m << (run.pen_down ? "subpath " : "travel to subpath ") << run.subpath << ", " << (lambda - from)
       << " mm along it";
@@ -110,7 +107,12 @@ Plan plan_path(const std::vector<BezierSegment>& segments, const MachineProfile&
         const std::vector<double> base_caps = speed_caps(pg, limits, profile, options);
         std::vector<double> caps = base_caps;
         for (std::size_t k = 0; k < g.size(); ++k) caps[k] *= local_cap[k];
-        for (std::size_t k = 0; k < g.size(); ++k) factor[k] = options.acceleration_margin * options.lookahead_bend_margin * local_factor[k];
+        std::vector<double> corner_factor(g.size(), 1.0);
+        reserve_for_corners(pg, limits, base_caps, span_time, corner_factor);
+        const auto set_factor = [&](std::size_t k) {
+            factor[k] = options.acceleration_margin * options.lookahead_bend_margin * local_factor[k] * corner_factor[k];
+        };
+        for (std::size_t k = 0; k < g.size(); ++k) set_factor(k);
         std::vector<PieceMotion> motion(pg.pieces.size());
         double done = 0;
         for (std::size_t p = 0; p < pg.pieces.size(); ++p) {
@@ -147,7 +149,7 @@ Plan plan_path(const std::vector<BezierSegment>& segments, const MachineProfile&
                 for (std::size_t k = from; k <= to; ++k) {
                     if (retry % 4 == 3) {
                         local_factor[k] *= 0.9;
-                        factor[k] = options.acceleration_margin * options.lookahead_bend_margin * local_factor[k];
+                        set_factor(k);
                     }
                     // 4 % below the lookahead; and within one span ahead of the failure also
                     // 10 % below the speed it failed at, so that the next attempt arrives slower.
@@ -159,14 +161,16 @@ Plan plan_path(const std::vector<BezierSegment>& segments, const MachineProfile&
                     local_cap[k] = std::min(local_cap[k], x / std::max(base_caps[k], 1e-300));
                     caps[k] = base_caps[k] * local_cap[k];
                 }
-                if (std::getenv("PS_DEBUG")) fprintf(stderr, "retry %d piece %zu fail l=%.4f node %zu window %zu..%zu\n", retry, p, motion[p].fail_lambda, f, from, to);
                 const std::size_t changed =
                     backward_pass(pg, piece, limits, factor, options.lookahead_margin, caps, span_time, dip, beta,
                                   to + 1, from);
                 const bool short_spans = retry >= 2 * options.max_local_retries / 3;
                 const PieceMotion previous = std::move(motion[p]);
+                // Knots in the interval ending at the first changed node interpolate its beta:
+                // resume before that interval.
+                const std::size_t keep = changed > piece.first ? changed - 1 : piece.first;
                 motion[p] = forward_pass(pg, piece, limits, caps, beta, profile, options, &previous,
-                                         g.lambda[changed], short_spans);
+                                         g.lambda[keep], short_spans);
                 ++st.local_retries;
                 site_end = std::max(site_end, to);
                 ++retry;
