@@ -6,6 +6,7 @@
 #include <string>
 #include <utility>
 
+#include "pathstream/host/core_span_conversion.hpp"
 #include "pathstream/setpoint_stream.hpp"
 
 namespace pathstream::host {
@@ -23,15 +24,7 @@ std::uint64_t play(const std::vector<CoreSpan>& spans, const std::function<void(
     Lsb out[Axes];
     for (;;) {
         while (next_to_push < spans.size() && stream->free_slots() > 0) {
-            const CoreSpan& from = spans[next_to_push];
-            Span<Axes> s;
-            s.basis = from.basis;
-            s.ticks = from.ticks;
-            s.tag = static_cast<std::uint32_t>(next_to_push);
-            s.outputs = from.pen_down ? kOutputPenDown : 0;
-            for (unsigned a = 0; a < Axes; ++a) {
-                for (std::size_t i = 0; i < 4; ++i) s.control[a][i] = from.control[a][i];
-            }
+            const Span<Axes> s = to_core_span<Axes>(spans[next_to_push], static_cast<std::uint32_t>(next_to_push));
             if (const Status st = stream->push(s); st != Status::kOk) {
                 throw std::runtime_error("the core refused span " + std::to_string(next_to_push) + ": " +
                                          status_name(st));
@@ -61,21 +54,12 @@ std::uint64_t play(const std::vector<CoreSpan>& spans, const std::function<void(
     return calls;
 }
 
-template <unsigned... A>
-std::uint64_t dispatch(std::size_t axes, const std::vector<CoreSpan>& spans,
-                       const std::function<void(const PlayedTick&)>& on_tick, std::integer_sequence<unsigned, A...>) {
-    std::uint64_t calls = 0;
-    const bool found = ((axes == A + 1 ? (calls = play<A + 1>(spans, on_tick), true) : false) || ...);
-    if (!found) throw std::logic_error("play_through_core: 1 to 8 axes");
-    return calls;
-}
-
 }  // namespace
 
 std::uint64_t play_through_core(const std::vector<CoreSpan>& spans, std::size_t axes,
                                 const std::function<void(const PlayedTick&)>& on_tick) {
     if (spans.empty()) return 0;
-    return dispatch(axes, spans, on_tick, std::make_integer_sequence<unsigned, 8>{});
+    return with_axes(axes, [&](auto n) { return play<decltype(n)::value>(spans, on_tick); });
 }
 
 }  // namespace pathstream::host

@@ -10,6 +10,7 @@
 #include <stdexcept>
 
 #include "pathstream/hal/linux_clock.hpp"
+#include "pathstream/host/core_span_conversion.hpp"
 #include "pathstream/setpoint_stream.hpp"
 #include "pathstream/sim/simulated_output.hpp"
 #include "pathstream/sim/virtual_clock.hpp"
@@ -29,24 +30,11 @@ std::string span_error(std::size_t index, Status s) {
     return m.str();
 }
 
-template <unsigned Axes>
-Span<Axes> to_core_span(const CoreSpan& in, std::size_t index) {
-    Span<Axes> s;
-    s.basis = in.basis;
-    s.ticks = in.ticks;
-    s.tag = static_cast<std::uint32_t>(index + 1);
-    s.outputs = in.pen_down ? kOutputPenDown : std::uint8_t{0};
-    for (unsigned a = 0; a < Axes; ++a) {
-        for (unsigned i = 0; i < 4; ++i) s.control[a][i] = in.control[a][i];
-    }
-    return s;
-}
-
 /// Where the first span starts, by the core's own evaluation (independent of the CoreSpan's
 /// cached cubic, which a hand-made plan may lack).
 template <unsigned Axes>
 void start_point(const CoreSpan& first, Lsb (&start)[Axes]) {
-    const Span<Axes> s = to_core_span<Axes>(first, 0);
+    const Span<Axes> s = host::to_core_span<Axes>(first, 1);
     ValidatedSpan<Axes> v;
     if (const Status st = validate_span(s, v); st != Status::kOk) {
         throw std::runtime_error(span_error(0, st));
@@ -101,7 +89,7 @@ SimulationResult run(const host::Plan& plan, const host::MachineProfile& profile
         std::uint32_t pushed = 0;
         while (next < span_count &&
                (options.max_pushes_per_run == 0 || pushed < options.max_pushes_per_run)) {
-            const Status s = stream->push(to_core_span<Axes>(plan.spans[next], next));
+            const Status s = stream->push(host::to_core_span<Axes>(plan.spans[next], static_cast<std::uint32_t>(next + 1)));
             if (s == Status::kQueueFull) {
                 ++r.stream.queue_full;
                 break;
@@ -200,24 +188,9 @@ SimulationResult dispatch(const host::Plan& plan, const host::MachineProfile& pr
         throw std::invalid_argument(
             "the machine profile needs a positive tick rate and mm per LSB");
     }
-    switch (axes) {
-        case 1:
-            return run<1>(plan, profile, options, pacing, progress);
-        case 2:
-            return run<2>(plan, profile, options, pacing, progress);
-        case 3:
-            return run<3>(plan, profile, options, pacing, progress);
-        case 4:
-            return run<4>(plan, profile, options, pacing, progress);
-        case 5:
-            return run<5>(plan, profile, options, pacing, progress);
-        case 6:
-            return run<6>(plan, profile, options, pacing, progress);
-        case 7:
-            return run<7>(plan, profile, options, pacing, progress);
-        default:
-            return run<8>(plan, profile, options, pacing, progress);
-    }
+    return host::with_axes(axes, [&](auto n) {
+        return run<decltype(n)::value>(plan, profile, options, pacing, progress);
+    });
 }
 
 host::plot::TickSeries series_base(const SimulationResult& r, std::string name) {
