@@ -13,6 +13,12 @@ packages=(
   libnewlib-arm-none-eabi qemu-system-arm
   # plots: SVG to PNG
   librsvg2-bin
+  # Modbus TCP/RTU (libmodbus) and an independent Modbus master for interoperability tests
+  libmodbus-dev mbpoll
+  # CAN and GPIO: SocketCAN tools and libgpiod 1.6 with its command-line tools
+  can-utils libgpiod-dev gpiod
+  # real-kernel test VM (SocketCAN vcan, gpio-sim): emulator, initramfs tools
+  qemu-system-x86 busybox-static cpio
 )
 
 missing=()
@@ -22,11 +28,16 @@ done
 
 if [ ${#missing[@]} -eq 0 ]; then
   echo "setup: all ${#packages[@]} packages already installed"
-  exit 0
+else
+  echo "setup: installing ${missing[*]}"
+  if [ "$(id -u)" -ne 0 ]; then sudo=sudo; else sudo=; fi
+  export DEBIAN_FRONTEND=noninteractive
+  $sudo apt-get update -q
+  $sudo apt-get install -y -q --no-install-recommends "${missing[@]}"
 fi
 
-echo "setup: installing ${missing[*]}"
-if [ "$(id -u)" -ne 0 ]; then sudo=sudo; else sudo=; fi
-export DEBIAN_FRONTEND=noninteractive
-$sudo apt-get update -q
-$sudo apt-get install -y -q --no-install-recommends "${missing[@]}"
+# The real-kernel test VM (Debian's kernel, its modules and out-of-tree gpio-sim) has its own
+# step: it unpacks kernel packages into a cache instead of installing them.
+if [ -x "$(dirname "$0")/setup_vm.sh" ]; then
+  "$(dirname "$0")/setup_vm.sh"
+fi
