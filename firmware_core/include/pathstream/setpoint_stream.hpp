@@ -84,6 +84,35 @@ public:
     std::uint8_t outputs() const { return outputs_; }
     /// Spans completed since construction. Consumer context.
     std::uint32_t spans_completed() const { return spans_completed_; }
+    /// True when no span is in progress: the next tick() starts the next queued span (or
+    /// holds). A device decides stops here, where the last span's end velocity is known.
+    /// Consumer context.
+    bool between_spans() const { return active_ == nullptr; }
+    /// Where the axes rest between spans (the last span's end point, or the start). Consumer.
+    Lsb resting_position(unsigned axis) const { return hold_[axis]; }
+    /// End point of the last pushed span (or the start): where the next push must begin.
+    /// Producer context.
+    Lsb pushed_end(unsigned axis) const { return pushed_end_[axis]; }
+
+    /// Consumer: drops the span in progress and every queued span, and holds `position`
+    /// from the next tick on. The producer must then call restart_producer_at() with the
+    /// same position before its next push (devices hand it over with an epoch counter).
+    /// O(queued spans). Consumer context.
+    void discard_all(const Lsb (&position)[Axes]) {
+        if (active_ != nullptr) {
+            completed_ticks_ += active_->ticks - remaining_;  // the ticks it did supply
+            narrow_active_ = nullptr;
+            active_ = nullptr;
+            remaining_ = 0;
+            queue_.release();
+        }
+        while (queue_.front() != nullptr) queue_.release();
+        for (unsigned a = 0; a < Axes; ++a) hold_[a] = position[a];
+    }
+    /// Producer: the next pushed span must start at `position`. O(Axes). Producer context.
+    void restart_producer_at(const Lsb (&position)[Axes]) {
+        for (unsigned a = 0; a < Axes; ++a) pushed_end_[a] = position[a];
+    }
 
 private:
     // Everything but a narrow span in progress: taking the next span from the queue, wide

@@ -17,6 +17,15 @@ enum class [[nodiscard]] Status : std::uint8_t {
     kTickOutsideSpan = 6,          ///< evaluation or start tick beyond the span's end
     kQueueFull = 7,                ///< span queue has no free slot; nothing was written
     kDiscontinuousSpan = 8,        ///< span does not start where the previous one ends
+    kVelocityLimit = 9,            ///< the span's exact curve is faster than an axis may move
+    kAccelerationLimit = 10,       ///< the span's exact curve accelerates harder than allowed
+    kBadLimits = 11,               ///< a configured limit is zero or out of range
+    kNotConfigured = 12,           ///< spans or start before the limits were configured
+    kBadSequence = 13,             ///< a batch does not carry the next expected sequence number
+    kBadBatch = 14,                ///< a batch's length, span count or check value is wrong
+    kWrongState = 15,              ///< the command is not allowed in the device's state
+    kStopTooLong = 16,             ///< no controlled stop fits in one span (limits too low)
+    kNothingToResume = 17,         ///< resume after an underrun needs queued spans
 };
 
 /// Short stable name of a status, for logs and host messages. Never null.
@@ -31,6 +40,15 @@ constexpr const char* status_name(Status s) {
         case Status::kTickOutsideSpan: return "tick outside span";
         case Status::kQueueFull: return "span queue full";
         case Status::kDiscontinuousSpan: return "span does not start where the previous one ends";
+        case Status::kVelocityLimit: return "span exceeds an axis velocity limit";
+        case Status::kAccelerationLimit: return "span exceeds an axis acceleration limit";
+        case Status::kBadLimits: return "limit zero or out of range";
+        case Status::kNotConfigured: return "device limits not configured";
+        case Status::kBadSequence: return "batch sequence number is not the next expected";
+        case Status::kBadBatch: return "batch length, span count or check value is wrong";
+        case Status::kWrongState: return "command not allowed in this state";
+        case Status::kStopTooLong: return "no controlled stop fits in one span";
+        case Status::kNothingToResume: return "nothing queued to resume";
     }
     return "unknown status";
 }

@@ -1,0 +1,62 @@
+#include "pathstream/device/motion_limits.hpp"
+
+#include "pathstream/wide_int.hpp"
+
+namespace pathstream::device {
+namespace {
+
+constexpr std::uint64_t magnitude64(std::int64_t v) {
+    return v < 0 ? static_cast<std::uint64_t>(0) - static_cast<std::uint64_t>(v)
+                 : static_cast<std::uint64_t>(v);
+}
+
+// |value| * factor <= bound, all exact. |value| < 2^40, factor < 2^40: the product < 2^80.
+bool scaled_within(std::int64_t value, std::uint64_t factor, Int128 bound) {
+    return multiply_unsigned(magnitude64(value), factor) <= bound;
+}
+
+}  // namespace
+
+Status check_axis_limits(const TickCubic& cubic, const SpanTiming& timing, const AxisLimits& limits,
+                         std::uint32_t tick_hz) {
+    // p(u) = (a u^3 + b u^2 + c u + d) / s with s = D / n^3 and u = k / n. Per second:
+    //   velocity     = p'(u) * hz / n    = (3a u^2 + 2b u + c) * hz / (s n)
+    //   acceleration = p''(u) * hz^2/n^2 = (6a u + 2b) * hz^2 / (s n^2)
+    // Every comparison multiplies out the denominators; nothing is divided.
+    const std::uint64_t n = timing.ticks;
+    const std::uint64_t scale = timing.denominator / (n * n * n);
+    const std::uint64_t hz = tick_hz;
+
+    // Acceleration at u = 0 (2b) and u = 1 (6a + 2b) against a_max * s * n^2 (< 2^70).
+    const Int128 accel_bound = multiply_unsigned(limits.max_acceleration * scale, n * n);
+    if (!scaled_within(2 * cubic.b, hz * hz, accel_bound) ||
+        !scaled_within(6 * cubic.a + 2 * cubic.b, hz * hz, accel_bound)) {
+        return Status::kAccelerationLimit;
+    }
+
+    // Velocity numerator f(u) = 3a u^2 + 2b u + c against v_max * s * n, at both ends...
+    const std::uint64_t velocity_bound_u = limits.max_velocity * scale * n;  // < 2^52
+    const Int128 velocity_bound = multiply_unsigned(velocity_bound_u, 1);
+    if (!scaled_within(cubic.c, hz, velocity_bound) ||
+        !scaled_within(3 * cubic.a + 2 * cubic.b + cubic.c, hz, velocity_bound)) {
+        return Status::kVelocityLimit;
+    }
+    // ...and at the vertex u* = -b / (3a) when it lies inside (0, 1), where
+    // f(u*) = (3ac - b^2) / (3a): check |3ac - b^2| * hz <= bound * |3a|.
+    const std::int64_t three_a = 3 * cubic.a;
+    if (three_a != 0) {
+        const std::int64_t minus_b = -cubic.b;
+        const bool inside = minus_b != 0 && ((minus_b > 0) == (three_a > 0)) &&
+                            magnitude64(minus_b) < magnitude64(three_a);
+        if (inside) {
+            const Int128 b_squared = multiply_unsigned(magnitude64(cubic.b), magnitude64(cubic.b));
+            const Int128 extremum = Int128::from(three_a) * cubic.c - b_squared;
+            const Int128 lhs = magnitude(extremum) * static_cast<std::int64_t>(hz);
+            const Int128 rhs = multiply_unsigned(velocity_bound_u, magnitude64(three_a));
+            if (lhs > rhs) return Status::kVelocityLimit;
+        }
+    }
+    return Status::kOk;
+}
+
+}  // namespace pathstream::device
