@@ -1,0 +1,72 @@
+// The Modbus register map, declared once for both ends: the device serves it
+// (modbus_register_map.hpp), the host's streaming client addresses it. docs/modbus.md has the
+// table; this header is its source.
+#pragma once
+
+#include <cstdint>
+
+namespace pathstream::device::modbus {
+
+inline constexpr std::uint16_t kMagic = 0x5053;  ///< "PS"
+inline constexpr std::uint16_t kProtocolVersion = 1;
+
+/// Status block: input registers (FC4) from 0, mirrored read-only in holding registers
+/// (FC3/FC23) at the same addresses so one FC23 can write spans and read the status.
+/// 32-bit values take two registers, high word first.
+namespace status {
+inline constexpr std::uint16_t kMagic = 0;
+inline constexpr std::uint16_t kVersion = 1;
+inline constexpr std::uint16_t kState = 2;  ///< DeviceState
+inline constexpr std::uint16_t kFaultCode = 3;
+inline constexpr std::uint16_t kFreeSlots = 4;
+inline constexpr std::uint16_t kCapacity = 5;
+inline constexpr std::uint16_t kLastAcceptedSequence = 6;  ///< u32
+inline constexpr std::uint16_t kTicksExecuted = 8;         ///< u32 (low 32 bits)
+inline constexpr std::uint16_t kPositions = 10;            ///< i32 per axis, up to 8 axes
+inline constexpr std::uint16_t kAxes = 26;
+inline constexpr std::uint16_t kUnderruns = 27;
+inline constexpr std::uint16_t kLastCompletedSequence = 28;  ///< u32
+inline constexpr std::uint16_t kLastRefusal = 30;    ///< core Status of the last refused write
+inline constexpr std::uint16_t kRefusals = 31;       ///< refused writes (wraps)
+inline constexpr std::uint16_t kDuplicates = 32;     ///< batches acknowledged as retries (wraps)
+inline constexpr std::uint16_t kOutputs = 33;        ///< discrete outputs in force
+inline constexpr std::uint16_t kQueuedSpans = 34;
+inline constexpr std::uint16_t kFlags = 35;          ///< bit 0: configured, bit 1: held by underrun
+inline constexpr std::uint16_t kCount = 36;          ///< registers in the block
+}  // namespace status
+
+/// Command register (holding, write-only in effect; reads return the last command written).
+inline constexpr std::uint16_t kCommand = 100;  ///< Command values (1 start ... 5 reset)
+
+/// Configuration block (holding), written whole in one FC16 at kConfig:
+///   +0..1 tick rate (Hz, u32), +2 axes (must equal the device's), +3..9 reserved (0),
+///   +10 + 4a .. : axis a max velocity (LSB/s, u32), max acceleration (LSB/s^2, u32).
+/// Accepted only idle with nothing queued; read back with FC3.
+inline constexpr std::uint16_t kConfig = 110;
+inline constexpr std::uint16_t kConfigAxisBase = 10;
+constexpr std::uint16_t config_registers(unsigned axes) {
+    return static_cast<std::uint16_t>(kConfigAxisBase + 4 * axes);
+}
+
+/// Span window (holding): one FC16 (or the write half of an FC23) at kSpanWindow carries
+///   +0..1 first sequence number (u32), +2 span count, +3 payload bytes, +4 CRC-16/MODBUS of
+///   the payload, +5.. payload (wire spans, two bytes per register, big-endian, the last
+///   register padded with a zero byte).
+inline constexpr std::uint16_t kSpanWindow = 200;
+inline constexpr std::uint16_t kSpanHeaderRegisters = 5;
+/// Largest FC16 write (123 registers) minus the header: payload registers per batch.
+inline constexpr std::uint16_t kMaxPayloadRegistersFc16 = 123 - kSpanHeaderRegisters;
+/// Largest FC23 write (121 registers) minus the header.
+inline constexpr std::uint16_t kMaxPayloadRegistersFc23 = 121 - kSpanHeaderRegisters;
+
+/// Exception codes the map answers with (Modbus values).
+enum class Exception : std::uint8_t {
+    kNone = 0,
+    kIllegalFunction = 1,
+    kIllegalDataAddress = 2,  ///< no such register, or a block written partially
+    kIllegalDataValue = 3,    ///< a value refused (bad span, sequence, limits, check value)
+    kServerDeviceFailure = 4, ///< refused by the state (fault, e-stop, not configured)
+    kServerDeviceBusy = 6,    ///< queue full: retry the same batch later
+};
+
+}  // namespace pathstream::device::modbus
