@@ -1,0 +1,463 @@
+#!/usr/bin/python3
+"""Run test programs inside Debian's real kernel under qemu-system-x86_64 (docs/vm.md).
+
+Builds an initramfs (busybox-static, the kernel modules for SocketCAN/vcan, configfs and the
+out-of-tree gpio-sim + irq_sim, can-utils and gpiod tools, the given programs with their shared
+libraries and data files, /init from init.sh), boots it with the kernel that scripts/setup_vm.sh
+unpacked, streams and saves the console, and exits with the test script's exit status.
+
+  run_in_vm.py --work DIR --script test.sh [--program EXE]... [--data FILE]... [--gpio-sim]
+
+Exit status: the test script's status inside the VM (200: the VM's own setup failed), or
+  124  the VM did not print a result within --timeout seconds
+  125  the VM stopped without printing a result, or the harness itself failed
+With --expect-rc N: 0 when the script's status was N, 1 otherwise.
+Uses only the Python standard library; run it with Debian's /usr/bin/python3.
+"""
+
+from __future__ import annotations
+
+import argparse
+import ctypes
+import fcntl
+import hashlib
+import json
+import os
+import re
+import shutil
+import signal
+import stat
+import subprocess
+import sys
+import threading
+import time
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+REPO = HERE.parent.parent
+RESULT_RE = re.compile(r"PATHSTREAM-VM-RESULT rc=(\d+)")
+# Bump when the initramfs layout changes: every cached archive is rebuilt.
+LAYOUT_VERSION = 1
+
+CAN_MODULES = ["can", "can-raw", "vcan"]
+GPIO_MODULES = ["configfs", "gpio-sim"]
+CAN_TOOLS = ["candump", "cansend", "cangen", "cansequence"]
+GPIO_TOOLS = ["gpiodetect", "gpioinfo", "gpioget", "gpioset", "gpiomon", "gpiofind"]
+GPIO_SIM_LINES = 16
+# Names of the first gpio-sim lines (the rest are unnamed): what pathstream wires to GPIO.
+GPIO_SIM_NAMES = ["pen-lift", "enable", "estop", "limit-x", "limit-y"]
+
+
+class HarnessError(Exception):
+    pass
+
+
+def log(msg: str) -> None:
+    print(f"run_in_vm: {msg}", flush=True)
+
+
+# --- kernel cache --------------------------------------------------------------------------------
+def default_cache() -> Path:
+    """The cache directory setup_vm.sh fills, from the kernel pinned at its top."""
+    setup = REPO / "scripts" / "setup_vm.sh"
+    abi = None
+    if setup.is_file():
+        m = re.search(r"^KERNEL_ABI=(\S+)", setup.read_text(), re.M)
+        abi = m.group(1) if m else None
+    if abi is None:
+        raise HarnessError(f"cannot read KERNEL_ABI from {setup}; pass --kernel-cache")
+    root = Path(os.environ.get("PATHSTREAM_VM_CACHE", "/var/cache/pathstream-vm"))
+    return root / f"{abi}-amd64"
+
+
+def read_cache(cache: Path) -> dict[str, str]:
+    ready = cache / "READY"
+    if not ready.is_file():
+        raise HarnessError(f"no kernel cache at {cache} (no READY): run scripts/setup_vm.sh")
+    info = {}
+    for line in ready.read_text().splitlines()[1:]:
+        key, _, value = line.partition("=")
+        info[key] = value
+    for key in ("VMLINUZ", "MODULES_DIR", "KERNEL_RELEASE"):
+        if key not in info:
+            raise HarnessError(f"{ready} lacks {key}: run scripts/setup_vm.sh again")
+    if not Path(info["VMLINUZ"]).is_file() or not (Path(info["MODULES_DIR"]) / "modules.dep").is_file():
+        raise HarnessError(f"kernel cache {cache} is incomplete: remove {ready} and run scripts/setup_vm.sh")
+    # The uncompressed ELF boots through PVH, without firmware or xz under TCG (~4 s faster).
+    vmlinux = info.get("VMLINUX", "")
+    info["KERNEL"] = vmlinux if vmlinux and Path(vmlinux).is_file() else info["VMLINUZ"]
+    info["CACHE"] = str(cache)
+    return info
+
+
+def module_order(moddir: Path, names: list[str]) -> list[str]:
+    """Relative paths of the modules NAMES and their dependencies from modules.dep, in load order."""
+    deps: dict[str, list[str]] = {}
+    by_name: dict[str, str] = {}
+    for line in (moddir / "modules.dep").read_text().splitlines():
+        if ":" not in line:
+            continue
+        mod, _, rest = line.partition(":")
+        deps[mod] = rest.split()
+        base = Path(mod).name.split(".ko")[0].replace("-", "_")
+        by_name[base] = mod
+    order: list[str] = []
+
+    def visit(mod: str, stack: tuple[str, ...]) -> None:
+        if mod in order:
+            return
+        if mod in stack:
+            raise HarnessError(f"module dependency cycle at {mod}")
+        for d in deps.get(mod, []):
+            visit(d, stack + (mod,))
+        order.append(mod)
+
+    for n in names:
+        mod = by_name.get(n.replace("-", "_"))
+        if mod is None:
+            raise HarnessError(f"module {n} is not in {moddir}/modules.dep")
+        visit(mod, ())
+    return order
+
+
+# --- files and their libraries ---------------------------------------------------------------------
+def shared_libraries(exe: Path) -> list[tuple[str, Path]]:
+    """(path inside the VM, host file) of every shared library EXE needs, from ldd."""
+    try:
+        out = subprocess.run(["ldd", str(exe)], capture_output=True, text=True, timeout=30)
+    except subprocess.TimeoutExpired as e:
+        raise HarnessError(f"ldd {exe} timed out") from e
+    text = out.stdout + out.stderr
+    if "not a dynamic executable" in text or "statically linked" in text:
+        return []
+    if out.returncode != 0:
+        raise HarnessError(f"ldd {exe} failed: {text.strip()}")
+    libs = []
+    for line in out.stdout.splitlines():
+        line = line.strip()
+        if "=> not found" in line:
+            raise HarnessError(f"{exe}: {line}")
+        m = re.match(r"(\S+) => (/\S+) \(0x", line)
+        if m:  # libfoo.so.1 => /lib/x86_64-linux-gnu/libfoo.so.1
+            libs.append((f"/lib/x86_64-linux-gnu/{m.group(1)}", Path(m.group(2)).resolve()))
+            continue
+        m = re.match(r"(/\S+) \(0x", line)
+        if m:  # the program interpreter, at the absolute path the ELF names
+            libs.append((m.group(1), Path(m.group(1)).resolve()))
+    return libs
+
+
+def is_elf(path: Path) -> bool:
+    with open(path, "rb") as f:
+        return f.read(4) == b"\x7fELF"
+
+
+class Tree:
+    """Files of one initramfs archive: path inside the VM -> (kind, source or target, mode)."""
+
+    def __init__(self) -> None:
+        self.entries: dict[str, tuple[str, str, int]] = {}
+
+    def add_file(self, dest: str, src: Path, mode: int | None = None) -> None:
+        if not src.is_file():
+            raise HarnessError(f"no such file: {src}")
+        if mode is None:
+            mode = 0o755 if os.access(src, os.X_OK) else 0o644
+        self.entries[dest] = ("file", str(src.resolve()), mode)
+
+    def add_bytes(self, dest: str, data: str, mode: int = 0o644) -> None:
+        self.entries[dest] = ("data", data, mode)
+
+    def add_symlink(self, dest: str, target: str) -> None:
+        self.entries[dest] = ("link", target, 0o777)
+
+    def add_dir(self, dest: str) -> None:
+        self.entries[dest] = ("dir", "", 0o755)
+
+    def add_program(self, dest: str, src: Path) -> None:
+        self.add_file(dest, src, 0o755)
+        if is_elf(src):
+            for vm_path, host in shared_libraries(src):
+                self.add_file(vm_path, host, 0o755)
+
+    def key(self) -> str:
+        """A digest of everything that ends up in the archive (file contents by size+mtime+name)."""
+        h = hashlib.sha256(f"layout {LAYOUT_VERSION}\n".encode())
+        for dest in sorted(self.entries):
+            kind, what, mode = self.entries[dest]
+            if kind == "file":
+                st = os.stat(what)
+                what = f"{what} {st.st_size} {st.st_mtime_ns}"
+            h.update(json.dumps([dest, kind, what, mode]).encode() + b"\n")
+        return h.hexdigest()[:20]
+
+    def write_cpio(self, out: Path) -> None:
+        """A newc cpio archive the kernel unpacks as initramfs (parents before children)."""
+        dirs = set()
+        for dest in self.entries:
+            parts = dest.strip("/").split("/")
+            for i in range(1, len(parts)):
+                dirs.add("/".join(parts[:i]))
+        for dest, (kind, _, _) in self.entries.items():
+            if kind == "dir":
+                dirs.add(dest.strip("/"))
+        ino = 1
+
+        def header(name: str, mode: int, size: int, nlink: int) -> bytes:
+            nonlocal ino
+            ino += 1
+            name_b = name.encode() + b"\0"
+            fields = [ino, mode, 0, 0, nlink, 0, size, 0, 0, 0, 0, len(name_b), 0]
+            h = b"070701" + b"".join(b"%08X" % f for f in fields) + name_b
+            return h + b"\0" * (-len(h) % 4)
+
+        tmp = out.with_name(out.name + f".tmp{os.getpid()}")
+        with open(tmp, "wb") as f:
+            for d in sorted(dirs):
+                f.write(header(d, stat.S_IFDIR | 0o755, 0, 2))
+            for dest in sorted(self.entries):
+                kind, what, mode = self.entries[dest]
+                name = dest.strip("/")
+                if kind == "dir":
+                    continue
+                if kind == "link":
+                    data = what.encode()
+                    f.write(header(name, stat.S_IFLNK | 0o777, len(data), 1))
+                else:
+                    data = Path(what).read_bytes() if kind == "file" else what.encode()
+                    f.write(header(name, stat.S_IFREG | mode, len(data), 1))
+                f.write(data + b"\0" * (-len(data) % 4))
+            f.write(header("TRAILER!!!", 0, 0, 1))
+            f.write(b"\0" * (-f.tell() % 512))
+        os.replace(tmp, out)
+
+
+def base_tree(info: dict[str, str]) -> Tree:
+    """What every VM gets: busybox, the modules, the Debian tools, /init and the helpers."""
+    t = Tree()
+    busybox = shutil.which("busybox") or "/bin/busybox"
+    busybox_path = Path(busybox)
+    if not busybox_path.is_file() or shared_libraries(busybox_path):
+        raise HarnessError("a static busybox is needed: apt-get install busybox-static")
+    t.add_file("/bin/busybox", busybox_path, 0o755)
+    applets = subprocess.run([busybox, "--list"], capture_output=True, text=True, check=True).stdout.split()
+    for a in applets:
+        if a not in ("busybox",):
+            t.add_symlink(f"/bin/{a}", "busybox")
+    for tool in CAN_TOOLS + GPIO_TOOLS:
+        path = shutil.which(tool)
+        if path is None:
+            raise HarnessError(f"{tool} not found: run scripts/setup.sh (can-utils, gpiod)")
+        t.add_program(f"/usr/bin/{tool}", Path(path))
+    moddir = Path(info["MODULES_DIR"])
+    krel = info["KERNEL_RELEASE"]
+    for rel in module_order(moddir, CAN_MODULES + GPIO_MODULES):
+        t.add_file(f"/lib/modules/{krel}/{rel}", moddir / rel, 0o644)
+    t.add_file("/init", HERE / "init.sh", 0o755)
+    t.add_file("/pathstream/vm_lib.sh", HERE / "vm_lib.sh", 0o644)
+    for d in ("/proc", "/sys", "/dev", "/tmp", "/run", "/root", "/pathstream/work", "/sbin", "/usr/sbin"):
+        t.add_dir(d)
+    return t
+
+
+def test_tree(args: argparse.Namespace, info: dict[str, str]) -> Tree:
+    t = Tree()
+    for p in args.program:
+        src = Path(p)
+        t.add_program(f"/pathstream/bin/{src.name}", src)
+    for p in args.data:
+        src = Path(p)
+        if src.is_dir():
+            for f in sorted(src.rglob("*")):
+                if f.is_file():
+                    t.add_file(f"/pathstream/data/{src.name}/{f.relative_to(src)}", f)
+        else:
+            t.add_file(f"/pathstream/data/{src.name}", src)
+    t.add_file("/pathstream/test.sh", Path(args.script), 0o755)
+    modules = []
+    if args.can:
+        modules += CAN_MODULES
+    if args.gpio_sim:
+        modules += GPIO_MODULES
+    order = module_order(Path(info["MODULES_DIR"]), modules) if modules else []
+    t.add_bytes("/etc/pathstream-vm/modules", "".join(m + "\n" for m in order))
+    cfg = {
+        "VM_CAN": "1" if args.can else "0",
+        "VM_CAN_IFACES": " ".join(args.can_iface),
+        "VM_GPIO_SIM": "1" if args.gpio_sim else "0",
+        "VM_GPIO_SIM_LINES": str(GPIO_SIM_LINES),
+        "VM_GPIO_SIM_NAMES": " ".join(GPIO_SIM_NAMES),
+        "VM_PROGRAM_TIMEOUT": str(args.program_timeout),
+        "VM_SCRIPT_TIMEOUT": str(args.script_timeout),
+    }
+    t.add_bytes("/etc/pathstream-vm/config", "".join(f"export {k}='{v}'\n" for k, v in cfg.items()))
+    return t
+
+
+def build_initrd(args: argparse.Namespace, info: dict[str, str], work: Path) -> Path:
+    cache = Path(args.base_cache) if args.base_cache else work / "cache"
+    cache.mkdir(parents=True, exist_ok=True)
+    base = base_tree(info)
+    base_key = base.key() + "-" + hashlib.sha256(info["VMLINUZ"].encode()).hexdigest()[:8]
+    base_file = cache / f"base-{base_key}.cpio"
+    # Several tests may start at once: one builds the shared base, the others wait for it.
+    with open(cache / ".lock", "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        if not base_file.is_file():
+            t0 = time.monotonic()
+            base.write_cpio(base_file)
+            log(f"built base initramfs {base_file.name} ({base_file.stat().st_size >> 10} KiB) "
+                f"in {time.monotonic() - t0:.2f} s")
+            # Keep the cache small: drop older bases.
+            for old in cache.glob("base-*.cpio"):
+                if old != base_file:
+                    old.unlink(missing_ok=True)
+    test = test_tree(args, info)
+    key = base_key + "-" + test.key()
+    initrd = work / "initrd.cpio"
+    key_file = work / "initrd.key"
+    if initrd.is_file() and key_file.is_file() and key_file.read_text() == key:
+        log(f"initramfs unchanged ({initrd})")
+        return initrd
+    t0 = time.monotonic()
+    overlay = work / "overlay.cpio"
+    test.write_cpio(overlay)
+    # The kernel unpacks concatenated archives in order: the test's files over the base.
+    tmp = work / "initrd.cpio.tmp"
+    with open(tmp, "wb") as out:
+        for part in (base_file, overlay):
+            with open(part, "rb") as f:
+                shutil.copyfileobj(f, out)
+    os.replace(tmp, initrd)
+    overlay.unlink()
+    key_file.write_text(key)
+    log(f"built initramfs {initrd} ({initrd.stat().st_size >> 10} KiB) in {time.monotonic() - t0:.2f} s")
+    return initrd
+
+
+# --- the VM ------------------------------------------------------------------------------------------
+def _die_with_parent() -> None:
+    """Runs in the qemu child: SIGKILL it when this harness dies (ctest timeout, Ctrl-C)."""
+    try:
+        libc = ctypes.CDLL(None, use_errno=True)
+        libc.prctl(1, signal.SIGKILL)  # PR_SET_PDEATHSIG
+    except OSError:
+        pass
+    os.setsid()
+
+
+def run_vm(args: argparse.Namespace, info: dict[str, str], initrd: Path, log_path: Path) -> int:
+    qemu = shutil.which("qemu-system-x86_64")
+    if qemu is None:
+        raise HarnessError("qemu-system-x86_64 not found: run scripts/setup.sh (qemu-system-x86)")
+    append = "console=ttyS0 quiet panic=-1 " + args.append
+    cmd = [qemu, "-m", str(args.memory), "-nographic", "-no-reboot", "-monitor", "none",
+           "-nic", "none", "-kernel", info["KERNEL"], "-initrd", str(initrd), "-append", append.strip()]
+    cmd += args.qemu_arg
+    if os.access("/dev/kvm", os.R_OK | os.W_OK) and not args.no_kvm:
+        cmd[1:1] = ["-enable-kvm", "-cpu", "host"]
+    log("booting " + " ".join(cmd))
+    t0 = time.monotonic()
+    proc = subprocess.Popen(cmd, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
+                            stderr=subprocess.STDOUT, preexec_fn=_die_with_parent)
+    result: list[int] = []
+    first_result_at: list[float] = []
+
+    def pump() -> None:
+        assert proc.stdout is not None
+        with open(log_path, "w", encoding="utf-8", errors="replace") as logf:
+            for raw in proc.stdout:
+                line = raw.decode("utf-8", errors="replace").replace("\r", "").rstrip("\n")
+                # SeaBIOS and the kernel may emit terminal escapes; keep the text readable.
+                line = re.sub(r"\x1b\[[0-9;?]*[a-zA-Z]|\x1bc", "", line)
+                logf.write(line + "\n")
+                logf.flush()
+                if not args.quiet:
+                    print(line, flush=True)
+                m = RESULT_RE.search(line)
+                if m and not result:
+                    result.append(int(m.group(1)))
+                    first_result_at.append(time.monotonic() - t0)
+
+    reader = threading.Thread(target=pump, daemon=True)
+    reader.start()
+
+    def stop(signum: int, _frame: object) -> None:
+        proc.kill()
+        raise SystemExit(128 + signum)
+
+    signal.signal(signal.SIGTERM, stop)
+    signal.signal(signal.SIGINT, stop)
+    timed_out = False
+    deadline = t0 + args.timeout
+    while proc.poll() is None:
+        now = time.monotonic()
+        if result and now - t0 > first_result_at[0] + 10:
+            log("the VM printed its result but did not power off within 10 s: killing it")
+            proc.kill()
+            break
+        if now > deadline:
+            timed_out = True
+            proc.kill()
+            break
+        time.sleep(0.05)
+    proc.wait()
+    reader.join(timeout=5)
+    elapsed = time.monotonic() - t0
+    if result:
+        log(f"result rc={result[0]} after {first_result_at[0]:.2f} s (qemu ran {elapsed:.2f} s); "
+            f"console log: {log_path}")
+        return result[0]
+    if timed_out:
+        log(f"ERROR: the VM printed no result within {args.timeout} s and was killed; "
+            f"console log: {log_path}")
+        return 124
+    log(f"ERROR: qemu exited with {proc.returncode} after {elapsed:.2f} s without printing a "
+        f"result (kernel panic? /init failed?); console log: {log_path}")
+    return 125
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--work", required=True, help="directory for the initramfs and logs (in the build dir)")
+    ap.add_argument("--base-cache", help="directory for the shared base initramfs (default WORK/cache); tests may share it")
+    ap.add_argument("--script", required=True, help="sh script run inside the VM (busybox sh)")
+    ap.add_argument("--program", action="append", default=[], help="executable copied to /pathstream/bin with its libraries")
+    ap.add_argument("--data", action="append", default=[], help="file or directory copied to /pathstream/data")
+    ap.add_argument("--gpio-sim", action="store_true", help="create the gpio-sim chip (16 lines, bank pathstream-sim)")
+    ap.add_argument("--no-can", dest="can", action="store_false", help="do not load CAN nor bring up vcan0")
+    ap.add_argument("--can-iface", action="append", default=None, help="vcan interfaces to create (default vcan0)")
+    ap.add_argument("--program-timeout", type=int, default=20, help="default vm_run timeout inside the VM (s)")
+    ap.add_argument("--script-timeout", type=int, default=0, help="timeout of the whole test script (s; default --timeout - 15)")
+    ap.add_argument("--timeout", type=int, default=90, help="overall timeout of the VM run (s)")
+    ap.add_argument("--memory", type=int, default=512, help="VM memory (MiB)")
+    ap.add_argument("--append", default="", help="extra kernel command line")
+    ap.add_argument("--qemu-arg", action="append", default=[], help="extra qemu argument (repeat for each word)")
+    ap.add_argument("--kernel-cache", help="setup_vm.sh's cache dir (default: from scripts/setup_vm.sh)")
+    ap.add_argument("--expect-rc", type=int, help="exit 0 iff the script exits with this status")
+    ap.add_argument("--log", help="console log file (default WORK/console.log)")
+    ap.add_argument("--no-kvm", action="store_true", help="use TCG even when /dev/kvm is usable")
+    ap.add_argument("--quiet", action="store_true", help="do not echo the console")
+    args = ap.parse_args()
+    if args.can_iface is None:
+        args.can_iface = ["vcan0"]
+    if args.script_timeout <= 0:
+        args.script_timeout = max(5, args.timeout - 15)
+    try:
+        info = read_cache(Path(args.kernel_cache) if args.kernel_cache else default_cache())
+        work = Path(args.work)
+        work.mkdir(parents=True, exist_ok=True)
+        initrd = build_initrd(args, info, work)
+        rc = run_vm(args, info, initrd, Path(args.log) if args.log else work / "console.log")
+    except HarnessError as e:
+        print(f"run_in_vm: ERROR: {e}", file=sys.stderr, flush=True)
+        return 125
+    if args.expect_rc is not None:
+        ok = rc == args.expect_rc
+        log(f"expected rc={args.expect_rc}, got rc={rc}: {'OK' if ok else 'FAIL'}")
+        return 0 if ok else 1
+    return rc
+
+
+if __name__ == "__main__":
+    sys.exit(main())
