@@ -34,7 +34,12 @@ if [ "$(id -u)" -ne 0 ]; then sudo=sudo; else sudo=; fi
 
 stamp="$CACHE/READY"
 want_stamp="format=$CACHE_FORMAT kernel=$KREL package=$KERNEL_PKG_VERSION"
-if [ -f "$stamp" ] && [ "$(head -n1 "$stamp")" = "$want_stamp" ]; then
+cache_ready() {  # the stamp of this very setup, and the artefacts the harness uses
+  [ -f "$stamp" ] && [ "$(head -n1 "$stamp")" = "$want_stamp" ] &&
+    [ -f "$CACHE/vmlinux" ] && [ -f "$CACHE/root/lib/modules/$KREL/modules.dep" ] &&
+    [ -f "$CACHE/root/lib/modules/$KREL/extra/gpio-sim.ko" ]
+}
+if cache_ready; then
   say "kernel $KREL ($KERNEL_PKG_VERSION) ready in $CACHE (nothing to do)"
   exit 0
 fi
@@ -46,7 +51,7 @@ mkdir -p "$CACHE"
 # One setup at a time (several engineers and CI may share the machine).
 exec 9>"$CACHE_ROOT/.lock"
 flock -w 900 9 || die "another setup_vm.sh holds $CACHE_ROOT/.lock for more than 15 minutes"
-if [ -f "$stamp" ] && [ "$(head -n1 "$stamp")" = "$want_stamp" ]; then
+if cache_ready; then
   say "kernel $KREL ready in $CACHE (built by a concurrent run)"
   exit 0
 fi

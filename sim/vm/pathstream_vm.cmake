@@ -108,5 +108,6 @@ function(pathstream_add_vm_test)
   add_test(NAME ${arg_NAME} COMMAND ${cmd})
   # ctest's own timeout is a backstop only: the harness kills the VM at TIMEOUT and says so.
   math(EXPR ctest_timeout "${arg_TIMEOUT} + 30")
-  set_tests_properties(${arg_NAME} PROPERTIES LABELS "vm;${arg_LABELS}" TIMEOUT ${ctest_timeout})
+  set(labels vm ${arg_LABELS})
+  set_tests_properties(${arg_NAME} PROPERTIES LABELS "${labels}" TIMEOUT ${ctest_timeout})
 endfunction()

@@ -82,7 +82,7 @@ def read_cache(cache: Path) -> dict[str, str]:
         if key not in info:
             raise HarnessError(f"{ready} lacks {key}: run scripts/setup_vm.sh again")
     if not Path(info["VMLINUZ"]).is_file() or not (Path(info["MODULES_DIR"]) / "modules.dep").is_file():
-        raise HarnessError(f"kernel cache {cache} is incomplete: remove {ready} and run scripts/setup_vm.sh")
+        raise HarnessError(f"kernel cache {cache} is incomplete: run scripts/setup_vm.sh")
     # The uncompressed ELF boots through PVH, without firmware or xz under TCG (~4 s faster).
     vmlinux = info.get("VMLINUX", "")
     info["KERNEL"] = vmlinux if vmlinux and Path(vmlinux).is_file() else info["VMLINUZ"]
@@ -121,8 +121,42 @@ def module_order(moddir: Path, names: list[str]) -> list[str]:
 
 
 # --- files and their libraries ---------------------------------------------------------------------
+_LDD_CACHE: dict[str, list] = {}
+_LDD_CACHE_FILE: Path | None = None
+
+
+def load_ldd_cache(path: Path) -> None:
+    """ldd answers from earlier runs, keyed by file, size and mtime (ldd costs ~0.1 s a call)."""
+    global _LDD_CACHE_FILE
+    _LDD_CACHE_FILE = path
+    try:
+        _LDD_CACHE.update(json.loads(path.read_text()))
+    except (OSError, ValueError):
+        pass
+
+
+def save_ldd_cache() -> None:
+    if _LDD_CACHE_FILE is not None:
+        tmp = _LDD_CACHE_FILE.with_name(_LDD_CACHE_FILE.name + f".tmp{os.getpid()}")
+        tmp.write_text(json.dumps(_LDD_CACHE))
+        os.replace(tmp, _LDD_CACHE_FILE)
+
+
 def shared_libraries(exe: Path) -> list[tuple[str, Path]]:
     """(path inside the VM, host file) of every shared library EXE needs, from ldd."""
+    st = exe.stat()
+    key = str(exe.resolve())
+    cached = _LDD_CACHE.get(key)
+    if cached and cached[0] == st.st_size and cached[1] == st.st_mtime_ns:
+        pairs = cached[2]
+    else:
+        pairs = _run_ldd(exe)
+        _LDD_CACHE[key] = [st.st_size, st.st_mtime_ns, pairs]
+    # Resolved now, not when cached: a library upgraded since still shows up.
+    return [(vm, Path(host).resolve()) for vm, host in pairs]
+
+
+def _run_ldd(exe: Path) -> list[list[str]]:
     try:
         out = subprocess.run(["ldd", str(exe)], capture_output=True, text=True, timeout=30)
     except subprocess.TimeoutExpired as e:
@@ -139,11 +173,11 @@ def shared_libraries(exe: Path) -> list[tuple[str, Path]]:
             raise HarnessError(f"{exe}: {line}")
         m = re.match(r"(\S+) => (/\S+) \(0x", line)
         if m:  # libfoo.so.1 => /lib/x86_64-linux-gnu/libfoo.so.1
-            libs.append((f"/lib/x86_64-linux-gnu/{m.group(1)}", Path(m.group(2)).resolve()))
+            libs.append([f"/lib/x86_64-linux-gnu/{m.group(1)}", m.group(2)])
             continue
         m = re.match(r"(/\S+) \(0x", line)
         if m:  # the program interpreter, at the absolute path the ELF names
-            libs.append((m.group(1), Path(m.group(1)).resolve()))
+            libs.append([m.group(1), m.group(1)])
     return libs
 
 
@@ -240,7 +274,13 @@ def base_tree(info: dict[str, str]) -> Tree:
     if not busybox_path.is_file() or shared_libraries(busybox_path):
         raise HarnessError("a static busybox is needed: apt-get install busybox-static")
     t.add_file("/bin/busybox", busybox_path, 0o755)
-    applets = subprocess.run([busybox, "--list"], capture_output=True, text=True, check=True).stdout.split()
+    st = busybox_path.stat()
+    cached = _LDD_CACHE.get("busybox --list")
+    if cached and cached[0] == st.st_size and cached[1] == st.st_mtime_ns:
+        applets = cached[2]
+    else:
+        applets = subprocess.run([busybox, "--list"], capture_output=True, text=True, check=True).stdout.split()
+        _LDD_CACHE["busybox --list"] = [st.st_size, st.st_mtime_ns, applets]
     for a in applets:
         if a not in ("busybox",):
             t.add_symlink(f"/bin/{a}", "busybox")
@@ -295,42 +335,44 @@ def test_tree(args: argparse.Namespace, info: dict[str, str]) -> Tree:
 
 
 def build_initrd(args: argparse.Namespace, info: dict[str, str], work: Path) -> Path:
+    """The test's initramfs: the shared base archive (cached by its inputs) + the test's own."""
     cache = Path(args.base_cache) if args.base_cache else work / "cache"
     cache.mkdir(parents=True, exist_ok=True)
-    base = base_tree(info)
-    base_key = base.key() + "-" + hashlib.sha256(info["VMLINUZ"].encode()).hexdigest()[:8]
-    base_file = cache / f"base-{base_key}.cpio"
-    # Several tests may start at once: one builds the shared base, the others wait for it.
+    # Tests run in parallel and share the base: one builds it, the others wait for it.
     with open(cache / ".lock", "w") as lock:
         fcntl.flock(lock, fcntl.LOCK_EX)
+        load_ldd_cache(cache / "ldd-cache.json")
+        base = base_tree(info)
+        test = test_tree(args, info)
+        save_ldd_cache()
+        base_key = base.key() + "-" + hashlib.sha256(info["KERNEL"].encode()).hexdigest()[:8]
+        base_file = cache / f"base-{base_key}.cpio"
         if not base_file.is_file():
             t0 = time.monotonic()
             base.write_cpio(base_file)
             log(f"built base initramfs {base_file.name} ({base_file.stat().st_size >> 10} KiB) "
                 f"in {time.monotonic() - t0:.2f} s")
-            # Keep the cache small: drop older bases.
-            for old in cache.glob("base-*.cpio"):
+            for old in cache.glob("base-*.cpio"):  # keep the cache small
                 if old != base_file:
                     old.unlink(missing_ok=True)
-    test = test_tree(args, info)
-    key = base_key + "-" + test.key()
-    initrd = work / "initrd.cpio"
-    key_file = work / "initrd.key"
-    if initrd.is_file() and key_file.is_file() and key_file.read_text() == key:
-        log(f"initramfs unchanged ({initrd})")
-        return initrd
-    t0 = time.monotonic()
-    overlay = work / "overlay.cpio"
-    test.write_cpio(overlay)
-    # The kernel unpacks concatenated archives in order: the test's files over the base.
-    tmp = work / "initrd.cpio.tmp"
-    with open(tmp, "wb") as out:
-        for part in (base_file, overlay):
-            with open(part, "rb") as f:
-                shutil.copyfileobj(f, out)
-    os.replace(tmp, initrd)
-    overlay.unlink()
-    key_file.write_text(key)
+        key = base_key + "-" + test.key()
+        initrd = work / "initrd.cpio"
+        key_file = work / "initrd.key"
+        if initrd.is_file() and key_file.is_file() and key_file.read_text() == key:
+            log(f"initramfs unchanged ({initrd})")
+            return initrd
+        t0 = time.monotonic()
+        overlay = work / "overlay.cpio"
+        test.write_cpio(overlay)
+        # The kernel unpacks concatenated archives in order: the test's files over the base.
+        tmp = work / "initrd.cpio.tmp"
+        with open(tmp, "wb") as out:
+            for part in (base_file, overlay):
+                with open(part, "rb") as f:
+                    shutil.copyfileobj(f, out)
+        os.replace(tmp, initrd)
+        overlay.unlink()
+        key_file.write_text(key)
     log(f"built initramfs {initrd} ({initrd.stat().st_size >> 10} KiB) in {time.monotonic() - t0:.2f} s")
     return initrd
 
