@@ -18,7 +18,8 @@ using std::chrono::milliseconds;
 void set_timeout(modbus_t* ctx, milliseconds timeout,
                  int (*setter)(modbus_t*, std::uint32_t, std::uint32_t)) {
     const auto us = std::chrono::duration_cast<std::chrono::microseconds>(timeout).count();
-    setter(ctx, static_cast<std::uint32_t>(us / 1'000'000), static_cast<std::uint32_t>(us % 1'000'000));
+    setter(ctx, static_cast<std::uint32_t>(us / 1'000'000),
+           static_cast<std::uint32_t>(us % 1'000'000));
 }
 
 // libmodbus reports through errno: its own codes above MODBUS_ENOBASE, the OS's below.
@@ -52,8 +53,7 @@ void check_count(const char* what, std::size_t count, std::size_t max) {
 void check_range(const char* what, std::uint16_t address, std::size_t count) {
     if (address + count > 0x10000u) {
         throw std::invalid_argument(std::string(what) + ": registers " + std::to_string(address) +
-                                    ".." + std::to_string(address + count - 1) +
-                                    " run past 65535");
+                                    ".." + std::to_string(address + count - 1) + " run past 65535");
     }
 }
 
@@ -72,9 +72,11 @@ struct ModbusClient::Impl {
     Impl(const ModbusTarget& t, const ModbusClientOptions& o)
         : target(t),
           options(o),
-          framing(t.transport == ModbusTarget::Transport::kTcp ? ModbusFraming::kTcp : ModbusFraming::kRtu),
+          framing(t.transport == ModbusTarget::Transport::kTcp ? ModbusFraming::kTcp
+                                                               : ModbusFraming::kRtu),
           name(to_string(t)) {
-        if (options.attempts < 1) throw std::invalid_argument("ModbusClient: attempts must be >= 1");
+        if (options.attempts < 1)
+            throw std::invalid_argument("ModbusClient: attempts must be >= 1");
         if (framing == ModbusFraming::kTcp) {
             const std::string port = std::to_string(target.port);
             ctx = modbus_new_tcp_pi(target.host.c_str(), port.c_str());
@@ -121,7 +123,8 @@ struct ModbusClient::Impl {
     // response to the next. Bounded by one response timeout.
     void settle_serial_line() {
         modbus_flush(ctx);
-        const milliseconds quiet = std::clamp(options.response_timeout / 10, milliseconds(2), milliseconds(50));
+        const milliseconds quiet =
+            std::clamp(options.response_timeout / 10, milliseconds(2), milliseconds(50));
         const auto deadline = std::chrono::steady_clock::now() + options.response_timeout;
         pollfd fd{modbus_get_socket(ctx), POLLIN, 0};
         while (std::chrono::steady_clock::now() < deadline &&
@@ -134,7 +137,8 @@ struct ModbusClient::Impl {
     // Runs `op` (a libmodbus call returning -1 on failure) under the retry policy.
     // request_pdu / response_pdu size the byte counters.
     template <class Op>
-    void transact(const std::string& what, std::size_t request_pdu, std::size_t response_pdu, Op op) {
+    void transact(const std::string& what, std::size_t request_pdu, std::size_t response_pdu,
+                  Op op) {
         const std::string context = name + ": " + what;
         const std::uint64_t request_adu = modbus_adu_bytes(framing, request_pdu);
         for (int attempt = 1;; ++attempt) {
@@ -158,7 +162,8 @@ struct ModbusClient::Impl {
                 case ModbusError::Kind::kExceptionResponse:
                     ++counters.exception_responses;
                     counters.adu_bytes_sent += request_adu;
-                    counters.adu_bytes_received += modbus_adu_bytes(framing, modbus_exception_pdu_bytes());
+                    counters.adu_bytes_received +=
+                        modbus_adu_bytes(framing, modbus_exception_pdu_bytes());
                     throw failure;  // a definite answer: retrying cannot change it
                 case ModbusError::Kind::kTimeout:
                     ++counters.timeouts;
@@ -175,7 +180,8 @@ struct ModbusClient::Impl {
                     break;  // counted in connect()
             }
             if (open) {
-                if (framing == ModbusFraming::kTcp || failure.kind() == ModbusError::Kind::kConnectionLost) {
+                if (framing == ModbusFraming::kTcp ||
+                    failure.kind() == ModbusError::Kind::kConnectionLost) {
                     disconnect();  // the next try (or call) starts on a fresh connection
                 } else {
                     settle_serial_line();
@@ -183,9 +189,10 @@ struct ModbusClient::Impl {
             }
             if (attempt >= options.attempts) {
                 if (options.attempts == 1) throw failure;
-                throw ModbusError(failure.kind(), std::string(failure.what()) + " (after " +
-                                                      std::to_string(attempt) + " tries)",
-                                  failure.exception_code());
+                throw ModbusError(
+                    failure.kind(),
+                    std::string(failure.what()) + " (after " + std::to_string(attempt) + " tries)",
+                    failure.exception_code());
             }
         }
     }
@@ -194,7 +201,8 @@ struct ModbusClient::Impl {
 
     void refuse_broadcast_read(const char* what) const {
         if (broadcast()) {
-            throw std::invalid_argument(name + ": " + what + " to the broadcast unit 0 (nobody answers)");
+            throw std::invalid_argument(name + ": " + what +
+                                        " to the broadcast unit 0 (nobody answers)");
         }
     }
 
@@ -204,7 +212,8 @@ struct ModbusClient::Impl {
         if (!open) connect();
         const int sent = modbus_send_raw_request(ctx, raw, length);
         if (sent < 0) {
-            const ModbusError failure = classify(errno, name + ": " + what, options.response_timeout);
+            const ModbusError failure =
+                classify(errno, name + ": " + what, options.response_timeout);
             ++counters.connection_losses;
             disconnect();
             throw failure;
@@ -231,9 +240,10 @@ void ModbusClient::read_input_registers(std::uint16_t address, std::span<std::ui
     check_range("read_input_registers", address, out.size());
     impl_->refuse_broadcast_read("read_input_registers");
     const int n = static_cast<int>(out.size());
-    impl_->transact("FC4 read input registers " + std::to_string(address) + " x" + std::to_string(n),
-                    modbus_read_request_pdu_bytes(), modbus_read_response_pdu_bytes(out.size()),
-                    [&](modbus_t* ctx) { return modbus_read_input_registers(ctx, address, n, out.data()); });
+    impl_->transact(
+        "FC4 read input registers " + std::to_string(address) + " x" + std::to_string(n),
+        modbus_read_request_pdu_bytes(), modbus_read_response_pdu_bytes(out.size()),
+        [&](modbus_t* ctx) { return modbus_read_input_registers(ctx, address, n, out.data()); });
 }
 
 void ModbusClient::read_holding_registers(std::uint16_t address, std::span<std::uint16_t> out) {
@@ -241,17 +251,21 @@ void ModbusClient::read_holding_registers(std::uint16_t address, std::span<std::
     check_range("read_holding_registers", address, out.size());
     impl_->refuse_broadcast_read("read_holding_registers");
     const int n = static_cast<int>(out.size());
-    impl_->transact("FC3 read holding registers " + std::to_string(address) + " x" + std::to_string(n),
-                    modbus_read_request_pdu_bytes(), modbus_read_response_pdu_bytes(out.size()),
-                    [&](modbus_t* ctx) { return modbus_read_registers(ctx, address, n, out.data()); });
+    impl_->transact(
+        "FC3 read holding registers " + std::to_string(address) + " x" + std::to_string(n),
+        modbus_read_request_pdu_bytes(), modbus_read_response_pdu_bytes(out.size()),
+        [&](modbus_t* ctx) { return modbus_read_registers(ctx, address, n, out.data()); });
 }
 
 void ModbusClient::write_register(std::uint16_t address, std::uint16_t value) {
     const std::string what = "FC6 write register " + std::to_string(address);
     if (impl_->broadcast()) {
-        std::uint8_t raw[] = {0, 0x06, static_cast<std::uint8_t>(address >> 8),
+        std::uint8_t raw[] = {0,
+                              0x06,
+                              static_cast<std::uint8_t>(address >> 8),
                               static_cast<std::uint8_t>(address & 0xFF),
-                              static_cast<std::uint8_t>(value >> 8), static_cast<std::uint8_t>(value & 0xFF)};
+                              static_cast<std::uint8_t>(value >> 8),
+                              static_cast<std::uint8_t>(value & 0xFF)};
         impl_->send_broadcast(what, raw, sizeof raw);
         return;
     }
@@ -263,11 +277,16 @@ void ModbusClient::write_registers(std::uint16_t address, std::span<const std::u
     check_count("write_registers", values.size(), 123);
     check_range("write_registers", address, values.size());
     const int n = static_cast<int>(values.size());
-    const std::string what = "FC16 write registers " + std::to_string(address) + " x" + std::to_string(n);
+    const std::string what =
+        "FC16 write registers " + std::to_string(address) + " x" + std::to_string(n);
     if (impl_->broadcast()) {
-        std::uint8_t raw[7 + 2 * 123] = {0, 0x10, static_cast<std::uint8_t>(address >> 8),
-                                         static_cast<std::uint8_t>(address & 0xFF), 0,
-                                         static_cast<std::uint8_t>(n), static_cast<std::uint8_t>(2 * n)};
+        std::uint8_t raw[7 + 2 * 123] = {0,
+                                         0x10,
+                                         static_cast<std::uint8_t>(address >> 8),
+                                         static_cast<std::uint8_t>(address & 0xFF),
+                                         0,
+                                         static_cast<std::uint8_t>(n),
+                                         static_cast<std::uint8_t>(2 * n)};
         for (int i = 0; i < n; ++i) {
             raw[7 + 2 * i] = static_cast<std::uint8_t>(values[static_cast<std::size_t>(i)] >> 8);
             raw[8 + 2 * i] = static_cast<std::uint8_t>(values[static_cast<std::size_t>(i)] & 0xFF);
@@ -276,11 +295,13 @@ void ModbusClient::write_registers(std::uint16_t address, std::span<const std::u
         return;
     }
     impl_->transact(what, modbus_write_multiple_request_pdu_bytes(values.size()),
-                    modbus_write_multiple_response_pdu_bytes(),
-                    [&](modbus_t* ctx) { return modbus_write_registers(ctx, address, n, values.data()); });
+                    modbus_write_multiple_response_pdu_bytes(), [&](modbus_t* ctx) {
+                        return modbus_write_registers(ctx, address, n, values.data());
+                    });
 }
 
-void ModbusClient::write_read_registers(std::uint16_t write_address, std::span<const std::uint16_t> values,
+void ModbusClient::write_read_registers(std::uint16_t write_address,
+                                        std::span<const std::uint16_t> values,
                                         std::uint16_t read_address, std::span<std::uint16_t> out) {
     check_count("write_read_registers (write)", values.size(), 121);
     check_count("write_read_registers (read)", out.size(), 125);
@@ -293,8 +314,8 @@ void ModbusClient::write_read_registers(std::uint16_t write_address, std::span<c
                         ", read " + std::to_string(read_address) + " x" + std::to_string(nr),
                     modbus_write_read_request_pdu_bytes(values.size()),
                     modbus_read_response_pdu_bytes(out.size()), [&](modbus_t* ctx) {
-                        return modbus_write_and_read_registers(ctx, write_address, nw, values.data(),
-                                                               read_address, nr, out.data());
+                        return modbus_write_and_read_registers(
+                            ctx, write_address, nw, values.data(), read_address, nr, out.data());
                     });
 }
 
@@ -303,10 +324,20 @@ void ModbusClient::reconnect() {
     impl_->connect();
 }
 
-void ModbusClient::close() { impl_->disconnect(); }
-bool ModbusClient::connected() const { return impl_->open; }
-const ModbusTarget& ModbusClient::target() const { return impl_->target; }
-const ModbusClientOptions& ModbusClient::options() const { return impl_->options; }
-const ModbusClientCounters& ModbusClient::counters() const { return impl_->counters; }
+void ModbusClient::close() {
+    impl_->disconnect();
+}
+bool ModbusClient::connected() const {
+    return impl_->open;
+}
+const ModbusTarget& ModbusClient::target() const {
+    return impl_->target;
+}
+const ModbusClientOptions& ModbusClient::options() const {
+    return impl_->options;
+}
+const ModbusClientCounters& ModbusClient::counters() const {
+    return impl_->counters;
+}
 
 }  // namespace pathstream::hal

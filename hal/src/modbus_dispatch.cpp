@@ -25,8 +25,8 @@ ModbusException call_handler(ModbusRegisterHandler& handler, const ModbusRequest
         case kFcWriteRead:
             decode_registers(req.values, req.write_count, s.values.data());
             return handler.write_read_holding_registers(req.write_address, req.write_count,
-                                                        s.values.data(), req.address,
-                                                        req.count, s.out.data());
+                                                        s.values.data(), req.address, req.count,
+                                                        s.out.data());
         default:
             return ModbusException::kIllegalFunction;
     }
@@ -71,7 +71,8 @@ int reply_success(modbus_t* ctx, const ModbusRequest& req, const std::uint8_t* a
             s.request.assign(adu, adu + length);
             const int header = modbus_get_header_length(ctx);
             std::uint8_t* values = s.request.data() + header + 10;  // FC23 write values
-            for (std::uint32_t a = req.write_address; a < req.write_address + req.write_count; ++a) {
+            for (std::uint32_t a = req.write_address; a < req.write_address + req.write_count;
+                 ++a) {
                 if (a >= req.address && a < static_cast<std::uint32_t>(req.address) + req.count) {
                     const std::uint16_t v = s.out[a - req.address];
                     values[2 * (a - req.write_address)] = static_cast<std::uint8_t>(v >> 8);
@@ -102,9 +103,10 @@ DispatchOutcome dispatch_modbus_request(modbus_t* ctx, ModbusFraming framing,
 
     const int pdu_length = length - header - trailer;
     ModbusRequest req;
-    ModbusException ex = pdu_length < 1
-                             ? ModbusException::kIllegalFunction
-                             : parse_modbus_request(adu + header, static_cast<std::size_t>(pdu_length), req);
+    ModbusException ex =
+        pdu_length < 1
+            ? ModbusException::kIllegalFunction
+            : parse_modbus_request(adu + header, static_cast<std::size_t>(pdu_length), req);
     if (ex == ModbusException::kNone) {
         // A broadcast has nobody to read the answer: only writes make sense (spec 2.1);
         // reads and FC23 are dropped without touching the handler.
@@ -114,9 +116,8 @@ DispatchOutcome dispatch_modbus_request(modbus_t* ctx, ModbusFraming framing,
     }
     outcome.exception = ex != ModbusException::kNone;
     if (outcome.broadcast) return outcome;
-    outcome.sent = outcome.exception
-                       ? modbus_reply_exception(ctx, adu, static_cast<unsigned>(ex))
-                       : reply_success(ctx, req, adu, length, s);
+    outcome.sent = outcome.exception ? modbus_reply_exception(ctx, adu, static_cast<unsigned>(ex))
+                                     : reply_success(ctx, req, adu, length, s);
     return outcome;
 }
 

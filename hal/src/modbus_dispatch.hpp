@@ -13,8 +13,8 @@ namespace pathstream::hal::detail {
 
 /// Buffers reused across requests so that serving allocates nothing after construction.
 struct DispatchScratch {
-    std::vector<std::uint16_t> values = std::vector<std::uint16_t>(125);  // registers to write
-    std::vector<std::uint16_t> out = std::vector<std::uint16_t>(125);     // registers read
+    std::vector<std::uint16_t> values = std::vector<std::uint16_t>(125);    // registers to write
+    std::vector<std::uint16_t> out = std::vector<std::uint16_t>(125);       // registers read
     std::vector<std::uint16_t> window = std::vector<std::uint16_t>(65536);  // modbus_reply's view
     std::vector<std::uint8_t> request;  // a patched copy of an FC23 request (see the .cpp)
 };
@@ -23,7 +23,7 @@ struct DispatchScratch {
 struct DispatchOutcome {
     bool exception = false;  ///< answered (or, broadcast, refused) with an exception
     bool broadcast = false;  ///< RTU unit 0: never answered
-    int sent = 0;            ///< ADU bytes written (0 for a broadcast), -1 if the send failed (errno set)
+    int sent = 0;  ///< ADU bytes written (0 for a broadcast), -1 if the send failed (errno set)
 };
 
 /// Parses `adu` (a whole frame from modbus_receive on `ctx`, `length` bytes with header and,

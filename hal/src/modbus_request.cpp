@@ -21,7 +21,8 @@ ModbusException parse_modbus_request(const std::uint8_t* pdu, std::size_t length
             if (length < 5) return ModbusException::kIllegalDataValue;
             out.address = load_be16(pdu + 1);
             out.count = load_be16(pdu + 3);
-            if (out.count < 1 || out.count > kMaxReadCount) return ModbusException::kIllegalDataValue;
+            if (out.count < 1 || out.count > kMaxReadCount)
+                return ModbusException::kIllegalDataValue;
             if (!range_fits(out.address, out.count)) return ModbusException::kIllegalDataAddress;
             return ModbusException::kNone;
         case kFcWriteSingle:

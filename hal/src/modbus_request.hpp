@@ -21,14 +21,15 @@ inline constexpr std::uint16_t kMaxWriteReadCount = 121;  // FC23 write
 /// One request, ready for the handler. Addresses and counts are in registers.
 struct ModbusRequest {
     std::uint8_t function = 0;
-    std::uint16_t address = 0;        ///< FC3/4/6/16; FC23: the read address
-    std::uint16_t count = 0;          ///< FC3/4/16 (1 for FC6); FC23: the read count
-    std::uint16_t write_address = 0;  ///< FC23 only
-    std::uint16_t write_count = 0;    ///< FC23 only
+    std::uint16_t address = 0;             ///< FC3/4/6/16; FC23: the read address
+    std::uint16_t count = 0;               ///< FC3/4/16 (1 for FC6); FC23: the read count
+    std::uint16_t write_address = 0;       ///< FC23 only
+    std::uint16_t write_count = 0;         ///< FC23 only
     const std::uint8_t* values = nullptr;  ///< big-endian register bytes to write (FC6/16/23)
 
     bool writes() const {
-        return function == kFcWriteSingle || function == kFcWriteMultiple || function == kFcWriteRead;
+        return function == kFcWriteSingle || function == kFcWriteMultiple ||
+               function == kFcWriteRead;
     }
 };
 

@@ -42,12 +42,14 @@ int listen_on(const ModbusTcpEndpoint& endpoint) {
     const std::string service = std::to_string(endpoint.port);
     const int gai = getaddrinfo(endpoint.host.c_str(), service.c_str(), &hints, &found);
     if (gai != 0) {
-        throw std::system_error(EINVAL, std::generic_category(),
-                                "Modbus TCP server: cannot resolve '" + endpoint.host + "': " + gai_strerror(gai));
+        throw std::system_error(
+            EINVAL, std::generic_category(),
+            "Modbus TCP server: cannot resolve '" + endpoint.host + "': " + gai_strerror(gai));
     }
     int err = 0;
     for (addrinfo* a = found; a != nullptr; a = a->ai_next) {
-        const int fd = ::socket(a->ai_family, a->ai_socktype | SOCK_CLOEXEC | SOCK_NONBLOCK, a->ai_protocol);
+        const int fd =
+            ::socket(a->ai_family, a->ai_socktype | SOCK_CLOEXEC | SOCK_NONBLOCK, a->ai_protocol);
         if (fd < 0) {
             err = errno;
             continue;
@@ -148,7 +150,8 @@ void ModbusServer::Impl::accept_clients() {
         if (clients.size() >= max_clients) {
             // Full: the longest-idle connection is most likely a master that vanished
             // without a FIN; the newcomer is most likely that master coming back.
-            const auto idle = std::min_element(clients.begin(), clients.end(),
+            const auto idle = std::min_element(
+                clients.begin(), clients.end(),
                 [](const Client& a, const Client& b) { return a.last_active < b.last_active; });
             close_client(static_cast<std::size_t>(idle - clients.begin()));
         }
@@ -206,7 +209,8 @@ std::size_t ModbusServer::Impl::poll_tcp(std::chrono::milliseconds max_wait) {
         handled += counters.requests.load(std::memory_order_relaxed) - before;
     }
     for (const int fd : to_close) {
-        const auto it = std::find_if(clients.begin(), clients.end(), [fd](const Client& c) { return c.fd == fd; });
+        const auto it = std::find_if(clients.begin(), clients.end(),
+                                     [fd](const Client& c) { return c.fd == fd; });
         if (it != clients.end()) close_client(static_cast<std::size_t>(it - clients.begin()));
     }
     if (fds[0].revents != 0) accept_clients();
@@ -267,8 +271,9 @@ namespace {
 
 void check_unit(int unit) {
     if (unit < 1 || unit > 247) {
-        throw std::system_error(EINVAL, std::generic_category(),
-                                "Modbus RTU server: unit id " + std::to_string(unit) + " is not in 1..247");
+        throw std::system_error(
+            EINVAL, std::generic_category(),
+            "Modbus RTU server: unit id " + std::to_string(unit) + " is not in 1..247");
     }
 }
 
@@ -279,17 +284,21 @@ ModbusServer ModbusServer::rtu(ModbusRegisterHandler& handler, const ModbusSeria
     check_unit(options.unit);
     auto impl = std::make_unique<Impl>(handler, ModbusFraming::kRtu, options);
     impl->device = line.device;
-    impl->ctx = modbus_new_rtu(line.device.c_str(), line.baud, line.parity, line.data_bits, line.stop_bits);
-    if (impl->ctx == nullptr) throw_errno("Modbus RTU server: bad serial settings for " + line.device);
+    impl->ctx =
+        modbus_new_rtu(line.device.c_str(), line.baud, line.parity, line.data_bits, line.stop_bits);
+    if (impl->ctx == nullptr)
+        throw_errno("Modbus RTU server: bad serial settings for " + line.device);
     modbus_set_slave(impl->ctx, options.unit);
     set_timeouts(impl->ctx, options.byte_timeout);
-    if (modbus_connect(impl->ctx) != 0) throw_errno("Modbus RTU server: cannot open " + line.device);
+    if (modbus_connect(impl->ctx) != 0)
+        throw_errno("Modbus RTU server: cannot open " + line.device);
     impl->serial_opened = true;
     impl->serial_fd = modbus_get_socket(impl->ctx);
     return ModbusServer(std::move(impl));
 }
 
-ModbusServer ModbusServer::rtu_pty(ModbusRegisterHandler& handler, const ModbusServerOptions& options) {
+ModbusServer ModbusServer::rtu_pty(ModbusRegisterHandler& handler,
+                                   const ModbusServerOptions& options) {
     check_unit(options.unit);
     auto impl = std::make_unique<Impl>(handler, ModbusFraming::kRtu, options);
     impl->pty.emplace();
@@ -307,7 +316,8 @@ ModbusServer ModbusServer::rtu_pty(ModbusRegisterHandler& handler, const ModbusS
 
 std::size_t ModbusServer::poll_once(std::chrono::milliseconds max_wait) {
     if (max_wait.count() < 0) max_wait = std::chrono::milliseconds(0);
-    return impl_->framing == ModbusFraming::kTcp ? impl_->poll_tcp(max_wait) : impl_->poll_rtu(max_wait);
+    return impl_->framing == ModbusFraming::kTcp ? impl_->poll_tcp(max_wait)
+                                                 : impl_->poll_rtu(max_wait);
 }
 
 std::size_t ModbusServer::serve_for(std::chrono::milliseconds duration) {
@@ -320,9 +330,17 @@ std::size_t ModbusServer::serve_for(std::chrono::milliseconds duration) {
     }
 }
 
-std::uint16_t ModbusServer::port() const { return impl_->port; }
-const std::string& ModbusServer::client_device() const { return impl_->device; }
-const ModbusServerCounters& ModbusServer::counters() const { return impl_->counters; }
-std::size_t ModbusServer::open_connections() const { return impl_->clients.size(); }
+std::uint16_t ModbusServer::port() const {
+    return impl_->port;
+}
+const std::string& ModbusServer::client_device() const {
+    return impl_->device;
+}
+const ModbusServerCounters& ModbusServer::counters() const {
+    return impl_->counters;
+}
+std::size_t ModbusServer::open_connections() const {
+    return impl_->clients.size();
+}
 
 }  // namespace pathstream::hal

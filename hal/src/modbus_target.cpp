@@ -17,8 +17,7 @@ constexpr std::string_view kRtuScheme = "modbus-rtu://";
 }
 
 // A whole decimal number in [lo, hi]; anything else (sign, spaces, hex, overflow) fails.
-int parse_int(std::string_view url, std::string_view name, std::string_view text, int lo,
-              int hi) {
+int parse_int(std::string_view url, std::string_view name, std::string_view text, int lo, int hi) {
     int value = 0;
     const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
     if (text.empty() || ec != std::errc() || end != text.data() + text.size() || value < lo ||
@@ -33,8 +32,7 @@ int parse_int(std::string_view url, std::string_view name, std::string_view text
 // are errors rather than silently ignored (a typo must not fall back to a default).
 void parse_query(std::string_view url, std::string_view query, ModbusTarget& target) {
     const bool rtu = target.transport == ModbusTarget::Transport::kRtu;
-    const std::string_view allowed =
-        rtu ? "unit, baud, parity, data_bits, stop_bits" : "unit";
+    const std::string_view allowed = rtu ? "unit, baud, parity, data_bits, stop_bits" : "unit";
     std::set<std::string, std::less<>> seen;
     while (!query.empty()) {
         const std::size_t amp = query.find('&');
@@ -56,16 +54,19 @@ void parse_query(std::string_view url, std::string_view query, ModbusTarget& tar
             target.serial.baud = parse_int(url, "baud", value, 50, 4'000'000);
             // libmodbus maps the rate to a termios constant and silently uses 9600 for
             // anything else: refuse those here.
-            static constexpr int kRates[] = {50, 75, 110, 134, 150, 200, 300, 600, 1200, 1800,
-                                             2400, 4800, 9600, 19200, 38400, 57600, 115200,
-                                             230400, 460800, 500000, 576000, 921600, 1000000,
-                                             1152000, 1500000, 2000000, 2500000, 3000000,
-                                             3500000, 4000000};
-            if (std::find(std::begin(kRates), std::end(kRates), target.serial.baud) == std::end(kRates)) {
-                fail(url, "baud '" + std::string(value) + "' is not a standard rate (e.g. 9600, 19200, 115200)");
+            static constexpr int kRates[] = {50,      75,      110,     134,     150,     200,
+                                             300,     600,     1200,    1800,    2400,    4800,
+                                             9600,    19200,   38400,   57600,   115200,  230400,
+                                             460800,  500000,  576000,  921600,  1000000, 1152000,
+                                             1500000, 2000000, 2500000, 3000000, 3500000, 4000000};
+            if (std::find(std::begin(kRates), std::end(kRates), target.serial.baud) ==
+                std::end(kRates)) {
+                fail(url, "baud '" + std::string(value) +
+                              "' is not a standard rate (e.g. 9600, 19200, 115200)");
             }
         } else if (rtu && key == "parity") {
-            if (value.size() != 1 || std::string_view("NEOneo").find(value[0]) == std::string_view::npos) {
+            if (value.size() != 1 ||
+                std::string_view("NEOneo").find(value[0]) == std::string_view::npos) {
                 fail(url, "parity '" + std::string(value) + "' is not N, E or O");
             }
             target.serial.parity = static_cast<char>(value[0] & ~0x20);  // upper case
@@ -74,7 +75,8 @@ void parse_query(std::string_view url, std::string_view query, ModbusTarget& tar
         } else if (rtu && key == "stop_bits") {
             target.serial.stop_bits = parse_int(url, "stop_bits", value, 1, 2);
         } else {
-            fail(url, "unknown parameter '" + std::string(key) + "' (want " + std::string(allowed) + ")");
+            fail(url, "unknown parameter '" + std::string(key) + "' (want " + std::string(allowed) +
+                          ")");
         }
     }
 }
@@ -82,10 +84,12 @@ void parse_query(std::string_view url, std::string_view query, ModbusTarget& tar
 void parse_tcp(std::string_view url, std::string_view rest, ModbusTarget& target) {
     const std::size_t slash = rest.find_first_of("/?");
     std::string_view authority = rest.substr(0, slash);
-    std::string_view tail = slash == std::string_view::npos ? std::string_view{} : rest.substr(slash);
+    std::string_view tail =
+        slash == std::string_view::npos ? std::string_view{} : rest.substr(slash);
     if (!tail.empty() && tail[0] == '/') {
         const std::size_t q = tail.find('?');
-        if (tail.substr(0, q) != "/") fail(url, "a TCP target has no path (got '" + std::string(tail.substr(0, q)) + "')");
+        if (tail.substr(0, q) != "/")
+            fail(url, "a TCP target has no path (got '" + std::string(tail.substr(0, q)) + "')");
         tail = tail.substr(q == std::string_view::npos ? tail.size() : q);
     }
     std::string_view port_text;

@@ -45,7 +45,9 @@ PseudoTerminal::PseudoTerminal(bool nonblocking) {
     }
 }
 
-PseudoTerminal::~PseudoTerminal() { close_all(); }
+PseudoTerminal::~PseudoTerminal() {
+    close_all();
+}
 
 PseudoTerminal::PseudoTerminal(PseudoTerminal&& other) noexcept
     : master_(std::exchange(other.master_, -1)),

@@ -27,7 +27,8 @@ public:
     ModbusException read_input_registers(std::uint16_t address, std::uint16_t count,
                                          std::uint16_t* out) override {
         if (address + count > kSize) return ModbusException::kIllegalDataAddress;
-        for (std::uint16_t i = 0; i < count; ++i) out[i] = static_cast<std::uint16_t>(3 * (address + i) + 1);
+        for (std::uint16_t i = 0; i < count; ++i)
+            out[i] = static_cast<std::uint16_t>(3 * (address + i) + 1);
         return ModbusException::kNone;
     }
     ModbusException read_holding_registers(std::uint16_t address, std::uint16_t count,

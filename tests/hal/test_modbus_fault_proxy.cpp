@@ -3,9 +3,8 @@
 #include <fcntl.h>
 #include <unistd.h>
 
-#include <catch2/catch.hpp>
-
 #include <array>
+#include <catch2/catch.hpp>
 #include <vector>
 
 #include "pathstream/hal/modbus_client.hpp"
@@ -80,7 +79,8 @@ void faulty_line_case(const PtyFaultOptions& faults, int transactions) {
     CHECK(c.retries == c.timeouts + c.bad_frames);
     INFO("retries " << c.retries << ", timeouts " << c.timeouts << ", bad frames " << c.bad_frames
                     << ", corrupted " << proxy.counters().corrupted << ", dropped "
-                    << proxy.counters().dropped << ", server bad frames " << server.counters().bad_frames);
+                    << proxy.counters().dropped << ", server bad frames "
+                    << server.counters().bad_frames);
     CHECK(proxy.counters().overflowed == 0);
 }
 

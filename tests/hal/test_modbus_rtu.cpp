@@ -18,7 +18,8 @@ using std::chrono::milliseconds;
 namespace {
 
 std::string url_for(const ModbusServer& server, int unit) {
-    return "modbus-rtu://" + server.client_device() + "?baud=115200&parity=N&unit=" + std::to_string(unit);
+    return "modbus-rtu://" + server.client_device() +
+           "?baud=115200&parity=N&unit=" + std::to_string(unit);
 }
 
 ModbusClientOptions fast(int attempts = 1) {
@@ -91,12 +92,12 @@ TEST_CASE("RTU: FC3, FC4, FC6, FC16 and FC23 round trips on a pty", "[modbus][rt
     CHECK(server.counters().adu_bytes_received == client.counters().adu_bytes_sent);
     CHECK(server.counters().adu_bytes_sent == client.counters().adu_bytes_received);
     CHECK(client.counters().adu_bytes_sent ==
-          modbus_adu_bytes(ModbusFraming::kRtu, 5) * 3 +                    // FC4, FC3, FC3 (exception)
-              modbus_adu_bytes(ModbusFraming::kRtu, 6 + 2 * 123) +          // FC16
-              modbus_adu_bytes(ModbusFraming::kRtu, 5) +                    // FC6
-              modbus_adu_bytes(ModbusFraming::kRtu, 10 + 2 * 3) +           // FC23
-              modbus_adu_bytes(ModbusFraming::kRtu, 6 + 2 * 2) +            // refused FC16
-              modbus_adu_bytes(ModbusFraming::kRtu, 5));                    // final FC3
+          modbus_adu_bytes(ModbusFraming::kRtu, 5) * 3 +            // FC4, FC3, FC3 (exception)
+              modbus_adu_bytes(ModbusFraming::kRtu, 6 + 2 * 123) +  // FC16
+              modbus_adu_bytes(ModbusFraming::kRtu, 5) +            // FC6
+              modbus_adu_bytes(ModbusFraming::kRtu, 10 + 2 * 3) +   // FC23
+              modbus_adu_bytes(ModbusFraming::kRtu, 6 + 2 * 2) +    // refused FC16
+              modbus_adu_bytes(ModbusFraming::kRtu, 5));            // final FC3
 }
 
 TEST_CASE("RTU: requests for another unit id are ignored, as on a shared bus", "[modbus][rtu]") {

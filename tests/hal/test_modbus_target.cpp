@@ -26,8 +26,8 @@ TEST_CASE("TCP target URLs", "[modbus][target]") {
 }
 
 TEST_CASE("RTU target URLs", "[modbus][target]") {
-    const ModbusTarget t =
-        parse_modbus_target("modbus-rtu:///dev/ttyUSB0?baud=115200&parity=n&unit=1&data_bits=8&stop_bits=2");
+    const ModbusTarget t = parse_modbus_target(
+        "modbus-rtu:///dev/ttyUSB0?baud=115200&parity=n&unit=1&data_bits=8&stop_bits=2");
     CHECK(t.transport == ModbusTarget::Transport::kRtu);
     CHECK(t.serial.device == "/dev/ttyUSB0");
     CHECK(t.serial.baud == 115200);
@@ -40,7 +40,8 @@ TEST_CASE("RTU target URLs", "[modbus][target]") {
     CHECK(d.serial.parity == 'E');
     CHECK(d.serial.data_bits == 8);
     CHECK(d.serial.stop_bits == 1);
-    CHECK(to_string(d) == "modbus-rtu:///dev/pts/3?baud=19200&parity=E&data_bits=8&stop_bits=1&unit=1");
+    CHECK(to_string(d) ==
+          "modbus-rtu:///dev/pts/3?baud=19200&parity=E&data_bits=8&stop_bits=1&unit=1");
     CHECK(to_string(parse_modbus_target(to_string(t))) == to_string(t));
 }
 
@@ -53,7 +54,8 @@ TEST_CASE("bad target URLs say what is wrong", "[modbus][target]") {
         }
         return std::string("(accepted)");
     };
-    CHECK(message("x") == "bad target URL 'x': unknown scheme (want modbus-tcp:// or modbus-rtu://)");
+    CHECK(message("x") ==
+          "bad target URL 'x': unknown scheme (want modbus-tcp:// or modbus-rtu://)");
     CHECK(message("modbus-tcp://") == "bad target URL 'modbus-tcp://': missing host");
     CHECK(message("modbus-tcp://h:") == "bad target URL 'modbus-tcp://h:': empty port after ':'");
     CHECK(message("modbus-tcp://h:99999") ==
@@ -69,22 +71,27 @@ TEST_CASE("bad target URLs say what is wrong", "[modbus][target]") {
     CHECK(message("modbus-tcp://h?unit=1&unit=2") ==
           "bad target URL 'modbus-tcp://h?unit=1&unit=2': parameter 'unit' given twice");
     CHECK(message("modbus-tcp://h?unit") ==
-          "bad target URL 'modbus-tcp://h?unit': query parameter 'unit' has no value (want name=value)");
+          "bad target URL 'modbus-tcp://h?unit': query parameter 'unit' has no value (want "
+          "name=value)");
     CHECK(message("modbus-rtu://") == "bad target URL 'modbus-rtu://': missing serial device path");
     CHECK(message("modbus-rtu://dev/ttyS0") ==
           "bad target URL 'modbus-rtu://dev/ttyS0': the serial device must be an absolute path "
           "(modbus-rtu:///dev/...), got 'dev/ttyS0'");
     CHECK(message("modbus-rtu:///dev/ttyS0?parity=X") ==
           "bad target URL 'modbus-rtu:///dev/ttyS0?parity=X': parity 'X' is not N, E or O");
-    CHECK(message("modbus-rtu:///dev/ttyS0?baud=12345") ==
-          "bad target URL 'modbus-rtu:///dev/ttyS0?baud=12345': baud '12345' is not a standard rate "
-          "(e.g. 9600, 19200, 115200)");
-    CHECK(message("modbus-rtu:///dev/ttyS0?unit=248") ==
-          "bad target URL 'modbus-rtu:///dev/ttyS0?unit=248': unit '248' is not a number in 0..247");
+    CHECK(
+        message("modbus-rtu:///dev/ttyS0?baud=12345") ==
+        "bad target URL 'modbus-rtu:///dev/ttyS0?baud=12345': baud '12345' is not a standard rate "
+        "(e.g. 9600, 19200, 115200)");
+    CHECK(
+        message("modbus-rtu:///dev/ttyS0?unit=248") ==
+        "bad target URL 'modbus-rtu:///dev/ttyS0?unit=248': unit '248' is not a number in 0..247");
     CHECK(message("modbus-rtu:///dev/ttyS0?data_bits=9") ==
-          "bad target URL 'modbus-rtu:///dev/ttyS0?data_bits=9': data_bits '9' is not a number in 5..8");
+          "bad target URL 'modbus-rtu:///dev/ttyS0?data_bits=9': data_bits '9' is not a number in "
+          "5..8");
     CHECK(message("modbus-rtu:///dev/ttyS0?stop=1") ==
-          "bad target URL 'modbus-rtu:///dev/ttyS0?stop=1': unknown parameter 'stop' (want unit, baud, "
+          "bad target URL 'modbus-rtu:///dev/ttyS0?stop=1': unknown parameter 'stop' (want unit, "
+          "baud, "
           "parity, data_bits, stop_bits)");
     CHECK(message("modbus-rtu:///dev/ttyS0?unit=-1") ==
           "bad target URL 'modbus-rtu:///dev/ttyS0?unit=-1': unit '-1' is not a number in 0..247");

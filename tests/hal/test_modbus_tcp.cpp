@@ -22,7 +22,8 @@ using std::chrono::milliseconds;
 namespace {
 
 std::string url_for(const ModbusServer& server, int unit = 1) {
-    return "modbus-tcp://127.0.0.1:" + std::to_string(server.port()) + "?unit=" + std::to_string(unit);
+    return "modbus-tcp://127.0.0.1:" + std::to_string(server.port()) +
+           "?unit=" + std::to_string(unit);
 }
 
 ModbusClientOptions fast(int attempts = 1) {
@@ -96,14 +97,16 @@ TEST_CASE("TCP: FC3, FC4, FC6, FC16 and FC23 round trips", "[modbus][tcp]") {
     CHECK(client.counters().attempts == 5);
 }
 
-TEST_CASE("TCP: FC23 answers with what the handler reads, not with what was written", "[modbus][tcp]") {
+TEST_CASE("TCP: FC23 answers with what the handler reads, not with what was written",
+          "[modbus][tcp]") {
     // A register map may transform writes (here: it stores the complement). modbus_reply
     // would copy the written values into the overlapping part of the answer; the server
     // must answer with the handler's read.
     struct Complementing : RegisterArray {
         ModbusException write_holding_registers(std::uint16_t address, std::uint16_t count,
                                                 const std::uint16_t* values) override {
-            for (std::uint16_t i = 0; i < count; ++i) holding[address + i] = static_cast<std::uint16_t>(~values[i]);
+            for (std::uint16_t i = 0; i < count; ++i)
+                holding[address + i] = static_cast<std::uint16_t>(~values[i]);
             return ModbusException::kNone;
         }
     } registers;
@@ -128,7 +131,8 @@ TEST_CASE("TCP: exception responses carry the code and change nothing", "[modbus
     ModbusError e = error_of([&] { client.read_holding_registers(999, two); });
     CHECK(e.kind() == Kind::kExceptionResponse);
     CHECK(e.exception_code() == 2);
-    CHECK(std::string(e.what()).find("exception response 2 (illegal data address)") != std::string::npos);
+    CHECK(std::string(e.what()).find("exception response 2 (illegal data address)") !=
+          std::string::npos);
 
     // Straddles the read-only block: refused as a whole, 890..899 keep their values.
     const std::vector<std::uint16_t> straddle(20, 1);
@@ -159,7 +163,8 @@ TEST_CASE("TCP: exception responses carry the code and change nothing", "[modbus
     CHECK(server.counters().exceptions == 6);
 }
 
-TEST_CASE("TCP: unsupported and malformed requests get exceptions, the stream stays in step", "[modbus][tcp]") {
+TEST_CASE("TCP: unsupported and malformed requests get exceptions, the stream stays in step",
+          "[modbus][tcp]") {
     RegisterArray registers;
     ModbusServer server = ModbusServer::tcp(registers, {});
     ServingThread serving(server);
@@ -287,7 +292,8 @@ TEST_CASE("TCP: a peer that never answers gives timeouts, one per try", "[modbus
     CHECK(c.timeouts == 3);
     CHECK(c.reconnects == 2);  // TCP reconnects between tries
     CHECK(c.transactions == 0);
-    CHECK(c.adu_bytes_sent == 3 * modbus_adu_bytes(ModbusFraming::kTcp, modbus_read_request_pdu_bytes()));
+    CHECK(c.adu_bytes_sent ==
+          3 * modbus_adu_bytes(ModbusFraming::kTcp, modbus_read_request_pdu_bytes()));
     CHECK(c.adu_bytes_received == 0);
 }
 
@@ -298,11 +304,11 @@ TEST_CASE("TCP: byte counters agree between client and server", "[modbus][tcp]")
     ModbusClient client(url_for(server), fast());
     std::vector<std::uint16_t> r(10);
     const std::vector<std::uint16_t> w(7, 3);
-    client.read_holding_registers(0, r);          // 12 + 29
-    client.read_input_registers(0, r);            // 12 + 29
-    client.write_register(0, 1);                  // 12 + 12
-    client.write_registers(0, w);                 // 27 + 12
-    client.write_read_registers(0, w, 0, r);      // 31 + 29
+    client.read_holding_registers(0, r);      // 12 + 29
+    client.read_input_registers(0, r);        // 12 + 29
+    client.write_register(0, 1);              // 12 + 12
+    client.write_registers(0, w);             // 27 + 12
+    client.write_read_registers(0, w, 0, r);  // 31 + 29
     std::vector<std::uint16_t> bad(1);
     CHECK_THROWS_AS(client.read_holding_registers(999 + 1, bad), ModbusError);  // 12 + 9
     serving.stop();

@@ -1,8 +1,10 @@
 // pathstream_modbus_test_server: a ModbusServer over a fixed register pattern, for
 // interoperability checks with independent masters (mbpoll, pymodbus).
-//   pathstream_modbus_test_server tcp|rtu-pty [--unit N] [--seconds S]
+//   pathstream_modbus_test_server tcp|rtu-pty|rtu [--device PATH] [--baud B] [--unit N] [--seconds
+//   S]
 // Input register a holds 1000 + a; holding registers start at 0 and accept any write.
-// Prints "port N" (tcp) or "device /dev/pts/N" (rtu-pty) once ready, then serves until
+// rtu serves an existing serial device (e.g. a PtyFaultProxy side) at B baud, 8N1.
+// Prints "port N" (tcp) or "device PATH" (rtu, rtu-pty) once ready, then serves until
 // SIGINT/SIGTERM or S seconds (default 30: a forgotten server never outlives its test).
 #include <chrono>
 #include <csignal>
@@ -16,21 +18,29 @@
 namespace {
 
 volatile std::sig_atomic_t g_stop = 0;
-extern "C" void on_signal(int) { g_stop = 1; }
+extern "C" void on_signal(int) {
+    g_stop = 1;
+}
 
 class PatternRegisters final : public pathstream::hal::ModbusRegisterHandler {
 public:
     using Ex = pathstream::hal::ModbusException;
-    Ex read_input_registers(std::uint16_t address, std::uint16_t count, std::uint16_t* out) override {
-        for (std::uint16_t i = 0; i < count; ++i) out[i] = static_cast<std::uint16_t>(1000 + address + i);
+    Ex read_input_registers(std::uint16_t address, std::uint16_t count,
+                            std::uint16_t* out) override {
+        for (std::uint16_t i = 0; i < count; ++i)
+            out[i] = static_cast<std::uint16_t>(1000 + address + i);
         return Ex::kNone;
     }
-    Ex read_holding_registers(std::uint16_t address, std::uint16_t count, std::uint16_t* out) override {
-        for (std::uint16_t i = 0; i < count; ++i) out[i] = holding_[static_cast<std::size_t>(address) + i];
+    Ex read_holding_registers(std::uint16_t address, std::uint16_t count,
+                              std::uint16_t* out) override {
+        for (std::uint16_t i = 0; i < count; ++i)
+            out[i] = holding_[static_cast<std::size_t>(address) + i];
         return Ex::kNone;
     }
-    Ex write_holding_registers(std::uint16_t address, std::uint16_t count, const std::uint16_t* values) override {
-        for (std::uint16_t i = 0; i < count; ++i) holding_[static_cast<std::size_t>(address) + i] = values[i];
+    Ex write_holding_registers(std::uint16_t address, std::uint16_t count,
+                               const std::uint16_t* values) override {
+        for (std::uint16_t i = 0; i < count; ++i)
+            holding_[static_cast<std::size_t>(address) + i] = values[i];
         return Ex::kNone;
     }
 
@@ -39,7 +49,9 @@ private:
 };
 
 int usage() {
-    std::fprintf(stderr, "usage: pathstream_modbus_test_server tcp|rtu-pty [--unit N] [--seconds S]\n");
+    std::fprintf(stderr,
+                 "usage: pathstream_modbus_test_server tcp|rtu-pty|rtu [--device PATH] [--baud B] "
+                 "[--unit N] [--seconds S]\n");
     return 2;
 }
 
@@ -50,11 +62,18 @@ int main(int argc, char** argv) {
     const std::string mode = argv[1];
     pathstream::hal::ModbusServerOptions options;
     int seconds = 30;
+    pathstream::hal::ModbusSerialLine line;
+    line.baud = 115200;
+    line.parity = 'N';
     try {
         for (int i = 2; i + 1 < argc; i += 2) {
             const std::string arg = argv[i];
             if (arg == "--unit") {
                 options.unit = std::stoi(argv[i + 1]);
+            } else if (arg == "--device") {
+                line.device = argv[i + 1];
+            } else if (arg == "--baud") {
+                line.baud = std::stoi(argv[i + 1]);
             } else if (arg == "--seconds") {
                 seconds = std::stoi(argv[i + 1]);
             } else {
@@ -68,6 +87,7 @@ int main(int argc, char** argv) {
         pathstream::hal::ModbusServer server =
             mode == "tcp"       ? pathstream::hal::ModbusServer::tcp(registers, {}, options)
             : mode == "rtu-pty" ? pathstream::hal::ModbusServer::rtu_pty(registers, options)
+            : mode == "rtu"     ? pathstream::hal::ModbusServer::rtu(registers, line, options)
                                 : throw std::invalid_argument("unknown mode '" + mode + "'");
         if (mode == "tcp") {
             std::printf("port %u\n", static_cast<unsigned>(server.port()));

@@ -15,7 +15,9 @@ PtyFaultProxy::PtyFaultProxy(const PtyFaultOptions& options)
     }
 }
 
-PtyFaultProxy::~PtyFaultProxy() { stop(); }
+PtyFaultProxy::~PtyFaultProxy() {
+    stop();
+}
 
 // splitmix64: tiny, seedable with any value, and the same on every platform (the standard
 // distributions are not).

@@ -14,10 +14,14 @@
 namespace {
 
 volatile std::sig_atomic_t g_stop = 0;
-extern "C" void on_signal(int) { g_stop = 1; }
+extern "C" void on_signal(int) {
+    g_stop = 1;
+}
 
 int usage() {
-    std::fprintf(stderr, "usage: pathstream_pty_fault_proxy [--corrupt-rate R] [--drop-rate R] [--seed N]\n");
+    std::fprintf(
+        stderr,
+        "usage: pathstream_pty_fault_proxy [--corrupt-rate R] [--drop-rate R] [--seed N]\n");
     return 2;
 }
 
@@ -49,12 +53,14 @@ int main(int argc, char** argv) {
         std::fflush(stdout);
         while (g_stop == 0) proxy.poll_once(std::chrono::milliseconds(100));
         const auto& c = proxy.counters();
-        std::fprintf(stderr, "a->b %llu bytes, b->a %llu bytes, corrupted %llu, dropped %llu, overflowed %llu\n",
-                     static_cast<unsigned long long>(c.bytes_a_to_b.load()),
-                     static_cast<unsigned long long>(c.bytes_b_to_a.load()),
-                     static_cast<unsigned long long>(c.corrupted.load()),
-                     static_cast<unsigned long long>(c.dropped.load()),
-                     static_cast<unsigned long long>(c.overflowed.load()));
+        std::fprintf(
+            stderr,
+            "a->b %llu bytes, b->a %llu bytes, corrupted %llu, dropped %llu, overflowed %llu\n",
+            static_cast<unsigned long long>(c.bytes_a_to_b.load()),
+            static_cast<unsigned long long>(c.bytes_b_to_a.load()),
+            static_cast<unsigned long long>(c.corrupted.load()),
+            static_cast<unsigned long long>(c.dropped.load()),
+            static_cast<unsigned long long>(c.overflowed.load()));
         return 0;
     } catch (const std::exception& e) {
         std::fprintf(stderr, "pathstream_pty_fault_proxy: %s\n", e.what());

@@ -58,12 +58,9 @@ public:
     /// accepted write leaves the write applied (the master sees the exception and cannot
     /// tell; a register map that cares overrides this to check the read range first).
     /// Default: write_holding_registers then read_holding_registers.
-    virtual ModbusException write_read_holding_registers(std::uint16_t write_address,
-                                                         std::uint16_t write_count,
-                                                         const std::uint16_t* values,
-                                                         std::uint16_t read_address,
-                                                         std::uint16_t read_count,
-                                                         std::uint16_t* out);
+    virtual ModbusException write_read_holding_registers(
+        std::uint16_t write_address, std::uint16_t write_count, const std::uint16_t* values,
+        std::uint16_t read_address, std::uint16_t read_count, std::uint16_t* out);
 };
 
 inline ModbusException ModbusRegisterHandler::write_read_holding_registers(

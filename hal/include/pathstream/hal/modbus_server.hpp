@@ -35,15 +35,17 @@ struct ModbusServerOptions {
 
 /// Counters, readable from any thread while the server runs (relaxed atomics).
 struct ModbusServerCounters {
-    std::atomic<std::uint64_t> requests{0};     ///< well-formed requests for this server, broadcasts included
-    std::atomic<std::uint64_t> exceptions{0};   ///< exception responses (or refused broadcasts)
-    std::atomic<std::uint64_t> broadcasts{0};   ///< RTU unit-0 requests (never answered)
-    std::atomic<std::uint64_t> ignored{0};      ///< RTU requests for other unit ids
-    std::atomic<std::uint64_t> bad_frames{0};   ///< CRC errors, incomplete or oversize frames
+    std::atomic<std::uint64_t> requests{
+        0};  ///< well-formed requests for this server, broadcasts included
+    std::atomic<std::uint64_t> exceptions{0};  ///< exception responses (or refused broadcasts)
+    std::atomic<std::uint64_t> broadcasts{0};  ///< RTU unit-0 requests (never answered)
+    std::atomic<std::uint64_t> ignored{0};     ///< RTU requests for other unit ids
+    std::atomic<std::uint64_t> bad_frames{0};  ///< CRC errors, incomplete or oversize frames
     std::atomic<std::uint64_t> connections_accepted{0};  ///< TCP
     std::atomic<std::uint64_t> connections_closed{0};    ///< TCP: by the peer, an error or eviction
-    std::atomic<std::uint64_t> adu_bytes_received{0};  ///< whole ADUs as on the wire (header/CRC included)
-    std::atomic<std::uint64_t> adu_bytes_sent{0};      ///< whole ADUs as on the wire
+    std::atomic<std::uint64_t> adu_bytes_received{
+        0};  ///< whole ADUs as on the wire (header/CRC included)
+    std::atomic<std::uint64_t> adu_bytes_sent{0};  ///< whole ADUs as on the wire
 };
 
 /// Serves one register space over one transport. libmodbus does the framing (MBAP, CRC,
