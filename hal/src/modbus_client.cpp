@@ -101,12 +101,13 @@ struct ModbusClient::Impl {
         modbus_free(ctx);
     }
 
-    void connect() {
+    // `context` starts the message: the URL, and the transaction when one needed the connect.
+    void connect(const std::string& context) {
         if (modbus_connect(ctx) != 0) {
             const int err = errno;
             ++counters.connect_failures;
             throw ModbusError(ModbusError::Kind::kConnectFailed,
-                              name + ": cannot connect (" + modbus_strerror(err) + ")");
+                              context + ": cannot connect (" + modbus_strerror(err) + ")");
         }
         open = true;
         if (ever_connected) ++counters.reconnects;
@@ -146,7 +147,7 @@ struct ModbusClient::Impl {
             if (attempt > 1) ++counters.retries;
             ModbusError failure(ModbusError::Kind::kConnectFailed, "");
             try {
-                if (!open) connect();
+                if (!open) connect(context);
                 errno = 0;
                 if (op(ctx) != -1) {
                     counters.adu_bytes_sent += request_adu;
@@ -156,7 +157,7 @@ struct ModbusClient::Impl {
                 }
                 failure = classify(errno, context, options.response_timeout);
             } catch (const ModbusError& e) {  // connect failed
-                failure = ModbusError(e.kind(), context + ": " + e.what());
+                failure = e;
             }
             switch (failure.kind()) {
                 case ModbusError::Kind::kExceptionResponse:
@@ -209,7 +210,7 @@ struct ModbusClient::Impl {
     // A broadcast write: one send, no response to wait for (Modbus over serial line 2.1).
     void send_broadcast(const std::string& what, std::uint8_t* raw, int length) {
         ++counters.attempts;
-        if (!open) connect();
+        if (!open) connect(name + ": " + what);
         const int sent = modbus_send_raw_request(ctx, raw, length);
         if (sent < 0) {
             const ModbusError failure =
@@ -225,7 +226,7 @@ struct ModbusClient::Impl {
 
 ModbusClient::ModbusClient(const ModbusTarget& target, const ModbusClientOptions& options)
     : impl_(std::make_unique<Impl>(target, options)) {
-    impl_->connect();
+    impl_->connect(impl_->name);
 }
 
 ModbusClient::ModbusClient(std::string_view url, const ModbusClientOptions& options)
@@ -321,7 +322,7 @@ void ModbusClient::write_read_registers(std::uint16_t write_address,
 
 void ModbusClient::reconnect() {
     impl_->disconnect();
-    impl_->connect();
+    impl_->connect(impl_->name);
 }
 
 void ModbusClient::close() {

@@ -263,7 +263,11 @@ TEST_CASE("TCP: after a server restart the client connects again", "[modbus][tcp
 
     std::vector<std::uint16_t> v(1);
     CHECK(error_of([&] { client.read_holding_registers(5, v); }).kind() == Kind::kConnectionLost);
-    CHECK(error_of([&] { client.read_holding_registers(5, v); }).kind() == Kind::kConnectFailed);
+    const ModbusError refused = error_of([&] { client.read_holding_registers(5, v); });
+    CHECK(refused.kind() == Kind::kConnectFailed);
+    CHECK(std::string(refused.what()) == "modbus-tcp://127.0.0.1:" + std::to_string(port) +
+                                             "?unit=1: FC3 read holding registers 5 x1: cannot "
+                                             "connect (Connection refused)");
 
     ModbusTcpEndpoint same_port;
     same_port.port = port;  // the restarted device comes back where it was
