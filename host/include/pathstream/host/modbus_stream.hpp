@@ -1,0 +1,61 @@
+// Streaming a plan to a device that runs the core, over Modbus TCP or RTU (docs/modbus.md).
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <stdexcept>
+#include <string>
+
+#include "pathstream/host/machine.hpp"
+#include "pathstream/host/plan.hpp"
+
+namespace pathstream::host {
+
+/// A streaming failure the user must act on (device refused, restarted, faulted, link dead).
+/// The message is complete and names the target.
+class StreamError : public std::runtime_error {
+public:
+    using std::runtime_error::runtime_error;
+};
+
+struct StreamOptions {
+    std::string target;                 ///< modbus-tcp://HOST:PORT?unit=N or modbus-rtu:///dev/X?...
+    double lead_seconds = 0.25;         ///< keep this much motion queued ahead of the device
+    unsigned response_timeout_ms = 500; ///< per Modbus transaction try
+    unsigned attempts = 3;              ///< tries per transaction (reconnect between TCP tries)
+    double link_timeout_seconds = 5;    ///< give up after this long without a successful transaction
+    unsigned poll_interval_ms = 2;      ///< status polling while the queue is full enough
+};
+
+/// What the device executed and what the link carried.
+struct StreamReport {
+    std::uint64_t spans_sent = 0;
+    std::uint64_t batches = 0;
+    std::uint64_t ticks_executed = 0;     ///< device's count at the end
+    std::uint32_t last_completed = 0;     ///< sequence number of the last span executed
+    std::uint32_t duplicates = 0;         ///< batches the device acknowledged as retries
+    std::uint32_t underruns = 0;
+    std::uint64_t transactions = 0;
+    std::uint64_t retries = 0;
+    std::uint64_t reconnects = 0;
+    std::uint64_t bytes_sent = 0;         ///< ADU bytes as on the wire
+    std::uint64_t bytes_received = 0;
+    double wall_seconds = 0;
+    std::int32_t final_position[8] = {};
+};
+
+/// Progress: fraction of the plan's ticks executed, and the device queue's lead in seconds.
+using StreamProgress = std::function<void(double fraction, double queued_seconds)>;
+
+/// Streams `plan` (Hermite spans, as plan_path makes them) to the device at options.target:
+/// checks its identity (magic, protocol version, axis count) and that it rests at the plan's
+/// start, configures its tick rate and limits from `profile` (rounded up to whole LSB/s and
+/// LSB/s^2), sends batches of spans with sequence numbers (FC23: batch + status in one
+/// transaction) keeping options.lead_seconds queued, starts it, resumes it after an underrun,
+/// and returns when the last span has executed. Throws StreamError (device refused a batch,
+/// restarted, faulted, or the link stayed dead past link_timeout_seconds) and
+/// std::invalid_argument (bad target URL, plan not streamable).
+StreamReport stream_modbus(const Plan& plan, const MachineProfile& profile, const StreamOptions& options,
+                           const StreamProgress& progress = {});
+
+}  // namespace pathstream::host

@@ -1,0 +1,366 @@
+// The Modbus streaming client: plan -> wire spans -> sequenced batches, flow-controlled by the
+// device's status block, with its own reconnect logic (docs/modbus.md).
+#include "pathstream/host/modbus_stream.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <sstream>
+#include <thread>
+#include <vector>
+
+#include "pathstream/device/modbus_map.hpp"
+#include "pathstream/device/motion_device.hpp"
+#include "pathstream/device/wire_span.hpp"
+#include "pathstream/hal/modbus_client.hpp"
+#include "pathstream/hal/modbus_error.hpp"
+#include "pathstream/status.hpp"
+
+namespace pathstream::host {
+namespace {
+
+namespace mb = device::modbus;
+namespace st = device::modbus::status;
+using Clock = std::chrono::steady_clock;
+
+std::uint32_t u32(const std::uint16_t* r) { return (static_cast<std::uint32_t>(r[0]) << 16) | r[1]; }
+
+struct DeviceStatus {
+    std::uint16_t magic = 0, version = 0, state = 0, fault = 0, free_slots = 0, capacity = 0, axes = 0;
+    std::uint32_t last_accepted = 0, ticks = 0, last_completed = 0;
+    std::uint16_t underruns = 0, last_refusal = 0, duplicates = 0, queued = 0, flags = 0;
+    std::int32_t position[8] = {};
+
+    static DeviceStatus parse(const std::uint16_t* r) {
+        DeviceStatus s;
+        s.magic = r[st::kMagic];
+        s.version = r[st::kVersion];
+        s.state = r[st::kState];
+        s.fault = r[st::kFaultCode];
+        s.free_slots = r[st::kFreeSlots];
+        s.capacity = r[st::kCapacity];
+        s.last_accepted = u32(&r[st::kLastAcceptedSequence]);
+        s.ticks = u32(&r[st::kTicksExecuted]);
+        for (unsigned a = 0; a < 8; ++a) s.position[a] = static_cast<std::int32_t>(u32(&r[st::kPositions + 2 * a]));
+        s.axes = r[st::kAxes];
+        s.underruns = r[st::kUnderruns];
+        s.last_completed = u32(&r[st::kLastCompletedSequence]);
+        s.last_refusal = r[st::kLastRefusal];
+        s.duplicates = r[st::kDuplicates];
+        s.queued = r[st::kQueuedSpans];
+        s.flags = r[st::kFlags];
+        return s;
+    }
+};
+
+const char* state_name(std::uint16_t s) {
+    static const char* const names[] = {"idle", "running", "holding", "stopping", "fault", "e-stop"};
+    return s < 6 ? names[s] : "unknown";
+}
+
+class Streamer {
+public:
+    Streamer(const Plan& plan, const MachineProfile& profile, const StreamOptions& options)
+        : plan_(plan), profile_(profile), options_(options), client_(options.target, client_options(options)) {}
+
+    StreamReport run(const StreamProgress& progress) {
+        const auto wall_start = Clock::now();
+        last_ok_ = Clock::now();
+        encode_plan();
+        DeviceStatus s = read_status();
+        check_identity(s);
+        configure();
+        base_ = s.last_accepted + 1;
+        acknowledged_ = s.last_accepted;
+        const std::uint64_t lead_target = static_cast<std::uint64_t>(std::ceil(options_.lead_seconds * profile_.tick_hz));
+        std::size_t next = 0;
+        bool started = false;
+        const std::uint32_t last_sequence = base_ + static_cast<std::uint32_t>(spans_.size()) - 1;
+        while (true) {
+            const std::uint64_t lead = queued_ticks(s, next);
+            if (next < spans_.size() && s.free_slots > 0 && (lead < lead_target || !started)) {
+                s = send_batch(next, s.free_slots);
+            } else {
+                std::this_thread::sleep_for(std::chrono::milliseconds(options_.poll_interval_ms));
+                s = read_status();
+            }
+            check_running(s, started);
+            if (!started && (queued_ticks(s, next) >= lead_target || next == spans_.size())) {
+                command(device::Command::kStart, false);
+                started = true;
+            }
+            if (s.state == static_cast<std::uint16_t>(device::DeviceState::kHolding) && (s.flags & 2u) != 0 &&
+                s.queued > 0) {
+                command(device::Command::kResume, true);
+            }
+            if (progress) {
+                progress(static_cast<double>(s.ticks - start_ticks_) / static_cast<double>(plan_.total_ticks),
+                         static_cast<double>(queued_ticks(s, next)) / profile_.tick_hz);
+            }
+            if (s.last_completed == last_sequence) break;
+        }
+        report_.ticks_executed = s.ticks - start_ticks_;
+        report_.last_completed = s.last_completed;
+        report_.duplicates = s.duplicates;
+        report_.underruns = s.underruns;
+        for (unsigned a = 0; a < 8; ++a) report_.final_position[a] = s.position[a];
+        const auto& c = client_.counters();
+        report_.transactions = c.transactions;
+        report_.retries = c.retries;
+        report_.reconnects = c.reconnects;
+        report_.bytes_sent = c.adu_bytes_sent;
+        report_.bytes_received = c.adu_bytes_received;
+        report_.wall_seconds = std::chrono::duration<double>(Clock::now() - wall_start).count();
+        return report_;
+    }
+
+private:
+    static hal::ModbusClientOptions client_options(const StreamOptions& o) {
+        hal::ModbusClientOptions c;
+        c.response_timeout = std::chrono::milliseconds(o.response_timeout_ms);
+        c.attempts = static_cast<int>(std::max(1u, o.attempts));
+        return c;
+    }
+
+    [[noreturn]] void fail(const std::string& what) const {
+        throw StreamError(options_.target + ": " + what);
+    }
+
+    // Runs one transaction; transient failures past the client's own tries reconnect and
+    // retry until link_timeout_seconds have passed without any success.
+    template <typename F>
+    void transact(F&& f) {
+        while (true) {
+            try {
+                f();
+                last_ok_ = Clock::now();
+                return;
+            } catch (const hal::ModbusError& e) {
+                if (!e.transient()) throw;
+                const double silent = std::chrono::duration<double>(Clock::now() - last_ok_).count();
+                if (silent > options_.link_timeout_seconds) {
+                    std::ostringstream m;
+                    m << "no answer for " << std::lround(silent) << " s (" << e.what() << ")";
+                    fail(m.str());
+                }
+                std::this_thread::sleep_for(std::chrono::milliseconds(20));
+                try {
+                    client_.reconnect();
+                } catch (const hal::ModbusError&) {
+                    // the next try reconnects again; the deadline above bounds it
+                }
+            }
+        }
+    }
+
+    DeviceStatus read_status() {
+        std::uint16_t r[st::kCount];
+        transact([&] { client_.read_input_registers(0, std::span<std::uint16_t>(r, st::kCount)); });
+        return DeviceStatus::parse(r);
+    }
+
+    void check_identity(const DeviceStatus& s) {
+        std::ostringstream m;
+        if (s.magic != mb::kMagic) {
+            m << "not a pathstream device (register 0 is 0x" << std::hex << s.magic << ", expected 0x5053)";
+            fail(m.str());
+        }
+        if (s.version != mb::kProtocolVersion) {
+            m << "device speaks protocol version " << s.version << ", this host " << mb::kProtocolVersion;
+            fail(m.str());
+        }
+        if (s.axes != axes_) {
+            m << "device has " << s.axes << " axes, the plan " << axes_;
+            fail(m.str());
+        }
+        if (s.state != 0) {
+            m << "device is " << state_name(s.state) << " (fault code " << s.fault
+              << "), not idle: reset or stop it first";
+            fail(m.str());
+        }
+        for (unsigned a = 0; a < axes_; ++a) {
+            if (s.position[a] != start_[a]) {
+                m << "device rests at";
+                for (unsigned b = 0; b < axes_; ++b) m << ' ' << s.position[b];
+                m << " LSB but the plan starts at";
+                for (unsigned b = 0; b < axes_; ++b) m << ' ' << start_[b];
+                m << " LSB";
+                fail(m.str());
+            }
+        }
+        start_ticks_ = s.ticks;
+    }
+
+    void configure() {
+        std::vector<std::uint16_t> r(mb::config_registers(axes_), 0);
+        const auto hz = static_cast<std::uint32_t>(std::llround(profile_.tick_hz));
+        r[0] = static_cast<std::uint16_t>(hz >> 16);
+        r[1] = static_cast<std::uint16_t>(hz & 0xFFFFu);
+        r[2] = static_cast<std::uint16_t>(axes_);
+        for (unsigned a = 0; a < axes_; ++a) {
+            // Rounded up: the planner works to the profile's limits exactly.
+            const double v = std::ceil(profile_.axes[a].max_velocity / profile_.mm_per_lsb);
+            const double acc = std::ceil(profile_.axes[a].max_acceleration / profile_.mm_per_lsb);
+            if (v > 4294967295.0 || acc > 4294967295.0) fail("a limit does not fit the device's 32-bit registers");
+            const auto vv = static_cast<std::uint32_t>(v), aa = static_cast<std::uint32_t>(acc);
+            r[mb::kConfigAxisBase + 4 * a] = static_cast<std::uint16_t>(vv >> 16);
+            r[mb::kConfigAxisBase + 4 * a + 1] = static_cast<std::uint16_t>(vv & 0xFFFFu);
+            r[mb::kConfigAxisBase + 4 * a + 2] = static_cast<std::uint16_t>(aa >> 16);
+            r[mb::kConfigAxisBase + 4 * a + 3] = static_cast<std::uint16_t>(aa & 0xFFFFu);
+        }
+        try {
+            transact([&] { client_.write_registers(mb::kConfig, r); });
+        } catch (const hal::ModbusError& e) {
+            fail(std::string("device refused the configuration (tick rate and limits): ") + e.what() + refusal());
+        }
+    }
+
+    std::string refusal() {
+        try {
+            const DeviceStatus s = read_status();
+            return std::string(" [device: ") + status_name(static_cast<Status>(s.last_refusal)) + "]";
+        } catch (const std::exception&) {
+            return "";
+        }
+    }
+
+    void command(device::Command c, bool tolerate_refusal) {
+        try {
+            transact([&] { client_.write_register(mb::kCommand, static_cast<std::uint16_t>(c)); });
+        } catch (const hal::ModbusError& e) {
+            if (!tolerate_refusal) fail(std::string("device refused command ") + std::to_string(static_cast<int>(c)) + ": " + e.what() + refusal());
+        }
+    }
+
+    void encode_plan() {
+        if (plan_.spans.empty()) throw std::invalid_argument("the plan has no spans");
+        axes_ = static_cast<unsigned>(plan_.spans.front().control.size());
+        if (axes_ < 1 || axes_ > 8) throw std::invalid_argument("1 to 8 axes");
+        for (unsigned a = 0; a < axes_; ++a) start_[a] = plan_.spans.front().control[a][0];
+        std::int32_t previous_tangent[8] = {};
+        for (std::size_t i = 0; i < plan_.spans.size(); ++i) {
+            const CoreSpan& c = plan_.spans[i];
+            if (c.basis != Basis::kHermite) throw std::invalid_argument("only Hermite spans stream (planned paths are)");
+            device::WireSpan w;
+            w.ticks = c.ticks;
+            w.outputs = c.pen_down ? kOutputPenDown : std::uint8_t{0};
+            bool continues = i > 0;
+            for (unsigned a = 0; a < axes_; ++a) {
+                w.end[a] = c.control[a][1];
+                w.start_tangent[a] = c.control[a][2];
+                w.end_tangent[a] = c.control[a][3];
+                continues = continues && c.control[a][2] == previous_tangent[a];
+                previous_tangent[a] = c.control[a][3];
+            }
+            if (i > 0) {
+                for (unsigned a = 0; a < axes_; ++a) {
+                    if (c.control[a][0] != plan_.spans[i - 1].control[a][1]) {
+                        throw std::invalid_argument("plan span " + std::to_string(i) +
+                                                    " does not start where the previous one ends");
+                    }
+                }
+            }
+            w.flags = continues ? device::kWireContinueTangent : 0;
+            std::vector<std::uint8_t> bytes(device::wire_span_bytes(axes_, continues));
+            if (device::encode_wire_span(w, axes_, bytes.data(), bytes.size()) != bytes.size()) {
+                throw std::invalid_argument("span " + std::to_string(i) + " cannot be encoded");
+            }
+            spans_.push_back(std::move(bytes));
+            ticks_.push_back(c.ticks);
+        }
+        prefix_ticks_.assign(ticks_.size() + 1, 0);
+        for (std::size_t i = 0; i < ticks_.size(); ++i) prefix_ticks_[i + 1] = prefix_ticks_[i] + ticks_[i];
+    }
+
+    // Ticks of motion accepted but not yet completed (an upper bound: the active span counts whole).
+    std::uint64_t queued_ticks(const DeviceStatus& s, std::size_t sent) const {
+        const std::size_t done = s.last_completed >= base_ ? s.last_completed - base_ + 1 : 0;
+        return done >= sent ? 0 : prefix_ticks_[sent] - prefix_ticks_[done];
+    }
+
+    DeviceStatus send_batch(std::size_t& next, std::uint16_t free_slots) {
+        const std::size_t max_bytes = 2u * mb::kMaxPayloadRegistersFc23;
+        const std::size_t max_spans = std::min<std::size_t>({device::kMaxBatchSpans, free_slots, spans_.size() - next});
+        std::vector<std::uint8_t> payload;
+        std::size_t count = 0;
+        while (count < max_spans && payload.size() + spans_[next + count].size() <= max_bytes) {
+            payload.insert(payload.end(), spans_[next + count].begin(), spans_[next + count].end());
+            ++count;
+        }
+        const std::uint32_t first = base_ + static_cast<std::uint32_t>(next);
+        std::vector<std::uint16_t> window = {static_cast<std::uint16_t>(first >> 16),
+                                             static_cast<std::uint16_t>(first & 0xFFFFu),
+                                             static_cast<std::uint16_t>(count),
+                                             static_cast<std::uint16_t>(payload.size()),
+                                             device::crc16_modbus(payload.data(), payload.size())};
+        for (std::size_t i = 0; i < payload.size(); i += 2) {
+            const std::uint16_t low = i + 1 < payload.size() ? payload[i + 1] : 0;
+            window.push_back(static_cast<std::uint16_t>((payload[i] << 8) | low));
+        }
+        std::uint16_t r[st::kCount];
+        try {
+            transact([&] {
+                client_.write_read_registers(mb::kSpanWindow, window, 0, std::span<std::uint16_t>(r, st::kCount));
+            });
+        } catch (const hal::ModbusError& e) {
+            if (e.exception_code() == static_cast<std::uint8_t>(mb::Exception::kServerDeviceBusy)) {
+                return read_status();  // queue fuller than we knew: send later
+            }
+            std::ostringstream m;
+            m << "device refused spans " << first << ".." << first + count - 1 << ": " << e.what() << refusal();
+            fail(m.str());
+        }
+        next += count;
+        ++report_.batches;
+        report_.spans_sent += count;
+        const DeviceStatus s = DeviceStatus::parse(r);
+        acknowledged_ = first + static_cast<std::uint32_t>(count) - 1;
+        return s;
+    }
+
+    void check_running(const DeviceStatus& s, bool started) {
+        std::ostringstream m;
+        if (s.magic != mb::kMagic) fail("status block lost its magic number: not the same device");
+        if (s.last_accepted < acknowledged_ || s.ticks < start_ticks_) {
+            m << "device restarted mid-stream (it reports sequence " << s.last_accepted << " and " << s.ticks
+              << " ticks; it had acknowledged " << acknowledged_
+              << "): stopping; the drawing is incomplete, restart it from the beginning";
+            fail(m.str());
+        }
+        if (s.state == static_cast<std::uint16_t>(device::DeviceState::kFault) ||
+            s.state == static_cast<std::uint16_t>(device::DeviceState::kEstop)) {
+            m << "device stopped in " << state_name(s.state) << " (fault code 0x" << std::hex << s.fault << std::dec
+              << ") after " << s.last_completed << " spans";
+            fail(m.str());
+        }
+        if (started && s.state == static_cast<std::uint16_t>(device::DeviceState::kIdle)) {
+            m << "device went idle after span " << s.last_completed << " (stopped by another master?)";
+            fail(m.str());
+        }
+    }
+
+    const Plan& plan_;
+    const MachineProfile& profile_;
+    const StreamOptions& options_;
+    hal::ModbusClient client_;
+    Clock::time_point last_ok_;
+    unsigned axes_ = 0;
+    std::int32_t start_[8] = {};
+    std::vector<std::vector<std::uint8_t>> spans_;
+    std::vector<std::uint32_t> ticks_;
+    std::vector<std::uint64_t> prefix_ticks_;
+    std::uint32_t base_ = 1;
+    std::uint32_t acknowledged_ = 0;
+    std::uint32_t start_ticks_ = 0;
+    StreamReport report_;
+};
+
+}  // namespace
+
+StreamReport stream_modbus(const Plan& plan, const MachineProfile& profile, const StreamOptions& options,
+                           const StreamProgress& progress) {
+    Streamer s(plan, profile, options);
+    return s.run(progress);
+}
+
+}  // namespace pathstream::host

@@ -1,0 +1,110 @@
+#include "pathstream/sim/modbus_device.hpp"
+
+#include <stdexcept>
+#include <string>
+#include <thread>
+
+#include "pathstream/device/modbus_register_map.hpp"
+#include "pathstream/host/core_span_conversion.hpp"
+
+namespace pathstream::sim {
+namespace {
+
+// Adapts the core's register map (no virtual functions, its own exception enum) to the
+// transport's handler interface; the values of the two enums are the Modbus codes.
+template <unsigned Axes>
+class MapHandler final : public hal::ModbusRegisterHandler {
+public:
+    explicit MapHandler(device::ModbusRegisterMap<Axes, kModbusDeviceCapacity>& map) : map_(map) {}
+
+    hal::ModbusException read_input_registers(std::uint16_t address, std::uint16_t count,
+                                              std::uint16_t* out) override {
+        return convert(map_.read_input_registers(address, count, out));
+    }
+    hal::ModbusException read_holding_registers(std::uint16_t address, std::uint16_t count,
+                                                std::uint16_t* out) override {
+        return convert(map_.read_holding_registers(address, count, out));
+    }
+    hal::ModbusException write_holding_registers(std::uint16_t address, std::uint16_t count,
+                                                 const std::uint16_t* values) override {
+        return convert(map_.write_holding_registers(address, count, values));
+    }
+    hal::ModbusException write_read_holding_registers(std::uint16_t write_address, std::uint16_t write_count,
+                                                      const std::uint16_t* values, std::uint16_t read_address,
+                                                      std::uint16_t read_count, std::uint16_t* out) override {
+        return convert(
+            map_.write_read_holding_registers(write_address, write_count, values, read_address, read_count, out));
+    }
+
+private:
+    static hal::ModbusException convert(device::modbus::Exception e) {
+        return static_cast<hal::ModbusException>(static_cast<std::uint8_t>(e));
+    }
+    device::ModbusRegisterMap<Axes, kModbusDeviceCapacity>& map_;
+};
+
+template <unsigned Axes>
+class Device final : public SimulatedModbusDevice {
+public:
+    explicit Device(const Lsb (&start)[Axes]) : device_(start), map_(device_), handler_(map_) {}
+
+    hal::ModbusRegisterHandler& handler() override { return handler_; }
+    void tick() override {
+        Lsb out[Axes];
+        const std::uint64_t before = device_.ticks_executed();
+        device_.tick(out);
+        ++ticks_run_;
+        if (recording_ && device_.ticks_executed() != before) {  // a path tick
+            setpoints_.insert(setpoints_.end(), out, out + Axes);
+            ticks_.push_back({static_cast<std::uint8_t>(device_.state()), device_.outputs()});
+        }
+    }
+    unsigned axes() const override { return Axes; }
+    std::uint32_t tick_hz() const override { return device_.configured() ? device_.limits().tick_hz : 0; }
+    std::uint8_t state() const override { return static_cast<std::uint8_t>(device_.state()); }
+    Lsb position(unsigned axis) const override { return device_.position(axis); }
+    void raise_fault() override { device_.raise_fault(device::FaultCode::kExternal); }
+
+private:
+    device::MotionDevice<Axes, kModbusDeviceCapacity> device_;
+    device::ModbusRegisterMap<Axes, kModbusDeviceCapacity> map_;
+    MapHandler<Axes> handler_;
+};
+
+}  // namespace
+
+std::unique_ptr<SimulatedModbusDevice> SimulatedModbusDevice::create(const std::vector<Lsb>& start) {
+    return host::with_axes(start.size(), [&](auto axes) -> std::unique_ptr<SimulatedModbusDevice> {
+        constexpr unsigned A = decltype(axes)::value;
+        Lsb s[A];
+        for (unsigned a = 0; a < A; ++a) s[a] = start[a];
+        return std::make_unique<Device<A>>(s);
+    });
+}
+
+std::uint64_t run_device_loop(SimulatedModbusDevice& device,
+                              const std::function<void(std::chrono::milliseconds)>& server_poll,
+                              const DeviceLoopOptions& options, const std::atomic<bool>& stop) {
+    using clock = std::chrono::steady_clock;
+    if (!(options.time_scale > 0)) throw std::invalid_argument("time scale must be positive");
+    const auto begin = clock::now();
+    std::uint64_t ticks = 0;
+    // Tick k is due at begin + sum of tick periods; the period follows the configured rate.
+    double due_seconds = 0;
+    while (!stop.load(std::memory_order_relaxed)) {
+        const auto now = clock::now();
+        if (options.run_for.count() > 0 && now - begin >= options.run_for) break;
+        const double elapsed = std::chrono::duration<double>(now - begin).count();
+        while (due_seconds <= elapsed) {
+            device.tick();
+            ++ticks;
+            const std::uint32_t hz = device.tick_hz() != 0 ? device.tick_hz() : 1000;
+            due_seconds += 1.0 / (hz * options.time_scale);
+        }
+        const double wait = due_seconds - elapsed;
+        server_poll(std::chrono::milliseconds(wait >= 0.001 ? static_cast<long>(wait * 1000) : 0));
+    }
+    return ticks;
+}
+
+}  // namespace pathstream::sim
