@@ -1,17 +1,23 @@
 // pathstream: the command-line tool. Exit codes (docs/cli.md): 0 success, 1 bad input file,
-// 2 bad command line, 3 output could not be written, 4 internal error, 5 planning failed.
+// 2 bad command line, 3 output could not be written, 4 internal error, 5 planning failed,
+// 6 device or link failure (stream, device).
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <exception>
+#include <stdexcept>
+#include <system_error>
 #include <iostream>
 
 #include "pathstream/host/input_error.hpp"
 #include "pathstream/host/planner.hpp"
 #include "cli/check_command.hpp"
+#include "cli/device_command.hpp"
 #include "cli/eval_command.hpp"
 #include "cli/plan_command.hpp"
 #include "cli/setpoints_command.hpp"
 #include "cli/sim_command.hpp"
+#include "cli/stream_command.hpp"
+#include "pathstream/hal/modbus_error.hpp"
 
 namespace {
 constexpr int kExitInput = 1;
@@ -19,6 +25,7 @@ constexpr int kExitUsage = 2;
 constexpr int kExitOutput = 3;
 constexpr int kExitInternal = 4;
 constexpr int kExitPlanning = 5;
+constexpr int kExitDevice = 6;
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -35,6 +42,10 @@ int main(int argc, char** argv) {
     pathstream::host::add_setpoints_command(app, setpoints);
     pathstream::host::EvalOptions eval;
     pathstream::host::add_eval_command(app, eval);
+    pathstream::host::StreamCommandOptions stream;
+    pathstream::host::add_stream_command(app, stream);
+    pathstream::host::DeviceCommandOptions device;
+    pathstream::host::add_device_command(app, device);
 
     try {
         app.parse(argc, argv);
@@ -53,12 +64,26 @@ int main(int argc, char** argv) {
         if (app.got_subcommand("check")) return pathstream::host::run_check(check);
         if (app.got_subcommand("plan")) return pathstream::host::run_plan(plan);
         if (app.got_subcommand("sim")) return pathstream::host::run_sim(sim);
+        if (app.got_subcommand("stream")) return pathstream::host::run_stream(stream);
+        if (app.got_subcommand("device")) return pathstream::host::run_device(device);
     } catch (const pathstream::host::InputError& e) {
         std::cerr << e.what() << '\n';
         return kExitInput;
     } catch (const pathstream::host::PlanError& e) {
         std::cerr << "pathstream: planning failed: " << e.what() << '\n';
         return kExitPlanning;
+    } catch (const pathstream::host::StreamError& e) {
+        std::cerr << "pathstream: device: " << e.what() << '\n';
+        return kExitDevice;
+    } catch (const pathstream::hal::ModbusError& e) {
+        std::cerr << "pathstream: device: " << e.what() << '\n';
+        return kExitDevice;
+    } catch (const std::invalid_argument& e) {
+        std::cerr << "pathstream: " << e.what() << '\n';
+        return kExitUsage;
+    } catch (const std::system_error& e) {
+        std::cerr << "pathstream: " << e.what() << '\n';
+        return kExitDevice;
     } catch (const std::runtime_error& e) {
         std::cerr << "pathstream: " << e.what() << '\n';
         return kExitOutput;

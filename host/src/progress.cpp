@@ -42,7 +42,9 @@ std::string ProgressBar::render(const std::string& label, double fraction, doubl
 
 void ProgressBar::draw(double fraction) {
     const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
-    std::fprintf(stream_, "\r%s\x1b[K", render(label_, fraction, elapsed).c_str());
+    std::string line = render(label_, fraction, elapsed);
+    if (!detail_.empty()) line += "  " + detail_;
+    std::fprintf(stream_, "\r%s\x1b[K", line.c_str());
     std::fflush(stream_);
 }
 
@@ -52,6 +54,11 @@ void ProgressBar::update(double fraction) {
     if (now - last_draw_ < std::chrono::milliseconds(100)) return;
     last_draw_ = now;
     draw(fraction);
+}
+
+void ProgressBar::update(double fraction, const std::string& detail) {
+    detail_ = detail;
+    update(fraction);
 }
 
 void ProgressBar::finish() {

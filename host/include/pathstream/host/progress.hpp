@@ -20,6 +20,8 @@ public:
 
     /// Reports progress in [0, 1]; values outside are clamped.
     void update(double fraction);
+    /// The same, with a short text shown after the ETA (e.g. a queue level).
+    void update(double fraction, const std::string& detail);
     /// Draws 100 % and ends the line (also done by the destructor if still open).
     void finish();
     bool enabled() const { return enabled_; }
@@ -32,6 +34,7 @@ private:
     void draw(double fraction);
 
     std::string label_;
+    std::string detail_;
     std::FILE* stream_;
     bool enabled_;
     bool open_ = true;
