@@ -144,7 +144,9 @@ TEST_CASE("a straight line takes the analytic minimum time (trapezoid and triang
         const Planned r = plan_and_check(path_of({polyline({{0, 0}, {0, 5}})}), p);
         const double optimum = 2 * std::sqrt(5 / 500.0);
         CHECK(motion_time(r, p) >= optimum * 0.999);
-        CHECK(motion_time(r, p) <= optimum * 1.01);
+        // 0.5 LSB/tick^2: spans are lengthened to 20 ticks (a n^2 >= 192), and the exact spans
+        // nearest the planned ones give up about 1 % of the acceleration; two span landings.
+        CHECK(motion_time(r, p) <= optimum * 1.025);
     }
     SECTION("diagonal: each axis at its own limits") {
         MachineProfile p = profile(50, 1000);
@@ -180,8 +182,9 @@ TEST_CASE("on a circle the speed is limited by acceleration: v = sqrt(a r)", "[p
     }
     CHECK(seen > 0);
     CHECK(pl.check.max_acceleration_fraction_exact > 0.95);  // it does use the acceleration
-    // The whole circle within 2 % of the continuous time-optimal profile (TOPP-RA, full limits).
-    CHECK(motion_time(pl, p) <= pl.stats.reference_motion_time * 1.02);
+    // The whole circle within 4 % of the continuous time-optimal profile (TOPP-RA, full limits):
+    // at 1 LSB/tick^2 the exact spans (14 ticks) keep a few per cent of the acceleration spare.
+    CHECK(motion_time(pl, p) <= pl.stats.reference_motion_time * 1.04);
 }
 
 TEST_CASE("a square polyline stops exactly at every corner", "[planner]") {

@@ -36,6 +36,28 @@ double exact_value(const CoreSpan& s, std::size_t axis, std::uint32_t k) {
            scale;
 }
 
+/// Peak |velocity| (LSB/tick) of axis `axis` over span `s` and |acceleration| (LSB/tick^2) at
+/// its two ends, from the core's exact cubic p(u) = (a u^3 + b u^2 + c u + d) / scale, u = k/n:
+/// the velocity is quadratic (peak at an end or where the acceleration crosses 0), the
+/// acceleration linear.
+struct SpanPeaks {
+    double velocity = 0, acceleration = 0;
+};
+SpanPeaks span_peaks(const CoreSpan& s, std::size_t axis) {
+    const TickCubic& c = s.cubic[axis];
+    const double n = s.ticks, scale = basis_matrix(s.basis).scale;
+    const double a = static_cast<double>(c.a), b = static_cast<double>(c.b), cc = static_cast<double>(c.c);
+    const auto v = [&](double u) { return std::fabs((3 * a * u + 2 * b) * u + cc) / (scale * n); };
+    SpanPeaks r;
+    r.velocity = std::max(v(0), v(1));
+    if (a != 0) {
+        const double u = -b / (3 * a);
+        if (u > 0 && u < 1) r.velocity = std::max(r.velocity, v(u));
+    }
+    r.acceleration = std::max(std::fabs(2 * b), std::fabs(6 * a + 2 * b)) / (scale * n * n);
+    return r;
+}
+
 /// Feed requested for a span: its subpath's (pen-down) or travel's (pen-up), else the profile's.
 class FeedTable {
 public:
@@ -69,6 +91,8 @@ public:
         }
         out_.axis_velocity_fraction.assign(axes_, 0);
         out_.axis_acceleration_fraction.assign(axes_, 0);
+        out_.axis_velocity_fraction_exact.assign(axes_, 0);
+        out_.axis_acceleration_fraction_exact.assign(axes_, 0);
         if (deviation) {
             std::vector<Cubic> down;
             std::vector<std::size_t> index;
@@ -134,6 +158,14 @@ private:
             span.outputs = cs.pen_down ? kOutputPenDown : 0;
             for (unsigned a = 0; a < Axes; ++a) {
                 for (unsigned k = 0; k < 4; ++k) span.control[a][k] = cs.control[a][k];
+            }
+            for (unsigned a = 0; a < Axes; ++a) {
+                const SpanPeaks peaks = span_peaks(cs, a);
+                const double fv = peaks.velocity / vlim_[a], fa = peaks.acceleration / alim_[a];
+                out_.max_span_velocity_fraction = std::max(out_.max_span_velocity_fraction, fv);
+                out_.max_span_acceleration_fraction = std::max(out_.max_span_acceleration_fraction, fa);
+                out_.axis_velocity_fraction_exact[a] = std::max(out_.axis_velocity_fraction_exact[a], fv);
+                out_.axis_acceleration_fraction_exact[a] = std::max(out_.axis_acceleration_fraction_exact[a], fa);
             }
             if (const Status st = s->push(span); st != Status::kOk) {
                 std::ostringstream m;
@@ -235,6 +267,7 @@ private:
         out_.axis_velocity_fraction[a] = std::max(out_.axis_velocity_fraction[a], allowed);
         out_.max_velocity_fraction_raw = std::max(out_.max_velocity_fraction_raw, d / vlim_[a]);
         out_.max_velocity_fraction_exact = std::max(out_.max_velocity_fraction_exact, de / vlim_[a]);
+        out_.axis_velocity_fraction_exact[a] = std::max(out_.axis_velocity_fraction_exact[a], de / vlim_[a]);
     }
 
     void acceleration(std::size_t a, double d, double de) {
@@ -242,6 +275,7 @@ private:
         out_.axis_acceleration_fraction[a] = std::max(out_.axis_acceleration_fraction[a], allowed);
         out_.max_acceleration_fraction_raw = std::max(out_.max_acceleration_fraction_raw, d / alim_[a]);
         out_.max_acceleration_fraction_exact = std::max(out_.max_acceleration_fraction_exact, de / alim_[a]);
+        out_.axis_acceleration_fraction_exact[a] = std::max(out_.axis_acceleration_fraction_exact[a], de / alim_[a]);
     }
 
     void finish() {
@@ -254,7 +288,11 @@ private:
             out_.max_acceleration_fraction =
                 std::max(out_.max_acceleration_fraction, out_.axis_acceleration_fraction[a]);
         }
-        out_.within_limits = out_.max_velocity_fraction <= 1 && out_.max_acceleration_fraction <= 1;
+        // The exact cubic must be within the limits too (a device that validates spans refuses
+        // anything over), not only the rounded setpoints with their allowance.
+        out_.within_limits = out_.max_velocity_fraction <= 1 && out_.max_acceleration_fraction <= 1 &&
+                             out_.max_velocity_fraction_exact <= 1 && out_.max_acceleration_fraction_exact <= 1 &&
+                             out_.max_span_velocity_fraction <= 1 && out_.max_span_acceleration_fraction <= 1;
         out_.ticks_checked = tick_;
     }
 

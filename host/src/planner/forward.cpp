@@ -7,6 +7,7 @@
 // continuous profile, so acceleration switches inside a span cannot overshoot the limits.
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 
 #include "internal.hpp"
 
@@ -19,30 +20,42 @@ public:
                const std::vector<double>& beta, const MachineProfile& profile, const PlanOptions& options)
         : pg_(pg), g_(pg.grid), piece_(piece), caps_(caps), beta_(beta), axes_(pg.grid.axes),
           tick_(1.0 / profile.tick_hz), n_(profile.ticks_per_span) {
+        // The spans are checked exactly as the device will run them (end points and tangents
+        // rounded to LSB), against the limits less a hair for the double arithmetic.
+        constexpr double kExact = 1 - 1e-9;
         for (std::size_t i = 0; i < axes_; ++i) {
-            acc_[i] = limits.acceleration[i] * options.acceleration_margin;
-            vel_[i] = limits.velocity[i] * options.velocity_margin;
+            acc_[i] = limits.acceleration[i] * options.acceleration_margin * kExact;
+            vel_[i] = limits.velocity[i] * options.velocity_margin * kExact;
             acc_norm_ += acc_[i] * acc_[i];
         }
+        lsb_ = profile.mm_per_lsb;
+        root_axes_ = std::sqrt(static_cast<double>(axes_));
         acc_norm_ = std::sqrt(acc_norm_);
         feed_ = piece.feed * options.feed_margin;
         delta_ = profile.chord_tolerance;
+        // Knots sit on the LSB grid, up to 1.5 LSB per axis off the path after a repair.
+        deviation_limit_ = 0.5 * delta_ + root_axes_ * lsb_;
         end_lambda_ = g_.lambda[piece.last];
-        end_q_ = g_.q[piece.last];
+        end_q_ = grid_point(g_.q[piece.last]);
     }
 
-    PieceMotion run(const PieceMotion* resume, double resume_lambda, bool short_spans) {
+    PieceMotion run(const Vec& start_q, const PieceMotion* resume, double resume_lambda, bool short_spans) {
         PieceMotion out;
         Knot k;
         k.lambda = g_.lambda[piece_.first];
-        k.q = g_.q[piece_.first];
+        k.q = start_q;
         out.start = k;
+        arrival_ = Arrival{};
         if (piece_.first == piece_.last || !(end_lambda_ - k.lambda > 1e-12)) return out;
+        const auto advance = [&](const MotionSpan& s) {
+            out.spans.push_back(s);
+            arrival_ = Arrival{k, s.ticks};
+            k = s.end;
+        };
         if (resume != nullptr) {  // keep the knots (and the spans ending there) before resume_lambda
             for (const MotionSpan& s : resume->spans) {
                 if (!(s.end.lambda < resume_lambda) || s.end.lambda >= end_lambda_) break;
-                out.spans.push_back(s);
-                k = s.end;
+                advance(s);
             }
         }
         const std::size_t limit = 50'000'000;
@@ -67,8 +80,7 @@ public:
                 out.fail_speed = k.speed;
                 return out;
             }
-            out.spans.push_back({ticks, next});
-            k = next;
+            advance({ticks, next});
         }
         out.ok = false;
         out.fail_lambda = k.lambda;
@@ -77,6 +89,77 @@ public:
     }
 
 private:
+    /// A point as a span carries it: on the LSB grid, rounded as the emitter rounds it.
+    Vec grid_point(const Vec& q) const { return on_lsb_grid(q, lsb_, axes_); }
+
+    /// The velocity a span of m ticks carries for v: its tangent dp/du = v m T / lsb rounded to
+    /// a whole LSB, as the emitter rounds it.
+    Vec span_velocity(const Vec& v, std::uint32_t m) const {
+        const double scale = m * tick_ / lsb_;
+        Vec r{};
+        for (std::size_t i = 0; i < axes_; ++i) r[i] = static_cast<double>(std::llround(v[i] * scale)) / scale;
+        return r;
+    }
+
+    /// The end point and end velocity of a span of m ticks from k0 (start velocity v0) moved to
+    /// the LSB grid: rounded to nearest, unless that puts an axis over its limits (rounding
+    /// moves the end accelerations by up to 9 / m^2 LSB/tick^2), in which case the point and
+    /// the tangent may each move one LSB further: the nearest combination within the limits,
+    /// else the least violating one (the caller's search then backs off).
+    void fit_end(const Knot& k0, const Vec& v0, Knot& k1, std::uint32_t m) const {
+        const double tau = m * tick_, scale = tau / lsb_;
+        for (std::size_t i = 0; i < axes_; ++i) {
+            // In LSB: a0 m^2 = 6 dP - 4 T0 - 2 T1, a1 m^2 = -6 dP + 2 T0 + 4 T1, p'(u) = T.
+            const double lim_a = acc_[i] * tau * tau / lsb_, lim_v = vel_[i] * scale;
+            const double p0 = std::round(k0.q[i] / lsb_), t0 = std::round(v0[i] * scale);
+            const double p = std::round(k1.q[i] / lsb_), t = std::round(k1.v[i] * scale);
+            const auto cost = [&](double p1, double t1) {
+                const double a0 = 6 * (p1 - p0) - 4 * t0 - 2 * t1, a1 = -6 * (p1 - p0) + 2 * t0 + 4 * t1;
+                double peak = std::max(std::fabs(t0), std::fabs(t1));
+                if (a0 * a1 < 0) peak = std::max(peak, std::fabs(t0 + 0.5 * a0 * a0 / (a0 - a1)));
+                return std::max(std::max(std::fabs(a0), std::fabs(a1)) / lim_a, peak / lim_v);
+            };
+            double best = cost(p, t), bp = 0, bt = 0;
+            for (int dp = -1; dp <= 1 && best > 1; ++dp) {
+                for (int dt = -1; dt <= 1; ++dt) {
+                    const double c = cost(p + dp, t + dt);
+                    const bool nearer = std::abs(dp) + std::abs(dt) < std::fabs(bp) + std::fabs(bt);
+                    if ((c <= 1 && (best > 1 || nearer)) || (best > 1 && c < best)) {
+                        best = c;
+                        bp = dp;
+                        bt = dt;
+                    }
+                }
+            }
+            k1.q[i] = (p + bp) * lsb_;
+            k1.v[i] = (t + bt) / scale;
+        }
+    }
+
+    /// The span that arrived at a knot: where it started and its ticks (0: none, at rest).
+    struct Arrival {
+        Knot from;
+        std::uint32_t ticks = 0;
+    };
+
+    /// Where the tick count changes at a moving knot, the two spans' tangents are rounded on
+    /// different scales and the velocity jumps by up to 1/2 LSB per tick of the shorter one:
+    /// the second difference of the exact cubic across the knot (tick before, knot, tick
+    /// after) over each axis's limit. 0 where the tick count does not change (then it is a
+    /// weighted mean of the two spans' accelerations, which are checked).
+    double junction(const Arrival& in, const Knot& k0, const Vec& v0, const Knot& k1, std::uint32_t m) const {
+        if (in.ticks == 0 || in.ticks == m) return 0;
+        const double tp = in.ticks * tick_, tau = m * tick_;
+        const Vec va = span_velocity(in.from.v, in.ticks);
+        double worst = 0;
+        for (std::size_t i = 0; i < axes_; ++i) {
+            const double before = hermite(in.from.q[i] - k0.q[i], 0, va[i] * tp, k0.v[i] * tp, 1 - 1.0 / in.ticks);
+            const double after = hermite(0, k1.q[i] - k0.q[i], v0[i] * tau, k1.v[i] * tau, 1.0 / m);
+            worst = std::max(worst, std::fabs(before + after) / (tick_ * tick_ * acc_[i]));
+        }
+        return worst;
+    }
+
     Knot end_knot() const {
         Knot e;
         e.lambda = end_lambda_;
@@ -119,8 +202,8 @@ private:
             if (lo > hi) continue;
             for (const double a : {0.5 * (lo + hi), hi, lo, lo + 0.75 * (hi - lo), lo + 0.25 * (hi - lo)}) {
                 if (!under_beta(k, a, tau)) continue;
-                Candidate c = evaluate(k, a, tau);
-                if (c.f > 0 || !finish_ok(c.end, f)) continue;
+                Candidate c = evaluate(k, a, n_);
+                if (c.f > 0 || !finish_ok(c.end, Arrival{k, n_}, f)) continue;
                 mid = c.end;
                 return f;
             }
@@ -187,10 +270,14 @@ private:
     /// How far the Hermite span between two knots over tau seconds exceeds the limits: max over
     /// axes of |acceleration| / limit (exact: it is linear in a cubic, so its ends bound it) and
     /// peak |velocity| / limit (exact: at the ends or where the acceleration crosses 0), and the
-    /// speed at eighths of the span over the feed and the speed cap there. <= 0: within.
-    /// Relative: the check is ratio - 1.
-    double violation(const Knot& k0, const Knot& k1, double tau) const {
-        const Vec &q0 = k0.q, &v0 = k0.v, &q1 = k1.q, &v1 = k1.v;
+    /// speed at eighths of the span over the feed and the speed cap there (less the rounding of
+    /// the tangents), and the junction with the span before (`in`). <= 0: within.
+    /// Relative: the check is ratio - 1. The knots are on the LSB grid, k1.v rounded for this
+    /// span; k0's velocity is rounded for it here, so this is the span the device runs.
+    double violation(const Knot& k0, const Arrival& in, const Knot& k1, std::uint32_t m) const {
+        const double tau = m * tick_;
+        const Vec v0 = span_velocity(k0.v, m);
+        const Vec &q0 = k0.q, &q1 = k1.q, &v1 = k1.v;
         double worst = 0;
         constexpr int kSamples = 7;
         Vec at[kSamples] = {};
@@ -212,16 +299,17 @@ private:
         }
         // Speed along the path at every eighth of the span, against the feed and the speed cap
         // where the path profile (constant acceleration) is then.
-        const double acc = (k1.speed - k0.speed) / tau;
+        const double acc = (k1.speed - k0.speed) / tau, rounding = root_axes_ * lsb_ / tau;
         for (int s = 0; s < kSamples; ++s) {
             const double t = kW[s] * tau;
-            const double speed = norm(at[s]);
+            const double speed = std::max(0.0, norm(at[s]) - rounding);
             const double cap = interpolate(caps_, std::clamp(k0.lambda + k0.speed * t + 0.5 * acc * t * t,
                                                              k0.lambda, std::max(k0.lambda, k1.lambda)));
             worst = std::max(worst, speed / feed_);
             if (cap > 0) worst = std::max(worst, speed / std::sqrt(cap));
             else if (speed > 0) worst = std::max(worst, 2.0);
         }
+        worst = std::max(worst, junction(in, k0, v0, k1, m));
         return worst - 1;
     }
 
@@ -239,7 +327,9 @@ private:
     /// wrong where the curvature changes along the span: the offset nearest 0 that the
     /// linearised end accelerations allow. f <= 0 means the span is within the limits and its
     /// end under beta.
-    Candidate evaluate(const Knot& k, double a, double tau) {
+    Candidate evaluate(const Knot& k, double a, std::uint32_t m) {
+        const double tau = m * tick_;
+        const Vec v0 = span_velocity(k.v, m);
         Candidate c;
         c.a = a;
         c.end.speed = std::max(0.0, k.speed + a * tau);
@@ -255,8 +345,8 @@ private:
         off_hi = std::min(off_hi, end_lambda_ - l1);
         for (std::size_t i = 0; i < axes_ && off_lo <= off_hi; ++i) {
             const double d = p.q[i] - k.q[i];
-            const double a0 = 6 * d / (tau * tau) - (4 * k.v[i] + 2 * v1 * p.t[i]) / tau;
-            const double a1 = -6 * d / (tau * tau) + (2 * k.v[i] + 4 * v1 * p.t[i]) / tau;
+            const double a0 = 6 * d / (tau * tau) - (4 * v0[i] + 2 * v1 * p.t[i]) / tau;
+            const double a1 = -6 * d / (tau * tau) + (2 * v0[i] + 4 * v1 * p.t[i]) / tau;
             const double s0 = 6 * p.t[i] / (tau * tau) - 2 * v1 * kappa[i] / tau;
             const double s1 = -6 * p.t[i] / (tau * tau) + 4 * v1 * kappa[i] / tau;
             for (const auto& [val, slope] : {std::pair{a0, s0}, std::pair{a1, s1}}) {
@@ -276,8 +366,9 @@ private:
         }
         c.end.q = p.q;
         c.end.v = scaled(p.t, v1);
-        c.f = violation(k, c.end, tau);
-        c.f = std::max(c.f, span_deviation(k, c.end, tau) / (0.5 * delta_) - 1);
+        fit_end(k, v0, c.end, m);
+        c.f = violation(k, arrival_, c.end, m);
+        c.f = std::max(c.f, span_deviation(k, c.end, m) / deviation_limit_ - 1);
         const double b1 = beta_at(c.end.lambda);
         if (v1 * v1 > b1 * (1 + 1e-6) + 1e-9) c.f = std::max(c.f, 1e-3);
         return c;
@@ -287,7 +378,9 @@ private:
     /// across the path at the arc length where the cubic's point projects onto the chord.
     /// Skipped (0) where the span is too short for the curvature it passes to matter:
     /// chord^2 kappa / 8 < delta / 64.
-    double span_deviation(const Knot& k, const Knot& end, double tau) {
+    double span_deviation(const Knot& k, const Knot& end, std::uint32_t m) {
+        const double tau = m * tick_;
+        const Vec v0 = span_velocity(k.v, m);
         const double len = end.lambda - k.lambda;
         double kappa = 0;
         bool corner = false;
@@ -306,7 +399,7 @@ private:
             const double h00 = 2 * w3 - 3 * w2 + 1, h10 = w3 - 2 * w2 + w, h01 = -2 * w3 + 3 * w2, h11 = w3 - w2;
             Vec x{};
             for (std::size_t i = 0; i < axes_; ++i) {
-                x[i] = h00 * k.q[i] + h10 * k.v[i] * tau + h01 * end.q[i] + h11 * end.v[i] * tau;
+                x[i] = h00 * k.q[i] + h10 * v0[i] * tau + h01 * end.q[i] + h11 * end.v[i] * tau;
             }
             const double along = c2 > 0 ? std::clamp(dot(sub(x, k.q), chord) / c2, 0.0, 1.0) : w;
             const PathAt p = path_at(pg_, piece_, k.lambda + along * len, h);
@@ -334,34 +427,34 @@ private:
         const double a_lo = -k.speed / tau;
         double a_hi;
         if (!max_under_beta(k, tau, a_lo, acc_norm_, a_hi)) return false;
-        Candidate hi = evaluate(k, a_hi, tau);
+        Candidate hi = evaluate(k, a_hi, m);
         if (hi.f <= 0) {
             next = hi.end;
             return true;
         }
         // No feasible span accelerates harder than the axes allow: search from there.
         const double a_floor = std::min(a_hi, std::max(a_lo, -1.5 * acc_norm_));
-        Candidate lo = evaluate(k, a_floor, tau);
+        Candidate lo = evaluate(k, a_floor, m);
         if (lo.f > 0) {
             // The violation is (nearly) a maximum of affine functions of the acceleration, so
             // convex: golden-section search for its minimum, a feasible span if any exists.
             constexpr double kGolden = 0.6180339887498949;
             double x0 = a_floor, x3 = a_hi;
             double x1 = x3 - kGolden * (x3 - x0), x2 = x0 + kGolden * (x3 - x0);
-            Candidate c1 = evaluate(k, x1, tau), c2 = evaluate(k, x2, tau);
+            Candidate c1 = evaluate(k, x1, m), c2 = evaluate(k, x2, m);
             for (int it = 0; it < 48 && c1.f > 0 && c2.f > 0; ++it) {
                 if (c1.f <= c2.f) {
                     x3 = x2;
                     x2 = x1;
                     c2 = c1;
                     x1 = x3 - kGolden * (x3 - x0);
-                    c1 = evaluate(k, x1, tau);
+                    c1 = evaluate(k, x1, m);
                 } else {
                     x0 = x1;
                     x1 = x2;
                     c1 = c2;
                     x2 = x0 + kGolden * (x3 - x0);
-                    c2 = evaluate(k, x2, tau);
+                    c2 = evaluate(k, x2, m);
                 }
             }
             const Candidate& best = c1.f <= c2.f ? c1 : c2;
@@ -375,7 +468,7 @@ private:
             if (hi.a - lo.a <= 1e-7 * acc_norm_) break;
             double a = lo.a - flo * (hi.a - lo.a) / (fhi - flo);
             if (!(a > lo.a && a < hi.a)) a = 0.5 * (lo.a + hi.a);
-            Candidate c = evaluate(k, a, tau);
+            Candidate c = evaluate(k, a, m);
             if (c.f <= 0) {
                 lo = c;
                 flo = c.f;
@@ -400,10 +493,11 @@ private:
 
     /// True when the final span of `ticks` ticks from k to rest at the end is within the limits
     /// and never passes the end point at a tick.
-    bool finish_ok(const Knot& k, std::uint32_t ticks) {
+    bool finish_ok(const Knot& k, const Arrival& in, std::uint32_t ticks) {
         const double tau = ticks * tick_;
-        if (violation(k, end_knot(), tau) > 0) return false;
-        if (span_deviation(k, end_knot(), tau) > 0.5 * delta_) return false;
+        const Vec v0 = span_velocity(k.v, ticks);
+        if (violation(k, in, end_knot(), ticks) > 0) return false;
+        if (span_deviation(k, end_knot(), ticks) > deviation_limit_) return false;
         // Under the speed caps along the way (corners, feed, chord tolerance): the cubic's speed
         // at eighths of the span against the cap where its point projects onto the chord. (Its
         // accelerations, the bends included, were checked above on the cubic itself.)
@@ -413,15 +507,16 @@ private:
             const double w = s / 8.0, w2 = w * w;
             double along = 0, speed2 = 0;
             for (std::size_t i = 0; i < axes_; ++i) {
-                const double x = (2 * w2 * w - 3 * w2 + 1) * k.q[i] + (w2 * w - 2 * w2 + w) * k.v[i] * tau +
+                const double x = (2 * w2 * w - 3 * w2 + 1) * k.q[i] + (w2 * w - 2 * w2 + w) * v0[i] * tau +
                                  (-2 * w2 * w + 3 * w2) * end_q_[i];
-                const double v = ((6 * w2 - 6 * w) * k.q[i] + (3 * w2 - 4 * w + 1) * k.v[i] * tau +
+                const double v = ((6 * w2 - 6 * w) * k.q[i] + (3 * w2 - 4 * w + 1) * v0[i] * tau +
                                   (-6 * w2 + 6 * w) * end_q_[i]) / tau;
                 along += (x - k.q[i]) * chord[i];
                 speed2 += v * v;
             }
             const double l = k.lambda + d * std::clamp(along / c2, 0.0, 1.0);
-            if (speed2 > interpolate(caps_, l) * (1 + 1e-6) + 1e-9) return false;
+            const double speed = std::max(0.0, std::sqrt(speed2) - root_axes_ * lsb_ / tau);
+            if (speed * speed > interpolate(caps_, l) * (1 + 1e-6) + 1e-9) return false;
         }
         const double len2 = c2;
         if (ticks < 2 || len2 <= 0) return true;
@@ -430,7 +525,7 @@ private:
             const double t = static_cast<double>(j) / (samples + 1);
             double along = 0;
             for (std::size_t i = 0; i < axes_; ++i) {
-                const double p = hermite(k.q[i], end_q_[i], k.v[i] * tau, 0, t);
+                const double p = hermite(k.q[i], end_q_[i], v0[i] * tau, 0, t);
                 along += (p - end_q_[i]) * chord[i];
             }
             if (along > 1e-9 * len2) return false;
@@ -462,9 +557,9 @@ private:
         const std::uint32_t hi = static_cast<std::uint32_t>(std::min<double>(n_, std::max(hi_f, lo_f)));
         const std::uint32_t stride = std::max<std::uint32_t>(1, (hi - lo) / 64);
         for (std::uint32_t t = lo; t <= hi; t += stride) {
-            if (!finish_ok(k, t)) continue;
+            if (!finish_ok(k, arrival_, t)) continue;
             std::uint32_t best = t;  // with a coarse stride, look for a shorter one just below
-            while (stride > 1 && best > lo && best + stride > t + 1 && finish_ok(k, best - 1)) --best;
+            while (stride > 1 && best > lo && best + stride > t + 1 && finish_ok(k, arrival_, best - 1)) --best;
             return best;
         }
         return 0;
@@ -482,6 +577,8 @@ private:
     double acc_norm_ = 0;
     double feed_ = 0;
     double delta_ = 0;
+    double lsb_ = 0, root_axes_ = 1, deviation_limit_ = 0;
+    Arrival arrival_;  ///< the span that arrived at the current knot
     double end_lambda_ = 0;
     Vec end_q_{};
     std::size_t hint_ = 0;
@@ -491,10 +588,10 @@ private:
 
 PieceMotion forward_pass(const PathGrid& g, const Piece& piece, const Limits& limits,
                          const std::vector<double>& caps, const std::vector<double>& beta,
-                         const MachineProfile& profile, const PlanOptions& options, const PieceMotion* resume,
-                         double resume_lambda, bool short_spans) {
+                         const MachineProfile& profile, const PlanOptions& options, const Vec& start_q,
+                         const PieceMotion* resume, double resume_lambda, bool short_spans) {
     PieceTimer timer(g, piece, limits, caps, beta, profile, options);
-    return timer.run(resume, resume_lambda, short_spans);
+    return timer.run(start_q, resume, resume_lambda, short_spans);
 }
 
 }  // namespace pathstream::host::planner_detail

@@ -237,14 +237,24 @@ struct PieceMotion {
 /// constant acceleration along the path in each span, the Hermite span between two knots
 /// checked against the limits, the speed kept under beta, and the final span ending at rest
 /// exactly at the piece's end.
+/// Knots are on the LSB grid and their velocities rounded as the emitter rounds tangents, so
+/// that what is checked is exactly what the device runs; `start_q` is where the previous piece
+/// ended (on the grid).
 /// `resume` (optional): a previous attempt whose knots before `resume_lambda` are kept.
 /// `short_spans`: allow spans shorter than ticks_per_span where a full one cannot be found
 /// (the last resort: their tangents are rounded on a different scale).
 PieceMotion forward_pass(const PathGrid& g, const Piece& piece, const Limits& limits,
                          const std::vector<double>& caps, const std::vector<double>& beta,
-                         const MachineProfile& profile, const PlanOptions& options,
+                         const MachineProfile& profile, const PlanOptions& options, const Vec& start_q,
                          const PieceMotion* resume = nullptr, double resume_lambda = 0,
                          bool short_spans = false);
+
+/// A point on the LSB grid (mm), rounded as the emitter rounds span end points.
+inline Vec on_lsb_grid(const Vec& q, double lsb, std::size_t axes) {
+    Vec r{};
+    for (std::size_t i = 0; i < axes; ++i) r[i] = static_cast<double>(std::llround(q[i] / lsb)) * lsb;
+    return r;
+}
 
 /// Distance from points to a set of Bezier segments (the pen-down path), for the plan check.
 /// Queries are expected to move along the path: each one first searches the segments around

@@ -34,7 +34,9 @@ struct PlanCheck {
     std::vector<double> axis_acceleration_fraction;  ///< per axis
     double max_deviation = 0;              ///< mm, worst distance of a pen-down setpoint from the path
     std::uint64_t worst_deviation_tick = 0;
-    bool within_limits = false;            ///< every fraction <= 1 (after the quantisation allowance)
+    /// Every fraction <= 1: the per-tick ones after the quantisation allowance, the exact
+    /// ones and the span ones (what a device validating each span against the limits checks).
+    bool within_limits = false;
     bool drawing_while_pen_moves = false;  ///< true if any tick moves while the pen settles
 
     // The same fractions without the rounding allowance: `raw` from the integer setpoints,
@@ -43,6 +45,14 @@ struct PlanCheck {
     double max_acceleration_fraction_raw = 0;
     double max_velocity_fraction_exact = 0;
     double max_acceleration_fraction_exact = 0;
+    /// Per span, the continuous cubic the core runs (before any rounding): peak |velocity| over
+    /// the span and |acceleration| at both ends (it is linear, so they bound it) over the limits,
+    /// max over spans and axes. A device that validates every span checks exactly these.
+    double max_span_velocity_fraction = 0;
+    double max_span_acceleration_fraction = 0;
+    /// Per axis: the larger of the exact per-tick and the span fraction.
+    std::vector<double> axis_velocity_fraction_exact;
+    std::vector<double> axis_acceleration_fraction_exact;
     /// Max over moving ticks of the per-tick speed along the path over the requested feed
     /// (pen-down: the subpath's feed; pen-up: travel_feed), after an allowance of
     /// 2 sqrt(axes) LSB per tick for the rounding of setpoints and span end points.

@@ -54,6 +54,9 @@ struct PlanStats {
     std::size_t segments = 0;          ///< Bezier segments in
     std::size_t grid_nodes = 0;        ///< lookahead grid nodes
     std::size_t pieces = 0;            ///< stretches between stops (corners, pen changes, ends)
+    /// Ticks of a regular span: the profile's ticks_per_span, or more where the limits are below
+    /// what spans that short can meet exactly on the LSB grid (docs/planner.md).
+    std::uint32_t ticks_per_span = 0;
     std::size_t motion_spans = 0;      ///< spans that move (dwells excluded)
     std::uint64_t motion_ticks = 0;    ///< ticks of motion (dwells excluded)
     std::uint64_t dwell_ticks = 0;     ///< ticks holding still while the pen moves
