@@ -59,6 +59,7 @@ public:
             }
         }
         const std::size_t limit = 50'000'000;
+        std::size_t stalled = 0;
         while (out.spans.size() < limit) {
             if (const std::uint32_t f = finish(k); f > 0) {
                 out.spans.push_back({f, end_knot()});
@@ -74,7 +75,10 @@ public:
             for (std::uint32_t m = n_; m >= (short_spans ? 1u : n_) && ticks == 0; --m) {
                 if (step(k, m, next)) ticks = m;
             }
-            if (ticks == 0 || (!(next.lambda > k.lambda) && next.speed <= 0 && k.speed <= 0)) {
+            // A run of spans that leave the point on the LSB grid where it is makes no progress
+            // the device could see (creeping towards a stop in ever smaller steps): stuck.
+            stalled = next.q == k.q ? stalled + 1 : 0;
+            if (ticks == 0 || (!(next.lambda > k.lambda) && next.speed <= 0 && k.speed <= 0) || stalled > 256) {
                 out.ok = false;
                 out.fail_lambda = k.lambda;
                 out.fail_speed = k.speed;
