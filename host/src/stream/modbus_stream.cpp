@@ -61,11 +61,11 @@ const char* state_name(std::uint16_t s) {
 class Streamer {
 public:
     Streamer(const Plan& plan, const MachineProfile& profile, const StreamOptions& options)
-        : plan_(plan), profile_(profile), options_(options), client_(options.target, client_options(options)) {}
+        : plan_(plan), profile_(profile), options_(options), client_(connect(options)) {}
 
     StreamReport run(const StreamProgress& progress) {
         const auto wall_start = Clock::now();
-        last_ok_ = Clock::now();
+        last_ok_ = last_batch_ok_ = Clock::now();
         encode_plan();
         DeviceStatus s = read_status();
         check_identity(s);
@@ -118,8 +118,27 @@ private:
     static hal::ModbusClientOptions client_options(const StreamOptions& o) {
         hal::ModbusClientOptions c;
         c.response_timeout = std::chrono::milliseconds(o.response_timeout_ms);
+        // A response that lost a byte would otherwise wait libmodbus's 500 ms byte timeout
+        // for it, whatever the response timeout: one gap of that size is already a lost frame.
+        c.byte_timeout = c.response_timeout;
         c.attempts = static_cast<int>(std::max(1u, o.attempts));
         return c;
+    }
+
+    // The first connection, tried until link_timeout_seconds have passed (a device may still
+    // be starting); then a StreamError like every other dead link, not the transport's error.
+    static hal::ModbusClient connect(const StreamOptions& o) {
+        const auto begin = Clock::now();
+        while (true) {
+            try {
+                return hal::ModbusClient(o.target, client_options(o));
+            } catch (const hal::ModbusError& e) {
+                if (std::chrono::duration<double>(Clock::now() - begin).count() > o.link_timeout_seconds) {
+                    throw StreamError(o.target + ": cannot connect to the device (" + e.what() + ")");
+                }
+                std::this_thread::sleep_for(std::chrono::milliseconds(50));
+            }
+        }
     }
 
     [[noreturn]] void fail(const std::string& what) const {
@@ -213,15 +232,20 @@ private:
         } catch (const hal::ModbusError& e) {
             fail(std::string("device refused the configuration (tick rate and limits): ") + e.what() + refusal());
         }
+        configured_ = true;
     }
 
+    // Why the device refused, from its status block; a device that restarted since the last
+    // acknowledgement refuses everything (it is unconfigured), so that is reported instead.
     std::string refusal() {
+        DeviceStatus s;
         try {
-            const DeviceStatus s = read_status();
-            return std::string(" [device: ") + status_name(static_cast<Status>(s.last_refusal)) + "]";
+            s = read_status();
         } catch (const std::exception&) {
             return "";
         }
+        check_restart(s);
+        return std::string(" [device: ") + status_name(static_cast<Status>(s.last_refusal)) + "]";
     }
 
     void command(device::Command c, bool tolerate_refusal) {
@@ -280,7 +304,8 @@ private:
 
     DeviceStatus send_batch(std::size_t& next, std::uint16_t free_slots) {
         const std::size_t max_bytes = 2u * mb::kMaxPayloadRegistersFc23;
-        const std::size_t max_spans = std::min<std::size_t>({device::kMaxBatchSpans, free_slots, spans_.size() - next});
+        const std::size_t max_spans =
+            std::min<std::size_t>({batch_limit_, free_slots, spans_.size() - next});
         std::vector<std::uint8_t> payload;
         std::size_t count = 0;
         while (count < max_spans && payload.size() + spans_[next + count].size() <= max_bytes) {
@@ -298,35 +323,75 @@ private:
             window.push_back(static_cast<std::uint16_t>((payload[i] << 8) | low));
         }
         std::uint16_t r[st::kCount];
+        const std::uint32_t last = first + static_cast<std::uint32_t>(count) - 1;
+        const std::uint64_t retries_before = client_.counters().retries;
         try {
-            transact([&] {
-                client_.write_read_registers(mb::kSpanWindow, window, 0, std::span<std::uint16_t>(r, st::kCount));
-            });
+            client_.write_read_registers(mb::kSpanWindow, window, 0, std::span<std::uint16_t>(r, st::kCount));
         } catch (const hal::ModbusError& e) {
             if (e.exception_code() == static_cast<std::uint8_t>(mb::Exception::kServerDeviceBusy)) {
                 return read_status();  // queue fuller than we knew: send later
             }
-            std::ostringstream m;
-            m << "device refused spans " << first << ".." << first + count - 1 << ": " << e.what() << refusal();
-            fail(m.str());
+            if (!e.transient()) {
+                std::ostringstream m;
+                m << "device refused spans " << first << ".." << last << ": " << e.what() << refusal();
+                fail(m.str());
+            }
+            // The batch may or may not have been applied (a lost response). Resend nothing
+            // blind: ask the device what it accepted, and try smaller batches, which a noisy
+            // line lets through far more often (each byte is a chance to lose the frame).
+            shrink_batches(count);
+            const double silent = std::chrono::duration<double>(Clock::now() - last_batch_ok_).count();
+            if (silent > options_.link_timeout_seconds) {
+                std::ostringstream m;
+                m << "no batch got through for " << std::lround(silent) << " s (" << e.what() << ")";
+                fail(m.str());
+            }
+            const DeviceStatus s = read_status();
+            check_restart(s);
+            if (s.last_accepted == last) {  // applied: only the response was lost
+                batch_done(next, count, last);
+            }
+            return s;
         }
+        last_ok_ = last_batch_ok_ = Clock::now();
+        if (client_.counters().retries != retries_before) {
+            shrink_batches(count);
+        } else if (++clean_batches_ >= kCleanBatchesToGrow && batch_limit_ < device::kMaxBatchSpans) {
+            batch_limit_ = std::min<std::size_t>(device::kMaxBatchSpans, 2 * batch_limit_);
+            clean_batches_ = 0;
+        }
+        batch_done(next, count, last);
+        return DeviceStatus::parse(r);
+    }
+
+    void batch_done(std::size_t& next, std::size_t count, std::uint32_t last) {
         next += count;
         ++report_.batches;
         report_.spans_sent += count;
-        const DeviceStatus s = DeviceStatus::parse(r);
-        acknowledged_ = first + static_cast<std::uint32_t>(count) - 1;
-        return s;
+        acknowledged_ = last;
+    }
+
+    // After a batch that needed a retry: at most half as many spans per batch from now on.
+    void shrink_batches(std::size_t count) {
+        batch_limit_ = std::max<std::size_t>(1, std::min(batch_limit_, count) / 2);
+        clean_batches_ = 0;
+    }
+
+    // A device whose sequence or tick count went backwards lost its queue: it restarted.
+    void check_restart(const DeviceStatus& s) const {
+        if (s.magic != mb::kMagic) fail("status block lost its magic number: not the same device");
+        if (s.last_accepted < acknowledged_ || s.ticks < start_ticks_ || (configured_ && (s.flags & 1u) == 0)) {
+            std::ostringstream m;
+            m << "device restarted mid-stream (it reports sequence " << s.last_accepted << " and " << s.ticks
+              << " ticks" << ((s.flags & 1u) == 0 ? ", unconfigured" : "") << "; it had acknowledged "
+              << acknowledged_ << "): stopping; the drawing is incomplete, restart it from the beginning";
+            fail(m.str());
+        }
     }
 
     void check_running(const DeviceStatus& s, bool started) {
         std::ostringstream m;
-        if (s.magic != mb::kMagic) fail("status block lost its magic number: not the same device");
-        if (s.last_accepted < acknowledged_ || s.ticks < start_ticks_) {
-            m << "device restarted mid-stream (it reports sequence " << s.last_accepted << " and " << s.ticks
-              << " ticks; it had acknowledged " << acknowledged_
-              << "): stopping; the drawing is incomplete, restart it from the beginning";
-            fail(m.str());
-        }
+        check_restart(s);
         if (s.state == static_cast<std::uint16_t>(device::DeviceState::kFault) ||
             s.state == static_cast<std::uint16_t>(device::DeviceState::kEstop)) {
             m << "device stopped in " << state_name(s.state) << " (fault code 0x" << std::hex << s.fault << std::dec
@@ -352,6 +417,13 @@ private:
     std::uint32_t base_ = 1;
     std::uint32_t acknowledged_ = 0;
     std::uint32_t start_ticks_ = 0;
+    bool configured_ = false;  // the device accepted our configuration: it must stay configured
+    // Adaptive batch size: halved after a batch that needed a retry, doubled after
+    // kCleanBatchesToGrow clean ones (a clean link stays at the largest batch).
+    static constexpr unsigned kCleanBatchesToGrow = 16;
+    std::size_t batch_limit_ = device::kMaxBatchSpans;
+    unsigned clean_batches_ = 0;
+    Clock::time_point last_batch_ok_ = Clock::now();
     StreamReport report_;
 };
 

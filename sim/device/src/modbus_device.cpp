@@ -54,6 +54,7 @@ public:
         const std::uint64_t before = device_.ticks_executed();
         device_.tick(out);
         ++ticks_run_;
+        if (recording_every_tick_) every_tick_.insert(every_tick_.end(), out, out + Axes);
         if (recording_ && device_.ticks_executed() != before) {  // a path tick
             setpoints_.insert(setpoints_.end(), out, out + Axes);
             ticks_.push_back({static_cast<std::uint8_t>(device_.state()), device_.outputs()});

@@ -53,11 +53,18 @@ public:
     void record(bool on) { recording_ = on; }
     const std::vector<Lsb>& recorded_setpoints() const { return setpoints_; }
     const std::vector<DeviceTick>& recorded_ticks() const { return ticks_; }
+    /// Records every tick from now on, path or not (stop and re-entry moves, rest): what the
+    /// axes were actually commanded, for checking the device's own moves against the limits.
+    /// every_tick_setpoints()[k * axes + axis] is tick k's (k counted from the call).
+    void record_every_tick(bool on) { recording_every_tick_ = on; }
+    const std::vector<Lsb>& every_tick_setpoints() const { return every_tick_; }
     std::uint64_t ticks_run() const { return ticks_run_; }
 
 protected:
     bool recording_ = false;
+    bool recording_every_tick_ = false;
     std::vector<Lsb> setpoints_;
+    std::vector<Lsb> every_tick_;
     std::vector<DeviceTick> ticks_;
     std::uint64_t ticks_run_ = 0;
 };
