@@ -405,7 +405,14 @@ void run_section(Context& ctx, Width width, std::uint32_t attempts, bool longest
     ctx.hash.u32(stream.last_completed_tag());
 }
 
-/// The whole workload: about 200k ticks over six sections, 1 to 8 axes.
+}  // namespace pathstream::workload
+
+#include "device_workload.hpp"
+
+namespace pathstream::workload {
+
+/// The whole workload: about 200k ticks over six sections, 1 to 8 axes, then the device
+/// (state machine and Modbus register map) at 1, 2 and 4 axes.
 inline Summary run() {
     Context ctx;
     run_section<1, 4>(ctx, Width::kNarrow, 48, false);
@@ -414,6 +421,9 @@ inline Summary run() {
     run_section<3, 16>(ctx, Width::kWide, 6, true);
     run_section<4, 8>(ctx, Width::kMixed, 40, false);
     run_section<8, 2>(ctx, Width::kMixed, 16, false);
+    DeviceWorkload<1>(ctx).run();
+    DeviceWorkload<2>(ctx).run();
+    DeviceWorkload<4>(ctx).run();
     ctx.summary.checksum = ctx.hash.value();
     return ctx.summary;
 }

@@ -83,8 +83,8 @@ public:
     /// acknowledged with kOk and not queued again (duplicates() counts it).
     /// Errors: kNotConfigured; kWrongState (fault, e-stop, stopping); kBadSequence (a gap or a
     /// partial overlap); kBadBatch (count 0 or > kMaxBatchSpans, length mismatch, bad flags);
-    /// kQueueFull (not enough free slots: retry later); a span's own Status (its validation,
-    /// kVelocityLimit, kAccelerationLimit, kDiscontinuousSpan never: the start is implied).
+    /// a span's own Status (its validation, kVelocityLimit, kAccelerationLimit); and only for
+    /// a batch that is otherwise acceptable, kQueueFull (not enough free slots: retry later).
     /// Cost: two decodes and one validation per span (~5,000 instructions per axis on M4).
     /// Task context.
     [[nodiscard]] Status accept_batch(std::uint32_t first_sequence, std::uint16_t count,
@@ -103,7 +103,6 @@ public:
             return Status::kOk;
         }
         if (first_sequence != next_sequence_) return Status::kBadSequence;
-        if (stream_.free_slots() < count) return Status::kQueueFull;
         // Pass 1: decode and check everything, chaining start points and tangents.
         Lsb start[Axes];
         std::int32_t tangent[Axes];
@@ -114,6 +113,9 @@ public:
         if (Status st = walk_batch(payload, length, count, start, tangent, nullptr); st != Status::kOk) {
             return st;
         }
+        // Room is checked after validity, as SetpointStream::push does: a master retrying on
+        // kQueueFull never retries a batch that can never go in.
+        if (stream_.free_slots() < count) return Status::kQueueFull;
         // Pass 2: the same walk, pushing. Cannot fail: pass 1 proved every span and the room.
         for (unsigned a = 0; a < Axes; ++a) {
             start[a] = stream_.pushed_end(a);
@@ -128,7 +130,8 @@ public:
         return Status::kOk;
     }
 
-    /// Requests a command; the next tick applies it. Errors (nothing requested): kWrongState
+    /// Requests a command; the next tick applies it (a second request before that tick
+    /// replaces the first). Errors (nothing requested): kWrongState
     /// when the state does not allow it (start: idle only and configured; hold: running;
     /// resume: holding; stop: running, holding or idle; reset: fault, or e-stop with the input
     /// released), kNotConfigured, kNothingToResume (a hold after an underrun with nothing
@@ -162,15 +165,21 @@ public:
                 }
                 break;
         }
-        request_.store(static_cast<std::uint16_t>(c), std::memory_order_release);
+        // Value first, then the sequence that publishes it; the tick compares sequences, so no
+        // read-modify-write is needed (ARMv6-M has none) and a request is never lost.
+        request_value_.store(static_cast<std::uint16_t>(c), std::memory_order_relaxed);
+        request_sequence_.store(request_sequence_.load(std::memory_order_relaxed) + 1, std::memory_order_release);
         return Status::kOk;
     }
 
     /// Any context (a GPIO edge interrupt too): raises a fault; the next tick freezes every
     /// axis where it is, drops the queue and enters kFault. The first fault's code is kept.
     void raise_fault(FaultCode code) {
-        std::uint16_t none = 0;
-        fault_request_.compare_exchange_strong(none, static_cast<std::uint16_t>(code));
+        // Loads and stores only (ARMv6-M has no atomic read-modify-write): two raisers racing
+        // in the same instant may keep either code, never none.
+        if (fault_request_.load(std::memory_order_acquire) == 0) {
+            fault_request_.store(static_cast<std::uint16_t>(code), std::memory_order_release);
+        }
     }
     /// Any context: the e-stop input's level. Active: the next tick freezes every axis, drops
     /// the queue and enters kEstop; kReset is refused until the input is released.
@@ -311,8 +320,10 @@ private:
             set_state(DeviceState::kFault);
             return;
         }
-        const std::uint16_t r = request_.exchange(0, std::memory_order_acq_rel);
-        if (r == 0) return;
+        const std::uint32_t sequence = request_sequence_.load(std::memory_order_acquire);
+        if (sequence == applied_sequence_) return;
+        applied_sequence_ = sequence;
+        const std::uint16_t r = request_value_.load(std::memory_order_relaxed);
         switch (static_cast<Command>(r)) {
             case Command::kStart:
                 if (s == DeviceState::kIdle) {
@@ -483,13 +494,15 @@ private:
     EndVelocity ends_[kEndRing];
 
     // requests (any context -> tick)
-    std::atomic<std::uint16_t> request_{0};
+    std::atomic<std::uint16_t> request_value_{0};
+    std::atomic<std::uint32_t> request_sequence_{0};  // written by the task only
     std::atomic<std::uint16_t> fault_request_{0};
     std::atomic<bool> estop_input_{false};
 
     // consumer (tick) side
     std::atomic<std::uint8_t> state_{static_cast<std::uint8_t>(DeviceState::kIdle)};
     std::atomic<std::uint32_t> drop_epoch_{0};
+    std::uint32_t applied_sequence_ = 0;
     Motion motion_ = Motion::kRest;
     Generated generated_kind_ = Generated::kNone;
     FaultCode fault_code_ = FaultCode::kNone;
