@@ -181,6 +181,28 @@ public:
             fault_request_.store(static_cast<std::uint16_t>(code), std::memory_order_release);
         }
     }
+    /// Redefines where the axes are (homing's "set zero"): the next tick makes `position` the
+    /// rest point and the last setpoint, without moving, and hands it to the producer side (the
+    /// next batch starts there; sequence numbers continue). Idle only, with nothing queued and
+    /// no earlier set_position still pending (position_pending()): kWrongState otherwise.
+    /// Task context.
+    [[nodiscard]] Status set_position(const Lsb (&position)[Axes]) {
+        sync_producer();
+        if (state() != DeviceState::kIdle || stream_.queued_spans() != 0 || position_pending()) {
+            return Status::kWrongState;
+        }
+        // The array is written before the sequence store (release) that publishes it; the tick
+        // reads it only after seeing the new sequence (acquire), and no second request can
+        // overwrite it before the tick has copied it (position_pending()).
+        for (unsigned a = 0; a < Axes; ++a) requested_position_[a] = position[a];
+        position_request_.store(position_request_.load(std::memory_order_relaxed) + 1, std::memory_order_release);
+        return Status::kOk;
+    }
+    /// True from set_position() until the tick that applies it. Task context.
+    bool position_pending() const {
+        return position_request_.load(std::memory_order_relaxed) != position_applied_.load(std::memory_order_acquire);
+    }
+
     /// Any context: the e-stop input's level. Active: the next tick freezes every axis, drops
     /// the queue and enters kEstop; kReset is refused until the input is released.
     void set_estop_input(bool active) { estop_input_.store(active, std::memory_order_release); }
@@ -320,6 +342,7 @@ private:
             set_state(DeviceState::kFault);
             return;
         }
+        apply_position_request(s);
         const std::uint32_t sequence = request_sequence_.load(std::memory_order_acquire);
         if (sequence == applied_sequence_) return;
         applied_sequence_ = sequence;
@@ -365,6 +388,18 @@ private:
                 }
                 break;
         }
+    }
+
+    // set_position: taken only while idle at rest (a start in the same tick comes after it);
+    // in any other state it is dropped (the task sees position_pending() clear either way).
+    void apply_position_request(DeviceState s) {
+        const std::uint32_t request = position_request_.load(std::memory_order_acquire);
+        if (request == position_applied_.load(std::memory_order_relaxed)) return;
+        if (s == DeviceState::kIdle && motion_ == Motion::kRest) {
+            for (unsigned a = 0; a < Axes; ++a) position_[a] = rest_[a] = requested_position_[a];
+            drop_queue();
+        }
+        position_applied_.store(request, std::memory_order_release);
     }
 
     // E-stop and faults: the axes stay where this tick's setpoint would have been computed
@@ -498,6 +533,9 @@ private:
     std::atomic<std::uint32_t> request_sequence_{0};  // written by the task only
     std::atomic<std::uint16_t> fault_request_{0};
     std::atomic<bool> estop_input_{false};
+    std::atomic<std::uint32_t> position_request_{0};  // written by the task only
+    std::atomic<std::uint32_t> position_applied_{0};  // written by the tick only
+    Lsb requested_position_[Axes] = {};
 
     // consumer (tick) side
     std::atomic<std::uint8_t> state_{static_cast<std::uint8_t>(DeviceState::kIdle)};

@@ -1,0 +1,59 @@
+// What the device's discrete I/O means, as pure functions of the device state: when the drive
+// enables are asserted, when the pen is down, which fault a limit switch raises, and a fault
+// code's name. The I/O glue (sim/gpio, the libgpiod driver) applies them; keeping the rules
+// here makes them the same on every port and testable without any I/O.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+
+#include "pathstream/device/motion_device.hpp"
+#include "pathstream/span.hpp"
+
+namespace pathstream::device {
+
+/// Which end of an axis a limit switch guards.
+enum class LimitSide : std::uint8_t {
+    kNegative = 0,  ///< "x-": the switch hit when moving toward lower positions
+    kPositive = 1,  ///< "x+"
+};
+
+/// The fault a limit switch raises: kLimitSwitchBase + axis * 2 + side. `axis` < kMaxAxes.
+constexpr FaultCode limit_fault(unsigned axis, LimitSide side) {
+    return static_cast<FaultCode>(static_cast<unsigned>(FaultCode::kLimitSwitchBase) + axis * 2u +
+                                  static_cast<unsigned>(side));
+}
+
+/// True when `code` is a limit-switch fault; then `axis` and `side` say which switch.
+constexpr bool limit_fault_switch(FaultCode code, unsigned& axis, LimitSide& side) {
+    const unsigned c = static_cast<unsigned>(code);
+    const unsigned base = static_cast<unsigned>(FaultCode::kLimitSwitchBase);
+    if (c < base || c >= base + 2u * kMaxAxes) return false;
+    axis = (c - base) / 2u;
+    side = static_cast<LimitSide>((c - base) % 2u);
+    return true;
+}
+
+/// Drive enables are asserted only while the device may move or must hold a position under
+/// control: running, holding (a held axis is servoed, not free) and stopping. Idle (also after
+/// a stop), fault and e-stop drop them: a drive without enable cannot move whatever the
+/// setpoints say, which is what makes the e-stop independent of the motion code.
+constexpr bool enable_asserted(DeviceState state) {
+    return state == DeviceState::kRunning || state == DeviceState::kHolding || state == DeviceState::kStopping;
+}
+
+/// The pen-lift output: the outputs of the span that plays (the planner's pen events sit at
+/// span boundaries) while the device runs, holds or stops; pen up when idle, in fault and in
+/// e-stop, so a frozen axis does not leave a blot.
+constexpr bool pen_down(DeviceState state, std::uint8_t outputs) {
+    return enable_asserted(state) && (outputs & kOutputPenDown) != 0;
+}
+
+/// Writes a NUL-terminated English name of `code` into out[0..capacity): "none", "external
+/// fault", "no controlled stop fits in one span", "limit switch x- (axis 0, negative side)"
+/// (axes 0..7 named x y z a b c u v), or "fault 0x1234". Returns the length written (without
+/// the NUL), truncated to capacity - 1; nothing is written when capacity is 0. No heap.
+/// Any context.
+std::size_t fault_name(FaultCode code, char* out, std::size_t capacity);
+
+}  // namespace pathstream::device

@@ -1,0 +1,399 @@
+// Homing one axis against a switch: search toward it, back off, approach slowly, set zero.
+//
+// The sequencer is a producer like a bus master: it feeds its own moves to a MotionDevice as
+// wire spans (accept_batch), starts and stops the device with commands, and finally redefines
+// the position with set_position. Every move is a rest-to-rest trapezoid of constant-
+// acceleration Hermite spans (cubic term exactly zero), so the device's exact limit check
+// passes them like any planned span; integer math only (docs/gpio.md).
+#pragma once
+
+#include <cstdint>
+
+#include "pathstream/device/motion_device.hpp"
+#include "pathstream/device/stop_spans.hpp"
+
+namespace pathstream::device {
+
+/// What to home and how. Velocities in LSB/s, distances in LSB.
+struct HomingConfig {
+    unsigned axis = 0;
+    bool toward_positive = false;      ///< the switch is at the positive end ("x+")
+    std::uint32_t search_velocity = 0;  ///< fast approach; >= 1
+    std::uint32_t latch_velocity = 0;   ///< slow approach that defines zero; >= 1
+    std::uint32_t backoff = 0;          ///< distance moved off the switch after the search; >= 1
+    std::uint32_t max_travel = 0;       ///< the search gives up after this distance; >= 1
+    Lsb home_position = 0;              ///< coordinate of the latch point after homing
+};
+
+enum class HomingPhase : std::uint8_t {
+    kIdle,        ///< not started
+    kStarting,    ///< started; the first poll chooses the first move
+    kSearch,      ///< moving toward the switch at search velocity
+    kSearchStop,  ///< switch seen: controlled stop
+    kBackoff,     ///< moving off the switch
+    kBackoffStop,
+    kLatch,       ///< approaching at latch velocity
+    kLatchStop,   ///< switch seen again: controlled stop
+    kSetZero,     ///< set_position requested
+    kDone,
+    kError,
+};
+
+enum class HomingError : std::uint8_t {
+    kNone,
+    kBadConfig,       ///< a velocity, distance or the axis is out of range
+    kDeviceRefused,   ///< the device refused a span, a command or set_position (error_status())
+    kSwitchNotFound,  ///< the search covered max_travel without the switch
+    kSwitchStuck,     ///< the switch was still active after the back-off
+    kLatchNotFound,   ///< the slow approach did not find the switch again
+    kInterrupted,     ///< the device went to fault or e-stop, or was stopped from outside
+};
+
+/// A rest-to-rest move of one axis as constant-acceleration spans: ramp up, cruise, ramp down,
+/// and (for the remainder the ramps cannot cover exactly) one short rest-to-rest creep span.
+/// Tangents are even, so every span's end point is an exact integer. Freestanding, no heap.
+template <unsigned Axes>
+class AxisMove {
+public:
+    AxisMove() = default;
+
+    /// Plans `distance` LSB (signed) on `axis` from `start` at up to `velocity` LSB/s within
+    /// `limits`. kBadLimits when no span length gives a usable acceleration step.
+    [[nodiscard]] Status plan(const Lsb (&start)[Axes], unsigned axis, std::int64_t distance, std::uint32_t velocity,
+                              const MotionLimits<Axes>& limits) {
+        for (unsigned a = 0; a < Axes; ++a) at_[a] = start[a];
+        axis_ = axis;
+        sign_ = distance < 0 ? -1 : 1;
+        remaining_ = distance < 0 ? -distance : distance;
+        limits_ = limits;
+        index_ = 0;
+        const std::uint64_t hz = limits.tick_hz;
+        const AxisLimits& l = limits.axis[axis];
+        if (velocity > l.max_velocity) velocity = l.max_velocity;
+        // Span length n: the smallest power of two whose per-span tangent step a n^2 / hz^2
+        // is at least 2 (tangents stay even); at least 8 ticks.
+        n_ = 8;
+        while (static_cast<std::uint64_t>(l.max_acceleration) * n_ * n_ < 2 * hz * hz) {
+            n_ *= 2;
+            if (n_ > kMaxSpanTicks / 2) return Status::kBadLimits;
+        }
+        step_ = even_floor(static_cast<std::uint64_t>(l.max_acceleration) * n_ * n_ / (hz * hz));
+        cruise_ = even_floor(static_cast<std::uint64_t>(velocity) * n_ / hz);
+        if (cruise_ < 2) cruise_ = 2;
+        while (static_cast<std::uint64_t>(cruise_) * hz > static_cast<std::uint64_t>(l.max_velocity) * n_ && cruise_ > 2) {
+            cruise_ -= 2;
+        }
+        // Shrink the cruise tangent until both ramps fit in the distance.
+        for (;;) {
+            ramp_spans_ = static_cast<std::uint32_t>((cruise_ + step_ - 1) / step_);
+            ramp_distance_ = 0;
+            for (std::uint32_t i = 0; i < ramp_spans_; ++i) ramp_distance_ += (ramp_tangent(i) + ramp_tangent(i + 1)) / 2;
+            if (2 * ramp_distance_ <= remaining_ || cruise_ <= 2) break;
+            cruise_ = even_floor(cruise_ / 2);
+            if (cruise_ < 2) cruise_ = 2;
+        }
+        if (2 * ramp_distance_ > remaining_) {
+            ramp_spans_ = 0;
+            ramp_distance_ = 0;
+        }
+        const std::int64_t middle = remaining_ - 2 * ramp_distance_;
+        cruise_spans_ = ramp_spans_ == 0 ? 0 : middle / cruise_;
+        creep_ = ramp_spans_ == 0 ? middle : middle % cruise_;
+        return Status::kOk;
+    }
+
+    /// True while spans remain.
+    bool pending() const { return index_ < total_spans(); }
+
+    /// Writes the next span (absolute end point, explicit tangents, pen up). False when the
+    /// move is complete or the creep span cannot be made to fit the limits.
+    bool next(WireSpan& w) {
+        if (!pending()) return false;
+        w = WireSpan{};
+        const std::int64_t i = index_;
+        const std::int64_t ramps = ramp_spans_;
+        std::int64_t t0 = 0, t1 = 0;
+        w.ticks = n_;
+        if (i < ramps) {
+            t0 = ramp_tangent(static_cast<std::uint32_t>(i));
+            t1 = ramp_tangent(static_cast<std::uint32_t>(i + 1));
+        } else if (i < ramps + cruise_spans_) {
+            t0 = t1 = cruise_;
+        } else if (i < 2 * ramps + cruise_spans_) {
+            const std::int64_t k = 2 * ramps + cruise_spans_ - i;  // ramp_spans_ .. 1
+            t0 = ramp_tangent(static_cast<std::uint32_t>(k));
+            t1 = ramp_tangent(static_cast<std::uint32_t>(k - 1));
+        } else {
+            if (!creep_span(w)) return false;
+            ++index_;
+            return true;
+        }
+        const std::int64_t delta = (t0 + t1) / 2;
+        at_[axis_] = static_cast<Lsb>(at_[axis_] + sign_ * delta);
+        fill(w, static_cast<std::int32_t>(sign_ * t0), static_cast<std::int32_t>(sign_ * t1));
+        ++index_;
+        return true;
+    }
+
+    /// Span length used by the ramps and the cruise.
+    std::uint32_t span_ticks() const { return n_; }
+
+private:
+    static std::int64_t even_floor(std::uint64_t v) { return static_cast<std::int64_t>(v & ~std::uint64_t{1}); }
+
+    // Tangent after i ramp spans: i/ramp_spans of the cruise tangent, rounded to even.
+    std::int64_t ramp_tangent(std::uint32_t i) const {
+        if (i >= ramp_spans_) return cruise_;
+        return even_floor(static_cast<std::uint64_t>(cruise_) * i / ramp_spans_);
+    }
+
+    std::int64_t total_spans() const { return 2 * static_cast<std::int64_t>(ramp_spans_) + cruise_spans_ + (creep_ != 0 ? 1 : 0); }
+
+    void fill(WireSpan& w, std::int32_t t0, std::int32_t t1) const {
+        for (unsigned a = 0; a < Axes; ++a) w.end[a] = at_[a];
+        w.start_tangent[axis_] = t0;
+        w.end_tangent[axis_] = t1;
+    }
+
+    // The remainder at rest: P1 = P0 + creep, T0 = T1 = 0, lengthened until it passes.
+    bool creep_span(WireSpan& w) {
+        Span<Axes> s;
+        s.basis = Basis::kHermite;
+        for (std::uint32_t ticks = n_; ticks <= kMaxSpanTicks; ticks *= 2) {
+            s.ticks = ticks;
+            for (unsigned a = 0; a < Axes; ++a) {
+                s.control[a][0] = at_[a];
+                s.control[a][1] = at_[a];
+                s.control[a][2] = s.control[a][3] = 0;
+            }
+            s.control[axis_][1] = static_cast<std::int32_t>(at_[axis_] + sign_ * creep_);
+            if (stop_detail::check_span(s, limits_) == Status::kOk) {
+                at_[axis_] = s.control[axis_][1];
+                w.ticks = ticks;
+                fill(w, 0, 0);
+                return true;
+            }
+        }
+        return false;
+    }
+
+    Lsb at_[Axes] = {};
+    unsigned axis_ = 0;
+    std::int64_t sign_ = 1;
+    std::int64_t remaining_ = 0;
+    MotionLimits<Axes> limits_;
+    std::uint32_t n_ = 8;
+    std::int64_t step_ = 2;
+    std::int64_t cruise_ = 2;
+    std::uint32_t ramp_spans_ = 0;
+    std::int64_t ramp_distance_ = 0;
+    std::int64_t cruise_spans_ = 0;
+    std::int64_t creep_ = 0;
+    std::int64_t index_ = 0;
+};
+
+/// Homes one axis of a MotionDevice. Task context: call poll() with the switch's level after
+/// every tick (or as often as the task runs; the latch point is the position at the poll that
+/// first sees the switch, so its precision is one poll period of latch velocity).
+template <unsigned Axes, std::uint32_t Capacity>
+class HomingSequencer {
+public:
+    explicit HomingSequencer(MotionDevice<Axes, Capacity>& device) : device_(device) {}
+
+    /// Starts homing. The device must be configured and idle (kWrongState otherwise);
+    /// kBadConfig for zero velocities or distances or a bad axis. Task context.
+    [[nodiscard]] Status start(const HomingConfig& config) {
+        config_ = config;
+        error_ = HomingError::kNone;
+        error_status_ = Status::kOk;
+        if (config.axis >= Axes || config.search_velocity == 0 || config.latch_velocity == 0 || config.backoff == 0 ||
+            config.max_travel == 0 || config.max_travel > kMaxPositionLsb) {
+            return finish_error(HomingError::kBadConfig, Status::kBadLimits);
+        }
+        if (!device_.configured()) return finish_error(HomingError::kDeviceRefused, Status::kNotConfigured);
+        if (device_.state() != DeviceState::kIdle) return finish_error(HomingError::kDeviceRefused, Status::kWrongState);
+        // The first move is chosen by the first poll, which knows the switch: a machine
+        // already standing on it backs off first.
+        phase_ = HomingPhase::kStarting;
+        return Status::kOk;
+    }
+
+    /// Advances the sequence; `switch_active` is the homing switch's level now. Task context.
+    void poll(bool switch_active) {
+        const DeviceState s = device_.state();
+        if (phase_ == HomingPhase::kIdle || phase_ == HomingPhase::kDone || phase_ == HomingPhase::kError) return;
+        if (s == DeviceState::kFault || s == DeviceState::kEstop) {
+            (void)finish_error(HomingError::kInterrupted, Status::kWrongState);
+            return;
+        }
+        if (stop_requested_for_ == HomingPhase::kError) {
+            // A failed search, back-off or latch: report once the device has stopped.
+            if (s == DeviceState::kIdle) phase_ = HomingPhase::kError;
+            return;
+        }
+        switch (phase_) {
+            case HomingPhase::kStarting:
+                if (switch_active) {
+                    trigger_ = device_.position(config_.axis);
+                    overshoot_ = 0;
+                    if (begin_move(-toward(config_.backoff), config_.search_velocity) == Status::kOk) {
+                        phase_ = HomingPhase::kBackoff;
+                    }
+                } else if (begin_move(toward(config_.max_travel), config_.search_velocity) == Status::kOk) {
+                    phase_ = HomingPhase::kSearch;
+                }
+                break;
+            case HomingPhase::kSearch:
+                if (switch_active) {
+                    trigger_ = device_.position(config_.axis);
+                    request_stop(HomingPhase::kSearchStop);
+                } else if (feed() && move_done(s)) {
+                    error_ = HomingError::kSwitchNotFound;
+                    request_stop(HomingPhase::kError);
+                }
+                break;
+            case HomingPhase::kSearchStop:
+                if (s == DeviceState::kIdle) {
+                    const Lsb here = device_.position(config_.axis);
+                    overshoot_ = here > trigger_ ? here - trigger_ : trigger_ - here;
+                    if (begin_move(-toward(config_.backoff), config_.search_velocity) == Status::kOk) {
+                        phase_ = HomingPhase::kBackoff;
+                    }
+                }
+                break;
+            case HomingPhase::kBackoff:
+                if (feed() && move_done(s)) {
+                    if (switch_active) {
+                        error_ = HomingError::kSwitchStuck;
+                        request_stop(HomingPhase::kError);
+                    } else {
+                        request_stop(HomingPhase::kBackoffStop);
+                    }
+                }
+                break;
+            case HomingPhase::kBackoffStop:
+                if (s == DeviceState::kIdle) {
+                    const std::int64_t travel = 2 * static_cast<std::int64_t>(config_.backoff) + overshoot_;
+                    if (begin_move(toward(travel), config_.latch_velocity) == Status::kOk) phase_ = HomingPhase::kLatch;
+                }
+                break;
+            case HomingPhase::kLatch:
+                if (switch_active) {
+                    trigger_ = device_.position(config_.axis);
+                    request_stop(HomingPhase::kLatchStop);
+                } else if (feed() && move_done(s)) {
+                    error_ = HomingError::kLatchNotFound;
+                    request_stop(HomingPhase::kError);
+                }
+                break;
+            case HomingPhase::kLatchStop:
+                if (s == DeviceState::kIdle) {
+                    Lsb p[Axes];
+                    for (unsigned a = 0; a < Axes; ++a) p[a] = device_.position(a);
+                    p[config_.axis] = config_.home_position + (p[config_.axis] - trigger_);
+                    if (Status st = device_.set_position(p); st != Status::kOk) {
+                        (void)finish_error(HomingError::kDeviceRefused, st);
+                        return;
+                    }
+                    phase_ = HomingPhase::kSetZero;
+                }
+                break;
+            case HomingPhase::kSetZero:
+                if (!device_.position_pending()) phase_ = HomingPhase::kDone;
+                break;
+            default:
+                break;
+        }
+    }
+
+    HomingPhase phase() const { return phase_; }
+    HomingError error() const { return error_; }
+    /// The device's Status behind kDeviceRefused (or kOk).
+    Status error_status() const { return error_status_; }
+    bool busy() const { return phase_ != HomingPhase::kIdle && phase_ != HomingPhase::kDone && phase_ != HomingPhase::kError; }
+    /// Position at which the latch approach saw the switch, before set zero (LSB).
+    Lsb latch_position() const { return trigger_; }
+    /// How far the search stop ran past the point where the switch was seen (LSB).
+    std::int64_t search_overshoot() const { return overshoot_; }
+
+private:
+    static constexpr unsigned kFeedSpans = 8;  // spans per accept_batch: a small stack buffer
+
+    std::int64_t toward(std::int64_t distance) const { return config_.toward_positive ? distance : -distance; }
+
+    Status finish_error(HomingError e, Status s) {
+        error_ = e;
+        error_status_ = s;
+        phase_ = HomingPhase::kError;
+        return e == HomingError::kBadConfig ? Status::kBadLimits : s;
+    }
+
+    Status begin_move(std::int64_t distance, std::uint32_t velocity) {
+        Lsb from[Axes];
+        for (unsigned a = 0; a < Axes; ++a) from[a] = device_.position(a);
+        if (Status s = move_.plan(from, config_.axis, distance, velocity, device_.limits()); s != Status::kOk) {
+            return finish_error(HomingError::kDeviceRefused, s);
+        }
+        stop_requested_for_ = HomingPhase::kIdle;
+        fed_all_ = false;
+        if (!feed()) return error_status_;
+        if (Status s = device_.command(Command::kStart); s != Status::kOk) return finish_error(HomingError::kDeviceRefused, s);
+        return Status::kOk;
+    }
+
+    // Queues as many of the move's spans as fit. False after an error (phase kError).
+    bool feed() {
+        if (stop_requested_for_ != HomingPhase::kIdle) return true;
+        while (move_.pending()) {
+            const std::uint32_t room = device_.free_slots();
+            if (room == 0) return true;
+            std::uint8_t bytes[kFeedSpans * (4 + 12 * Axes)];
+            std::size_t length = 0;
+            std::uint16_t count = 0;
+            while (count < kFeedSpans && count < room && move_.pending()) {
+                WireSpan w;
+                if (!move_.next(w)) {
+                    (void)finish_error(HomingError::kDeviceRefused, Status::kAccelerationLimit);
+                    return false;
+                }
+                length += encode_wire_span(w, Axes, bytes + length, sizeof bytes - length);
+                ++count;
+            }
+            const Status s = device_.accept_batch(device_.last_accepted_sequence() + 1u, count, bytes, length);
+            if (s != Status::kOk) {
+                (void)finish_error(HomingError::kDeviceRefused, s);
+                return false;
+            }
+        }
+        fed_all_ = true;
+        return true;
+    }
+
+    // The whole move was queued and executed: running at rest with nothing queued.
+    bool move_done(DeviceState s) const {
+        return fed_all_ && s == DeviceState::kRunning && device_.queued_spans() == 0 &&
+               device_.last_completed_sequence() == device_.last_accepted_sequence();
+    }
+
+    void request_stop(HomingPhase next) {
+        if (Status st = device_.command(Command::kStop); st != Status::kOk) {
+            (void)finish_error(HomingError::kDeviceRefused, st);
+            return;
+        }
+        stop_requested_for_ = next;
+        if (next != HomingPhase::kError) phase_ = next;
+    }
+
+    MotionDevice<Axes, Capacity>& device_;
+    HomingConfig config_;
+    HomingPhase phase_ = HomingPhase::kIdle;
+    HomingError error_ = HomingError::kNone;
+    Status error_status_ = Status::kOk;
+    AxisMove<Axes> move_;
+    bool fed_all_ = false;
+    HomingPhase stop_requested_for_ = HomingPhase::kIdle;
+    Lsb trigger_ = 0;
+    std::int64_t overshoot_ = 0;
+};
+
+}  // namespace pathstream::device
