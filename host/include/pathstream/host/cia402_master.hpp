@@ -212,3 +212,25 @@ Cia402Report stream_cia402(const Plan& plan, const MachineProfile& profile, cons
                            hal::CanBus& bus, hal::Clock& clock_us, const Cia402Progress& progress = {});
 
 }  // namespace pathstream::host
+
+namespace pathstream::host {
+
+/// A hal::Clock counting microseconds of std::chrono::steady_clock from its construction;
+/// wait_until() sleeps. What the master runs on outside tests.
+class SteadyMicrosecondClock final : public hal::Clock {
+public:
+    SteadyMicrosecondClock();
+    std::uint64_t now() const override;
+    void wait_until(std::uint64_t tick) override;
+
+private:
+    std::int64_t start_ns_;
+};
+
+/// `pathstream stream --target can://IFACE?...&protocol=cia402`: parses `target` for the
+/// profile's axes, runs stream_cia402 on `bus` with a progress bar and prints the report
+/// (cycles, bus frames and worst-case load, following). Returns the exit code (0); throws
+/// Cia402Error (exit 6) when the drives stopped early, std::invalid_argument for a bad target.
+int run_cia402_stream(const Plan& plan, const MachineProfile& profile, const std::string& target, hal::CanBus& bus);
+
+}  // namespace pathstream::host
