@@ -37,7 +37,7 @@ public:
     MachineProfile read(const json& root) const {
         if (!root.is_object()) fail("", "a machine profile must be a JSON object");
         only_keys(root, "", {"axes", "mm_per_lsb", "tick_hz", "ticks_per_span", "feed", "travel_feed",
-                             "pen_down_delay", "pen_up_delay", "chord_tolerance"});
+                             "pen_down_delay", "pen_up_delay", "chord_tolerance", "gpio"});
         MachineProfile p;
         if (!root.contains("axes")) fail("", "machine profile has no \"axes\"");
         const json& axes = root["axes"];
@@ -84,7 +84,105 @@ public:
               << " mm): integer setpoints cannot meet it";
             fail(root.contains("chord_tolerance") ? "/chord_tolerance" : "/mm_per_lsb", m.str());
         }
+        if (root.contains("gpio")) p.gpio = gpio(root["gpio"], p);
         return p;
+    }
+
+private:
+    GpioLineConfig line(const json& v, const std::string& ptr, const char* what) const {
+        if (!v.is_object()) fail(ptr, std::string(what) + " must be an object like {\"line\": 3}");
+        only_keys(v, ptr, {"line", "active_low", "bias"});
+        if (!v.contains("line")) fail(ptr, std::string(what) + " has no \"line\"");
+        GpioLineConfig c;
+        const json& l = v["line"];
+        if (l.is_number_integer()) {
+            if (l.get<long long>() < 0 || l.get<long long>() > 65535) fail(ptr + "/line", "line offset must be 0..65535");
+            c.line = std::to_string(l.get<long long>());
+        } else if (l.is_string() && !l.get<std::string>().empty()) {
+            c.line = l.get<std::string>();
+        } else {
+            fail(ptr + "/line", "line must be an offset (whole number) or a line name (string)");
+        }
+        if (v.contains("active_low")) {
+            if (!v["active_low"].is_boolean()) fail(ptr + "/active_low", "active_low must be true or false");
+            c.active_low = v["active_low"].get<bool>();
+        }
+        if (v.contains("bias")) {
+            const json& b = v["bias"];
+            const std::set<std::string> biases{"as-is", "disable", "pull-up", "pull-down"};
+            if (!b.is_string() || biases.count(b.get<std::string>()) == 0) {
+                fail(ptr + "/bias", "bias must be one of: as-is, disable, pull-up, pull-down");
+            }
+            c.bias = b.get<std::string>();
+        }
+        return c;
+    }
+
+    GpioConfig gpio(const json& g, const MachineProfile& p) const {
+        if (!g.is_object()) fail("/gpio", "gpio must be an object");
+        only_keys(g, "/gpio", {"chip", "enable", "estop", "pen", "limits", "home"});
+        GpioConfig c;
+        c.present = true;
+        if (!g.contains("chip")) fail("/gpio", "gpio has no \"chip\"");
+        if (!g["chip"].is_string() || g["chip"].get<std::string>().empty()) {
+            fail("/gpio/chip", "chip must be a chip name, path, number or label (non-empty string)");
+        }
+        c.chip = g["chip"].get<std::string>();
+        if (g.contains("enable")) c.enable = line(g["enable"], "/gpio/enable", "enable"), c.has_enable = true;
+        if (g.contains("estop")) c.estop = line(g["estop"], "/gpio/estop", "estop"), c.has_estop = true;
+        if (g.contains("pen")) c.pen = line(g["pen"], "/gpio/pen", "pen"), c.has_pen = true;
+        std::set<std::string> switch_names;
+        for (const auto& a : p.axes) {
+            switch_names.insert(a.name + "-");
+            switch_names.insert(a.name + "+");
+        }
+        if (g.contains("limits")) {
+            const json& lim = g["limits"];
+            if (!lim.is_object()) fail("/gpio/limits", "limits must be an object like {\"x-\": {\"line\": 3}}");
+            only_keys(lim, "/gpio/limits", switch_names);
+            for (auto it = lim.begin(); it != lim.end(); ++it) {
+                c.limits.emplace_back(it.key(), line(it.value(), "/gpio/limits/" + it.key(), "limit switch"));
+            }
+        }
+        if (g.contains("home")) {
+            const json& home = g["home"];
+            if (!home.is_object()) fail("/gpio/home", "home must be an object like {\"x\": {\"switch\": \"x-\", ...}}");
+            std::set<std::string> axis_names;
+            for (const auto& a : p.axes) axis_names.insert(a.name);
+            only_keys(home, "/gpio/home", axis_names);
+            for (auto it = home.begin(); it != home.end(); ++it) {
+                const std::string ptr = "/gpio/home/" + it.key();
+                const json& h = it.value();
+                if (!h.is_object()) fail(ptr, "homing must be an object with switch, search_velocity, latch_velocity, backoff, max_travel");
+                only_keys(h, ptr, {"switch", "search_velocity", "latch_velocity", "backoff", "max_travel", "position"});
+                for (const char* key : {"switch", "search_velocity", "latch_velocity", "backoff", "max_travel"}) {
+                    if (!h.contains(key)) fail(ptr, std::string("homing has no \"") + key + "\"");
+                }
+                HomingAxisConfig hc;
+                hc.axis = it.key();
+                const AxisLimits* axis = nullptr;
+                for (const auto& a : p.axes) {
+                    if (a.name == hc.axis) axis = &a;
+                }
+                const json& sw = h["switch"];
+                if (!sw.is_string() || (sw.get<std::string>() != hc.axis + "-" && sw.get<std::string>() != hc.axis + "+")) {
+                    fail(ptr + "/switch", "switch must be \"" + hc.axis + "-\" or \"" + hc.axis + "+\"");
+                }
+                hc.switch_name = sw.get<std::string>();
+                bool fitted = false;
+                for (const auto& l : c.limits) fitted = fitted || l.first == hc.switch_name;
+                if (!fitted) fail(ptr + "/switch", "switch \"" + hc.switch_name + "\" is not in gpio.limits");
+                hc.search_velocity = number(h["search_velocity"], ptr + "/search_velocity", "search_velocity", 0,
+                                            axis->max_velocity, true, "mm/s");
+                hc.latch_velocity = number(h["latch_velocity"], ptr + "/latch_velocity", "latch_velocity", 0,
+                                           hc.search_velocity, true, "mm/s");
+                hc.backoff = number(h["backoff"], ptr + "/backoff", "backoff", 0, 1e4, true, "mm");
+                hc.max_travel = number(h["max_travel"], ptr + "/max_travel", "max_travel", 0, 1e5, true, "mm");
+                if (h.contains("position")) hc.position = number(h["position"], ptr + "/position", "position", -1e5, 1e5, false, "mm");
+                c.home.push_back(hc);
+            }
+        }
+        return c;
     }
 };
 

@@ -3,6 +3,7 @@
 
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace pathstream::host {
@@ -12,6 +13,37 @@ struct AxisLimits {
     std::string name;                  ///< "x", "y", ...
     double max_velocity = 0;           ///< mm/s, > 0
     double max_acceleration = 0;       ///< mm/s^2, > 0
+};
+
+/// One GPIO line of the profile's "gpio" object (docs/formats.md, docs/gpio.md).
+struct GpioLineConfig {
+    std::string line;              ///< offset ("3") or line name ("estop")
+    bool active_low = false;       ///< active = electrically low
+    std::string bias = "as-is";    ///< "as-is", "disable", "pull-up" or "pull-down"
+};
+
+/// Homing of one axis against one of its limit switches, in mm and mm/s.
+struct HomingAxisConfig {
+    std::string axis;              ///< axis name
+    std::string switch_name;       ///< a key of GpioConfig::limits for this axis ("x-")
+    double search_velocity = 0;    ///< > 0, <= the axis's max_velocity
+    double latch_velocity = 0;     ///< > 0, <= search_velocity
+    double backoff = 0;            ///< > 0
+    double max_travel = 0;         ///< > 0
+    double position = 0;           ///< coordinate of the switch point after homing
+};
+
+/// Which chip lines do what. Absent from the profile: present == false.
+struct GpioConfig {
+    bool present = false;
+    std::string chip;              ///< "gpiochip0", "/dev/gpiochip0", a number or a chip label
+    bool has_enable = false, has_estop = false, has_pen = false;
+    GpioLineConfig enable;         ///< drive enable output
+    GpioLineConfig estop;          ///< e-stop input
+    GpioLineConfig pen;            ///< pen-lift output (active = pen down)
+    /// Limit switch inputs by "<axis><side>": "x-", "x+", "y-", ... (side "-" or "+").
+    std::vector<std::pair<std::string, GpioLineConfig>> limits;
+    std::vector<HomingAxisConfig> home;  ///< in profile order
 };
 
 /// Everything the planner and the simulated device need to know about the machine.
@@ -25,6 +57,7 @@ struct MachineProfile {
     double pen_down_delay = 0.05;      ///< s the pen needs to settle after going down
     double pen_up_delay = 0.05;        ///< s the pen needs to lift
     double chord_tolerance = 0.005;    ///< mm: max distance of executed ticks from the path
+    GpioConfig gpio;                   ///< optional "gpio" object
     std::string source;                ///< file it came from, for messages
 
     double tick_seconds() const { return 1.0 / tick_hz; }

@@ -1,0 +1,114 @@
+// The I/O glue between a MotionDevice and its discrete lines: e-stop and limit-switch inputs
+// in, enable and pen-lift outputs out. The rules are firmware_core's (gpio_logic.hpp); this
+// class only moves levels, edges and requests between the hal interfaces and the device. The
+// same code runs against the simulated lines (tests) and libgpiod (the VM test's driver).
+#pragma once
+
+#include <cstdint>
+
+#include "pathstream/device/gpio_logic.hpp"
+#include "pathstream/device/motion_device.hpp"
+#include "pathstream/hal/gpio.hpp"
+
+namespace pathstream::sim {
+
+/// Which line does what; a null pointer means "not fitted".
+template <unsigned Axes>
+struct DeviceWiring {
+    hal::DigitalInput* estop = nullptr;
+    hal::DigitalInput* limit[Axes][2] = {};  ///< [axis][LimitSide]
+    hal::DigitalOutput* enable = nullptr;
+    hal::DigitalOutput* pen = nullptr;
+};
+
+/// Task-side glue. Call poll_inputs() before each tick (or whenever an input's event_fd is
+/// readable) and update_outputs() after each tick.
+template <unsigned Axes, std::uint32_t Capacity>
+class DeviceGpio {
+public:
+    using Device = device::MotionDevice<Axes, Capacity>;
+
+    /// `device` and every line in `wiring` must outlive this object. Drives the outputs to
+    /// the device's current state at once (enable off for an idle device).
+    DeviceGpio(Device& device, const DeviceWiring<Axes>& wiring) : device_(device), wiring_(wiring) {
+        update_outputs();
+    }
+
+    /// Drains every input's edges and applies them:
+    /// * e-stop: an edge to active requests the e-stop at once (a pulse shorter than a poll
+    ///   still counts); the input is reported released only when the line is inactive and
+    ///   the device has entered kEstop (so the tick has seen it).
+    /// * limit switch: an edge to active (or a switch already active at the first poll) raises
+    ///   limit_fault(axis, side), unless masked (the switch homing is looking for). A switch
+    ///   that stays active does not fault again after a reset, so the machine can move off it.
+    void poll_inputs() {
+        if (wiring_.estop != nullptr) {
+            hal::InputEdge e;
+            bool activated = false;
+            while (wiring_.estop->next_edge(e)) {
+                if (e.active) {
+                    activated = true;
+                    last_estop_edge_ns_ = e.timestamp_ns;
+                    ++estop_edges_;
+                }
+            }
+            const bool level = wiring_.estop->active();
+            if (activated || level) estop_held_ = true;
+            if (estop_held_ && !level && !activated && device_.state() == device::DeviceState::kEstop) {
+                estop_held_ = false;
+            }
+            device_.set_estop_input(estop_held_);
+        }
+        for (unsigned a = 0; a < Axes; ++a) {
+            for (unsigned side = 0; side < 2; ++side) {
+                hal::DigitalInput* in = wiring_.limit[a][side];
+                if (in == nullptr) continue;
+                hal::InputEdge e;
+                bool tripped = false;
+                while (in->next_edge(e)) tripped = tripped || e.active;
+                const bool level = in->active();
+                if (first_poll_ && level) tripped = true;
+                limit_level_[a][side] = level || tripped;
+                if (tripped && !masked_[a][side]) {
+                    device_.raise_fault(device::limit_fault(a, static_cast<device::LimitSide>(side)));
+                    ++limit_trips_;
+                }
+            }
+        }
+        first_poll_ = false;
+    }
+
+    /// Drives enable and pen from the state the last tick left. Cheap: each output switches
+    /// only on a change (one ioctl with libgpiod).
+    void update_outputs() {
+        const device::DeviceState s = device_.state();
+        if (wiring_.enable != nullptr) wiring_.enable->set(device::enable_asserted(s));
+        if (wiring_.pen != nullptr) wiring_.pen->set(device::pen_down(s, device_.outputs()));
+    }
+
+    /// Masks (or unmasks) one switch's fault: homing drives onto its own switch on purpose.
+    void mask_limit(unsigned axis, device::LimitSide side, bool masked) {
+        masked_[axis][static_cast<unsigned>(side)] = masked;
+    }
+    /// The switch's level seen by the last poll_inputs (true also for a pulse seen then).
+    bool limit_active(unsigned axis, device::LimitSide side) const {
+        return limit_level_[axis][static_cast<unsigned>(side)];
+    }
+    std::uint32_t estop_edges() const { return estop_edges_; }
+    std::uint32_t limit_trips() const { return limit_trips_; }
+    /// Timestamp of the last activating e-stop edge (backend clock, ns; 0 if none).
+    std::uint64_t last_estop_edge_ns() const { return last_estop_edge_ns_; }
+
+private:
+    Device& device_;
+    DeviceWiring<Axes> wiring_;
+    bool first_poll_ = true;
+    bool estop_held_ = false;
+    bool masked_[Axes][2] = {};
+    bool limit_level_[Axes][2] = {};
+    std::uint32_t estop_edges_ = 0;
+    std::uint32_t limit_trips_ = 0;
+    std::uint64_t last_estop_edge_ns_ = 0;
+};
+
+}  // namespace pathstream::sim

@@ -1,0 +1,313 @@
+// The VM test's driver (docs/gpio.md): a simulated 2-axis plotter (MotionDevice at 1 kHz, real
+// time) whose e-stop, limit switches, enable and pen lines are gpio-sim lines opened through
+// the libgpiod backend as a machine profile's "gpio" object maps them. Every wait is bounded.
+//
+//   pathstream_gpio_vm_driver run PROFILE DIR MAX_MS
+//       moves until an e-stop or a limit fault comes from outside (the script writes the
+//       sim's pull attributes); DIR/running once enable is up; on e-stop: DIR/estop, waits for
+//       the input's release, resets, DIR/reset; on a fault: prints its name. Exit 0 if one came.
+//   pathstream_gpio_vm_driver measure PROFILE PULL_PATH ROUNDS
+//       ROUNDS times: run, write "pull-up" to PULL_PATH (the e-stop line's sim pull) and time
+//       the write to the enable line dropping; release, reset, again. Prints the figures.
+#include <time.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "pathstream/device/gpio_logic.hpp"
+#include "pathstream/device/homing.hpp"
+#include "pathstream/device/motion_device.hpp"
+#include "pathstream/hal/gpio_gpiod.hpp"
+#include "pathstream/host/input_error.hpp"
+#include "pathstream/host/machine.hpp"
+#include "pathstream/sim/device_gpio.hpp"
+
+namespace {
+
+using namespace pathstream;
+using Device = device::MotionDevice<2, 64>;
+using Glue = sim::DeviceGpio<2, 64>;
+
+std::uint64_t now_ns() {
+    timespec ts{};
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return static_cast<std::uint64_t>(ts.tv_sec) * 1000000000u + static_cast<std::uint64_t>(ts.tv_nsec);
+}
+
+void sleep_until_ns(std::uint64_t t) {
+    timespec ts{static_cast<time_t>(t / 1000000000u), static_cast<long>(t % 1000000000u)};
+    clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr);
+}
+
+hal::GpioLineSpec spec(const std::string& chip, const host::GpioLineConfig& c) {
+    hal::GpioLineSpec s;
+    s.chip = chip;
+    s.line = c.line;
+    s.active_low = c.active_low;
+    s.bias = c.bias == "pull-up"     ? hal::Bias::kPullUp
+             : c.bias == "pull-down" ? hal::Bias::kPullDown
+             : c.bias == "disable"   ? hal::Bias::kDisable
+                                     : hal::Bias::kAsIs;
+    return s;
+}
+
+// The plotter: device, lines, glue, and a feeder that keeps it moving back and forth.
+struct Plotter {
+    explicit Plotter(const host::MachineProfile& p) : device(origin()) {
+        const host::GpioConfig& g = p.gpio;
+        if (!g.present) throw hal::GpioError("the profile has no gpio object");
+        if (g.has_estop) estop = hal::open_gpiod_input(spec(g.chip, g.estop), "pathstream-estop");
+        if (g.has_enable) enable = hal::open_gpiod_output(spec(g.chip, g.enable), "pathstream-enable");
+        if (g.has_pen) pen = hal::open_gpiod_output(spec(g.chip, g.pen), "pathstream-pen");
+        sim::DeviceWiring<2> w;
+        w.estop = estop.get();
+        w.enable = enable.get();
+        w.pen = pen.get();
+        for (const auto& [name, line] : g.limits) {
+            const unsigned axis = name[0] == 'x' ? 0u : 1u;
+            const unsigned side = name[1] == '-' ? 0u : 1u;
+            limits.push_back(hal::open_gpiod_input(spec(g.chip, line), "pathstream-limit-" + name));
+            w.limit[axis][side] = limits.back().get();
+        }
+        device::MotionLimits<2> l;
+        l.tick_hz = 1000;
+        for (auto& a : l.axis) a = {200000, 2000000};
+        if (device.configure(l) != Status::kOk) throw hal::GpioError("configure failed");
+        glue = std::make_unique<Glue>(device, w);
+    }
+
+    static const Lsb (&origin())[2] {
+        static const Lsb o[2] = {0, 0};
+        return o;
+    }
+
+    // Keeps spans queued: x and y in turn, 20 mm out and back, pen down.
+    void feed() {
+        const device::DeviceState s = device.state();
+        if (s == device::DeviceState::kFault || s == device::DeviceState::kEstop || s == device::DeviceState::kStopping) return;
+        while (device.free_slots() > 8) {
+            if (!move.pending()) {
+                Lsb from[2] = {end[0], end[1]};
+                const unsigned axis = leg % 2;
+                const std::int64_t d = (leg / 2) % 2 == 0 ? 20000 : -20000;
+                (void)move.plan(from, axis, d, 100000, device.limits());
+                end[axis] = static_cast<Lsb>(end[axis] + d);
+                ++leg;
+            }
+            device::WireSpan w;
+            if (!move.next(w)) return;
+            w.outputs = kOutputPenDown;
+            std::uint8_t bytes[4 + 12 * 2];
+            const std::size_t n = device::encode_wire_span(w, 2, bytes, sizeof bytes);
+            if (device.accept_batch(device.last_accepted_sequence() + 1, 1, bytes, n) != Status::kOk) return;
+        }
+    }
+
+    // After a stop the device rests where it stopped: moves continue from there.
+    void restart_moves() {
+        end[0] = device.position(0);
+        end[1] = device.position(1);
+        move = device::AxisMove<2>{};
+    }
+
+    // One tick at `deadline`: inputs, tick, outputs.
+    void tick() {
+        glue->poll_inputs();
+        Lsb out[2];
+        device.tick(out);
+        glue->update_outputs();
+        ++ticks;
+    }
+
+    Device device;
+    std::unique_ptr<hal::DigitalInput> estop;
+    std::vector<std::unique_ptr<hal::DigitalInput>> limits;
+    std::unique_ptr<hal::DigitalOutput> enable, pen;
+    std::unique_ptr<Glue> glue;
+    device::AxisMove<2> move;
+    Lsb end[2] = {0, 0};
+    unsigned leg = 0;
+    std::uint64_t ticks = 0;
+};
+
+void touch(const std::string& path) { std::ofstream(path) << "1\n"; }
+
+bool write_attr(const std::string& path, const char* value) {
+    std::ofstream out(path);
+    out << value;
+    out.flush();
+    return static_cast<bool>(out);
+}
+
+const char* state_name(device::DeviceState s) {
+    switch (s) {
+        case device::DeviceState::kIdle: return "idle";
+        case device::DeviceState::kRunning: return "running";
+        case device::DeviceState::kHolding: return "holding";
+        case device::DeviceState::kStopping: return "stopping";
+        case device::DeviceState::kFault: return "fault";
+        case device::DeviceState::kEstop: return "estop";
+    }
+    return "?";
+}
+
+std::string fault_text(device::FaultCode code) {
+    char buf[64];
+    device::fault_name(code, buf, sizeof buf);
+    return buf;
+}
+
+int run(const host::MachineProfile& profile, const std::string& dir, std::uint64_t max_ms) {
+    Plotter p(profile);
+    p.feed();
+    if (p.device.command(device::Command::kStart) != Status::kOk) return std::fprintf(stderr, "start refused\n"), 1;
+    const std::uint64_t period = 1000000;  // 1 kHz
+    std::uint64_t deadline = now_ns();
+    device::DeviceState last = p.device.state();
+    bool running_marked = false;
+    std::uint64_t estop_tick = 0;
+    Lsb frozen[2] = {0, 0};
+    for (std::uint64_t k = 0; k < max_ms; ++k) {
+        deadline += period;
+        sleep_until_ns(deadline);
+        const std::uint32_t edges_before = p.glue->estop_edges();
+        const Lsb before[2] = {p.device.position(0), p.device.position(1)};
+        p.tick();
+        const std::uint64_t after_ns = now_ns();
+        p.feed();
+        const device::DeviceState s = p.device.state();
+        if (s != last) {
+            std::printf("driver: tick %llu: %s -> %s\n", static_cast<unsigned long long>(p.ticks), state_name(last), state_name(s));
+            if (s == device::DeviceState::kEstop) {
+                estop_tick = p.ticks;
+                frozen[0] = p.device.position(0);
+                frozen[1] = p.device.position(1);
+                const bool same = frozen[0] == before[0] && frozen[1] == before[1];
+                const std::uint64_t edge = p.glue->last_estop_edge_ns();
+                std::printf("driver: estop: reaction %s tick (edge seen by the poll before tick %llu, state estop "
+                            "and enable dropped after it); setpoint repeated: %s; kernel edge timestamp -> enable "
+                            "dropped: %llu us\n",
+                            p.glue->estop_edges() > edges_before ? "1" : "<=1",
+                            static_cast<unsigned long long>(p.ticks), same ? "yes" : "NO",
+                            static_cast<unsigned long long>(edge != 0 && after_ns > edge ? (after_ns - edge) / 1000 : 0));
+                std::fflush(stdout);
+                if (!same) return 1;
+                touch(dir + "/estop");
+            }
+            if (s == device::DeviceState::kFault) {
+                std::printf("driver: fault: %s\n", fault_text(p.device.fault_code()).c_str());
+                std::fflush(stdout);
+                touch(dir + "/fault");
+                // Hold the lines a moment so the script can see enable low, then leave.
+                for (int i = 0; i < 500; ++i) {
+                    deadline += period;
+                    sleep_until_ns(deadline);
+                    p.tick();
+                }
+                return 0;
+            }
+            if (s == device::DeviceState::kIdle && estop_tick != 0) {
+                std::printf("driver: reset after e-stop: idle, enable %s\n", device::enable_asserted(s) ? "high" : "low");
+                touch(dir + "/reset");
+                for (int i = 0; i < 300; ++i) {
+                    deadline += period;
+                    sleep_until_ns(deadline);
+                    p.tick();
+                }
+                return 0;
+            }
+            last = s;
+        }
+        if (s == device::DeviceState::kRunning && !running_marked && k > 50) {
+            running_marked = true;
+            touch(dir + "/running");
+        }
+        if (s == device::DeviceState::kEstop) {
+            if (p.device.position(0) != frozen[0] || p.device.position(1) != frozen[1]) {
+                std::printf("driver: FAIL: moved during e-stop\n");
+                return 1;
+            }
+            if (!p.estop->active()) (void)p.device.command(device::Command::kReset);
+        }
+    }
+    std::printf("driver: FAIL: nothing happened within %llu ms\n", static_cast<unsigned long long>(max_ms));
+    return 1;
+}
+
+int measure(const host::MachineProfile& profile, const std::string& pull, int rounds) {
+    Plotter p(profile);
+    const std::uint64_t period = 1000000;
+    std::uint64_t deadline = now_ns();
+    std::vector<double> us;
+    std::vector<std::uint64_t> tick_counts;
+    for (int r = 0; r < rounds; ++r) {
+        p.restart_moves();
+        p.feed();
+        if (p.device.command(device::Command::kStart) != Status::kOk) return std::fprintf(stderr, "start refused\n"), 1;
+        // Run 100 ticks, then make the edge and time it.
+        for (int i = 0; i < 100; ++i) {
+            deadline += period;
+            sleep_until_ns(deadline);
+            p.tick();
+            p.feed();
+        }
+        if (p.device.state() != device::DeviceState::kRunning) return std::fprintf(stderr, "not running\n"), 1;
+        const std::uint64_t t0 = now_ns();
+        const std::uint64_t tick0 = p.ticks;
+        if (!write_attr(pull, "pull-up")) return std::fprintf(stderr, "cannot write %s\n", pull.c_str()), 1;
+        bool dropped = false;
+        for (int i = 0; i < 1000 && !dropped; ++i) {
+            deadline = std::max(deadline + period, now_ns());  // the write took time: no burst
+            sleep_until_ns(deadline);
+            p.tick();
+            dropped = p.device.state() == device::DeviceState::kEstop;
+        }
+        const std::uint64_t t1 = now_ns();
+        if (!dropped) return std::fprintf(stderr, "no e-stop within 1000 ticks\n"), 1;
+        us.push_back(static_cast<double>(t1 - t0) / 1000.0);
+        tick_counts.push_back(p.ticks - tick0);
+        write_attr(pull, "pull-down");
+        for (int i = 0; i < 2000 && p.device.state() != device::DeviceState::kIdle; ++i) {
+            deadline += period;
+            sleep_until_ns(deadline);
+            if (!p.estop->active()) (void)p.device.command(device::Command::kReset);
+            p.tick();
+        }
+        if (p.device.state() != device::DeviceState::kIdle) return std::fprintf(stderr, "no reset\n"), 1;
+    }
+    std::vector<double> sorted = us;
+    std::sort(sorted.begin(), sorted.end());
+    const std::uint64_t max_ticks = *std::max_element(tick_counts.begin(), tick_counts.end());
+    std::printf("driver: measure: %d e-stops, sysfs pull write -> enable line low: min %.0f us, median %.0f us, "
+                "max %.0f us; ticks from the write to the e-stop state: max %llu\n",
+                rounds, sorted.front(), sorted[sorted.size() / 2], sorted.back(), static_cast<unsigned long long>(max_ticks));
+    return 0;
+}
+
+int usage() {
+    std::fprintf(stderr,
+                 "usage: pathstream_gpio_vm_driver run PROFILE DIR MAX_MS\n"
+                 "       pathstream_gpio_vm_driver measure PROFILE PULL_PATH ROUNDS\n");
+    return 2;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    if (argc != 5) return usage();
+    const std::string mode = argv[1];
+    try {
+        const host::MachineProfile profile = host::load_machine_profile(argv[2]);
+        if (mode == "run") return run(profile, argv[3], std::strtoull(argv[4], nullptr, 10));
+        if (mode == "measure") return measure(profile, argv[3], std::atoi(argv[4]));
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "pathstream_gpio_vm_driver: %s\n", e.what());
+        return 1;
+    }
+    return usage();
+}

@@ -1,0 +1,104 @@
+// The machine profile's "gpio" object: chip, lines by offset or name, active-low, bias, limit
+// switches per axis and side, homing; each bad value with its file:line:col.
+#include <catch2/catch.hpp>
+#include <string>
+
+#include "pathstream/host/input_error.hpp"
+#include "pathstream/host/machine.hpp"
+
+using namespace pathstream::host;
+
+namespace {
+const char* kAxes = R"("axes": [{"name": "x", "max_velocity": 100, "max_acceleration": 1000},
+                                {"name": "y", "max_velocity": 100, "max_acceleration": 1000}])";
+
+// Line 3 of the document starts with `"gpio": ` (8 columns) before the object.
+std::string with_gpio(const std::string& gpio) { return std::string("{") + kAxes + ",\n\"gpio\": " + gpio + "}"; }
+
+std::string error_of(const std::string& text) {
+    try {
+        parse_machine_profile(text, "m.json");
+    } catch (const InputError& e) {
+        return e.what();
+    }
+    return "no error";
+}
+}  // namespace
+
+TEST_CASE("gpio profile: absent means no gpio", "[host][gpio][machine]") {
+    const MachineProfile p = parse_machine_profile(std::string("{") + kAxes + "}", "m.json");
+    CHECK_FALSE(p.gpio.present);
+}
+
+TEST_CASE("gpio profile: every field", "[host][gpio][machine]") {
+    const MachineProfile p = parse_machine_profile(with_gpio(R"({
+        "chip": "pathstream-sim",
+        "enable": {"line": 1},
+        "estop": {"line": "estop", "active_low": true, "bias": "pull-up"},
+        "pen": {"line": "pen-lift"},
+        "limits": {"x-": {"line": 3}, "y+": {"line": "limit-y", "active_low": true, "bias": "disable"}},
+        "home": {"x": {"switch": "x-", "search_velocity": 10, "latch_velocity": 1, "backoff": 2,
+                       "max_travel": 300, "position": -5}}})"),
+                                                   "m.json");
+    const GpioConfig& g = p.gpio;
+    REQUIRE(g.present);
+    CHECK(g.chip == "pathstream-sim");
+    CHECK(g.has_enable);
+    CHECK(g.enable.line == "1");
+    CHECK_FALSE(g.enable.active_low);
+    CHECK(g.enable.bias == "as-is");
+    CHECK(g.estop.line == "estop");
+    CHECK(g.estop.active_low);
+    CHECK(g.estop.bias == "pull-up");
+    CHECK(g.pen.line == "pen-lift");
+    REQUIRE(g.limits.size() == 2);
+    CHECK(g.limits[0].first == "x-");
+    CHECK(g.limits[0].second.line == "3");
+    CHECK(g.limits[1].first == "y+");
+    CHECK(g.limits[1].second.active_low);
+    CHECK(g.limits[1].second.bias == "disable");
+    REQUIRE(g.home.size() == 1);
+    CHECK(g.home[0].axis == "x");
+    CHECK(g.home[0].switch_name == "x-");
+    CHECK(g.home[0].search_velocity == 10);
+    CHECK(g.home[0].latch_velocity == 1);
+    CHECK(g.home[0].backoff == 2);
+    CHECK(g.home[0].max_travel == 300);
+    CHECK(g.home[0].position == -5);
+}
+
+TEST_CASE("gpio profile: bad values are refused with the place and the reason", "[host][gpio][machine]") {
+    CHECK(error_of(with_gpio(R"({"enable": {"line": 1}})")) == "m.json:3:9: gpio has no \"chip\"");
+    CHECK(error_of(with_gpio(R"({"chip": ""})")) ==
+          "m.json:3:18: chip must be a chip name, path, number or label (non-empty string)");
+    CHECK(error_of(with_gpio(R"({"chip": "c", "beeper": {"line": 1}})")) ==
+          "m.json:3:33: unknown key \"beeper\" (expected one of: chip, enable, estop, home, limits, pen)");
+    CHECK(error_of(with_gpio(R"({"chip": "c", "enable": {"line": -1}})")) == "m.json:3:42: line offset must be 0..65535");
+    CHECK(error_of(with_gpio(R"({"chip": "c", "enable": {"line": 1.5}})")) ==
+          "m.json:3:42: line must be an offset (whole number) or a line name (string)");
+    CHECK(error_of(with_gpio(R"({"chip": "c", "enable": {}})")) == "m.json:3:33: enable has no \"line\"");
+    CHECK(error_of(with_gpio(R"({"chip": "c", "estop": {"line": 2, "bias": "up"}})")) ==
+          "m.json:3:52: bias must be one of: as-is, disable, pull-up, pull-down");
+    CHECK(error_of(with_gpio(R"({"chip": "c", "estop": {"line": 2, "active_low": 1}})")) ==
+          "m.json:3:58: active_low must be true or false");
+    CHECK(error_of(with_gpio(R"({"chip": "c", "limits": {"z-": {"line": 2}}})")) ==
+          "m.json:3:40: unknown key \"z-\" (expected one of: x+, x-, y+, y-)");
+    CHECK(error_of(with_gpio(R"({"chip": "c", "limits": {"x-": {"line": 2}},
+        "home": {"x": {"switch": "x+", "search_velocity": 10, "latch_velocity": 1, "backoff": 2, "max_travel": 300}}})")) ==
+          "m.json:4:34: switch \"x+\" is not in gpio.limits");
+    CHECK(error_of(with_gpio(R"({"chip": "c", "limits": {"x-": {"line": 2}},
+        "home": {"x": {"switch": "y-", "search_velocity": 10, "latch_velocity": 1, "backoff": 2, "max_travel": 300}}})")) ==
+          "m.json:4:34: switch must be \"x-\" or \"x+\"");
+    CHECK(error_of(with_gpio(R"({"chip": "c", "limits": {"x-": {"line": 2}},
+        "home": {"x": {"switch": "x-", "search_velocity": 500, "latch_velocity": 1, "backoff": 2, "max_travel": 300}}})")) ==
+          "m.json:4:59: search_velocity 500 mm/s is impossible (allowed: > 0 and <= 100 mm/s)");
+    CHECK(error_of(with_gpio(R"({"chip": "c", "limits": {"x-": {"line": 2}},
+        "home": {"x": {"switch": "x-", "search_velocity": 10, "latch_velocity": 20, "backoff": 2, "max_travel": 300}}})")) ==
+          "m.json:4:81: latch_velocity 20 mm/s is impossible (allowed: > 0 and <= 10 mm/s)");
+    CHECK(error_of(with_gpio(R"({"chip": "c", "limits": {"x-": {"line": 2}},
+        "home": {"x": {"switch": "x-", "search_velocity": 10, "latch_velocity": 1, "backoff": 2}}})")) ==
+          "m.json:4:23: homing has no \"max_travel\"");
+    CHECK(error_of(with_gpio(R"({"chip": "c", "limits": {"x-": {"line": 2}},
+        "home": {"x": {"switch": "x-", "search_velocity": 10, "latch_velocity": 1, "backoff": 0, "max_travel": 300}}})")) ==
+          "m.json:4:95: backoff 0 mm is impossible (allowed: > 0 and <= 10000 mm)");
+}
