@@ -414,7 +414,7 @@ TEST_CASE("an RTU line that corrupts and drops ~1 % of bytes: retries, and the d
     const host::StreamReport report = host::stream_modbus(job.plan, job.machine, o);
     loop.join();
 
-    WARN("rtu faults: " << report.transactions << " transactions, " << report.retries << " retries, " << report.batches
+    INFO("rtu faults: " << report.transactions << " transactions, " << report.retries << " retries, " << report.batches
                         << " batches, " << report.wall_seconds << " s, underruns " << report.underruns << ", bad frames "
                         << server.counters().bad_frames.load() << ", requests " << server.counters().requests.load());
     CHECK(report.retries > 0);
@@ -555,6 +555,24 @@ TEST_CASE("the queue runs dry: the device stops within its limits, reports the u
             REQUIRE(std::abs(x2 - 2 * x1 + x0) <= a_max);
         }
     }
+}
+
+TEST_CASE("a lead longer than the device's queue holds: the host starts when the queue is full", "[modbus][faults]") {
+    const Job job = plan_example("wave.json");
+    const auto device = sim::SimulatedModbusDevice::create(start_of(job.plan));
+    device->record(true);
+    hal::ModbusServer server = hal::ModbusServer::tcp(device->handler(), {"127.0.0.1", 0, 4});
+    Runner loop;
+    run_device(loop, *device, server, 10.0);
+    host::StreamOptions o;
+    o.target = tcp_target(server.port());
+    o.lead_seconds = 60;  // far more than 64 spans of 8 ticks
+    o.link_timeout_seconds = 2;
+    const auto t0 = SteadyClock::now();
+    const host::StreamReport report = host::stream_modbus(job.plan, job.machine, o);
+    loop.join();
+    CHECK(seconds_since(t0) < 10);
+    check_executed(job, *device, report);
 }
 
 TEST_CASE("a dead TCP peer (accepts, never answers): StreamError within the link timeout", "[modbus][faults]") {

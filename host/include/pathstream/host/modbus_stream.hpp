@@ -35,7 +35,10 @@ struct StreamReport {
     std::uint32_t last_completed = 0;     ///< sequence number of the last span executed
     std::uint32_t duplicates = 0;         ///< batches the device acknowledged as retries
     std::uint32_t underruns = 0;
-    std::uint64_t transactions = 0;
+    std::uint64_t transactions = 0;       ///< successful Modbus transactions of every kind
+    std::uint64_t status_reads = 0;       ///< of which FC4 status polls (the rest: batches, config, commands)
+    std::uint64_t attempts = 0;           ///< requests sent (first tries and retries)
+    std::uint64_t exception_responses = 0;  ///< device refusals (e.g. busy: queue fuller than known)
     std::uint64_t retries = 0;
     std::uint64_t reconnects = 0;
     std::uint64_t bytes_sent = 0;         ///< ADU bytes as on the wire
