@@ -71,7 +71,7 @@ public:
                 return out;
             }
             Knot next;
-            std::uint32_t ticks = 0;
+            std::uint32_t ticks = corner_landing(k, next);
             for (std::uint32_t m = n_; m >= (short_spans ? 1u : n_) && ticks == 0; --m) {
                 if (step(k, m, next)) ticks = m;
             }
@@ -411,6 +411,112 @@ private:
             worst = std::max(worst, norm(sub(off, scaled(p.t, dot(off, p.t)))));
         }
         return worst;
+    }
+
+    /// A span that ends exactly on the next crossed corner, when the corner's speed limit binds
+    /// and the regular span would run past it: a span of m <= ticks_per_span ticks (the fewest
+    /// that work) with the constant path acceleration that lands on the corner at a speed under
+    /// beta there. The knot on the corner moves along the bisector of the two tangents (the
+    /// velocity stays continuous; both spans leave the straight pieces by about 4/27 of their
+    /// length times half the turn, checked as every span). So the corner limits the speed at a
+    /// point, not over a whole span. Returns the ticks (0: no such span, take a regular one).
+    std::uint32_t corner_landing(const Knot& k, Knot& out) {
+        const double tau_n = n_ * tick_;
+        const double reach = k.speed * tau_n + 0.5 * acc_norm_ * tau_n * tau_n;
+        std::size_t c = 0;
+        bool found = false;
+        for (std::size_t i = interval(k.lambda); i <= piece_.last && g_.lambda[i] <= k.lambda + reach; ++i) {
+            if (g_.lambda[i] > k.lambda + 1e-9 && g_.lambda[i] < end_lambda_ - 1e-9 && i + 1 <= piece_.last &&
+                g_.lambda[i + 1] == g_.lambda[i] && norm(g_.corner_jump[i]) > 0) {
+                c = i;
+                found = true;
+                break;
+            }
+        }
+        if (!found) return 0;
+        const double lc = g_.lambda[c];
+        const double xc = std::min(beta_[c], beta_[c + 1]);
+        // Only where the corner slows the motion down.
+        if (!(xc < 0.81 * std::max(k.speed * k.speed, beta_at(k.lambda)))) return 0;
+        // The regular span stops short of the corner: take it.
+        double a_hi;
+        if (max_under_beta(k, tau_n, -k.speed / tau_n, acc_norm_, a_hi) &&
+            k.lambda + k.speed * tau_n + 0.5 * a_hi * tau_n * tau_n < lc - 1e-9) {
+            return 0;
+        }
+        Vec dir = sub(Vec(g_.tangent[c + 1]), scaled(Vec(g_.tangent[c]), -1.0));
+        const double dn = norm(dir);
+        if (!(dn > 1e-9)) return 0;
+        dir = scaled(dir, 1 / dn);
+        if (const std::uint32_t m = land_on_corner(k, c, dir, xc, out)) return m;
+        // Too near (or too fast) to land from here: a regular span of fewer ticks first, from
+        // whose end the landing works (the landing itself is taken at the next knot).
+        const Arrival saved = arrival_;
+        // Two spans, j then m ticks, the first with the constant path acceleration that lets the
+        // second (also of constant acceleration) arrive at the corner speed: fewest ticks first.
+        const double d_all = lc - k.lambda, vt = std::sqrt(xc);
+        for (std::uint32_t total = 2; total <= 2 * n_; ++total) {
+            for (std::uint32_t j = std::min(n_, total - 1); j >= 1 && total - j <= n_; --j) {
+                const double tj = j * tick_, tm = (total - j) * tick_;
+                const double a = (d_all - k.speed * tj - (k.speed + vt) * tm / 2) / (tj * tj / 2 + tj * tm / 2);
+                if (k.speed + a * tj < 0 || std::fabs(a) > 1.5 * acc_norm_ || !under_beta(k, a, tj)) continue;
+                Candidate c1 = evaluate(k, a, j);
+                if (c1.f > 0 || !(c1.end.lambda < lc - 1e-9)) continue;
+                arrival_ = Arrival{k, j};
+                Knot e;
+                const std::uint32_t m = land_on_corner(c1.end, c, dir, xc, e);
+                arrival_ = saved;
+                if (m > 0) {
+                    out = c1.end;
+                    return j;
+                }
+            }
+        }
+        for (std::uint32_t j = n_; j >= 1; --j) {
+            Knot mid;
+            if (!step(k, j, mid) || !(mid.lambda < lc - 1e-9)) continue;
+            arrival_ = Arrival{k, j};
+            Knot e;
+            const std::uint32_t m = land_on_corner(mid, c, dir, xc, e);
+            arrival_ = saved;
+            if (m > 0) {
+                out = mid;
+                return j;
+            }
+        }
+        return 0;
+    }
+
+    /// One span from k that ends exactly on corner node c (velocity along dir, speed^2 <= xc):
+    /// the fewest ticks that work. Its speed is the constant-acceleration one, or xc where that
+    /// is faster (then the cubic is not of constant path acceleration; it is checked as is).
+    std::uint32_t land_on_corner(const Knot& k, std::size_t c, const Vec& dir, double xc, Knot& out) {
+        const double lc = g_.lambda[c], d = lc - k.lambda;
+        for (std::uint32_t m = 1; m <= n_; ++m) {
+            const double tau = m * tick_;
+            double v1 = 2 * d / tau - k.speed;
+            if (v1 < 0) break;
+            if (v1 * v1 > xc) {
+                v1 = std::sqrt(xc);
+            } else {
+                const double a = (v1 - k.speed) / tau;
+                if (std::fabs(a) > 1.5 * acc_norm_ || !under_beta(k, a, tau)) continue;
+            }
+            Knot e;
+            e.lambda = lc;
+            e.speed = v1;
+            e.q = g_.q[c];
+            e.v = scaled(dir, v1);
+            const Vec v0 = span_velocity(k.v, m);
+            fit_end(k, v0, e, m);
+            double f = violation(k, arrival_, e, m);
+            if (f > 0) continue;
+            f = std::max(f, span_deviation(k, e, m) / deviation_limit_ - 1);
+            if (f > 0) continue;
+            out = e;
+            return m;
+        }
+        return 0;
     }
 
     /// Curvature vector at arc length l, interpolated between grid nodes.
