@@ -82,10 +82,18 @@ public:
             if (next < spans_.size() && s.free_slots > 0 && (lead < lead_target || !started)) {
                 s = send_batch(next, s.free_slots);
             } else {
-                std::this_thread::sleep_for(poll_wait(lead, lead_target, started));
-                s = read_status();
-                observe_rate(s, started);
+                bool predicted = false;
+                std::this_thread::sleep_for(poll_wait(lead, lead_target, started, predicted));
+                // Woken when the lead should have drained to the target: send the next batch
+                // at once (its FC23 answer is the status) instead of polling first. The free
+                // slots known are a lower bound (slots only free up), so the batch fits.
+                if (predicted && next < spans_.size() && s.free_slots > 0) {
+                    s = send_batch(next, s.free_slots);
+                } else {
+                    s = read_status();
+                }
             }
+            observe_rate(s, started);
             check_running(s, started);
             // Start once the lead is queued, or everything is, or the device's queue is full
             // (a lead longer than the queue holds would otherwise never start).
@@ -303,10 +311,10 @@ private:
         for (std::size_t i = 0; i < ticks_.size(); ++i) prefix_ticks_[i + 1] = prefix_ticks_[i] + ticks_[i];
     }
 
-    // Ticks of motion accepted but not yet completed (an upper bound: the active span counts whole).
+    // Ticks of motion sent but not yet executed, exact: the device counts path ticks.
     std::uint64_t queued_ticks(const DeviceStatus& s, std::size_t sent) const {
-        const std::size_t done = s.last_completed >= base_ ? s.last_completed - base_ + 1 : 0;
-        return done >= sent ? 0 : prefix_ticks_[sent] - prefix_ticks_[done];
+        const std::uint64_t done = static_cast<std::uint32_t>(s.ticks - start_ticks_);
+        return done >= prefix_ticks_[sent] ? 0 : prefix_ticks_[sent] - done;
     }
 
     DeviceStatus send_batch(std::size_t& next, std::uint16_t free_slots) {
@@ -388,12 +396,18 @@ private:
     // until the device should have worked it down to the lead (at its observed tick rate), but
     // never more than half the queued motion: polling every poll_interval_ms instead would
     // fill a serial line with status reads (bench_modbus: ~35 % of 115200 baud at 2 ms).
-    std::chrono::microseconds poll_wait(std::uint64_t lead, std::uint64_t lead_target, bool started) const {
+    // `predicted` tells whether the wait ends when the lead should be at the target (not at
+    // the half-lead cap or the minimum).
+    std::chrono::microseconds poll_wait(std::uint64_t lead, std::uint64_t lead_target, bool started,
+                                        bool& predicted) const {
         const double minimum = options_.poll_interval_ms * 1e-3;
         double wait = minimum;
+        predicted = false;
         if (started && lead > lead_target && rate_ > 0) {
-            wait = std::clamp(static_cast<double>(lead - lead_target) / rate_, minimum,
-                              std::max(minimum, 0.5 * static_cast<double>(lead) / rate_));
+            const double drain = static_cast<double>(lead - lead_target) / rate_;
+            const double cap = std::max(minimum, 0.5 * static_cast<double>(lead) / rate_);
+            wait = std::clamp(drain, minimum, cap);
+            predicted = drain >= minimum && drain <= cap;
         }
         return std::chrono::microseconds(static_cast<std::int64_t>(wait * 1e6));
     }
