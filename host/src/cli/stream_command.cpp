@@ -1,9 +1,13 @@
 #include "stream_command.hpp"
 
+#include <algorithm>
 #include <cstdio>
 #include <iostream>
 
 #include "plan_command.hpp"
+#include "pathstream/hal/socketcan_bus.hpp"
+#include "pathstream/host/can_stream.hpp"
+#include "pathstream/host/cia402_master.hpp"
 #include "pathstream/host/progress.hpp"
 
 namespace pathstream::host {
@@ -14,7 +18,8 @@ void add_stream_command(CLI::App& app, StreamCommandOptions& o) {
     add_path_options(*cmd, o.path);
     cmd->add_option("--machine,-m", o.machine, "machine profile (JSON, docs/formats.md)")->required()->check(CLI::ExistingFile);
     cmd->add_option("--target,-t", o.stream.target,
-                    "device: modbus-tcp://HOST:PORT?unit=N or modbus-rtu:///dev/ttyX?baud=115200&parity=N&unit=1")
+                    "device: modbus-tcp://HOST:PORT?unit=N, modbus-rtu:///dev/ttyX?baud=115200&parity=N&unit=1 or "
+                    "can://IFACE?node=N&protocol=native")
         ->required();
     cmd->add_option("--lead", o.stream.lead_seconds, "seconds of motion kept queued ahead of the device")
         ->capture_default_str()
@@ -31,8 +36,53 @@ void add_stream_command(CLI::App& app, StreamCommandOptions& o) {
         ->check(CLI::Range(0.1, 3600.0));
 }
 
+// ---- CAN targets (docs/can.md): can://IFACE?node=N&protocol=native|cia402 ----------------
+namespace {
+
+int run_stream_can(const StreamCommandOptions& o, const PlannedJob& job) {
+    if (o.stream.target.find("protocol=cia402") != std::string::npos) {  // its own keys (cycle=...): docs/cia402.md
+        hal::SocketCanBus cia402_bus(parse_cia402_target(o.stream.target, job.machine.axes.size()).interface);
+        return run_cia402_stream(job.plan, job.machine, o.stream.target, cia402_bus);
+    }
+    const CanTarget t = parse_can_target(o.stream.target);
+    hal::SocketCanBus bus(t.interface_name);
+    CanStreamOptions c;
+    c.node = t.node;
+    c.name = o.stream.target;
+    c.lead_seconds = o.stream.lead_seconds;
+    c.ack_timeout_ms = std::min(o.stream.response_timeout_ms, 100u);
+    c.link_timeout_seconds = o.stream.link_timeout_seconds;
+    CanStreamReport r;
+    {
+        ProgressBar bar("streaming");
+        r = stream_can(job.plan, job.machine, bus, c, [&](double fraction, double queued) {
+            char detail[48];
+            std::snprintf(detail, sizeof detail, "queue %.2f s", queued);
+            bar.update(fraction, detail);
+        });
+    }
+    const double motion = static_cast<double>(r.ticks_executed) / job.machine.tick_hz;
+    std::printf("streamed      %s (native CAN protocol, node %u)\n", o.stream.target.c_str(), unsigned(t.node));
+    std::printf("executed      %llu ticks (%.3f s of motion), %llu spans in %llu batches, last span %u\n",
+                static_cast<unsigned long long>(r.ticks_executed), motion,
+                static_cast<unsigned long long>(r.spans_sent), static_cast<unsigned long long>(r.batches),
+                r.last_completed);
+    std::printf("bus           %llu frames sent, %llu received, %llu retransmitted batches, %llu timeouts;"
+                " %.1f kbit/s worst case (%.2f %% of 1 Mbit/s)\n",
+                static_cast<unsigned long long>(r.frames_sent), static_cast<unsigned long long>(r.frames_received),
+                static_cast<unsigned long long>(r.retransmissions), static_cast<unsigned long long>(r.timeouts),
+                static_cast<double>(r.bits_sent + r.bits_received) / motion / 1e3,
+                static_cast<double>(r.bits_sent + r.bits_received) / motion / 1e4);
+    std::printf("device        %u underruns, %u duplicate batches acknowledged; wall time %.2f s\n", r.underruns,
+                r.duplicates, r.wall_seconds);
+    return 0;
+}
+
+}  // namespace
+
 int run_stream(const StreamCommandOptions& o) {
     const PlannedJob job = plan_job(o.path, o.machine);
+    if (o.stream.target.rfind("can://", 0) == 0) return run_stream_can(o, job);
     StreamReport r;
     {
         ProgressBar bar("streaming");

@@ -1,0 +1,189 @@
+// The device end of the native CAN protocol (can_protocol.hpp): assembles span batches from
+// span-start and span-data frames and feeds MotionDevice::accept_batch (all or nothing,
+// duplicates acknowledged), applies commands and the configuration, answers with acks and
+// status frames. Freestanding: no heap, storage inline (one batch buffer).
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+
+#include "pathstream/device/can_protocol.hpp"
+#include "pathstream/device/motion_device.hpp"
+#include "pathstream/status.hpp"
+
+namespace pathstream::device::can {
+
+/// Serves node `node` over a MotionDevice<Axes, Capacity>. Task context only (the bus task);
+/// the device's tick runs elsewhere as usual.
+template <unsigned Axes, std::uint32_t Capacity>
+class CanNode {
+public:
+    /// `node` must be kMinNode..kMaxNode (the caller checks it).
+    CanNode(MotionDevice<Axes, Capacity>& device, std::uint8_t node) : device_(device), node_(node) {}
+
+    std::uint8_t node() const { return node_; }
+
+    /// True when `id` is a host -> device frame addressed to this node (the receive filter).
+    bool addressed(std::uint32_t id) const {
+        if (node_of(id) != node_) return false;
+        const std::uint32_t f = function_of(id);
+        return f == kCommandBase || f == kConfigBase || f == kSpanStartBase || f == kSpanDataBase;
+    }
+
+    /// Handles one received frame; calls `send(const Frame&)` for each answer (0 to 3).
+    /// Frames for other nodes or functions are ignored. Cost: a batch's accept_batch when its
+    /// last data frame arrives, O(1) otherwise.
+    template <typename Send>
+    void handle(const Frame& f, Send&& send) {
+        if (!addressed(f.id)) return;
+        switch (function_of(f.id)) {
+            case kCommandBase: on_command(f, send); break;
+            case kConfigBase: on_config(f, send); break;
+            case kSpanStartBase: on_span_start(f, send); break;
+            case kSpanDataBase: on_span_data(f, send); break;
+            default: break;
+        }
+    }
+
+    /// Sends the three status frames.
+    template <typename Send>
+    void send_status(Send&& send) const {
+        Status3 s;
+        s.state = static_cast<std::uint8_t>(device_.state());
+        s.flags = static_cast<std::uint8_t>((device_.configured() ? kFlagConfigured : 0) |
+                                            (device_.held_by_underrun() ? kFlagHeldByUnderrun : 0) |
+                                            (bus_problem_ ? kFlagBusProblem : 0));
+        s.free_slots = saturate8(device_.free_slots());
+        s.queued = saturate8(device_.queued_spans());
+        s.fault_code = static_cast<std::uint16_t>(device_.fault_code());
+        s.underruns = static_cast<std::uint16_t>(device_.underruns());
+        s.last_accepted = device_.last_accepted_sequence();
+        s.last_completed = device_.last_completed_sequence();
+        s.ticks_executed = static_cast<std::uint32_t>(device_.ticks_executed());
+        s.duplicates = static_cast<std::uint16_t>(device_.duplicates());
+        s.axes = static_cast<std::uint8_t>(Axes);
+        s.version = kProtocolVersion;
+        Frame out[3];
+        encode_status(node_, s, out);
+        for (const Frame& o : out) send(o);
+    }
+
+    /// The bus went error-passive or bus-off: the link to the host may be gone, so a running
+    /// device holds (a controlled stop; the host resumes once it hears from it again).
+    void link_lost() {
+        bus_problem_ = true;
+        if (device_.state() == DeviceState::kRunning) (void)device_.command(Command::kHold);
+    }
+
+    /// Batches refused because a data frame was missing (the host resends them).
+    std::uint32_t incomplete_transfers() const { return incomplete_; }
+    /// Batches refused for any other reason (kQueueFull included): a correct host keeps it 0.
+    std::uint32_t refused_batches() const { return refused_; }
+
+private:
+    static std::uint8_t saturate8(std::uint32_t v) { return static_cast<std::uint8_t>(v > 255 ? 255 : v); }
+
+    template <typename Send>
+    void ack(std::uint8_t kind, std::uint8_t result, std::uint32_t sequence, Send& send) const {
+        Ack a;
+        a.kind = kind;
+        a.result = result;
+        a.sequence = sequence;
+        a.free_slots = saturate8(device_.free_slots());
+        a.state = static_cast<std::uint8_t>(device_.state());
+        send(encode_ack(node_, a));
+    }
+
+    template <typename Send>
+    void on_command(const Frame& f, Send& send) {
+        if (f.length < 1) return;
+        const std::uint8_t c = f.data[0];
+        if (c == kCommandStatusRequest) {
+            send_status(send);
+            return;
+        }
+        std::uint8_t result = kResultBadFrame;
+        if (c >= static_cast<std::uint8_t>(Command::kStart) && c <= static_cast<std::uint8_t>(Command::kReset)) {
+            result = static_cast<std::uint8_t>(device_.command(static_cast<Command>(c)));
+            if (c == static_cast<std::uint8_t>(Command::kReset)) bus_problem_ = false;
+        }
+        ack(kAckCommand, result, c, send);
+    }
+
+    template <typename Send>
+    void on_config(const Frame& f, Send& send) {
+        if (f.length != 6) return ack(kAckConfig, kResultBadFrame, 0, send);
+        const std::uint8_t item = static_cast<std::uint8_t>(get(f, kConfigSignals[0]));
+        const std::uint8_t axes = static_cast<std::uint8_t>(get(f, kConfigSignals[1]));
+        const std::uint32_t value = get(f, kConfigSignals[2]);
+        if (axes != Axes) return ack(kAckConfig, static_cast<std::uint8_t>(Status::kBadLimits), item, send);
+        if (item > 2 * Axes) return ack(kAckConfig, kResultBadFrame, item, send);
+        if (item == 0) {
+            config_seen_ = 0;
+            pending_.tick_hz = value;
+        } else if (item % 2 == 1) {
+            pending_.axis[(item - 1) / 2].max_velocity = value;
+        } else {
+            pending_.axis[(item - 2) / 2].max_acceleration = value;
+        }
+        config_seen_ |= 1u << item;
+        if (item != 2 * Axes) return;  // items before the last are not acknowledged: one ack per set
+        const std::uint32_t all = (1u << (2 * Axes + 1)) - 1u;
+        const std::uint8_t result = config_seen_ == all
+                                        ? static_cast<std::uint8_t>(device_.configure(pending_))
+                                        : kResultIncomplete;
+        config_seen_ = 0;
+        ack(kAckConfig, result, item, send);
+    }
+
+    template <typename Send>
+    void on_span_start(const Frame& f, Send& send) {
+        SpanStart s;
+        active_ = false;
+        if (!decode_span_start(f, s)) return ack(kAckSpans, kResultBadFrame, 0, send);
+        if (s.length > kMaxTransferBytes) return ack(kAckSpans, kResultTooLong, s.first_sequence, send);
+        if (s.length == 0 || s.count == 0) {
+            return ack(kAckSpans, static_cast<std::uint8_t>(Status::kBadBatch), s.first_sequence, send);
+        }
+        transfer_ = s;
+        received_ = 0;
+        next_index_ = 0;
+        active_ = true;
+    }
+
+    template <typename Send>
+    void on_span_data(const Frame& f, Send& send) {
+        if (!active_ || f.length < 2) return;  // no transfer (its start was lost): the host times out
+        const std::uint8_t index = f.data[0];
+        const std::size_t n = static_cast<std::size_t>(f.length) - 1;
+        if (index != next_index_ || received_ + n > transfer_.length) {
+            // A frame was lost: refuse now rather than let the host wait for its timeout.
+            active_ = false;
+            ++incomplete_;
+            return ack(kAckSpans, kResultIncomplete, transfer_.first_sequence, send);
+        }
+        for (std::size_t i = 0; i < n; ++i) buffer_[received_ + i] = f.data[1 + i];
+        received_ += n;
+        ++next_index_;
+        if (received_ < transfer_.length) return;
+        active_ = false;
+        const Status st = device_.accept_batch(transfer_.first_sequence, transfer_.count, buffer_, received_);
+        if (st != Status::kOk) ++refused_;
+        ack(kAckSpans, static_cast<std::uint8_t>(st), transfer_.first_sequence, send);
+    }
+
+    MotionDevice<Axes, Capacity>& device_;
+    std::uint8_t node_;
+    MotionLimits<Axes> pending_{};
+    std::uint32_t config_seen_ = 0;  // bit per configuration item received since item 0
+    SpanStart transfer_{};
+    bool active_ = false;
+    std::size_t received_ = 0;
+    std::uint8_t next_index_ = 0;
+    std::uint32_t incomplete_ = 0;
+    std::uint32_t refused_ = 0;
+    bool bus_problem_ = false;
+    std::uint8_t buffer_[kMaxTransferBytes] = {};
+};
+
+}  // namespace pathstream::device::can

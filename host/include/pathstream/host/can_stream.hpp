@@ -1,0 +1,67 @@
+// Streaming a plan to a device that runs the core, over CAN with the native pathstream
+// protocol (docs/can.md; frames declared in firmware_core's device/can_protocol.hpp).
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include "pathstream/hal/can_bus.hpp"
+#include "pathstream/host/machine.hpp"
+#include "pathstream/host/modbus_stream.hpp"  // StreamError, StreamProgress
+#include "pathstream/host/plan.hpp"
+
+namespace pathstream::host {
+
+/// A parsed `can://IFACE?node=N&protocol=native|cia402` target.
+struct CanTarget {
+    std::string interface_name;
+    std::uint8_t node = 0;        ///< 1..127
+    std::string protocol = "native";
+};
+
+/// Parses `url`. Throws std::invalid_argument naming what is wrong (no interface, node
+/// missing or outside 1..127, unknown protocol or parameter).
+CanTarget parse_can_target(const std::string& url);
+
+struct CanStreamOptions {
+    std::uint8_t node = 1;             ///< the device's node id, 1..127
+    std::string name = "can";          ///< how messages name the target (e.g. the URL)
+    double lead_seconds = 0.25;        ///< keep this much motion queued ahead of the device
+    unsigned ack_timeout_ms = 100;     ///< resend a batch, configuration or status request after this
+    double link_timeout_seconds = 2;   ///< give up after this long without a frame from the device
+    unsigned poll_interval_ms = 10;    ///< status requests (4 frames) while the queue is full enough
+};
+
+/// What the device executed and what the bus carried.
+struct CanStreamReport {
+    std::uint64_t spans_sent = 0;         ///< spans acknowledged (each once)
+    std::uint64_t batches = 0;            ///< batches acknowledged
+    std::uint64_t retransmissions = 0;    ///< batches sent again (timeout or incomplete)
+    std::uint64_t timeouts = 0;           ///< waits for an answer that ran out
+    std::uint64_t incomplete = 0;         ///< batches the device reported a lost data frame of
+    std::uint64_t status_requests = 0;
+    std::uint64_t ticks_executed = 0;     ///< path ticks the device executed for this plan
+    std::uint32_t last_completed = 0;     ///< sequence number of the last span executed
+    std::uint32_t duplicates = 0;         ///< batches the device acknowledged as retries
+    std::uint32_t underruns = 0;
+    std::uint64_t frames_sent = 0;
+    std::uint64_t frames_received = 0;    ///< frames from this node
+    std::uint64_t bits_sent = 0;          ///< worst-case stuffed bits (can::frame_bits_worst_case)
+    std::uint64_t bits_received = 0;
+    double wall_seconds = 0;
+    std::int32_t final_position[8] = {};  ///< the plan's end point, which the device reached
+};
+
+/// Streams `plan` to node options.node on `bus` (native protocol): checks the device's
+/// identity (protocol version, axis count, idle), configures its tick rate and limits from
+/// `profile` (rounded up to whole LSB/s and LSB/s^2), sends batches of spans with sequence
+/// numbers keeping options.lead_seconds queued and never more spans than the device has free
+/// slots, starts it, resumes it after an underrun, resends batches lost on the bus (timeouts,
+/// incomplete-transfer nacks), and returns when the last span has executed.
+/// Throws StreamError (device refused a batch, restarted, faulted, the host's controller went
+/// bus-off, or nothing came from the device for link_timeout_seconds) and
+/// std::invalid_argument (plan not streamable).
+CanStreamReport stream_can(const Plan& plan, const MachineProfile& profile, hal::CanBus& bus,
+                           const CanStreamOptions& options, const StreamProgress& progress = {});
+
+}  // namespace pathstream::host

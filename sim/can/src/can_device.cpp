@@ -1,0 +1,122 @@
+#include "pathstream/sim/can_device.hpp"
+
+#include <deque>
+#include <stdexcept>
+
+#include "pathstream/device/can_node.hpp"
+#include "pathstream/device/motion_device.hpp"
+#include "pathstream/host/core_span_conversion.hpp"
+
+namespace pathstream::sim {
+namespace {
+
+namespace pc = device::can;
+
+hal::CanFrame to_hal(const pc::Frame& f) {
+    hal::CanFrame h;
+    h.id = f.id;
+    h.length = f.length;
+    for (unsigned i = 0; i < 8; ++i) h.data[i] = f.data[i];
+    return h;
+}
+
+template <unsigned Axes>
+class Device final : public SimulatedCanDevice {
+public:
+    Device(const Lsb (&start)[Axes], std::uint8_t node) : device_(start), node_(device_, node) {}
+
+    void serve(hal::CanBus& bus, std::chrono::microseconds wait) override {
+        flush(bus);
+        const hal::CanBusState s = bus.state();
+        if (s >= hal::CanBusState::kErrorPassive && last_state_ < hal::CanBusState::kErrorPassive) node_.link_lost();
+        last_state_ = s;
+        hal::CanFrame in;
+        auto send = [&](const pc::Frame& f) { pending_.push_back(to_hal(f)); };
+        std::uint32_t timeout = static_cast<std::uint32_t>(wait.count() > 0 ? wait.count() : 0);
+        while (bus.receive(in, timeout)) {
+            timeout = 0;
+            if (in.extended || in.remote) continue;
+            pc::Frame f;
+            f.id = in.id;
+            f.length = in.length;
+            for (unsigned i = 0; i < 8; ++i) f.data[i] = in.data[i];
+            node_.handle(f, send);
+            flush(bus);
+        }
+    }
+
+    void tick() override {
+        Lsb out[Axes];
+        const std::uint64_t before = device_.ticks_executed();
+        device_.tick(out);
+        if (recording_ && device_.ticks_executed() != before) {
+            setpoints_.insert(setpoints_.end(), out, out + Axes);
+            ticks_.push_back({static_cast<std::uint8_t>(device_.state()), device_.outputs()});
+        }
+    }
+    unsigned axes() const override { return Axes; }
+    std::uint32_t tick_hz() const override { return device_.configured() ? device_.limits().tick_hz : 0; }
+    std::uint8_t state() const override { return static_cast<std::uint8_t>(device_.state()); }
+    Lsb position(unsigned axis) const override { return device_.position(axis); }
+    std::uint32_t refused_batches() const override { return node_.refused_batches(); }
+    std::uint32_t incomplete_transfers() const override { return node_.incomplete_transfers(); }
+    std::uint32_t duplicates() const override { return device_.duplicates(); }
+    std::uint64_t answers_dropped() const override { return dropped_; }
+
+private:
+    // Sends what waits; a full transmit queue keeps the rest for later, a bus-off drops it
+    // (stale answers are worthless once the bus is back: the host asks again).
+    void flush(hal::CanBus& bus) {
+        while (!pending_.empty()) {
+            const hal::CanSendResult r = bus.send(pending_.front());
+            if (r == hal::CanSendResult::kQueueFull) return;
+            if (r != hal::CanSendResult::kQueued) ++dropped_;
+            pending_.pop_front();
+        }
+    }
+
+    device::MotionDevice<Axes, kCanDeviceCapacity> device_;
+    pc::CanNode<Axes, kCanDeviceCapacity> node_;
+    std::deque<hal::CanFrame> pending_;
+    hal::CanBusState last_state_ = hal::CanBusState::kErrorActive;
+    std::uint64_t dropped_ = 0;
+};
+
+}  // namespace
+
+std::unique_ptr<SimulatedCanDevice> SimulatedCanDevice::create(const std::vector<Lsb>& start, std::uint8_t node) {
+    if (node < pc::kMinNode || node > pc::kMaxNode) {
+        throw std::invalid_argument("CAN node id " + std::to_string(node) + " is outside 1..127");
+    }
+    return host::with_axes(start.size(), [&](auto axes) -> std::unique_ptr<SimulatedCanDevice> {
+        constexpr unsigned A = decltype(axes)::value;
+        Lsb s[A];
+        for (unsigned a = 0; a < A; ++a) s[a] = start[a];
+        return std::make_unique<Device<A>>(s, node);
+    });
+}
+
+std::uint64_t run_can_device_loop(SimulatedCanDevice& device, hal::CanBus& bus, const DeviceLoopOptions& options,
+                                  const std::atomic<bool>& stop) {
+    using clock = std::chrono::steady_clock;
+    if (!(options.time_scale > 0)) throw std::invalid_argument("time scale must be positive");
+    const auto begin = clock::now();
+    std::uint64_t ticks = 0;
+    double due_seconds = 0;  // tick k is due at begin + the sum of the tick periods before it
+    while (!stop.load(std::memory_order_relaxed)) {
+        const auto now = clock::now();
+        if (options.run_for.count() > 0 && now - begin >= options.run_for) break;
+        const double elapsed = std::chrono::duration<double>(now - begin).count();
+        while (due_seconds <= elapsed) {
+            device.tick();
+            ++ticks;
+            const std::uint32_t hz = device.tick_hz() != 0 ? device.tick_hz() : 1000;
+            due_seconds += 1.0 / (hz * options.time_scale);
+        }
+        const double wait = due_seconds - elapsed;
+        device.serve(bus, std::chrono::microseconds(wait > 0 ? static_cast<long>(wait * 1e6) : 0));
+    }
+    return ticks;
+}
+
+}  // namespace pathstream::sim

@@ -1,0 +1,216 @@
+// A planned drawing streamed with the native CAN protocol over the in-process loopback to the
+// simulated device running the core: the device executes, tick for tick, the setpoints
+// `pathstream plan` computes; with lost frames too; bus-off at the device stops the host.
+#include <catch2/catch.hpp>
+
+#include <atomic>
+#include <thread>
+#include <vector>
+
+#include "pathstream/device/can_protocol.hpp"
+#include "pathstream/host/can_stream.hpp"
+#include "pathstream/host/core_playback.hpp"
+#include "pathstream/host/geometry.hpp"
+#include "pathstream/host/json_path.hpp"
+#include "pathstream/host/machine.hpp"
+#include "pathstream/host/planner.hpp"
+#include "pathstream/sim/can_device.hpp"
+#include "pathstream/sim/can_loopback.hpp"
+#include "pathstream/span.hpp"
+
+using namespace pathstream;
+
+namespace {
+
+struct Job {
+    host::MachineProfile machine;
+    host::Plan plan;
+};
+
+Job plan_wave() {
+    Job j;
+    j.machine = host::load_machine_profile(std::string(PATHSTREAM_SOURCE_DIR) + "/examples/machines/pen_plotter.json");
+    const host::Path path = host::load_json_path(std::string(PATHSTREAM_SOURCE_DIR) + "/examples/wave.json");
+    j.plan = host::plan_path(host::to_bezier_segments(path), j.machine);
+    return j;
+}
+
+std::vector<Lsb> plan_setpoints(const host::Plan& plan, std::size_t axes) {
+    std::vector<Lsb> out;
+    host::play_through_core(plan.spans, axes, [&](const host::PlayedTick& t) {
+        out.insert(out.end(), t.setpoint, t.setpoint + axes);
+    });
+    return out;
+}
+
+std::vector<Lsb> start_of(const host::Plan& plan) {
+    std::vector<Lsb> s;
+    for (const auto& c : plan.spans.front().control) s.push_back(c[0]);
+    return s;
+}
+
+// The device on loopback endpoint 0, served and ticked on its own thread.
+struct DeviceThread {
+    std::unique_ptr<sim::SimulatedCanDevice> device;
+    std::atomic<bool> stop{false};
+    std::thread thread;
+
+    void run(hal::CanBus& bus, double time_scale) {
+        thread = std::thread([this, &bus, time_scale] {
+            sim::DeviceLoopOptions o;
+            o.time_scale = time_scale;
+            sim::run_can_device_loop(*device, bus, o, stop);
+        });
+    }
+    void join() {
+        stop = true;
+        if (thread.joinable()) thread.join();
+    }
+    ~DeviceThread() { join(); }
+};
+
+void check_executed(const Job& job, const sim::SimulatedCanDevice& device, const host::CanStreamReport& report) {
+    const std::size_t axes = job.plan.spans.front().control.size();
+    const std::vector<Lsb> expected = plan_setpoints(job.plan, axes);
+    const std::vector<Lsb>& got = device.recorded_setpoints();
+    REQUIRE(report.ticks_executed == job.plan.total_ticks);
+    REQUIRE(got.size() == job.plan.total_ticks * axes);
+    for (std::size_t i = 0; i < got.size(); ++i) {
+        INFO("tick " << i / axes << " axis " << i % axes);
+        REQUIRE(got[i] == expected[i]);
+    }
+    CHECK(report.last_completed == job.plan.spans.size());
+    std::size_t k = 0;
+    for (const auto& span : job.plan.spans) {
+        for (std::uint32_t t = 0; t < span.ticks; ++t, ++k) {
+            REQUIRE((device.recorded_ticks()[k].outputs & kOutputPenDown) == (span.pen_down ? 1 : 0));
+        }
+    }
+}
+
+struct Run {
+    host::CanStreamReport report;
+    std::unique_ptr<sim::SimulatedCanDevice> device;
+    sim::CanLoopbackCounters bus;
+};
+
+Run stream_over_loopback(const Job& job, const sim::CanFaults& faults, double time_scale = 10.0) {
+    sim::CanLoopback loop(faults);
+    hal::CanBus& device_bus = loop.add_endpoint();
+    hal::CanBus& host_bus = loop.add_endpoint();
+    DeviceThread dt;
+    dt.device = sim::SimulatedCanDevice::create(start_of(job.plan), 5);
+    dt.device->record(true);
+    dt.run(device_bus, time_scale);
+    host::CanStreamOptions o;
+    o.node = 5;
+    o.ack_timeout_ms = 30;
+    Run r;
+    r.report = host::stream_can(job.plan, job.machine, host_bus, o);
+    dt.join();
+    r.device = std::move(dt.device);
+    r.bus = loop.counters();
+    return r;
+}
+
+}  // namespace
+
+TEST_CASE("a drawing streamed natively over CAN executes exactly the planned setpoints", "[can][stream]") {
+    const Job job = plan_wave();
+    const Run r = stream_over_loopback(job, {});
+    check_executed(job, *r.device, r.report);
+    CHECK(r.report.spans_sent == job.plan.spans.size());
+    CHECK(r.report.retransmissions == 0);
+    CHECK(r.device->refused_batches() == 0);  // never a span the device refuses (queue full included)
+    CHECK(r.device->duplicates() == 0);
+    CHECK(r.bus.frames == r.report.frames_sent + r.report.frames_received);
+}
+
+TEST_CASE("natively over CAN with 1 % of the frames lost, the device still executes every span once",
+          "[can][stream]") {
+    const Job job = plan_wave();
+    sim::CanFaults faults;
+    faults.drop_fraction = 0.01;
+    faults.seed = 42;
+    const Run r = stream_over_loopback(job, faults);
+    check_executed(job, *r.device, r.report);  // no span lost or repeated: every path tick exactly once
+    CHECK(r.bus.dropped > 0);
+    CHECK(r.report.retransmissions > 0);
+    CHECK(r.device->refused_batches() == 0);
+}
+
+TEST_CASE("natively over CAN with a transmit budget per poll, frames wait and nothing is lost", "[can][stream]") {
+    const Job job = plan_wave();
+    sim::CanFaults faults;
+    faults.tx_budget = 4;
+    const Run r = stream_over_loopback(job, faults);
+    check_executed(job, *r.device, r.report);
+    CHECK(r.device->refused_batches() == 0);
+}
+
+TEST_CASE("bus-off at the device: the host stops with a clear error and the device holds", "[can][stream]") {
+    const Job job = plan_wave();
+    sim::CanLoopback loop;
+    hal::CanBus& device_bus = loop.add_endpoint();
+    hal::CanBus& host_bus = loop.add_endpoint();
+    DeviceThread dt;
+    dt.device = sim::SimulatedCanDevice::create(start_of(job.plan), 5);
+    dt.run(device_bus, 1.0);
+    host::CanStreamOptions o;
+    o.node = 5;
+    o.ack_timeout_ms = 30;
+    o.link_timeout_seconds = 0.5;
+    o.name = "can://loop?node=5";
+    std::atomic<bool> cut{false};
+    std::string message;
+    try {
+        host::stream_can(job.plan, job.machine, host_bus, o, [&](double fraction, double) {
+            if (fraction > 0.05 && !cut.exchange(true)) loop.set_bus_off(0, true);
+        });
+    } catch (const host::StreamError& e) {
+        message = e.what();
+    }
+    REQUIRE(cut.load());
+    CHECK_THAT(message, Catch::Contains("can://loop?node=5: no answer from node 5"));
+    // The device saw its bus go off and held (a controlled stop), rather than run on blind.
+    for (int i = 0; i < 200 && dt.device->state() != 2; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    CHECK(dt.device->state() == 2);  // holding
+    dt.join();
+}
+
+TEST_CASE("bus-off at the host: the streamer stops at once", "[can][stream]") {
+    const Job job = plan_wave();
+    sim::CanLoopback loop;
+    loop.add_endpoint();
+    hal::CanBus& host_bus = loop.add_endpoint();
+    loop.set_bus_off(1, true);
+    host::CanStreamOptions o;
+    o.node = 5;
+    CHECK_THROWS_WITH(host::stream_can(job.plan, job.machine, host_bus, o), Catch::Contains("bus-off"));
+}
+
+TEST_CASE("a silent node: the streamer gives up after the link timeout", "[can][stream]") {
+    const Job job = plan_wave();
+    sim::CanLoopback loop;
+    loop.add_endpoint();
+    hal::CanBus& host_bus = loop.add_endpoint();
+    host::CanStreamOptions o;
+    o.node = 9;
+    o.ack_timeout_ms = 20;
+    o.link_timeout_seconds = 0.2;
+    CHECK_THROWS_WITH(host::stream_can(job.plan, job.machine, host_bus, o), Catch::Contains("no answer from node 9"));
+}
+
+TEST_CASE("can:// targets parse and refuse what is wrong", "[can]") {
+    const host::CanTarget t = host::parse_can_target("can://vcan0?node=5&protocol=native");
+    CHECK(t.interface_name == "vcan0");
+    CHECK(t.node == 5);
+    CHECK(t.protocol == "native");
+    CHECK(host::parse_can_target("can://can1?protocol=cia402&node=127").protocol == "cia402");
+    CHECK_THROWS_WITH(host::parse_can_target("can://vcan0"), Catch::Contains("node=N"));
+    CHECK_THROWS_WITH(host::parse_can_target("can://vcan0?node=0"), Catch::Contains("1..127"));
+    CHECK_THROWS_WITH(host::parse_can_target("can://vcan0?node=128"), Catch::Contains("1..127"));
+    CHECK_THROWS_WITH(host::parse_can_target("can://vcan0?node=5&protocol=x"), Catch::Contains("native or cia402"));
+    CHECK_THROWS_WITH(host::parse_can_target("can://?node=5"), Catch::Contains("no CAN interface"));
+    CHECK_THROWS_WITH(host::parse_can_target("can://vcan0?node=5&baud=1"), Catch::Contains("unknown parameter"));
+}
