@@ -10,6 +10,7 @@
 #include "pathstream/host/json_path.hpp"
 #include "pathstream/host/machine.hpp"
 #include "pathstream/host/planner.hpp"
+#include "pathstream/host/plot.hpp"
 #include "pathstream/sim/gpio_bench.hpp"
 
 using namespace pathstream;
@@ -87,4 +88,28 @@ TEST_CASE("gpio pen: the pen line switches at the plan's pen events, never while
             REQUIRE(b.ticks[first + j] == b.ticks[first]);
         }
     }
+
+    // The report counts what the pen line did and the plan's pen dwells.
+    host::plot::TickSeries exec;
+    exec.axes = 2;
+    exec.tick_hz = profile.tick_hz;
+    exec.quantum_mm = profile.mm_per_lsb;
+    std::size_t s = 0;
+    bool down = false;
+    for (std::size_t k = 0; k < b.ticks.size(); ++k) {
+        while (s < switches.size() && switches[s] == k + 1) {
+            down = !down;
+            ++s;
+        }
+        exec.position.push_back(b.ticks[k][0] * profile.mm_per_lsb);
+        exec.position.push_back(b.ticks[k][1] * profile.mm_per_lsb);
+        exec.pen_down.push_back(down ? 1 : 0);
+    }
+    host::plot::RunSummary run;
+    run.ticks = b.ticks.size();
+    run.pen_switches = switches.size();
+    const std::string report = host::plot::text_report(plan, nullptr, profile, exec, run);
+    INFO(report);
+    CHECK(report.find("  pen        2 down, 2 up; down ") != std::string::npos);
+    CHECK(report.find("dwells 0.280 s") != std::string::npos);  // 2 x 80 ms down + 2 x 60 ms up
 }

@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <sstream>
 
+#include "pathstream/host/planner.hpp"
 #include "pathstream/host/plot.hpp"
 
 namespace pathstream::host::plot {
@@ -54,6 +55,27 @@ std::string text_report(const Plan& plan, const PlanCheck* check, const MachineP
     o << (run.realtime ? ", paced" : "") << "\n";
     o << "  path       " << fmt("%.2f", plan.path_length) << " mm pen-down, "
       << fmt("%.2f", plan.travel_length) << " mm travel, " << run.pen_switches << " pen switches\n";
+    // Pen: what the pen-lift output did on the executed ticks, and the time the plan holds the
+    // axes still while the pen moves (no drawing then).
+    {
+        std::uint64_t downs = 0, ups = 0, down_ticks = 0;
+        for (std::size_t k = 0; k < executed.pen_down.size(); ++k) {
+            const bool down = executed.pen_down[k] != 0;
+            const bool before = k > 0 && executed.pen_down[k - 1] != 0;
+            down_ticks += down ? 1 : 0;
+            if (down && !before) ++downs;
+            if (!down && before) ++ups;
+        }
+        std::uint64_t dwell_ticks = 0;
+        for (const auto& e : plan.pen) {
+            dwell_ticks += delay_ticks(e.down ? profile.pen_down_delay : profile.pen_up_delay, profile.tick_hz);
+        }
+        const double total = static_cast<double>(executed.pen_down.size());
+        o << "  pen        " << downs << " down, " << ups << " up; down "
+          << fmt("%.3f", static_cast<double>(down_ticks) / profile.tick_hz) << " s ("
+          << fmt("%.0f", total > 0 ? 100.0 * static_cast<double>(down_ticks) / total : 0.0) << " %), dwells "
+          << fmt("%.3f", static_cast<double>(dwell_ticks) / profile.tick_hz) << " s\n";
+    }
     o << "  device     " << run.ticks << " ticks, " << run.spans << " spans, " << run.underruns
       << " underruns";
     if (run.realtime) o << ", " << run.late_ticks << " late ticks";

@@ -30,6 +30,10 @@ kill "$set_pid"
 wait "$set_pid"
 vm_log "gpio: gpioget/gpioset agree with the sim's pull and value attributes"
 
+# The backend's errors on the real chip name chip and line (label lookup included).
+vm_run pathstream_gpio_vm_driver errors pathstream-sim > errors.out || { cat errors.out; vm_fail "backend errors"; }
+cat errors.out
+
 # Starts the driver in the background; waits until it runs with enable (and pen) up.
 start_driver() {
   rm -rf "$1"; mkdir -p "$1"

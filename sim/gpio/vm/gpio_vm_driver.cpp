@@ -6,6 +6,9 @@
 //       moves until an e-stop or a limit fault comes from outside (the script writes the
 //       sim's pull attributes); DIR/running once enable is up; on e-stop: DIR/estop, waits for
 //       the input's release, resets, DIR/reset; on a fault: prints its name. Exit 0 if one came.
+//   pathstream_gpio_vm_driver errors CHIP
+//       the libgpiod backend's errors on the real chip (unknown line name, offset out of
+//       range, a line busy with its holder named).
 //   pathstream_gpio_vm_driver measure PROFILE PULL_PATH ROUNDS
 //       ROUNDS times: run, write "pull-up" to PULL_PATH (the e-stop line's sim pull) and time
 //       the write to the enable line dropping; release, reset, again. Prints the figures.
@@ -289,16 +292,57 @@ int measure(const host::MachineProfile& profile, const std::string& pull, int ro
     return 0;
 }
 
+// The backend's errors against the real chip: each message must name chip and line.
+int errors(const std::string& chip) {
+    int failures = 0;
+    auto expect = [&](const hal::GpioLineSpec& s, bool output, const std::string& want) {
+        std::string got = "no error";
+        try {
+            if (output) {
+                (void)hal::open_gpiod_output(s, "pathstream-errors");
+            } else {
+                (void)hal::open_gpiod_input(s, "pathstream-errors");
+            }
+        } catch (const hal::GpioError& e) {
+            got = e.what();
+        }
+        std::printf("driver: error: %s\n", got.c_str());
+        if (got.find(want) == std::string::npos) {
+            std::printf("driver: FAIL: expected '%s'\n", want.c_str());
+            ++failures;
+        }
+    };
+    expect({chip, "no-such-line", false, hal::Bias::kAsIs}, false,
+           "gpio " + chip + " line \"no-such-line\": the chip has no line of that name");
+    expect({chip, "16", false, hal::Bias::kAsIs}, true,
+           "gpio " + chip + " line \"16\": offset out of range (the chip has 16 lines)");
+    // A line held by another request: busy, and the holder is named.
+    const hal::GpioLineSpec estop{chip, "estop", false, hal::Bias::kAsIs};
+    auto held = hal::open_gpiod_input(estop, "pathstream-holder");
+    expect(estop, false, "gpio " + chip + " line \"estop\": request edge events (in use by \"pathstream-holder\")");
+    expect(estop, true, "request as output (in use by \"pathstream-holder\")");
+    return failures == 0 ? 0 : 1;
+}
+
 int usage() {
     std::fprintf(stderr,
                  "usage: pathstream_gpio_vm_driver run PROFILE DIR MAX_MS\n"
-                 "       pathstream_gpio_vm_driver measure PROFILE PULL_PATH ROUNDS\n");
+                 "       pathstream_gpio_vm_driver measure PROFILE PULL_PATH ROUNDS\n"
+                 "       pathstream_gpio_vm_driver errors CHIP\n");
     return 2;
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
+    if (argc == 3 && std::string(argv[1]) == "errors") {
+        try {
+            return errors(argv[2]);
+        } catch (const std::exception& e) {
+            std::fprintf(stderr, "pathstream_gpio_vm_driver: %s\n", e.what());
+            return 1;
+        }
+    }
     if (argc != 5) return usage();
     const std::string mode = argv[1];
     try {
