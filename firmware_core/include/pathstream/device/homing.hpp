@@ -89,7 +89,7 @@ public:
             ramp_distance_ = 0;
             for (std::uint32_t i = 0; i < ramp_spans_; ++i) ramp_distance_ += (ramp_tangent(i) + ramp_tangent(i + 1)) / 2;
             if (2 * ramp_distance_ <= remaining_ || cruise_ <= 2) break;
-            cruise_ = even_floor(cruise_ / 2);
+            cruise_ = even_floor(static_cast<std::uint64_t>(cruise_) / 2);
             if (cruise_ < 2) cruise_ = 2;
         }
         if (2 * ramp_distance_ > remaining_) {
