@@ -72,6 +72,7 @@ public:
             if (!started && (queued_ticks(s, next) >= lead_target || next == spans_.size())) {
                 command(static_cast<std::uint8_t>(device::Command::kStart), false);
                 started = true;
+                started_at_ = Clock::now();
             }
             if (s.state == static_cast<std::uint8_t>(device::DeviceState::kHolding) &&
                 (s.flags & pc::kFlagHeldByUnderrun) != 0 && s.queued > 0) {
@@ -339,7 +340,7 @@ private:
 
     // A device whose sequence or tick count went backwards, or that lost its configuration,
     // restarted: its queue is gone.
-    void check_running(const pc::Status3& s, bool started) const {
+    void check_running(const pc::Status3& s, bool started) {
         std::ostringstream m;
         if (s.last_accepted < acknowledged_ || s.ticks_executed < start_ticks_ || (s.flags & pc::kFlagConfigured) == 0) {
             m << "device restarted mid-stream (it reports sequence " << s.last_accepted << " and " << s.ticks_executed
@@ -353,7 +354,13 @@ private:
               << std::dec << ") after span " << (s.last_completed >= base_ ? s.last_completed - base_ + 1 : 0);
             fail(m.str());
         }
-        if (started && s.state == static_cast<std::uint8_t>(device::DeviceState::kIdle)) {
+        // The device applies a start at its next tick: idle right after the acknowledged start
+        // is the start still pending, not a stop, until it has been seen running or has had
+        // ample time (half a second) to tick.
+        if (started && s.state != static_cast<std::uint8_t>(device::DeviceState::kIdle)) seen_running_ = true;
+        const bool start_pending =
+            !seen_running_ && std::chrono::duration<double>(Clock::now() - started_at_).count() < 0.5;
+        if (started && s.state == static_cast<std::uint8_t>(device::DeviceState::kIdle) && !start_pending) {
             m << "device went idle after span " << s.last_completed << " (stopped by another master?)";
             fail(m.str());
         }
@@ -373,6 +380,8 @@ private:
     std::uint32_t acknowledged_ = 0;
     std::uint32_t start_ticks_ = 0;
     std::size_t free_slots_ = 0;
+    Clock::time_point started_at_;
+    bool seen_running_ = false;
     CanStreamReport report_;
 };
 
