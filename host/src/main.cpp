@@ -12,6 +12,7 @@
 #include "pathstream/host/planner.hpp"
 #include "cli/check_command.hpp"
 #include "cli/device_command.hpp"
+#include "cli/drive_command.hpp"
 #include "cli/eval_command.hpp"
 #include "cli/plan_command.hpp"
 #include "cli/setpoints_command.hpp"
@@ -46,6 +47,8 @@ int main(int argc, char** argv) {
     pathstream::host::add_stream_command(app, stream);
     pathstream::host::DeviceCommandOptions device;
     pathstream::host::add_device_command(app, device);
+    pathstream::host::DriveCommandOptions drive;
+    pathstream::host::add_drive_command(app, drive);
 
     try {
         app.parse(argc, argv);
@@ -66,6 +69,7 @@ int main(int argc, char** argv) {
         if (app.got_subcommand("sim")) return pathstream::host::run_sim(sim);
         if (app.got_subcommand("stream")) return pathstream::host::run_stream(stream);
         if (app.got_subcommand("device")) return pathstream::host::run_device(device);
+        if (app.got_subcommand("drive")) return pathstream::host::run_drive(drive);
     } catch (const pathstream::host::InputError& e) {
         std::cerr << e.what() << '\n';
         return kExitInput;
