@@ -139,7 +139,10 @@ std::size_t backward_pass(const PathGrid& pg, const Piece& piece, const Limits& 
         // faster than that at the lower end of each interval (x linear between nodes, as the
         // forward pass interpolates it), 5 % to spare.
         double d = bend;
-        if (span_time > 0) {
+        // A dip of 0 (a node at rest: the piece's end, or one its retries capped there) is no
+        // dip to approach span by span: its slope sqrt(0) would hold beta at 0 over the whole
+        // piece before it. The end itself is approached by the landings of the forward pass.
+        if (span_time > 0 && dip[k + 1] > 0) {
             const double below = dip[k + 1];
             d = std::min(d, below + 1.9 * std::sqrt(below) * std::max(dl, 0.0) / span_time);
         }
