@@ -1,5 +1,7 @@
 // The simulated drive's SDO server and object dictionary: expedited transfers only, with the
 // abort codes a real drive gives for unknown objects, wrong sizes and writes in the wrong state.
+#include <cmath>
+
 #include "drive_state.hpp"
 
 namespace pathstream::sim {
@@ -102,7 +104,7 @@ std::uint32_t SimulatedCia402Drive::State::od_read(std::uint16_t index, std::uin
         case kStatusword: return one(statusword(), 2);
         case kModesOfOperation: return one(static_cast<std::uint8_t>(mode), 1);
         case kModesDisplay: return one(static_cast<std::uint8_t>(mode), 1);
-        case kPositionDemand: return one(static_cast<std::uint32_t>(static_cast<std::int32_t>(demand)), 4);
+        case kPositionDemand: return one(static_cast<std::uint32_t>(static_cast<std::int32_t>(std::llround(demand))), 4);
         case kPositionActual: return one(static_cast<std::uint32_t>(actual()), 4);
         case kFollowingErrorWindow: return one(fe_window, 4);
         case kTargetPosition: return one(static_cast<std::uint32_t>(target), 4);
