@@ -49,6 +49,8 @@ std::size_t fault_name(FaultCode code, char* out, std::size_t capacity) {
         w.put("external fault");
     } else if (code == FaultCode::kStopFailed) {
         w.put("no controlled stop fits in one span");
+    } else if (code == FaultCode::kReentryFailed) {
+        w.put("no move back onto the path fits in one span");
     } else if (limit_fault_switch(code, axis, side)) {
         const char* names = "xyzabcuv";
         const bool negative = side == LimitSide::kNegative;

@@ -40,6 +40,7 @@ enum class FaultCode : std::uint16_t {
     kNone = 0,
     kExternal = 1,      ///< raised by the integration (e.g. a drive fault input)
     kStopFailed = 2,    ///< no controlled stop fits in one span: stopped at once
+    kReentryFailed = 3, ///< resume: no move back onto the path fits in one span
     kLimitSwitchBase = 0x100,
 };
 
@@ -470,7 +471,12 @@ private:
         Span<Axes> reentry;
         if (plan_reentry(rest_, boundary_, boundary_tangent_, boundary_ticks_, limits_, reentry) != Status::kOk ||
             !start_generated(reentry)) {
-            return;  // stays holding; the move cannot be planned within one span
+            // No move back onto the path fits in one span: a fault the master sees (rather
+            // than a hold that silently never resumes); reset, then restart the job.
+            fault_code_ = FaultCode::kReentryFailed;
+            stop_at_once();
+            set_state(DeviceState::kFault);
+            return;
         }
         generated_kind_ = Generated::kReentry;
         set_state(DeviceState::kRunning);
