@@ -14,6 +14,7 @@
 #include "pathstream/device/can_protocol.hpp"
 #include "pathstream/device/motion_device.hpp"
 #include "pathstream/device/wire_span.hpp"
+#include "pathstream/host/wire_plan.hpp"
 #include "pathstream/status.hpp"
 
 namespace pathstream::host {
@@ -303,34 +304,10 @@ private:
     // ---- plan and bookkeeping ------------------------------------------------------------
 
     void encode_plan() {
-        if (plan_.spans.empty()) throw std::invalid_argument("the plan has no spans");
-        axes_ = static_cast<unsigned>(plan_.spans.front().control.size());
-        if (axes_ < 1 || axes_ > 8) throw std::invalid_argument("1 to 8 axes");
-        std::int32_t previous_tangent[8] = {};
-        for (std::size_t i = 0; i < plan_.spans.size(); ++i) {
-            const CoreSpan& c = plan_.spans[i];
-            if (c.basis != Basis::kHermite) throw std::invalid_argument("only Hermite spans stream (planned paths are)");
-            device::WireSpan w;
-            w.ticks = c.ticks;
-            w.outputs = c.pen_down ? kOutputPenDown : std::uint8_t{0};
-            bool continues = i > 0;
-            for (unsigned a = 0; a < axes_; ++a) {
-                w.end[a] = c.control[a][1];
-                w.start_tangent[a] = c.control[a][2];
-                w.end_tangent[a] = c.control[a][3];
-                continues = continues && c.control[a][2] == previous_tangent[a];
-                previous_tangent[a] = c.control[a][3];
-            }
-            w.flags = continues ? device::kWireContinueTangent : 0;
-            std::vector<std::uint8_t> bytes(device::wire_span_bytes(axes_, continues));
-            if (device::encode_wire_span(w, axes_, bytes.data(), bytes.size()) != bytes.size()) {
-                throw std::invalid_argument("span " + std::to_string(i) + " cannot be encoded");
-            }
-            spans_.push_back(std::move(bytes));
-            ticks_.push_back(c.ticks);
-        }
-        prefix_ticks_.assign(ticks_.size() + 1, 0);
-        for (std::size_t i = 0; i < ticks_.size(); ++i) prefix_ticks_[i + 1] = prefix_ticks_[i] + ticks_[i];
+        WirePlan w = encode_wire_plan(plan_);
+        axes_ = w.axes;
+        spans_ = std::move(w.spans);
+        prefix_ticks_ = std::move(w.prefix_ticks);
     }
 
     std::uint64_t queued_ticks(const pc::Status3& s, std::size_t sent) const {
@@ -374,7 +351,6 @@ private:
     Clock::time_point last_heard_;
     unsigned axes_ = 0;
     std::vector<std::vector<std::uint8_t>> spans_;
-    std::vector<std::uint32_t> ticks_;
     std::vector<std::uint64_t> prefix_ticks_;
     std::uint32_t base_ = 1;
     std::uint32_t acknowledged_ = 0;

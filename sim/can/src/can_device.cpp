@@ -98,25 +98,8 @@ std::unique_ptr<SimulatedCanDevice> SimulatedCanDevice::create(const std::vector
 
 std::uint64_t run_can_device_loop(SimulatedCanDevice& device, hal::CanBus& bus, const DeviceLoopOptions& options,
                                   const std::atomic<bool>& stop) {
-    using clock = std::chrono::steady_clock;
-    if (!(options.time_scale > 0)) throw std::invalid_argument("time scale must be positive");
-    const auto begin = clock::now();
-    std::uint64_t ticks = 0;
-    double due_seconds = 0;  // tick k is due at begin + the sum of the tick periods before it
-    while (!stop.load(std::memory_order_relaxed)) {
-        const auto now = clock::now();
-        if (options.run_for.count() > 0 && now - begin >= options.run_for) break;
-        const double elapsed = std::chrono::duration<double>(now - begin).count();
-        while (due_seconds <= elapsed) {
-            device.tick();
-            ++ticks;
-            const std::uint32_t hz = device.tick_hz() != 0 ? device.tick_hz() : 1000;
-            due_seconds += 1.0 / (hz * options.time_scale);
-        }
-        const double wait = due_seconds - elapsed;
-        device.serve(bus, std::chrono::microseconds(wait > 0 ? static_cast<long>(wait * 1e6) : 0));
-    }
-    return ticks;
+    return run_paced_loop([&] { device.tick(); }, [&] { return device.tick_hz(); },
+                          [&](std::chrono::microseconds wait) { device.serve(bus, wait); }, options, stop);
 }
 
 }  // namespace pathstream::sim

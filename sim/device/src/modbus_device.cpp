@@ -83,29 +83,38 @@ std::unique_ptr<SimulatedModbusDevice> SimulatedModbusDevice::create(const std::
     });
 }
 
-std::uint64_t run_device_loop(SimulatedModbusDevice& device,
-                              const std::function<void(std::chrono::milliseconds)>& server_poll,
-                              const DeviceLoopOptions& options, const std::atomic<bool>& stop) {
+std::uint64_t run_paced_loop(const std::function<void()>& tick, const std::function<std::uint32_t()>& tick_hz,
+                             const std::function<void(std::chrono::microseconds)>& serve,
+                             const DeviceLoopOptions& options, const std::atomic<bool>& stop) {
     using clock = std::chrono::steady_clock;
     if (!(options.time_scale > 0)) throw std::invalid_argument("time scale must be positive");
     const auto begin = clock::now();
     std::uint64_t ticks = 0;
-    // Tick k is due at begin + sum of tick periods; the period follows the configured rate.
-    double due_seconds = 0;
+    double due_seconds = 0;  // tick k is due at begin + the sum of the tick periods before it
     while (!stop.load(std::memory_order_relaxed)) {
         const auto now = clock::now();
         if (options.run_for.count() > 0 && now - begin >= options.run_for) break;
         const double elapsed = std::chrono::duration<double>(now - begin).count();
         while (due_seconds <= elapsed) {
-            device.tick();
+            tick();
             ++ticks;
-            const std::uint32_t hz = device.tick_hz() != 0 ? device.tick_hz() : 1000;
+            const std::uint32_t hz = tick_hz() != 0 ? tick_hz() : 1000;
             due_seconds += 1.0 / (hz * options.time_scale);
         }
         const double wait = due_seconds - elapsed;
-        server_poll(std::chrono::milliseconds(wait >= 0.001 ? static_cast<long>(wait * 1000) : 0));
+        serve(std::chrono::microseconds(wait > 0 ? static_cast<long>(wait * 1e6) : 0));
     }
     return ticks;
+}
+
+std::uint64_t run_device_loop(SimulatedModbusDevice& device,
+                              const std::function<void(std::chrono::milliseconds)>& server_poll,
+                              const DeviceLoopOptions& options, const std::atomic<bool>& stop) {
+    return run_paced_loop([&] { device.tick(); }, [&] { return device.tick_hz(); },
+                          [&](std::chrono::microseconds wait) {
+                              server_poll(std::chrono::duration_cast<std::chrono::milliseconds>(wait));
+                          },
+                          options, stop);
 }
 
 }  // namespace pathstream::sim

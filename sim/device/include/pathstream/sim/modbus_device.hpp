@@ -78,6 +78,16 @@ struct DeviceLoopOptions {
     std::chrono::milliseconds run_for{0};
 };
 
+/// The pacing shared by every simulated device: calls `tick` whenever a tick falls due on the
+/// steady clock (period 1 / (tick_hz() x time_scale), tick_hz() read after every tick, 1 kHz
+/// while it is 0), and `serve` with the time left until the next one, until `stop` becomes
+/// true or options.run_for passes. Ticks that fall due while `serve` runs are run right after
+/// it, so the count never drifts. Returns the ticks run. Throws std::invalid_argument for a
+/// time scale <= 0.
+std::uint64_t run_paced_loop(const std::function<void()>& tick, const std::function<std::uint32_t()>& tick_hz,
+                             const std::function<void(std::chrono::microseconds)>& serve,
+                             const DeviceLoopOptions& options, const std::atomic<bool>& stop);
+
 /// Serves `server_poll` (a function polling the Modbus server for up to the given wait) and
 /// ticks `device` on the steady clock until `stop` becomes true or run_for passes. Ticks that
 /// fall due while a request is served run right after it (the count never drifts).
