@@ -75,10 +75,18 @@ struct DeviceThread {
             sim::run_device_loop(*device, [&](std::chrono::milliseconds w) { server->poll_once(w); }, {}, stop);
         });
     }
-    ~DeviceThread() {
+    void halt() {
         stop = true;
         if (thread.joinable()) thread.join();
     }
+    ~DeviceThread() { halt(); }
+};
+
+// Declared after the server it guards: joins the device thread before the server goes away,
+// on every exit from the scope (a failed REQUIRE included).
+struct HaltBeforeServer {
+    DeviceThread& thread;
+    ~HaltBeforeServer() { thread.halt(); }
 };
 
 // The configuration block for 2 axes at 1 kHz, 250,000 LSB/s and 3,000,000 LSB/s^2 per axis, as
@@ -172,6 +180,7 @@ TEST_CASE("mbpoll reads the simulated device's status block and drives its comma
         dt.device = sim::SimulatedModbusDevice::create({1234, -70000});
         hal::ModbusServer server = hal::ModbusServer::tcp(dt.device->handler(), {"127.0.0.1", 0, 4});
         dt.server = &server;
+        const HaltBeforeServer guard{dt};
         dt.run();
         check_device(program, "-m tcp -a 1 -o 2 -p " + std::to_string(server.port()) + " 127.0.0.1");
     }
@@ -180,6 +189,7 @@ TEST_CASE("mbpoll reads the simulated device's status block and drives its comma
         dt.device = sim::SimulatedModbusDevice::create({1234, -70000});
         hal::ModbusServer server = hal::ModbusServer::rtu_pty(dt.device->handler());
         dt.server = &server;
+        const HaltBeforeServer guard{dt};
         dt.run();
         check_device(program, "-m rtu -b 115200 -P none -a 1 -o 2 " + server.client_device());
     }
