@@ -7,6 +7,7 @@
 #include <thread>
 #include <vector>
 
+#include "stream_support.hpp"
 #include "pathstream/device/can_protocol.hpp"
 #include "pathstream/host/can_stream.hpp"
 #include "pathstream/host/core_playback.hpp"
@@ -19,35 +20,12 @@
 #include "pathstream/span.hpp"
 
 using namespace pathstream;
+using test::Job;
+using test::plan_example;
+using test::plan_setpoints;
+using test::start_of;
 
 namespace {
-
-struct Job {
-    host::MachineProfile machine;
-    host::Plan plan;
-};
-
-Job plan_wave() {
-    Job j;
-    j.machine = host::load_machine_profile(std::string(PATHSTREAM_SOURCE_DIR) + "/examples/machines/pen_plotter.json");
-    const host::Path path = host::load_json_path(std::string(PATHSTREAM_SOURCE_DIR) + "/examples/wave.json");
-    j.plan = host::plan_path(host::to_bezier_segments(path), j.machine);
-    return j;
-}
-
-std::vector<Lsb> plan_setpoints(const host::Plan& plan, std::size_t axes) {
-    std::vector<Lsb> out;
-    host::play_through_core(plan.spans, axes, [&](const host::PlayedTick& t) {
-        out.insert(out.end(), t.setpoint, t.setpoint + axes);
-    });
-    return out;
-}
-
-std::vector<Lsb> start_of(const host::Plan& plan) {
-    std::vector<Lsb> s;
-    for (const auto& c : plan.spans.front().control) s.push_back(c[0]);
-    return s;
-}
 
 // The device on loopback endpoint 0, served and ticked on its own thread.
 struct DeviceThread {
@@ -116,7 +94,7 @@ Run stream_over_loopback(const Job& job, const sim::CanFaults& faults, double ti
 }  // namespace
 
 TEST_CASE("a drawing streamed natively over CAN executes exactly the planned setpoints", "[can][stream]") {
-    const Job job = plan_wave();
+    const Job job = plan_example("wave.json");
     const Run r = stream_over_loopback(job, {});
     check_executed(job, *r.device, r.report);
     CHECK(r.report.spans_sent == job.plan.spans.size());
@@ -128,7 +106,7 @@ TEST_CASE("a drawing streamed natively over CAN executes exactly the planned set
 
 TEST_CASE("natively over CAN with 1 % of the frames lost, the device still executes every span once",
           "[can][stream]") {
-    const Job job = plan_wave();
+    const Job job = plan_example("wave.json");
     sim::CanFaults faults;
     faults.drop_fraction = 0.01;
     faults.seed = 42;
@@ -140,7 +118,7 @@ TEST_CASE("natively over CAN with 1 % of the frames lost, the device still execu
 }
 
 TEST_CASE("natively over CAN with a transmit budget per poll, frames wait and nothing is lost", "[can][stream]") {
-    const Job job = plan_wave();
+    const Job job = plan_example("wave.json");
     sim::CanFaults faults;
     faults.tx_budget = 4;
     const Run r = stream_over_loopback(job, faults);
@@ -149,7 +127,7 @@ TEST_CASE("natively over CAN with a transmit budget per poll, frames wait and no
 }
 
 TEST_CASE("bus-off at the device: the host stops with a clear error and the device holds", "[can][stream]") {
-    const Job job = plan_wave();
+    const Job job = plan_example("wave.json");
     sim::CanLoopback loop;
     hal::CanBus& device_bus = loop.add_endpoint();
     hal::CanBus& host_bus = loop.add_endpoint();
@@ -179,7 +157,7 @@ TEST_CASE("bus-off at the device: the host stops with a clear error and the devi
 }
 
 TEST_CASE("bus-off at the host: the streamer stops at once", "[can][stream]") {
-    const Job job = plan_wave();
+    const Job job = plan_example("wave.json");
     sim::CanLoopback loop;
     loop.add_endpoint();
     hal::CanBus& host_bus = loop.add_endpoint();
@@ -190,7 +168,7 @@ TEST_CASE("bus-off at the host: the streamer stops at once", "[can][stream]") {
 }
 
 TEST_CASE("a silent node: the streamer gives up after the link timeout", "[can][stream]") {
-    const Job job = plan_wave();
+    const Job job = plan_example("wave.json");
     sim::CanLoopback loop;
     loop.add_endpoint();
     hal::CanBus& host_bus = loop.add_endpoint();

@@ -24,6 +24,7 @@
 #include <thread>
 #include <vector>
 
+#include "stream_support.hpp"
 #include "pathstream/device/modbus_map.hpp"
 #include "pathstream/device/motion_device.hpp"
 #include "pathstream/hal/modbus_server.hpp"
@@ -38,39 +39,16 @@
 #include "pathstream/span.hpp"
 
 using namespace pathstream;
+using test::Job;
+using test::plan_example;
+using test::plan_setpoints;
+using test::start_of;
 using Catch::Matchers::Contains;
 using SteadyClock = std::chrono::steady_clock;
 
 namespace {
 
 namespace st = device::modbus::status;
-
-struct Job {
-    host::MachineProfile machine;
-    host::Plan plan;
-};
-
-Job plan_example(const std::string& name) {
-    Job j;
-    j.machine = host::load_machine_profile(std::string(PATHSTREAM_SOURCE_DIR) + "/examples/machines/pen_plotter.json");
-    const host::Path path = host::load_json_path(std::string(PATHSTREAM_SOURCE_DIR) + "/examples/" + name);
-    j.plan = host::plan_path(host::to_bezier_segments(path), j.machine);
-    return j;
-}
-
-std::vector<Lsb> plan_setpoints(const host::Plan& plan, std::size_t axes) {
-    std::vector<Lsb> out;
-    host::play_through_core(plan.spans, axes, [&](const host::PlayedTick& t) {
-        out.insert(out.end(), t.setpoint, t.setpoint + axes);
-    });
-    return out;
-}
-
-std::vector<Lsb> start_of(const host::Plan& plan) {
-    std::vector<Lsb> s;
-    for (const auto& c : plan.spans.front().control) s.push_back(c[0]);
-    return s;
-}
 
 // The device's recorded path ticks are the plan's setpoints, tick for tick, every span once.
 void check_executed(const Job& job, const sim::SimulatedModbusDevice& device, const host::StreamReport& report) {

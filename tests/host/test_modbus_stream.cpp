@@ -6,6 +6,7 @@
 #include <thread>
 #include <vector>
 
+#include "stream_support.hpp"
 #include "pathstream/hal/modbus_server.hpp"
 #include "pathstream/host/core_playback.hpp"
 #include "pathstream/host/geometry.hpp"
@@ -17,29 +18,12 @@
 #include "pathstream/span.hpp"
 
 using namespace pathstream;
+using test::Job;
+using test::plan_example;
+using test::plan_setpoints;
+using test::start_of;
 
 namespace {
-
-struct Job {
-    host::MachineProfile machine;
-    host::Plan plan;
-};
-
-Job plan_example(const std::string& name) {
-    Job j;
-    j.machine = host::load_machine_profile(std::string(PATHSTREAM_SOURCE_DIR) + "/examples/machines/pen_plotter.json");
-    const host::Path path = host::load_json_path(std::string(PATHSTREAM_SOURCE_DIR) + "/examples/" + name);
-    j.plan = host::plan_path(host::to_bezier_segments(path), j.machine);
-    return j;
-}
-
-std::vector<Lsb> plan_setpoints(const host::Plan& plan, std::size_t axes) {
-    std::vector<Lsb> out;
-    host::play_through_core(plan.spans, axes, [&](const host::PlayedTick& t) {
-        out.insert(out.end(), t.setpoint, t.setpoint + axes);
-    });
-    return out;
-}
 
 // Runs the device loop on its own thread until stopped.
 struct DeviceThread {
@@ -79,12 +63,6 @@ void check_executed(const Job& job, const sim::SimulatedModbusDevice& device, co
             REQUIRE((device.recorded_ticks()[k].outputs & kOutputPenDown) == (span.pen_down ? 1 : 0));
         }
     }
-}
-
-std::vector<Lsb> start_of(const host::Plan& plan) {
-    std::vector<Lsb> s;
-    for (const auto& c : plan.spans.front().control) s.push_back(c[0]);
-    return s;
 }
 
 }  // namespace
