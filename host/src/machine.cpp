@@ -154,7 +154,7 @@ private:
                 const std::string ptr = "/gpio/home/" + it.key();
                 const json& h = it.value();
                 if (!h.is_object()) fail(ptr, "homing must be an object with switch, search_velocity, latch_velocity, backoff, max_travel");
-                only_keys(h, ptr, {"switch", "search_velocity", "latch_velocity", "backoff", "max_travel", "position"});
+                only_keys(h, ptr, {"switch", "search_velocity", "latch_velocity", "backoff", "max_travel", "position", "pull_off"});
                 for (const char* key : {"switch", "search_velocity", "latch_velocity", "backoff", "max_travel"}) {
                     if (!h.contains(key)) fail(ptr, std::string("homing has no \"") + key + "\"");
                 }
@@ -178,6 +178,9 @@ private:
                                            hc.search_velocity, true, "mm/s");
                 hc.backoff = number(h["backoff"], ptr + "/backoff", "backoff", 0, 1e4, true, "mm");
                 hc.max_travel = number(h["max_travel"], ptr + "/max_travel", "max_travel", 0, 1e5, true, "mm");
+                hc.pull_off = h.contains("pull_off")
+                                  ? number(h["pull_off"], ptr + "/pull_off", "pull_off", 0, 1e4, false, "mm")
+                                  : hc.backoff;
                 if (h.contains("position")) hc.position = number(h["position"], ptr + "/position", "position", -1e5, 1e5, false, "mm");
                 c.home.push_back(hc);
             }

@@ -18,6 +18,7 @@
 #include "cli/setpoints_command.hpp"
 #include "cli/sim_command.hpp"
 #include "cli/stream_command.hpp"
+#include "pathstream/hal/gpio_gpiod.hpp"
 #include "pathstream/hal/modbus_error.hpp"
 
 namespace {
@@ -81,6 +82,9 @@ int main(int argc, char** argv) {
         return kExitDevice;
     } catch (const pathstream::hal::ModbusError& e) {
         std::cerr << "pathstream: device: " << e.what() << '\n';
+        return kExitDevice;
+    } catch (const pathstream::hal::GpioError& e) {
+        std::cerr << "pathstream: " << e.what() << '\n';
         return kExitDevice;
     } catch (const std::invalid_argument& e) {
         std::cerr << "pathstream: " << e.what() << '\n';

@@ -64,5 +64,14 @@ expect axes-mismatch 1 "the machine has 1 axes but" -- "$bin" plan "$src/example
 printf '{"axes": [{"name": "x", "max_velocity": -1, "max_acceleration": 1000}]}' > "$work/bad_machine.json"
 expect bad-machine 1 "bad_machine.json:1:41: max_velocity -1 mm/s is impossible" -- "$bin" plan "$src/examples/rose.json" -m "$work/bad_machine.json"
 
+# pathstream device --machine: configured from the profile; GPIO errors name chip and line.
+gpio_machine="$src/examples/machines/pen_plotter_gpio.json"
+sed 's/"gpiochip0"/"no-such-chip"/' "$gpio_machine" > "$work/gpio_nochip.json"
+expect device-machine 0 "x 250000 LSB/s 3000000 LSB/s^2" -- "$bin" device -m "$gpio_machine" --no-gpio --tcp 127.0.0.1:0 --exit-after 0.05
+expect device-no-chip 6 'gpio no-such-chip line "17": no GPIO chip is named or labelled "no-such-chip"' -- "$bin" device -m "$work/gpio_nochip.json" --tcp 127.0.0.1:0 --exit-after 0.05
+expect device-home-no-gpio 2 'no "gpio" object: --home has no switches' -- "$bin" device -m "$machine" --home --exit-after 0.05
+expect device-home-needs-machine 2 "--home: needs --machine" -- "$bin" device --home
+expect device-axes-and-machine 2 "the axis count comes from --machine" -- "$bin" device -m "$machine" --axes 3
+
 echo "cli: $passed passed, $failures failed"
 [ "$failures" -eq 0 ]

@@ -31,7 +31,10 @@ Result run_homing(Device& d, HomingSequencer<kAxes, 32>& h, Lsb trigger, bool po
     Result r;
     Lsb out[kAxes];
     for (std::uint32_t k = 0; k < max_ticks; ++k) {
-        const Lsb p = d.position(0);
+        // The switch sits at a physical place: after set zero (the machine rests on that tick)
+        // the coordinates moved by the difference between the two ticks.
+        const Lsb shift = r.set_at != 0 && r.x.size() > r.set_at ? r.x[r.set_at] - r.x[r.set_at - 1] : 0;
+        const Lsb p = d.position(0) - shift;
         const bool active = positive ? p >= trigger : p <= trigger;
         h.poll(active);
         if (!h.busy()) {
@@ -143,6 +146,54 @@ TEST_CASE("homing finds the switch, backs off, latches slowly and sets zero ther
         CHECK(d.accept_batch(d.last_accepted_sequence() + 1, static_cast<std::uint16_t>(spans.size()), bytes.data(),
                              bytes.size()) == Status::kOk);
     }
+}
+
+TEST_CASE("homing pulls off the switch after setting zero", "[device][homing]") {
+    for (bool positive : {false, true}) {
+        const Lsb start[kAxes] = {5000, 777};
+        const Lsb trigger = positive ? 20000 : 1000;
+        Device d(start);
+        REQUIRE(d.configure(test::test_limits<kAxes>()) == Status::kOk);
+        HomingSequencer<kAxes, 32> h(d);
+        HomingConfig c = config(positive);
+        c.home_position = positive ? 300000 : 0;
+        c.pull_off = 2000;
+        REQUIRE(h.start(c) == Status::kOk);
+        const Result r = run_homing(d, h, trigger, positive, 200000, [](std::uint32_t) {});
+        REQUIRE(r.finished);
+        REQUIRE(h.phase() == HomingPhase::kDone);
+        CHECK(d.state() == DeviceState::kIdle);
+        REQUIRE(r.set_at > 0);
+        // Set zero, then a rest-to-rest move of exactly pull_off away from the switch.
+        const Lsb physical = r.x[r.set_at - 1];
+        const Lsb zeroed = c.home_position + (physical - h.latch_position());
+        CHECK(d.position(0) == (positive ? zeroed - 2000 : zeroed + 2000));
+        CHECK(d.position(1) == 777);
+        // Off the switch: the physical position is 2000 LSB back from where the latch stop ended.
+        const Lsb physical_end = physical + (positive ? -2000 : 2000);
+        CHECK((positive ? physical_end < trigger : physical_end > trigger));
+        // The pull-off ticks (new coordinates) stay within the limits too.
+        for (std::size_t k = r.set_at + 2; k < r.x.size(); ++k) {
+            REQUIRE(std::abs(r.x[k] - r.x[k - 1]) <= 200);
+            REQUIRE(std::abs(r.x[k] - 2 * r.x[k - 1] + r.x[k - 2]) <= 3);
+        }
+    }
+}
+
+TEST_CASE("homing: a pull-off that does not clear the switch is an error", "[device][homing]") {
+    const Lsb start[kAxes] = {5000, 0};
+    Device d(start);
+    REQUIRE(d.configure(test::test_limits<kAxes>()) == Status::kOk);
+    HomingSequencer<kAxes, 32> h(d);
+    HomingConfig c = config();
+    c.pull_off = 10;  // the latch stop runs further past the switch point than this
+    c.latch_velocity = 50000;
+    REQUIRE(h.start(c) == Status::kOk);
+    const Result r = run_homing(d, h, 1000, false, 200000, [](std::uint32_t) {});
+    REQUIRE(r.finished);
+    CHECK(h.phase() == HomingPhase::kError);
+    CHECK(h.error() == HomingError::kSwitchStuck);
+    CHECK(d.state() == DeviceState::kIdle);
 }
 
 TEST_CASE("homing errors: switch never found, switch stuck, e-stop, bad config, wrong state", "[device][homing]") {

@@ -3,12 +3,21 @@
 #include <atomic>
 #include <csignal>
 #include <iostream>
+#include <memory>
+#include <optional>
 #include <stdexcept>
+#include <thread>
 
+#include "pathstream/device/gpio_logic.hpp"
 #include "pathstream/hal/modbus_server.hpp"
 #include "pathstream/hal/socketcan_bus.hpp"
-#include "pathstream/sim/can_device.hpp"
 #include "pathstream/host/atomic_file.hpp"
+#include "pathstream/host/device_setup.hpp"
+#include "pathstream/host/machine.hpp"
+#include "pathstream/host/modbus_stream.hpp"
+#include "pathstream/sim/can_device.hpp"
+#include "pathstream/sim/machine_homing.hpp"
+#include "pathstream/sim/machine_lines.hpp"
 #include "pathstream/sim/modbus_device.hpp"
 
 namespace pathstream::host {
@@ -17,8 +26,7 @@ namespace {
 std::atomic<bool> g_stop{false};
 extern "C" void on_signal(int) { g_stop.store(true); }
 
-template <typename Device>
-void write_record_any(const Device& d, const std::string& path) {
+void write_record(const sim::SimulatedMotionDevice& d, const std::string& path) {
     AtomicFile f(path);
     std::ostream& out = f.stream();
     static const char* const names[] = {"x", "y", "z", "a", "b", "c", "u", "v"};
@@ -35,71 +43,134 @@ void write_record_any(const Device& d, const std::string& path) {
     f.commit();
 }
 
-// ---- native CAN (docs/can.md): --can IFACE --node N ---------------------------------------
-// Kept here, not in DeviceCommandOptions, so this addition stays in this file.
-struct CanDeviceOptions {
-    std::string interface_name;
-    unsigned node = 1;
-};
-CanDeviceOptions g_can;
+// Logs the transitions an operator must see (e-stop, faults with their names, the way back
+// to idle); a streaming host sees the same in the status block.
+class StateLog {
+public:
+    void after_tick(const sim::SimulatedMotionDevice& d) {
+        const std::uint8_t s = d.state();
+        if (s == last_) return;
+        const auto st = static_cast<device::DeviceState>(s);
+        const auto was = static_cast<device::DeviceState>(last_);
+        last_ = s;
+        if (st == device::DeviceState::kEstop) {
+            std::cout << "pathstream device: E-STOP at tick " << d.ticks_run() << ": axes held, drives disabled; "
+                      << "release the e-stop and send reset" << std::endl;
+        } else if (st == device::DeviceState::kFault) {
+            char name[64];
+            device::fault_name(static_cast<device::FaultCode>(d.fault_code()), name, sizeof name);
+            std::cout << "pathstream device: FAULT at tick " << d.ticks_run() << ": " << name
+                      << "; drives disabled until reset" << std::endl;
+        } else if (st == device::DeviceState::kIdle &&
+                   (was == device::DeviceState::kEstop || was == device::DeviceState::kFault)) {
+            std::cout << "pathstream device: reset: idle at tick " << d.ticks_run() << std::endl;
+        }
+    }
 
-int run_can_device(const DeviceCommandOptions& o, const std::vector<Lsb>& start) {
-    auto device = sim::SimulatedCanDevice::create(start, static_cast<std::uint8_t>(g_can.node));
-    device->record(!o.record.empty());
-    hal::SocketCanBus bus(g_can.interface_name);
-    std::cout << "pathstream device: " << o.axes << " axes, native CAN node " << g_can.node << " on "
-              << g_can.interface_name << " (can://" << g_can.interface_name << "?node=" << g_can.node
-              << "&protocol=native)" << std::endl;
-    std::signal(SIGINT, on_signal);
-    std::signal(SIGTERM, on_signal);
+private:
+    std::uint8_t last_ = static_cast<std::uint8_t>(device::DeviceState::kIdle);
+};
+
+// Homes in real time (times --time-scale), before any bus is served: a host cannot start a
+// job on a half-homed machine. SIGINT/SIGTERM stop the axis where it is (controlled stop).
+void home(sim::SimulatedMotionDevice& device, sim::DeviceIo& io, const MachineProfile& profile, double time_scale) {
+    sim::DeviceLoopOptions loop;
+    loop.time_scale = time_scale;
+    StateLog state_log;
+    const auto run_until = [&](const std::function<bool()>& done) {
+        std::atomic<bool> finished{false};
+        sim::run_paced_loop(
+            [&] {
+                device.tick();
+                state_log.after_tick(device);
+                if (done() || g_stop.load()) finished.store(true);
+            },
+            [&] { return device.tick_hz(); }, [](std::chrono::microseconds w) { std::this_thread::sleep_for(w); },
+            loop, finished);
+        return done();
+    };
+    const auto log = [](const std::string& line) { std::cout << "pathstream device: " << line << std::endl; };
+    try {
+        (void)sim::home_axes(device, io, homing_setups(profile), profile.mm_per_lsb, run_until, log);
+    } catch (const sim::HomingFailed& e) {
+        throw StreamError(e.what());
+    }
+}
+
+// Configuration, GPIO and homing from the profile, shared by every transport.
+struct Machine {
+    std::optional<MachineProfile> profile;
+    std::optional<sim::MachineLines> lines;
+    sim::DeviceIo* io = nullptr;
+};
+
+Machine prepare_machine(sim::SimulatedMotionDevice& device, const DeviceCommandOptions& o,
+                        const std::optional<MachineProfile>& profile) {
+    Machine m;
+    if (!profile) return m;
+    m.profile = profile;
+    const DeviceLimitsLsb limits = device_limits(*profile);
+    if (Status s = device.configure(limits); s != Status::kOk) {
+        throw std::invalid_argument(profile->source + ": the device refused the profile's limits: " + status_name(s));
+    }
+    std::cout << "pathstream device: configured from " << profile->source << ": " << limits.tick_hz << " Hz ticks";
+    for (std::size_t a = 0; a < profile->axes.size(); ++a) {
+        std::cout << ", " << profile->axes[a].name << " " << limits.max_velocity[a] << " LSB/s "
+                  << limits.max_acceleration[a] << " LSB/s^2";
+    }
+    std::cout << std::endl;
+    if (profile->gpio.present && !o.no_gpio) {
+        m.lines.emplace(sim::MachineLines::open(*profile));
+        m.io = &device.attach_io(m.lines->wiring());
+        std::cout << "pathstream device: GPIO " << m.lines->summary() << std::endl;
+    }
+    if (o.home) {
+        if (m.io == nullptr) {
+            throw std::invalid_argument(profile->source + ": no \"gpio\" object: --home has no switches to home against");
+        }
+        if (profile->gpio.home.empty()) throw std::invalid_argument(profile->source + ": --home: gpio.home is empty");
+        home(device, *m.io, *profile, o.time_scale);
+    }
+    return m;
+}
+
+sim::DeviceLoopOptions loop_options(const DeviceCommandOptions& o) {
     sim::DeviceLoopOptions loop;
     loop.time_scale = o.time_scale;
     loop.run_for = std::chrono::milliseconds(static_cast<long>(o.exit_after * 1000));
-    const std::uint64_t ticks = sim::run_can_device_loop(*device, bus, loop, g_stop);
+    return loop;
+}
+
+int run_can_device(const DeviceCommandOptions& o, const std::vector<Lsb>& start,
+                   const std::optional<MachineProfile>& profile) {
+    auto device = sim::SimulatedCanDevice::create(start, static_cast<std::uint8_t>(o.node));
+    device->record(!o.record.empty());
+    const Machine machine = prepare_machine(*device, o, profile);
+    hal::SocketCanBus bus(o.can_interface);
+    std::cout << "pathstream device: " << device->axes() << " axes, native CAN node " << o.node << " on "
+              << o.can_interface << " (can://" << o.can_interface << "?node=" << o.node << "&protocol=native)"
+              << std::endl;
+    StateLog log;
+    const std::uint64_t ticks = sim::run_paced_loop(
+        [&] {
+            device->tick();
+            log.after_tick(*device);
+        },
+        [&] { return device->tick_hz(); }, [&](std::chrono::microseconds w) { device->serve(bus, w); },
+        loop_options(o), g_stop);
     const hal::SocketCanCounters& c = bus.counters();
     std::cout << "pathstream device: stopped after " << ticks << " ticks, " << c.frames_received << " frames in, "
               << c.frames_sent << " out, " << device->incomplete_transfers() << " incomplete and "
               << device->refused_batches() << " refused batches, " << c.error_frames << " error frames" << std::endl;
-    if (!o.record.empty()) write_record_any(*device, o.record);
+    if (!o.record.empty()) write_record(*device, o.record);
     return 0;
 }
 
-}  // namespace
-
-void add_device_command(CLI::App& app, DeviceCommandOptions& o) {
-    CLI::App* cmd = app.add_subcommand(
-        "device", "Run the simulated device (the firmware core) as a Modbus TCP or RTU server (docs/modbus.md)");
-    cmd->add_option("--axes", o.axes, "axis count")->capture_default_str()->check(CLI::Range(1, 8));
-    cmd->add_option("--position", o.position, "initial position, LSB per axis (default 0)")->delimiter(',');
-    cmd->add_option("--tcp", o.tcp, "serve Modbus TCP on HOST:PORT (port 0: any free port)")->capture_default_str();
-    cmd->add_flag("--rtu-pty", o.rtu_pty, "serve Modbus RTU on a new pseudo-terminal (prints its path)");
-    cmd->add_option("--rtu", o.rtu_device, "serve Modbus RTU on this serial device");
-    cmd->add_option("--baud", o.baud, "RTU baud rate")->capture_default_str();
-    cmd->add_option("--parity", o.parity, "RTU parity")->capture_default_str()->check(CLI::IsMember({"N", "E", "O"}));
-    cmd->add_option("--unit", o.unit, "RTU unit id")->capture_default_str()->check(CLI::Range(1, 247));
-    cmd->add_option("--time-scale", o.time_scale, "run ticks this many times faster than real time")
-        ->capture_default_str()
-        ->check(CLI::Range(0.01, 1000.0));
-    cmd->add_option("--record", o.record, "write every executed path tick to this CSV (tick,x,y,...,pen) at exit");
-    cmd->add_option("--can", g_can.interface_name, "serve the native CAN protocol on this SocketCAN interface (docs/can.md)");
-    cmd->add_option("--node", g_can.node, "CAN node id (with --can)")->capture_default_str()->check(CLI::Range(1, 127));
-    cmd->add_option("--exit-after", o.exit_after, "stop after this many seconds (default: at SIGINT/SIGTERM)")
-        ->check(CLI::Range(0.0, 1e6));
-}
-
-int run_device(const DeviceCommandOptions& o) {
-    std::vector<Lsb> start(o.axes, 0);
-    if (!o.position.empty()) {
-        if (o.position.size() != o.axes) {
-            std::cerr << "pathstream device: --position has " << o.position.size() << " values for " << o.axes
-                      << " axes\n";
-            return 2;
-        }
-        for (unsigned a = 0; a < o.axes; ++a) start[a] = o.position[a];
-    }
-    if (!g_can.interface_name.empty()) return run_can_device(o, start);
+int run_modbus_device(const DeviceCommandOptions& o, const std::vector<Lsb>& start,
+                      const std::optional<MachineProfile>& profile) {
     auto device = sim::SimulatedModbusDevice::create(start);
     device->record(!o.record.empty());
+    const Machine machine = prepare_machine(*device, o, profile);
     hal::ModbusServerOptions server_options;
     server_options.unit = o.unit;
     std::string url;
@@ -124,18 +195,84 @@ int run_device(const DeviceCommandOptions& o) {
         url = "modbus-tcp://" + endpoint.host + ":" + std::to_string(s.port()) + "?unit=" + std::to_string(o.unit);
         return s;
     }();
-    std::cout << "pathstream device: " << o.axes << " axes, serving " << url << std::endl;
-    std::signal(SIGINT, on_signal);
-    std::signal(SIGTERM, on_signal);
-    sim::DeviceLoopOptions loop;
-    loop.time_scale = o.time_scale;
-    loop.run_for = std::chrono::milliseconds(static_cast<long>(o.exit_after * 1000));
-    const std::uint64_t ticks =
-        sim::run_device_loop(*device, [&](std::chrono::milliseconds w) { server.poll_once(w); }, loop, g_stop);
+    std::cout << "pathstream device: " << device->axes() << " axes, serving " << url << std::endl;
+    StateLog log;
+    const std::uint64_t ticks = sim::run_paced_loop(
+        [&] {
+            device->tick();
+            log.after_tick(*device);
+        },
+        [&] { return device->tick_hz(); },
+        [&](std::chrono::microseconds w) {
+            server.poll_once(std::chrono::duration_cast<std::chrono::milliseconds>(w));
+        },
+        loop_options(o), g_stop);
     std::cout << "pathstream device: stopped after " << ticks << " ticks, " << server.counters().requests.load()
               << " requests (" << server.counters().exceptions.load() << " refused)" << std::endl;
-    if (!o.record.empty()) write_record_any(*device, o.record);
+    if (!o.record.empty()) write_record(*device, o.record);
     return 0;
+}
+
+}  // namespace
+
+void add_device_command(CLI::App& app, DeviceCommandOptions& o) {
+    CLI::App* cmd = app.add_subcommand(
+        "device",
+        "Run the simulated device (the firmware core) as a Modbus TCP/RTU server or a native CAN node "
+        "(docs/modbus.md, docs/can.md); with --machine wired to the profile's GPIO lines (docs/gpio.md)");
+    cmd->add_option("--axes", o.axes, "axis count (default 2, or the profile's)")->check(CLI::Range(1, 8));
+    cmd->add_option("--position", o.position, "initial position, LSB per axis (default 0)")->delimiter(',');
+    cmd->add_option("--tcp", o.tcp, "serve Modbus TCP on HOST:PORT (port 0: any free port)")->capture_default_str();
+    cmd->add_flag("--rtu-pty", o.rtu_pty, "serve Modbus RTU on a new pseudo-terminal (prints its path)");
+    cmd->add_option("--rtu", o.rtu_device, "serve Modbus RTU on this serial device");
+    cmd->add_option("--baud", o.baud, "RTU baud rate")->capture_default_str();
+    cmd->add_option("--parity", o.parity, "RTU parity")->capture_default_str()->check(CLI::IsMember({"N", "E", "O"}));
+    cmd->add_option("--unit", o.unit, "RTU unit id")->capture_default_str()->check(CLI::Range(1, 247));
+    cmd->add_option("--can", o.can_interface, "serve the native CAN protocol on this SocketCAN interface (docs/can.md)");
+    cmd->add_option("--node", o.node, "CAN node id (with --can)")->capture_default_str()->check(CLI::Range(1, 127));
+    cmd->add_option("--machine,-m", o.machine,
+                    "machine profile: configure the device from it (axes, tick rate, limits) and open its \"gpio\" "
+                    "lines: e-stop, limit switches, enable, pen (docs/gpio.md)")
+        ->check(CLI::ExistingFile);
+    cmd->add_flag("--no-gpio", o.no_gpio, "with --machine: do not open the profile's GPIO lines");
+    cmd->add_flag("--home", o.home, "home the axes of the profile's gpio.home (in profile order) before serving");
+    cmd->add_option("--time-scale", o.time_scale, "run ticks this many times faster than real time")
+        ->capture_default_str()
+        ->check(CLI::Range(0.01, 1000.0));
+    cmd->add_option("--record", o.record, "write every executed path tick to this CSV (tick,x,y,...,pen) at exit");
+    cmd->add_option("--exit-after", o.exit_after, "stop after this many seconds (default: at SIGINT/SIGTERM)")
+        ->check(CLI::Range(0.0, 1e6));
+    cmd->callback([cmd, &o] {
+        if (o.home && o.machine.empty()) throw CLI::ValidationError("--home", "needs --machine (the profile's gpio.home)");
+        if (o.no_gpio && o.machine.empty()) throw CLI::ValidationError("--no-gpio", "needs --machine");
+        if (o.no_gpio && o.home) throw CLI::ValidationError("--home", "homes against the GPIO switches: not with --no-gpio");
+        if (!o.can_interface.empty() && (o.rtu_pty || !o.rtu_device.empty() || cmd->count("--tcp") > 0)) {
+            throw CLI::ValidationError("--can", "serves CAN; --tcp, --rtu and --rtu-pty serve Modbus: choose one");
+        }
+        if (!o.machine.empty() && cmd->count("--axes") > 0) {
+            throw CLI::ValidationError("--axes", "the axis count comes from --machine");
+        }
+    });
+}
+
+int run_device(const DeviceCommandOptions& o) {
+    std::optional<MachineProfile> profile;
+    if (!o.machine.empty()) profile = load_machine_profile(o.machine);
+    const unsigned axes = profile ? static_cast<unsigned>(profile->axes.size()) : o.axes;
+    std::vector<Lsb> start(axes, 0);
+    if (!o.position.empty()) {
+        if (o.position.size() != axes) {
+            std::cerr << "pathstream device: --position has " << o.position.size() << " values for " << axes
+                      << " axes\n";
+            return 2;
+        }
+        for (unsigned a = 0; a < axes; ++a) start[a] = o.position[a];
+    }
+    // Before homing: an interrupted homing must stop cleanly too.
+    std::signal(SIGINT, on_signal);
+    std::signal(SIGTERM, on_signal);
+    if (!o.can_interface.empty()) return run_can_device(o, start, profile);
+    return run_modbus_device(o, start, profile);
 }
 
 }  // namespace pathstream::host

@@ -1,4 +1,6 @@
-// `pathstream device`: the simulated device (the firmware core) serving Modbus TCP or RTU.
+// `pathstream device`: the simulated device (the firmware core) serving Modbus TCP or RTU or
+// the native CAN protocol; with --machine configured from a profile and wired to its GPIO
+// lines (e-stop, limit switches, enable, pen), with --home homed before it serves.
 #pragma once
 
 #include <CLI/CLI.hpp>
@@ -17,6 +19,11 @@ struct DeviceCommandOptions {
     int baud = 115200;
     std::string parity = "N";
     int unit = 1;
+    std::string can_interface;  ///< native CAN on this SocketCAN interface instead of Modbus
+    unsigned node = 1;          ///< CAN node id
+    std::string machine;        ///< profile: configuration, GPIO lines and homing
+    bool no_gpio = false;       ///< with --machine: do not open the profile's GPIO lines
+    bool home = false;          ///< home the profile's gpio.home axes before serving
     double time_scale = 1.0;
     std::string record;
     double exit_after = 0;  ///< seconds of wall time; 0 = until SIGINT/SIGTERM

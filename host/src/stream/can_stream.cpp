@@ -14,6 +14,7 @@
 #include "pathstream/device/can_protocol.hpp"
 #include "pathstream/device/motion_device.hpp"
 #include "pathstream/device/wire_span.hpp"
+#include "pathstream/host/device_setup.hpp"
 #include "pathstream/host/wire_plan.hpp"
 #include "pathstream/status.hpp"
 
@@ -95,6 +96,14 @@ public:
     }
 
 private:
+    DeviceLimitsLsb limits_or_fail() const {
+        try {
+            return device_limits(profile_);
+        } catch (const std::range_error& e) {
+            fail(e.what());
+        }
+    }
+
     [[noreturn]] void fail(const std::string& what) const { throw StreamError(options_.name + ": " + what); }
 
     // ---- the bus -----------------------------------------------------------------------
@@ -220,17 +229,13 @@ private:
     }
 
     void configure() {
-        const auto hz = static_cast<std::uint32_t>(std::llround(profile_.tick_hz));
-        std::vector<pc::Frame> frames{pc::encode_config(node_, 0, static_cast<std::uint8_t>(axes_), hz)};
+        const DeviceLimitsLsb l = limits_or_fail();
+        std::vector<pc::Frame> frames{pc::encode_config(node_, 0, static_cast<std::uint8_t>(axes_), l.tick_hz)};
         for (unsigned a = 0; a < axes_; ++a) {
-            // Rounded up: the planner works to the profile's limits exactly.
-            const double v = std::ceil(profile_.axes[a].max_velocity / profile_.mm_per_lsb);
-            const double acc = std::ceil(profile_.axes[a].max_acceleration / profile_.mm_per_lsb);
-            if (v > 4294967295.0 || acc > 4294967295.0) fail("a limit does not fit the device's 32-bit values");
             frames.push_back(pc::encode_config(node_, pc::config_item_velocity(a), static_cast<std::uint8_t>(axes_),
-                                               static_cast<std::uint32_t>(v)));
+                                               l.max_velocity[a]));
             frames.push_back(pc::encode_config(node_, pc::config_item_acceleration(a),
-                                               static_cast<std::uint8_t>(axes_), static_cast<std::uint32_t>(acc)));
+                                               static_cast<std::uint8_t>(axes_), l.max_acceleration[a]));
         }
         const auto last_item = static_cast<std::uint8_t>(2 * axes_);
         while (true) {

@@ -12,6 +12,7 @@
 #include "pathstream/device/modbus_map.hpp"
 #include "pathstream/device/motion_device.hpp"
 #include "pathstream/device/wire_span.hpp"
+#include "pathstream/host/device_setup.hpp"
 #include "pathstream/host/wire_plan.hpp"
 #include "pathstream/hal/modbus_client.hpp"
 #include "pathstream/hal/modbus_error.hpp"
@@ -156,6 +157,14 @@ private:
         }
     }
 
+    DeviceLimitsLsb limits_or_fail() const {
+        try {
+            return device_limits(profile_);
+        } catch (const std::range_error& e) {
+            fail(e.what());
+        }
+    }
+
     [[noreturn]] void fail(const std::string& what) const {
         throw StreamError(options_.target + ": " + what);
     }
@@ -228,16 +237,12 @@ private:
 
     void configure() {
         std::vector<std::uint16_t> r(mb::config_registers(axes_), 0);
-        const auto hz = static_cast<std::uint32_t>(std::llround(profile_.tick_hz));
-        r[0] = static_cast<std::uint16_t>(hz >> 16);
-        r[1] = static_cast<std::uint16_t>(hz & 0xFFFFu);
+        const DeviceLimitsLsb l = limits_or_fail();
+        r[0] = static_cast<std::uint16_t>(l.tick_hz >> 16);
+        r[1] = static_cast<std::uint16_t>(l.tick_hz & 0xFFFFu);
         r[2] = static_cast<std::uint16_t>(axes_);
         for (unsigned a = 0; a < axes_; ++a) {
-            // Rounded up: the planner works to the profile's limits exactly.
-            const double v = std::ceil(profile_.axes[a].max_velocity / profile_.mm_per_lsb);
-            const double acc = std::ceil(profile_.axes[a].max_acceleration / profile_.mm_per_lsb);
-            if (v > 4294967295.0 || acc > 4294967295.0) fail("a limit does not fit the device's 32-bit registers");
-            const auto vv = static_cast<std::uint32_t>(v), aa = static_cast<std::uint32_t>(acc);
+            const std::uint32_t vv = l.max_velocity[a], aa = l.max_acceleration[a];
             r[mb::kConfigAxisBase + 4 * a] = static_cast<std::uint16_t>(vv >> 16);
             r[mb::kConfigAxisBase + 4 * a + 1] = static_cast<std::uint16_t>(vv & 0xFFFFu);
             r[mb::kConfigAxisBase + 4 * a + 2] = static_cast<std::uint16_t>(aa >> 16);

@@ -21,9 +21,10 @@ hal::CanFrame to_hal(const pc::Frame& f) {
 }
 
 template <unsigned Axes>
-class Device final : public SimulatedCanDevice {
+class Device final : public MotionDeviceBase<Axes, kCanDeviceCapacity, SimulatedCanDevice> {
 public:
-    Device(const Lsb (&start)[Axes], std::uint8_t node) : device_(start), node_(device_, node) {}
+    Device(const Lsb (&start)[Axes], std::uint8_t node)
+        : MotionDeviceBase<Axes, kCanDeviceCapacity, SimulatedCanDevice>(start), node_(this->device_, node) {}
 
     void serve(hal::CanBus& bus, std::chrono::microseconds wait) override {
         flush(bus);
@@ -45,22 +46,9 @@ public:
         }
     }
 
-    void tick() override {
-        Lsb out[Axes];
-        const std::uint64_t before = device_.ticks_executed();
-        device_.tick(out);
-        if (recording_ && device_.ticks_executed() != before) {
-            setpoints_.insert(setpoints_.end(), out, out + Axes);
-            ticks_.push_back({static_cast<std::uint8_t>(device_.state()), device_.outputs()});
-        }
-    }
-    unsigned axes() const override { return Axes; }
-    std::uint32_t tick_hz() const override { return device_.configured() ? device_.limits().tick_hz : 0; }
-    std::uint8_t state() const override { return static_cast<std::uint8_t>(device_.state()); }
-    Lsb position(unsigned axis) const override { return device_.position(axis); }
     std::uint32_t refused_batches() const override { return node_.refused_batches(); }
     std::uint32_t incomplete_transfers() const override { return node_.incomplete_transfers(); }
-    std::uint32_t duplicates() const override { return device_.duplicates(); }
+    std::uint32_t duplicates() const override { return this->device_.duplicates(); }
     std::uint64_t answers_dropped() const override { return dropped_; }
 
 private:
@@ -75,7 +63,6 @@ private:
         }
     }
 
-    device::MotionDevice<Axes, kCanDeviceCapacity> device_;
     pc::CanNode<Axes, kCanDeviceCapacity> node_;
     std::deque<hal::CanFrame> pending_;
     hal::CanBusState last_state_ = hal::CanBusState::kErrorActive;

@@ -44,30 +44,14 @@ private:
 };
 
 template <unsigned Axes>
-class Device final : public SimulatedModbusDevice {
+class Device final : public MotionDeviceBase<Axes, kModbusDeviceCapacity, SimulatedModbusDevice> {
 public:
-    explicit Device(const Lsb (&start)[Axes]) : device_(start), map_(device_), handler_(map_) {}
+    explicit Device(const Lsb (&start)[Axes])
+        : MotionDeviceBase<Axes, kModbusDeviceCapacity, SimulatedModbusDevice>(start), map_(this->device_), handler_(map_) {}
 
     hal::ModbusRegisterHandler& handler() override { return handler_; }
-    void tick() override {
-        Lsb out[Axes];
-        const std::uint64_t before = device_.ticks_executed();
-        device_.tick(out);
-        ++ticks_run_;
-        if (recording_every_tick_) every_tick_.insert(every_tick_.end(), out, out + Axes);
-        if (recording_ && device_.ticks_executed() != before) {  // a path tick
-            setpoints_.insert(setpoints_.end(), out, out + Axes);
-            ticks_.push_back({static_cast<std::uint8_t>(device_.state()), device_.outputs()});
-        }
-    }
-    unsigned axes() const override { return Axes; }
-    std::uint32_t tick_hz() const override { return device_.configured() ? device_.limits().tick_hz : 0; }
-    std::uint8_t state() const override { return static_cast<std::uint8_t>(device_.state()); }
-    Lsb position(unsigned axis) const override { return device_.position(axis); }
-    void raise_fault() override { device_.raise_fault(device::FaultCode::kExternal); }
 
 private:
-    device::MotionDevice<Axes, kModbusDeviceCapacity> device_;
     device::ModbusRegisterMap<Axes, kModbusDeviceCapacity> map_;
     MapHandler<Axes> handler_;
 };

@@ -23,6 +23,10 @@ struct HomingConfig {
     std::uint32_t backoff = 0;          ///< distance moved off the switch after the search; >= 1
     std::uint32_t max_travel = 0;       ///< the search gives up after this distance; >= 1
     Lsb home_position = 0;              ///< coordinate of the latch point after homing
+    /// Distance moved off the switch after zero is set (0: stay where the latch stop ended,
+    /// on the switch). A machine pulled off its switch can move either way without
+    /// re-triggering it, and the switch's next edge is a real event.
+    std::uint32_t pull_off = 0;
 };
 
 enum class HomingPhase : std::uint8_t {
@@ -35,6 +39,8 @@ enum class HomingPhase : std::uint8_t {
     kLatch,       ///< approaching at latch velocity
     kLatchStop,   ///< switch seen again: controlled stop
     kSetZero,     ///< set_position requested
+    kPullOff,     ///< moving off the switch in the new coordinates
+    kPullOffStop,
     kDone,
     kError,
 };
@@ -44,7 +50,7 @@ enum class HomingError : std::uint8_t {
     kBadConfig,       ///< a velocity, distance or the axis is out of range
     kDeviceRefused,   ///< the device refused a span, a command or set_position (error_status())
     kSwitchNotFound,  ///< the search covered max_travel without the switch
-    kSwitchStuck,     ///< the switch was still active after the back-off
+    kSwitchStuck,     ///< the switch was still active after the back-off or the pull-off
     kLatchNotFound,   ///< the slow approach did not find the switch again
     kInterrupted,     ///< the device went to fault or e-stop, or was stopped from outside
 };
@@ -207,7 +213,7 @@ public:
         error_ = HomingError::kNone;
         error_status_ = Status::kOk;
         if (config.axis >= Axes || config.search_velocity == 0 || config.latch_velocity == 0 || config.backoff == 0 ||
-            config.max_travel == 0 || config.max_travel > kMaxPositionLsb) {
+            config.max_travel == 0 || config.max_travel > kMaxPositionLsb || config.pull_off > kMaxPositionLsb) {
             return finish_error(HomingError::kBadConfig, Status::kBadLimits);
         }
         if (!device_.configured()) return finish_error(HomingError::kDeviceRefused, Status::kNotConfigured);
@@ -299,7 +305,25 @@ public:
                 }
                 break;
             case HomingPhase::kSetZero:
-                if (!device_.position_pending()) phase_ = HomingPhase::kDone;
+                if (device_.position_pending()) break;
+                if (config_.pull_off == 0) {
+                    phase_ = HomingPhase::kDone;
+                } else if (begin_move(-toward(config_.pull_off), config_.search_velocity) == Status::kOk) {
+                    phase_ = HomingPhase::kPullOff;
+                }
+                break;
+            case HomingPhase::kPullOff:
+                if (feed() && move_done(s)) {
+                    if (switch_active) {
+                        error_ = HomingError::kSwitchStuck;
+                        request_stop(HomingPhase::kError);
+                    } else {
+                        request_stop(HomingPhase::kPullOffStop);
+                    }
+                }
+                break;
+            case HomingPhase::kPullOffStop:
+                if (s == DeviceState::kIdle) phase_ = HomingPhase::kDone;
                 break;
             default:
                 break;

@@ -31,6 +31,9 @@ struct HomingAxisConfig {
     double backoff = 0;            ///< > 0
     double max_travel = 0;         ///< > 0
     double position = 0;           ///< coordinate of the switch point after homing
+    /// Distance moved off the switch after zero is set (>= 0; default: backoff), so the
+    /// machine ends homing off its switch.
+    double pull_off = 0;
 };
 
 /// Which chip lines do what. Absent from the profile: present == false.

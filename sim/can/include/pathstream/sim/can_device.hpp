@@ -20,24 +20,17 @@ inline constexpr std::uint32_t kCanDeviceCapacity = 64;
 
 /// A MotionDevice<axes, kCanDeviceCapacity> with its CAN node, type-erased over the axis
 /// count. Not thread-safe: one thread serves and ticks it.
-class SimulatedCanDevice {
+class SimulatedCanDevice : public SimulatedMotionDevice {
 public:
     /// `start`: initial position (LSB), its size is the axis count (1..8); `node` 1..127.
     /// Throws std::invalid_argument otherwise.
     static std::unique_ptr<SimulatedCanDevice> create(const std::vector<Lsb>& start, std::uint8_t node);
-    virtual ~SimulatedCanDevice() = default;
 
     /// Handles the frames `bus` delivers within `wait` (at least one wait for the first,
     /// then whatever is already there) and sends the answers; answers the bus refuses
     /// (transmit queue full) wait for the next call. Notices error-passive/bus-off (the node
     /// holds a running device: the link may be gone).
     virtual void serve(hal::CanBus& bus, std::chrono::microseconds wait) = 0;
-    /// One device tick; path ticks are recorded when recording.
-    virtual void tick() = 0;
-    virtual unsigned axes() const = 0;
-    virtual std::uint32_t tick_hz() const = 0;
-    virtual std::uint8_t state() const = 0;
-    virtual Lsb position(unsigned axis) const = 0;
     /// Batches refused for any reason but a lost data frame (queue full included).
     virtual std::uint32_t refused_batches() const = 0;
     /// Batches refused because a data frame was lost (the host resends them).
@@ -45,15 +38,6 @@ public:
     virtual std::uint32_t duplicates() const = 0;
     /// Answers dropped because they waited too long for a full transmit queue.
     virtual std::uint64_t answers_dropped() const = 0;
-
-    void record(bool on) { recording_ = on; }
-    const std::vector<Lsb>& recorded_setpoints() const { return setpoints_; }
-    const std::vector<DeviceTick>& recorded_ticks() const { return ticks_; }
-
-protected:
-    bool recording_ = false;
-    std::vector<Lsb> setpoints_;
-    std::vector<DeviceTick> ticks_;
 };
 
 /// Serves `bus` and ticks `device` on the steady clock (options.time_scale times real time)

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "pathstream/hal/modbus_register_handler.hpp"
+#include "pathstream/sim/simulated_motion_device.hpp"
 #include "pathstream/units.hpp"
 
 namespace pathstream::sim {
@@ -19,54 +20,16 @@ namespace pathstream::sim {
 /// Span queue depth of the simulated Modbus device.
 inline constexpr std::uint32_t kModbusDeviceCapacity = 64;
 
-/// One tick the device executed, as recorded.
-struct DeviceTick {
-    std::uint8_t state = 0;    ///< device::DeviceState after the tick
-    std::uint8_t outputs = 0;  ///< discrete outputs (pen) after the tick
-};
-
 /// A MotionDevice<axes, kModbusDeviceCapacity> with its register map, type-erased over the
 /// axis count. Not thread-safe: one thread serves and ticks it.
-class SimulatedModbusDevice {
+class SimulatedModbusDevice : public SimulatedMotionDevice {
 public:
     /// `start`: the axes' initial position (LSB), its size is the axis count (1..8).
     /// Throws std::invalid_argument for another size.
     static std::unique_ptr<SimulatedModbusDevice> create(const std::vector<Lsb>& start);
-    virtual ~SimulatedModbusDevice() = default;
 
     /// The register map as a transport's handler.
     virtual hal::ModbusRegisterHandler& handler() = 0;
-    /// One device tick; when recording and the tick was a path tick (supplied by an accepted
-    /// span, not a generated stop or re-entry move) appends its setpoints and outputs.
-    virtual void tick() = 0;
-    virtual unsigned axes() const = 0;
-    /// Tick rate the host configured (0 before configuration).
-    virtual std::uint32_t tick_hz() const = 0;
-    /// Device state (device::DeviceState as a number).
-    virtual std::uint8_t state() const = 0;
-    /// Setpoint of the last tick.
-    virtual Lsb position(unsigned axis) const = 0;
-    /// Raises an external fault (as a drive fault input would).
-    virtual void raise_fault() = 0;
-
-    /// Records every path tick from now on: setpoints[k * axes + axis] is path tick k's.
-    void record(bool on) { recording_ = on; }
-    const std::vector<Lsb>& recorded_setpoints() const { return setpoints_; }
-    const std::vector<DeviceTick>& recorded_ticks() const { return ticks_; }
-    /// Records every tick from now on, path or not (stop and re-entry moves, rest): what the
-    /// axes were actually commanded, for checking the device's own moves against the limits.
-    /// every_tick_setpoints()[k * axes + axis] is tick k's (k counted from the call).
-    void record_every_tick(bool on) { recording_every_tick_ = on; }
-    const std::vector<Lsb>& every_tick_setpoints() const { return every_tick_; }
-    std::uint64_t ticks_run() const { return ticks_run_; }
-
-protected:
-    bool recording_ = false;
-    bool recording_every_tick_ = false;
-    std::vector<Lsb> setpoints_;
-    std::vector<Lsb> every_tick_;
-    std::vector<DeviceTick> ticks_;
-    std::uint64_t ticks_run_ = 0;
 };
 
 /// How the device loop paces ticks.

@@ -1,0 +1,45 @@
+// What a device is told from a machine profile: its tick rate and limits in LSB, and homing
+// in LSB. One conversion for every transport (Modbus and CAN streamers, `pathstream device
+// --machine`), so a device configured by a host and one configured from the same profile
+// hold the same numbers.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "pathstream/device/homing.hpp"
+#include "pathstream/device/gpio_logic.hpp"
+#include "pathstream/host/machine.hpp"
+
+namespace pathstream::host {
+
+/// The device's configuration: tick rate (Hz) and per-axis limits (LSB/s, LSB/s^2).
+struct DeviceLimitsLsb {
+    std::uint32_t tick_hz = 0;
+    std::vector<std::uint32_t> max_velocity;
+    std::vector<std::uint32_t> max_acceleration;
+};
+
+/// The profile's limits rounded up to whole LSB (the planner works to the profile's limits
+/// exactly, so the device must allow them). Throws std::range_error naming the axis when a
+/// limit does not fit 32 bits.
+DeviceLimitsLsb device_limits(const MachineProfile& profile);
+
+/// Index of the axis called `name` in the profile. Throws std::invalid_argument if none.
+unsigned axis_index(const MachineProfile& profile, const std::string& name);
+
+/// One axis's homing in the device's units, and which switch ends it.
+struct HomingSetup {
+    std::string axis_name;          ///< "x"
+    std::string switch_name;        ///< "x-"
+    device::HomingConfig config;    ///< axis, direction, velocities and distances in LSB
+    device::LimitSide side = device::LimitSide::kNegative;
+};
+
+/// The profile's gpio.home entries (profile order) in LSB: velocities and distances rounded
+/// to the nearest LSB (at least 1), `pull_off` = the profile's pull_off. Throws
+/// std::range_error when a value does not fit the device's 32-bit fields.
+std::vector<HomingSetup> homing_setups(const MachineProfile& profile);
+
+}  // namespace pathstream::host

@@ -1,0 +1,71 @@
+#include "pathstream/host/device_setup.hpp"
+
+#include <cmath>
+#include <stdexcept>
+
+namespace pathstream::host {
+namespace {
+
+std::uint32_t fit_u32(double lsb, const std::string& what) {
+    if (!(lsb >= 0) || lsb > 4294967295.0) {
+        throw std::range_error(what + " (" + std::to_string(lsb) + " LSB) does not fit the device's 32-bit values");
+    }
+    return static_cast<std::uint32_t>(lsb);
+}
+
+// Homing distances and velocities: the nearest LSB, at least one (a positive profile value
+// never becomes a zero the sequencer would refuse).
+std::uint32_t positive_lsb(double mm, double mm_per_lsb, const std::string& what) {
+    const double v = std::round(mm / mm_per_lsb);
+    return fit_u32(v < 1 ? 1 : v, what);
+}
+
+}  // namespace
+
+DeviceLimitsLsb device_limits(const MachineProfile& profile) {
+    DeviceLimitsLsb l;
+    l.tick_hz = static_cast<std::uint32_t>(std::llround(profile.tick_hz));
+    for (const AxisLimits& a : profile.axes) {
+        // Rounded up: the planner works to the profile's limits exactly.
+        l.max_velocity.push_back(fit_u32(std::ceil(a.max_velocity / profile.mm_per_lsb), "axis " + a.name + " max_velocity"));
+        l.max_acceleration.push_back(
+            fit_u32(std::ceil(a.max_acceleration / profile.mm_per_lsb), "axis " + a.name + " max_acceleration"));
+    }
+    return l;
+}
+
+unsigned axis_index(const MachineProfile& profile, const std::string& name) {
+    for (std::size_t i = 0; i < profile.axes.size(); ++i) {
+        if (profile.axes[i].name == name) return static_cast<unsigned>(i);
+    }
+    throw std::invalid_argument("the machine profile has no axis \"" + name + "\"");
+}
+
+std::vector<HomingSetup> homing_setups(const MachineProfile& profile) {
+    std::vector<HomingSetup> out;
+    const double q = profile.mm_per_lsb;
+    for (const HomingAxisConfig& h : profile.gpio.home) {
+        HomingSetup s;
+        s.axis_name = h.axis;
+        s.switch_name = h.switch_name;
+        s.side = h.switch_name.back() == '+' ? device::LimitSide::kPositive : device::LimitSide::kNegative;
+        device::HomingConfig& c = s.config;
+        c.axis = axis_index(profile, h.axis);
+        c.toward_positive = s.side == device::LimitSide::kPositive;
+        const std::string where = "gpio.home." + h.axis + ".";
+        c.search_velocity = positive_lsb(h.search_velocity, q, where + "search_velocity");
+        c.latch_velocity = positive_lsb(h.latch_velocity, q, where + "latch_velocity");
+        c.backoff = positive_lsb(h.backoff, q, where + "backoff");
+        c.max_travel = positive_lsb(h.max_travel, q, where + "max_travel");
+        c.pull_off = h.pull_off > 0 ? positive_lsb(h.pull_off, q, where + "pull_off") : 0;
+        const double home = std::round(h.position / q);
+        if (std::fabs(home) > static_cast<double>(kMaxPositionLsb)) {
+            throw std::range_error(where + "position is beyond the device's position range");
+        }
+        c.home_position = static_cast<Lsb>(home);
+        out.push_back(s);
+    }
+    return out;
+}
+
+}  // namespace pathstream::host

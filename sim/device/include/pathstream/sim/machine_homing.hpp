@@ -1,0 +1,43 @@
+// Homing a simulated device's axes one after another through its DeviceIo (docs/gpio.md):
+// what `pathstream device --machine M --home` runs before it serves. The caller owns the
+// ticking (paced in real time by the CLI, as fast as possible with simulated switches in tests).
+#pragma once
+
+#include <functional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "pathstream/host/device_setup.hpp"
+#include "pathstream/sim/device_io.hpp"
+#include "pathstream/sim/simulated_motion_device.hpp"
+
+namespace pathstream::sim {
+
+/// Homing ended in an error; what() names the axis, the switch and the reason:
+/// "homing x: switch x- not found within 300 mm (max_travel)".
+class HomingFailed : public std::runtime_error {
+public:
+    using std::runtime_error::runtime_error;
+};
+
+/// One homed axis.
+struct HomedAxis {
+    std::string axis_name;
+    Lsb latch = 0;              ///< where the slow approach saw the switch (old coordinates)
+    std::int64_t overshoot = 0; ///< how far the search stop ran past the switch (LSB)
+    Lsb rest = 0;               ///< the axis's position afterwards (new coordinates)
+    std::uint64_t ticks = 0;    ///< ticks the axis's homing took
+};
+
+/// Ticks the device until `done()` is true; false if it gave up (interrupted by the user).
+using RunTicksUntil = std::function<bool(const std::function<bool()>& done)>;
+/// Receives one line of progress (phase changes) at a time.
+using HomingLog = std::function<void(const std::string& line)>;
+
+/// Homes `setups` in order. `device` must be configured and idle, `io` attached to it.
+/// Throws HomingFailed (with the device stopped: idle, or in fault/e-stop if that ended it).
+std::vector<HomedAxis> home_axes(SimulatedMotionDevice& device, DeviceIo& io, const std::vector<host::HomingSetup>& setups,
+                                 double mm_per_lsb, const RunTicksUntil& run_until, const HomingLog& log);
+
+}  // namespace pathstream::sim

@@ -1,0 +1,114 @@
+// What every simulated bus device (Modbus, native CAN) shares: a MotionDevice ticked by the
+// host, per-tick recording, self-configuration from a machine profile, and optional GPIO and
+// homing (DeviceIo). The bus side differs; this part is written once.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "pathstream/device/motion_device.hpp"
+#include "pathstream/host/device_setup.hpp"
+#include "pathstream/sim/device_io.hpp"
+#include "pathstream/units.hpp"
+
+namespace pathstream::sim {
+
+/// One tick the device executed, as recorded.
+struct DeviceTick {
+    std::uint8_t state = 0;    ///< device::DeviceState after the tick
+    std::uint8_t outputs = 0;  ///< discrete outputs (pen) after the tick
+};
+
+/// A MotionDevice type-erased over the axis count. Not thread-safe: one thread serves and
+/// ticks it.
+class SimulatedMotionDevice {
+public:
+    virtual ~SimulatedMotionDevice() = default;
+
+    /// One device tick (with the I/O's inputs before and outputs after it, when attached);
+    /// when recording and the tick was a path tick (supplied by an accepted span, not a
+    /// generated stop or re-entry move) appends its setpoints and outputs.
+    virtual void tick() = 0;
+    virtual unsigned axes() const = 0;
+    /// Tick rate the device is configured for (0 before configuration).
+    virtual std::uint32_t tick_hz() const = 0;
+    /// Device state (device::DeviceState as a number).
+    virtual std::uint8_t state() const = 0;
+    /// Fault code (device::FaultCode as a number; 0 = none).
+    virtual std::uint16_t fault_code() const = 0;
+    /// Setpoint of the last tick.
+    virtual Lsb position(unsigned axis) const = 0;
+    /// Raises an external fault (as a drive fault input would).
+    virtual void raise_fault() = 0;
+    /// Configures the device as a host's configuration would (idle only). Returns the
+    /// device's Status (kBadLimits for zero limits or a wrong axis count, kWrongState).
+    [[nodiscard]] virtual Status configure(const host::DeviceLimitsLsb& limits) = 0;
+    /// Wires the device to discrete lines; from now on every tick polls the inputs before
+    /// it and drives the outputs after it. The lines must outlive the device. Init context.
+    virtual DeviceIo& attach_io(const MachineWiring& wiring) = 0;
+
+    /// Records every path tick from now on: setpoints[k * axes + axis] is path tick k's.
+    void record(bool on) { recording_ = on; }
+    const std::vector<Lsb>& recorded_setpoints() const { return setpoints_; }
+    const std::vector<DeviceTick>& recorded_ticks() const { return ticks_; }
+    /// Records every tick from now on, path or not (stop and re-entry moves, rest): what the
+    /// axes were actually commanded, for checking the device's own moves against the limits.
+    /// every_tick_setpoints()[k * axes + axis] is tick k's (k counted from the call).
+    void record_every_tick(bool on) { recording_every_tick_ = on; }
+    const std::vector<Lsb>& every_tick_setpoints() const { return every_tick_; }
+    std::uint64_t ticks_run() const { return ticks_run_; }
+
+protected:
+    bool recording_ = false;
+    bool recording_every_tick_ = false;
+    std::vector<Lsb> setpoints_;
+    std::vector<Lsb> every_tick_;
+    std::vector<DeviceTick> ticks_;
+    std::uint64_t ticks_run_ = 0;
+};
+
+/// The shared half of a simulated device class: `Interface` (a SimulatedMotionDevice) with
+/// its MotionDevice<Axes, Capacity> and the common functions implemented.
+template <unsigned Axes, std::uint32_t Capacity, typename Interface>
+class MotionDeviceBase : public Interface {
+public:
+    explicit MotionDeviceBase(const Lsb (&start)[Axes]) : device_(start) {}
+
+    void tick() override {
+        if (io_) io_->before_tick();
+        Lsb out[Axes];
+        const std::uint64_t before = device_.ticks_executed();
+        device_.tick(out);
+        if (io_) io_->after_tick();
+        ++this->ticks_run_;
+        if (this->recording_every_tick_) this->every_tick_.insert(this->every_tick_.end(), out, out + Axes);
+        if (this->recording_ && device_.ticks_executed() != before) {  // a path tick
+            this->setpoints_.insert(this->setpoints_.end(), out, out + Axes);
+            this->ticks_.push_back({static_cast<std::uint8_t>(device_.state()), device_.outputs()});
+        }
+    }
+    unsigned axes() const override { return Axes; }
+    std::uint32_t tick_hz() const override { return device_.configured() ? device_.limits().tick_hz : 0; }
+    std::uint8_t state() const override { return static_cast<std::uint8_t>(device_.state()); }
+    std::uint16_t fault_code() const override { return static_cast<std::uint16_t>(device_.fault_code()); }
+    Lsb position(unsigned axis) const override { return device_.position(axis); }
+    void raise_fault() override { device_.raise_fault(device::FaultCode::kExternal); }
+    Status configure(const host::DeviceLimitsLsb& l) override {
+        if (l.max_velocity.size() != Axes || l.max_acceleration.size() != Axes) return Status::kBadLimits;
+        device::MotionLimits<Axes> m;
+        m.tick_hz = l.tick_hz;
+        for (unsigned a = 0; a < Axes; ++a) m.axis[a] = {l.max_velocity[a], l.max_acceleration[a]};
+        return device_.configure(m);
+    }
+    DeviceIo& attach_io(const MachineWiring& wiring) override {
+        io_ = std::make_unique<DeviceIoFor<Axes, Capacity>>(device_, wiring);
+        return *io_;
+    }
+
+protected:
+    device::MotionDevice<Axes, Capacity> device_;
+    std::unique_ptr<DeviceIo> io_;
+};
+
+}  // namespace pathstream::sim

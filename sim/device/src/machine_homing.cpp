@@ -1,0 +1,103 @@
+#include "pathstream/sim/machine_homing.hpp"
+
+#include <sstream>
+
+#include "pathstream/device/gpio_logic.hpp"
+#include "pathstream/status.hpp"
+
+namespace pathstream::sim {
+namespace {
+
+std::string mm(double lsb, double mm_per_lsb) {
+    std::ostringstream s;
+    s.precision(3);
+    s << std::fixed << lsb * mm_per_lsb << " mm";
+    return s.str();
+}
+
+const char* phase_text(device::HomingPhase p) {
+    switch (p) {
+        case device::HomingPhase::kSearch: return "searching";
+        case device::HomingPhase::kSearchStop: return "switch seen, stopping";
+        case device::HomingPhase::kBackoff: return "backing off";
+        case device::HomingPhase::kLatch: return "approaching slowly";
+        case device::HomingPhase::kSetZero: return "setting zero";
+        case device::HomingPhase::kPullOff: return "pulling off the switch";
+        default: return nullptr;
+    }
+}
+
+std::string failure(const SimulatedMotionDevice& d, const DeviceIo& io, const host::HomingSetup& s, double q) {
+    const device::HomingConfig& c = s.config;
+    std::string why;
+    switch (io.homing_error()) {
+        case device::HomingError::kSwitchNotFound:
+            why = "switch " + s.switch_name + " not found within " + mm(c.max_travel, q) + " (max_travel)";
+            break;
+        case device::HomingError::kSwitchStuck:
+            why = "switch " + s.switch_name + " still active after moving off it (backoff " + mm(c.backoff, q) +
+                  ", pull_off " + mm(c.pull_off, q) + "): check its wiring and active_low";
+            break;
+        case device::HomingError::kLatchNotFound:
+            why = "the slow approach did not find switch " + s.switch_name + " again";
+            break;
+        case device::HomingError::kInterrupted: {
+            char name[64];
+            device::fault_name(static_cast<device::FaultCode>(d.fault_code()), name, sizeof name);
+            why = d.state() == static_cast<std::uint8_t>(device::DeviceState::kEstop)
+                      ? std::string("interrupted by the e-stop")
+                      : std::string("interrupted by a fault: ") + name;
+            break;
+        }
+        case device::HomingError::kBadConfig: why = "a homing velocity or distance is out of range"; break;
+        case device::HomingError::kDeviceRefused:
+            why = std::string("the device refused a homing step: ") + status_name(io.homing_error_status());
+            break;
+        case device::HomingError::kNone: why = "stopped"; break;
+    }
+    return "homing " + s.axis_name + ": " + why;
+}
+
+}  // namespace
+
+std::vector<HomedAxis> home_axes(SimulatedMotionDevice& device, DeviceIo& io, const std::vector<host::HomingSetup>& setups,
+                                 double mm_per_lsb, const RunTicksUntil& run_until, const HomingLog& log) {
+    std::vector<HomedAxis> homed;
+    for (const host::HomingSetup& s : setups) {
+        const device::HomingConfig& c = s.config;
+        log("homing " + s.axis_name + " toward switch " + s.switch_name + ": search at " +
+            mm(c.search_velocity, mm_per_lsb) + "/s for at most " + mm(c.max_travel, mm_per_lsb) + ", latch at " +
+            mm(c.latch_velocity, mm_per_lsb) + "/s");
+        if (Status st = io.start_homing(c, s.side); st != Status::kOk) {
+            if (st == Status::kBadLimits && io.homing_phase() != device::HomingPhase::kError) {
+                throw HomingFailed("homing " + s.axis_name + ": switch " + s.switch_name + " is not wired");
+            }
+            throw HomingFailed(failure(device, io, s, mm_per_lsb));
+        }
+        const std::uint64_t t0 = device.ticks_run();
+        device::HomingPhase shown = device::HomingPhase::kStarting;
+        const bool finished = run_until([&] {
+            const device::HomingPhase p = io.homing_phase();
+            if (p != shown) {
+                shown = p;
+                if (const char* t = phase_text(p)) log("  " + s.axis_name + ": " + t);
+            }
+            return !io.homing_busy();
+        });
+        if (!finished) throw HomingFailed("homing " + s.axis_name + ": interrupted");
+        if (io.homing_phase() != device::HomingPhase::kDone) throw HomingFailed(failure(device, io, s, mm_per_lsb));
+        HomedAxis h;
+        h.axis_name = s.axis_name;
+        h.latch = io.latch_position();
+        h.overshoot = io.search_overshoot();
+        h.rest = device.position(c.axis);
+        h.ticks = device.ticks_run() - t0;
+        log("  " + s.axis_name + ": homed: switch point = " + mm(c.home_position, mm_per_lsb) + ", now at " +
+            mm(h.rest, mm_per_lsb) + " (search overshoot " + mm(static_cast<double>(h.overshoot), mm_per_lsb) + ", " +
+            std::to_string(h.ticks) + " ticks)");
+        homed.push_back(h);
+    }
+    return homed;
+}
+
+}  // namespace pathstream::sim

@@ -1,0 +1,45 @@
+// A machine profile's GPIO lines opened through libgpiod (docs/gpio.md): what
+// `pathstream device --machine` and the VM test's driver wire a device to.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "pathstream/hal/digital_output.hpp"
+#include "pathstream/hal/gpio.hpp"
+#include "pathstream/hal/gpio_gpiod.hpp"
+#include "pathstream/host/machine.hpp"
+#include "pathstream/sim/device_io.hpp"
+
+namespace pathstream::sim {
+
+/// The libgpiod request for one profile line (chip from the gpio object).
+hal::GpioLineSpec line_spec(const std::string& chip, const host::GpioLineConfig& line);
+
+/// Owns the requested lines. Outputs start inactive (drives disabled, pen up).
+class MachineLines {
+public:
+    /// Requests every line the profile's "gpio" object names, consumers "pathstream-<function>"
+    /// (gpioinfo shows them). Throws hal::GpioError naming chip, line and function's failure
+    /// (no such chip or line, busy with its holder named), std::invalid_argument when the
+    /// profile has no gpio object.
+    static MachineLines open(const host::MachineProfile& profile);
+
+    MachineLines(MachineLines&&) = default;
+    MachineLines& operator=(MachineLines&&) = default;
+
+    /// Pointers into the owned lines; valid while this object lives.
+    const MachineWiring& wiring() const { return wiring_; }
+    /// "enable=enable estop=estop pen=0 x-=limit-x ..." on chip: what was opened, for the log.
+    const std::string& summary() const { return summary_; }
+
+private:
+    MachineLines() = default;
+    std::vector<std::unique_ptr<hal::DigitalInput>> inputs_;
+    std::vector<std::unique_ptr<hal::DigitalOutput>> outputs_;
+    MachineWiring wiring_;
+    std::string summary_;
+};
+
+}  // namespace pathstream::sim
