@@ -34,6 +34,17 @@ DeviceLimitsLsb device_limits(const MachineProfile& profile) {
     return l;
 }
 
+std::string fault_text(std::uint16_t fault_code) {
+    char name[64];
+    device::fault_name(static_cast<device::FaultCode>(fault_code), name, sizeof name);
+    return name;
+}
+
+std::string fault_suffix(unsigned state, std::uint16_t fault_code) {
+    if (state != static_cast<unsigned>(device::DeviceState::kFault)) return "";
+    return " (" + fault_text(fault_code) + ")";
+}
+
 unsigned axis_index(const MachineProfile& profile, const std::string& name) {
     for (std::size_t i = 0; i < profile.axes.size(); ++i) {
         if (profile.axes[i].name == name) return static_cast<unsigned>(i);

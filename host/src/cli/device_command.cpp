@@ -151,7 +151,7 @@ int run_can_device(const DeviceCommandOptions& o, const std::vector<Lsb>& start,
               << o.can_interface << " (can://" << o.can_interface << "?node=" << o.node << "&protocol=native)"
               << std::endl;
     StateLog log;
-    const std::uint64_t ticks = sim::run_paced_loop(
+    sim::run_paced_loop(
         [&] {
             device->tick();
             log.after_tick(*device);
@@ -159,7 +159,7 @@ int run_can_device(const DeviceCommandOptions& o, const std::vector<Lsb>& start,
         [&] { return device->tick_hz(); }, [&](std::chrono::microseconds w) { device->serve(bus, w); },
         loop_options(o), g_stop);
     const hal::SocketCanCounters& c = bus.counters();
-    std::cout << "pathstream device: stopped after " << ticks << " ticks, " << c.frames_received << " frames in, "
+    std::cout << "pathstream device: stopped after " << device->ticks_run() << " ticks, " << c.frames_received << " frames in, "
               << c.frames_sent << " out, " << device->incomplete_transfers() << " incomplete and "
               << device->refused_batches() << " refused batches, " << c.error_frames << " error frames" << std::endl;
     if (!o.record.empty()) write_record(*device, o.record);
@@ -197,7 +197,7 @@ int run_modbus_device(const DeviceCommandOptions& o, const std::vector<Lsb>& sta
     }();
     std::cout << "pathstream device: " << device->axes() << " axes, serving " << url << std::endl;
     StateLog log;
-    const std::uint64_t ticks = sim::run_paced_loop(
+    sim::run_paced_loop(
         [&] {
             device->tick();
             log.after_tick(*device);
@@ -207,7 +207,7 @@ int run_modbus_device(const DeviceCommandOptions& o, const std::vector<Lsb>& sta
             server.poll_once(std::chrono::duration_cast<std::chrono::milliseconds>(w));
         },
         loop_options(o), g_stop);
-    std::cout << "pathstream device: stopped after " << ticks << " ticks, " << server.counters().requests.load()
+    std::cout << "pathstream device: stopped after " << device->ticks_run() << " ticks, " << server.counters().requests.load()
               << " requests (" << server.counters().exceptions.load() << " refused)" << std::endl;
     if (!o.record.empty()) write_record(*device, o.record);
     return 0;

@@ -221,8 +221,8 @@ private:
             fail(m.str());
         }
         if (s.state != 0) {
-            m << "device is " << state_name(s.state) << " (fault code " << s.fault_code
-              << "), not idle: reset or stop it first";
+            m << "device is " << state_name(s.state) << fault_suffix(s.state, s.fault_code)
+              << ", not idle: reset or stop it first";
             fail(m.str());
         }
         start_ticks_ = s.ticks_executed;
@@ -332,8 +332,8 @@ private:
         }
         if (s.state == static_cast<std::uint8_t>(device::DeviceState::kFault) ||
             s.state == static_cast<std::uint8_t>(device::DeviceState::kEstop)) {
-            m << "device stopped in " << state_name(s.state) << " (fault code 0x" << std::hex << s.fault_code
-              << std::dec << ") after span " << (s.last_completed >= base_ ? s.last_completed - base_ + 1 : 0);
+            m << "device stopped in " << state_name(s.state) << fault_suffix(s.state, s.fault_code) << " after span "
+              << (s.last_completed >= base_ ? s.last_completed - base_ + 1 : 0);
             fail(m.str());
         }
         // The device applies a start at its next tick: idle right after the acknowledged start

@@ -218,8 +218,8 @@ private:
             fail(m.str());
         }
         if (s.state != 0) {
-            m << "device is " << state_name(s.state) << " (fault code " << s.fault
-              << "), not idle: reset or stop it first";
+            m << "device is " << state_name(s.state) << fault_suffix(s.state, s.fault)
+              << ", not idle: reset or stop it first";
             fail(m.str());
         }
         for (unsigned a = 0; a < axes_; ++a) {
@@ -420,8 +420,8 @@ private:
         check_restart(s);
         if (s.state == static_cast<std::uint16_t>(device::DeviceState::kFault) ||
             s.state == static_cast<std::uint16_t>(device::DeviceState::kEstop)) {
-            m << "device stopped in " << state_name(s.state) << " (fault code 0x" << std::hex << s.fault << std::dec
-              << ") after " << s.last_completed << " spans";
+            m << "device stopped in " << state_name(s.state) << fault_suffix(s.state, s.fault) << " after "
+              << s.last_completed << " spans";
             fail(m.str());
         }
         if (started && s.state == static_cast<std::uint16_t>(device::DeviceState::kIdle)) {

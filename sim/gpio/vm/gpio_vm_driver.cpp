@@ -29,6 +29,7 @@
 #include "pathstream/host/input_error.hpp"
 #include "pathstream/host/machine.hpp"
 #include "pathstream/sim/device_gpio.hpp"
+#include "pathstream/sim/machine_lines.hpp"
 
 namespace {
 
@@ -47,17 +48,7 @@ void sleep_until_ns(std::uint64_t t) {
     clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr);
 }
 
-hal::GpioLineSpec spec(const std::string& chip, const host::GpioLineConfig& c) {
-    hal::GpioLineSpec s;
-    s.chip = chip;
-    s.line = c.line;
-    s.active_low = c.active_low;
-    s.bias = c.bias == "pull-up"     ? hal::Bias::kPullUp
-             : c.bias == "pull-down" ? hal::Bias::kPullDown
-             : c.bias == "disable"   ? hal::Bias::kDisable
-                                     : hal::Bias::kAsIs;
-    return s;
-}
+hal::GpioLineSpec spec(const std::string& chip, const host::GpioLineConfig& c) { return sim::line_spec(chip, c); }
 
 // The plotter: device, lines, glue, and a feeder that keeps it moving back and forth.
 struct Plotter {

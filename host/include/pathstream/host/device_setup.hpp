@@ -29,6 +29,12 @@ DeviceLimitsLsb device_limits(const MachineProfile& profile);
 /// Index of the axis called `name` in the profile. Throws std::invalid_argument if none.
 unsigned axis_index(const MachineProfile& profile, const std::string& name);
 
+/// A device's fault code as its name: "limit switch x- (axis 0, negative side)",
+/// "external fault", "fault 0x1234" (device::fault_name).
+std::string fault_text(std::uint16_t fault_code);
+/// " (<fault_text>)" for the fault state, "" for any other state (a DeviceState number).
+std::string fault_suffix(unsigned state, std::uint16_t fault_code);
+
 /// One axis's homing in the device's units, and which switch ends it.
 struct HomingSetup {
     std::string axis_name;          ///< "x"
