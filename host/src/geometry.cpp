@@ -178,4 +178,24 @@ PathPoint bezier_d2(const BezierSegment& s, double u) {
     return r;
 }
 
+void prepend_lead_in(std::vector<BezierSegment>& segments, const PathPoint& from) {
+    if (segments.empty()) return;
+    const PathPoint to = segments.front().p[0];
+    if (from.size() != to.size()) {
+        throw std::invalid_argument("lead-in: the machine has " + std::to_string(from.size()) + " axes, the path " +
+                                    std::to_string(to.size()));
+    }
+    if (from == to) return;
+    BezierSegment travel;
+    travel.pen_down = false;
+    travel.subpath = 0;
+    for (int k = 0; k < 4; ++k) {
+        travel.p[k].resize(from.size());
+        for (std::size_t i = 0; i < from.size(); ++i) travel.p[k][i] = from[i] + (to[i] - from[i]) * k / 3.0;
+    }
+    travel.p[0] = from;
+    travel.p[3] = to;  // exactly the path's start: consecutive segments share end points
+    segments.insert(segments.begin(), travel);
+}
+
 }  // namespace pathstream::host

@@ -98,3 +98,37 @@ TEST_CASE("a drawing streamed over Modbus RTU on a pty executes exactly the plan
     dt.thread.join();
     check_executed(job, *dt.device, report);
 }
+
+TEST_CASE("--lead-in: a device resting elsewhere (after homing) gets a pen-up move to the drawing first",
+          "[modbus][stream]") {
+    const Job drawing = plan_example("rose.json");
+    const Lsb rest[2] = {5000, -7000};  // where homing left the machine, not the drawing's start
+    DeviceThread dt;
+    dt.device = sim::SimulatedModbusDevice::create({rest[0], rest[1]});
+    dt.device->record(true);
+    hal::ModbusServer server = hal::ModbusServer::tcp(dt.device->handler(), {"127.0.0.1", 0, 4});
+    dt.run(server, 20.0);
+    host::StreamOptions o;
+    o.target = "modbus-tcp://127.0.0.1:" + std::to_string(server.port()) + "?unit=1";
+    // Without the lead-in the streamer refuses, naming both points.
+    CHECK_THROWS_WITH(host::stream_modbus(drawing.plan, drawing.machine, o),
+                      Catch::Contains("device rests at 5000 -7000 LSB but the plan starts at 139322 100000 LSB"));
+    const std::vector<Lsb> at = host::modbus_rest_position(drawing.machine, o);
+    REQUIRE(at == std::vector<Lsb>{5000, -7000});
+    const host::Path path = host::load_json_path(std::string(PATHSTREAM_SOURCE_DIR) + "/examples/rose.json");
+    std::vector<host::BezierSegment> segments = host::to_bezier_segments(path);
+    host::prepend_lead_in(segments, {at[0] * drawing.machine.mm_per_lsb, at[1] * drawing.machine.mm_per_lsb});
+    Job job{drawing.machine, host::plan_path(segments, drawing.machine)};
+    REQUIRE(start_of(job.plan) == std::vector<Lsb>{5000, -7000});
+    REQUIRE(job.plan.total_ticks > drawing.plan.total_ticks);
+    const host::StreamReport report = host::stream_modbus(job.plan, job.machine, o);
+    dt.stop = true;
+    dt.thread.join();
+    check_executed(job, *dt.device, report);
+    // Pen up until the drawing's first point, which the move reaches exactly.
+    const std::vector<Lsb>& got = dt.device->recorded_setpoints();
+    std::size_t first_down = 0;
+    while ((dt.device->recorded_ticks()[first_down].outputs & kOutputPenDown) == 0) ++first_down;
+    CHECK(got[2 * first_down] == 139322);
+    CHECK(got[2 * first_down + 1] == 100000);
+}

@@ -22,7 +22,8 @@ void add_plan_command(CLI::App& app, PlanCommandOptions& o) {
     cmd->add_option("--out,-o", o.output, "CSV output file (default: only the summary)");
 }
 
-PlannedJob plan_job(const PathOptions& path_options, const std::string& machine_file) {
+PlannedJob plan_job(const PathOptions& path_options, const std::string& machine_file,
+                    const std::vector<double>* lead_in_from) {
     PlannedJob job;
     job.path = load_path(path_options);
     job.machine = load_machine_profile(machine_file);
@@ -32,6 +33,7 @@ PlannedJob plan_job(const PathOptions& path_options, const std::string& machine_
                                                std::to_string(job.path.axes));
     }
     job.segments = to_bezier_segments(job.path);
+    if (lead_in_from != nullptr) prepend_lead_in(job.segments, *lead_in_from);
     const auto t0 = std::chrono::steady_clock::now();
     {
         ProgressBar bar("planning");

@@ -32,7 +32,10 @@ struct PlannedJob {
 
 /// Loads both files, checks they agree (axis count), plans with a progress bar and checks
 /// every tick. Throws InputError for bad files, PlanError when planning fails.
-PlannedJob plan_job(const PathOptions& path, const std::string& machine_file);
+/// `lead_in_from` (mm per axis, optional): the machine's position; when it is not the path's
+/// first point, a straight pen-up move from it to there is planned first.
+PlannedJob plan_job(const PathOptions& path, const std::string& machine_file,
+                    const std::vector<double>* lead_in_from = nullptr);
 
 /// The summary lines both commands print (duration, lengths, deviation, limit fractions).
 void print_plan_summary(const PlannedJob& job, std::ostream& out);

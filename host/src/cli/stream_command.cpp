@@ -21,6 +21,9 @@ void add_stream_command(CLI::App& app, StreamCommandOptions& o) {
                     "device: modbus-tcp://HOST:PORT?unit=N, modbus-rtu:///dev/ttyX?baud=115200&parity=N&unit=1 or "
                     "can://IFACE?node=N&protocol=native")
         ->required();
+    cmd->add_flag("--lead-in", o.lead_in,
+                  "start with a pen-up move from where the device rests (e.g. after homing) to the drawing's first "
+                  "point (Modbus targets: their status carries the position)");
     cmd->add_option("--lead", o.stream.lead_seconds, "seconds of motion kept queued ahead of the device")
         ->capture_default_str()
         ->check(CLI::Range(0.01, 60.0));
@@ -81,7 +84,20 @@ int run_stream_can(const StreamCommandOptions& o, const PlannedJob& job) {
 }  // namespace
 
 int run_stream(const StreamCommandOptions& o) {
-    const PlannedJob job = plan_job(o.path, o.machine);
+    std::vector<double> rest_mm;
+    if (o.lead_in) {
+        if (o.stream.target.rfind("can://", 0) == 0) {
+            throw std::invalid_argument("--lead-in needs a Modbus target: the CAN status carries no position");
+        }
+        const MachineProfile machine = load_machine_profile(o.machine);
+        for (const Lsb p : modbus_rest_position(machine, o.stream)) rest_mm.push_back(p * machine.mm_per_lsb);
+        std::printf("lead-in       from the device's rest position");
+        for (std::size_t a = 0; a < rest_mm.size(); ++a) {
+            std::printf(" %s %.4f mm", machine.axes[a].name.c_str(), rest_mm[a]);
+        }
+        std::printf("\n");
+    }
+    const PlannedJob job = plan_job(o.path, o.machine, o.lead_in ? &rest_mm : nullptr);
     if (o.stream.target.rfind("can://", 0) == 0) return run_stream_can(o, job);
     StreamReport r;
     {

@@ -13,6 +13,7 @@ struct StreamCommandOptions {
     PathOptions path;
     std::string machine;
     StreamOptions stream;
+    bool lead_in = false;  ///< plan a pen-up move from where the device rests (Modbus targets)
 };
 
 void add_stream_command(CLI::App& app, StreamCommandOptions& options);

@@ -65,6 +65,15 @@ public:
     Streamer(const Plan& plan, const MachineProfile& profile, const StreamOptions& options)
         : plan_(plan), profile_(profile), options_(options), client_(connect(options)) {}
 
+    /// Identity and state checked, the device's rest position (LSB per axis).
+    std::vector<Lsb> rest_position() {
+        last_ok_ = last_batch_ok_ = Clock::now();
+        axes_ = static_cast<unsigned>(profile_.axes.size());
+        const DeviceStatus s = read_status();
+        check_identity(s, false);
+        return std::vector<Lsb>(s.position, s.position + axes_);
+    }
+
     StreamReport run(const StreamProgress& progress) {
         const auto wall_start = Clock::now();
         last_ok_ = last_batch_ok_ = Clock::now();
@@ -203,7 +212,7 @@ private:
         return DeviceStatus::parse(r);
     }
 
-    void check_identity(const DeviceStatus& s) {
+    void check_identity(const DeviceStatus& s, bool check_start = true) {
         std::ostringstream m;
         if (s.magic != mb::kMagic) {
             m << "not a pathstream device (register 0 is 0x" << std::hex << s.magic << ", expected 0x5053)";
@@ -222,13 +231,13 @@ private:
               << ", not idle: reset or stop it first";
             fail(m.str());
         }
-        for (unsigned a = 0; a < axes_; ++a) {
+        for (unsigned a = 0; a < axes_ && check_start; ++a) {
             if (s.position[a] != start_[a]) {
                 m << "device rests at";
                 for (unsigned b = 0; b < axes_; ++b) m << ' ' << s.position[b];
                 m << " LSB but the plan starts at";
                 for (unsigned b = 0; b < axes_; ++b) m << ' ' << start_[b];
-                m << " LSB";
+                m << " LSB (--lead-in plans a pen-up move from where it rests)";
                 fail(m.str());
             }
         }
@@ -456,6 +465,12 @@ private:
 };
 
 }  // namespace
+
+std::vector<Lsb> modbus_rest_position(const MachineProfile& profile, const StreamOptions& options) {
+    const Plan none;
+    Streamer s(none, profile, options);
+    return s.rest_position();
+}
 
 StreamReport stream_modbus(const Plan& plan, const MachineProfile& profile, const StreamOptions& options,
                            const StreamProgress& progress) {

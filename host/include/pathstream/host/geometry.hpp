@@ -25,6 +25,12 @@ struct BezierSegment {
 /// end points exactly.
 std::vector<BezierSegment> to_bezier_segments(const Path& path);
 
+/// Puts a straight pen-up move from `from` (mm per axis: where the machine rests, e.g. after
+/// homing) to the first segment's start in front of `segments` (control points at thirds,
+/// subpath 0). Nothing when `from` is that point already or `segments` is empty. Throws
+/// std::invalid_argument when `from` has another axis count.
+void prepend_lead_in(std::vector<BezierSegment>& segments, const PathPoint& from);
+
 /// Point of a segment at parameter u in [0, 1] (de Casteljau), and its first and second
 /// derivatives with respect to u.
 PathPoint bezier_point(const BezierSegment& s, double u);

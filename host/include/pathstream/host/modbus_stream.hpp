@@ -58,6 +58,11 @@ using StreamProgress = std::function<void(double fraction, double queued_seconds
 /// and returns when the last span has executed. Throws StreamError (device refused a batch,
 /// restarted, faulted, or the link stayed dead past link_timeout_seconds) and
 /// std::invalid_argument (bad target URL, plan not streamable).
+/// Connects to options.target, checks the device's identity (magic, version, axis count =
+/// the profile's) and that it is idle, and returns where it rests (LSB per axis): the start
+/// of a lead-in move. Throws StreamError like stream_modbus.
+std::vector<Lsb> modbus_rest_position(const MachineProfile& profile, const StreamOptions& options);
+
 StreamReport stream_modbus(const Plan& plan, const MachineProfile& profile, const StreamOptions& options,
                            const StreamProgress& progress = {});
 
