@@ -72,7 +72,8 @@ private:
 };
 
 // Homes in real time (times --time-scale), before any bus is served: a host cannot start a
-// job on a half-homed machine. SIGINT/SIGTERM stop the axis where it is (controlled stop).
+// job on a half-homed machine. SIGINT/SIGTERM end homing at the next tick (exit 6); the lines
+// are then released with enable and pen inactive (MachineLines).
 void home(sim::SimulatedMotionDevice& device, sim::DeviceIo& io, const MachineProfile& profile, double time_scale) {
     sim::DeviceLoopOptions loop;
     loop.time_scale = time_scale;

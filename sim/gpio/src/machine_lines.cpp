@@ -18,6 +18,16 @@ hal::GpioLineSpec line_spec(const std::string& chip, const host::GpioLineConfig&
     return s;
 }
 
+MachineLines::~MachineLines() {
+    for (auto& out : outputs_) {
+        try {
+            out->set(false);
+        } catch (const hal::GpioError&) {
+            // The line is gone (chip removed): nothing left to drive.
+        }
+    }
+}
+
 MachineLines MachineLines::open(const host::MachineProfile& profile) {
     const host::GpioConfig& g = profile.gpio;
     if (!g.present) throw std::invalid_argument(profile.source + ": the machine profile has no \"gpio\" object");

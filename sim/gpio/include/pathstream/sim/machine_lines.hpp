@@ -27,7 +27,11 @@ public:
     static MachineLines open(const host::MachineProfile& profile);
 
     MachineLines(MachineLines&&) = default;
-    MachineLines& operator=(MachineLines&&) = default;
+    MachineLines& operator=(MachineLines&&) = delete;
+    /// Drives every output inactive (drives disabled, pen up) before releasing the lines: a
+    /// released line may keep its last level, and a program that ends must not leave the
+    /// drives enabled.
+    ~MachineLines();
 
     /// Pointers into the owned lines; valid while this object lives.
     const MachineWiring& wiring() const { return wiring_; }
