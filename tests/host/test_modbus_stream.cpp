@@ -99,7 +99,7 @@ TEST_CASE("a drawing streamed over Modbus RTU on a pty executes exactly the plan
     check_executed(job, *dt.device, report);
 }
 
-TEST_CASE("--lead-in: a device resting elsewhere (after homing) gets a pen-up move to the drawing first",
+TEST_CASE("stream with a lead-in: a device resting elsewhere (after homing) gets a pen-up move to the drawing first",
           "[modbus][stream]") {
     const Job drawing = plan_example("rose.json");
     const Lsb rest[2] = {5000, -7000};  // where homing left the machine, not the drawing's start
