@@ -12,6 +12,12 @@ Exit status: the test script's status inside the VM (200: the VM's own setup fai
   124  the VM did not print a result within --timeout seconds
   125  the VM stopped without printing a result, or the harness itself failed
 With --expect-rc N: 0 when the script's status was N, 1 otherwise.
+
+Accelerator (--accel, default auto): KVM is used only when a short probe boot under it
+prints the kernel's first line; otherwise (no /dev/kvm, or a /dev/kvm that cannot run the
+guest) the harness says so in one line and uses TCG. The verdict is cached in --base-cache,
+so a suite pays for the probe once. PATHSTREAM_VM_KVM_ACCEL replaces the -accel option the
+probe tries (default "kvm"); a value qemu cannot start exercises the fallback.
 Uses only the Python standard library; run it with Debian's /usr/bin/python3.
 """
 
@@ -377,6 +383,132 @@ def build_initrd(args: argparse.Namespace, info: dict[str, str], work: Path) -> 
     return initrd
 
 
+# --- the accelerator -------------------------------------------------------------------------------
+KVM_PROBE_TIMEOUT = 10.0  # a KVM guest prints its first kernel line well within a second
+KVM_PROBE_LINE = re.compile(r"Linux version \d")
+VERDICT_FILE = "accel-verdict.json"
+
+
+def kvm_accel_option() -> tuple[str, bool]:
+    """The -accel value tried for KVM, and whether it was forced through the environment."""
+    forced = os.environ.get("PATHSTREAM_VM_KVM_ACCEL", "").strip()
+    return (forced, True) if forced else ("kvm", False)
+
+
+def probe_kvm(qemu: str, info: dict[str, str], accel: str) -> tuple[bool, str]:
+    """Boots the kernel alone (no initramfs) under ACCEL; True once it prints its first line.
+
+    A KVM that cannot run the guest makes qemu abort at once or hang silently: both are a
+    no. The kernel panics without a root file system and, with -no-reboot, qemu exits.
+    """
+    cmd = [qemu, "-accel", accel, "-cpu", "host", "-m", "256", "-nographic", "-no-reboot",
+           "-monitor", "none", "-nic", "none", "-kernel", info["KERNEL"],
+           "-append", "console=ttyS0 panic=-1 loglevel=4"]
+    t0 = time.monotonic()
+    proc = subprocess.Popen(cmd, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
+                            stderr=subprocess.STDOUT, preexec_fn=_die_with_parent)
+    seen: list[str] = []
+    tail: list[str] = []
+
+    def pump() -> None:
+        assert proc.stdout is not None
+        for raw in proc.stdout:
+            line = raw.decode("utf-8", errors="replace").strip()
+            if KVM_PROBE_LINE.search(line) and not seen:
+                seen.append(line)
+            elif line:
+                tail[:] = (tail + [line])[-3:]
+
+    reader = threading.Thread(target=pump, daemon=True)
+    reader.start()
+    while proc.poll() is None and not seen and time.monotonic() - t0 < KVM_PROBE_TIMEOUT:
+        time.sleep(0.02)
+    if proc.poll() is None:
+        proc.kill()
+    proc.wait()
+    reader.join(timeout=2)
+    elapsed = time.monotonic() - t0
+    if seen:
+        return True, f"the guest kernel started in {elapsed:.2f} s"
+    why = tail[-1] if tail else "no output"
+    if proc.returncode is not None and elapsed < KVM_PROBE_TIMEOUT:
+        return False, f"qemu exited with {proc.returncode} after {elapsed:.2f} s ({why})"
+    return False, f"the guest printed nothing within {KVM_PROBE_TIMEOUT:.0f} s ({why})"
+
+
+def verdict_key(qemu: str, info: dict[str, str], accel: str) -> str:
+    """What the verdict depends on: qemu, the kernel, /dev/kvm, the option, this boot."""
+    parts = [accel, info["KERNEL"]]
+    for path in (qemu, info["KERNEL"], "/dev/kvm"):
+        try:
+            st = os.stat(path)
+            parts.append(f"{path} {st.st_size} {st.st_mtime_ns} {st.st_rdev}")
+        except OSError:
+            parts.append(f"{path} missing")
+    try:
+        parts.append(Path("/proc/sys/kernel/random/boot_id").read_text().strip())
+    except OSError:
+        pass
+    return hashlib.sha256("\n".join(parts).encode()).hexdigest()[:20]
+
+
+def choose_accel(args: argparse.Namespace, qemu: str, info: dict[str, str],
+                 cache: Path) -> tuple[str, str]:
+    """The -accel value for the test run ("kvm", or the forced option, if it starts, else
+    "tcg") and the key of the cached verdict it came from ("" when nothing was probed)."""
+    if args.accel == "tcg":
+        return "tcg", ""
+    accel, forced = kvm_accel_option()
+    if args.accel == "auto" and not forced and not os.path.exists("/dev/kvm"):
+        return "tcg", ""  # nothing to try: the usual case without nested virtualisation
+    key = verdict_key(qemu, info, accel)
+    verdict_path = cache / VERDICT_FILE
+    cache.mkdir(parents=True, exist_ok=True)
+    # Tests start in parallel: one probes, the others wait for its verdict.
+    with open(cache / ".accel-lock", "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        try:
+            verdicts = json.loads(verdict_path.read_text())
+        except (OSError, ValueError):
+            verdicts = {}
+        cached = verdicts.get(key)
+        if cached is None:
+            ok, why = probe_kvm(qemu, info, accel)
+            cached = {"accel": accel if ok else "tcg", "why": why, "tried": accel}
+            verdicts[key] = cached
+            tmp = verdict_path.with_name(verdict_path.name + f".tmp{os.getpid()}")
+            tmp.write_text(json.dumps(verdicts, indent=1))
+            os.replace(tmp, verdict_path)
+            if ok:
+                log(f"accelerator: KVM ({why}); verdict cached in {verdict_path}")
+            else:
+                log(f"accelerator: KVM (-accel {accel}) cannot start the guest: {why}; "
+                    f"using TCG (verdict cached in {verdict_path})")
+        elif cached["accel"] == "tcg":
+            log(f"accelerator: TCG (cached verdict: -accel {cached['tried']} failed: {cached['why']})")
+        else:
+            log(f"accelerator: KVM (cached verdict: {cached['why']})")
+    if cached["accel"] == "tcg" and args.accel == "kvm":
+        raise HarnessError(f"--accel kvm: KVM cannot start the guest ({cached['why']})")
+    return cached["accel"], key
+
+
+def forget_kvm(cache: Path, key: str, why: str) -> None:
+    """Records that KVM failed after all (a run that died at start), so later tests use TCG."""
+    verdict_path = cache / VERDICT_FILE
+    with open(cache / ".accel-lock", "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        try:
+            verdicts = json.loads(verdict_path.read_text())
+        except (OSError, ValueError):
+            verdicts = {}
+        if key in verdicts:
+            verdicts[key].update(accel="tcg", why=why)
+        tmp = verdict_path.with_name(verdict_path.name + f".tmp{os.getpid()}")
+        tmp.write_text(json.dumps(verdicts, indent=1))
+        os.replace(tmp, verdict_path)
+
+
 # --- the VM ------------------------------------------------------------------------------------------
 def _die_with_parent() -> None:
     """Runs in the qemu child: SIGKILL it when this harness dies (ctest timeout, Ctrl-C)."""
@@ -388,16 +520,23 @@ def _die_with_parent() -> None:
     os.setsid()
 
 
-def run_vm(args: argparse.Namespace, info: dict[str, str], initrd: Path, log_path: Path) -> int:
+def find_qemu() -> str:
     qemu = shutil.which("qemu-system-x86_64")
     if qemu is None:
         raise HarnessError("qemu-system-x86_64 not found: run scripts/setup.sh (qemu-system-x86)")
+    return qemu
+
+
+def run_vm(args: argparse.Namespace, info: dict[str, str], initrd: Path, log_path: Path,
+           qemu: str, accel: str) -> int | None:
+    """Boots the test VM; the script's status, 124/125, or None when a KVM run died at start."""
     append = "console=ttyS0 quiet panic=-1 " + args.append
-    cmd = [qemu, "-m", str(args.memory), "-nographic", "-no-reboot", "-monitor", "none",
-           "-nic", "none", "-kernel", info["KERNEL"], "-initrd", str(initrd), "-append", append.strip()]
+    cmd = [qemu, "-accel", accel, "-m", str(args.memory), "-nographic", "-no-reboot",
+           "-monitor", "none", "-nic", "none", "-kernel", info["KERNEL"], "-initrd", str(initrd),
+           "-append", append.strip()]
+    if accel != "tcg":
+        cmd[3:3] = ["-cpu", "host"]
     cmd += args.qemu_arg
-    if os.access("/dev/kvm", os.R_OK | os.W_OK) and not args.no_kvm:
-        cmd[1:1] = ["-enable-kvm", "-cpu", "host"]
     log("booting " + " ".join(cmd))
     t0 = time.monotonic()
     proc = subprocess.Popen(cmd, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
@@ -454,6 +593,8 @@ def run_vm(args: argparse.Namespace, info: dict[str, str], initrd: Path, log_pat
         log(f"ERROR: the VM printed no result within {args.timeout} s and was killed; "
             f"console log: {log_path}")
         return 124
+    if accel != "tcg" and elapsed < 5:
+        return None  # KVM passed the probe but this run died at start: the caller retries
     log(f"ERROR: qemu exited with {proc.returncode} after {elapsed:.2f} s without printing a "
         f"result (kernel panic? /init failed?); console log: {log_path}")
     return 125
@@ -478,7 +619,11 @@ def main() -> int:
     ap.add_argument("--kernel-cache", help="setup_vm.sh's cache dir (default: from scripts/setup_vm.sh)")
     ap.add_argument("--expect-rc", type=int, help="exit 0 iff the script exits with this status")
     ap.add_argument("--log", help="console log file (default WORK/console.log)")
-    ap.add_argument("--no-kvm", action="store_true", help="use TCG even when /dev/kvm is usable")
+    ap.add_argument("--accel", choices=("auto", "kvm", "tcg"), default="auto",
+                    help="auto: KVM if a probe boot starts under it, else TCG (default); "
+                         "kvm: KVM or fail; tcg: never KVM")
+    ap.add_argument("--no-kvm", dest="accel", action="store_const", const="tcg",
+                    help="the same as --accel tcg")
     ap.add_argument("--quiet", action="store_true", help="do not echo the console")
     args = ap.parse_args()
     if args.can_iface is None:
@@ -490,7 +635,19 @@ def main() -> int:
         work = Path(args.work)
         work.mkdir(parents=True, exist_ok=True)
         initrd = build_initrd(args, info, work)
-        rc = run_vm(args, info, initrd, Path(args.log) if args.log else work / "console.log")
+        qemu = find_qemu()
+        cache = Path(args.base_cache) if args.base_cache else work / "cache"
+        accel, key = choose_accel(args, qemu, info, cache)
+        log_path = Path(args.log) if args.log else work / "console.log"
+        rc = run_vm(args, info, initrd, log_path, qemu, accel)
+        if rc is None:
+            why = f"a test run under -accel {accel} exited at start without a result"
+            if args.accel == "kvm":
+                raise HarnessError(why)
+            log(f"accelerator: {why}; running it again under TCG (later tests use TCG too)")
+            forget_kvm(cache, key, why)
+            rc = run_vm(args, info, initrd, log_path, qemu, "tcg")
+            assert rc is not None
     except HarnessError as e:
         print(f"run_in_vm: ERROR: {e}", file=sys.stderr, flush=True)
         return 125
