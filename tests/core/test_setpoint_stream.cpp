@@ -517,7 +517,7 @@ TEST_CASE("Spans of one tick: every tick is a boundary", "[stream]") {
 }
 
 TEST_CASE("A producer thread and a ticking consumer thread agree with the reference",
-          "[stream]") {
+          "[stream][threads]") {
     const auto seed = pathstream::test::property_seed();
     INFO("seed " << seed);
     SpanGenerator gen(seed + 23);

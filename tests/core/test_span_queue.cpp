@@ -151,7 +151,7 @@ TEST_CASE("Queue keeps FIFO order through many wrap-arounds at every fill level"
 }
 
 TEST_CASE("Two threads: one producer, one consumer, nothing lost, duplicated or reordered",
-          "[queue]") {
+          "[queue][threads]") {
     constexpr std::uint64_t kItems = 1000000;
     SpanQueue<Item, 64> q;
     std::atomic<bool> failed{false};

@@ -86,21 +86,21 @@ void faulty_line_case(const PtyFaultOptions& faults, int transactions) {
 
 }  // namespace
 
-TEST_CASE("RTU through a line corrupting 1 % of the bytes", "[modbus][rtu][faults]") {
+TEST_CASE("RTU through a line corrupting 1 % of the bytes", "[modbus][rtu][faults][threads]") {
     PtyFaultOptions faults;
     faults.corrupt_rate = 0.01;
     faults.seed = 20240601;
     faulty_line_case(faults, 60);
 }
 
-TEST_CASE("RTU through a line dropping 1 % of the bytes", "[modbus][rtu][faults]") {
+TEST_CASE("RTU through a line dropping 1 % of the bytes", "[modbus][rtu][faults][threads]") {
     PtyFaultOptions faults;
     faults.drop_rate = 0.01;
     faults.seed = 7;
     faulty_line_case(faults, 40);
 }
 
-TEST_CASE("the fault proxy forwards both ways and its faults follow the seed", "[modbus][faults]") {
+TEST_CASE("the fault proxy forwards both ways and its faults follow the seed", "[modbus][faults][threads]") {
     const auto corrupted_after = [](std::uint64_t seed) {
         PtyFaultOptions faults;
         faults.corrupt_rate = 0.05;

@@ -50,7 +50,7 @@ ModbusError error_of(Call call) {
 
 }  // namespace
 
-TEST_CASE("RTU: FC3, FC4, FC6, FC16 and FC23 round trips on a pty", "[modbus][rtu]") {
+TEST_CASE("RTU: FC3, FC4, FC6, FC16 and FC23 round trips on a pty", "[modbus][rtu][threads]") {
     RegisterArray registers;
     ModbusServer server = ModbusServer::rtu_pty(registers, unit(17));
     REQUIRE(server.client_device().rfind("/dev/pts/", 0) == 0);
@@ -100,7 +100,7 @@ TEST_CASE("RTU: FC3, FC4, FC6, FC16 and FC23 round trips on a pty", "[modbus][rt
               modbus_adu_bytes(ModbusFraming::kRtu, 5));            // final FC3
 }
 
-TEST_CASE("RTU: requests for another unit id are ignored, as on a shared bus", "[modbus][rtu]") {
+TEST_CASE("RTU: requests for another unit id are ignored, as on a shared bus", "[modbus][rtu][threads]") {
     RegisterArray registers;
     ModbusServer server = ModbusServer::rtu_pty(registers, unit(1));
     ServingThread serving(server);
@@ -119,7 +119,7 @@ TEST_CASE("RTU: requests for another unit id are ignored, as on a shared bus", "
     CHECK(server.counters().requests == 1);
 }
 
-TEST_CASE("RTU: broadcast writes are applied and never answered", "[modbus][rtu]") {
+TEST_CASE("RTU: broadcast writes are applied and never answered", "[modbus][rtu][threads]") {
     RegisterArray registers;
     ModbusServer server = ModbusServer::rtu_pty(registers, unit(5));
     ServingThread serving(server);
@@ -147,7 +147,7 @@ TEST_CASE("RTU: broadcast writes are applied and never answered", "[modbus][rtu]
     CHECK(five == std::vector<std::uint16_t>{10, 20, 30, 40, 0});
 }
 
-TEST_CASE("RTU: a server that never answers gives a timeout per try", "[modbus][rtu]") {
+TEST_CASE("RTU: a server that never answers gives a timeout per try", "[modbus][rtu][threads]") {
     RegisterArray registers;
     ModbusServer server = ModbusServer::rtu_pty(registers, unit(1));  // never polled
     ModbusClientOptions options = fast(2);
@@ -162,7 +162,7 @@ TEST_CASE("RTU: a server that never answers gives a timeout per try", "[modbus][
     CHECK(client.counters().reconnects == 0);
 }
 
-TEST_CASE("RTU: reconnect() reopens the port", "[modbus][rtu]") {
+TEST_CASE("RTU: reconnect() reopens the port", "[modbus][rtu][threads]") {
     RegisterArray registers;
     ModbusServer server = ModbusServer::rtu_pty(registers, unit(1));
     ServingThread serving(server);

@@ -61,7 +61,7 @@ int raw_connect(std::uint16_t port) {
 
 }  // namespace
 
-TEST_CASE("TCP: FC3, FC4, FC6, FC16 and FC23 round trips", "[modbus][tcp]") {
+TEST_CASE("TCP: FC3, FC4, FC6, FC16 and FC23 round trips", "[modbus][tcp][threads]") {
     RegisterArray registers;
     ModbusServer server = ModbusServer::tcp(registers, {});
     REQUIRE(server.port() != 0);
@@ -98,7 +98,7 @@ TEST_CASE("TCP: FC3, FC4, FC6, FC16 and FC23 round trips", "[modbus][tcp]") {
 }
 
 TEST_CASE("TCP: FC23 answers with what the handler reads, not with what was written",
-          "[modbus][tcp]") {
+          "[modbus][tcp][threads]") {
     // A register map may transform writes (here: it stores the complement). modbus_reply
     // would copy the written values into the overlapping part of the answer; the server
     // must answer with the handler's read.
@@ -119,7 +119,7 @@ TEST_CASE("TCP: FC23 answers with what the handler reads, not with what was writ
     CHECK(r == std::vector<std::uint16_t>{0xFFFD, 0xFFFC, 0, 0});
 }
 
-TEST_CASE("TCP: exception responses carry the code and change nothing", "[modbus][tcp]") {
+TEST_CASE("TCP: exception responses carry the code and change nothing", "[modbus][tcp][threads]") {
     RegisterArray registers;
     ModbusServer server = ModbusServer::tcp(registers, {});
     ServingThread serving(server);
@@ -164,7 +164,7 @@ TEST_CASE("TCP: exception responses carry the code and change nothing", "[modbus
 }
 
 TEST_CASE("TCP: unsupported and malformed requests get exceptions, the stream stays in step",
-          "[modbus][tcp]") {
+          "[modbus][tcp][threads]") {
     RegisterArray registers;
     ModbusServer server = ModbusServer::tcp(registers, {});
     ServingThread serving(server);
@@ -204,7 +204,7 @@ TEST_CASE("TCP: unsupported and malformed requests get exceptions, the stream st
     CHECK(registers.writes_applied == 0);
 }
 
-TEST_CASE("TCP: a half-sent request or a vanished client never stops the server", "[modbus][tcp]") {
+TEST_CASE("TCP: a half-sent request or a vanished client never stops the server", "[modbus][tcp][threads]") {
     RegisterArray registers;
     ModbusServer server = ModbusServer::tcp(registers, {});
     ServingThread serving(server);
@@ -223,7 +223,7 @@ TEST_CASE("TCP: a half-sent request or a vanished client never stops the server"
     CHECK(pathstream::test::eventually([&] { return server.counters().connections_closed >= 2; }));
 }
 
-TEST_CASE("TCP: a connection dropped mid-session, reconnect() resumes", "[modbus][tcp]") {
+TEST_CASE("TCP: a connection dropped mid-session, reconnect() resumes", "[modbus][tcp][threads]") {
     RegisterArray registers;
     ModbusTcpEndpoint endpoint;
     endpoint.max_clients = 1;  // a second connection evicts the first: a real mid-session drop
@@ -250,7 +250,7 @@ TEST_CASE("TCP: a connection dropped mid-session, reconnect() resumes", "[modbus
     CHECK(first.counters().connection_losses == 1);
 }
 
-TEST_CASE("TCP: after a server restart the client connects again", "[modbus][tcp]") {
+TEST_CASE("TCP: after a server restart the client connects again", "[modbus][tcp][threads]") {
     RegisterArray registers;
     std::optional<ModbusServer> server = ModbusServer::tcp(registers, {});
     const std::uint16_t port = server->port();
@@ -279,7 +279,7 @@ TEST_CASE("TCP: after a server restart the client connects again", "[modbus][tcp
     CHECK(client.counters().reconnects == 1);
 }
 
-TEST_CASE("TCP: a peer that never answers gives timeouts, one per try", "[modbus][tcp]") {
+TEST_CASE("TCP: a peer that never answers gives timeouts, one per try", "[modbus][tcp][threads]") {
     RegisterArray registers;
     // Listening (the kernel completes connects) but never polled: requests go unanswered.
     ModbusServer server = ModbusServer::tcp(registers, {});
@@ -301,7 +301,7 @@ TEST_CASE("TCP: a peer that never answers gives timeouts, one per try", "[modbus
     CHECK(c.adu_bytes_received == 0);
 }
 
-TEST_CASE("TCP: byte counters agree between client and server", "[modbus][tcp]") {
+TEST_CASE("TCP: byte counters agree between client and server", "[modbus][tcp][threads]") {
     RegisterArray registers;
     ModbusServer server = ModbusServer::tcp(registers, {});
     ServingThread serving(server);
@@ -322,7 +322,7 @@ TEST_CASE("TCP: byte counters agree between client and server", "[modbus][tcp]")
     CHECK(server.counters().adu_bytes_sent == client.counters().adu_bytes_received);
 }
 
-TEST_CASE("TCP: several clients at once", "[modbus][tcp]") {
+TEST_CASE("TCP: several clients at once", "[modbus][tcp][threads]") {
     RegisterArray registers;
     ModbusServer server = ModbusServer::tcp(registers, {});
     ServingThread serving(server);

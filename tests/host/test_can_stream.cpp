@@ -93,7 +93,7 @@ Run stream_over_loopback(const Job& job, const sim::CanFaults& faults, double ti
 
 }  // namespace
 
-TEST_CASE("a drawing streamed natively over CAN executes exactly the planned setpoints", "[can][stream]") {
+TEST_CASE("a drawing streamed natively over CAN executes exactly the planned setpoints", "[can][stream][threads]") {
     const Job job = plan_example("wave.json");
     const Run r = stream_over_loopback(job, {});
     check_executed(job, *r.device, r.report);
@@ -105,7 +105,7 @@ TEST_CASE("a drawing streamed natively over CAN executes exactly the planned set
 }
 
 TEST_CASE("natively over CAN with 1 % of the frames lost, the device still executes every span once",
-          "[can][stream]") {
+          "[can][stream][threads]") {
     const Job job = plan_example("wave.json");
     sim::CanFaults faults;
     faults.drop_fraction = 0.01;
@@ -117,7 +117,7 @@ TEST_CASE("natively over CAN with 1 % of the frames lost, the device still execu
     CHECK(r.device->refused_batches() == 0);
 }
 
-TEST_CASE("natively over CAN with a transmit budget per poll, frames wait and nothing is lost", "[can][stream]") {
+TEST_CASE("natively over CAN with a transmit budget per poll, frames wait and nothing is lost", "[can][stream][threads]") {
     const Job job = plan_example("wave.json");
     sim::CanFaults faults;
     faults.tx_budget = 4;
@@ -126,7 +126,7 @@ TEST_CASE("natively over CAN with a transmit budget per poll, frames wait and no
     CHECK(r.device->refused_batches() == 0);
 }
 
-TEST_CASE("bus-off at the device: the host stops with a clear error and the device holds", "[can][stream]") {
+TEST_CASE("bus-off at the device: the host stops with a clear error and the device holds", "[can][stream][threads]") {
     const Job job = plan_example("wave.json");
     sim::CanLoopback loop;
     hal::CanBus& device_bus = loop.add_endpoint();
@@ -156,7 +156,7 @@ TEST_CASE("bus-off at the device: the host stops with a clear error and the devi
     dt.join();
 }
 
-TEST_CASE("bus-off at the host: the streamer stops at once", "[can][stream]") {
+TEST_CASE("bus-off at the host: the streamer stops at once", "[can][stream][threads]") {
     const Job job = plan_example("wave.json");
     sim::CanLoopback loop;
     loop.add_endpoint();
@@ -167,7 +167,7 @@ TEST_CASE("bus-off at the host: the streamer stops at once", "[can][stream]") {
     CHECK_THROWS_WITH(host::stream_can(job.plan, job.machine, host_bus, o), Catch::Contains("bus-off"));
 }
 
-TEST_CASE("a silent node: the streamer gives up after the link timeout", "[can][stream]") {
+TEST_CASE("a silent node: the streamer gives up after the link timeout", "[can][stream][threads]") {
     const Job job = plan_example("wave.json");
     sim::CanLoopback loop;
     loop.add_endpoint();

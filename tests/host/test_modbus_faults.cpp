@@ -342,7 +342,7 @@ double seconds_since(SteadyClock::time_point t) { return std::chrono::duration<d
 }  // namespace
 
 TEST_CASE("a TCP connection cut mid-frame: the host reconnects and no span is lost or run twice",
-          "[modbus][faults]") {
+          "[modbus][faults][threads]") {
     const bool response_lost = GENERATE(true, false);
     const Job job = plan_example("wave.json");
     REQUIRE(job.plan.spans.size() > 40);  // several batches: the cut falls mid-stream
@@ -373,7 +373,7 @@ TEST_CASE("a TCP connection cut mid-frame: the host reconnects and no span is lo
 }
 
 TEST_CASE("an RTU line that corrupts and drops ~1 % of bytes: retries, and the drawing completes exactly",
-          "[modbus][faults]") {
+          "[modbus][faults][threads]") {
     const Job job = plan_example("wave.json");
     FaultLine line(0.006, 0.004, 11);
     const auto device = sim::SimulatedModbusDevice::create(start_of(job.plan));
@@ -402,7 +402,7 @@ TEST_CASE("an RTU line that corrupts and drops ~1 % of bytes: retries, and the d
 
 TEST_CASE("a device power-cycled mid-stream (TCP server gone and back on the same port): the host stops with "
           "'restarted'",
-          "[modbus][faults]") {
+          "[modbus][faults][threads]") {
     const Job job = plan_example("wave.json");
     std::unique_ptr<sim::SimulatedModbusDevice> first = sim::SimulatedModbusDevice::create(start_of(job.plan));
     std::unique_ptr<sim::SimulatedModbusDevice> second;
@@ -446,7 +446,7 @@ TEST_CASE("a device power-cycled mid-stream (TCP server gone and back on the sam
 }
 
 TEST_CASE("a device restarted behind a link that stays up (RTU): the host stops with 'restarted'",
-          "[modbus][faults]") {
+          "[modbus][faults][threads]") {
     const Job job = plan_example("wave.json");
     const auto first = sim::SimulatedModbusDevice::create(start_of(job.plan));
     const auto second = sim::SimulatedModbusDevice::create(start_of(job.plan));
@@ -483,7 +483,7 @@ TEST_CASE("a device restarted behind a link that stays up (RTU): the host stops 
 
 TEST_CASE("the queue runs dry: the device stops within its limits, reports the underrun, resumes, and the path is "
           "exact",
-          "[modbus][faults]") {
+          "[modbus][faults][threads]") {
     const Job job = plan_example("wave.json");
     const auto device = sim::SimulatedModbusDevice::create(start_of(job.plan));
     device->record(true);
@@ -535,7 +535,7 @@ TEST_CASE("the queue runs dry: the device stops within its limits, reports the u
     }
 }
 
-TEST_CASE("a lead longer than the device's queue holds: the host starts when the queue is full", "[modbus][faults]") {
+TEST_CASE("a lead longer than the device's queue holds: the host starts when the queue is full", "[modbus][faults][threads]") {
     const Job job = plan_example("wave.json");
     const auto device = sim::SimulatedModbusDevice::create(start_of(job.plan));
     device->record(true);
@@ -553,7 +553,7 @@ TEST_CASE("a lead longer than the device's queue holds: the host starts when the
     check_executed(job, *device, report);
 }
 
-TEST_CASE("a dead TCP peer (accepts, never answers): StreamError within the link timeout", "[modbus][faults]") {
+TEST_CASE("a dead TCP peer (accepts, never answers): StreamError within the link timeout", "[modbus][faults][threads]") {
     const Job job = plan_example("wave.json");
     SilentListener silent;
     host::StreamOptions o;
@@ -571,7 +571,7 @@ TEST_CASE("a dead TCP peer (accepts, never answers): StreamError within the link
     CHECK(seconds_since(t0) < 10 * o.link_timeout_seconds);
 }
 
-TEST_CASE("nothing listening on the TCP port: StreamError, not a transport exception", "[modbus][faults]") {
+TEST_CASE("nothing listening on the TCP port: StreamError, not a transport exception", "[modbus][faults][threads]") {
     const Job job = plan_example("wave.json");
     std::uint16_t port = 0;
     {
@@ -593,7 +593,7 @@ TEST_CASE("nothing listening on the TCP port: StreamError, not a transport excep
     CHECK(seconds_since(t0) < 10 * o.link_timeout_seconds);
 }
 
-TEST_CASE("a dead RTU peer (a pty nobody serves): StreamError within the link timeout", "[modbus][faults]") {
+TEST_CASE("a dead RTU peer (a pty nobody serves): StreamError within the link timeout", "[modbus][faults][threads]") {
     const Job job = plan_example("wave.json");
     hal::PseudoTerminal unserved(true);
     host::StreamOptions o;

@@ -169,7 +169,7 @@ void check_device(const std::string& program, const std::string& link) {
 }  // namespace
 
 TEST_CASE("mbpoll reads the simulated device's status block and drives its commands over TCP and RTU",
-          "[modbus][mbpoll]") {
+          "[modbus][mbpoll][threads]") {
     const std::string program = find_mbpoll();
     if (program.empty()) {
         WARN("mbpoll not found on PATH: the interoperability test is skipped (scripts/setup.sh installs it)");

@@ -67,7 +67,7 @@ void check_executed(const Job& job, const sim::SimulatedModbusDevice& device, co
 
 }  // namespace
 
-TEST_CASE("a drawing streamed over Modbus TCP executes exactly the planned setpoints", "[modbus][stream]") {
+TEST_CASE("a drawing streamed over Modbus TCP executes exactly the planned setpoints", "[modbus][stream][threads]") {
     const Job job = plan_example("wave.json");
     DeviceThread dt;
     dt.device = sim::SimulatedModbusDevice::create(start_of(job.plan));
@@ -84,7 +84,7 @@ TEST_CASE("a drawing streamed over Modbus TCP executes exactly the planned setpo
     CHECK(report.bytes_sent > 0);
 }
 
-TEST_CASE("a drawing streamed over Modbus RTU on a pty executes exactly the planned setpoints", "[modbus][stream]") {
+TEST_CASE("a drawing streamed over Modbus RTU on a pty executes exactly the planned setpoints", "[modbus][stream][threads]") {
     const Job job = plan_example("wave.json");
     DeviceThread dt;
     dt.device = sim::SimulatedModbusDevice::create(start_of(job.plan));
@@ -100,7 +100,7 @@ TEST_CASE("a drawing streamed over Modbus RTU on a pty executes exactly the plan
 }
 
 TEST_CASE("stream with a lead-in: a device resting elsewhere (after homing) gets a pen-up move to the drawing first",
-          "[modbus][stream]") {
+          "[modbus][stream][threads]") {
     const Job drawing = plan_example("rose.json");
     const Lsb rest[2] = {5000, -7000};  // where homing left the machine, not the drawing's start
     DeviceThread dt;
