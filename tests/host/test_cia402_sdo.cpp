@@ -10,7 +10,8 @@ using namespace pathstream::host::cia402;
 using cia402_test::Rig;
 
 TEST_CASE("statusword table and texts", "[cia402]") {
-    // DESIGN.md's mask/value table, with the other bits set or clear.
+    // The statusword mask/value table of docs/cia402.md (CiA 402's power state machine), with
+    // the other bits set or clear: the decoder must look only at the masked bits.
     CHECK(decode_statusword(0x0040) == DriveState::kSwitchOnDisabled);
     CHECK(decode_statusword(0x0250) == DriveState::kSwitchOnDisabled);
     CHECK(decode_statusword(0x0021) == DriveState::kReadyToSwitchOn);

@@ -1,5 +1,6 @@
 // Sizes of Modbus frames on the wire, per function code, for byte counters and bus-load
-// budgets (DESIGN.md section 5: wire time = ADU bytes x bits per character / baud).
+// budgets: a serial line's wire time is ADU bytes x bits per character / baud
+// (docs/modbus-transport.md).
 #pragma once
 
 #include <cstddef>

@@ -1,5 +1,6 @@
-// A pseudo-terminal pair in raw mode: a serial line inside one machine (DESIGN.md section 6:
-// ptys carry Modbus RTU; libmodbus and mbpoll open the far end like any tty).
+// A pseudo-terminal pair in raw mode: a serial line inside one machine, so Modbus RTU can be
+// tested without serial hardware (docs/modbus-transport.md); libmodbus and mbpoll open the far
+// end like any tty.
 #pragma once
 
 #include <string>
