@@ -68,6 +68,43 @@ public:
         return TickState::kMoving;
     }
 
+    /// Consumer, for code that wants many ticks at once (a host simulator, a batch fill; the
+    /// tick interrupt calls tick()): writes out[0..count) exactly as `count` calls of tick()
+    /// would, with the same counters, outputs() and state afterwards, and returns how many of
+    /// those ticks were kIdle. A span's ticks come from emit_span_ticks, the state in
+    /// registers rather than loaded and stored every tick. Cost: O(count * Axes) plus O(Axes)
+    /// per span started or finished. Consumer context.
+    std::uint32_t tick_many(Lsb (*out)[Axes], std::uint32_t count) {
+        std::uint32_t idle = 0;
+        for (std::uint32_t done = 0; done < count;) {
+            if (active_ == nullptr) {
+                // Starts the next span as tick_slow() does; the queue is looked at every idle
+                // tick, as tick() would, so a span pushed meanwhile starts at the same tick.
+                active_ = queue_.front();
+                if (active_ == nullptr) {
+                    for (unsigned a = 0; a < Axes; ++a) out[done][a] = hold_[a];
+                    ++idle;
+                    ++done;
+                    continue;
+                }
+                remaining_ = active_->ticks;
+                outputs_ = active_->outputs;
+                narrow_active_ = active_->wide ? nullptr : active_;
+            }
+            const std::uint32_t k = remaining_ < count - done ? remaining_ : count - done;
+            if (active_->wide) {
+                emit_span_ticks(active_->wide_state, out + done, k, active_->bias);
+            } else {
+                emit_span_ticks(active_->narrow, out + done, k,
+                                static_cast<std::uint32_t>(active_->bias));
+            }
+            done += k;
+            remaining_ -= k;
+            if (remaining_ == 0) finish_span();
+        }
+        return idle;
+    }
+
     /// Spans queued, the active one included. Either context.
     std::uint32_t queued_spans() const { return queue_.size(); }
     /// Free queue slots as seen by the producer.
