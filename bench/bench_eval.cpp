@@ -62,6 +62,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <ctime>
 #include <functional>
 #include <limits>
 #include <memory>
@@ -238,6 +239,48 @@ Sink raw_steps(const Path& path, Sink sink) {
             sink(out[0], out[1]);
         }
     }
+    return sink;
+}
+
+/// Setpoints per call of the batch kernels below: the buffer (2 KiB for 2 axes) stays in L1.
+constexpr std::uint32_t kBatchTicks = 256;
+
+/// The like-for-like row: prepared spans (as double Horner gets its coefficients ready), each
+/// stepped by emit_span_ticks into a buffer of up to kBatchTicks setpoints, which the sink
+/// then reads back; every setpoint is written to memory and read again, work the baseline,
+/// which hands its values to the sink in registers, does not do.
+template <class Word, class Sink>
+Sink span_ticks(const Path& path, Sink sink) {
+    Lsb out[kBatchTicks][kAxes];
+    for (const pathstream::PreparedSpan<kAxes>& span : path.prepared) {
+        pathstream::DifferenceState<Word> state[kAxes];
+        if constexpr (sizeof(Word) == 4) {
+            std::memcpy(state, span.narrow, sizeof state);
+        } else {
+            std::memcpy(state, span.wide_state, sizeof state);
+        }
+        const Word bias = static_cast<Word>(span.bias);
+        for (std::uint32_t k = 0; k < span.ticks; k += kBatchTicks) {
+            const std::uint32_t count = std::min(kBatchTicks, span.ticks - k);
+            pathstream::emit_span_ticks(state, out, count, bias);
+            for (std::uint32_t i = 0; i < count; ++i) sink(out[i][0], out[i][1]);
+        }
+    }
+    return sink;
+}
+
+/// SetpointStream::tick_many over spans already queued, kBatchTicks setpoints per call.
+template <class Sink>
+Sink stream_tick_many(QueuedStream& stream, std::size_t count, Sink sink, std::size_t& idle) {
+    Lsb out[kBatchTicks][kAxes];
+    std::size_t idle_ticks = 0;
+    for (std::size_t t = 0; t < count; t += kBatchTicks) {
+        const auto batch =
+            static_cast<std::uint32_t>(std::min<std::size_t>(kBatchTicks, count - t));
+        idle_ticks += stream.tick_many(out, batch);
+        for (std::uint32_t i = 0; i < batch; ++i) sink(out[i][0], out[i][1]);
+    }
+    idle += idle_ticks;
     return sink;
 }
 
@@ -466,13 +509,31 @@ struct Config {
     bool markdown = false;
     int runs = 5;
     double min_time_ms = 50.0;
+    bool wall_clock = false;
     std::vector<std::uint32_t> ticks_per_span;
 };
 
-using Clock = std::chrono::steady_clock;
+/// What every timed region is measured with: by default the calling thread's CPU time
+/// (CLOCK_THREAD_CPUTIME_ID), so that time the scheduler gives other jobs on a shared machine
+/// is not charged to whichever method happened to be running; --wall-clock switches to
+/// std::chrono::steady_clock. Nanoseconds either way.
+struct Clock {
+    using time_point = std::int64_t;
+    static inline bool wall = false;
+    static time_point now() {
+        if (wall) {
+            return std::chrono::duration_cast<std::chrono::nanoseconds>(
+                       std::chrono::steady_clock::now().time_since_epoch())
+                .count();
+        }
+        timespec ts{};
+        clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+        return std::int64_t{ts.tv_sec} * 1000000000 + ts.tv_nsec;
+    }
+};
 
 double elapsed_ns(Clock::time_point t0, Clock::time_point t1) {
-    return std::chrono::duration<double, std::nano>(t1 - t0).count();
+    return static_cast<double>(t1 - t0);
 }
 
 struct PassResult {
@@ -657,11 +718,12 @@ bool run_case(const Config& cfg, std::uint32_t n, std::uint64_t& grand_checksum)
         }
     }
     auto queued = std::make_unique<QueuedStream>(start);
+    auto batched = std::make_unique<QueuedStream>(start);
     auto fed = std::make_unique<FedStream>(start);
 
     // Verification pass: every method's outputs checked against the exact values as they come.
     std::vector<Row> rows;
-    rows.reserve(7);
+    rows.reserve(9);
     auto record = [&](const std::string& method, auto&& body) {
         VerifyState state(path);
         body(Verifier{&state});
@@ -672,7 +734,17 @@ bool run_case(const Config& cfg, std::uint32_t n, std::uint64_t& grand_checksum)
         row.verified_checksum = state.checksum.value();
         rows.push_back(row);
     };
-    enum RowId { kStreamTick, kStreamPush, kRawStep, kIntHorner, kDoubleHorner, kFloatFd, kEigen };
+    enum RowId {
+        kStreamTick,
+        kStreamPush,
+        kRawStep,
+        kStreamBatch,
+        kSpanTicks,
+        kIntHorner,
+        kDoubleHorner,
+        kFloatFd,
+        kEigen
+    };
 
     record("exact FD: SetpointStream::tick (spans queued)", [&](Verifier r) {
         std::size_t idle = 0;
@@ -696,6 +768,24 @@ bool run_case(const Config& cfg, std::uint32_t n, std::uint64_t& grand_checksum)
                else
                    raw_steps<std::uint64_t>(path, r);
            });
+    record("exact FD: SetpointStream::tick_many (spans queued)", [&](Verifier r) {
+        std::size_t idle = 0;
+        bool pushed = true;
+        for (std::size_t first = 0; first < path.spans.size();) {
+            const std::size_t count = queue_spans(path, *batched, first, pushed);
+            r = stream_tick_many(*batched, count * n, r, idle);
+            first += count;
+        }
+        if (!pushed || idle != 0) fail("SetpointStream (tick_many): push failed or went idle");
+    });
+    record(std::string("exact FD: emit_span_ticks (") + (narrow ? "32" : "64") +
+               "-bit), like-for-like",
+           [&](Verifier r) {
+               if (narrow)
+                   span_ticks<std::uint32_t>(path, r);
+               else
+                   span_ticks<std::uint64_t>(path, r);
+           });
     record("integer Horner: evaluate_at (128-bit)", [&](Verifier r) {
         bool good = true;
         integer_horner(path, r, good);
@@ -710,7 +800,7 @@ bool run_case(const Config& cfg, std::uint32_t n, std::uint64_t& grand_checksum)
         fail("integer Horner (evaluate_at) differs from the independent __int128 reference in " +
              std::to_string(rows[kIntHorner].accuracy.mismatches) + " values");
     }
-    for (RowId id : {kStreamTick, kStreamPush, kRawStep}) {
+    for (RowId id : {kStreamTick, kStreamPush, kRawStep, kStreamBatch, kSpanTicks}) {
         if (rows[id].verified_checksum != rows[kIntHorner].verified_checksum ||
             rows[id].accuracy.mismatches != rows[kIntHorner].accuracy.mismatches ||
             rows[id].accuracy.max_error != 0) {
@@ -755,6 +845,27 @@ bool run_case(const Config& cfg, std::uint32_t n, std::uint64_t& grand_checksum)
         });
     });
     passes.push_back([&] {
+        Checksum c;
+        double timed = 0.0;
+        std::size_t idle = 0;
+        bool pushed = true;
+        for (std::size_t first = 0; first < path.spans.size();) {
+            const std::size_t count = queue_spans(path, *batched, first, pushed);  // untimed
+            const Clock::time_point t0 = Clock::now();
+            c = stream_tick_many(*batched, count * n, c, idle);
+            timed += elapsed_ns(t0, Clock::now());
+            first += count;
+        }
+        if (!pushed || idle != 0) fail("SetpointStream (tick_many) misbehaved in a timed pass");
+        return PassResult{timed, c.value()};
+    });
+    passes.push_back([&] {
+        return timed_pass([&] {
+            return narrow ? span_ticks<std::uint32_t>(path, Checksum{})
+                          : span_ticks<std::uint64_t>(path, Checksum{});
+        });
+    });
+    passes.push_back([&] {
         bool good = true;
         const PassResult r = timed_pass([&] { return integer_horner(path, Checksum{}, good); });
         if (!good) fail("evaluate_at returned an error in a timed pass");
@@ -789,7 +900,7 @@ bool run_case(const Config& cfg, std::uint32_t n, std::uint64_t& grand_checksum)
     std::printf("\n%s%zu spans, %zu setpoints per pass (%zu axis values)%s", indent,
                 path.spans.size(), setpoints, values, end);
     bool fd_identical = true;
-    for (RowId id : {kStreamTick, kStreamPush, kRawStep}) {
+    for (RowId id : {kStreamTick, kStreamPush, kRawStep, kStreamBatch, kSpanTicks}) {
         fd_identical &= rows[id].accuracy.mismatches == 0 &&
                         rows[id].verified_checksum == rows[kIntHorner].verified_checksum;
     }
@@ -821,12 +932,13 @@ bool parse_uint(const char* s, long long lo, long long hi, long long& out) {
 void usage(std::FILE* f) {
     std::fprintf(f,
                  "usage: bench_eval [--quick] [--ticks-per-span N]... [--markdown] [--runs R] "
-                 "[--min-time-ms T]\n"
+                 "[--min-time-ms T] [--wall-clock]\n"
                  "  --quick             one timed pass per method (CI smoke; checks still run)\n"
                  "  --ticks-per-span N  n of every span, 1..%u (repeatable; default 64 and 4096)\n"
                  "  --markdown          print the tables as Markdown\n"
                  "  --runs R            runs per method, best taken (default 5)\n"
                  "  --min-time-ms T     timed work per run (default 50)\n"
+                 "  --wall-clock        time with steady_clock instead of the thread's CPU time\n"
                  "Exit status: 0, 1 on an exactness mismatch, 2 on a usage error.\n",
                  pathstream::kMaxSpanTicks);
 }
@@ -842,6 +954,8 @@ int main(int argc, char** argv) {
             cfg.quick = true;
         } else if (arg == "--markdown") {
             cfg.markdown = true;
+        } else if (arg == "--wall-clock") {
+            cfg.wall_clock = true;
         } else if (arg == "--help" || arg == "-h") {
             usage(stdout);
             return 0;
@@ -867,17 +981,18 @@ int main(int argc, char** argv) {
         cfg.min_time_ms = 0.0;
     }
     if (cfg.ticks_per_span.empty()) cfg.ticks_per_span = {64, 4096};
+    Clock::wall = cfg.wall_clock;
 
     std::printf(
         "%sbench_eval: closed uniform cubic B-spline, %d control points (7-petal rose, "
         "amplitude %.0f LSB), 2 axes; one setpoint = both axes at one tick\n",
         cfg.markdown ? "" : "", kControlPoints, kAmplitude);
     std::printf(
-        "timing: steady_clock, best of %d run(s) of >= %.0f ms timed work%s; ratio = "
+        "timing: %s, best of %d run(s) of >= %.0f ms timed work%s; ratio = "
         "double Horner ns / method ns (> 1: faster than the baseline); bench -O2, core "
         "library build type %s\n",
-        cfg.runs, cfg.min_time_ms, cfg.quick ? " (--quick)" : " after a warm-up pass",
-        PATHSTREAM_BENCH_BUILD_TYPE);
+        cfg.wall_clock ? "steady_clock (wall time)" : "thread CPU time", cfg.runs, cfg.min_time_ms,
+        cfg.quick ? " (--quick)" : " after a warm-up pass", PATHSTREAM_BENCH_BUILD_TYPE);
 
     bool ok = true;
     std::uint64_t checksum = 0;
