@@ -14,7 +14,9 @@ std::int64_t steady_ns() {
         .count();
 }
 
-// DESIGN.md's worst case for a CAN 2.0A frame with n data bytes (bit stuffing included).
+// Bits of a CAN 2.0A frame with n data bytes: 47 + 8n, plus one stuff bit per 5 of the 34 + 8n
+// stuffed bits. Slightly below can::frame_bits_worst_case (a stuff bit every 4 bits after the
+// first 5), which the native streamer and bench_can count: docs/cia402.md "Bus load per cycle".
 unsigned worst_case_bits(unsigned n) { return (269 + 48 * n) / 5; }
 
 }  // namespace
