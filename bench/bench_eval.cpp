@@ -15,6 +15,18 @@
 //                                        of every span inside the timed region.
 //   * exact FD, raw emit_and_step      : DifferenceState of spans prepared once, stepped by
 //                                        emit_and_step (the state copy per span is timed).
+//     These three are the tick interrupt's path: one tick per call, the state loaded from
+//     memory and stored back every tick, as an interrupt must keep it between ticks.
+//   * exact FD, SetpointStream::tick_many: a second queued stream, 256 ticks per call
+//                                        (emit_span_ticks inside, the state in registers).
+//   * exact FD, emit_span_ticks        : THE LIKE-FOR-LIKE ROW. Spans prepared once (as the
+//                                        baseline's coefficients are), each stepped by
+//                                        emit_span_ticks into a 256-setpoint buffer that the
+//                                        checksum then reads: the same work per setpoint as
+//                                        double Horner (every tick of every span, both axes,
+//                                        each setpoint handed to the same checksum), plus one
+//                                        store and one load per value that the baseline,
+//                                        whose values stay in registers, does not do.
 //   * integer Horner, evaluate_at      : the core's 128-bit Horner and 128/64 division, per
 //                                        axis per tick (make_tick_cubic done beforehand).
 //   * double Horner                    : THE BASELINE. The same cubic per span, coefficients
@@ -31,11 +43,14 @@
 //                                        A2.2 (Cox-de Boor basis functions), then the weighted
 //                                        sum of the four control points.
 //
-// How the figures are measured: std::chrono::steady_clock around whole passes over the path
-// (every span, every tick). A run repeats passes until it has timed at least --min-time-ms
-// (50 ms); the figure is the best (lowest ns per setpoint) of --runs (5) runs, after one
-// untimed warm-up pass. Runs are interleaved across methods (run 1 of each, then run 2 of
-// each, ...) so that load elsewhere on the machine cannot bias one method against another.
+// How the figures are measured: the thread's CPU time (CLOCK_THREAD_CPUTIME_ID; with
+// --wall-clock, std::chrono::steady_clock) around whole passes over the path (every span, every
+// tick), so that on a shared machine the time other jobs run is not counted. A run repeats
+// passes until it has timed at least --min-time-ms (50 ms); the figure is the best (lowest ns
+// per setpoint) of --runs (5) runs, after one untimed warm-up pass. Runs are interleaved
+// across methods (run 1 of each, then run 2 of each, ...) so that load elsewhere on the
+// machine (which still costs caches and a shared core's execution units) cannot bias one
+// method against another.
 // Every output goes into a running Fletcher-style checksum so that no work can be optimised
 // away; each method's checksum of its last timed pass must equal the checksum of its
 // verified outputs, and the exact methods' must equal the exact one (the program prints a
@@ -46,13 +61,13 @@
 //
 // Exactness: the exact setpoints are round(Q(k) / D) computed here independently with
 // __int128 (Q(k) = a k^3 + b n k^2 + c n^2 k + d n^3, D = 6 n^3, halves up). Integer Horner
-// must equal them and all three exact FD variants must equal integer Horner bit for bit; the
+// must equal them and all five exact FD variants must equal integer Horner bit for bit; the
 // Eigen outputs must be within 1 LSB. Any violation prints what failed and exits with 1.
 // "max error" is max |output - exact setpoint| in LSB over both axes and every tick;
 // "pre-rounding error" is max |value before rounding - exact rational value| in LSB.
 //
 // Usage: bench_eval [--quick] [--ticks-per-span N]... [--markdown] [--runs R]
-//                   [--min-time-ms T]
+//                   [--min-time-ms T] [--wall-clock]
 #include <algorithm>
 #include <array>
 #include <chrono>
