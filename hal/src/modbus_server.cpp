@@ -29,7 +29,7 @@ using Clock = std::chrono::steady_clock;
 }
 
 void bump(std::atomic<std::uint64_t>& counter, std::uint64_t by = 1) {
-    counter.fetch_add(by, std::memory_order_relaxed);
+    counter.fetch_add(by, std::memory_order_release);
 }
 
 // Bound, listening, non-blocking TCP socket for host:port (port 0 = ephemeral).
@@ -340,7 +340,12 @@ const ModbusServerCounters& ModbusServer::counters() const {
     return impl_->counters;
 }
 std::size_t ModbusServer::open_connections() const {
-    return impl_->clients.size();
+    // From the counters, not the client list: another thread may be serving (and editing the
+    // list). Closed is read first, so the difference is never negative.
+    const std::uint64_t closed = impl_->counters.connections_closed.load(std::memory_order_acquire);
+    const std::uint64_t accepted =
+        impl_->counters.connections_accepted.load(std::memory_order_acquire);
+    return static_cast<std::size_t>(accepted - closed);
 }
 
 }  // namespace pathstream::hal

@@ -99,7 +99,8 @@ public:
     const std::string& client_device() const;
     /// Live counters (see ModbusServerCounters).
     const ModbusServerCounters& counters() const;
-    /// TCP: connections currently open.
+    /// TCP: connections currently open (accepted minus closed). Safe from any thread while
+    /// another one polls: a count from the atomic counters, never the client list itself.
     std::size_t open_connections() const;
 
 private:
