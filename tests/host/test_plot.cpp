@@ -494,10 +494,17 @@ TEST_CASE("the report shows the run's figures", "[plot]") {
     check.max_deviation = 0.0032;
     check.worst_deviation_tick = 1234;
     check.within_limits = true;
+    // The allowance-subtracted fractions (whole-LSB steps) must not be what the report shows.
     check.max_velocity_fraction = 0.5;
     check.max_acceleration_fraction = 0.25;
-    check.axis_velocity_fraction = {0.42, 0.5};
-    check.axis_acceleration_fraction = {0.25, 0.2};
+    check.axis_velocity_fraction = {0.4234, 0.4987};
+    check.axis_acceleration_fraction = {0.6667, 0.3333};
+    check.axis_velocity_fraction_exact = {0.4321, 0.5012};
+    check.axis_acceleration_fraction_exact = {0.9896, 0.7543};
+    check.axis_max_step = {53, 51};
+    check.axis_max_second_difference = {3, 2};
+    check.axis_velocity_limit_lsb = {120, 100};
+    check.axis_acceleration_limit_lsb = {2, 1.5};
     plot::RunSummary run;
     run.plant = "servo, 2nd order, f_n 50 Hz, zeta 1";
     run.ticks = 3201;
@@ -509,13 +516,35 @@ TEST_CASE("the report shows the run's figures", "[plot]") {
     run.rms_following_error_mm = {0.201, 0.1};
     const std::string text = plot::text_report(plan, &check, m, exec, run);
     INFO(text);
-    for (const char* figure :
-         {"3.200 s planned", "3.201 s simulated in 0.050 s wall", "(64x)", "120.00 mm pen-down",
-          "40.00 mm travel", "2 pen switches", "3201 ticks", "400 spans", "0 underruns",
-          "3.20 um max (tick 1234)", "within the axis limits", "812.3", "201.0", "42.0",
-          "servo, 2nd order"}) {
+    for (const char* figure : {"3.200 s planned",
+                               "3.201 s simulated in 0.050 s wall",
+                               "(64x)",
+                               "120.00 mm pen-down",
+                               "40.00 mm travel",
+                               "2 pen switches",
+                               "3201 ticks",
+                               "400 spans",
+                               "0 underruns",
+                               "3.20 um max (tick 1234)",
+                               "within the axis limits",
+                               "812.3",
+                               "201.0",
+                               "servo, 2nd order",
+                               "exact cubic peak: v 50.12 %, a 98.96 %",
+                               "43.21",
+                               "53 of 120",
+                               "98.96",
+                               "3 of 2",
+                               "50.12",
+                               "51 of 100",
+                               "75.43",
+                               "2 of 1.5",
+                               "LSB/tick^2",
+                               "following error um"}) {
         CHECK(text.find(figure) != std::string::npos);
     }
+    for (const char* allowance : {"42.3", "49.9", "66.7", "33.3"})
+        CHECK(text.find(allowance) == std::string::npos);
     // Executed peaks: 50 mm/s on each axis against 120 and 100 mm/s limits.
     CHECK(text.find("41.7") != std::string::npos);
     CHECK(text.find("50.0") != std::string::npos);
@@ -523,6 +552,17 @@ TEST_CASE("the report shows the run's figures", "[plot]") {
     std::size_t count = 0;
     for (std::string line; std::getline(lines, line); ++count) CHECK(line.size() <= 80);
     CHECK(count <= 24);
+
+    // Over the limits: the exact figure says so; setpoints over limit + rounding get a line.
+    check.within_limits = false;
+    check.axis_acceleration_fraction_exact = {1.2, 0.7543};
+    check.max_acceleration_fraction = 1.1;
+    const std::string over = plot::text_report(plan, &check, m, exec, run);
+    CHECK(over.find("LIMITS EXCEEDED (exact cubic peak: v 50.12 %, a 120.00 %)") !=
+          std::string::npos);
+    CHECK(over.find("setpoint differences over limit + rounding (v 50.0 %, a 110.0 %)") !=
+          std::string::npos);
+    CHECK(text.find("over limit + rounding") == std::string::npos);
 
     run.max_following_error_mm.clear();
     run.underruns = 7;

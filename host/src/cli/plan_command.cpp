@@ -64,10 +64,18 @@ void print_plan_summary(const PlannedJob& job, std::ostream& out) {
                   c.max_deviation * 1000, job.machine.chord_tolerance * 1000,
                   static_cast<unsigned long long>(c.worst_deviation_tick));
     out << line;
+    // The exact cubic's peaks (what a device checks) and the integer setpoints' largest
+    // differences next to the limits in the same unit (rounding adds < 1 and < 2 LSB).
     for (std::size_t a = 0; a < job.machine.axes.size(); ++a) {
-        std::snprintf(line, sizeof line, "  axis %s: peak %.1f %% of max velocity, %.1f %% of max acceleration\n",
-                      job.machine.axes[a].name.c_str(), 100 * c.axis_velocity_fraction.at(a),
-                      100 * c.axis_acceleration_fraction.at(a));
+        std::snprintf(
+            line, sizeof line,
+            "  axis %s: exact cubic peak %.2f %% of max velocity, %.2f %% of max acceleration; "
+            "setpoints %lld of %.4g LSB/tick, %lld of %.4g LSB/tick^2\n",
+            job.machine.axes[a].name.c_str(), 100 * c.axis_velocity_fraction_exact.at(a),
+            100 * c.axis_acceleration_fraction_exact.at(a),
+            static_cast<long long>(c.axis_max_step.at(a)), c.axis_velocity_limit_lsb.at(a),
+            static_cast<long long>(c.axis_max_second_difference.at(a)),
+            c.axis_acceleration_limit_lsb.at(a));
         out << line;
     }
     std::snprintf(line, sizeof line, "  every tick checked (%llu): %s%s\n", static_cast<unsigned long long>(c.ticks_checked),

@@ -7,7 +7,9 @@
 // axes rest before tick 0 and after the last tick. Rounding each setpoint once (error in
 // (-1/2, 1/2] LSB) moves a first difference by less than 1 LSB and a second difference by less
 // than 2 LSB, so a tick is within the limits when |first difference| <= v T / lsb + 1 and
-// |second difference| <= a T^2 / lsb + 2 (the fractions reported subtract exactly this).
+// |second difference| <= a T^2 / lsb + 2 (max_*_fraction subtract exactly this). Those fractions
+// come in coarse steps (1/3 of the limit at 3 LSB/tick^2) and stay below the exact cubic's, so
+// the check also keeps the raw integer peaks in LSB and the exact fractions for reports.
 #include <algorithm>
 #include <cmath>
 #include <map>
@@ -93,6 +95,12 @@ public:
         out_.axis_acceleration_fraction.assign(axes_, 0);
         out_.axis_velocity_fraction_exact.assign(axes_, 0);
         out_.axis_acceleration_fraction_exact.assign(axes_, 0);
+        out_.axis_max_step.assign(axes_, 0);
+        out_.axis_max_second_difference.assign(axes_, 0);
+        out_.axis_velocity_limit_lsb.assign(vlim_.begin(),
+                                            vlim_.begin() + static_cast<std::ptrdiff_t>(axes_));
+        out_.axis_acceleration_limit_lsb.assign(alim_.begin(),
+                                                alim_.begin() + static_cast<std::ptrdiff_t>(axes_));
         if (deviation) {
             std::vector<Cubic> down;
             std::vector<std::size_t> index;
@@ -216,10 +224,12 @@ private:
         bool moved = false;
         double speed2 = 0;
         for (std::size_t a = 0; a < axes_; ++a) {
-            const double d = static_cast<double>(p[a] - p1_[a]);
+            const std::int64_t step = p[a] - p1_[a];
+            const double d = static_cast<double>(step);
             const double de = e[a] - e1_[a];
             if (d != 0) moved = true;
             speed2 += d * d;
+            out_.axis_max_step[a] = std::max(out_.axis_max_step[a], step < 0 ? -step : step);
             velocity(a, std::fabs(d), std::fabs(de));
         }
         if (k > 0 && moved && in_window(k - 1)) out_.drawing_while_pen_moves = true;
@@ -234,8 +244,7 @@ private:
         // Second difference centred on k - 1.
         if (k > 0) {
             for (std::size_t a = 0; a < axes_; ++a) {
-                acceleration(a, std::fabs(static_cast<double>(p[a] - 2 * p1_[a] + p2_[a])),
-                             std::fabs(e[a] - 2 * e1_[a] + e2_[a]));
+                acceleration(a, p[a] - 2 * p1_[a] + p2_[a], std::fabs(e[a] - 2 * e1_[a] + e2_[a]));
             }
         }
         // Deviation of a pen-down setpoint.
@@ -270,7 +279,12 @@ private:
         out_.axis_velocity_fraction_exact[a] = std::max(out_.axis_velocity_fraction_exact[a], de / vlim_[a]);
     }
 
-    void acceleration(std::size_t a, double d, double de) {
+    /// `second` is the integer setpoints' second difference, `de` the exact cubic's (magnitude).
+    void acceleration(std::size_t a, std::int64_t second, double de) {
+        const std::int64_t magnitude = second < 0 ? -second : second;
+        out_.axis_max_second_difference[a] =
+            std::max(out_.axis_max_second_difference[a], magnitude);
+        const double d = static_cast<double>(magnitude);
         const double allowed = std::max(0.0, d - 2) / alim_[a];
         out_.axis_acceleration_fraction[a] = std::max(out_.axis_acceleration_fraction[a], allowed);
         out_.max_acceleration_fraction_raw = std::max(out_.max_acceleration_fraction_raw, d / alim_[a]);
@@ -281,7 +295,7 @@ private:
     void finish() {
         // The axes rest after the end: one more second difference, centred on the end point.
         for (std::size_t a = 0; a < axes_; ++a) {
-            acceleration(a, std::fabs(static_cast<double>(p2_[a] - p1_[a])), std::fabs(e2_[a] - e1_[a]));
+            acceleration(a, p2_[a] - p1_[a], std::fabs(e2_[a] - e1_[a]));
         }
         for (std::size_t a = 0; a < axes_; ++a) {
             out_.max_velocity_fraction = std::max(out_.max_velocity_fraction, out_.axis_velocity_fraction[a]);

@@ -21,6 +21,17 @@ std::string percent(double fraction) {
     return fmt("%.1f", 100 * fraction);
 }
 
+/// Two decimals: the exact cubic's figures are exact, and the last per cent matters (98.96).
+std::string percent2(double fraction) {
+    if (!std::isfinite(fraction)) return "-";
+    return fmt("%.2f", 100 * fraction);
+}
+
+std::string pad_right(std::string s, std::size_t width) {
+    if (s.size() < width) s.append(width - s.size(), ' ');
+    return s;
+}
+
 std::string pad(std::string s, std::size_t width) {
     if (s.size() < width) s.insert(0, width - s.size(), ' ');
     return s;
@@ -80,26 +91,37 @@ std::string text_report(const Plan& plan, const PlanCheck* check, const MachineP
       << " underruns";
     if (run.realtime) o << ", " << run.late_ticks << " late ticks";
     o << "\n";
+    // Figures against the limits say what they measure: the exact cubic (what a device that
+    // validates spans checks), the integer setpoints' differences in LSB next to the limit in
+    // LSB, and the executed series' smoothed differences.
+    const auto exact_peak = [&](const std::vector<double>& f) {
+        double m = 0;
+        for (const double x : f) m = std::max(m, x);
+        return m;
+    };
     if (check != nullptr) {
         o << "  deviation  " << fmt("%.2f", check->max_deviation * 1000) << " um max (tick "
           << check->worst_deviation_tick << "), tolerance "
           << fmt("%.2f", profile.chord_tolerance * 1000) << " um (planner check)\n";
         o << "  limits     "
           << (check->within_limits ? "within the axis limits" : "LIMITS EXCEEDED")
-          << " (planner check: v " << percent(check->max_velocity_fraction) << " %, a "
-          << percent(check->max_acceleration_fraction) << " %)\n";
+          << " (exact cubic peak: v " << percent2(exact_peak(check->axis_velocity_fraction_exact))
+          << " %, a " << percent2(exact_peak(check->axis_acceleration_fraction_exact)) << " %)\n";
+        if (check->max_velocity_fraction > 1 || check->max_acceleration_fraction > 1) {
+            o << "             setpoint differences over limit + rounding (v "
+              << percent(check->max_velocity_fraction) << " %, a "
+              << percent(check->max_acceleration_fraction) << " %)\n";
+        }
     } else {
         o << "  deviation  not checked (no planner check given)\n";
     }
 
-    // Per axis: peak fractions of the limits (planner, executed setpoints) and following error.
+    // Per axis: peaks against the limits, then the following error.
     const Derivatives d = differentiate(executed, profile);
     const bool following = !run.max_following_error_mm.empty();
-    o << "\n  axis      v peak % of limit     a peak % of limit";
-    if (following) o << "   following error um";
-    o << "\n            planner  executed     planner  executed";
-    if (following) o << "       max       rms";
-    o << "\n";
+    o << "\n            velocity peak                      acceleration peak\n"
+      << "  axis      cubic   setpoints  executed     cubic   setpoints  executed\n"
+      << "            % lim    LSB/tick     % lim     % lim  LSB/tick^2     % lim\n";
     for (std::size_t a = 0; a < axes; ++a) {
         double v = 0, acc = 0;
         for (std::size_t k = 0; k < executed.ticks(); ++k) {
@@ -108,28 +130,47 @@ std::string text_report(const Plan& plan, const PlanCheck* check, const MachineP
         }
         const double v_lim = a < profile.axes.size() ? profile.axes[a].max_velocity : 0;
         const double a_lim = a < profile.axes.size() ? profile.axes[a].max_acceleration : 0;
-        const auto planned = [&](const std::vector<double>& f) {
-            return check != nullptr && a < f.size() ? percent(f[a]) : std::string("-");
+        const bool checked = check != nullptr && a < check->axis_velocity_fraction_exact.size() &&
+                             a < check->axis_acceleration_fraction_exact.size() &&
+                             a < check->axis_max_step.size() &&
+                             a < check->axis_max_second_difference.size() &&
+                             a < check->axis_velocity_limit_lsb.size() &&
+                             a < check->axis_acceleration_limit_lsb.size();
+        const auto steps = [&](std::int64_t peak, double limit) {
+            return std::to_string(peak) + " of " + fmt("%.4g", limit);
         };
-        std::string name = name_of(profile, a);
-        name.resize(std::max<std::size_t>(name.size(), 6), ' ');
-        o << "  " << name
-          << pad(planned(check ? check->axis_velocity_fraction : std::vector<double>{}), 9)
+        o << "  " << pad_right(name_of(profile, a), 6)
+          << pad(checked ? percent2(check->axis_velocity_fraction_exact[a]) : "-", 9)
+          << pad(checked ? steps(check->axis_max_step[a], check->axis_velocity_limit_lsb[a]) : "-",
+                 12)
           << pad(v_lim > 0 ? percent(v / v_lim) : "-", 10)
-          << pad(planned(check ? check->axis_acceleration_fraction : std::vector<double>{}), 12)
-          << pad(a_lim > 0 ? percent(acc / a_lim) : "-", 10);
-        if (following && a < run.max_following_error_mm.size()) {
-            o << pad(fmt("%.1f", run.max_following_error_mm[a] * 1000), 13)
+          << pad(checked ? percent2(check->axis_acceleration_fraction_exact[a]) : "-", 10)
+          << pad(checked ? steps(check->axis_max_second_difference[a],
+                                 check->axis_acceleration_limit_lsb[a])
+                         : "-",
+                 12)
+          << pad(a_lim > 0 ? percent(acc / a_lim) : "-", 10) << "\n";
+    }
+    o << "  cubic      the spans' exact cubics before rounding: what the device checks\n"
+      << "  setpoints  largest integer difference \"of\" the limit, both in LSB; rounding\n"
+      << "             adds < 1 LSB/tick to a step, < 2 LSB/tick^2 to a 2nd difference\n";
+    o << "  executed   setpoint differences over +/-" << d.half_window
+      << " ticks (a noise <= " << fmt("%.0f", d.acceleration_noise) << " mm/s^2)\n";
+    if (following) {
+        o << "\n  axis      following error um\n"
+          << "                 max       rms\n";
+        for (std::size_t a = 0; a < axes && a < run.max_following_error_mm.size(); ++a) {
+            o << "  " << pad_right(name_of(profile, a), 6)
+              << pad(fmt("%.1f", run.max_following_error_mm[a] * 1000), 11)
               << pad(a < run.rms_following_error_mm.size()
                          ? fmt("%.1f", run.rms_following_error_mm[a] * 1000)
                          : "-",
-                     10);
+                     10)
+              << "\n";
         }
-        o << "\n";
+    } else {
+        o << "  following error: 0 (ideal plant: position = setpoint)\n";
     }
-    o << "  executed: setpoint differences over +/-" << d.half_window
-      << " ticks (a noise <= " << fmt("%.0f", d.acceleration_noise) << " mm/s^2)\n";
-    if (!following) o << "  following error: 0 (ideal plant: position = setpoint)\n";
     if (run.underruns > 0) {
         o << "  WARNING: the span queue ran dry " << run.underruns
           << " times before the end of the plan\n";

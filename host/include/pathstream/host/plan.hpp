@@ -28,10 +28,14 @@ struct Plan {
 
 /// Per-tick check of a plan against the machine and the geometry (every tick executed).
 struct PlanCheck {
-    double max_velocity_fraction = 0;      ///< max over axes and ticks of |v| / v_max
-    double max_acceleration_fraction = 0;  ///< max over axes and ticks of |a| / a_max
-    std::vector<double> axis_velocity_fraction;      ///< per axis
-    std::vector<double> axis_acceleration_fraction;  ///< per axis
+    /// The integer setpoints after the rounding allowance, max over axes and ticks:
+    /// (|first difference| - 1 LSB)+ / (v_max T) and (|second difference| - 2 LSB)+ / (a_max T^2).
+    /// Coarse (the differences are whole LSB) and never above the exact fractions below, so
+    /// reports show those and the raw differences (axis_max_step, axis_max_second_difference).
+    double max_velocity_fraction = 0;
+    double max_acceleration_fraction = 0;
+    std::vector<double> axis_velocity_fraction;      ///< per axis, as above
+    std::vector<double> axis_acceleration_fraction;  ///< per axis, as above
     double max_deviation = 0;              ///< mm, worst distance of a pen-down setpoint from the path
     std::uint64_t worst_deviation_tick = 0;
     /// Every fraction <= 1: the per-tick ones after the quantisation allowance, the exact
@@ -53,6 +57,14 @@ struct PlanCheck {
     /// Per axis: the larger of the exact per-tick and the span fraction.
     std::vector<double> axis_velocity_fraction_exact;
     std::vector<double> axis_acceleration_fraction_exact;
+    /// Per axis, the integer setpoints' largest |first difference| (LSB/tick) and |second
+    /// difference| (LSB/tick^2) over the ticks examined, and the limits in the same units
+    /// (v T / lsb, a T^2 / lsb). Rounding each setpoint once makes a step exceed the exact
+    /// cubic's by less than 1 LSB/tick and a second difference by less than 2 LSB/tick^2.
+    std::vector<std::int64_t> axis_max_step;
+    std::vector<std::int64_t> axis_max_second_difference;
+    std::vector<double> axis_velocity_limit_lsb;
+    std::vector<double> axis_acceleration_limit_lsb;
     /// Max over moving ticks of the per-tick speed along the path over the requested feed
     /// (pen-down: the subpath's feed; pen-up: travel_feed), after an allowance of
     /// 2 sqrt(axes) LSB per tick for the rounding of setpoints and span end points.
