@@ -20,10 +20,12 @@
 // "motion" is the executed motion time (span ticks / tick_hz, pen dwells excluded); "% above"
 // compares it with fine and with optimum. Every plan goes through check_plan (every tick, the
 // core's setpoints): within the limits, no motion during pen dwells, deviation within the chord
-// tolerance plus 1.5 sqrt(2) LSB; any failure prints why and exits with 1. Timings are never
-// asserted.
+// tolerance plus 1.5 sqrt(2) LSB; any failure prints why and exits with 1. Timings and the
+// motion times against fine and optimum are printed, never judged.
 //
-// Usage: bench_plan [--quick] [--segments N] [--density D] [--runs R] [--markdown]
+// Usage: bench_plan [--quick] [--segments N] [--density D] [--runs R] [--markdown] [--help]
+// Exit status (also printed by --help): 0 every plan passed its check, 1 a plan failed its check
+// or could not be made, 2 usage error.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -120,6 +122,24 @@ double ms_since(std::chrono::steady_clock::time_point t0) {
 
 }  // namespace
 
+constexpr const char* kUsageText =
+    "usage: bench_plan [--quick] [--segments N] [--density D] [--runs R] [--markdown] [--help]\n"
+    "  Plans three 2-axis drawings (rose, wander, spiral) of N segments (default 10000) for the "
+    "pen\n"
+    "  plotter and prints planning time, motion time against the same planner on a D times denser\n"
+    "  grid (default 16) and the continuous optimum, and the check of every executed tick.\n"
+    "  --quick        1000 segments, one run (the ctest smoke run)\n"
+    "  --segments N   segments per path (>= 10)\n"
+    "  --density D    the denser grid's factor (>= 1)\n"
+    "  --runs R       planning runs per path, best time kept (default 3)\n"
+    "  --markdown     the table in Markdown\n"
+    "targets (independent of the machine's speed): every plan within the limits for its exact\n"
+    "cubic and every tick, no motion during a pen dwell, deviation within the chord tolerance "
+    "plus\n"
+    "1.5 sqrt(2) LSB. Times are printed, never judged.\n"
+    "exit status: 0 every plan passed; 1 a plan failed its check or could not be made; 2 usage\n"
+    "error.\n";
+
 int main(int argc, char** argv) {
     std::size_t segments = 10000;
     double density = 16;
@@ -138,8 +158,11 @@ int main(int argc, char** argv) {
             density = std::strtod(argv[++i], nullptr);
         } else if (a == "--runs" && has_value) {
             runs = std::atoi(argv[++i]);
+        } else if (a == "--help" || a == "-h") {
+            std::fputs(kUsageText, stdout);
+            return 0;
         } else {
-            std::fprintf(stderr, "usage: bench_plan [--quick] [--segments N] [--density D] [--runs R] [--markdown]\n");
+            std::fputs(kUsageText, stderr);
             return 2;
         }
     }
