@@ -21,7 +21,8 @@ void add_eval_command(CLI::App& app, EvalOptions& o) {
         ->check(CLI::Range(1u, kMaxSpanTicks));
     cmd->add_option("--out,-o", o.output, "CSV output file (default: standard output)");
     cmd->add_option("--lsb", o.mm_per_lsb, "millimetres per LSB")->capture_default_str()->check(CLI::Range(1e-6, 10.0));
-    cmd->add_option("--machine,-m", o.machine, "machine profile (JSON): takes the LSB size from it (instead of --lsb)")
+    cmd->add_option("--machine,-m", o.machine,
+                    "machine profile (JSON): takes the LSB size from it (instead of --lsb)")
         ->check(CLI::ExistingFile);
 }
 

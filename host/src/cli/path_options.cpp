@@ -13,7 +13,9 @@
 namespace pathstream::host {
 
 void add_path_options(CLI::App& command, PathOptions& o) {
-    command.add_option("file", o.file, "path file: .json, .csv, .svg, .gcode/.ngc/.nc/.gc (docs/formats.md)")
+    command
+        .add_option("file", o.file,
+                    "path file: .json, .csv, .svg, .gcode/.ngc/.nc/.gc (docs/formats.md)")
         ->required()
         ->check(CLI::ExistingFile);
     command.add_option("--csv-basis", o.csv_basis, "basis of CSV points")
@@ -52,7 +54,9 @@ Path load_path(const PathOptions& o) {
         g.arc_tolerance_mm = o.tolerance;
         return load_gcode_path(o.file, g);
     }
-    throw InputError(o.file, {}, "unknown file type \"" + ext + "\" (expected .json, .csv, .svg, .gcode, .ngc, .nc or .gc)");
+    throw InputError(
+        o.file, {},
+        "unknown file type \"" + ext + "\" (expected .json, .csv, .svg, .gcode, .ngc, .nc or .gc)");
 }
 
 const char* axis_column_name(std::size_t axis) {

@@ -6,24 +6,27 @@
 #include <stdexcept>
 #include <string>
 
-#include "plan_command.hpp"
 #include "pathstream/hal/socketcan_bus.hpp"
 #include "pathstream/host/can_stream.hpp"
 #include "pathstream/host/cia402_master.hpp"
 #include "pathstream/host/progress.hpp"
+#include "plan_command.hpp"
 
 namespace pathstream::host {
 
 void add_stream_command(CLI::App& app, StreamCommandOptions& o) {
-    CLI::App* cmd = app.add_subcommand(
-        "stream",
-        "Plan the path and stream it to a device running the core over Modbus TCP or RTU (docs/modbus.md) or native "
-        "CAN (docs/can.md), or to CiA 402 drives in cyclic synchronous position mode (docs/cia402.md)");
+    CLI::App* cmd = app.add_subcommand("stream",
+                                       "Plan the path and stream it to a device running the core "
+                                       "over Modbus TCP or RTU (docs/modbus.md) or native "
+                                       "CAN (docs/can.md), or to CiA 402 drives in cyclic "
+                                       "synchronous position mode (docs/cia402.md)");
     add_path_options(*cmd, o.path);
     cmd->add_option("--machine,-m", o.machine, "machine profile (JSON, docs/formats.md)")->required()->check(CLI::ExistingFile);
     cmd->add_option("--target,-t", o.stream.target,
-                    "device: modbus-tcp://HOST:PORT?unit=N, modbus-rtu:///dev/ttyX?baud=115200&parity=N&unit=1, "
-                    "can://IFACE?node=N&protocol=native or CiA 402 drives can://IFACE?node=N&protocol=cia402&cycle=2ms")
+                    "device: modbus-tcp://HOST:PORT?unit=N, "
+                    "modbus-rtu:///dev/ttyX?baud=115200&parity=N&unit=1, "
+                    "can://IFACE?node=N&protocol=native or CiA 402 drives "
+                    "can://IFACE?node=N&protocol=cia402&cycle=2ms")
         ->required();
     cmd->add_flag("--lead-in", o.lead_in,
                   "start with a pen-up move from where the device rests (e.g. after homing) to the drawing's first "
@@ -33,10 +36,12 @@ void add_stream_command(CLI::App& app, StreamCommandOptions& o) {
         ->capture_default_str()
         ->check(CLI::Range(0.01, 60.0));
     cmd->add_option("--timeout-ms", o.stream.response_timeout_ms,
-                    "response timeout per Modbus try (native CAN: wait for an answer before resending, at most 100)")
+                    "response timeout per Modbus try (native CAN: wait for an answer before "
+                    "resending, at most 100)")
         ->capture_default_str()
         ->check(CLI::Range(10u, 60000u));
-    cmd->add_option("--attempts", o.stream.attempts, "tries per Modbus transaction before reconnecting")
+    cmd->add_option("--attempts", o.stream.attempts,
+                    "tries per Modbus transaction before reconnecting")
         ->capture_default_str()
         ->check(CLI::Range(1u, 100u));
     cmd->add_option("--link-timeout", o.stream.link_timeout_seconds,
@@ -91,9 +96,11 @@ int run_stream_can(const StreamCommandOptions& o, const PlannedJob& job) {
 
 int run_stream(const StreamCommandOptions& o) {
     const std::string& url = o.stream.target;
-    if (url.rfind("modbus-tcp://", 0) != 0 && url.rfind("modbus-rtu://", 0) != 0 && url.rfind("can://", 0) != 0) {
-        throw std::invalid_argument("bad target URL '" + url +
-                                    "': unknown scheme (want modbus-tcp://, modbus-rtu:// or can://)");
+    if (url.rfind("modbus-tcp://", 0) != 0 && url.rfind("modbus-rtu://", 0) != 0 &&
+        url.rfind("can://", 0) != 0) {
+        throw std::invalid_argument(
+            "bad target URL '" + url +
+            "': unknown scheme (want modbus-tcp://, modbus-rtu:// or can://)");
     }
     std::vector<double> rest_mm;
     if (o.lead_in) {
