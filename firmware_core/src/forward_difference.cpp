@@ -10,6 +10,12 @@ Status start_differences(const TickCubic& cubic, const SpanTiming& timing, std::
     const std::int64_t k = k0;
     const std::uint64_t den = timing.denominator;
     const Word bias = static_cast<Word>(difference_bias(timing));
+    // D = 2^m: remainders kept as binary fractions of the word, r * 2^(W - m), with K = 0.
+    // For D = 1 every remainder is 0 (and a shift by W would be undefined); m >= W only
+    // breaks the precondition on Word.
+    constexpr unsigned kWordBits = 8 * sizeof(Word);
+    const auto m = static_cast<unsigned>(__builtin_ctzll(den));
+    const unsigned binary_shift = is_binary(timing) && m > 0 && m < kWordBits ? kWordBits - m : 0;
 
     // The differences of Q at k: Delta1 = Q(k+1) - Q(k), Delta2, Delta3, expanded in k.
     const Int128 bn = Int128::from(cubic.b) * n;
@@ -26,7 +32,8 @@ Status start_differences(const TickCubic& cubic, const SpanTiming& timing, std::
     for (int i = 0; i < 4; ++i) {
         const FloorDivision qr = floor_divide(level[i], den);
         const auto quotient = static_cast<std::uint32_t>(qr.quotient.lo);
-        const auto remainder = static_cast<Word>(static_cast<Word>(qr.remainder) + level_bias[i]);
+        const auto remainder = static_cast<Word>(
+            static_cast<Word>(static_cast<Word>(qr.remainder) << binary_shift) + level_bias[i]);
         if (i < 3) {
             s.quotient[i] = quotient;
             s.remainder[i] = remainder;

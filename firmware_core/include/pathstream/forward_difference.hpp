@@ -126,41 +126,20 @@ struct DifferenceState {
 using NarrowDifferences = DifferenceState<std::uint32_t>;
 using WideDifferences = DifferenceState<std::uint64_t>;
 
-/// Writes each axis's current setpoint to `out`, then advances every axis one tick.
-/// This is the tick interrupt's whole per-axis work. On Thumb-2 (Cortex-M3/M4/M7) the narrow
-/// case is one LDMIA, one store, twelve ALU/IT instructions and one STMDB per axis, the
-/// same arithmetic as DifferenceState::step written so the loads and stores coalesce (GCC
-/// emits five loads and three stores for the C++). Define PATHSTREAM_PORTABLE_STEP to force
-/// the C++ everywhere; tests compare both builds' checksums bit for bit.
+/// Writes each axis's current setpoint to `out`, then advances every axis one tick: the
+/// per-axis work of one tick in C++. The tick interrupt's narrow spans go through
+/// narrow_tick (narrow_tick.hpp), which is this plus the span's countdown and, on Cortex-M,
+/// assembly. Interrupt-safe: touches only `state` and `out`.
 template <unsigned Axes, typename Word>
 inline void emit_and_step(DifferenceState<Word> (&state)[Axes], Lsb (&out)[Axes], Word bias) {
-#if defined(__thumb2__) && !defined(PATHSTREAM_PORTABLE_STEP)
+#if defined(__arm__)
     if constexpr (sizeof(Word) == 4) {
-        static_assert(sizeof(DifferenceState<Word>) == 32, "LDMIA of eight words");
-        DifferenceState<Word>* p = state;
-        Lsb* o = out;
+        // Unrolled (GCC keeps the loop otherwise): the setpoint is stored before the step, so
+        // aliasing costs nothing, and the constant jerk level is never written back.
 #pragma GCC unroll 8
         for (unsigned a = 0; a < Axes; ++a) {
-            // r4 jerk remainder, r5 jerk quotient, r6..r8 remainders 0..2, r9..r11 quotients.
-            asm volatile(
-                "ldmia %[p]!, {r4-r11}\n\t"
-                "str   r9, [%[o]], #4\n\t"
-                "adds  r6, r6, r7\n\t"
-                "adc   r9, r9, r10\n\t"
-                "it    cs\n\t"
-                "addcs r6, r6, %[k]\n\t"
-                "adds  r7, r7, r8\n\t"
-                "adc   r10, r10, r11\n\t"
-                "it    cc\n\t"
-                "subcc r7, r7, %[k]\n\t"
-                "adds  r8, r8, r4\n\t"
-                "adc   r11, r11, r5\n\t"
-                "it    cs\n\t"
-                "addcs r8, r8, %[k]\n\t"
-                "stmdb %[p], {r6-r11}"
-                : [p] "+r"(p), [o] "+r"(o)
-                : [k] "r"(bias)
-                : "r4", "r5", "r6", "r7", "r8", "r9", "r10", "r11", "cc", "memory");
+            out[a] = state[a].position();
+            state[a].step(bias);
         }
         return;
     }
@@ -235,8 +214,17 @@ constexpr bool is_narrow(const SpanTiming& timing) {
     return timing.denominator < (std::uint64_t{1} << 32);
 }
 
-/// K = 2^W - D for the word width the span uses (returned in 64 bits for both widths).
+/// True when D is a power of two: Hermite and Bezier spans of 2^j ticks, Catmull-Rom spans of
+/// 2^j ticks. Their remainders are kept as binary fractions of the word (r * 2^W / D), so the
+/// word's carry is the mixed-radix carry with no bias at all (K = 0, docs/exact-math.md).
+constexpr bool is_binary(const SpanTiming& timing) {
+    return (timing.denominator & (timing.denominator - 1)) == 0;
+}
+
+/// K = 2^W - D for the word width the span uses (returned in 64 bits for both widths), or 0
+/// when D is a power of two (is_binary).
 constexpr std::uint64_t difference_bias(const SpanTiming& timing) {
+    if (is_binary(timing)) return 0;
     return is_narrow(timing) ? (std::uint64_t{1} << 32) - timing.denominator
                              : 0 - timing.denominator;
 }

@@ -4,6 +4,7 @@
 
 #include <cstdint>
 
+#include "pathstream/narrow_tick.hpp"
 #include "pathstream/span.hpp"
 #include "pathstream/span_queue.hpp"
 #include "pathstream/status.hpp"
@@ -58,14 +59,28 @@ public:
     }
 
     /// Consumer (tick interrupt): writes this tick's setpoint for every axis to `out`.
-    /// Steady state on a narrow span tests one pointer and runs one forward-differencing step
-    /// per axis; everything else (a span boundary, a wide span, an empty queue) is out of line.
-    TickState tick(Lsb (&out)[Axes]) {
-        PreparedSpan<Axes>* const span = narrow_active_;
-        if (span == nullptr) return tick_slow(out);
-        emit_and_step(span->narrow, out, static_cast<std::uint32_t>(span->bias));
-        if (--remaining_ == 0) finish_span();
-        return TickState::kMoving;
+    /// Steady state on a narrow span tests one pointer (two when D is a power of two) and runs
+    /// narrow_tick: one forward-differencing step per axis and the span's countdown; everything
+    /// else (a span boundary, a wide span, an empty queue) is out of line. Always inlined, so
+    /// that the interrupt handler holds the fast path itself.
+    [[gnu::always_inline]] TickState tick(Lsb (&out)[Axes]) {
+        if (PreparedSpan<Axes>* const span = narrow_active_; span != nullptr) [[likely]] {
+            // An opaque copy of `this`: GCC then keeps it where it came (r0 on ARM) instead
+            // of copying it to a callee-saved register on every tick for the rare call below.
+            SetpointStream* self = this;
+            asm("" : "+r"(self));
+            if (narrow_tick<false, kCompactTick>(*span, out) == 0) [[unlikely]]
+                self->finish_span();
+            return TickState::kMoving;
+        }
+        if (PreparedSpan<Axes>* const span = binary_active_; span != nullptr) [[likely]] {
+            SetpointStream* self = this;
+            asm("" : "+r"(self));
+            if (narrow_tick<true, kCompactTick>(*span, out) == 0) [[unlikely]]
+                self->finish_span();
+            return TickState::kMoving;
+        }
+        return tick_slow(out);
     }
 
     /// Consumer, for code that wants many ticks at once (a host simulator, a batch fill; the
@@ -87,11 +102,10 @@ public:
                     ++done;
                     continue;
                 }
-                remaining_ = active_->ticks;
-                outputs_ = active_->outputs;
-                narrow_active_ = active_->wide ? nullptr : active_;
+                start_span();
             }
-            const std::uint32_t k = remaining_ < count - done ? remaining_ : count - done;
+            const std::uint32_t left = active_->countdown;
+            const std::uint32_t k = left < count - done ? left : count - done;
             if (active_->wide) {
                 emit_span_ticks(active_->wide_state, out + done, k, active_->bias);
             } else {
@@ -99,8 +113,8 @@ public:
                                 static_cast<std::uint32_t>(active_->bias));
             }
             done += k;
-            remaining_ -= k;
-            if (remaining_ == 0) finish_span();
+            active_->countdown = left - k;
+            if (left == k) finish_span();
         }
         return idle;
     }
@@ -112,7 +126,7 @@ public:
     static constexpr std::uint32_t capacity() { return Capacity; }
     /// Ticks supplied by spans since construction (idle ticks excluded). Consumer context.
     std::uint64_t ticks_executed() const {
-        return completed_ticks_ + (active_ != nullptr ? active_->ticks - remaining_ : 0u);
+        return completed_ticks_ + (active_ != nullptr ? active_->ticks - active_->countdown : 0u);
     }
     /// Tag of the last span whose every tick was supplied; 0 before the first. Consumer.
     std::uint32_t last_completed_tag() const { return last_completed_tag_; }
@@ -137,10 +151,9 @@ public:
     /// O(queued spans). Consumer context.
     void discard_all(const Lsb (&position)[Axes]) {
         if (active_ != nullptr) {
-            completed_ticks_ += active_->ticks - remaining_;  // the ticks it did supply
-            narrow_active_ = nullptr;
+            completed_ticks_ += active_->ticks - active_->countdown;  // the ticks it did supply
+            narrow_active_ = binary_active_ = nullptr;
             active_ = nullptr;
-            remaining_ = 0;
             queue_.release();
         }
         while (queue_.front() != nullptr) queue_.release();
@@ -152,6 +165,10 @@ public:
     }
 
 private:
+    // tick() repeats its per-axis code up to 4 axes and loops beyond, which costs 2
+    // instructions per axis and keeps the core within 8 KiB at 8 axes (docs/cortex-m.md).
+    static constexpr bool kCompactTick = Axes > 4;
+
     // Everything but a narrow span in progress: taking the next span from the queue, wide
     // spans (D >= 2^32: long spans) and holding when the queue is empty.
     [[gnu::noinline]] TickState tick_slow(Lsb (&out)[Axes]) {
@@ -161,16 +178,24 @@ private:
                 for (unsigned a = 0; a < Axes; ++a) out[a] = hold_[a];
                 return TickState::kIdle;
             }
-            remaining_ = active_->ticks;
-            outputs_ = active_->outputs;
+            start_span();
             if (!active_->wide) {
-                narrow_active_ = active_;
-                return tick(out);
+                // The first tick: the general step is exact for binary spans too (their K is
+                // 0), and its compact form keeps this rare path short.
+                if (narrow_tick<false, true>(*active_, out) == 0) finish_span();
+                return TickState::kMoving;
             }
         }
         emit_and_step(active_->wide_state, out, active_->bias);
-        if (--remaining_ == 0) finish_span();
+        if (--active_->countdown == 0) finish_span();
         return TickState::kMoving;
+    }
+
+    // Makes the queue's front span (active_) the one in progress.
+    void start_span() {
+        active_->countdown = active_->ticks;
+        outputs_ = active_->outputs;
+        if (!active_->wide) (active_->narrow_bias == 0 ? binary_active_ : narrow_active_) = active_;
     }
 
     [[gnu::noinline]] void finish_span() {
@@ -179,7 +204,7 @@ private:
             hold_[a] = active_->wide ? active_->wide_state[a].position()
                                      : active_->narrow[a].position();
         }
-        narrow_active_ = nullptr;
+        narrow_active_ = binary_active_ = nullptr;
         last_completed_tag_ = active_->tag;
         completed_ticks_ += active_->ticks;
         ++spans_completed_;
@@ -187,10 +212,11 @@ private:
         queue_.release();
     }
 
+    // First, so that the tick interrupt reaches them without an offset load (ARMv6-M).
+    PreparedSpan<Axes>* narrow_active_ = nullptr;  // == active_ when narrow and K != 0, else null
+    PreparedSpan<Axes>* binary_active_ = nullptr;  // == active_ when narrow and K == 0, else null
     SpanQueue<PreparedSpan<Axes>, Capacity> queue_;
-    PreparedSpan<Axes>* active_ = nullptr;         // span being played, narrow or wide
-    PreparedSpan<Axes>* narrow_active_ = nullptr;  // == active_ when it is narrow, else null
-    std::uint32_t remaining_ = 0;
+    PreparedSpan<Axes>* active_ = nullptr;  // span being played, narrow or wide
     std::uint64_t completed_ticks_ = 0;
     std::uint32_t last_completed_tag_ = 0;
     std::uint32_t spans_completed_ = 0;

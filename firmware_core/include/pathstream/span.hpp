@@ -33,7 +33,10 @@ inline constexpr std::uint8_t kOutputPenDown = 1u << 0;
 /// Holds either narrow or wide state for all axes (they share D). ~40 or ~48 bytes per axis.
 template <unsigned Axes>
 struct PreparedSpan {
-    // The states come first so the tick loop addresses them from the span pointer itself.
+    // The tick interrupt reads these two words and the states from the span pointer itself:
+    // on Cortex-M one LDM loads K, the countdown and the first axis (narrow_tick.hpp).
+    std::uint32_t narrow_bias = 0;  ///< narrow: K = 2^32 - D, or 0 when D is a power of two
+    std::uint32_t countdown = 0;    ///< ticks still to supply; counted down by the consumer
     union {
         NarrowDifferences narrow[Axes];
         WideDifferences wide_state[Axes];
@@ -87,6 +90,8 @@ void prepare_validated(const ValidatedSpan<Axes>& v, PreparedSpan<Axes>& out) {
     out.outputs = v.outputs;
     out.wide = !narrow;
     out.bias = difference_bias(v.timing);
+    out.narrow_bias = narrow ? static_cast<std::uint32_t>(out.bias) : 0u;
+    out.countdown = v.timing.ticks;
 }
 
 /// Validates `span` on every axis and writes its prepared form to `out`. Either every axis

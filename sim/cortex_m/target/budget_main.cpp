@@ -2,9 +2,12 @@
 // (plugin/insn_count.c) and read by host/budget_report.cpp.
 //
 // For A = 1, 2, 3, 4, 8 axes it streams spans through SetpointStream<A, 16> in phases:
-//   narrow: spans of n = 64 ticks (the typical streaming case, 32-bit remainders), S = 16
+//   narrow: spans of n = 60 ticks, all four bases (32-bit remainders, D not a power of two:
+//           the general step with its correction by K), S = 16
+//   binary: spans of n = 8 ticks, Hermite, Bezier and Catmull-Rom (D = 2^m: the step without
+//           correction); the planner streams Hermite spans of ticks_per_span = 8 ticks, S = 16
 //   wide:   spans of n = 2048 ticks (D >= 2^32, 64-bit remainders), S = 4
-// and for each width three phases on the same control values: (n, S spans), (2n, S spans),
+// and for each kind three phases on the same control values: (n, S spans), (2n, S spans),
 // (n, 2S spans), plus a phase of push() alone. Differences between phases cancel everything
 // that does not scale with the tick count:
 //   (2n, S) - (n, S): the steady per-tick cost (same number of span switches);
@@ -79,8 +82,16 @@ template <> TickState tick_of<4>(Stream<4>& s, Lsb (&out)[4]) { return budget_ti
 template <> TickState tick_of<8>(Stream<8>& s, Lsb (&out)[8]) { return budget_tick_8(s, out); }
 
 constexpr int kPoolSize = 4;
+using Bases = pathstream::Basis[kPoolSize];
+using pathstream::Basis;
+// Every basis (the last must be Hermite, see make_pool); for n a power of two only those whose
+// D = s n^3 is one then too (B-spline: s = 6).
+constexpr Bases kAllBases = {Basis::kUniformBSpline, Basis::kCatmullRom, Basis::kBezier,
+                             Basis::kHermite};
+constexpr Bases kBinaryBases = {Basis::kCatmullRom, Basis::kHermite, Basis::kBezier,
+                                Basis::kHermite};
 
-/// Four spans of `n` ticks, one per basis, gentle random control values, chained into a
+/// Four spans of `n` ticks of the given bases, gentle random control values, chained into a
 /// closed loop: push() accepts only a span that starts where the previous one ends, and the
 /// phases push the pool round and round from `start` (pool[0]'s tick-0 value). Each span is
 /// translated (the same offset on its position control values) to start at the previous
@@ -88,11 +99,10 @@ constexpr int kPoolSize = 4;
 /// (u = 0 and u = 1) do not depend on n, so the loop stays closed when n changes.
 /// Returns false if the core refuses a span (it cannot: the values are gentle).
 template <unsigned A>
-bool make_pool(pathstream::workload::SplitMix64& rng, std::uint32_t n,
+bool make_pool(pathstream::workload::SplitMix64& rng, std::uint32_t n, const Bases& bases,
                pathstream::Span<A> (&pool)[kPoolSize], Lsb (&start)[A]) {
-    static_assert(kPoolSize == 4, "one span per basis; the last one is the Hermite span");
     for (int i = 0; i < kPoolSize; ++i) {
-        pool[i].basis = static_cast<pathstream::Basis>(i);
+        pool[i].basis = bases[i];
         pool[i].ticks = n;
         pool[i].tag = static_cast<std::uint32_t>(i + 1);
         for (unsigned a = 0; a < A; ++a) {
@@ -180,15 +190,15 @@ template <unsigned A>
     report_phase(kind, A, pool[0].ticks, kCapacity, 0, kCapacity, ok);
 }
 
-/// The phases of one span width: (n, S), (2n, S), (n, 2S) on the same control values (only
+/// The phases of one kind of span: (n, S), (2n, S), (n, 2S) on the same control values (only
 /// the tick count changes, and S is a multiple of the pool size, so the (n, 2S) phase runs
 /// the (n, S) phase's spans twice), then push() alone.
 template <unsigned A>
-void width_phases(pathstream::workload::SplitMix64& rng, const char* kind, const char* push_kind,
-                  std::uint32_t n, std::uint32_t spans) {
+void kind_phases(pathstream::workload::SplitMix64& rng, const char* kind, const char* push_kind,
+                 const Bases& bases, std::uint32_t n, std::uint32_t spans) {
     pathstream::Span<A> pool[kPoolSize];
     Lsb start[A];
-    if (!make_pool<A>(rng, n, pool, start)) {
+    if (!make_pool<A>(rng, n, bases, pool, start)) {
         cortex_m::write("budget image: make_pool failed\n");
         g_failed = true;
     }
@@ -202,10 +212,12 @@ void width_phases(pathstream::workload::SplitMix64& rng, const char* kind, const
 
 template <unsigned A>
 void stream_phases(pathstream::workload::SplitMix64& rng) {
-    // Narrow: n = 64 (D = scale * 2^18 < 2^32 for every basis).
-    width_phases<A>(rng, "narrow", "push_narrow", 64, 16);
+    // Narrow: n = 60 and 120, D = s n^3 < 2^32 and never a power of two.
+    kind_phases<A>(rng, "narrow", "push_narrow", kAllBases, 60, 16);
+    // Binary: n = 8 and 16, D = 2^9 .. 2^13.
+    kind_phases<A>(rng, "binary", "push_binary", kBinaryBases, 8, 16);
     // Wide: n = 2048 (D >= 2^33 for every basis).
-    width_phases<A>(rng, "wide", "push_wide", 2048, 4);
+    kind_phases<A>(rng, "wide", "push_wide", kAllBases, 2048, 4);
 }
 
 /// evaluate_at at `calls` ticks spread over a span of n ticks; cost per call.
@@ -239,7 +251,7 @@ void stream_phases(pathstream::workload::SplitMix64& rng) {
 
 int main() {
     pathstream::workload::SplitMix64 rng(0xb0d6e7u);
-    cortex_m::write("budget image: SetpointStream<A, 16>, narrow n=64, wide n=2048\n");
+    cortex_m::write("budget image: SetpointStream<A, 16>, narrow n=60, binary n=8, wide n=2048\n");
     calibration_phase(1000);
     stream_phases<1>(rng);
     stream_phases<2>(rng);
