@@ -4,7 +4,9 @@
 #   asan     AddressSanitizer + UBSan build of the host tests
 #   tsan     ThreadSanitizer build of the test cases that run threads (Catch2 tag [threads])
 # Every preset runs even when an earlier one failed; a summary of all of them comes last, and
-# the exit status is non-zero when any failed.
+# the exit status is non-zero when any failed. When one to three tests of a preset fail, each
+# is run once more alone; one that then passes is named FLAKY in the summary (and does not
+# fail the run), one that fails again fails the preset.
 #   scripts/test.sh                 # what CI runs: every preset
 #   scripts/test.sh --quick         # the default preset only
 #   scripts/test.sh asan tsan       # the named presets only
@@ -30,7 +32,7 @@ fi
 scripts/setup.sh || { echo "test.sh: scripts/setup.sh failed: nothing was built" >&2; exit 1; }
 mkdir -p build
 
-declare -A status seconds passed failed total
+declare -A status seconds passed failed total flaky
 start_all=$SECONDS
 for p in "${presets[@]}"; do
   echo "=== test.sh: preset $p: configure, build, test ==="
@@ -46,6 +48,21 @@ for p in "${presets[@]}"; do
     passed[$p]=$((total[$p] - failed[$p]))
   else
     total[$p]=0 failed[$p]=0 passed[$p]=0  # it stopped before testing (configure or build)
+  fi
+  # A few failed tests get one more run each, on their own: a test that fails only when the
+  # machine is loaded (qemu under TCG, timing on a shared core) is reported as flaky by name
+  # in the summary, not hidden; one that fails again fails the preset.
+  flaky[$p]=""
+  if [ "${status[$p]}" != 0 ] && [ "${failed[$p]}" -gt 0 ] && [ "${failed[$p]}" -le 3 ]; then
+    mapfile -t names < <(sed -n -E 's/^[[:space:]]*[0-9]+ - (.*) \((Failed|Timeout|SEGFAULT|Subprocess aborted|Child aborted|Exception)\)$/\1/p' "build/$p.log")
+    echo "=== test.sh: preset $p: running the ${#names[@]} failed test(s) once more ==="
+    ctest --preset "$p" --rerun-failed --output-on-failure 2>&1 | tee -a "build/$p.log" | tail -n 20
+    if [ "${PIPESTATUS[0]}" = 0 ]; then
+      flaky[$p]=$(printf '%s; ' "${names[@]}")
+      status[$p]=0
+      passed[$p]=${total[$p]}
+      failed[$p]=0
+    fi
   fi
 done
 
@@ -65,6 +82,7 @@ for p in "${presets[@]}"; do
   fi
   printf '%-9s %-8s %8s %8s %8s %10s\n' "$p" "$result" "${total[$p]}" "${passed[$p]}" \
     "${failed[$p]}" "${seconds[$p]}"
+  [ -n "${flaky[$p]}" ] && echo "          FLAKY (failed, then passed when run again alone): ${flaky[$p]}"
   sum_passed=$((sum_passed + passed[$p]))
   sum_failed=$((sum_failed + failed[$p]))
 done
