@@ -395,6 +395,12 @@ def kvm_accel_option() -> tuple[str, bool]:
     return (forced, True) if forced else ("kvm", False)
 
 
+def spawn_qemu(cmd: list[str]) -> subprocess.Popen:
+    """qemu with its console (stdout and stderr) on a pipe; it dies with this harness."""
+    return subprocess.Popen(cmd, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
+                            stderr=subprocess.STDOUT, preexec_fn=_die_with_parent)
+
+
 def probe_kvm(qemu: str, info: dict[str, str], accel: str) -> tuple[bool, str]:
     """Boots the kernel alone (no initramfs) under ACCEL; True once it prints its first line.
 
@@ -405,8 +411,7 @@ def probe_kvm(qemu: str, info: dict[str, str], accel: str) -> tuple[bool, str]:
            "-monitor", "none", "-nic", "none", "-kernel", info["KERNEL"],
            "-append", "console=ttyS0 panic=-1 loglevel=4"]
     t0 = time.monotonic()
-    proc = subprocess.Popen(cmd, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
-                            stderr=subprocess.STDOUT, preexec_fn=_die_with_parent)
+    proc = spawn_qemu(cmd)
     seen: list[str] = []
     tail: list[str] = []
 
@@ -539,8 +544,7 @@ def run_vm(args: argparse.Namespace, info: dict[str, str], initrd: Path, log_pat
     cmd += args.qemu_arg
     log("booting " + " ".join(cmd))
     t0 = time.monotonic()
-    proc = subprocess.Popen(cmd, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
-                            stderr=subprocess.STDOUT, preexec_fn=_die_with_parent)
+    proc = spawn_qemu(cmd)
     result: list[int] = []
     first_result_at: list[float] = []
 
