@@ -3,6 +3,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "pathstream/host/planner.hpp"
+
 namespace pathstream::host {
 namespace {
 
@@ -31,6 +33,11 @@ DeviceLimitsLsb device_limits(const MachineProfile& profile) {
         l.max_acceleration.push_back(
             fit_u32(std::ceil(a.max_acceleration / profile.mm_per_lsb), "axis " + a.name + " max_acceleration"));
     }
+    const std::uint64_t pen = delay_ticks(profile.pen_down_delay, profile.tick_hz);
+    if (pen > 65535)
+        throw std::range_error("pen_down_delay (" + std::to_string(pen) +
+                               " ticks) exceeds 65535 ticks");
+    l.pen_down_ticks = static_cast<std::uint32_t>(pen);
     return l;
 }
 

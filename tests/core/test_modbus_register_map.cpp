@@ -59,7 +59,7 @@ TEST_CASE("status block layout", "[device][modbus]") {
     Map m(d);
     const auto s = status(m);
     CHECK(s[0] == 0x5053);
-    CHECK(s[1] == 1);
+    CHECK(s[1] == modbus::kProtocolVersion);
     CHECK(s[2] == 0);  // idle
     CHECK(s[4] == 16);
     CHECK(s[5] == 16);

@@ -62,12 +62,16 @@ TEST_CASE("encoders and decoders agree with the declared layout", "[can][dbc]") 
     s.ticks_executed = 123456;
     s.axes = 4;
     s.version = 1;
-    pc::Frame out[3];
+    s.finished_job = 31;
+    s.finished_job_ticks = 0x01020304u;
+    pc::Frame out[pc::kStatusFrames];
     pc::encode_status(5, s, out);
+    CHECK(out[3].id == 0x505u);
     pc::Status3 t;
     for (const auto& o : out) REQUIRE(pc::decode_status_part(o, t));
     CHECK((t.state == 2 && t.fault_code == 0x0103 && t.last_accepted == 77 && t.last_completed == 70 &&
            t.ticks_executed == 123456 && t.axes == 4 && t.version == 1));
+    CHECK((t.finished_job == 31 && t.finished_job_ticks == 0x01020304u));
     const std::uint8_t payload[9] = {1, 2, 3, 4, 5, 6, 7, 8, 9};
     CHECK(pc::data_frames(9) == 2);
     const pc::Frame d1 = pc::encode_span_data(5, 1, payload, 9);

@@ -128,14 +128,21 @@ TEST_CASE("CAN node: configuration needs every item; commands and status answer"
     f.feed(pc::encode_command(5, 1));
     CHECK(f.last_ack().result == static_cast<std::uint8_t>(Status::kNotConfigured));
     f.configure();
-    f.feed(pc::encode_command(5, 1));
-    CHECK((f.last_ack().kind == pc::kAckCommand && f.last_ack().result == 0 && f.last_ack().sequence == 1));
+    f.feed(pc::encode_command(5, 1));  // start with nothing queued: nothing would move
+    CHECK((f.last_ack().kind == pc::kAckCommand && f.last_ack().sequence == 1 &&
+           f.last_ack().result == static_cast<std::uint8_t>(Status::kNothingToResume)));
+    f.feed(pc::encode_command(5, 4));  // stop while idle: drops nothing, accepted
+    CHECK((f.last_ack().kind == pc::kAckCommand && f.last_ack().result == 0 &&
+           f.last_ack().sequence == 4));
+    f.feed(pc::encode_command(5, 9));  // no such command: the core refuses it
+    CHECK(f.last_ack().result == static_cast<std::uint8_t>(Status::kUnknownCommand));
     f.out.clear();
     f.feed(pc::encode_command(5, pc::kCommandStatusRequest));
-    REQUIRE(f.out.size() == 3);
+    REQUIRE(f.out.size() == pc::kStatusFrames);
     pc::Status3 s;
     for (const auto& o : f.out) REQUIRE(pc::decode_status_part(o, s));
-    CHECK((s.axes == 2 && s.version == 1 && (s.flags & pc::kFlagConfigured) != 0 && s.free_slots == 16));
+    CHECK((s.axes == 2 && s.version == pc::kProtocolVersion &&
+           (s.flags & pc::kFlagConfigured) != 0 && s.free_slots == 16));
     f.out.clear();
     f.feed(pc::encode_command(6, pc::kCommandStatusRequest));  // another node
     CHECK(f.out.empty());

@@ -20,8 +20,11 @@
 #include "pathstream/span.hpp"
 
 using namespace pathstream;
+using test::check_recorded;
+using test::end_of;
 using test::Job;
 using test::plan_example;
+using test::plan_example_from;
 using test::plan_setpoints;
 using test::start_of;
 
@@ -102,6 +105,40 @@ TEST_CASE("a drawing streamed natively over CAN executes exactly the planned set
     CHECK(r.device->refused_batches() == 0);  // never a span the device refuses (queue full included)
     CHECK(r.device->duplicates() == 0);
     CHECK(r.bus.frames == r.report.frames_sent + r.report.frames_received);
+}
+
+TEST_CASE("two drawings in a row natively over CAN, each ending idle at rest, no manual step",
+          "[can][stream][threads]") {
+    // Each stream marks its last span as the job's end: the device runs to rest there, reports
+    // the job finished (status frame D) and idles; the second stream, planned from where the
+    // first ended, finds it idle there.
+    const Job first = plan_example("wave.json");
+    const Job second = plan_example_from("rose.json", end_of(first.plan));
+    sim::CanLoopback loop;
+    hal::CanBus& device_bus = loop.add_endpoint();
+    hal::CanBus& host_bus = loop.add_endpoint();
+    DeviceThread dt;
+    dt.device = sim::SimulatedCanDevice::create(start_of(first.plan), 5);
+    dt.device->record(true);
+    dt.run(device_bus, 20.0);
+    host::CanStreamOptions o;
+    o.node = 5;
+    o.ack_timeout_ms = 30;
+    const host::CanStreamReport r1 = host::stream_can(first.plan, first.machine, host_bus, o);
+    CHECK(r1.ticks_executed == first.plan.total_ticks);
+    CHECK(dt.device->state() == 0);  // idle
+    for (unsigned a = 0; a < 2; ++a) CHECK(dt.device->position(a) == end_of(first.plan)[a]);
+    const host::CanStreamReport r2 = host::stream_can(second.plan, second.machine, host_bus, o);
+    CHECK(r2.ticks_executed == second.plan.total_ticks);
+    CHECK(r2.last_completed == second.plan.spans.size());
+    CHECK(dt.device->state() == 0);
+    for (unsigned a = 0; a < 2; ++a) CHECK(dt.device->position(a) == end_of(second.plan)[a]);
+    dt.join();
+    check_recorded(first.plan, *dt.device, 0);
+    check_recorded(second.plan, *dt.device, first.plan.total_ticks);
+    CHECK(dt.device->recorded_setpoints().size() ==
+          (first.plan.total_ticks + second.plan.total_ticks) * 2);
+    CHECK(dt.device->refused_batches() == 0);
 }
 
 TEST_CASE("natively over CAN with 1 % of the frames lost, the device still executes every span once",

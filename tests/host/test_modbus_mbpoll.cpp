@@ -154,10 +154,15 @@ void check_device(const std::string& program, const std::string& link) {
     const auto flags = values(mbpoll(program, link + " -r " + std::to_string(st::kFlags + 1) + " -c 1 -t 3 -1"));
     CHECK(flags.at(st::kFlags + 1) == 1);
 
-    // FC6 start: running (at rest, nothing queued); FC6 stop: idle again.
+    // FC6 start with nothing queued: refused (nothing would move), the device stays idle and
+    // register 30 says why (17, nothing queued); FC6 stop while idle: accepted (it drops
+    // whatever is queued, here nothing).
     CHECK_THAT(mbpoll(program, link + " -r " + std::to_string(mb::kCommand + 1) + " -t 4 -1 1"),
-               Contains("Written 1 references"));
-    CHECK(wait_state(program, link, 1) == 1);
+               Contains("failure"));
+    CHECK(wait_state(program, link, 0) == 0);
+    const auto why = values(
+        mbpoll(program, link + " -r " + std::to_string(st::kLastRefusal + 1) + " -c 1 -t 3 -1"));
+    CHECK(why.at(st::kLastRefusal + 1) == static_cast<long>(Status::kNothingToResume));
     CHECK_THAT(mbpoll(program, link + " -r " + std::to_string(mb::kCommand + 1) + " -t 4 -1 4"),
                Contains("Written 1 references"));
     CHECK(wait_state(program, link, 0) == 0);

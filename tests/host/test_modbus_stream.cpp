@@ -18,8 +18,11 @@
 #include "pathstream/span.hpp"
 
 using namespace pathstream;
+using test::check_recorded;
+using test::end_of;
 using test::Job;
 using test::plan_example;
+using test::plan_example_from;
 using test::plan_setpoints;
 using test::start_of;
 
@@ -131,4 +134,54 @@ TEST_CASE("stream with a lead-in: a device resting elsewhere (after homing) gets
     while ((dt.device->recorded_ticks()[first_down].outputs & kOutputPenDown) == 0) ++first_down;
     CHECK(got[2 * first_down] == 139322);
     CHECK(got[2 * first_down + 1] == 100000);
+}
+
+// Two drawings in a row to one device, with no manual step between them: each stream marks
+// its last span as the job's end, the device runs to rest there, reports the job finished and
+// idles; the second stream finds it idle where the first ended and (with the lead-in) starts
+// there. The recorded ticks are compared once the device thread has stopped.
+static void two_drawings_in_a_row(DeviceThread& dt, const std::string& target,
+                                  const char* second_name) {
+    const Job first = plan_example("wave.json");
+    host::StreamOptions o;
+    o.target = target;
+    const host::StreamReport r1 = host::stream_modbus(first.plan, first.machine, o);
+    CHECK(r1.ticks_executed == first.plan.total_ticks);
+    const std::vector<Lsb> rest =
+        host::modbus_rest_position(first.machine, o);  // throws unless idle
+    CHECK(rest == end_of(first.plan));
+    const Job second = plan_example_from(second_name, rest);
+    const host::StreamReport r2 = host::stream_modbus(second.plan, second.machine, o);
+    CHECK(r2.ticks_executed == second.plan.total_ticks);
+    CHECK(r2.last_completed == first.plan.spans.size() + second.plan.spans.size());
+    CHECK(host::modbus_rest_position(second.machine, o) == end_of(second.plan));
+    CHECK(dt.device->state() == 0);  // idle
+    dt.stop = true;
+    dt.thread.join();
+    check_recorded(first.plan, *dt.device, 0);
+    check_recorded(second.plan, *dt.device, first.plan.total_ticks);
+    CHECK(dt.device->recorded_setpoints().size() ==
+          (first.plan.total_ticks + second.plan.total_ticks) * 2);
+}
+
+TEST_CASE("two drawings in a row over Modbus TCP, each ending idle at rest, no manual step",
+          "[modbus][stream][threads]") {
+    DeviceThread dt;
+    dt.device = sim::SimulatedModbusDevice::create(start_of(plan_example("wave.json").plan));
+    dt.device->record(true);
+    hal::ModbusServer server = hal::ModbusServer::tcp(dt.device->handler(), {"127.0.0.1", 0, 4});
+    dt.run(server, 20.0);
+    two_drawings_in_a_row(dt, "modbus-tcp://127.0.0.1:" + std::to_string(server.port()) + "?unit=1",
+                          "rose.json");
+}
+
+TEST_CASE("two drawings in a row over Modbus RTU, each ending idle at rest, no manual step",
+          "[modbus][stream][threads]") {
+    DeviceThread dt;
+    dt.device = sim::SimulatedModbusDevice::create(start_of(plan_example("wave.json").plan));
+    dt.device->record(true);
+    hal::ModbusServer server = hal::ModbusServer::rtu_pty(dt.device->handler());
+    dt.run(server, 20.0);
+    two_drawings_in_a_row(
+        dt, "modbus-rtu://" + server.client_device() + "?baud=115200&parity=N&unit=1", "wave.json");
 }

@@ -38,7 +38,11 @@ public:
     /// the span's own validation error; kDiscontinuousSpan (a jump no axis could execute);
     /// kQueueFull (retry later: the span itself is fine). Cost: validation, one Horner end
     /// point per axis, preparation. Never call from the tick interrupt.
-    [[nodiscard]] Status push(const Span<Axes>& span) {
+    [[nodiscard]] Status push(const Span<Axes>& span) { return push(span, SpanStamp<Axes>{}); }
+
+    /// push() that also stores `stamp` in the queue entry before publishing it, so the consumer
+    /// sees the stamp whenever it sees the span (next_span()). Same errors and cost. Producer.
+    [[nodiscard]] Status push(const Span<Axes>& span, const SpanStamp<Axes>& stamp) {
         ValidatedSpan<Axes> v;
         if (Status s = validate_span(span, v); s != Status::kOk) return s;
         Lsb end[Axes];
@@ -53,6 +57,7 @@ public:
         PreparedSpan<Axes>* slot = queue_.claim();
         if (slot == nullptr) return Status::kQueueFull;
         prepare_validated(v, *slot);
+        slot->stamp = stamp;
         queue_.publish();
         for (unsigned a = 0; a < Axes; ++a) pushed_end_[a] = end[a];
         return Status::kOk;
@@ -159,6 +164,13 @@ public:
         while (queue_.front() != nullptr) queue_.release();
         for (unsigned a = 0; a < Axes; ++a) hold_[a] = position[a];
     }
+    /// Consumer, between spans: the span the next tick() starts (its stamp included), or
+    /// nullptr when none is queued. A span seen here stays the next one until the consumer
+    /// ticks or drops it. O(1). Consumer context.
+    const PreparedSpan<Axes>* next_span() { return between_spans() ? queue_.front() : nullptr; }
+    /// Consumer, between spans: releases the span next_span() returned without playing it (no
+    /// ticks counted, the rest point unchanged). Precondition: next_span() != nullptr. O(1).
+    void drop_next() { queue_.release(); }
     /// Producer: the next pushed span must start at `position`. O(Axes). Producer context.
     void restart_producer_at(const Lsb (&position)[Axes]) {
         for (unsigned a = 0; a < Axes; ++a) pushed_end_[a] = position[a];

@@ -29,6 +29,18 @@ struct Span {
 /// change happens exactly at a span boundary (the planner puts a dwell span there).
 inline constexpr std::uint8_t kOutputPenDown = 1u << 0;
 
+/// What a queue entry carries besides the motion, for whoever consumes the queue; the stream
+/// itself never reads it. A device stamps each span with the queue epoch it was accepted in,
+/// its job, the end marker and the end tangent it needs to plan a stop at the span's end
+/// (device/motion_device.hpp); written by the producer before the entry is published.
+template <unsigned Axes>
+struct SpanStamp {
+    std::uint32_t epoch = 0;
+    std::uint32_t job = 0;
+    std::int32_t end_tangent[Axes] = {};  ///< Hermite T1 per axis (LSB per span)
+    bool job_end = false;
+};
+
 /// A span validated and converted to forward-differencing state at its first tick.
 /// Holds either narrow or wide state for all axes (they share D). ~40 or ~48 bytes per axis.
 template <unsigned Axes>
@@ -46,6 +58,7 @@ struct PreparedSpan {
     std::uint64_t bias = 0;  ///< K = 2^W - D (its low 32 bits when narrow)
     bool wide = false;
     std::uint8_t outputs = 0;  ///< Span::outputs, applied while the span plays
+    SpanStamp<Axes> stamp;     ///< the producer's stamp (never read by the tick loop)
     PreparedSpan() : narrow{} {}
 };
 

@@ -7,25 +7,28 @@
 namespace pathstream {
 
 /// Outcome of a core operation. Values are stable: they travel on the wire as fault codes.
-enum class [[nodiscard]] Status : std::uint8_t {
+enum class [[nodiscard]] Status : std::uint8_t{
     kOk = 0,
-    kTickCountOutOfRange = 1,      ///< a span must last 1..kMaxSpanTicks ticks
-    kControlValueOutOfRange = 2,   ///< a control point or tangent is outside its range
-    kCurveOutOfRange = 3,          ///< the curve could leave +/-kMaxCurveLsb inside the span
-    kDifferenceOutOfRange = 4,     ///< a per-tick difference could exceed +/-kMaxDifferenceLsb
-    kUnknownBasis = 5,             ///< basis id not one of the Basis enumerators
-    kTickOutsideSpan = 6,          ///< evaluation or start tick beyond the span's end
-    kQueueFull = 7,                ///< span queue has no free slot; nothing was written
-    kDiscontinuousSpan = 8,        ///< span does not start where the previous one ends
-    kVelocityLimit = 9,            ///< the span's exact curve is faster than an axis may move
-    kAccelerationLimit = 10,       ///< the span's exact curve accelerates harder than allowed
-    kBadLimits = 11,               ///< a configured limit is zero or out of range
-    kNotConfigured = 12,           ///< spans or start before the limits were configured
-    kBadSequence = 13,             ///< a batch does not carry the next expected sequence number
-    kBadBatch = 14,                ///< a batch's length, span count or check value is wrong
-    kWrongState = 15,              ///< the command is not allowed in the device's state
-    kStopTooLong = 16,             ///< no controlled stop fits in one span (limits too low)
-    kNothingToResume = 17,         ///< resume after an underrun needs queued spans
+    kTickCountOutOfRange = 1,     ///< a span must last 1..kMaxSpanTicks ticks
+    kControlValueOutOfRange = 2,  ///< a control point or tangent is outside its range
+    kCurveOutOfRange = 3,         ///< the curve could leave +/-kMaxCurveLsb inside the span
+    kDifferenceOutOfRange = 4,    ///< a per-tick difference could exceed +/-kMaxDifferenceLsb
+    kUnknownBasis = 5,            ///< basis id not one of the Basis enumerators
+    kTickOutsideSpan = 6,         ///< evaluation or start tick beyond the span's end
+    kQueueFull = 7,               ///< span queue has no free slot; nothing was written
+    kDiscontinuousSpan = 8,       ///< span does not start where the previous one ends
+    kVelocityLimit = 9,           ///< the span's exact curve is faster than an axis may move
+    kAccelerationLimit = 10,      ///< the span's exact curve accelerates harder than allowed
+    kBadLimits = 11,              ///< a configured limit is zero or out of range
+    kNotConfigured = 12,          ///< spans or start before the limits were configured
+    kBadSequence = 13,            ///< a batch does not carry the next expected sequence number
+    kBadBatch = 14,               ///< a batch's length, span count or check value is wrong
+    kWrongState = 15,             ///< the command is not allowed in the device's state
+    kStopTooLong = 16,            ///< no controlled stop fits in one span (limits too low)
+    kNothingToResume = 17,        ///< start, or resume after an underrun, needs queued spans
+    kVelocityStep = 18,           ///< a span starts at another velocity than the previous one ends
+    kJobEndMoving = 19,           ///< the last span of a job must end at rest (end tangents 0)
+    kUnknownCommand = 20,         ///< a command value the device does not know
 };
 
 /// Short stable name of a status, for logs and host messages. Never null.
@@ -48,7 +51,14 @@ constexpr const char* status_name(Status s) {
         case Status::kBadBatch: return "batch length, span count or check value is wrong";
         case Status::kWrongState: return "command not allowed in this state";
         case Status::kStopTooLong: return "no controlled stop fits in one span";
-        case Status::kNothingToResume: return "nothing queued to resume";
+        case Status::kNothingToResume:
+            return "nothing queued to start or resume";
+        case Status::kVelocityStep:
+            return "span starts at another velocity than the previous one ends";
+        case Status::kJobEndMoving:
+            return "the last span of a job must end at rest";
+        case Status::kUnknownCommand:
+            return "unknown command";
     }
     return "unknown status";
 }

@@ -59,4 +59,20 @@ Status check_axis_limits(const TickCubic& cubic, const SpanTiming& timing, const
     return Status::kOk;
 }
 
+Status check_join(std::int32_t start_tangent, std::uint32_t ticks,
+                  std::int32_t previous_end_tangent, std::uint32_t previous_ticks,
+                  const AxisLimits& limits, std::uint32_t tick_hz) {
+    // Velocities T0 hz / n and T1' hz / n' (LSB/s); their difference against a_max / hz plus
+    // the rounding of each tangent (hz / 2n and hz / 2n'), multiplied by 2 n n' hz.
+    const std::int64_t n = ticks, previous = previous_ticks;
+    const std::int64_t difference = static_cast<std::int64_t>(start_tangent) * previous -
+                                    static_cast<std::int64_t>(previous_end_tangent) * n;  // < 2^47
+    const std::uint64_t hz2 = static_cast<std::uint64_t>(tick_hz) * tick_hz;              // < 2^34
+    const Int128 lhs = multiply_unsigned(2 * magnitude64(difference), hz2);               // < 2^82
+    const Int128 rhs = multiply_unsigned(2 * static_cast<std::uint64_t>(limits.max_acceleration),
+                                         static_cast<std::uint64_t>(n * previous)) +  // < 2^65
+                       multiply_unsigned(static_cast<std::uint64_t>(n + previous), hz2);
+    return lhs <= rhs ? Status::kOk : Status::kVelocityStep;
+}
+
 }  // namespace pathstream::device

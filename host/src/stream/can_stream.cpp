@@ -55,8 +55,8 @@ public:
         base_ = s.last_accepted + 1;
         acknowledged_ = s.last_accepted;
         free_slots_ = s.free_slots;
-        const auto lead_target = static_cast<std::uint64_t>(std::ceil(options_.lead_seconds * profile_.tick_hz));
-        const std::uint32_t last_sequence = base_ + static_cast<std::uint32_t>(spans_.size()) - 1;
+        const auto lead_target =
+            static_cast<std::uint64_t>(std::ceil(options_.lead_seconds * profile_.tick_hz));
         std::size_t next = 0;
         bool started = false;
         while (true) {
@@ -84,9 +84,11 @@ public:
                 progress(static_cast<double>(s.ticks_executed - start_ticks_) / static_cast<double>(plan_.total_ticks),
                          static_cast<double>(queued_ticks(s, next)) / profile_.tick_hz);
             }
-            if (s.last_completed == last_sequence) break;
+            // The plan is one job (its last span marks the end): done when the device reports
+            // it finished, idle at its end point.
+            if (job_finished(s)) break;
         }
-        report_.ticks_executed = s.ticks_executed - start_ticks_;
+        report_.ticks_executed = s.finished_job_ticks;
         report_.last_completed = s.last_completed - base_ + 1;
         report_.duplicates = s.duplicates;
         report_.underruns = s.underruns;
@@ -148,7 +150,10 @@ private:
     bool take(const hal::CanFrame& in) {
         if (in.extended || in.remote || pc::node_of(in.id) != node_) return false;
         const std::uint32_t f = pc::function_of(in.id);
-        if (f != pc::kAckBase && f != pc::kStatusABase && f != pc::kStatusBBase && f != pc::kStatusCBase) return false;
+        if (f != pc::kAckBase && f != pc::kStatusABase && f != pc::kStatusBBase &&
+            f != pc::kStatusCBase && f != pc::kStatusDBase) {
+            return false;
+        }
         ++report_.frames_received;
         report_.bits_received += pc::frame_bits_worst_case(in.length);
         last_heard_ = Clock::now();
@@ -194,16 +199,20 @@ private:
             pc::Status3 s;
             unsigned seen = 0;
             const auto deadline = Clock::now() + std::chrono::microseconds(ack_timeout_us());
-            while (seen != 7u && Clock::now() < deadline) {
+            constexpr unsigned kAll = (1u << pc::kStatusFrames) - 1u;
+            while (seen != kAll && Clock::now() < deadline) {
                 pc::Frame f;
                 const auto left = std::chrono::duration_cast<std::chrono::microseconds>(deadline - Clock::now()).count();
                 if (!next_frame(f, static_cast<std::uint32_t>(std::max<long long>(0, left)))) break;
                 const std::uint32_t fn = pc::function_of(f.id);
                 if (pc::decode_status_part(f, s)) {
-                    seen |= fn == pc::kStatusABase ? 1u : fn == pc::kStatusBBase ? 2u : 4u;
+                    seen |= fn == pc::kStatusABase   ? 1u
+                            : fn == pc::kStatusBBase ? 2u
+                            : fn == pc::kStatusCBase ? 4u
+                                                     : 8u;
                 }
             }
-            if (seen == 7u) return s;
+            if (seen == kAll) return s;
             ++report_.timeouts;
             check_link();
         }
@@ -342,10 +351,18 @@ private:
         if (started && s.state != static_cast<std::uint8_t>(device::DeviceState::kIdle)) seen_running_ = true;
         const bool start_pending =
             !seen_running_ && std::chrono::duration<double>(Clock::now() - started_at_).count() < 0.5;
-        if (started && s.state == static_cast<std::uint8_t>(device::DeviceState::kIdle) && !start_pending) {
+        if (started && s.state == static_cast<std::uint8_t>(device::DeviceState::kIdle) &&
+            !start_pending && !job_finished(s)) {
             m << "device went idle after span " << s.last_completed << " (stopped by another master?)";
             fail(m.str());
         }
+    }
+
+    // Our job (its id: the sequence number of its first span) ran to its end: the device idles
+    // at the plan's end point.
+    bool job_finished(const pc::Status3& s) const {
+        return s.state == static_cast<std::uint8_t>(device::DeviceState::kIdle) &&
+               s.finished_job == base_;
     }
 
     const Plan& plan_;

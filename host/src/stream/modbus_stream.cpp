@@ -31,6 +31,7 @@ struct DeviceStatus {
     std::uint16_t magic = 0, version = 0, state = 0, fault = 0, free_slots = 0, capacity = 0, axes = 0;
     std::uint32_t last_accepted = 0, ticks = 0, last_completed = 0;
     std::uint16_t underruns = 0, last_refusal = 0, duplicates = 0, queued = 0, flags = 0;
+    std::uint32_t finished_job = 0, finished_job_ticks = 0, epoch = 0;
     std::int32_t position[8] = {};
 
     static DeviceStatus parse(const std::uint16_t* r) {
@@ -51,6 +52,9 @@ struct DeviceStatus {
         s.duplicates = r[st::kDuplicates];
         s.queued = r[st::kQueuedSpans];
         s.flags = r[st::kFlags];
+        s.finished_job = u32(&r[st::kFinishedJob]);
+        s.finished_job_ticks = u32(&r[st::kFinishedJobTicks]);
+        s.epoch = u32(&r[st::kEpoch]);
         return s;
     }
 };
@@ -87,7 +91,6 @@ public:
         const std::uint64_t lead_target = static_cast<std::uint64_t>(std::ceil(options_.lead_seconds * profile_.tick_hz));
         std::size_t next = 0;
         bool started = false;
-        const std::uint32_t last_sequence = base_ + static_cast<std::uint32_t>(spans_.size()) - 1;
         while (true) {
             const std::uint64_t lead = queued_ticks(s, next);
             if (next < spans_.size() && s.free_slots > 0 && (lead < lead_target || !started)) {
@@ -111,6 +114,7 @@ public:
             if (!started && (queued_ticks(s, next) >= lead_target || next == spans_.size() || s.free_slots == 0)) {
                 command(device::Command::kStart, false);
                 started = true;
+                started_at_ = Clock::now();
             }
             if (s.state == static_cast<std::uint16_t>(device::DeviceState::kHolding) && (s.flags & 2u) != 0 &&
                 s.queued > 0) {
@@ -120,9 +124,11 @@ public:
                 progress(static_cast<double>(s.ticks - start_ticks_) / static_cast<double>(plan_.total_ticks),
                          static_cast<double>(queued_ticks(s, next)) / profile_.tick_hz);
             }
-            if (s.last_completed == last_sequence) break;
+            // The plan is one job (its last span marks the end): done when the device reports
+            // it finished, idle at its end point.
+            if (job_finished(s)) break;
         }
-        report_.ticks_executed = s.ticks - start_ticks_;
+        report_.ticks_executed = s.finished_job_ticks;
         report_.last_completed = s.last_completed;
         report_.duplicates = s.duplicates;
         report_.underruns = s.underruns;
@@ -250,6 +256,7 @@ private:
         r[0] = static_cast<std::uint16_t>(l.tick_hz >> 16);
         r[1] = static_cast<std::uint16_t>(l.tick_hz & 0xFFFFu);
         r[2] = static_cast<std::uint16_t>(axes_);
+        r[mb::kConfigPenDownTicks] = static_cast<std::uint16_t>(l.pen_down_ticks);
         for (unsigned a = 0; a < axes_; ++a) {
             const std::uint32_t vv = l.max_velocity[a], aa = l.max_acceleration[a];
             r[mb::kConfigAxisBase + 4 * a] = static_cast<std::uint16_t>(vv >> 16);
@@ -433,10 +440,26 @@ private:
               << s.last_completed << " spans";
             fail(m.str());
         }
-        if (started && s.state == static_cast<std::uint16_t>(device::DeviceState::kIdle)) {
+        // The device applies a start at its next tick: idle right after the acknowledged start
+        // is the start still pending, not a stop, until it has been seen running or has had
+        // ample time (half a second) to tick.
+        if (started && s.state != static_cast<std::uint16_t>(device::DeviceState::kIdle))
+            seen_running_ = true;
+        const bool start_pending =
+            !seen_running_ &&
+            std::chrono::duration<double>(Clock::now() - started_at_).count() < 0.5;
+        if (started && s.state == static_cast<std::uint16_t>(device::DeviceState::kIdle) &&
+            !job_finished(s) && !start_pending) {
             m << "device went idle after span " << s.last_completed << " (stopped by another master?)";
             fail(m.str());
         }
+    }
+
+    // Our job (its id: the sequence number of its first span) ran to its end: the device idles
+    // at the plan's end point.
+    bool job_finished(const DeviceStatus& s) const {
+        return s.state == static_cast<std::uint16_t>(device::DeviceState::kIdle) &&
+               s.finished_job == base_;
     }
 
     const Plan& plan_;
@@ -451,6 +474,8 @@ private:
     std::uint32_t base_ = 1;
     std::uint32_t acknowledged_ = 0;
     std::uint32_t start_ticks_ = 0;
+    Clock::time_point started_at_;
+    bool seen_running_ = false;
     bool configured_ = false;  // the device accepted our configuration: it must stay configured
     // Adaptive batch size: halved after a batch that needed a retry, doubled after
     // kCleanBatchesToGrow clean ones (a clean link stays at the largest batch).

@@ -45,25 +45,28 @@ public:
         }
     }
 
-    /// Sends the three status frames.
+    /// Sends the status frames (A, B, C, D), every tick-side value from one status read.
     template <typename Send>
     void send_status(Send&& send) const {
+        const DeviceStatus<Axes> d = device_.status();
         Status3 s;
-        s.state = static_cast<std::uint8_t>(device_.state());
+        s.state = static_cast<std::uint8_t>(d.state);
         s.flags = static_cast<std::uint8_t>((device_.configured() ? kFlagConfigured : 0) |
-                                            (device_.held_by_underrun() ? kFlagHeldByUnderrun : 0) |
+                                            (d.held_by_underrun() ? kFlagHeldByUnderrun : 0) |
                                             (bus_problem_ ? kFlagBusProblem : 0));
         s.free_slots = saturate8(device_.free_slots());
         s.queued = saturate8(device_.queued_spans());
-        s.fault_code = static_cast<std::uint16_t>(device_.fault_code());
-        s.underruns = static_cast<std::uint16_t>(device_.underruns());
+        s.fault_code = static_cast<std::uint16_t>(d.fault_code);
+        s.underruns = static_cast<std::uint16_t>(d.underruns);
         s.last_accepted = device_.last_accepted_sequence();
-        s.last_completed = device_.last_completed_sequence();
-        s.ticks_executed = static_cast<std::uint32_t>(device_.ticks_executed());
+        s.last_completed = d.last_completed_sequence;
+        s.ticks_executed = d.ticks_executed_low;
         s.duplicates = static_cast<std::uint16_t>(device_.duplicates());
         s.axes = static_cast<std::uint8_t>(Axes);
         s.version = kProtocolVersion;
-        Frame out[3];
+        s.finished_job = d.finished_job;
+        s.finished_job_ticks = d.finished_job_ticks;
+        Frame out[kStatusFrames];
         encode_status(node_, s, out);
         for (const Frame& o : out) send(o);
     }
@@ -102,11 +105,10 @@ private:
             send_status(send);
             return;
         }
-        std::uint8_t result = kResultBadFrame;
-        if (c >= static_cast<std::uint8_t>(Command::kStart) && c <= static_cast<std::uint8_t>(Command::kReset)) {
-            result = static_cast<std::uint8_t>(device_.command(static_cast<Command>(c)));
-            if (c == static_cast<std::uint8_t>(Command::kReset)) bus_problem_ = false;
-        }
+        // Every value but the status request goes to the core, which refuses what is no command.
+        const std::uint8_t result =
+            static_cast<std::uint8_t>(device_.command(static_cast<Command>(c)));
+        if (c == static_cast<std::uint8_t>(Command::kReset) && result == 0) bus_problem_ = false;
         ack(kAckCommand, result, c, send);
     }
 

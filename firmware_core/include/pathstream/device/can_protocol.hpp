@@ -13,7 +13,8 @@
 
 namespace pathstream::device::can {
 
-inline constexpr std::uint8_t kProtocolVersion = 1;
+/// 2: job ends (wire flag kWireJobEnd, status frame D), continuity checked at every join.
+inline constexpr std::uint8_t kProtocolVersion = 2;
 inline constexpr std::uint8_t kMinNode = 1;
 inline constexpr std::uint8_t kMaxNode = 127;
 
@@ -27,18 +28,20 @@ inline constexpr std::uint32_t kStatusCBase = 0x300;    ///< device -> host
 inline constexpr std::uint32_t kConfigBase = 0x380;     ///< host -> device
 inline constexpr std::uint32_t kSpanStartBase = 0x400;  ///< host -> device
 inline constexpr std::uint32_t kSpanDataBase = 0x480;   ///< host -> device
+inline constexpr std::uint32_t kStatusDBase = 0x500;  ///< device -> host (jobs; added in version 2)
 
 /// Identifier of function `base` for node `node`. Constant, any context.
 constexpr std::uint32_t can_id(std::uint32_t base, std::uint8_t node) { return base + node; }
 /// Function base of identifier `id` (0 when `id` is not one of ours). Constant.
 constexpr std::uint32_t function_of(std::uint32_t id) {
     const std::uint32_t base = id & ~0x7Fu;
-    return (base >= kCommandBase && base <= kSpanDataBase && (id & 0x7Fu) != 0) ? base : 0;
+    return (base >= kCommandBase && base <= kStatusDBase && (id & 0x7Fu) != 0) ? base : 0;
 }
 constexpr std::uint8_t node_of(std::uint32_t id) { return static_cast<std::uint8_t>(id & 0x7Fu); }
 
-/// Command frame values: device::Command (1..5) plus a status request.
-inline constexpr std::uint8_t kCommandStatusRequest = 0x10;  ///< answer with status A, B, C
+/// Command frame values: device::Command (1..5) plus a status request. Any other value is
+/// passed to the device, which refuses it (ack result kUnknownCommand).
+inline constexpr std::uint8_t kCommandStatusRequest = 0x10;  ///< answer with status A, B, C, D
 
 /// Ack kinds (what is acknowledged).
 inline constexpr std::uint8_t kAckSpans = 1;
@@ -47,7 +50,8 @@ inline constexpr std::uint8_t kAckConfig = 3;
 
 /// Ack results: a core Status value (status.hpp, 0 = kOk), or one of these protocol codes.
 inline constexpr std::uint8_t kResultIncomplete = 0x80;   ///< a span data frame was lost: send the batch again
-inline constexpr std::uint8_t kResultBadFrame = 0x81;     ///< wrong length, unknown item or command
+inline constexpr std::uint8_t kResultBadFrame =
+    0x81;  ///< wrong length or unknown configuration item
 inline constexpr std::uint8_t kResultTooLong = 0x82;      ///< batch payload over kMaxTransferBytes
 
 /// Span transfer: one span-start frame, then ceil(length / 7) data frames indexed 0, 1, ...
@@ -124,6 +128,11 @@ inline constexpr Signal kStatusCSignals[] = {
     {"Axes", 6, 1, false, "", "axis count"},
     {"Version", 7, 1, false, "", "protocol version"},
 };
+inline constexpr Signal kStatusDSignals[] = {
+    {"FinishedJob", 0, 4, false, "",
+     "id (first span's sequence number) of the last job run to its end, 0 none"},
+    {"FinishedJobTicks", 4, 4, false, "tick", "path ticks that job executed (low 32 bits)"},
+};
 inline constexpr Signal kConfigSignals[] = {
     {"Item", 0, 1, false, "", "0 tick rate, 1+2a axis a max velocity, 2+2a axis a max acceleration", -2},
     {"Axes", 1, 1, false, "", "axis count (must match the device)"},
@@ -157,14 +166,21 @@ inline constexpr Signal kSpanDataSignals[] = {
 };
 
 inline constexpr Message kMessages[] = {
-    {"Command", kCommandBase, 1, false, "host -> device: a command or a status request", kCommandSignals, 1},
-    {"Ack", kAckBase, 8, true, "device -> host: answer to a span batch, command or configuration", kAckSignals, 5},
-    {"StatusA", kStatusABase, 8, true, "device -> host: state, flow control, faults", kStatusASignals, 6},
+    {"Command", kCommandBase, 1, false, "host -> device: a command or a status request",
+     kCommandSignals, 1},
+    {"Ack", kAckBase, 8, true, "device -> host: answer to a span batch, command or configuration",
+     kAckSignals, 5},
+    {"StatusA", kStatusABase, 8, true, "device -> host: state, flow control, faults",
+     kStatusASignals, 6},
     {"StatusB", kStatusBBase, 8, true, "device -> host: span sequence numbers", kStatusBSignals, 2},
     {"StatusC", kStatusCBase, 8, true, "device -> host: progress and identity", kStatusCSignals, 4},
-    {"Config", kConfigBase, 6, false, "host -> device: tick rate and per-axis limits, one item per frame", kConfigSignals, 19},
-    {"SpanStart", kSpanStartBase, 8, false, "host -> device: starts a span batch transfer", kSpanStartSignals, 4},
-    {"SpanData", kSpanDataBase, 8, false, "host -> device: 7 bytes of the batch's wire spans", kSpanDataSignals, 2},
+    {"Config", kConfigBase, 6, false,
+     "host -> device: tick rate and per-axis limits, one item per frame", kConfigSignals, 19},
+    {"SpanStart", kSpanStartBase, 8, false, "host -> device: starts a span batch transfer",
+     kSpanStartSignals, 4},
+    {"SpanData", kSpanDataBase, 8, false, "host -> device: 7 bytes of the batch's wire spans",
+     kSpanDataSignals, 2},
+    {"StatusD", kStatusDBase, 8, true, "device -> host: jobs", kStatusDSignals, 2},
 };
 inline constexpr std::size_t kMessageCount = sizeof(kMessages) / sizeof(kMessages[0]);
 
@@ -192,7 +208,7 @@ struct Ack {
     std::uint8_t state = 0;
 };
 
-/// Everything the three status frames carry.
+/// Everything the status frames (A, B, C, D) carry.
 struct Status3 {
     std::uint8_t state = 0, flags = 0, free_slots = 0, queued = 0;
     std::uint16_t fault_code = 0, underruns = 0;
@@ -200,7 +216,11 @@ struct Status3 {
     std::uint32_t ticks_executed = 0;
     std::uint16_t duplicates = 0;
     std::uint8_t axes = 0, version = 0;
+    std::uint32_t finished_job = 0, finished_job_ticks = 0;
 };
+
+/// Status frames the device sends per status request.
+inline constexpr std::size_t kStatusFrames = 4;
 
 struct SpanStart {
     std::uint32_t first_sequence = 0;
@@ -233,8 +253,8 @@ constexpr bool decode_ack(const Frame& f, Ack& a) {
     return true;
 }
 
-/// The three status frames, A, B, C.
-constexpr void encode_status(std::uint8_t node, const Status3& s, Frame (&out)[3]) {
+/// The status frames, A, B, C, D.
+constexpr void encode_status(std::uint8_t node, const Status3& s, Frame (&out)[kStatusFrames]) {
     Frame a{can_id(kStatusABase, node), 8, {}};
     put(a, kStatusASignals[0], s.state);
     put(a, kStatusASignals[1], s.flags);
@@ -250,11 +270,15 @@ constexpr void encode_status(std::uint8_t node, const Status3& s, Frame (&out)[3
     put(c, kStatusCSignals[1], s.duplicates);
     put(c, kStatusCSignals[2], s.axes);
     put(c, kStatusCSignals[3], s.version);
+    Frame d{can_id(kStatusDBase, node), 8, {}};
+    put(d, kStatusDSignals[0], s.finished_job);
+    put(d, kStatusDSignals[1], s.finished_job_ticks);
     out[0] = a;
     out[1] = b;
     out[2] = c;
+    out[3] = d;
 }
-/// Merges one status frame (A, B or C) into `s`; false when `f` is none of them.
+/// Merges one status frame (A, B, C or D) into `s`; false when `f` is none of them.
 constexpr bool decode_status_part(const Frame& f, Status3& s) {
     if (f.length != 8) return false;
     switch (function_of(f.id)) {
@@ -275,6 +299,10 @@ constexpr bool decode_status_part(const Frame& f, Status3& s) {
             s.duplicates = static_cast<std::uint16_t>(get(f, kStatusCSignals[1]));
             s.axes = static_cast<std::uint8_t>(get(f, kStatusCSignals[2]));
             s.version = static_cast<std::uint8_t>(get(f, kStatusCSignals[3]));
+            return true;
+        case kStatusDBase:
+            s.finished_job = get(f, kStatusDSignals[0]);
+            s.finished_job_ticks = get(f, kStatusDSignals[1]);
             return true;
         default:
             return false;

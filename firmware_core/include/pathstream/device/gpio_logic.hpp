@@ -42,9 +42,11 @@ constexpr bool enable_asserted(DeviceState state) {
     return state == DeviceState::kRunning || state == DeviceState::kHolding || state == DeviceState::kStopping;
 }
 
-/// The pen-lift output: the outputs of the span that plays (the planner's pen events sit at
-/// span boundaries) while the device runs, holds or stops; pen up when idle, in fault and in
-/// e-stop, so a frozen axis does not leave a blot.
+/// The pen-lift output: `outputs` are those the device's last tick drove (MotionDevice::
+/// outputs): the playing span's on a path tick (the planner's pen events sit at span
+/// boundaries), none on any other tick (stop, re-entry except its pen-down lead, rest), so the
+/// device's own moves never draw; pen up when idle, in fault and in e-stop, so a frozen axis
+/// does not leave a blot.
 constexpr bool pen_down(DeviceState state, std::uint8_t outputs) {
     return enable_asserted(state) && (outputs & kOutputPenDown) != 0;
 }

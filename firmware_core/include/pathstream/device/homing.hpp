@@ -1,10 +1,11 @@
 // Homing one axis against a switch: search toward it, back off, approach slowly, set zero.
 //
 // The sequencer is a producer like a bus master: it feeds its own moves to a MotionDevice as
-// wire spans (accept_batch), starts and stops the device with commands, and finally redefines
-// the position with set_position. Every move is a rest-to-rest trapezoid of constant-
-// acceleration Hermite spans (cubic term exactly zero), so the device's exact limit check
-// passes them like any planned span; integer math only (docs/gpio.md).
+// wire spans (accept_batch), each move one job (its last span marks the job end, so the
+// device idles at the move's end by itself), stops the device with a command when the switch
+// is seen, and finally redefines the position with set_position. Every move is a rest-to-rest
+// trapezoid of constant- acceleration Hermite spans (cubic term exactly zero), so the device's
+// exact limit check passes them like any planned span; integer math only (docs/gpio.md).
 #pragma once
 
 #include <cstdint>
@@ -234,7 +235,7 @@ public:
         }
         if (stop_requested_for_ == HomingPhase::kError) {
             // A failed search, back-off or latch: report once the device has stopped.
-            if (s == DeviceState::kIdle) phase_ = HomingPhase::kError;
+            if (idle(s)) phase_ = HomingPhase::kError;
             return;
         }
         switch (phase_) {
@@ -259,7 +260,7 @@ public:
                 }
                 break;
             case HomingPhase::kSearchStop:
-                if (s == DeviceState::kIdle) {
+                if (idle(s)) {
                     const Lsb here = device_.position(config_.axis);
                     overshoot_ = here > trigger_ ? here - trigger_ : trigger_ - here;
                     if (begin_move(-toward(config_.backoff), config_.search_velocity) == Status::kOk) {
@@ -278,7 +279,7 @@ public:
                 }
                 break;
             case HomingPhase::kBackoffStop:
-                if (s == DeviceState::kIdle) {
+                if (idle(s)) {
                     const std::int64_t travel = 2 * static_cast<std::int64_t>(config_.backoff) + overshoot_;
                     if (begin_move(toward(travel), config_.latch_velocity) == Status::kOk) phase_ = HomingPhase::kLatch;
                 }
@@ -293,7 +294,7 @@ public:
                 }
                 break;
             case HomingPhase::kLatchStop:
-                if (s == DeviceState::kIdle) {
+                if (idle(s)) {
                     Lsb p[Axes];
                     for (unsigned a = 0; a < Axes; ++a) p[a] = device_.position(a);
                     p[config_.axis] = config_.home_position + (p[config_.axis] - trigger_);
@@ -323,7 +324,7 @@ public:
                 }
                 break;
             case HomingPhase::kPullOffStop:
-                if (s == DeviceState::kIdle) phase_ = HomingPhase::kDone;
+                if (idle(s)) phase_ = HomingPhase::kDone;
                 break;
             default:
                 break;
@@ -360,6 +361,7 @@ private:
         }
         stop_requested_for_ = HomingPhase::kIdle;
         fed_all_ = false;
+        move_job_ = device_.last_accepted_sequence() + 1u;  // a job's id: its first span's sequence
         if (!feed()) return error_status_;
         if (Status s = device_.command(Command::kStart); s != Status::kOk) return finish_error(HomingError::kDeviceRefused, s);
         return Status::kOk;
@@ -380,6 +382,7 @@ private:
                     (void)finish_error(HomingError::kDeviceRefused, Status::kAccelerationLimit);
                     return false;
                 }
+                if (!move_.pending()) w.flags |= kWireJobEnd;  // the move ends at rest: the job too
                 length += encode_wire_span(w, Axes, bytes + length, sizeof bytes - length);
                 ++count;
             }
@@ -393,20 +396,26 @@ private:
         return true;
     }
 
-    // The whole move was queued and executed: running at rest with nothing queued.
+    // The whole move was queued and executed: its job finished, the device idle at its end.
     bool move_done(DeviceState s) const {
-        return fed_all_ && s == DeviceState::kRunning && device_.queued_spans() == 0 &&
-               device_.last_completed_sequence() == device_.last_accepted_sequence();
+        return fed_all_ && s == DeviceState::kIdle && device_.finished_job() == move_job_;
     }
 
+    // Stops the device unless it already idles (its move finished); the phases that wait for
+    // idle also wait until the tick has taken the stop, so a later move is never dropped by it.
     void request_stop(HomingPhase next) {
-        if (Status st = device_.command(Command::kStop); st != Status::kOk) {
-            (void)finish_error(HomingError::kDeviceRefused, st);
-            return;
+        if (device_.state() != DeviceState::kIdle) {
+            if (Status st = device_.command(Command::kStop); st != Status::kOk) {
+                (void)finish_error(HomingError::kDeviceRefused, st);
+                return;
+            }
         }
         stop_requested_for_ = next;
         if (next != HomingPhase::kError) phase_ = next;
     }
+
+    // Idle, and no command of ours still waiting for the tick.
+    bool idle(DeviceState s) const { return s == DeviceState::kIdle && !device_.command_pending(); }
 
     MotionDevice<Axes, Capacity>& device_;
     HomingConfig config_;
@@ -415,6 +424,7 @@ private:
     Status error_status_ = Status::kOk;
     AxisMove<Axes> move_;
     bool fed_all_ = false;
+    std::uint32_t move_job_ = 0;
     HomingPhase stop_requested_for_ = HomingPhase::kIdle;
     Lsb trigger_ = 0;
     std::int64_t overshoot_ = 0;

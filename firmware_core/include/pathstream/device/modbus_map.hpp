@@ -8,11 +8,14 @@
 namespace pathstream::device::modbus {
 
 inline constexpr std::uint16_t kMagic = 0x5053;  ///< "PS"
-inline constexpr std::uint16_t kProtocolVersion = 1;
+/// 2: job ends (wire flag kWireJobEnd, registers 36-39), the queue epoch (40-41), the
+/// pen-down delay in the configuration (+3), continuity checked at every join.
+inline constexpr std::uint16_t kProtocolVersion = 2;
 
 /// Status block: input registers (FC4) from 0, mirrored read-only in holding registers
 /// (FC3/FC23) at the same addresses so one FC23 can write spans and read the status.
-/// 32-bit values take two registers, high word first.
+/// 32-bit values take two registers, high word first. Every read takes the whole block from
+/// one tick's status (never a mix of two ticks).
 namespace status {
 inline constexpr std::uint16_t kMagic = 0;
 inline constexpr std::uint16_t kVersion = 1;
@@ -32,17 +35,23 @@ inline constexpr std::uint16_t kDuplicates = 32;     ///< batches acknowledged a
 inline constexpr std::uint16_t kOutputs = 33;        ///< discrete outputs in force
 inline constexpr std::uint16_t kQueuedSpans = 34;
 inline constexpr std::uint16_t kFlags = 35;          ///< bit 0: configured, bit 1: held by underrun
-inline constexpr std::uint16_t kCount = 36;          ///< registers in the block
+inline constexpr std::uint16_t kFinishedJob =
+    36;  ///< u32: id of the last job run to its end (0: none)
+inline constexpr std::uint16_t kFinishedJobTicks = 38;  ///< u32: path ticks that job executed
+inline constexpr std::uint16_t kEpoch = 40;  ///< u32: queue epoch (advanced by every queue drop)
+inline constexpr std::uint16_t kCount = 42;  ///< registers in the block
 }  // namespace status
 
 /// Command register (holding, write-only in effect; reads return the last command written).
 inline constexpr std::uint16_t kCommand = 100;  ///< Command values (1 start ... 5 reset)
 
 /// Configuration block (holding), written whole in one FC16 at kConfig:
-///   +0..1 tick rate (Hz, u32), +2 axes (must equal the device's), +3..9 reserved (0),
+///   +0..1 tick rate (Hz, u32), +2 axes (must equal the device's), +3 pen-down delay (ticks,
+///   the re-entry's pen lead), +4..9 reserved (0),
 ///   +10 + 4a .. : axis a max velocity (LSB/s, u32), max acceleration (LSB/s^2, u32).
 /// Accepted only idle with nothing queued; read back with FC3.
 inline constexpr std::uint16_t kConfig = 110;
+inline constexpr std::uint16_t kConfigPenDownTicks = 3;
 inline constexpr std::uint16_t kConfigAxisBase = 10;
 constexpr std::uint16_t config_registers(unsigned axes) {
     return static_cast<std::uint16_t>(kConfigAxisBase + 4 * axes);
@@ -64,9 +73,9 @@ enum class Exception : std::uint8_t {
     kNone = 0,
     kIllegalFunction = 1,
     kIllegalDataAddress = 2,  ///< no such register, or a block written partially
-    kIllegalDataValue = 3,    ///< a value refused (bad span, sequence, limits, check value)
-    kServerDeviceFailure = 4, ///< refused by the state (fault, e-stop, not configured)
-    kServerDeviceBusy = 6,    ///< queue full: retry the same batch later
+    kIllegalDataValue = 3,  ///< a value refused (bad span, sequence, limits, check value, command)
+    kServerDeviceFailure = 4,  ///< refused by the state (fault, e-stop, not configured)
+    kServerDeviceBusy = 6,     ///< queue full: retry the same batch later
 };
 
 }  // namespace pathstream::device::modbus

@@ -58,13 +58,9 @@ public:
         Status s = Status::kOk;
         Exception e = Exception::kNone;
         if (address == modbus::kCommand && count == 1) {
-            if (values[0] < 1 || values[0] > static_cast<std::uint16_t>(Command::kReset)) {
-                e = Exception::kIllegalDataValue;
-                s = Status::kWrongState;
-            } else {
-                s = device_.command(static_cast<Command>(values[0]));
-                if (s == Status::kOk) last_command_ = values[0];
-            }
+            // Any value goes to the core, which refuses what is no command (kUnknownCommand).
+            s = device_.command(static_cast<Command>(values[0]));
+            if (s == Status::kOk) last_command_ = values[0];
         } else if (address == modbus::kConfig && count == modbus::config_registers(Axes)) {
             s = write_config(values, e);
         } else if (address == modbus::kSpanWindow && count >= modbus::kSpanHeaderRegisters) {
@@ -113,30 +109,34 @@ private:
         r[1] = static_cast<std::uint16_t>(v & 0xFFFFu);
     }
 
+    // One status read: every tick-side register comes from the same tick.
     void fill_status(std::uint16_t (&b)[modbus::status::kCount]) const {
         namespace st = modbus::status;
+        const DeviceStatus<Axes> s = device_.status();
         for (auto& r : b) r = 0;
         b[st::kMagic] = modbus::kMagic;
         b[st::kVersion] = modbus::kProtocolVersion;
-        b[st::kState] = static_cast<std::uint16_t>(device_.state());
-        b[st::kFaultCode] = static_cast<std::uint16_t>(device_.fault_code());
+        b[st::kState] = static_cast<std::uint16_t>(s.state);
+        b[st::kFaultCode] = static_cast<std::uint16_t>(s.fault_code);
         b[st::kFreeSlots] = static_cast<std::uint16_t>(device_.free_slots());
         b[st::kCapacity] = static_cast<std::uint16_t>(Capacity);
         put_u32(&b[st::kLastAcceptedSequence], device_.last_accepted_sequence());
-        put_u32(&b[st::kTicksExecuted], static_cast<std::uint32_t>(device_.ticks_executed() & 0xFFFFFFFFu));
-        for (unsigned a = 0; a < Axes; ++a) {
-            put_u32(&b[st::kPositions + 2 * a], static_cast<std::uint32_t>(device_.position(a)));
-        }
+        put_u32(&b[st::kTicksExecuted], s.ticks_executed_low);
+        for (unsigned a = 0; a < Axes; ++a)
+            put_u32(&b[st::kPositions + 2 * a], static_cast<std::uint32_t>(s.position[a]));
         b[st::kAxes] = static_cast<std::uint16_t>(Axes);
-        b[st::kUnderruns] = static_cast<std::uint16_t>(device_.underruns() & 0xFFFFu);
-        put_u32(&b[st::kLastCompletedSequence], device_.last_completed_sequence());
+        b[st::kUnderruns] = static_cast<std::uint16_t>(s.underruns & 0xFFFFu);
+        put_u32(&b[st::kLastCompletedSequence], s.last_completed_sequence);
         b[st::kLastRefusal] = last_refusal_;
         b[st::kRefusals] = refusals_;
         b[st::kDuplicates] = static_cast<std::uint16_t>(device_.duplicates() & 0xFFFFu);
-        b[st::kOutputs] = device_.outputs();
+        b[st::kOutputs] = static_cast<std::uint16_t>(s.outputs);
         b[st::kQueuedSpans] = static_cast<std::uint16_t>(device_.queued_spans());
         b[st::kFlags] = static_cast<std::uint16_t>((device_.configured() ? 1u : 0u) |
-                                                   (device_.held_by_underrun() ? 2u : 0u));
+                                                   (s.held_by_underrun() ? 2u : 0u));
+        put_u32(&b[st::kFinishedJob], s.finished_job);
+        put_u32(&b[st::kFinishedJobTicks], s.finished_job_ticks);
+        put_u32(&b[st::kEpoch], s.epoch);
     }
 
     void fill_config(std::uint16_t (&b)[modbus::config_registers(kMaxAxes)]) const {
@@ -144,6 +144,7 @@ private:
         const MotionLimits<Axes>& l = device_.limits();
         put_u32(&b[0], l.tick_hz);
         b[2] = static_cast<std::uint16_t>(Axes);
+        b[modbus::kConfigPenDownTicks] = static_cast<std::uint16_t>(l.pen_down_ticks);
         for (unsigned a = 0; a < Axes; ++a) {
             put_u32(&b[modbus::kConfigAxisBase + 4 * a], l.axis[a].max_velocity);
             put_u32(&b[modbus::kConfigAxisBase + 4 * a + 2], l.axis[a].max_acceleration);
@@ -155,7 +156,7 @@ private:
             e = Exception::kIllegalDataValue;
             return Status::kBadLimits;
         }
-        for (std::uint16_t i = 3; i < modbus::kConfigAxisBase; ++i) {
+        for (std::uint16_t i = modbus::kConfigPenDownTicks + 1; i < modbus::kConfigAxisBase; ++i) {
             if (v[i] != 0) {
                 e = Exception::kIllegalDataValue;
                 return Status::kBadLimits;
@@ -163,6 +164,7 @@ private:
         }
         MotionLimits<Axes> l;
         l.tick_hz = u32(&v[0]);
+        l.pen_down_ticks = v[modbus::kConfigPenDownTicks];
         for (unsigned a = 0; a < Axes; ++a) {
             l.axis[a].max_velocity = u32(&v[modbus::kConfigAxisBase + 4 * a]);
             l.axis[a].max_acceleration = u32(&v[modbus::kConfigAxisBase + 4 * a + 2]);

@@ -9,6 +9,7 @@
 
 #include "pathstream/status.hpp"
 #include "pathstream/tick_cubic.hpp"
+#include "pathstream/units.hpp"
 
 namespace pathstream::device {
 
@@ -21,18 +22,24 @@ struct AxisLimits {
     std::uint32_t max_acceleration = 0;  ///< LSB/s^2
 };
 
-/// The device's motion configuration: tick rate and each axis's limits.
+/// The device's motion configuration: tick rate, each axis's limits, and the pen-down delay
+/// the device allows for when it brings the pen back onto the paper after a re-entry.
 template <unsigned Axes>
 struct MotionLimits {
     std::uint32_t tick_hz = 0;  ///< 1..kMaxTickHz
     AxisLimits axis[Axes] = {};
+    /// Ticks from switching the pen output on to the pen touching (0..kMaxSpanTicks): a
+    /// re-entry onto a pen-down span switches the pen on this many ticks before it reaches
+    /// the boundary, so the pen lands there (docs/device.md, "Pen").
+    std::uint32_t pen_down_ticks = 0;
 };
 
-/// kOk when tick_hz is 1..kMaxTickHz and every limit is >= 1; kBadLimits otherwise.
-/// Cost: a loop over the axes. Any context.
+/// kOk when tick_hz is 1..kMaxTickHz, every limit is >= 1 and pen_down_ticks is at most
+/// kMaxSpanTicks; kBadLimits otherwise. Cost: a loop over the axes. Any context.
 template <unsigned Axes>
 [[nodiscard]] Status check_limits(const MotionLimits<Axes>& limits) {
     if (limits.tick_hz < 1 || limits.tick_hz > kMaxTickHz) return Status::kBadLimits;
+    if (limits.pen_down_ticks > kMaxSpanTicks) return Status::kBadLimits;
     for (unsigned a = 0; a < Axes; ++a) {
         if (limits.axis[a].max_velocity < 1 || limits.axis[a].max_acceleration < 1) {
             return Status::kBadLimits;
@@ -49,5 +56,18 @@ template <unsigned Axes>
 /// Task context.
 [[nodiscard]] Status check_axis_limits(const TickCubic& cubic, const SpanTiming& timing,
                                        const AxisLimits& limits, std::uint32_t tick_hz);
+
+/// Checks one axis at the join of two Hermite spans: a span of `ticks` ticks starting with
+/// tangent `start_tangent` may follow one of `previous_ticks` ticks that ended with tangent
+/// `previous_end_tangent` (0 and any tick count for rest) when the velocities differ by at
+/// most one tick of max_acceleration plus the rounding of the two integer tangents (half a
+/// unit each, i.e. 1/(2n) LSB per tick):
+///   2 |T0 n' - T1' n| hz^2 <= 2 a_max n n' + (n + n') hz^2.
+/// Returns kOk or kVelocityStep. Exact (two-word integers). `tick_hz` 1..kMaxTickHz, tick
+/// counts 1..kMaxSpanTicks, tangents within kMaxTangentLsb. Cost: a few 128-bit products.
+/// Task context.
+[[nodiscard]] Status check_join(std::int32_t start_tangent, std::uint32_t ticks,
+                                std::int32_t previous_end_tangent, std::uint32_t previous_ticks,
+                                const AxisLimits& limits, std::uint32_t tick_hz);
 
 }  // namespace pathstream::device

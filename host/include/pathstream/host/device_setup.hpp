@@ -14,16 +14,19 @@
 
 namespace pathstream::host {
 
-/// The device's configuration: tick rate (Hz) and per-axis limits (LSB/s, LSB/s^2).
+/// The device's configuration: tick rate (Hz), per-axis limits (LSB/s, LSB/s^2) and the
+/// pen-down delay in ticks (the lead a re-entry gives the pen).
 struct DeviceLimitsLsb {
     std::uint32_t tick_hz = 0;
     std::vector<std::uint32_t> max_velocity;
     std::vector<std::uint32_t> max_acceleration;
+    std::uint32_t pen_down_ticks = 0;
 };
 
 /// The profile's limits rounded up to whole LSB (the planner works to the profile's limits
-/// exactly, so the device must allow them). Throws std::range_error naming the axis when a
-/// limit does not fit 32 bits.
+/// exactly, so the device must allow them), and its pen_down_delay in ticks as the planner
+/// counts it (delay_ticks). Throws std::range_error naming the axis when a limit does not fit
+/// 32 bits, or when the pen-down delay exceeds 65535 ticks.
 DeviceLimitsLsb device_limits(const MachineProfile& profile);
 
 /// Index of the axis called `name` in the profile. Throws std::invalid_argument if none.

@@ -16,10 +16,12 @@ struct WirePlan {
     std::vector<std::uint64_t> prefix_ticks;       ///< prefix_ticks[i]: ticks of spans [0, i)
 };
 
-/// Encodes `plan` (Hermite spans that chain exactly, as plan_path makes them): T0 is left out
-/// (kWireContinueTangent) wherever it equals the previous span's T1. Throws
-/// std::invalid_argument for an empty plan, 0 or more than 8 axes, a span of another basis,
-/// a span that does not start where the previous one ends, or one that cannot be encoded.
+/// Encodes `plan` (Hermite spans that chain exactly, as plan_path makes them) as one job: T0
+/// is left out (kWireContinueTangent) wherever it equals the previous span's T1, and the last
+/// span carries kWireJobEnd (the device idles at its end and reports the job finished).
+/// Throws std::invalid_argument for an empty plan, 0 or more than 8 axes, a span of another
+/// basis, a span that does not start where the previous one ends, a plan that does not end
+/// at rest, or a span that cannot be encoded.
 WirePlan encode_wire_plan(const Plan& plan);
 
 }  // namespace pathstream::host

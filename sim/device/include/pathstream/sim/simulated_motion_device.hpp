@@ -99,6 +99,7 @@ public:
         device::MotionLimits<Axes> m;
         m.tick_hz = l.tick_hz;
         for (unsigned a = 0; a < Axes; ++a) m.axis[a] = {l.max_velocity[a], l.max_acceleration[a]};
+        m.pen_down_ticks = l.pen_down_ticks;
         return device_.configure(m);
     }
     DeviceIo& attach_io(const MachineWiring& wiring) override {

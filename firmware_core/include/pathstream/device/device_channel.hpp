@@ -1,0 +1,122 @@
+// Everything the device's two contexts share, and nothing else: the span queue, the mailbox
+// the task side posts requests to, and the status board the tick side publishes to. Every
+// shared word is a 32-bit atomic used with loads and stores only (ARMv6-M has no atomic
+// read-modify-write); each has exactly one writing context, named below.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+
+#include "pathstream/device/device_state.hpp"
+#include "pathstream/device/motion_limits.hpp"
+#include "pathstream/setpoint_stream.hpp"
+#include "pathstream/units.hpp"
+
+namespace pathstream::device {
+
+/// A value of `T` (32-bit words only) published by one writer and read whole by any reader:
+/// two slots, each a sequence lock. The writer fills the slot readers are not directed to
+/// (its sequence odd while it writes), then directs readers to it; a reader copies the slot it
+/// is directed to and retries only if the writer came back to that same slot meanwhile, i.e.
+/// if its copy took longer than a whole publication period. The writer never waits. On a
+/// single-core MCU the writer is the tick interrupt, so a reader retries at most once per
+/// tick that interrupts its copy; on a host, a writer publishing flat out does not starve it.
+template <typename T>
+class StatusBoard {
+    static_assert(sizeof(T) % sizeof(std::uint32_t) == 0, "32-bit words only");
+    static constexpr unsigned kWords = sizeof(T) / sizeof(std::uint32_t);
+
+public:
+    /// Writer only (one context). Cost: three control stores and kWords release stores (on
+    /// Cortex-M a release store is a DMB and a store).
+    void publish(const T& value) {
+        std::uint32_t words[kWords];
+        __builtin_memcpy(words, &value, sizeof words);
+        const std::uint32_t index = 1u - latest_.load(std::memory_order_relaxed);
+        Slot& slot = slots_[index];
+        const std::uint32_t sequence = slot.sequence.load(std::memory_order_relaxed);
+        slot.sequence.store(sequence + 1, std::memory_order_relaxed);
+        // Each word store is a release: a reader that sees one word of this publish()
+        // (acquire) also sees the odd sequence stored before it, and retries.
+        for (unsigned i = 0; i < kWords; ++i)
+            slot.words[i].store(words[i], std::memory_order_release);
+        slot.sequence.store(sequence + 2, std::memory_order_release);
+        latest_.store(index, std::memory_order_release);
+    }
+
+    /// Any context that cannot preempt the writer (it would spin while the writer it
+    /// interrupted is inside publish()). Returns a copy of one publish() whole. Cost: kWords
+    /// loads per try.
+    T read() const {
+        std::uint32_t words[kWords];
+        for (;;) {
+            const Slot& slot = slots_[latest_.load(std::memory_order_acquire)];
+            const std::uint32_t before = slot.sequence.load(std::memory_order_acquire);
+            if ((before & 1u) != 0) continue;
+            // Acquire loads keep the second sequence load after every word load, without a
+            // standalone fence (which ThreadSanitizer does not model).
+            for (unsigned i = 0; i < kWords; ++i)
+                words[i] = slot.words[i].load(std::memory_order_acquire);
+            if (slot.sequence.load(std::memory_order_relaxed) == before) break;
+        }
+        T value;
+        __builtin_memcpy(&value, words, sizeof words);
+        return value;
+    }
+
+private:
+    struct Slot {
+        std::atomic<std::uint32_t> sequence{0};  // written by the writer only; odd while writing
+        std::atomic<std::uint32_t> words[kWords] = {};
+    };
+    Slot slots_[2];
+    std::atomic<std::uint32_t> latest_{0};  // the slot of the last complete publish()
+};
+
+/// Requests to the tick. Who writes each field and when is part of its contract.
+template <unsigned Axes>
+struct DeviceMailbox {
+    /// Command word: (request number << 8) | Command value. Written by the task side
+    /// (DeviceReceiver::command) in one store; the tick takes each new word once. A second
+    /// request before that tick replaces the first.
+    std::atomic<std::uint32_t> command{0};
+    /// Fault request: 0 or a FaultCode. Written by any context (raise_fault, first code kept)
+    /// and cleared by the tick when a reset leaves the fault.
+    std::atomic<std::uint32_t> fault{0};
+    /// E-stop input level (0 released, 1 active). Written by any context (the input's edge
+    /// interrupt or poll); read by the tick.
+    std::atomic<std::uint32_t> estop{0};
+    /// set_position request: `position` is written by the task, then `position_request`
+    /// (release); the tick reads `position` after seeing a new number (acquire) and reports
+    /// it taken in DeviceStatus::position_applied. The task never writes `position` while a
+    /// request is pending, so the array itself needs no atomics.
+    Lsb position[Axes] = {};
+    std::atomic<std::uint32_t> position_request{0};
+    /// Configuration. Written by the task only while the device is idle with nothing queued
+    /// (DeviceReceiver::configure); read by the tick only while it runs, holds or stops, which
+    /// it reaches through a start command posted after the write (the command's release and
+    /// the tick's acquire order the two), so the limits are never read while written.
+    MotionLimits<Axes> limits{};
+};
+
+/// The three things the task side and the tick side share. Init context builds it; then
+/// `queue` has one producer (the task side: DeviceReceiver) and one consumer (the tick side:
+/// DeviceExecutor), `mailbox` is written as documented per field, and `board` is written by
+/// the tick only.
+template <unsigned Axes, std::uint32_t Capacity>
+struct DeviceChannel {
+    /// Idle at `start` (LSB per axis). Init context.
+    explicit DeviceChannel(const Lsb (&start)[Axes]) : queue(start) {
+        DeviceStatus<Axes> s;
+        for (unsigned a = 0; a < Axes; ++a) s.origin[a] = s.position[a] = start[a];
+        board.publish(s);
+    }
+
+    /// Spans with their stamps (epoch, job, end tangent). Producer: task; consumer: tick.
+    SetpointStream<Axes, Capacity> queue;
+    DeviceMailbox<Axes> mailbox;
+    /// The tick's status, published once per tick.
+    StatusBoard<DeviceStatus<Axes>> board;
+};
+
+}  // namespace pathstream::device

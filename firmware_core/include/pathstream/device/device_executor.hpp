@@ -1,0 +1,410 @@
+// The device's tick side: consumes the span queue one tick at a time, applies the task side's
+// requests from the mailbox, owns the one motion-stop path (hold, stop, underrun, job end,
+// fault, e-stop) and the re-entry, drives the discrete outputs, and publishes the status.
+// Runs in the tick interrupt only. Shares nothing with the task side but the DeviceChannel.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+
+#include "pathstream/device/device_channel.hpp"
+#include "pathstream/device/device_state.hpp"
+#include "pathstream/device/motion_limits.hpp"
+#include "pathstream/device/stop_spans.hpp"
+#include "pathstream/setpoint_stream.hpp"
+#include "pathstream/span.hpp"
+#include "pathstream/status.hpp"
+
+namespace pathstream::device {
+
+/// Tick side of a device of `Axes` axes with a span queue `Capacity` deep. tick() runs in the
+/// tick interrupt; nothing else of this class runs anywhere else. Storage inline.
+template <unsigned Axes, std::uint32_t Capacity>
+class DeviceExecutor {
+public:
+    /// Idle at `start` (the channel's start). Init context. `channel` must outlive it.
+    DeviceExecutor(DeviceChannel<Axes, Capacity>& channel, const Lsb (&start)[Axes])
+        : channel_(channel) {
+        for (unsigned a = 0; a < Axes; ++a) {
+            position_[a] = rest_[a] = start[a];
+            status_.origin[a] = status_.position[a] = start[a];
+        }
+    }
+
+    /// One tick: applies the mailbox's requests, then writes every axis's setpoint to `out`
+    /// and publishes the status. Only a span stamped with the current epoch is ever played:
+    /// older ones are dropped unplayed whenever the queue is between spans. Steady state
+    /// costs SetpointStream::tick plus the request loads and the status publication; a
+    /// controlled stop or re-entry is planned in this call at a span boundary (a one-off of a
+    /// few thousand instructions per axis). Tick interrupt context.
+    void tick(Lsb (&out)[Axes]) {
+        SetpointStream<Axes, Capacity>& queue = channel_.queue;
+        apply_requests();
+        // A generated move whose last tick was output ends here, so the tick that outputs its
+        // end point already carries the state it leads to (idle only once at rest).
+        if (motion_ == Motion::kGenerated && generated_.between_spans() &&
+            generated_.queued_spans() == 0) {
+            finish_generated();
+        }
+        bool play = !queue.between_spans();
+        if (!play) {
+            drop_stale();
+            if (state_ == DeviceState::kRunning && motion_ == Motion::kStream) play = at_boundary();
+        }
+        bool path = false;
+        switch (motion_) {
+            case Motion::kStream:
+                if (play) {
+                    (void)queue.tick(out);
+                    outputs_ = queue.outputs();
+                    path = true;
+                } else {
+                    for (unsigned a = 0; a < Axes; ++a) out[a] = queue.resting_position(a);
+                    outputs_ = 0;
+                }
+                break;
+            case Motion::kGenerated:
+                (void)generated_.tick(out);
+                ++generated_ticks_;
+                // Only the pen, and only for the last pen-down delay of a re-entry onto a
+                // pen-down span: it lands as the axes reach the boundary.
+                outputs_ =
+                    generated_kind_ == Generated::kReentry && generated_left_ <= pen_lead_ticks_
+                        ? pen_lead_outputs_
+                        : std::uint8_t{0};
+                --generated_left_;
+                break;
+            case Motion::kRest:
+            default:
+                for (unsigned a = 0; a < Axes; ++a) out[a] = rest_[a];
+                outputs_ = 0;
+                break;
+        }
+        for (unsigned a = 0; a < Axes; ++a) position_[a] = out[a];
+        publish(path);
+    }
+
+private:
+    enum class Motion : std::uint8_t { kRest, kStream, kGenerated };
+    enum class Generated : std::uint8_t { kNone, kHoldStop, kStopStop, kReentry };
+
+    // The stamp of the span in progress, or of the last one played (tick side's copy: the
+    // queue slot is reused once the span is done). Default: at rest.
+    struct Current {
+        std::int32_t tangent[Axes] = {};
+        std::uint32_t ticks = 1;
+        bool job_end = false;
+    };
+
+    const MotionLimits<Axes>& limits() const { return channel_.mailbox.limits; }
+
+    void set_state(DeviceState s) {
+        state_ = s;
+        status_.state = static_cast<std::uint32_t>(s);
+    }
+    void set_held_by_underrun(bool held) {
+        status_.flags = held ? (status_.flags | kStatusHeldByUnderrun)
+                             : (status_.flags & ~kStatusHeldByUnderrun);
+    }
+
+    void publish(bool path) {
+        status_.tick_count = status_.tick_count + 1u;
+        status_.tick_check = status_.tick_count;
+        for (unsigned a = 0; a < Axes; ++a) status_.position[a] = position_[a];
+        status_.outputs = outputs_;
+        status_.flags =
+            path ? (status_.flags | kStatusPathTick) : (status_.flags & ~kStatusPathTick);
+        const std::uint64_t executed = channel_.queue.ticks_executed();
+        status_.ticks_executed_low = static_cast<std::uint32_t>(executed);
+        status_.ticks_executed_high = static_cast<std::uint32_t>(executed >> 32);
+        status_.generated_ticks_low = static_cast<std::uint32_t>(generated_ticks_);
+        status_.generated_ticks_high = static_cast<std::uint32_t>(generated_ticks_ >> 32);
+        status_.last_completed_sequence = channel_.queue.last_completed_tag();
+        channel_.board.publish(status_);
+    }
+
+    void apply_requests() {
+        DeviceMailbox<Axes>& m = channel_.mailbox;
+        // The command word first: its acquire makes everything the task side wrote before
+        // posting it (configuration, spans) visible to the rest of this tick.
+        const std::uint32_t command = m.command.load(std::memory_order_acquire);
+        const bool estop = m.estop.load(std::memory_order_acquire) != 0;
+        const std::uint32_t fault = m.fault.load(std::memory_order_acquire);
+        const DeviceState s = state_;
+        if (estop && s != DeviceState::kEstop) {
+            stop_at_once();
+            set_state(DeviceState::kEstop);
+            return;
+        }
+        if (fault != 0 && s != DeviceState::kFault && s != DeviceState::kEstop) {
+            stop_at_once();
+            status_.fault_code = fault;
+            set_state(DeviceState::kFault);
+            return;
+        }
+        apply_position_request(s);
+        if (command == status_.command_applied) return;
+        status_.command_applied = command;
+        switch (static_cast<Command>(command & 0xFFu)) {
+            case Command::kStart:
+                // Starting with nothing (current) queued does nothing.
+                drop_stale();
+                if (s == DeviceState::kIdle && channel_.queue.next_span() != nullptr) {
+                    motion_ = Motion::kStream;
+                    set_state(DeviceState::kRunning);
+                }
+                break;
+            case Command::kHold:
+                if (s == DeviceState::kRunning) hold_requested_ = true;
+                break;
+            case Command::kResume:
+                if (s == DeviceState::kHolding) {
+                    if (motion_ == Motion::kRest) {
+                        begin_reentry();
+                    } else {
+                        resume_pending_ = true;  // still decelerating: resume once at rest
+                    }
+                }
+                break;
+            case Command::kStop:
+                if (s == DeviceState::kRunning) {
+                    stop_requested_ = true;
+                } else if (s == DeviceState::kHolding) {
+                    if (motion_ == Motion::kRest) {
+                        drop_queue();
+                        set_state(DeviceState::kIdle);
+                    } else {
+                        stop_requested_ = true;  // finish_generated completes it
+                    }
+                } else if (s == DeviceState::kIdle) {
+                    drop_queue();
+                }
+                break;
+            case Command::kReset:
+                if ((s == DeviceState::kFault || s == DeviceState::kEstop) && !estop) {
+                    m.fault.store(0, std::memory_order_release);
+                    status_.fault_code = static_cast<std::uint32_t>(FaultCode::kNone);
+                    drop_queue();
+                    set_state(DeviceState::kIdle);
+                }
+                break;
+            default:
+                break;  // the task side refuses every other value before posting
+        }
+    }
+
+    // set_position: taken only while idle at rest (a start in the same tick comes after it);
+    // in any other state it is dropped (the task sees it applied either way).
+    void apply_position_request(DeviceState s) {
+        DeviceMailbox<Axes>& m = channel_.mailbox;
+        const std::uint32_t request = m.position_request.load(std::memory_order_acquire);
+        if (request == status_.position_applied) return;
+        if (s == DeviceState::kIdle && motion_ == Motion::kRest) {
+            for (unsigned a = 0; a < Axes; ++a) position_[a] = rest_[a] = m.position[a];
+            drop_queue();
+        }
+        status_.position_applied = request;
+    }
+
+    // Every queue drop: the queue emptied, a new epoch whose chain starts at the rest point.
+    // Spans the task side still pushes with the old stamp are dropped by drop_stale().
+    void drop_queue() {
+        channel_.queue.discard_all(rest_);
+        status_.epoch = status_.epoch + 1u;
+        for (unsigned a = 0; a < Axes; ++a) status_.origin[a] = rest_[a];
+        current_ = Current{};
+        set_held_by_underrun(false);
+    }
+
+    // Between spans: spans of an older epoch at the head of the queue are never played.
+    void drop_stale() {
+        SetpointStream<Axes, Capacity>& queue = channel_.queue;
+        for (const PreparedSpan<Axes>* next = queue.next_span();
+             next != nullptr && next->stamp.epoch != status_.epoch; next = queue.next_span()) {
+            queue.drop_next();
+        }
+    }
+
+    // E-stop and faults: the axes stay at the last output; everything queued is dropped.
+    void stop_at_once() {
+        for (unsigned a = 0; a < Axes; ++a) rest_[a] = position_[a];
+        motion_ = Motion::kRest;
+        generated_kind_ = Generated::kNone;
+        hold_requested_ = stop_requested_ = resume_pending_ = false;
+        drop_queue();
+    }
+
+    void fault(FaultCode code) {
+        stop_at_once();
+        status_.fault_code = static_cast<std::uint32_t>(code);
+        set_state(DeviceState::kFault);
+    }
+
+    // The next span becomes the one in progress: its stamp is copied here, where the tick
+    // can keep it after the slot is reused.
+    void adopt(const PreparedSpan<Axes>& next) {
+        for (unsigned a = 0; a < Axes; ++a) current_.tangent[a] = next.stamp.end_tangent[a];
+        current_.ticks = next.ticks;
+        current_.job_end = next.stamp.job_end;
+        if (next.stamp.job != status_.job) {
+            status_.job = next.stamp.job;
+            job_start_ticks_ = channel_.queue.ticks_executed();
+        }
+        status_.span_epoch = next.stamp.epoch;
+    }
+
+    // The last span of a job ended (at rest): report it, and idle there.
+    void finish_job() {
+        SetpointStream<Axes, Capacity>& queue = channel_.queue;
+        status_.finished_job = status_.job;
+        status_.finished_job_ticks =
+            static_cast<std::uint32_t>(queue.ticks_executed() - job_start_ticks_);
+        for (unsigned a = 0; a < Axes; ++a) rest_[a] = queue.resting_position(a);
+        motion_ = Motion::kRest;
+        current_ = Current{};
+        hold_requested_ = false;
+        set_state(DeviceState::kIdle);
+        if (stop_requested_) {
+            stop_requested_ = false;
+            drop_queue();
+        }
+    }
+
+    // Running, between two spans: the job ends, the next span starts, or a controlled stop
+    // begins (stop, hold, underrun). True when the stream plays the next span this tick.
+    bool at_boundary() {
+        SetpointStream<Axes, Capacity>& queue = channel_.queue;
+        if (current_.job_end) {
+            finish_job();
+            return false;
+        }
+        const PreparedSpan<Axes>* next = queue.next_span();
+        bool moving = false;
+        for (unsigned a = 0; a < Axes; ++a) moving = moving || current_.tangent[a] != 0;
+        const bool underrun = next == nullptr && moving && !stop_requested_ && !hold_requested_;
+        if (!stop_requested_ && !hold_requested_ && !underrun) {
+            if (next == nullptr) return false;  // at rest with nothing queued: wait there
+            adopt(*next);
+            return true;
+        }
+        for (unsigned a = 0; a < Axes; ++a) {
+            boundary_[a] = rest_[a] = queue.resting_position(a);
+            boundary_tangent_[a] = current_.tangent[a];
+        }
+        boundary_ticks_ = current_.ticks;
+        const bool stopping = stop_requested_;
+        set_held_by_underrun(underrun);
+        if (underrun) status_.underruns = status_.underruns + 1u;
+        hold_requested_ = stop_requested_ = false;
+        if (!moving) {
+            motion_ = Motion::kRest;
+            if (stopping) {
+                drop_queue();
+                set_state(DeviceState::kIdle);
+            } else {
+                set_state(DeviceState::kHolding);
+            }
+            return false;
+        }
+        Span<Axes> stop;
+        if (plan_stop(boundary_, boundary_tangent_, boundary_ticks_, limits(), stop) !=
+                Status::kOk ||
+            !start_generated(stop)) {
+            fault(FaultCode::kStopFailed);
+            return false;
+        }
+        generated_kind_ = stopping ? Generated::kStopStop : Generated::kHoldStop;
+        set_state(stopping ? DeviceState::kStopping : DeviceState::kHolding);
+        return false;
+    }
+
+    void begin_reentry() {
+        bool at_boundary = true;
+        bool moving = false;
+        for (unsigned a = 0; a < Axes; ++a) {
+            at_boundary = at_boundary && rest_[a] == boundary_[a];
+            moving = moving || boundary_tangent_[a] != 0;
+        }
+        set_held_by_underrun(false);
+        if (at_boundary && !moving) {
+            motion_ = Motion::kStream;
+            set_state(DeviceState::kRunning);
+            return;
+        }
+        Span<Axes> reentry;
+        if (plan_reentry(rest_, boundary_, boundary_tangent_, boundary_ticks_, limits(), reentry) !=
+                Status::kOk ||
+            !start_generated(reentry)) {
+            // No move back onto the path fits in one span: a fault the master sees (rather
+            // than a hold that silently never resumes); reset, then restart the job.
+            fault(FaultCode::kReentryFailed);
+            return;
+        }
+        generated_kind_ = Generated::kReentry;
+        drop_stale();
+        const PreparedSpan<Axes>* next = channel_.queue.next_span();
+        pen_lead_outputs_ = next != nullptr
+                                ? static_cast<std::uint8_t>(next->outputs & kOutputPenDown)
+                                : std::uint8_t{0};
+        pen_lead_ticks_ = limits().pen_down_ticks;
+        set_state(DeviceState::kRunning);
+    }
+
+    bool start_generated(const Span<Axes>& span) {
+        Lsb from[Axes];
+        for (unsigned a = 0; a < Axes; ++a) from[a] = span.control[a][0];
+        generated_.discard_all(from);
+        generated_.restart_producer_at(from);
+        if (generated_.push(span) != Status::kOk) return false;
+        generated_left_ = span.ticks;
+        motion_ = Motion::kGenerated;
+        return true;
+    }
+
+    void finish_generated() {
+        const Generated kind = generated_kind_;
+        generated_kind_ = Generated::kNone;
+        for (unsigned a = 0; a < Axes; ++a) rest_[a] = generated_.resting_position(a);
+        motion_ = Motion::kRest;
+        if (kind == Generated::kReentry) {
+            // The stream resumes at the boundary it left; a stop or hold requested meanwhile
+            // is taken at the next boundary.
+            motion_ = Motion::kStream;
+            return;
+        }
+        if (kind == Generated::kStopStop || stop_requested_) {
+            stop_requested_ = resume_pending_ = false;
+            drop_queue();
+            set_state(DeviceState::kIdle);
+            return;
+        }
+        if (resume_pending_) {
+            resume_pending_ = false;
+            begin_reentry();
+        }
+    }
+
+    DeviceChannel<Axes, Capacity>& channel_;
+    SetpointStream<Axes, 2> generated_;  // the device's own stop and re-entry spans
+    DeviceStatus<Axes> status_;          // published by every tick
+    DeviceState state_ = DeviceState::kIdle;
+    Motion motion_ = Motion::kRest;
+    Generated generated_kind_ = Generated::kNone;
+    bool hold_requested_ = false;
+    bool stop_requested_ = false;
+    bool resume_pending_ = false;
+    std::uint8_t outputs_ = 0;
+    std::uint8_t pen_lead_outputs_ = 0;
+    std::uint32_t pen_lead_ticks_ = 0;
+    std::uint32_t generated_left_ = 0;  // ticks of the generated span still to output
+    std::uint64_t generated_ticks_ = 0;
+    std::uint64_t job_start_ticks_ = 0;  // path ticks executed when the current job began
+    Current current_;
+    Lsb position_[Axes] = {};
+    Lsb rest_[Axes] = {};
+    Lsb boundary_[Axes] = {};
+    std::int32_t boundary_tangent_[Axes] = {};
+    std::uint32_t boundary_ticks_ = 1;
+};
+
+}  // namespace pathstream::device
