@@ -86,9 +86,16 @@ TEST_CASE(
     constexpr std::uint64_t kMinActions = 20000;
     std::atomic<bool> done{false};
     std::atomic<std::uint64_t> actions{0};
+    // The tick count of the task side's last action: the ticker never runs more than
+    // kMaxLead ticks past it, so a starved task thread (a loaded machine, one core) cannot
+    // leave the whole run to the tick alone; the two still run at once, in any interleaving.
+    constexpr std::uint64_t kMaxLead = 400;
+    std::atomic<std::uint64_t> task_mark{0};
     std::thread ticker([&] {
         for (std::uint64_t k = 0;
              k < ticks || actions.load(std::memory_order_relaxed) < kMinActions; ++k) {
+            while (k > task_mark.load(std::memory_order_acquire) + kMaxLead)
+                std::this_thread::yield();
             Lsb out[kAxes];
             d.tick(out);
             checker.after_tick(d.status());
@@ -109,6 +116,7 @@ TEST_CASE(
         last_action = d.status().tick_count;
         driver.step(device::NoInterleave{});
         actions.store(driver.counts().actions, std::memory_order_relaxed);
+        task_mark.store(d.status().tick_count, std::memory_order_release);
     }
     ticker.join();
     INFO(checker.failure());

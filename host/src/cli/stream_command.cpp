@@ -81,6 +81,7 @@ int run_stream_can(const StreamCommandOptions& o, const PlannedJob& job) {
                 static_cast<unsigned long long>(r.ticks_executed), motion,
                 static_cast<unsigned long long>(r.spans_sent), static_cast<unsigned long long>(r.batches),
                 r.last_completed);
+    std::printf("job           %u finished: the device is idle at the drawing's end point\n", r.job);
     std::printf("bus           %llu frames sent, %llu received, %llu retransmitted batches, %llu timeouts;"
                 " %.1f kbit/s worst case (%.2f %% of 1 Mbit/s)\n",
                 static_cast<unsigned long long>(r.frames_sent), static_cast<unsigned long long>(r.frames_received),
@@ -130,6 +131,7 @@ int run_stream(const StreamCommandOptions& o) {
     std::printf("executed      %llu ticks (%.3f s of motion), %llu spans in %llu batches, last span %u\n",
                 static_cast<unsigned long long>(r.ticks_executed), static_cast<double>(r.ticks_executed) / job.machine.tick_hz,
                 static_cast<unsigned long long>(r.spans_sent), static_cast<unsigned long long>(r.batches), r.last_completed);
+    std::printf("job           %u finished: the device is idle at the drawing's end point\n", r.job);
     std::printf("final point  ");
     for (std::size_t a = 0; a < job.machine.axes.size(); ++a) {
         std::printf(" %s %.4f mm", job.machine.axes[a].name.c_str(), r.final_position[a] * job.machine.mm_per_lsb);

@@ -89,6 +89,7 @@ public:
             if (job_finished(s)) break;
         }
         report_.ticks_executed = s.finished_job_ticks;
+        report_.job = s.finished_job;
         report_.last_completed = s.last_completed - base_ + 1;
         report_.duplicates = s.duplicates;
         report_.underruns = s.underruns;

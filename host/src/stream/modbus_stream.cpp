@@ -129,6 +129,7 @@ public:
             if (job_finished(s)) break;
         }
         report_.ticks_executed = s.finished_job_ticks;
+        report_.job = s.finished_job;
         report_.last_completed = s.last_completed;
         report_.duplicates = s.duplicates;
         report_.underruns = s.underruns;

@@ -42,6 +42,7 @@ struct CanStreamReport {
     std::uint64_t status_requests = 0;
     std::uint64_t ticks_executed = 0;     ///< path ticks the device executed for this plan
     std::uint32_t last_completed = 0;     ///< sequence number of the last span executed
+    std::uint32_t job = 0;                ///< the job's id (its first span's sequence number), finished
     std::uint32_t duplicates = 0;         ///< batches the device acknowledged as retries
     std::uint32_t underruns = 0;
     std::uint64_t frames_sent = 0;

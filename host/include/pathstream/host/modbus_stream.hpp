@@ -33,6 +33,7 @@ struct StreamReport {
     std::uint64_t batches = 0;
     std::uint64_t ticks_executed = 0;     ///< device's count at the end
     std::uint32_t last_completed = 0;     ///< sequence number of the last span executed
+    std::uint32_t job = 0;                ///< the job's id (its first span's sequence number), finished
     std::uint32_t duplicates = 0;         ///< batches the device acknowledged as retries
     std::uint32_t underruns = 0;
     std::uint64_t transactions = 0;       ///< successful Modbus transactions of every kind
