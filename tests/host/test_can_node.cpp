@@ -35,6 +35,7 @@ struct Fixture {
             feed(pc::encode_config(5, pc::config_item_velocity(a), 2, 1000000));
             feed(pc::encode_config(5, pc::config_item_acceleration(a), 2, 100000000));
         }
+        feed(pc::encode_config(5, pc::kConfigItemPenDown, 2, 40));
         const pc::Ack a = last_ack();
         REQUIRE(a.kind == pc::kAckConfig);
         REQUIRE(a.result == 0);
@@ -121,13 +122,18 @@ TEST_CASE("CAN node: configuration needs every item; commands and status answer"
     Fixture f;
     f.feed(pc::encode_config(5, 0, 2, 1000));
     f.feed(pc::encode_config(5, pc::config_item_acceleration(1), 2, 5));
+    CHECK(f.out.empty());  // not the last item: no answer yet
+    f.feed(pc::encode_config(5, pc::kConfigItemPenDown, 2, 5));
     CHECK(f.last_ack().result == pc::kResultIncomplete);
     CHECK_FALSE(f.dev.configured());
+    f.feed(pc::encode_config(5, 5, 2, 5));  // axis 2's velocity: the device has two axes
+    CHECK(f.last_ack().result == pc::kResultBadFrame);
     f.feed(pc::encode_config(5, 0, 3, 1000));
     CHECK(f.last_ack().result == static_cast<std::uint8_t>(Status::kBadLimits));
     f.feed(pc::encode_command(5, 1));
     CHECK(f.last_ack().result == static_cast<std::uint8_t>(Status::kNotConfigured));
     f.configure();
+    CHECK(f.dev.limits().pen_down_ticks == 40);  // the pen-down delay item reached the device
     f.feed(pc::encode_command(5, 1));  // start with nothing queued: nothing would move
     CHECK((f.last_ack().kind == pc::kAckCommand && f.last_ack().sequence == 1 &&
            f.last_ack().result == static_cast<std::uint8_t>(Status::kNothingToResume)));

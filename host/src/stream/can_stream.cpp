@@ -247,7 +247,9 @@ private:
             frames.push_back(pc::encode_config(node_, pc::config_item_acceleration(a),
                                                static_cast<std::uint8_t>(axes_), l.max_acceleration[a]));
         }
-        const auto last_item = static_cast<std::uint8_t>(2 * axes_);
+        frames.push_back(pc::encode_config(node_, pc::kConfigItemPenDown,
+                                           static_cast<std::uint8_t>(axes_), l.pen_down_ticks));
+        const std::uint8_t last_item = pc::kConfigItemPenDown;
         while (true) {
             for (const pc::Frame& f : frames) send(f);
             pc::Ack ack;

@@ -30,7 +30,7 @@ public:
         return f == kCommandBase || f == kConfigBase || f == kSpanStartBase || f == kSpanDataBase;
     }
 
-    /// Handles one received frame; calls `send(const Frame&)` for each answer (0 to 3).
+    /// Handles one received frame; calls `send(const Frame&)` for each answer (0 to 4: a status request is answered by four frames).
     /// Frames for other nodes or functions are ignored. Cost: a batch's accept_batch when its
     /// last data frame arrives, O(1) otherwise.
     template <typename Send>
@@ -119,18 +119,23 @@ private:
         const std::uint8_t axes = static_cast<std::uint8_t>(get(f, kConfigSignals[1]));
         const std::uint32_t value = get(f, kConfigSignals[2]);
         if (axes != Axes) return ack(kAckConfig, static_cast<std::uint8_t>(Status::kBadLimits), item, send);
-        if (item > 2 * Axes) return ack(kAckConfig, kResultBadFrame, item, send);
+        if (item > 2 * Axes && item != kConfigItemPenDown) {
+            return ack(kAckConfig, kResultBadFrame, item, send);
+        }
         if (item == 0) {
             config_seen_ = 0;
             pending_.tick_hz = value;
+        } else if (item == kConfigItemPenDown) {
+            pending_.pen_down_ticks = value;
         } else if (item % 2 == 1) {
             pending_.axis[(item - 1) / 2].max_velocity = value;
         } else {
             pending_.axis[(item - 2) / 2].max_acceleration = value;
         }
         config_seen_ |= 1u << item;
-        if (item != 2 * Axes) return;  // items before the last are not acknowledged: one ack per set
-        const std::uint32_t all = (1u << (2 * Axes + 1)) - 1u;
+        // Items before the last (the pen-down delay) are not acknowledged: one ack per set.
+        if (item != kConfigItemPenDown) return;
+        const std::uint32_t all = ((1u << (2 * Axes + 1)) - 1u) | (1u << kConfigItemPenDown);
         const std::uint8_t result = config_seen_ == all
                                         ? static_cast<std::uint8_t>(device_.configure(pending_))
                                         : kResultIncomplete;

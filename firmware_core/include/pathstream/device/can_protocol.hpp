@@ -64,8 +64,10 @@ inline constexpr std::uint8_t kFlagConfigured = 1u << 0;
 inline constexpr std::uint8_t kFlagHeldByUnderrun = 1u << 1;
 inline constexpr std::uint8_t kFlagBusProblem = 1u << 2;  ///< the device saw error-passive or bus-off
 
-/// Configuration items: 0 tick rate, 1 + 2a axis a's max velocity, 2 + 2a its acceleration.
-/// The device applies the set when the last item (2 * axes) arrives after all others.
+/// Configuration items: 0 tick rate, 1 + 2a axis a's max velocity, 2 + 2a its acceleration,
+/// kConfigItemPenDown the pen-down delay in ticks. The pen-down delay is sent last: the device
+/// applies the set when it arrives after all the others (item 0 starts a set).
+inline constexpr std::uint8_t kConfigItemPenDown = 17;
 constexpr std::uint8_t config_item_velocity(unsigned axis) { return static_cast<std::uint8_t>(1 + 2 * axis); }
 constexpr std::uint8_t config_item_acceleration(unsigned axis) { return static_cast<std::uint8_t>(2 + 2 * axis); }
 
@@ -115,7 +117,7 @@ inline constexpr Signal kStatusASignals[] = {
     {"Flags", 1, 1, false, "", "bit 0 configured, bit 1 held by underrun, bit 2 bus problem seen"},
     {"FreeSlots", 2, 1, false, "span", "free span slots"},
     {"Queued", 3, 1, false, "span", "spans queued"},
-    {"FaultCode", 4, 2, false, "", "0 none, 1 external, 2 stop failed, 0x01xx limit switch"},
+    {"FaultCode", 4, 2, false, "", "0 none, 1 external, 2 stop failed, 3 re-entry failed, 0x01xx limit switch"},
     {"Underruns", 6, 2, false, "", "controlled stops because the queue ran dry"},
 };
 inline constexpr Signal kStatusBSignals[] = {
@@ -134,7 +136,9 @@ inline constexpr Signal kStatusDSignals[] = {
     {"FinishedJobTicks", 4, 4, false, "tick", "path ticks that job executed (low 32 bits)"},
 };
 inline constexpr Signal kConfigSignals[] = {
-    {"Item", 0, 1, false, "", "0 tick rate, 1+2a axis a max velocity, 2+2a axis a max acceleration", -2},
+    {"Item", 0, 1, false, "",
+     "0 tick rate, 1+2a axis a max velocity, 2+2a axis a max acceleration, 17 pen-down delay (last)",
+     -2},
     {"Axes", 1, 1, false, "", "axis count (must match the device)"},
     {"TickRate", 2, 4, false, "Hz", "device tick rate", 0},
     {"MaxVelocity0", 2, 4, false, "LSB/s", "axis 0", 1},
@@ -153,6 +157,8 @@ inline constexpr Signal kConfigSignals[] = {
     {"MaxAcceleration6", 2, 4, false, "LSB/s^2", "axis 6", 14},
     {"MaxVelocity7", 2, 4, false, "LSB/s", "axis 7", 15},
     {"MaxAcceleration7", 2, 4, false, "LSB/s^2", "axis 7", 16},
+    {"PenDownDelay", 2, 4, false, "tick", "pen-down delay, 0..65535; the last item of a set",
+     kConfigItemPenDown},
 };
 inline constexpr Signal kSpanStartSignals[] = {
     {"FirstSequence", 0, 4, false, "", "sequence number of the batch's first span"},
@@ -175,7 +181,8 @@ inline constexpr Message kMessages[] = {
     {"StatusB", kStatusBBase, 8, true, "device -> host: span sequence numbers", kStatusBSignals, 2},
     {"StatusC", kStatusCBase, 8, true, "device -> host: progress and identity", kStatusCSignals, 4},
     {"Config", kConfigBase, 6, false,
-     "host -> device: tick rate and per-axis limits, one item per frame", kConfigSignals, 19},
+     "host -> device: tick rate, per-axis limits and pen-down delay, one item per frame",
+     kConfigSignals, 20},
     {"SpanStart", kSpanStartBase, 8, false, "host -> device: starts a span batch transfer",
      kSpanStartSignals, 4},
     {"SpanData", kSpanDataBase, 8, false, "host -> device: 7 bytes of the batch's wire spans",

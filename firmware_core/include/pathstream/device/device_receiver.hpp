@@ -66,7 +66,7 @@ public:
     /// otherwise acceptable, kQueueFull (not enough free slots: retry later).
     /// `between` is called before each span is queued: a test hook that runs the tick there
     /// (the interrupt could); the default does nothing. Cost: two decodes and one validation
-    /// per span (~5,000 instructions per axis on M4).
+    /// per span, and the push's own validation (~5,000 instructions per axis on M4).
     template <typename Between = NoInterleave>
     [[nodiscard]] Status accept_batch(std::uint32_t first_sequence, std::uint16_t count,
                                       const std::uint8_t* payload, std::size_t length,

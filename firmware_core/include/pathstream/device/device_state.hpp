@@ -61,7 +61,8 @@ template <unsigned Axes>
 struct DeviceStatus {
     std::uint32_t tick_count = 0;  ///< ticks run since construction (wraps); == tick_check
     std::uint32_t state = 0;       ///< DeviceState
-    std::uint32_t fault_code = 0;  ///< FaultCode (kNone unless state is kFault)
+    /// FaultCode: kNone until a fault; kept through an e-stop that follows it; a reset clears it.
+    std::uint32_t fault_code = 0;
     std::uint32_t flags = 0;       ///< kStatusHeldByUnderrun, kStatusPathTick
     std::uint32_t outputs = 0;     ///< discrete outputs the last tick drove (kOutputPenDown)
     /// Advanced by every queue drop (stop, e-stop, fault, reset, set position); spans stamped

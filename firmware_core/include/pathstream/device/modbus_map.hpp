@@ -74,7 +74,7 @@ enum class Exception : std::uint8_t {
     kIllegalFunction = 1,
     kIllegalDataAddress = 2,  ///< no such register, or a block written partially
     kIllegalDataValue = 3,  ///< a value refused (bad span, sequence, limits, check value, command)
-    kServerDeviceFailure = 4,  ///< refused by the state (fault, e-stop, not configured)
+    kServerDeviceFailure = 4,  ///< refused by the state (fault, e-stop, not configured, nothing to resume)
     kServerDeviceBusy = 6,     ///< queue full: retry the same batch later
 };
 

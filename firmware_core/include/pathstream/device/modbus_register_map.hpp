@@ -13,7 +13,7 @@ namespace pathstream::device {
 /// Serves MotionDevice<Axes, Capacity> as Modbus registers. Methods mirror a transport's
 /// register handler (hal::ModbusRegisterHandler): addresses and counts already checked for
 /// shape by the transport; the map decides meaning. Task context (the bus server), the same
-/// task that owns the device's producer side. No allocation; a 256-byte payload buffer inline.
+/// task that owns the device's producer side. No allocation; a 246-byte payload buffer inline.
 template <unsigned Axes, std::uint32_t Capacity>
 class ModbusRegisterMap {
 public:

@@ -28,18 +28,21 @@ template <unsigned Axes>
 struct MotionLimits {
     std::uint32_t tick_hz = 0;  ///< 1..kMaxTickHz
     AxisLimits axis[Axes] = {};
-    /// Ticks from switching the pen output on to the pen touching (0..kMaxSpanTicks): a
+    /// Ticks from switching the pen output on to the pen touching (0..kMaxPenDownTicks): a
     /// re-entry onto a pen-down span switches the pen on this many ticks before it reaches
     /// the boundary, so the pen lands there (docs/device.md, "Pen").
     std::uint32_t pen_down_ticks = 0;
 };
 
+/// Longest pen-down delay, in ticks: what one 16-bit Modbus register holds.
+inline constexpr std::uint32_t kMaxPenDownTicks = 65535;
+
 /// kOk when tick_hz is 1..kMaxTickHz, every limit is >= 1 and pen_down_ticks is at most
-/// kMaxSpanTicks; kBadLimits otherwise. Cost: a loop over the axes. Any context.
+/// kMaxPenDownTicks; kBadLimits otherwise. Cost: a loop over the axes. Any context.
 template <unsigned Axes>
 [[nodiscard]] Status check_limits(const MotionLimits<Axes>& limits) {
     if (limits.tick_hz < 1 || limits.tick_hz > kMaxTickHz) return Status::kBadLimits;
-    if (limits.pen_down_ticks > kMaxSpanTicks) return Status::kBadLimits;
+    if (limits.pen_down_ticks > kMaxPenDownTicks) return Status::kBadLimits;
     for (unsigned a = 0; a < Axes; ++a) {
         if (limits.axis[a].max_velocity < 1 || limits.axis[a].max_acceleration < 1) {
             return Status::kBadLimits;
