@@ -445,6 +445,27 @@ int main(int argc, char** argv) {
                   << " instructions per call (whole call, 128-bit arithmetic and libgcc helpers"
                      " included)\n";
     }
+    // The whole device: phases (n, S) and (2n, S) of the same axis count; their difference is
+    // S n steady ticks of MotionDevice::tick and the driver loop's check per tick.
+    std::map<unsigned, std::vector<Phase>> device_phases;
+    for (const Phase& p : phases) {
+        if (p.kind == "device") device_phases[p.axes].push_back(p);
+    }
+    for (const auto& [axes, list] : device_phases) {
+        if (list.size() != 2 || list[1].n != 2 * list[0].n || list[1].spans != list[0].spans) {
+            fail("device phases are not (n, S) and (2n, S)");
+            continue;
+        }
+        const double per_tick = (delta(list[1], 0) - delta(list[0], 0)) /
+                                static_cast<double>(list[0].spans * list[0].n);
+        const double whole = delta(list[0], 0) / static_cast<double>(list[0].ticks);
+        std::cout << "MotionDevice<" << axes << ", 16>::tick in steady state, narrow spans n = "
+                  << list[0].n << ": " << fmt(per_tick) << " instructions per tick ("
+                  << fmt(per_tick / axes) << " per axis; the status publication, the mailbox"
+                     " reads and SetpointStream::tick included); whole run with batches decoded"
+                     " and checked: "
+                  << fmt(whole) << " per tick\n";
+    }
     if (o.legend) std::cout << "\nColumns (docs/cortex-m.md):\n"
                  "- tick() per tick: steady state, instructions executed inside tick() (and"
                  " tick_slow for wide spans) per tick, from two runs with the same spans and n vs"

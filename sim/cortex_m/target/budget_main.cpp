@@ -21,6 +21,8 @@
 #include <cstdint>
 #include <new>
 
+#include "pathstream/device/motion_device.hpp"
+#include "pathstream/device/wire_span.hpp"
 #include "pathstream/setpoint_stream.hpp"
 #include "pathstream/tick_cubic.hpp"
 #include "semihosting.hpp"
@@ -36,8 +38,13 @@ constexpr std::uint32_t kCapacity = 16;
 template <unsigned A>
 using Stream = pathstream::SetpointStream<A, kCapacity>;
 
-// One stream at a time lives here (the micro:bit has 16 KiB of RAM).
-alignas(8) unsigned char g_arena[sizeof(Stream<8>)];
+template <unsigned A>
+using Device = pathstream::device::MotionDevice<A, kCapacity>;
+
+// One stream or device at a time lives here (the micro:bit has 16 KiB of RAM).
+constexpr std::size_t kArenaBytes =
+    sizeof(Stream<8>) > sizeof(Device<2>) ? sizeof(Stream<8>) : sizeof(Device<2>);
+alignas(8) unsigned char g_arena[kArenaBytes];
 Lsb g_out[8];
 bool g_failed = false;
 
@@ -240,6 +247,59 @@ void stream_phases(pathstream::workload::SplitMix64& rng) {
     report_phase("horner", 1, n, 1, 0, calls, ok);
 }
 
+/// The whole device: MotionDevice<A, 16> (task side and tick side) runs one straight move of
+/// `spans` spans of `n` ticks at 4 LSB per tick on every axis: one span accelerating from rest,
+/// cruising spans, one span braking to rest, sent as wire batches of up to 8 whenever 8 slots
+/// are free (a bus task would), the device ticked until it rests at the end. The phases
+/// (n, S) and (2n, S) send the same number of batches, so their difference is S n ticks of
+/// MotionDevice::tick in steady state (the status publication and the mailbox reads
+/// included) plus the driver loop's free-slot check per tick. Total instructions, no ranges.
+template <unsigned A>
+[[gnu::noinline]] void device_phase(std::uint32_t n, std::uint32_t spans) {
+    namespace dev = pathstream::device;
+    const Lsb start[A] = {};
+    budget_mark(2 * g_phase);
+    Device<A>& d = *new (g_arena) Device<A>(start);
+    dev::MotionLimits<A> limits;
+    limits.tick_hz = 1000;
+    for (unsigned a = 0; a < A; ++a) limits.axis[a] = {1000000, 100000000};
+    bool ok = d.configure(limits) == Status::kOk;
+    constexpr std::int32_t kVelocity = 4;  // LSB per tick
+    const auto span_ticks = static_cast<std::int32_t>(n);
+    std::int32_t position = 0;
+    std::uint32_t sent = 0;
+    auto send_batch = [&](std::uint32_t count) {
+        std::uint8_t bytes[8 * (4 + 12 * A)];
+        std::size_t length = 0;
+        for (std::uint32_t i = 0; i < count; ++i, ++sent) {
+            dev::WireSpan w;
+            w.ticks = n;
+            const bool first = sent == 0, last = sent + 1 == spans;
+            const std::int32_t cruise = kVelocity * span_ticks;
+            const std::int32_t t0 = first ? 0 : cruise, t1 = last ? 0 : cruise;
+            position += first || last ? cruise / 2 : cruise;  // a parabola from or to rest
+            for (unsigned a = 0; a < A; ++a) {
+                w.end[a] = position;
+                w.start_tangent[a] = t0;
+                w.end_tangent[a] = t1;
+            }
+            length += dev::encode_wire_span(w, A, bytes + length, sizeof bytes - length);
+        }
+        ok &= d.accept_batch(sent - count + 1, static_cast<std::uint16_t>(count), bytes, length) ==
+              Status::kOk;
+    };
+    send_batch(8);
+    ok &= d.command(dev::Command::kStart) == Status::kOk;
+    const std::uint64_t ticks = std::uint64_t{spans} * n;
+    for (std::uint64_t t = 0; t < ticks; ++t) {
+        d.tick(reinterpret_cast<Lsb(&)[A]>(g_out));
+        if (sent < spans && d.free_slots() >= 8) send_batch(spans - sent < 8 ? spans - sent : 8);
+    }
+    budget_mark(2 * g_phase + 1);
+    ok &= d.ticks_executed() == ticks && d.queued_spans() == 0 && sent == spans;
+    report_phase("device", A, n, spans, ticks, 0, ok);
+}
+
 [[gnu::noinline]] void calibration_phase(std::uint32_t iterations) {
     budget_mark(2 * g_phase);
     budget_calibrate(iterations);
@@ -260,6 +320,8 @@ int main() {
     stream_phases<8>(rng);
     horner_phase(rng, 64, 64);      // |Q| < 2^64: one 64-bit division
     horner_phase(rng, 65536, 64);   // |Q| >= 2^64: the bit-serial 128/64 division
+    device_phase<2>(60, 32);
+    device_phase<2>(120, 32);
     cortex_m::Line line;
     line.text("budget done phases=").dec(g_phase).text(g_failed ? " FAILED" : " ok").end();
     return g_failed ? 1 : 0;

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <atomic>
+#include <cstddef>
 #include <cstdint>
 
 #include "pathstream/device/device_state.hpp"
@@ -15,22 +16,24 @@
 namespace pathstream::device {
 
 /// A value of `T` (32-bit words only) published by one writer and read whole by any reader:
-/// two slots, each a sequence lock. The writer fills the slot readers are not directed to
-/// (its sequence odd while it writes), then directs readers to it; a reader copies the slot it
-/// is directed to and retries only if the writer came back to that same slot meanwhile, i.e.
-/// if its copy took longer than a whole publication period. The writer never waits. On a
-/// single-core MCU the writer is the tick interrupt, so a reader retries at most once per
-/// tick that interrupts its copy; on a host, a writer publishing flat out does not starve it.
+/// one sequence lock. The writer makes the sequence odd, stores the words, makes it even; a
+/// reader copies the words between two loads of an even, unchanged sequence, else retries.
+/// publish() stores only the first `HotWords` words when told the others did not change since
+/// the last publish(): what a tick changes on every tick sits first in `T`, so the tick pays
+/// for the rest only on the ticks that change it. The writer never waits. On a single-core
+/// MCU the writer is the tick interrupt and a reader retries at most once per tick that
+/// interrupts its copy.
 ///
-/// Ordering: the classic sequence lock, one release fence after the odd sequence and one
-/// acquire fence after the word loads, the words themselves relaxed (on Cortex-M: two DMBs
-/// per publish instead of one per word). ThreadSanitizer does not model standalone fences
-/// (GCC refuses them under -fsanitize=thread), so a ThreadSanitizer build orders every word
-/// itself instead (release stores, acquire loads): the same guarantee, checked by the tool.
-template <typename T>
+/// Ordering: one release fence after the odd sequence and one acquire fence after the word
+/// loads, the words themselves relaxed (on Cortex-M: one DMB per publish instead of one per
+/// word). ThreadSanitizer does not model standalone fences (GCC refuses them under
+/// -fsanitize=thread), so a ThreadSanitizer build orders every word itself instead (release
+/// stores, acquire loads): the same guarantee, checked by the tool.
+template <typename T, unsigned HotWords>
 class StatusBoard {
     static_assert(sizeof(T) % sizeof(std::uint32_t) == 0, "32-bit words only");
     static constexpr unsigned kWords = sizeof(T) / sizeof(std::uint32_t);
+    static_assert(HotWords <= kWords, "hot words are a prefix of T");
 #if defined(__SANITIZE_THREAD__)
     static constexpr bool kWordOrdered = true;
 #else
@@ -42,20 +45,24 @@ class StatusBoard {
         kWordOrdered ? std::memory_order_acquire : std::memory_order_relaxed;
 
 public:
-    /// Writer only (one context). Cost: three control stores, kWords stores, one fence.
-    void publish(const T& value) {
-        std::uint32_t words[kWords];
-        __builtin_memcpy(words, &value, sizeof words);
-        const std::uint32_t index = 1u - latest_.load(std::memory_order_relaxed);
-        Slot& slot = slots_[index];
-        const std::uint32_t sequence = slot.sequence.load(std::memory_order_relaxed);
-        slot.sequence.store(sequence + 1, std::memory_order_relaxed);
+    /// Writer only (one context). `all`: store every word; otherwise only the first HotWords
+    /// (the caller guarantees the rest equal the last publish()). Cost: two sequence stores,
+    /// one fence, HotWords (or all) word loads and stores.
+    void publish(const T& value, bool all) {
+        // Word-aligned (T is made of 32-bit words): whole-word loads, also on ARMv6-M.
+        const auto* bytes = static_cast<const unsigned char*>(
+            __builtin_assume_aligned(static_cast<const void*>(&value), alignof(std::uint32_t)));
+        const std::uint32_t sequence = sequence_.load(std::memory_order_relaxed);
+        sequence_.store(sequence + 1, std::memory_order_relaxed);
         // A reader that sees any word of this publish() also sees the odd sequence stored
         // before it, and retries.
         if constexpr (!kWordOrdered) std::atomic_thread_fence(std::memory_order_release);
-        for (unsigned i = 0; i < kWords; ++i) slot.words[i].store(words[i], kWordStore);
-        slot.sequence.store(sequence + 2, std::memory_order_release);
-        latest_.store(index, std::memory_order_release);
+        if (all) {
+            store_words<kWords>(bytes);
+        } else {
+            store_words<HotWords>(bytes);  // a constant count: unrolled, no loop per word
+        }
+        sequence_.store(sequence + 2, std::memory_order_release);
     }
 
     /// Any context that cannot preempt the writer (it would spin while the writer it
@@ -64,13 +71,12 @@ public:
     T read() const {
         std::uint32_t words[kWords];
         for (;;) {
-            const Slot& slot = slots_[latest_.load(std::memory_order_acquire)];
-            const std::uint32_t before = slot.sequence.load(std::memory_order_acquire);
+            const std::uint32_t before = sequence_.load(std::memory_order_acquire);
             if ((before & 1u) != 0) continue;
-            for (unsigned i = 0; i < kWords; ++i) words[i] = slot.words[i].load(kWordLoad);
+            for (unsigned i = 0; i < kWords; ++i) words[i] = words_[i].load(kWordLoad);
             // Keeps the second sequence load after every word load.
             if constexpr (!kWordOrdered) std::atomic_thread_fence(std::memory_order_acquire);
-            if (slot.sequence.load(std::memory_order_relaxed) == before) break;
+            if (sequence_.load(std::memory_order_relaxed) == before) break;
         }
         T value;
         __builtin_memcpy(&value, words, sizeof words);
@@ -78,12 +84,18 @@ public:
     }
 
 private:
-    struct Slot {
-        std::atomic<std::uint32_t> sequence{0};  // written by the writer only; odd while writing
-        std::atomic<std::uint32_t> words[kWords] = {};
-    };
-    Slot slots_[2];
-    std::atomic<std::uint32_t> latest_{0};  // the slot of the last complete publish()
+    template <unsigned Count>
+    void store_words(const unsigned char* bytes) {
+#pragma GCC unroll 32
+        for (unsigned i = 0; i < Count; ++i) {
+            std::uint32_t word;
+            __builtin_memcpy(&word, bytes + i * sizeof word, sizeof word);
+            words_[i].store(word, kWordStore);
+        }
+    }
+
+    std::atomic<std::uint32_t> sequence_{0};  // written by the writer only; odd while writing
+    std::atomic<std::uint32_t> words_[kWords] = {};
 };
 
 /// Requests to the tick. Who writes each field and when is part of its contract.
@@ -122,14 +134,17 @@ struct DeviceChannel {
     explicit DeviceChannel(const Lsb (&start)[Axes]) : queue(start) {
         DeviceStatus<Axes> s;
         for (unsigned a = 0; a < Axes; ++a) s.origin[a] = s.position[a] = start[a];
-        board.publish(s);
+        board.publish(s, true);
     }
 
     /// Spans with their stamps (epoch, job, end tangent). Producer: task; consumer: tick.
     SetpointStream<Axes, Capacity> queue;
     DeviceMailbox<Axes> mailbox;
     /// The tick's status, published once per tick.
-    StatusBoard<DeviceStatus<Axes>> board;
+    StatusBoard<DeviceStatus<Axes>, DeviceStatus<Axes>::kHotWords> board;
+    static_assert(offsetof(DeviceStatus<Axes>, tick_check) ==
+                      (DeviceStatus<Axes>::kHotWords - 1) * sizeof(std::uint32_t),
+                  "the hot words end at tick_check");
 };
 
 }  // namespace pathstream::device

@@ -39,7 +39,10 @@ public:
     /// few thousand instructions per axis). Tick interrupt context.
     void tick(Lsb (&out)[Axes]) {
         SetpointStream<Axes, Capacity>& queue = channel_.queue;
-        apply_requests();
+        // In the middle of a span, with no request taken, a tick changes only the status's hot
+        // words (position, counters): it publishes only those.
+        const bool mid_span = motion_ == Motion::kStream && !queue.between_spans();
+        const bool took_request = apply_requests();
         // A generated move whose last tick was output ends here, so the tick that outputs its
         // end point already carries the state it leads to (idle only once at rest).
         if (motion_ == Motion::kGenerated && generated_.between_spans() &&
@@ -81,7 +84,7 @@ public:
                 break;
         }
         for (unsigned a = 0; a < Axes; ++a) position_[a] = out[a];
-        publish(path);
+        publish(path, !mid_span || took_request);
     }
 
 private:
@@ -107,7 +110,8 @@ private:
                              : (status_.flags & ~kStatusHeldByUnderrun);
     }
 
-    void publish(bool path) {
+    // `all`: this tick may have changed words after the hot ones.
+    void publish(bool path, bool all) {
         status_.tick_count = status_.tick_count + 1u;
         status_.tick_check = status_.tick_count;
         for (unsigned a = 0; a < Axes; ++a) status_.position[a] = position_[a];
@@ -120,10 +124,26 @@ private:
         status_.generated_ticks_low = static_cast<std::uint32_t>(generated_ticks_);
         status_.generated_ticks_high = static_cast<std::uint32_t>(generated_ticks_ >> 32);
         status_.last_completed_sequence = channel_.queue.last_completed_tag();
-        channel_.board.publish(status_);
+        channel_.board.publish(status_, all);
     }
 
-    void apply_requests() {
+    // Takes the mailbox's new requests; true when it took one (the status then changed beyond
+    // its hot words). Most ticks find none: four relaxed loads decide that without a barrier;
+    // take_requests() loads again with acquire before it reads what a request carries.
+    bool apply_requests() {
+        const DeviceMailbox<Axes>& m = channel_.mailbox;
+        const std::uint32_t command = m.command.load(std::memory_order_relaxed);
+        const std::uint32_t estop = m.estop.load(std::memory_order_relaxed);
+        const std::uint32_t fault = m.fault.load(std::memory_order_relaxed);
+        const std::uint32_t position = m.position_request.load(std::memory_order_relaxed);
+        if (command == status_.command_applied && position == status_.position_applied &&
+            (estop | fault) == 0) {
+            return false;
+        }
+        return take_requests();
+    }
+
+    bool take_requests() {
         DeviceMailbox<Axes>& m = channel_.mailbox;
         // The command word first: its acquire makes everything the task side wrote before
         // posting it (configuration, spans) visible to the rest of this tick.
@@ -134,16 +154,16 @@ private:
         if (estop && s != DeviceState::kEstop) {
             stop_at_once();
             set_state(DeviceState::kEstop);
-            return;
+            return true;
         }
         if (fault != 0 && s != DeviceState::kFault && s != DeviceState::kEstop) {
             stop_at_once();
             status_.fault_code = fault;
             set_state(DeviceState::kFault);
-            return;
+            return true;
         }
-        apply_position_request(s);
-        if (command == status_.command_applied) return;
+        const bool position = apply_position_request(s);
+        if (command == status_.command_applied) return position;
         status_.command_applied = command;
         switch (static_cast<Command>(command & 0xFFu)) {
             case Command::kStart:
@@ -191,19 +211,22 @@ private:
             default:
                 break;  // the task side refuses every other value before posting
         }
+        return true;
     }
 
     // set_position: taken only while idle at rest (a start in the same tick comes after it);
     // in any other state it is dropped (the task sees it applied either way).
-    void apply_position_request(DeviceState s) {
+    // True when it took a request.
+    bool apply_position_request(DeviceState s) {
         DeviceMailbox<Axes>& m = channel_.mailbox;
         const std::uint32_t request = m.position_request.load(std::memory_order_acquire);
-        if (request == status_.position_applied) return;
+        if (request == status_.position_applied) return false;
         if (s == DeviceState::kIdle && motion_ == Motion::kRest) {
             for (unsigned a = 0; a < Axes; ++a) position_[a] = rest_[a] = m.position[a];
             drop_queue();
         }
         status_.position_applied = request;
+        return true;
     }
 
     // Every queue drop: the queue emptied, a new epoch whose chain starts at the rest point.
@@ -384,9 +407,9 @@ private:
         }
     }
 
+    // The per-tick fields first, at small offsets (ARMv6-M loads and stores reach 124 bytes).
     DeviceChannel<Axes, Capacity>& channel_;
-    SetpointStream<Axes, 2> generated_;  // the device's own stop and re-entry spans
-    DeviceStatus<Axes> status_;          // published by every tick
+    DeviceStatus<Axes> status_;  // published by every tick
     DeviceState state_ = DeviceState::kIdle;
     Motion motion_ = Motion::kRest;
     Generated generated_kind_ = Generated::kNone;
@@ -405,6 +428,7 @@ private:
     Lsb boundary_[Axes] = {};
     std::int32_t boundary_tangent_[Axes] = {};
     std::uint32_t boundary_ticks_ = 1;
+    SetpointStream<Axes, 2> generated_;  // the device's own stop and re-entry spans
 };
 
 }  // namespace pathstream::device

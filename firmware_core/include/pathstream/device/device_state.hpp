@@ -59,30 +59,37 @@ inline constexpr std::uint32_t kStatusPathTick = 1u << 1;     ///< the last tick
 /// publishing is a word copy (no 64-bit access, which would tear on a 32-bit MCU).
 template <unsigned Axes>
 struct DeviceStatus {
+    // Words a path tick changes: first, so that the tick publishes only these on a tick in
+    // the middle of a span (StatusBoard's hot prefix, kHotWords).
     std::uint32_t tick_count = 0;  ///< ticks run since construction (wraps); == tick_check
-    std::uint32_t state = 0;       ///< DeviceState
-    /// FaultCode: kNone until a fault; kept through an e-stop that follows it; a reset clears it.
-    std::uint32_t fault_code = 0;
     std::uint32_t flags = 0;       ///< kStatusHeldByUnderrun, kStatusPathTick
     std::uint32_t outputs = 0;     ///< discrete outputs the last tick drove (kOutputPenDown)
+    Lsb position[Axes] = {};       ///< setpoints the last tick output
+    std::uint32_t ticks_executed_low = 0;  ///< path ticks executed (64 bits in two words)
+    std::uint32_t ticks_executed_high = 0;
+    std::uint32_t last_completed_sequence = 0;  ///< sequence of the last span executed to its end
+    std::uint32_t tick_check = 0;               ///< == tick_count: a torn copy would differ
+    // Words that change only on a tick that changes the state, the queue, the job or applies
+    // a request (every word after the hot ones).
+    std::uint32_t state = 0;  ///< DeviceState
+    /// FaultCode: kNone until a fault; kept through an e-stop that follows it; a reset clears it.
+    std::uint32_t fault_code = 0;
     /// Advanced by every queue drop (stop, e-stop, fault, reset, set position); spans stamped
     /// with an older epoch are never executed.
     std::uint32_t epoch = 0;
-    Lsb origin[Axes] = {};                 ///< where the first span of this epoch must start
-    Lsb position[Axes] = {};               ///< setpoints the last tick output
-    std::uint32_t ticks_executed_low = 0;  ///< path ticks executed (64 bits in two words)
-    std::uint32_t ticks_executed_high = 0;
+    Lsb origin[Axes] = {};                  ///< where the first span of this epoch must start
     std::uint32_t generated_ticks_low = 0;  ///< ticks of the device's own stop and re-entry moves
     std::uint32_t generated_ticks_high = 0;
-    std::uint32_t underruns = 0;                ///< controlled stops because the queue ran dry
-    std::uint32_t last_completed_sequence = 0;  ///< sequence of the last span executed to its end
+    std::uint32_t underruns = 0;           ///< controlled stops because the queue ran dry
     std::uint32_t job = 0;                 ///< job of the span in progress or last played (0: none)
     std::uint32_t span_epoch = 0;          ///< epoch stamp of the span in progress or last played
     std::uint32_t finished_job = 0;        ///< id of the last job run to its end (0: none yet)
     std::uint32_t finished_job_ticks = 0;  ///< path ticks that job executed (low 32 bits)
     std::uint32_t command_applied = 0;     ///< last command word the tick took from the mailbox
     std::uint32_t position_applied = 0;    ///< last set_position request the tick took
-    std::uint32_t tick_check = 0;          ///< == tick_count: a torn copy would differ
+
+    /// Words from tick_count to tick_check: the ones a tick in the middle of a span changes.
+    static constexpr unsigned kHotWords = 7 + Axes;
 
     DeviceState device_state() const { return static_cast<DeviceState>(state); }
     FaultCode fault() const { return static_cast<FaultCode>(fault_code); }
