@@ -3,7 +3,7 @@
 #include <cmath>
 #include <stdexcept>
 
-#include "pathstream/host/planner.hpp"
+#include "pathstream/host/machine.hpp"
 
 namespace pathstream::host {
 namespace {

@@ -205,4 +205,9 @@ MachineProfile load_machine_profile(const std::string& file) {
     return parse_machine_profile(buffer.str(), file);
 }
 
+std::uint64_t delay_ticks(double seconds, double tick_hz) {
+    if (!(seconds > 0)) return 0;
+    return static_cast<std::uint64_t>(std::ceil(seconds * tick_hz - 1e-9));
+}
+
 }  // namespace pathstream::host

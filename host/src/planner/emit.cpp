@@ -144,12 +144,3 @@ Plan emit_plan(const PathGrid& g, const std::vector<PieceMotion>& motion, const 
 }
 
 }  // namespace pathstream::host::planner_detail
-
-namespace pathstream::host {
-
-std::uint64_t delay_ticks(double seconds, double tick_hz) {
-    if (!(seconds > 0)) return 0;
-    return static_cast<std::uint64_t>(std::ceil(seconds * tick_hz - 1e-9));
-}
-
-}  // namespace pathstream::host

@@ -74,4 +74,9 @@ MachineProfile parse_machine_profile(const std::string& text, const std::string&
 /// Reads and parses a machine profile file. Throws InputError.
 MachineProfile load_machine_profile(const std::string& file);
 
+/// Ticks the planner dwells for a pen delay of `seconds`: ceil(seconds * tick_hz), ignoring
+/// floating-point noise below 1e-9 tick. The device's pen-down delay comes from the same
+/// rounding (device_setup.hpp), so it lives with the profile rather than with the planner.
+std::uint64_t delay_ticks(double seconds, double tick_hz);
+
 }  // namespace pathstream::host

@@ -93,8 +93,4 @@ Plan plan_path(const std::vector<BezierSegment>& segments, const MachineProfile&
 PlanCheck check_plan(const Plan& plan, const std::vector<BezierSegment>& segments,
                      const MachineProfile& profile);
 
-/// Ticks the planner dwells for a pen delay of `seconds`: ceil(seconds * tick_hz), ignoring
-/// floating-point noise below 1e-9 tick.
-std::uint64_t delay_ticks(double seconds, double tick_hz);
-
 }  // namespace pathstream::host
