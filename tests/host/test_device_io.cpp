@@ -12,8 +12,8 @@
 #include "pathstream/device/motion_device.hpp"
 #include "pathstream/host/device_setup.hpp"
 #include "pathstream/host/machine.hpp"
+#include "pathstream/linux_device/machine_homing.hpp"
 #include "pathstream/sim/can_device.hpp"
-#include "pathstream/sim/machine_homing.hpp"
 #include "pathstream/sim/modbus_device.hpp"
 #include "pathstream/sim/simulated_input.hpp"
 #include "pathstream/sim/simulated_output.hpp"
@@ -70,7 +70,7 @@ struct Machine {
         }
     }
 
-    sim::RunTicksUntil run_until(std::uint64_t max_ticks) {
+    linux_device::RunTicksUntil run_until(std::uint64_t max_ticks) {
         return [this, max_ticks](const std::function<bool()>& done) {
             for (std::uint64_t k = 0; k < max_ticks; ++k) {
                 if (done()) return true;
@@ -159,7 +159,7 @@ TEST_CASE("device io: homing x then y from the profile, pulled off the switches"
         std::vector<std::string> log;
         bool enable_seen = false;
         auto run = m.run_until(400000);
-        const auto homed = sim::home_axes(*m.dev, *m.io, host::homing_setups(p), p.mm_per_lsb,
+        const auto homed = linux_device::home_axes(*m.dev, *m.io, host::homing_setups(p), p.mm_per_lsb,
                                           [&](const std::function<bool()>& done) {
                                               return run([&] {
                                                   enable_seen = enable_seen || m.enable.state();
@@ -209,7 +209,7 @@ TEST_CASE("device io: homing errors name the axis, the switch and the reason", "
         Machine m(modbus_device(25000, 0));
         start(m);
         m.x_switch = -100000;
-        CHECK_THROWS_WITH(sim::home_axes(*m.dev, *m.io, host::homing_setups(p), p.mm_per_lsb, m.run_until(400000), quiet),
+        CHECK_THROWS_WITH(linux_device::home_axes(*m.dev, *m.io, host::homing_setups(p), p.mm_per_lsb, m.run_until(400000), quiet),
                           "homing x: switch x- not found within 40.000 mm (max_travel)");
         CHECK(m.dev->state() == static_cast<std::uint8_t>(DeviceState::kIdle));
         CHECK(m.dev->position(0) == 25000 - 40000);
@@ -218,7 +218,7 @@ TEST_CASE("device io: homing errors name the axis, the switch and the reason", "
         Machine m(modbus_device(25000, 0));
         start(m);
         m.x_switch = 1000000;
-        CHECK_THROWS_WITH(sim::home_axes(*m.dev, *m.io, host::homing_setups(p), p.mm_per_lsb, m.run_until(400000), quiet),
+        CHECK_THROWS_WITH(linux_device::home_axes(*m.dev, *m.io, host::homing_setups(p), p.mm_per_lsb, m.run_until(400000), quiet),
                           Catch::StartsWith("homing x: switch x- still active after moving off it"));
     }
     SECTION("the e-stop during homing") {
@@ -226,7 +226,7 @@ TEST_CASE("device io: homing errors name the axis, the switch and the reason", "
         start(m);
         std::uint64_t ticks = 0;
         auto run = m.run_until(400000);
-        CHECK_THROWS_WITH(sim::home_axes(*m.dev, *m.io, host::homing_setups(p), p.mm_per_lsb,
+        CHECK_THROWS_WITH(linux_device::home_axes(*m.dev, *m.io, host::homing_setups(p), p.mm_per_lsb,
                                          [&](const std::function<bool()>& done) {
                                              return run([&] {
                                                  if (++ticks == 200) m.estop.drive(true);
@@ -241,13 +241,13 @@ TEST_CASE("device io: homing errors name the axis, the switch and the reason", "
         Machine m(modbus_device(25000, 0));
         m.wiring.limit[0][0] = nullptr;
         start(m);
-        CHECK_THROWS_WITH(sim::home_axes(*m.dev, *m.io, host::homing_setups(p), p.mm_per_lsb, m.run_until(1000), quiet),
+        CHECK_THROWS_WITH(linux_device::home_axes(*m.dev, *m.io, host::homing_setups(p), p.mm_per_lsb, m.run_until(1000), quiet),
                           "homing x: switch x- is not wired");
     }
     SECTION("an unconfigured device") {
         Machine m(modbus_device(25000, 0));
         m.io = &m.dev->attach_io(m.wiring);
-        CHECK_THROWS_WITH(sim::home_axes(*m.dev, *m.io, host::homing_setups(p), p.mm_per_lsb, m.run_until(1000), quiet),
+        CHECK_THROWS_WITH(linux_device::home_axes(*m.dev, *m.io, host::homing_setups(p), p.mm_per_lsb, m.run_until(1000), quiet),
                           "homing x: the device refused a homing step: device limits not configured");
     }
 }

@@ -15,9 +15,9 @@
 #include "pathstream/host/device_setup.hpp"
 #include "pathstream/host/machine.hpp"
 #include "pathstream/host/modbus_stream.hpp"
+#include "pathstream/linux_device/machine_homing.hpp"
+#include "pathstream/linux_device/machine_lines.hpp"
 #include "pathstream/sim/can_device.hpp"
-#include "pathstream/sim/machine_homing.hpp"
-#include "pathstream/sim/machine_lines.hpp"
 #include "pathstream/sim/modbus_device.hpp"
 
 namespace pathstream::host {
@@ -92,8 +92,8 @@ void home(sim::SimulatedMotionDevice& device, sim::DeviceIo& io, const MachinePr
     };
     const auto log = [](const std::string& line) { std::cout << "pathstream device: " << line << std::endl; };
     try {
-        (void)sim::home_axes(device, io, homing_setups(profile), profile.mm_per_lsb, run_until, log);
-    } catch (const sim::HomingFailed& e) {
+        (void)linux_device::home_axes(device, io, homing_setups(profile), profile.mm_per_lsb, run_until, log);
+    } catch (const linux_device::HomingFailed& e) {
         throw StreamError(e.what());
     }
 }
@@ -101,7 +101,7 @@ void home(sim::SimulatedMotionDevice& device, sim::DeviceIo& io, const MachinePr
 // Configuration, GPIO and homing from the profile, shared by every transport.
 struct Machine {
     std::optional<MachineProfile> profile;
-    std::optional<sim::MachineLines> lines;
+    std::optional<linux_device::MachineLines> lines;
     sim::DeviceIo* io = nullptr;
 };
 
@@ -121,7 +121,7 @@ Machine prepare_machine(sim::SimulatedMotionDevice& device, const DeviceCommandO
     }
     std::cout << std::endl;
     if (profile->gpio.present && !o.no_gpio) {
-        m.lines.emplace(sim::MachineLines::open(*profile));
+        m.lines.emplace(linux_device::MachineLines::open(*profile));
         m.io = &device.attach_io(m.lines->wiring());
         std::cout << "pathstream device: GPIO " << m.lines->summary() << std::endl;
     }

@@ -28,8 +28,8 @@
 #include "pathstream/hal/gpio_gpiod.hpp"
 #include "pathstream/host/input_error.hpp"
 #include "pathstream/host/machine.hpp"
+#include "pathstream/linux_device/machine_lines.hpp"
 #include "pathstream/sim/device_gpio.hpp"
-#include "pathstream/sim/machine_lines.hpp"
 
 namespace {
 
@@ -48,7 +48,7 @@ void sleep_until_ns(std::uint64_t t) {
     clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr);
 }
 
-hal::GpioLineSpec spec(const std::string& chip, const host::GpioLineConfig& c) { return sim::line_spec(chip, c); }
+hal::GpioLineSpec spec(const std::string& chip, const host::GpioLineConfig& c) { return linux_device::line_spec(chip, c); }
 
 // The plotter: device, lines, glue, and a feeder that keeps it moving back and forth.
 struct Plotter {

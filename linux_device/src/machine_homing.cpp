@@ -1,11 +1,11 @@
-#include "pathstream/sim/machine_homing.hpp"
+#include "pathstream/linux_device/machine_homing.hpp"
 
 #include <sstream>
 
 #include "pathstream/device/gpio_logic.hpp"
 #include "pathstream/status.hpp"
 
-namespace pathstream::sim {
+namespace pathstream::linux_device {
 namespace {
 
 std::string mm(double lsb, double mm_per_lsb) {
@@ -27,7 +27,7 @@ const char* phase_text(device::HomingPhase p) {
     }
 }
 
-std::string failure(const SimulatedMotionDevice& d, const DeviceIo& io, const host::HomingSetup& s, double q) {
+std::string failure(const sim::SimulatedMotionDevice& d, const sim::DeviceIo& io, const host::HomingSetup& s, double q) {
     const device::HomingConfig& c = s.config;
     std::string why;
     switch (io.homing_error()) {
@@ -60,7 +60,7 @@ std::string failure(const SimulatedMotionDevice& d, const DeviceIo& io, const ho
 
 }  // namespace
 
-std::vector<HomedAxis> home_axes(SimulatedMotionDevice& device, DeviceIo& io, const std::vector<host::HomingSetup>& setups,
+std::vector<HomedAxis> home_axes(sim::SimulatedMotionDevice& device, sim::DeviceIo& io, const std::vector<host::HomingSetup>& setups,
                                  double mm_per_lsb, const RunTicksUntil& run_until, const HomingLog& log) {
     std::vector<HomedAxis> homed;
     for (const host::HomingSetup& s : setups) {
@@ -100,4 +100,4 @@ std::vector<HomedAxis> home_axes(SimulatedMotionDevice& device, DeviceIo& io, co
     return homed;
 }
 
-}  // namespace pathstream::sim
+}  // namespace pathstream::linux_device

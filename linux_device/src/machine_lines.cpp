@@ -1,10 +1,10 @@
-#include "pathstream/sim/machine_lines.hpp"
+#include "pathstream/linux_device/machine_lines.hpp"
 
 #include <stdexcept>
 
 #include "pathstream/host/device_setup.hpp"
 
-namespace pathstream::sim {
+namespace pathstream::linux_device {
 
 hal::GpioLineSpec line_spec(const std::string& chip, const host::GpioLineConfig& line) {
     hal::GpioLineSpec s;
@@ -62,4 +62,4 @@ MachineLines MachineLines::open(const host::MachineProfile& profile) {
     return m;
 }
 
-}  // namespace pathstream::sim
+}  // namespace pathstream::linux_device

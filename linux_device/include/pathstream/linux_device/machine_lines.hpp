@@ -12,7 +12,7 @@
 #include "pathstream/host/machine.hpp"
 #include "pathstream/sim/device_io.hpp"
 
-namespace pathstream::sim {
+namespace pathstream::linux_device {
 
 /// The libgpiod request for one profile line (chip from the gpio object).
 hal::GpioLineSpec line_spec(const std::string& chip, const host::GpioLineConfig& line);
@@ -34,7 +34,7 @@ public:
     ~MachineLines();
 
     /// Pointers into the owned lines; valid while this object lives.
-    const MachineWiring& wiring() const { return wiring_; }
+    const sim::MachineWiring& wiring() const { return wiring_; }
     /// "enable=enable estop=estop pen=0 x-=limit-x ..." on chip: what was opened, for the log.
     const std::string& summary() const { return summary_; }
 
@@ -42,8 +42,8 @@ private:
     MachineLines() = default;
     std::vector<std::unique_ptr<hal::DigitalInput>> inputs_;
     std::vector<std::unique_ptr<hal::DigitalOutput>> outputs_;
-    MachineWiring wiring_;
+    sim::MachineWiring wiring_;
     std::string summary_;
 };
 
-}  // namespace pathstream::sim
+}  // namespace pathstream::linux_device

@@ -1,4 +1,4 @@
-// Homing a simulated device's axes one after another through its DeviceIo (docs/gpio.md):
+// Homing a device's axes one after another through its DeviceIo (docs/gpio.md):
 // what `pathstream device --machine M --home` runs before it serves. The caller owns the
 // ticking (paced in real time by the CLI, as fast as possible with simulated switches in tests).
 #pragma once
@@ -12,7 +12,7 @@
 #include "pathstream/sim/device_io.hpp"
 #include "pathstream/sim/simulated_motion_device.hpp"
 
-namespace pathstream::sim {
+namespace pathstream::linux_device {
 
 /// Homing ended in an error; what() names the axis, the switch and the reason:
 /// "homing x: switch x- not found within 300 mm (max_travel)".
@@ -37,7 +37,7 @@ using HomingLog = std::function<void(const std::string& line)>;
 
 /// Homes `setups` in order. `device` must be configured and idle, `io` attached to it.
 /// Throws HomingFailed (with the device stopped: idle, or in fault/e-stop if that ended it).
-std::vector<HomedAxis> home_axes(SimulatedMotionDevice& device, DeviceIo& io, const std::vector<host::HomingSetup>& setups,
+std::vector<HomedAxis> home_axes(sim::SimulatedMotionDevice& device, sim::DeviceIo& io, const std::vector<host::HomingSetup>& setups,
                                  double mm_per_lsb, const RunTicksUntil& run_until, const HomingLog& log);
 
-}  // namespace pathstream::sim
+}  // namespace pathstream::linux_device
