@@ -11,6 +11,7 @@
 #include "pathstream/host/input_error.hpp"
 #include "pathstream/host/planner.hpp"
 #include "cli/check_command.hpp"
+#include "cli/ctl_command.hpp"
 #include "cli/device_command.hpp"
 #include "cli/drive_command.hpp"
 #include "cli/eval_command.hpp"
@@ -50,6 +51,8 @@ int main(int argc, char** argv) {
     pathstream::host::add_device_command(app, device);
     pathstream::host::DriveCommandOptions drive;
     pathstream::host::add_drive_command(app, drive);
+    pathstream::host::CtlCommandOptions ctl;
+    pathstream::host::add_ctl_command(app, ctl);
 
     try {
         app.parse(argc, argv);
@@ -71,6 +74,7 @@ int main(int argc, char** argv) {
         if (app.got_subcommand("stream")) return pathstream::host::run_stream(stream);
         if (app.got_subcommand("device")) return pathstream::host::run_device(device);
         if (app.got_subcommand("drive")) return pathstream::host::run_drive(drive);
+        if (app.got_subcommand("ctl")) return pathstream::host::run_ctl(ctl);
     } catch (const pathstream::host::InputError& e) {
         std::cerr << e.what() << '\n';
         return kExitInput;

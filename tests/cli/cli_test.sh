@@ -71,7 +71,7 @@ expect device-machine 0 "x 250000 LSB/s 3000000 LSB/s^2" -- "$bin" device -m "$g
 expect device-no-chip 6 'gpio no-such-chip line "17": no GPIO chip is named or labelled "no-such-chip"' -- "$bin" device -m "$work/gpio_nochip.json" --tcp 127.0.0.1:0 --exit-after 0.05
 expect device-home-no-gpio 2 'no "gpio" object: --home has no switches' -- "$bin" device -m "$machine" --home --exit-after 0.05
 expect device-home-needs-machine 2 "--home: needs --machine" -- "$bin" device --home
-expect stream-lead-in-can 2 "--lead-in needs a Modbus target" -- "$bin" stream "$src/examples/rose.json" -m "$machine" -t "can://vcan0?node=1" --lead-in
+expect stream-lead-in-can 6 "nosuchcan0: no such interface" -- "$bin" stream "$src/examples/rose.json" -m "$machine" -t "can://nosuchcan0?node=1" --lead-in
 expect device-axes-and-machine 2 "the axis count comes from --machine" -- "$bin" device -m "$machine" --axes 3
 
 echo "cli: $passed passed, $failures failed"

@@ -72,6 +72,13 @@ TEST_CASE("encoders and decoders agree with the declared layout", "[can][dbc]") 
     CHECK((t.state == 2 && t.fault_code == 0x0103 && t.last_accepted == 77 && t.last_completed == 70 &&
            t.ticks_executed == 123456 && t.axes == 4 && t.version == 1));
     CHECK((t.finished_job == 31 && t.finished_job_ticks == 0x01020304u));
+    // Status E: a negative position and the epoch's low 16 bits survive the trip.
+    const pc::Frame e = pc::encode_status_axis(5, 3, -123456789, 0x12345u);
+    CHECK(e.id == 0x585u);
+    REQUIRE(pc::decode_status_part(e, t));
+    CHECK((t.position[3] == -123456789 && t.epoch == 0x2345u));
+    const pc::Frame bad_axis = pc::encode_status_axis(5, 8, 1, 0);
+    CHECK_FALSE(pc::decode_status_part(bad_axis, t));
     const std::uint8_t payload[9] = {1, 2, 3, 4, 5, 6, 7, 8, 9};
     CHECK(pc::data_frames(9) == 2);
     const pc::Frame d1 = pc::encode_span_data(5, 1, payload, 9);

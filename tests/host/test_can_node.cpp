@@ -144,11 +144,16 @@ TEST_CASE("CAN node: configuration needs every item; commands and status answer"
     CHECK(f.last_ack().result == static_cast<std::uint8_t>(Status::kUnknownCommand));
     f.out.clear();
     f.feed(pc::encode_command(5, pc::kCommandStatusRequest));
-    REQUIRE(f.out.size() == pc::kStatusFrames);
+    REQUIRE(f.out.size() == pc::kStatusFrames + 2);  // A to D, then E for axes 0 and 1
     pc::Status3 s;
+    s.position[0] = s.position[1] = -1;
     for (const auto& o : f.out) REQUIRE(pc::decode_status_part(o, s));
     CHECK((s.axes == 2 && s.version == pc::kProtocolVersion &&
            (s.flags & pc::kFlagConfigured) != 0 && s.free_slots == 16));
+    CHECK((pc::function_of(f.out[4].id) == pc::kStatusEBase && f.out[4].data[0] == 0 &&
+           f.out[5].data[0] == 1));
+    CHECK((s.position[0] == f.dev.position(0) && s.position[1] == f.dev.position(1)));
+    CHECK(s.epoch == (f.dev.epoch() & 0xFFFFu));
     f.out.clear();
     f.feed(pc::encode_command(6, pc::kCommandStatusRequest));  // another node
     CHECK(f.out.empty());

@@ -141,6 +141,42 @@ TEST_CASE("two drawings in a row natively over CAN, each ending idle at rest, no
     CHECK(dt.device->refused_batches() == 0);
 }
 
+TEST_CASE("over CAN the host reads where the device rests: a plan elsewhere is refused, a lead-in "
+          "from there streams",
+          "[can][stream][threads]") {
+    const Job job = plan_example("wave.json");
+    const std::vector<Lsb> rest = {start_of(job.plan)[0] + 12345, start_of(job.plan)[1] - 6789};
+    sim::CanLoopback loop;
+    hal::CanBus& device_bus = loop.add_endpoint();
+    hal::CanBus& host_bus = loop.add_endpoint();
+    DeviceThread dt;
+    dt.device = sim::SimulatedCanDevice::create(rest, 5);
+    dt.device->record(true);
+    dt.run(device_bus, 20.0);
+    host::CanStreamOptions o;
+    o.node = 5;
+    o.ack_timeout_ms = 30;
+    CHECK(host::can_rest_position(job.machine, host_bus, o) == rest);
+    std::string message;
+    try {
+        (void)host::stream_can(job.plan, job.machine, host_bus, o);
+    } catch (const host::StreamError& e) {
+        message = e.what();
+    }
+    const std::vector<Lsb> start = start_of(job.plan);
+    const std::string expected = "device rests at " + std::to_string(rest[0]) + " " +
+                                 std::to_string(rest[1]) + " LSB but the plan starts at " +
+                                 std::to_string(start[0]) + " " + std::to_string(start[1]) + " LSB";
+    INFO(message);
+    CHECK(message.find(expected) != std::string::npos);
+    CHECK(dt.device->recorded_setpoints().empty());  // nothing moved
+    const Job led = plan_example_from("wave.json", rest);
+    const host::CanStreamReport r = host::stream_can(led.plan, led.machine, host_bus, o);
+    CHECK(r.ticks_executed == led.plan.total_ticks);
+    dt.join();
+    check_recorded(led.plan, *dt.device, 0);
+}
+
 TEST_CASE("natively over CAN with 1 % of the frames lost, the device still executes every span once",
           "[can][stream][threads]") {
     const Job job = plan_example("wave.json");

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <iostream>
 #include <limits>
+#include <nlohmann/json.hpp>
 
 #include "pathstream/host/geometry.hpp"
 
@@ -13,6 +14,7 @@ namespace pathstream::host {
 void add_check_command(CLI::App& app, CheckOptions& o) {
     CLI::App* cmd = app.add_subcommand("check", "Validate a path file and print a summary: subpaths, spans, length, bounding box");
     add_path_options(*cmd, o.path);
+    cmd->add_flag("--json", o.json, "print the summary as one JSON document on standard output");
 }
 
 namespace {
@@ -63,25 +65,35 @@ void extend_box(const BezierSegment& s, std::vector<double>& lo, std::vector<dou
     }
 }
 
-}  // namespace
+/// What check reports, measured once for the text and the JSON summary alike.
+struct CheckFigures {
+    double drawn = 0, travel = 0;  ///< mm
+    std::size_t drawing_segments = 0, travel_segments = 0;
+    std::vector<double> lo, hi;  ///< bounding box of the drawing, per axis
+};
 
-int run_check(const CheckOptions& o) {
-    const Path path = load_path(o.path);
+/// Lengths, span counts and the drawing's bounding box of the path's cubics.
+CheckFigures measure(const Path& path) {
     const std::vector<BezierSegment> segments = to_bezier_segments(path);
-    double drawn = 0, travel = 0;
-    std::size_t drawing_segments = 0;
-    std::vector<double> lo(path.axes, std::numeric_limits<double>::infinity());
-    std::vector<double> hi(path.axes, -std::numeric_limits<double>::infinity());
+    CheckFigures f;
+    f.lo.assign(path.axes, std::numeric_limits<double>::infinity());
+    f.hi.assign(path.axes, -std::numeric_limits<double>::infinity());
     for (const auto& s : segments) {
         const double length = segment_length(s);
         if (s.pen_down) {
-            drawn += length;
-            ++drawing_segments;
-            extend_box(s, lo, hi);
+            f.drawn += length;
+            ++f.drawing_segments;
+            extend_box(s, f.lo, f.hi);
         } else {
-            travel += length;
+            f.travel += length;
         }
     }
+    f.travel_segments = segments.size() - f.drawing_segments;
+    return f;
+}
+
+/// The human summary (the first 20 subpaths; the rest are counted).
+void print_text(const CheckOptions& o, const Path& path, const CheckFigures& f) {
     std::printf("%s: valid, %zu axes, units %s\n", o.path.file.c_str(), path.axes, path.units.c_str());
     std::printf("  subpaths: %zu\n", path.subpaths.size());
     for (std::size_t i = 0; i < path.subpaths.size() && i < 20; ++i) {
@@ -90,11 +102,59 @@ int run_check(const CheckOptions& o) {
                     sp.points.size(), sp.feed > 0 ? (", feed " + std::to_string(sp.feed) + " mm/s").c_str() : "");
     }
     if (path.subpaths.size() > 20) std::printf("    ... %zu more\n", path.subpaths.size() - 20);
-    std::printf("  spans: %zu drawing, %zu travel\n", drawing_segments, segments.size() - drawing_segments);
-    std::printf("  length: %.3f mm drawn, %.3f mm pen-up travel\n", drawn, travel);
+    std::printf("  spans: %zu drawing, %zu travel\n", f.drawing_segments, f.travel_segments);
+    std::printf("  length: %.3f mm drawn, %.3f mm pen-up travel\n", f.drawn, f.travel);
     std::printf("  bounding box (drawing):");
     for (std::size_t a = 0; a < path.axes; ++a) {
-        std::printf(" %s %.3f .. %.3f mm%s", axis_column_name(a), lo[a], hi[a], a + 1 < path.axes ? "," : "\n");
+        std::printf(" %s %.3f .. %.3f mm%s", axis_column_name(a), f.lo[a], f.hi[a],
+                    a + 1 < path.axes ? "," : "\n");
+    }
+}
+
+/// Every subpath (not only the first 20): basis, closed, point count, feed (null: none).
+nlohmann::ordered_json subpaths_json(const Path& path) {
+    nlohmann::ordered_json list = nlohmann::ordered_json::array();
+    for (const Subpath& sp : path.subpaths) {
+        list.push_back(
+            {{"basis", basis_name(sp.basis)},
+             {"closed", sp.closed},
+             {"points", sp.points.size()},
+             {"feed_mm_per_s", sp.feed > 0 ? nlohmann::ordered_json(sp.feed) : nullptr}});
+    }
+    return list;
+}
+
+/// The summary for machines: the same figures, unrounded (an empty drawing's box is null).
+nlohmann::ordered_json summary_json(const CheckOptions& o, const Path& path,
+                                    const CheckFigures& f) {
+    nlohmann::ordered_json box = nlohmann::ordered_json::object();
+    for (std::size_t a = 0; a < path.axes; ++a) {
+        box[axis_column_name(a)] = {{"min", f.lo[a]}, {"max", f.hi[a]}};
+    }
+    nlohmann::ordered_json j;
+    j["file"] = o.path.file;
+    j["valid"] = true;
+    j["axes"] = path.axes;
+    j["units"] = path.units;
+    j["subpath_count"] = path.subpaths.size();
+    j["subpaths"] = subpaths_json(path);
+    j["drawing_spans"] = f.drawing_segments;
+    j["travel_spans"] = f.travel_segments;
+    j["drawn_length_mm"] = f.drawn;
+    j["travel_length_mm"] = f.travel;
+    j["bounding_box_mm"] = box;
+    return j;
+}
+
+}  // namespace
+
+int run_check(const CheckOptions& o) {
+    const Path path = load_path(o.path);
+    const CheckFigures figures = measure(path);
+    if (o.json) {
+        std::cout << summary_json(o, path, figures).dump(2) << '\n';
+    } else {
+        print_text(o, path, figures);
     }
     return 0;
 }

@@ -9,6 +9,7 @@ namespace pathstream::host {
 
 struct CheckOptions {
     PathOptions path;
+    bool json = false;  ///< --json: one JSON document on standard output instead of text
 };
 
 void add_check_command(CLI::App& app, CheckOptions& options);

@@ -1,6 +1,8 @@
 #include "device_command.hpp"
 
+#include <algorithm>
 #include <atomic>
+#include <cmath>
 #include <csignal>
 #include <iostream>
 #include <memory>
@@ -24,6 +26,34 @@ namespace pathstream::host {
 namespace {
 
 std::atomic<bool> g_stop{false};
+
+// One --position value: mm ("139.322"), or LSB with the suffix "lsb" ("139322lsb"); a whole
+// number of LSB within the core's position range, else std::invalid_argument (exit 2).
+Lsb parse_position(const std::string& text, double mm_per_lsb) {
+    const bool lsb = text.size() > 3 && text.compare(text.size() - 3, 3, "lsb") == 0;
+    const std::string number = lsb ? text.substr(0, text.size() - 3) : text;
+    double value = 0;
+    std::size_t used = 0;
+    try {
+        value = std::stod(number, &used);
+    } catch (const std::exception&) {
+        used = 0;
+    }
+    if (used == 0 || used != number.size() || !std::isfinite(value)) {
+        throw std::invalid_argument("--position: '" + text + "' is not a number of mm (or of LSB with the suffix lsb)");
+    }
+    const double in_lsb = lsb ? value : value / mm_per_lsb;
+    const double whole = std::round(in_lsb);
+    if (std::fabs(in_lsb - whole) > 1e-6 * std::max(1.0, std::fabs(whole))) {
+        throw std::invalid_argument("--position: '" + text + "' is not a whole number of LSB (" +
+                                    std::to_string(mm_per_lsb) + " mm each)");
+    }
+    if (std::fabs(whole) > static_cast<double>(kMaxPositionLsb)) {
+        throw std::invalid_argument("--position: '" + text + "' is outside the core's position range (+-" +
+                                    std::to_string(kMaxPositionLsb) + " LSB)");
+    }
+    return static_cast<Lsb>(whole);
+}
 extern "C" void on_signal(int) { g_stop.store(true); }
 
 void write_record(const sim::SimulatedMotionDevice& d, const std::string& path) {
@@ -222,7 +252,10 @@ void add_device_command(CLI::App& app, DeviceCommandOptions& o) {
         "Run the simulated device (the firmware core) as a Modbus TCP/RTU server or a native CAN node "
         "(docs/modbus.md, docs/can.md); with --machine wired to the profile's GPIO lines (docs/gpio.md)");
     cmd->add_option("--axes", o.axes, "axis count (default 2, or the profile's)")->check(CLI::Range(1, 8));
-    cmd->add_option("--position", o.position, "initial position, LSB per axis (default 0)")->delimiter(',');
+    cmd->add_option("--position", o.position,
+                    "initial position per axis in mm (e.g. 139.322,100), or in LSB with the suffix lsb "
+                    "(139322lsb); mm per LSB from --machine, else 0.001 (default 0)")
+        ->delimiter(',');
     cmd->add_option("--tcp", o.tcp, "serve Modbus TCP on HOST:PORT (port 0: any free port)")->capture_default_str();
     cmd->add_flag("--rtu-pty", o.rtu_pty, "serve Modbus RTU on a new pseudo-terminal (prints its path)");
     cmd->add_option("--rtu", o.rtu_device, "serve Modbus RTU on this serial device");
@@ -267,7 +300,8 @@ int run_device(const DeviceCommandOptions& o) {
                       << " axes\n";
             return 2;
         }
-        for (unsigned a = 0; a < axes; ++a) start[a] = o.position[a];
+        const double mm_per_lsb = profile ? profile->mm_per_lsb : 0.001;
+        for (unsigned a = 0; a < axes; ++a) start[a] = parse_position(o.position[a], mm_per_lsb);
     }
     // Before homing: an interrupted homing must stop cleanly too.
     std::signal(SIGINT, on_signal);

@@ -12,7 +12,7 @@ namespace pathstream::host {
 
 struct DeviceCommandOptions {
     unsigned axes = 2;
-    std::vector<std::int32_t> position;  ///< LSB per axis; default all zero
+    std::vector<std::string> position;  ///< per axis: mm, or LSB with the suffix "lsb"; default all zero
     std::string tcp = "127.0.0.1:1502";
     bool rtu_pty = false;
     std::string rtu_device;

@@ -3,6 +3,7 @@
 #include <chrono>
 #include <cmath>
 #include <iostream>
+#include <nlohmann/json.hpp>
 #include <stdexcept>
 
 #include "pathstream/host/atomic_file.hpp"
@@ -20,6 +21,7 @@ void add_plan_command(CLI::App& app, PlanCommandOptions& o) {
     add_path_options(*cmd, o.path);
     cmd->add_option("--machine,-m", o.machine, "machine profile (JSON, docs/formats.md)")->required()->check(CLI::ExistingFile);
     cmd->add_option("--out,-o", o.output, "CSV output file (default: only the summary)");
+    cmd->add_flag("--json", o.json, "print the summary as one JSON document on standard output");
 }
 
 PlannedJob plan_job(const PathOptions& path_options, const std::string& machine_file,
@@ -84,27 +86,85 @@ void print_plan_summary(const PlannedJob& job, std::ostream& out) {
     out << line;
 }
 
+namespace {
+
+/// Per axis, keyed by name: the plan check's limit figures, as the summary prints them.
+nlohmann::ordered_json plan_axes_json(const PlannedJob& job) {
+    const PlanCheck& c = job.check;
+    nlohmann::ordered_json axes = nlohmann::ordered_json::object();
+    for (std::size_t a = 0; a < job.machine.axes.size(); ++a) {
+        axes[job.machine.axes[a].name] = {
+            {"velocity_fraction_cubic", c.axis_velocity_fraction_exact.at(a)},
+            {"acceleration_fraction_cubic", c.axis_acceleration_fraction_exact.at(a)},
+            {"max_step_lsb_per_tick", c.axis_max_step.at(a)},
+            {"velocity_limit_lsb_per_tick", c.axis_velocity_limit_lsb.at(a)},
+            {"max_second_difference_lsb_per_tick2", c.axis_max_second_difference.at(a)},
+            {"acceleration_limit_lsb_per_tick2", c.axis_acceleration_limit_lsb.at(a)}};
+    }
+    return axes;
+}
+
+/// The summary's figures for machines: the same numbers, unrounded, in the units the keys name.
+nlohmann::ordered_json plan_summary_json(const PlanCommandOptions& o, const PlannedJob& job) {
+    const PlanCheck& c = job.check;
+    nlohmann::ordered_json j;
+    j["file"] = o.path.file;
+    j["machine"] = o.machine;
+    j["output"] =
+        o.output.empty() ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(o.output);
+    j["duration_s"] = job.plan.duration;
+    j["ticks"] = job.plan.total_ticks;
+    j["tick_hz"] = job.machine.tick_hz;
+    j["spans"] = job.plan.spans.size();
+    j["pen_changes"] = job.plan.pen.size();
+    j["drawn_length_mm"] = job.plan.path_length;
+    j["travel_length_mm"] = job.plan.travel_length;
+    j["planning_time_s"] = job.planning_seconds;
+    j["max_deviation_mm"] = c.max_deviation;
+    j["max_deviation_tick"] = c.worst_deviation_tick;
+    j["chord_tolerance_mm"] = job.machine.chord_tolerance;
+    j["axes"] = plan_axes_json(job);
+    j["ticks_checked"] = c.ticks_checked;
+    j["within_limits"] = c.within_limits;
+    j["motion_while_pen_moves"] = c.drawing_while_pen_moves;
+    return j;
+}
+
+/// Writes every executed tick as CSV (atomically: a failed run leaves no file).
+void write_plan_csv(const PlannedJob& job, const std::string& output) {
+    AtomicFile file(output);
+    std::ostream& csv = file.stream();
+    csv << "tick,t";
+    for (std::size_t a = 0; a < job.path.axes; ++a) csv << ',' << axis_column_name(a);
+    csv << ",pen\n";
+    play_through_core(job.plan.spans, job.path.axes, [&](const PlayedTick& t) {
+        csv << t.tick << ',' << exact_decimal(static_cast<double>(t.tick) / job.machine.tick_hz);
+        for (std::size_t a = 0; a < job.path.axes; ++a) {
+            csv << ',' << lsb_to_mm_text(t.setpoint[a], job.machine.mm_per_lsb);
+        }
+        csv << ',' << (t.pen_down ? 1 : 0) << '\n';
+    });
+    file.commit();
+}
+
+}  // namespace
+
 int run_plan(const PlanCommandOptions& o) {
     const PlannedJob job = plan_job(o.path, o.machine);
-    if (!o.output.empty()) {
-        AtomicFile file(o.output);
-        std::ostream& csv = file.stream();
-        csv << "tick,t";
-        for (std::size_t a = 0; a < job.path.axes; ++a) csv << ',' << axis_column_name(a);
-        csv << ",pen\n";
-        play_through_core(job.plan.spans, job.path.axes, [&](const PlayedTick& t) {
-            csv << t.tick << ',' << exact_decimal(static_cast<double>(t.tick) / job.machine.tick_hz);
-            for (std::size_t a = 0; a < job.path.axes; ++a) csv << ',' << lsb_to_mm_text(t.setpoint[a], job.machine.mm_per_lsb);
-            csv << ',' << (t.pen_down ? 1 : 0) << '\n';
-        });
-        file.commit();
+    if (!o.output.empty()) write_plan_csv(job, o.output);
+    const bool failed = !job.check.within_limits || job.check.drawing_while_pen_moves;
+    // With --json, standard output holds the document or, on failure, nothing: the text
+    // summary the error message points to then goes to standard error.
+    std::ostream& text = o.json ? std::cerr : std::cout;
+    if (!o.json || failed) {
+        text << "pathstream plan: " << o.path.file << " on " << o.machine
+             << (o.output.empty() ? "" : " -> " + o.output) << '\n';
+        print_plan_summary(job, text);
     }
-    std::cout << "pathstream plan: " << o.path.file << " on " << o.machine
-              << (o.output.empty() ? "" : " -> " + o.output) << '\n';
-    print_plan_summary(job, std::cout);
-    if (!job.check.within_limits || job.check.drawing_while_pen_moves) {
+    if (failed) {
         throw PlanError("the plan failed its per-tick check (a planner bug): see the summary above");
     }
+    if (o.json) std::cout << plan_summary_json(o, job).dump(2) << '\n';
     return 0;
 }
 

@@ -15,6 +15,7 @@ struct PlanCommandOptions {
     PathOptions path;
     std::string machine;
     std::string output;
+    bool json = false;  ///< --json: one JSON document on standard output instead of text
 };
 
 void add_plan_command(CLI::App& app, PlanCommandOptions& options);

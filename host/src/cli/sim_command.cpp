@@ -2,12 +2,13 @@
 
 #include <filesystem>
 #include <iostream>
+#include <nlohmann/json.hpp>
 
-#include "plan_command.hpp"
 #include "pathstream/host/planner.hpp"
 #include "pathstream/host/plot.hpp"
 #include "pathstream/host/progress.hpp"
 #include "pathstream/sim/device.hpp"
+#include "plan_command.hpp"
 
 namespace pathstream::host {
 
@@ -25,45 +26,178 @@ void add_sim_command(CLI::App& app, SimCommandOptions& o) {
     cmd->add_option("--bandwidth", o.bandwidth_hz, "servo bandwidth, Hz")->capture_default_str()->check(CLI::Range(0.1, 10000.0));
     cmd->add_option("--damping", o.damping, "servo damping ratio")->capture_default_str()->check(CLI::Range(0.05, 20.0));
     cmd->add_flag("--y-up", o.y_up, "draw path.svg with +y upwards (default: downwards, like SVG and most plotters)");
+    cmd->add_flag("--json", o.json, "print the report as one JSON document on standard output");
 }
 
-int run_sim(const SimCommandOptions& o) {
-    const PlannedJob job = plan_job(o.path, o.machine);
+namespace {
 
+using Json = nlohmann::ordered_json;
+
+/// A fraction of a limit, or null when there is no limit to compare with.
+Json fraction_of(double value, double limit) {
+    return limit > 0 ? Json(value / limit) : Json(nullptr);
+}
+
+/// One axis of the report's table: cubic, setpoints and executed peaks, following error.
+Json axis_json(const plot::AxisFigures& x) {
+    Json j;
+    j["velocity_fraction_cubic"] = x.checked ? Json(x.velocity_fraction_cubic) : Json(nullptr);
+    j["max_step_lsb_per_tick"] = x.checked ? Json(x.max_step) : Json(nullptr);
+    j["velocity_limit_lsb_per_tick"] = x.checked ? Json(x.velocity_limit_lsb) : Json(nullptr);
+    j["velocity_fraction_executed"] = fraction_of(x.executed_velocity, x.max_velocity);
+    j["executed_velocity_mm_per_s"] = x.executed_velocity;
+    j["acceleration_fraction_cubic"] =
+        x.checked ? Json(x.acceleration_fraction_cubic) : Json(nullptr);
+    j["max_second_difference_lsb_per_tick2"] =
+        x.checked ? Json(x.max_second_difference) : Json(nullptr);
+    j["acceleration_limit_lsb_per_tick2"] =
+        x.checked ? Json(x.acceleration_limit_lsb) : Json(nullptr);
+    j["acceleration_fraction_executed"] = fraction_of(x.executed_acceleration, x.max_acceleration);
+    j["executed_acceleration_mm_per_s2"] = x.executed_acceleration;
+    // Not measured: the ideal plant's position is the setpoint, its error 0 (as the text says).
+    j["max_following_error_mm"] = x.following ? x.max_following_error_mm : 0.0;
+    j["rms_following_error_mm"] = x.has_rms ? x.rms_following_error_mm : 0.0;
+    return j;
+}
+
+/// The machine and plant lines of the report.
+void machine_json(const SimCommandOptions& o, const PlannedJob& job, const plot::RunSummary& run,
+                  Json& j) {
+    j["target"] = run.target;
+    j["file"] = o.path.file;
+    j["machine"] = {{"file", o.machine},
+                    {"axes", job.machine.axes.size()},
+                    {"tick_hz", job.machine.tick_hz},
+                    {"mm_per_lsb", job.machine.mm_per_lsb}};
+    j["plant"] = {{"model", o.plant}, {"description", run.plant}};
+    if (o.plant == "servo") {
+        j["plant"]["bandwidth_hz"] = o.bandwidth_hz;
+        j["plant"]["damping"] = o.damping;
+    }
+}
+
+/// The duration, path, pen and device lines of the report.
+void run_json(const PlannedJob& job, const plot::RunSummary& run, const plot::ReportFigures& f,
+              Json& j) {
+    const double tick_hz = job.machine.tick_hz;
+    j["planned_duration_s"] = f.duration;
+    j["simulated_duration_s"] = run.simulated_seconds;
+    j["wall_time_s"] = run.wall_seconds;
+    j["speedup"] =
+        run.wall_seconds > 0 ? Json(run.simulated_seconds / run.wall_seconds) : Json(nullptr);
+    j["realtime"] = run.realtime;
+    j["drawn_length_mm"] = job.plan.path_length;
+    j["travel_length_mm"] = job.plan.travel_length;
+    j["pen_switches"] = run.pen_switches;
+    j["pen"] = {{"downs", f.pen_downs},
+                {"ups", f.pen_ups},
+                {"down_time_s", static_cast<double>(f.pen_down_ticks) / tick_hz},
+                {"down_fraction", f.executed_ticks > 0 ? static_cast<double>(f.pen_down_ticks) /
+                                                             static_cast<double>(f.executed_ticks)
+                                                       : 0.0},
+                {"dwell_time_s", static_cast<double>(f.dwell_ticks) / tick_hz}};
+    j["device"] = {{"ticks", run.ticks},
+                   {"spans", run.spans},
+                   {"underruns", run.underruns},
+                   {"late_ticks", run.late_ticks}};
+}
+
+/// The deviation and limits lines, then the per-axis table keyed by axis name.
+void limits_json(const PlannedJob& job, const plot::ReportFigures& f, Json& j) {
+    const PlanCheck& c = job.check;
+    j["max_deviation_mm"] = c.max_deviation;
+    j["max_deviation_tick"] = c.worst_deviation_tick;
+    j["chord_tolerance_mm"] = job.machine.chord_tolerance;
+    j["within_limits"] = c.within_limits;
+    j["velocity_fraction_cubic"] = f.velocity_fraction_cubic;
+    j["acceleration_fraction_cubic"] = f.acceleration_fraction_cubic;
+    j["velocity_fraction_setpoints"] = c.max_velocity_fraction;
+    j["acceleration_fraction_setpoints"] = c.max_acceleration_fraction;
+    j["executed_window_ticks"] = f.executed_half_window;
+    j["executed_acceleration_noise_mm_per_s2"] = f.executed_acceleration_noise;
+    Json axes = Json::object();
+    for (const plot::AxisFigures& x : f.axes) axes[x.name] = axis_json(x);
+    j["axes"] = axes;
+}
+
+/// The report for machines: every figure of the text report, unrounded, units in the keys.
+Json report_json(const SimCommandOptions& o, const PlannedJob& job,
+                 const plot::TickSeries& executed, const plot::RunSummary& run) {
+    const plot::ReportFigures f =
+        plot::report_figures(job.plan, &job.check, job.machine, executed, run);
+    Json j;
+    machine_json(o, job, run, j);
+    run_json(job, run, f, j);
+    limits_json(job, f, j);
+    return j;
+}
+
+/// Writes the plots into o.plot_dir (created if needed).
+plot::WrittenPlots write_sim_plots(const SimCommandOptions& o, const PlannedJob& job,
+                                   const plot::TickSeries& executed,
+                                   const plot::TickSeries* plant) {
+    std::filesystem::create_directories(o.plot_dir);
+    plot::Options plot_options;
+    plot_options.y_up = o.y_up;
+    plot_options.title = o.path.file;
+    return plot::write_plots(o.plot_dir, job.segments, executed, plant, job.machine, plot_options);
+}
+
+/// Prints what write_sim_plots wrote, as the text report's last lines.
+void print_plots(const plot::WrittenPlots& written) {
+    std::cout << "plots:";
+    for (const auto& f : written.files) std::cout << ' ' << f;
+    std::cout << '\n';
+    if (!written.note.empty()) std::cout << "note: " << written.note << '\n';
+}
+
+/// Runs the plan on the simulated device, with a progress bar on standard error.
+sim::SimulationResult simulate_job(const SimCommandOptions& o, const PlannedJob& job) {
     sim::SimOptions options;
     options.plant = o.plant == "ideal" ? sim::PlantModel::kIdeal : sim::PlantModel::kServo;
     options.servo.bandwidth_hz = o.bandwidth_hz;
     options.servo.damping = o.damping;
     options.realtime = o.realtime;
-    sim::SimulationResult result;
-    {
-        ProgressBar bar(o.realtime ? "running (real time)" : "simulating");
-        result = sim::simulate(job.plan, job.machine, options, [&](double f) { bar.update(f); });
-    }
+    ProgressBar bar(o.realtime ? "running (real time)" : "simulating");
+    return sim::simulate(job.plan, job.machine, options, [&](double f) { bar.update(f); });
+}
+
+}  // namespace
+
+int run_sim(const SimCommandOptions& o) {
+    const PlannedJob job = plan_job(o.path, o.machine);
+    const sim::SimulationResult result = simulate_job(o, job);
     const plot::TickSeries executed = sim::setpoint_series(result);
     const plot::TickSeries plant = sim::plant_series(result);
-
-    std::cout << plot::text_report(job.plan, &job.check, job.machine, executed, sim::run_summary(result));
+    const plot::RunSummary run = sim::run_summary(result);
+    const bool servo = result.plant == sim::PlantModel::kServo;
+    const bool failed =
+        result.underruns != 0 || !job.check.within_limits || job.check.drawing_while_pen_moves;
+    // With --json, standard output holds the document or, on failure, nothing: the text
+    // report the error message points to then goes to standard error.
+    if (!o.json) std::cout << plot::text_report(job.plan, &job.check, job.machine, executed, run);
+    if (o.json && failed)
+        std::cerr << plot::text_report(job.plan, &job.check, job.machine, executed, run);
+    Json document;
+    if (o.json) document = report_json(o, job, executed, run);
     if (!o.plot_dir.empty()) {
-        std::filesystem::create_directories(o.plot_dir);
-        plot::Options plot_options;
-        plot_options.y_up = o.y_up;
-        plot_options.title = o.path.file;
-        const plot::WrittenPlots written = plot::write_plots(
-            o.plot_dir, job.segments, executed, options.plant == sim::PlantModel::kServo ? &plant : nullptr,
-            job.machine, plot_options);
-        std::cout << "plots:";
-        for (const auto& f : written.files) std::cout << ' ' << f;
-        std::cout << '\n';
-        if (!written.note.empty()) std::cout << "note: " << written.note << '\n';
+        const plot::WrittenPlots written =
+            write_sim_plots(o, job, executed, servo ? &plant : nullptr);
+        if (o.json) {
+            document["plots"] = written.files;
+            document["plot_note"] = written.note.empty() ? Json(nullptr) : Json(written.note);
+        } else {
+            print_plots(written);
+        }
     }
     if (result.underruns != 0) {
         std::cerr << "pathstream: the device ran dry " << result.underruns << " times (a streaming bug)\n";
         return 4;
     }
-    if (!job.check.within_limits || job.check.drawing_while_pen_moves) {
+    if (failed) {
         throw PlanError("the plan failed its per-tick check (a planner bug): see the report above");
     }
+    if (o.json) std::cout << document.dump(2) << '\n';
     return 0;
 }
 

@@ -17,6 +17,7 @@ struct SimCommandOptions {
     double bandwidth_hz = 50;
     double damping = 1.0;
     bool y_up = false;
+    bool json = false;  ///< --json: one JSON document on standard output instead of text
 };
 
 void add_sim_command(CLI::App& app, SimCommandOptions& options);

@@ -1,7 +1,14 @@
 #include "stream_command.hpp"
 
+#include <unistd.h>
+
 #include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <csignal>
 #include <cstdio>
+#include <filesystem>
+#include <memory>
 #include <iostream>
 #include <stdexcept>
 #include <string>
@@ -9,6 +16,9 @@
 #include "pathstream/hal/socketcan_bus.hpp"
 #include "pathstream/host/can_stream.hpp"
 #include "pathstream/host/cia402_master.hpp"
+#include "pathstream/host/device_link.hpp"
+#include "pathstream/host/device_setup.hpp"
+#include "pathstream/host/job_journal.hpp"
 #include "pathstream/host/progress.hpp"
 #include "plan_command.hpp"
 
@@ -21,16 +31,30 @@ void add_stream_command(CLI::App& app, StreamCommandOptions& o) {
                                        "CAN (docs/can.md), or to CiA 402 drives in cyclic "
                                        "synchronous position mode (docs/cia402.md)");
     add_path_options(*cmd, o.path);
-    cmd->add_option("--machine,-m", o.machine, "machine profile (JSON, docs/formats.md)")->required()->check(CLI::ExistingFile);
+    // FILE, --machine and --target come from the journal with --resume.
+    cmd->get_option("file")->required(false);
+    cmd->add_option("--machine,-m", o.machine, "machine profile (JSON, docs/formats.md); required unless --resume")
+        ->check(CLI::ExistingFile);
     cmd->add_option("--target,-t", o.stream.target,
                     "device: modbus-tcp://HOST:PORT?unit=N, "
                     "modbus-rtu:///dev/ttyX?baud=115200&parity=N&unit=1, "
                     "can://IFACE?node=N&protocol=native or CiA 402 drives "
-                    "can://IFACE?node=N&protocol=cia402&cycle=2ms")
-        ->required();
+                    "can://IFACE?node=N&protocol=cia402&cycle=2ms; required unless --resume");
     cmd->add_flag("--lead-in", o.lead_in,
                   "start with a pen-up move from where the device rests (e.g. after homing) to the drawing's first "
-                  "point (Modbus targets: their status carries the position)");
+                  "point");
+    cmd->add_option("--journal", o.journal,
+                    "job journal, written as the stream goes, for --resume (default: DRAWING.journal.json in the "
+                    "current directory, DRAWING the file's name without its extension)");
+    cmd->add_flag("--no-journal", o.no_journal, "write no job journal");
+    cmd->add_option("--resume", o.resume,
+                    "continue the drawing of this job journal after a Ctrl-C, a stop, a fault reset, a device "
+                    "restart or a host crash (FILE, --machine and --target default to the journal's)")
+        ->check(CLI::ExistingFile);
+    cmd->add_option("--hold-timeout", o.hold_timeout_seconds,
+                    "Ctrl-C: seconds for the hold to come to rest before the device is stopped instead")
+        ->capture_default_str()
+        ->check(CLI::Range(0.1, 600.0));
     cmd->add_option("--lead", o.stream.lead_seconds,
                     "seconds of motion kept queued ahead of the device (Modbus, native CAN)")
         ->capture_default_str()
@@ -50,14 +74,71 @@ void add_stream_command(CLI::App& app, StreamCommandOptions& o) {
         ->check(CLI::Range(0.1, 3600.0));
 }
 
-// ---- CAN targets (docs/can.md): can://IFACE?node=N&protocol=native|cia402 ----------------
 namespace {
 
-int run_stream_can(const StreamCommandOptions& o, const PlannedJob& job) {
-    if (o.stream.target.find("protocol=cia402") != std::string::npos) {  // its own keys (cycle=...): docs/cia402.md
-        hal::SocketCanBus cia402_bus(parse_cia402_target(o.stream.target, job.machine.axes.size()).interface);
-        return run_cia402_stream(job.plan, job.machine, o.stream.target, cia402_bus);
+// Ctrl-C and SIGTERM: the first asks for a hold, the second for a stop (StreamInterrupt).
+std::atomic<int> g_interrupts{0};
+extern "C" void on_stream_signal(int) {
+    const int n = g_interrupts.fetch_add(1) + 1;
+    static const char hold[] =
+        "\npathstream: interrupt: holding at the next span boundary (Ctrl-C again: stop and drop the queue)\n";
+    static const char stop[] = "\npathstream: interrupt: stopping\n";
+    if (n == 1) {
+        (void)!write(2, hold, sizeof hold - 1);
+    } else if (n == 2) {
+        (void)!write(2, stop, sizeof stop - 1);
     }
+}
+
+// Keeps the journal file in step with the stream: at most five writes a second, and at once
+// when the state or the acknowledged span changes kind (an interrupt, a fault).
+class JournalWriter {
+public:
+    JournalWriter(std::string path, JobJournal journal) : path_(std::move(path)), journal_(std::move(journal)) {
+        if (!path_.empty()) write_journal(journal_, path_);
+    }
+
+    void trace(const StreamTrace& t) {
+        if (path_.empty()) return;
+        const std::string state = device_state_name(t.status.state);
+        const bool changed = state != journal_.state || t.job != journal_.job;
+        journal_.job = t.job;
+        journal_.acknowledged = t.acknowledged;
+        journal_.last_completed = t.status.last_completed;
+        journal_.epoch = t.status.epoch;
+        journal_.state = state;
+        journal_.position.assign(t.status.position, t.status.position + std::min<unsigned>(t.status.axes, kMaxAxes));
+        const auto now = std::chrono::steady_clock::now();
+        if (changed || now - last_write_ > std::chrono::milliseconds(200)) {
+            write_journal(journal_, path_);
+            last_write_ = now;
+        }
+    }
+
+    void finish(const std::string& outcome, const std::string& error = "") {
+        if (path_.empty()) return;
+        journal_.outcome = outcome;
+        journal_.error = error;
+        write_journal(journal_, path_);
+    }
+
+    const std::string& path() const { return path_; }
+
+private:
+    std::string path_;
+    JobJournal journal_;
+    std::chrono::steady_clock::time_point last_write_{};
+};
+
+// What a stream ended with, whichever bus carried it.
+struct StreamEnd {
+    int interrupted = 0;
+    DeviceSnapshot status;
+    std::uint32_t job = 0;
+};
+
+StreamEnd stream_over_can(const Plan& plan, const MachineProfile& machine, const StreamCommandOptions& o,
+                          const StreamObserver& observer, const HeldJob* held) {
     const CanTarget t = parse_can_target(o.stream.target);
     hal::SocketCanBus bus(t.interface_name);
     CanStreamOptions c;
@@ -66,16 +147,20 @@ int run_stream_can(const StreamCommandOptions& o, const PlannedJob& job) {
     c.lead_seconds = o.stream.lead_seconds;
     c.ack_timeout_ms = std::min(o.stream.response_timeout_ms, 100u);
     c.link_timeout_seconds = o.stream.link_timeout_seconds;
+    c.interrupt = o.stream.interrupt;
+    c.observer = observer;
+    c.held = held;
     CanStreamReport r;
     {
         ProgressBar bar("streaming");
-        r = stream_can(job.plan, job.machine, bus, c, [&](double fraction, double queued) {
+        r = stream_can(plan, machine, bus, c, [&](double fraction, double queued) {
             char detail[48];
             std::snprintf(detail, sizeof detail, "queue %.2f s", queued);
             bar.update(fraction, detail);
         });
     }
-    const double motion = static_cast<double>(r.ticks_executed) / job.machine.tick_hz;
+    if (r.interrupted != 0) return {r.interrupted, r.final_status, r.job};
+    const double motion = static_cast<double>(r.ticks_executed) / machine.tick_hz;
     std::printf("streamed      %s (native CAN protocol, node %u)\n", o.stream.target.c_str(), unsigned(t.node));
     std::printf("executed      %llu ticks (%.3f s of motion), %llu spans in %llu batches, last span %u\n",
                 static_cast<unsigned long long>(r.ticks_executed), motion,
@@ -90,12 +175,187 @@ int run_stream_can(const StreamCommandOptions& o, const PlannedJob& job) {
                 static_cast<double>(r.bits_sent + r.bits_received) / motion / 1e4);
     std::printf("device        %u underruns, %u duplicate batches acknowledged; wall time %.2f s\n", r.underruns,
                 r.duplicates, r.wall_seconds);
-    return 0;
+    return {0, r.final_status, r.job};
+}
+
+StreamEnd stream_over_modbus(const Plan& plan, const MachineProfile& machine, const StreamCommandOptions& o,
+                             const StreamObserver& observer, const HeldJob* held) {
+    StreamOptions options = o.stream;
+    options.observer = observer;
+    options.held = held;
+    StreamReport r;
+    {
+        ProgressBar bar("streaming");
+        r = stream_modbus(plan, machine, options, [&](double fraction, double queued) {
+            char detail[48];
+            std::snprintf(detail, sizeof detail, "queue %.2f s", queued);
+            bar.update(fraction, detail);
+        });
+    }
+    if (r.interrupted != 0) return {r.interrupted, r.final_status, r.job};
+    std::printf("streamed      %s\n", o.stream.target.c_str());
+    std::printf("executed      %llu ticks (%.3f s of motion), %llu spans in %llu batches, last span %u\n",
+                static_cast<unsigned long long>(r.ticks_executed), static_cast<double>(r.ticks_executed) / machine.tick_hz,
+                static_cast<unsigned long long>(r.spans_sent), static_cast<unsigned long long>(r.batches), r.last_completed);
+    std::printf("job           %u finished: the device is idle at the drawing's end point\n", r.job);
+    std::printf("final point  ");
+    for (std::size_t a = 0; a < machine.axes.size(); ++a) {
+        std::printf(" %s %.4f mm", machine.axes[a].name.c_str(), r.final_position[a] * machine.mm_per_lsb);
+    }
+    std::printf("\nlink          %llu transactions, %llu retries, %llu reconnects, %llu bytes sent, %llu received"
+                " (%.0f B per s of motion)\n",
+                static_cast<unsigned long long>(r.transactions), static_cast<unsigned long long>(r.retries),
+                static_cast<unsigned long long>(r.reconnects), static_cast<unsigned long long>(r.bytes_sent),
+                static_cast<unsigned long long>(r.bytes_received),
+                (r.bytes_sent + r.bytes_received) / (static_cast<double>(r.ticks_executed) / machine.tick_hz));
+    std::printf("device        %u underruns, %u duplicate batches acknowledged; wall time %.2f s\n", r.underruns,
+                r.duplicates, r.wall_seconds);
+    return {0, r.final_status, r.job};
+}
+
+// Where an interrupted job stopped, in the drawing's terms, and how to go on.
+void print_interrupted(const StreamEnd& end, const JobSpans& job, std::uint32_t job_id, const MachineProfile& machine,
+                       const std::string& journal) {
+    const DeviceSnapshot& s = end.status;
+    std::printf("interrupted   the device %s at",
+                end.interrupted == 1 && s.state == 2 ? "holds at rest (the rest of the job queued)"
+                : s.state == 0                       ? "stopped and is idle (queue dropped)"
+                                                     : device_state_name(s.state));
+    for (std::size_t a = 0; a < machine.axes.size(); ++a) {
+        std::printf(" %s %.4f mm", machine.axes[a].name.c_str(), s.position[a] * machine.mm_per_lsb);
+    }
+    std::printf(", pen up\n");
+    // The next span of the job that was not executed to its end.
+    std::size_t next = 0;
+    if (job_id != 0 && s.last_completed + 1 >= job_id) next = s.last_completed + 1 - job_id;
+    while (next < job.origin.size() && job.origin[next] < 0) ++next;
+    if (next < job.plan.spans.size()) {
+        std::printf("              stopped before drawing span %lld of %zu (subpath %zu of %zu, tick %llu of %llu)\n",
+                    static_cast<long long>(job.origin[next]) + 1, job.drawing_spans,
+                    static_cast<std::size_t>(job.plan.spans[next].subpath) + 1, job.subpaths,
+                    static_cast<unsigned long long>(job.drawing_tick[next]),
+                    static_cast<unsigned long long>(job.drawing_ticks));
+    }
+    if (!journal.empty()) {
+        std::printf("resume with   pathstream stream --resume %s\n", journal.c_str());
+    } else {
+        std::printf("resume        not possible: --no-journal\n");
+    }
+}
+
+std::string default_journal_path(const std::string& drawing) {
+    return std::filesystem::path(drawing).stem().string() + ".journal.json";
+}
+
+// Streams `job` (its spans as the plan), keeping the journal; returns the exit status.
+int stream_job(const JobSpans& job, const MachineProfile& machine, StreamCommandOptions o, JobJournal journal,
+               const std::string& journal_path, const HeldJob* held) {
+    const bool can = o.stream.target.rfind("can://", 0) == 0;
+    if (!journal_path.empty()) {
+        const std::string plan_file = std::filesystem::absolute(journal_path + ".plan").string();
+        journal.plan_file = plan_file;
+        journal.plan_hash = write_job_spans(job, plan_file);
+        std::printf("journal       %s\n", journal_path.c_str());
+    }
+    JournalWriter writer(journal_path, journal);
+    o.stream.interrupt.request = &g_interrupts;
+    o.stream.interrupt.hold_timeout_seconds = o.hold_timeout_seconds;
+    g_interrupts.store(0);
+    std::signal(SIGINT, on_stream_signal);
+    std::signal(SIGTERM, on_stream_signal);
+    const StreamObserver observer = [&](const StreamTrace& t) { writer.trace(t); };
+    StreamEnd end;
+    try {
+        end = can ? stream_over_can(job.plan, machine, o, observer, held)
+                  : stream_over_modbus(job.plan, machine, o, observer, held);
+    } catch (const std::exception& e) {
+        writer.finish("failed", e.what());
+        throw;
+    }
+    std::signal(SIGINT, SIG_DFL);
+    std::signal(SIGTERM, SIG_DFL);
+    if (end.interrupted == 0) {
+        writer.finish("finished");
+        return 0;
+    }
+    writer.finish(end.interrupted == 1 ? "held" : "stopped");
+    print_interrupted(end, job, end.job, machine, writer.path());
+    return kExitInterrupted;
+}
+
+// --resume: the device holds the job (go on streaming, then resume), or rests idle (a
+// re-entry from where it rests to the first span not executed, then the rest of the job).
+int run_resume(StreamCommandOptions o) {
+    const JobJournal journal = read_journal(o.resume);
+    if (o.machine.empty()) o.machine = journal.machine;
+    if (o.stream.target.empty()) o.stream.target = journal.target;
+    const MachineProfile machine = load_machine_profile(o.machine);
+    const JobSpans job = read_job_spans(journal.plan_file, journal.plan_hash);
+    if (journal.outcome == "finished") {
+        std::printf("resume        %s: the job already ran to its end; nothing to do\n", o.resume.c_str());
+        return 0;
+    }
+    LinkOptions l;
+    l.response_timeout_ms = o.stream.response_timeout_ms;
+    l.attempts = o.stream.attempts;
+    l.link_timeout_seconds = o.stream.link_timeout_seconds;
+    DeviceSnapshot s;
+    {
+        const std::unique_ptr<DeviceLink> link = open_device_link(o.stream.target, l);
+        s = link->status();
+    }
+    if (s.axes != machine.axes.size()) {
+        throw StreamError(o.stream.target + ": device has " + std::to_string(s.axes) + " axes, the profile " +
+                          std::to_string(machine.axes.size()));
+    }
+    const std::size_t spans = job.plan.spans.size();
+    const bool ours = journal.job != 0 && s.last_accepted >= journal.job && s.last_accepted - journal.job < spans &&
+                      s.last_completed + 1 >= journal.job;
+    if (s.state == static_cast<unsigned>(device::DeviceState::kHolding) && ours && s.epoch == journal.epoch &&
+        (s.flags & 1u) != 0) {
+        std::printf("resume        the device holds job %u at span %u of %zu: streaming the rest, then resume\n",
+                    journal.job, s.last_completed + 1 - journal.job, spans);
+        const HeldJob held{journal.job, s.last_accepted};
+        return stream_job(job, machine, o, journal, o.resume, &held);
+    }
+    if (s.state != static_cast<unsigned>(device::DeviceState::kIdle)) {
+        throw StreamError(o.stream.target + ": device is " + device_state_name(s.state) +
+                          fault_suffix(s.state, s.fault_code) +
+                          (s.state == static_cast<unsigned>(device::DeviceState::kHolding)
+                               ? " another job: stop it first (pathstream ctl TARGET stop)"
+                               : ": reset it first (pathstream ctl TARGET reset)") +
+                          ", then resume");
+    }
+    std::size_t first = 0;
+    if (ours) {
+        first = s.last_completed + 1 - journal.job;
+    } else if (journal.job != 0 && journal.last_completed + 1 >= journal.job) {
+        first = journal.last_completed + 1 - journal.job;
+        std::printf("resume        the device does not know job %u (restarted?): from the journal's last record, "
+                    "span %zu\n", journal.job, first);
+    }
+    std::vector<Lsb> rest(s.position, s.position + machine.axes.size());
+    const JobSpans resumed = resume_from(job, first, rest, device_limits(machine));
+    std::printf("resume        from where the device rests, back onto the drawing at span %lld of %zu (tick %llu)\n",
+                static_cast<long long>(resumed.origin[resumed.origin.size() - (spans - first)]) + 1,
+                job.drawing_spans, static_cast<unsigned long long>(resumed.drawing_tick.front()));
+    JobJournal next = journal;
+    next.job = 0;
+    next.outcome = "streaming";
+    next.error.clear();
+    return stream_job(resumed, machine, o, next, o.resume, nullptr);
 }
 
 }  // namespace
 
 int run_stream(const StreamCommandOptions& o) {
+    if (!o.resume.empty()) {
+        if (o.lead_in) throw std::invalid_argument("--resume: --lead-in does not apply (the resume plans its own move)");
+        return run_resume(o);
+    }
+    if (o.path.file.empty()) throw std::invalid_argument("stream: FILE is required (or --resume JOURNAL)");
+    if (o.machine.empty()) throw std::invalid_argument("stream: --machine is required (or --resume JOURNAL)");
+    if (o.stream.target.empty()) throw std::invalid_argument("stream: --target is required (or --resume JOURNAL)");
     const std::string& url = o.stream.target;
     if (url.rfind("modbus-tcp://", 0) != 0 && url.rfind("modbus-rtu://", 0) != 0 &&
         url.rfind("can://", 0) != 0) {
@@ -105,46 +365,39 @@ int run_stream(const StreamCommandOptions& o) {
     }
     std::vector<double> rest_mm;
     if (o.lead_in) {
-        if (o.stream.target.rfind("can://", 0) == 0) {
-            throw std::invalid_argument("--lead-in needs a Modbus target: the CAN status carries no position");
-        }
         const MachineProfile machine = load_machine_profile(o.machine);
-        for (const Lsb p : modbus_rest_position(machine, o.stream)) rest_mm.push_back(p * machine.mm_per_lsb);
+        std::vector<Lsb> rest;
+        if (o.stream.target.rfind("can://", 0) == 0) {
+            const CanTarget t = parse_can_target(o.stream.target);
+            hal::SocketCanBus bus(t.interface_name);
+            CanStreamOptions c;
+            c.node = t.node;
+            c.name = o.stream.target;
+            c.ack_timeout_ms = std::min(o.stream.response_timeout_ms, 100u);
+            c.link_timeout_seconds = o.stream.link_timeout_seconds;
+            rest = can_rest_position(machine, bus, c);
+        } else {
+            rest = modbus_rest_position(machine, o.stream);
+        }
+        for (const Lsb p : rest) rest_mm.push_back(p * machine.mm_per_lsb);
         std::printf("lead-in       from the device's rest position");
         for (std::size_t a = 0; a < rest_mm.size(); ++a) {
             std::printf(" %s %.4f mm", machine.axes[a].name.c_str(), rest_mm[a]);
         }
         std::printf("\n");
     }
-    const PlannedJob job = plan_job(o.path, o.machine, o.lead_in ? &rest_mm : nullptr);
-    if (o.stream.target.rfind("can://", 0) == 0) return run_stream_can(o, job);
-    StreamReport r;
-    {
-        ProgressBar bar("streaming");
-        r = stream_modbus(job.plan, job.machine, o.stream, [&](double fraction, double queued) {
-            char detail[48];
-            std::snprintf(detail, sizeof detail, "queue %.2f s", queued);
-            bar.update(fraction, detail);
-        });
+    const PlannedJob planned = plan_job(o.path, o.machine, o.lead_in ? &rest_mm : nullptr);
+    if (url.rfind("can://", 0) == 0 && url.find("protocol=cia402") != std::string::npos) {
+        // CiA 402 drives take one setpoint per cycle from the host: no device queue to hold.
+        hal::SocketCanBus cia402_bus(parse_cia402_target(url, planned.machine.axes.size()).interface);
+        return run_cia402_stream(planned.plan, planned.machine, url, cia402_bus);
     }
-    std::printf("streamed      %s\n", o.stream.target.c_str());
-    std::printf("executed      %llu ticks (%.3f s of motion), %llu spans in %llu batches, last span %u\n",
-                static_cast<unsigned long long>(r.ticks_executed), static_cast<double>(r.ticks_executed) / job.machine.tick_hz,
-                static_cast<unsigned long long>(r.spans_sent), static_cast<unsigned long long>(r.batches), r.last_completed);
-    std::printf("job           %u finished: the device is idle at the drawing's end point\n", r.job);
-    std::printf("final point  ");
-    for (std::size_t a = 0; a < job.machine.axes.size(); ++a) {
-        std::printf(" %s %.4f mm", job.machine.axes[a].name.c_str(), r.final_position[a] * job.machine.mm_per_lsb);
-    }
-    std::printf("\nlink          %llu transactions, %llu retries, %llu reconnects, %llu bytes sent, %llu received"
-                " (%.0f B per s of motion)\n",
-                static_cast<unsigned long long>(r.transactions), static_cast<unsigned long long>(r.retries),
-                static_cast<unsigned long long>(r.reconnects), static_cast<unsigned long long>(r.bytes_sent),
-                static_cast<unsigned long long>(r.bytes_received),
-                (r.bytes_sent + r.bytes_received) / (static_cast<double>(r.ticks_executed) / job.machine.tick_hz));
-    std::printf("device        %u underruns, %u duplicate batches acknowledged; wall time %.2f s\n", r.underruns,
-                r.duplicates, r.wall_seconds);
-    return 0;
+    JobJournal journal;
+    journal.target = url;
+    journal.machine = std::filesystem::absolute(o.machine).string();
+    journal.drawing = o.path.file;
+    const std::string journal_path = o.no_journal ? "" : (o.journal.empty() ? default_journal_path(o.path.file) : o.journal);
+    return stream_job(job_from_plan(planned.plan), planned.machine, o, journal, journal_path, nullptr);
 }
 
 }  // namespace pathstream::host

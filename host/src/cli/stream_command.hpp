@@ -13,8 +13,16 @@ struct StreamCommandOptions {
     PathOptions path;
     std::string machine;
     StreamOptions stream;
-    bool lead_in = false;  ///< plan a pen-up move from where the device rests (Modbus targets)
+    bool lead_in = false;  ///< plan a pen-up move from where the device rests
+    std::string journal;   ///< job journal path ("" : DRAWING-STEM.journal.json in the current directory)
+    bool no_journal = false;
+    std::string resume;    ///< continue the job of this journal
+    double hold_timeout_seconds = 10;  ///< Ctrl-C: a hold not at rest by then becomes a stop
 };
+
+/// Exit status of a stream interrupted by Ctrl-C or SIGTERM: the device holds at rest or
+/// stopped, and the journal can resume the drawing.
+inline constexpr int kExitInterrupted = 7;
 
 void add_stream_command(CLI::App& app, StreamCommandOptions& options);
 int run_stream(const StreamCommandOptions& options);

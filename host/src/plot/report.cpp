@@ -43,11 +43,95 @@ std::string name_of(const MachineProfile& profile, std::size_t axis) {
     return "axis" + std::to_string(axis);
 }
 
+/// Pen-lift edges and down time on the executed ticks, and the plan's pen dwells: the time
+/// the axes are held still while the pen moves (no drawing then).
+void pen_figures(const Plan& plan, const MachineProfile& profile, const TickSeries& executed,
+                 ReportFigures& f) {
+    for (std::size_t k = 0; k < executed.pen_down.size(); ++k) {
+        const bool down = executed.pen_down[k] != 0;
+        const bool before = k > 0 && executed.pen_down[k - 1] != 0;
+        f.pen_down_ticks += down ? 1 : 0;
+        if (down && !before) ++f.pen_downs;
+        if (!down && before) ++f.pen_ups;
+    }
+    f.executed_ticks = executed.pen_down.size();
+    for (const auto& e : plan.pen) {
+        f.dwell_ticks +=
+            delay_ticks(e.down ? profile.pen_down_delay : profile.pen_up_delay, profile.tick_hz);
+    }
+}
+
+/// The largest element (0 when empty): the peak of per-axis fractions.
+double peak_of(const std::vector<double>& values) {
+    double m = 0;
+    for (const double x : values) m = std::max(m, x);
+    return m;
+}
+
+/// The planner check's figures of one axis, when the check has them all.
+void checked_axis_figures(const PlanCheck* check, std::size_t a, AxisFigures& f) {
+    f.checked = check != nullptr && a < check->axis_velocity_fraction_exact.size() &&
+                a < check->axis_acceleration_fraction_exact.size() &&
+                a < check->axis_max_step.size() && a < check->axis_max_second_difference.size() &&
+                a < check->axis_velocity_limit_lsb.size() &&
+                a < check->axis_acceleration_limit_lsb.size();
+    if (!f.checked) return;
+    f.velocity_fraction_cubic = check->axis_velocity_fraction_exact[a];
+    f.acceleration_fraction_cubic = check->axis_acceleration_fraction_exact[a];
+    f.max_step = check->axis_max_step[a];
+    f.velocity_limit_lsb = check->axis_velocity_limit_lsb[a];
+    f.max_second_difference = check->axis_max_second_difference[a];
+    f.acceleration_limit_lsb = check->axis_acceleration_limit_lsb[a];
+}
+
+/// One axis's row: the check's figures, the executed series' peaks, the following error.
+AxisFigures axis_figures(const PlanCheck* check, const MachineProfile& profile,
+                         const TickSeries& executed, const Derivatives& d, const RunSummary& run,
+                         std::size_t a) {
+    AxisFigures f;
+    f.name = name_of(profile, a);
+    checked_axis_figures(check, a, f);
+    const std::size_t axes = executed.axes;
+    for (std::size_t k = 0; k < executed.ticks(); ++k) {
+        f.executed_velocity = std::max(f.executed_velocity, std::fabs(d.velocity[k * axes + a]));
+        f.executed_acceleration =
+            std::max(f.executed_acceleration, std::fabs(d.acceleration[k * axes + a]));
+    }
+    f.max_velocity = a < profile.axes.size() ? profile.axes[a].max_velocity : 0;
+    f.max_acceleration = a < profile.axes.size() ? profile.axes[a].max_acceleration : 0;
+    f.following = a < run.max_following_error_mm.size();
+    if (f.following) f.max_following_error_mm = run.max_following_error_mm[a];
+    f.has_rms = a < run.rms_following_error_mm.size();
+    if (f.has_rms) f.rms_following_error_mm = run.rms_following_error_mm[a];
+    return f;
+}
+
 }  // namespace
+
+ReportFigures report_figures(const Plan& plan, const PlanCheck* check,
+                             const MachineProfile& profile, const TickSeries& executed,
+                             const RunSummary& run) {
+    ReportFigures f;
+    f.duration =
+        plan.duration > 0 ? plan.duration : static_cast<double>(plan.total_ticks) / profile.tick_hz;
+    pen_figures(plan, profile, executed, f);
+    if (check != nullptr) {
+        f.velocity_fraction_cubic = peak_of(check->axis_velocity_fraction_exact);
+        f.acceleration_fraction_cubic = peak_of(check->axis_acceleration_fraction_exact);
+    }
+    const Derivatives d = differentiate(executed, profile);
+    f.executed_half_window = d.half_window;
+    f.executed_acceleration_noise = d.acceleration_noise;
+    for (std::size_t a = 0; a < executed.axes; ++a) {
+        f.axes.push_back(axis_figures(check, profile, executed, d, run, a));
+    }
+    return f;
+}
 
 std::string text_report(const Plan& plan, const PlanCheck* check, const MachineProfile& profile,
                         const TickSeries& executed, const RunSummary& run) {
     std::ostringstream o;
+    const ReportFigures f = report_figures(plan, check, profile, executed, run);
     const std::size_t axes = executed.axes;
     std::string names;
     for (std::size_t a = 0; a < axes; ++a) names += (a ? ", " : "") + name_of(profile, a);
@@ -56,9 +140,7 @@ std::string text_report(const Plan& plan, const PlanCheck* check, const MachineP
     o << "  machine    " << axes << " axes (" << names << "), " << fmt("%.6g", profile.tick_hz)
       << " Hz tick, " << fmt("%.6g", profile.mm_per_lsb) << " mm/LSB\n";
     o << "  plant      " << run.plant << "\n";
-    const double duration =
-        plan.duration > 0 ? plan.duration : static_cast<double>(plan.total_ticks) / profile.tick_hz;
-    o << "  duration   " << fmt("%.3f", duration) << " s planned; "
+    o << "  duration   " << fmt("%.3f", f.duration) << " s planned; "
       << fmt("%.3f", run.simulated_seconds) << " s simulated in " << fmt("%.3f", run.wall_seconds)
       << " s wall";
     if (run.wall_seconds > 0)
@@ -66,26 +148,13 @@ std::string text_report(const Plan& plan, const PlanCheck* check, const MachineP
     o << (run.realtime ? ", paced" : "") << "\n";
     o << "  path       " << fmt("%.2f", plan.path_length) << " mm pen-down, "
       << fmt("%.2f", plan.travel_length) << " mm travel, " << run.pen_switches << " pen switches\n";
-    // Pen: what the pen-lift output did on the executed ticks, and the time the plan holds the
-    // axes still while the pen moves (no drawing then).
     {
-        std::uint64_t downs = 0, ups = 0, down_ticks = 0;
-        for (std::size_t k = 0; k < executed.pen_down.size(); ++k) {
-            const bool down = executed.pen_down[k] != 0;
-            const bool before = k > 0 && executed.pen_down[k - 1] != 0;
-            down_ticks += down ? 1 : 0;
-            if (down && !before) ++downs;
-            if (!down && before) ++ups;
-        }
-        std::uint64_t dwell_ticks = 0;
-        for (const auto& e : plan.pen) {
-            dwell_ticks += delay_ticks(e.down ? profile.pen_down_delay : profile.pen_up_delay, profile.tick_hz);
-        }
-        const double total = static_cast<double>(executed.pen_down.size());
-        o << "  pen        " << downs << " down, " << ups << " up; down "
-          << fmt("%.3f", static_cast<double>(down_ticks) / profile.tick_hz) << " s ("
-          << fmt("%.0f", total > 0 ? 100.0 * static_cast<double>(down_ticks) / total : 0.0) << " %), dwells "
-          << fmt("%.3f", static_cast<double>(dwell_ticks) / profile.tick_hz) << " s\n";
+        const double total = static_cast<double>(f.executed_ticks);
+        const double down_ticks = static_cast<double>(f.pen_down_ticks);
+        o << "  pen        " << f.pen_downs << " down, " << f.pen_ups << " up; down "
+          << fmt("%.3f", down_ticks / profile.tick_hz) << " s ("
+          << fmt("%.0f", total > 0 ? 100.0 * down_ticks / total : 0.0) << " %), dwells "
+          << fmt("%.3f", static_cast<double>(f.dwell_ticks) / profile.tick_hz) << " s\n";
     }
     o << "  device     " << run.ticks << " ticks, " << run.spans << " spans, " << run.underruns
       << " underruns";
@@ -94,19 +163,14 @@ std::string text_report(const Plan& plan, const PlanCheck* check, const MachineP
     // Figures against the limits say what they measure: the exact cubic (what a device that
     // validates spans checks), the integer setpoints' differences in LSB next to the limit in
     // LSB, and the executed series' smoothed differences.
-    const auto exact_peak = [&](const std::vector<double>& f) {
-        double m = 0;
-        for (const double x : f) m = std::max(m, x);
-        return m;
-    };
     if (check != nullptr) {
         o << "  deviation  " << fmt("%.2f", check->max_deviation * 1000) << " um max (tick "
           << check->worst_deviation_tick << "), tolerance "
           << fmt("%.2f", profile.chord_tolerance * 1000) << " um (planner check)\n";
         o << "  limits     "
           << (check->within_limits ? "within the axis limits" : "LIMITS EXCEEDED")
-          << " (exact cubic peak: v " << percent2(exact_peak(check->axis_velocity_fraction_exact))
-          << " %, a " << percent2(exact_peak(check->axis_acceleration_fraction_exact)) << " %)\n";
+          << " (exact cubic peak: v " << percent2(f.velocity_fraction_cubic) << " %, a "
+          << percent2(f.acceleration_fraction_cubic) << " %)\n";
         if (check->max_velocity_fraction > 1 || check->max_acceleration_fraction > 1) {
             o << "             setpoint differences over limit + rounding (v "
               << percent(check->max_velocity_fraction) << " %, a "
@@ -117,56 +181,38 @@ std::string text_report(const Plan& plan, const PlanCheck* check, const MachineP
     }
 
     // Per axis: peaks against the limits, then the following error.
-    const Derivatives d = differentiate(executed, profile);
     const bool following = !run.max_following_error_mm.empty();
     o << "\n            velocity peak                      acceleration peak\n"
       << "  axis      cubic   setpoints  executed     cubic   setpoints  executed\n"
       << "            % lim    LSB/tick     % lim     % lim  LSB/tick^2     % lim\n";
-    for (std::size_t a = 0; a < axes; ++a) {
-        double v = 0, acc = 0;
-        for (std::size_t k = 0; k < executed.ticks(); ++k) {
-            v = std::max(v, std::fabs(d.velocity[k * axes + a]));
-            acc = std::max(acc, std::fabs(d.acceleration[k * axes + a]));
-        }
-        const double v_lim = a < profile.axes.size() ? profile.axes[a].max_velocity : 0;
-        const double a_lim = a < profile.axes.size() ? profile.axes[a].max_acceleration : 0;
-        const bool checked = check != nullptr && a < check->axis_velocity_fraction_exact.size() &&
-                             a < check->axis_acceleration_fraction_exact.size() &&
-                             a < check->axis_max_step.size() &&
-                             a < check->axis_max_second_difference.size() &&
-                             a < check->axis_velocity_limit_lsb.size() &&
-                             a < check->axis_acceleration_limit_lsb.size();
+    for (const AxisFigures& x : f.axes) {
         const auto steps = [&](std::int64_t peak, double limit) {
             return std::to_string(peak) + " of " + fmt("%.4g", limit);
         };
-        o << "  " << pad_right(name_of(profile, a), 6)
-          << pad(checked ? percent2(check->axis_velocity_fraction_exact[a]) : "-", 9)
-          << pad(checked ? steps(check->axis_max_step[a], check->axis_velocity_limit_lsb[a]) : "-",
-                 12)
-          << pad(v_lim > 0 ? percent(v / v_lim) : "-", 10)
-          << pad(checked ? percent2(check->axis_acceleration_fraction_exact[a]) : "-", 10)
-          << pad(checked ? steps(check->axis_max_second_difference[a],
-                                 check->axis_acceleration_limit_lsb[a])
-                         : "-",
-                 12)
-          << pad(a_lim > 0 ? percent(acc / a_lim) : "-", 10) << "\n";
+        o << "  " << pad_right(x.name, 6)
+          << pad(x.checked ? percent2(x.velocity_fraction_cubic) : "-", 9)
+          << pad(x.checked ? steps(x.max_step, x.velocity_limit_lsb) : "-", 12)
+          << pad(x.max_velocity > 0 ? percent(x.executed_velocity / x.max_velocity) : "-", 10)
+          << pad(x.checked ? percent2(x.acceleration_fraction_cubic) : "-", 10)
+          << pad(x.checked ? steps(x.max_second_difference, x.acceleration_limit_lsb) : "-", 12)
+          << pad(x.max_acceleration > 0 ? percent(x.executed_acceleration / x.max_acceleration)
+                                        : "-",
+                 10)
+          << "\n";
     }
     o << "  cubic      the spans' exact cubics before rounding: what the device checks\n"
       << "  setpoints  largest integer difference \"of\" the limit, both in LSB; rounding\n"
       << "             adds < 1 LSB/tick to a step, < 2 LSB/tick^2 to a 2nd difference\n";
-    o << "  executed   setpoint differences over +/-" << d.half_window
-      << " ticks (a noise <= " << fmt("%.0f", d.acceleration_noise) << " mm/s^2)\n";
+    o << "  executed   setpoint differences over +/-" << f.executed_half_window
+      << " ticks (a noise <= " << fmt("%.0f", f.executed_acceleration_noise) << " mm/s^2)\n";
     if (following) {
         o << "\n  axis      following error um\n"
           << "                 max       rms\n";
-        for (std::size_t a = 0; a < axes && a < run.max_following_error_mm.size(); ++a) {
-            o << "  " << pad_right(name_of(profile, a), 6)
-              << pad(fmt("%.1f", run.max_following_error_mm[a] * 1000), 11)
-              << pad(a < run.rms_following_error_mm.size()
-                         ? fmt("%.1f", run.rms_following_error_mm[a] * 1000)
-                         : "-",
-                     10)
-              << "\n";
+        for (const AxisFigures& x : f.axes) {
+            if (!x.following) break;
+            o << "  " << pad_right(x.name, 6)
+              << pad(fmt("%.1f", x.max_following_error_mm * 1000), 11)
+              << pad(x.has_rms ? fmt("%.1f", x.rms_following_error_mm * 1000) : "-", 10) << "\n";
         }
     } else {
         o << "  following error: 0 (ideal plant: position = setpoint)\n";

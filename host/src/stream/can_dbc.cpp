@@ -1,5 +1,5 @@
 // DBC text from the protocol's declaration (device/can_protocol.hpp): one BO_ per message,
-// one SG_ per signal (little-endian, unsigned, scale 1), comments with the meaning.
+// one SG_ per signal (little-endian, scale 1), comments with the meaning, value tables.
 #include "pathstream/host/can_dbc.hpp"
 
 #include <sstream>
@@ -28,9 +28,15 @@ std::string can_dbc(std::uint8_t node) {
             o << " SG_ " << s.name;
             if (s.mux == -2) o << " M";
             if (s.mux >= 0) o << " m" << s.mux;
+            // Signed signals are two's complement: DBC's "-" and a range around zero.
             const unsigned long long max = bits >= 64 ? ~0ull : (1ull << bits) - 1;
-            o << " : " << 8u * s.byte << '|' << bits << "@1+ (1,0) [0|" << max << "] \"" << s.unit << "\" "
-              << (m.from_device ? "Host" : "Device") << '\n';
+            o << " : " << 8u * s.byte << '|' << bits << "@1" << (s.is_signed ? '-' : '+') << " (1,0) [";
+            if (s.is_signed) {
+                o << '-' << (max >> 1) + 1 << '|' << (max >> 1);
+            } else {
+                o << "0|" << max;
+            }
+            o << "] \"" << s.unit << "\" " << (m.from_device ? "Host" : "Device") << '\n';
         }
     }
     o << '\n';
@@ -42,6 +48,12 @@ std::string can_dbc(std::uint8_t node) {
         for (unsigned i = 0; i < m.signal_count; ++i) {
             o << "CM_ SG_ " << pc::can_id(m.base, node) << ' ' << m.signals[i].name << " \"" << m.signals[i].comment
               << "\";\n";
+        }
+    }
+    for (const pc::Message& m : pc::kMessages) {
+        for (unsigned i = 0; i < m.signal_count; ++i) {
+            if (m.signals[i].values == nullptr) continue;
+            o << "VAL_ " << pc::can_id(m.base, node) << ' ' << m.signals[i].name << ' ' << m.signals[i].values << " ;\n";
         }
     }
     return o.str();

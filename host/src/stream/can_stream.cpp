@@ -11,6 +11,9 @@
 #include <thread>
 #include <vector>
 
+#include "can_link.hpp"
+#include "stream_interrupt.hpp"
+#include "pathstream/host/device_link.hpp"
 #include "pathstream/device/can_protocol.hpp"
 #include "pathstream/device/motion_device.hpp"
 #include "pathstream/device/wire_span.hpp"
@@ -24,59 +27,63 @@ namespace {
 namespace pc = device::can;
 using Clock = std::chrono::steady_clock;
 
-const char* state_name(std::uint8_t s) {
-    static const char* const names[] = {"idle", "running", "holding", "stopping", "fault", "e-stop"};
-    return s < 6 ? names[s] : "unknown";
-}
-
-std::string result_name(std::uint8_t r) {
-    switch (r) {
-        case pc::kResultIncomplete: return "incomplete transfer";
-        case pc::kResultBadFrame: return "bad frame";
-        case pc::kResultTooLong: return "batch too long";
-        default: return status_name(static_cast<Status>(r));
-    }
-}
-
 class CanStreamer {
 public:
     CanStreamer(const Plan& plan, const MachineProfile& profile, hal::CanBus& bus, const CanStreamOptions& options)
-        : plan_(plan), profile_(profile), bus_(bus), options_(options), node_(options.node) {
-        if (node_ < pc::kMinNode || node_ > pc::kMaxNode) throw std::invalid_argument("CAN node id outside 1..127");
+        : plan_(plan), profile_(profile), options_(options), node_(options.node), link_(bus, options, report_) {}
+
+    /// Identity and state checked, the device's rest position (LSB per axis, status E).
+    std::vector<Lsb> rest_position() {
+        link_.mark_alive();
+        axes_ = static_cast<unsigned>(profile_.axes.size());
+        const pc::Status3 s = link_.request_status();
+        check_identity(s, false);
+        return std::vector<Lsb>(s.position, s.position + axes_);
     }
 
     CanStreamReport run(const StreamProgress& progress) {
         const auto wall_start = Clock::now();
-        last_heard_ = Clock::now();
+        link_.mark_alive();
         encode_plan();
-        pc::Status3 s = request_status();
-        check_identity(s);
-        configure();
-        base_ = s.last_accepted + 1;
-        acknowledged_ = s.last_accepted;
+        pc::Status3 s = link_.request_status();
+        std::size_t next = 0;
+        if (options_.held != nullptr) {
+            next = continue_held(s);
+        } else {
+            check_identity(s);
+            configure();
+            base_ = s.last_accepted + 1;
+            acknowledged_ = s.last_accepted;
+        }
         free_slots_ = s.free_slots;
+        // A held job goes on with a resume (the device's own re-entry) instead of a start.
+        const device::Command go = options_.held != nullptr ? device::Command::kResume : device::Command::kStart;
         const auto lead_target =
             static_cast<std::uint64_t>(std::ceil(options_.lead_seconds * profile_.tick_hz));
-        std::size_t next = 0;
         bool started = false;
+        StreamInterrupt interrupt(options_.interrupt);
         while (true) {
+            const StreamInterrupt::Action action = interrupt.next_action(started);
+            if (action == StreamInterrupt::Action::kHold) command(static_cast<std::uint8_t>(device::Command::kHold), true);
+            if (action == StreamInterrupt::Action::kStop) command(static_cast<std::uint8_t>(device::Command::kStop), true);
             const std::uint64_t lead = queued_ticks(s, next);
-            if (next < spans_.size() && free_slots_ > 0 && (lead < lead_target || !started)) {
+            if (!interrupt.active() && next < spans_.size() && free_slots_ > 0 && (lead < lead_target || !started)) {
                 send_batch(next);
                 // Flow control: never more than the device's free slots, as last reported.
                 s.last_accepted = acknowledged_;
             } else {
                 std::this_thread::sleep_for(std::chrono::milliseconds(options_.poll_interval_ms));
-                s = request_status();
+                s = link_.request_status();
                 free_slots_ = s.free_slots;
-                check_running(s, started);
+                observe(s, interrupt);
+                check_running(s, started && !interrupt.stop_sent());
             }
-            if (!started && (queued_ticks(s, next) >= lead_target || next == spans_.size())) {
-                command(static_cast<std::uint8_t>(device::Command::kStart), false);
+            if (!started && !interrupt.active() && (queued_ticks(s, next) >= lead_target || next == spans_.size())) {
+                command(static_cast<std::uint8_t>(go), false);
                 started = true;
                 started_at_ = Clock::now();
             }
-            if (s.state == static_cast<std::uint8_t>(device::DeviceState::kHolding) &&
+            if (!interrupt.active() && s.state == static_cast<std::uint8_t>(device::DeviceState::kHolding) &&
                 (s.flags & pc::kFlagHeldByUnderrun) != 0 && s.queued > 0) {
                 command(static_cast<std::uint8_t>(device::Command::kResume), true);
             }
@@ -87,9 +94,14 @@ public:
             // The plan is one job (its last span marks the end): done when the device reports
             // it finished, idle at its end point.
             if (job_finished(s)) break;
+            if (interrupt.active() && interrupt.settled(snapshot_of(s))) {
+                report_.interrupted = interrupt.outcome();
+                break;
+            }
         }
+        report_.final_status = snapshot_of(s);
         report_.ticks_executed = s.finished_job_ticks;
-        report_.job = s.finished_job;
+        report_.job = report_.interrupted != 0 ? base_ : s.finished_job;
         report_.last_completed = s.last_completed - base_ + 1;
         report_.duplicates = s.duplicates;
         report_.underruns = s.underruns;
@@ -109,117 +121,40 @@ private:
 
     [[noreturn]] void fail(const std::string& what) const { throw StreamError(options_.name + ": " + what); }
 
-    // ---- the bus -----------------------------------------------------------------------
-
-    void send(const pc::Frame& f) {
-        hal::CanFrame h;
-        h.id = f.id;
-        h.length = f.length;
-        std::copy(f.data, f.data + 8, h.data);
-        while (true) {
-            const hal::CanSendResult r = bus_.send(h);
-            if (r == hal::CanSendResult::kQueued) break;
-            if (r == hal::CanSendResult::kBusOff) fail("the host's CAN controller is bus-off: stopping");
-            if (r == hal::CanSendResult::kError) fail("the CAN interface refused a frame (down?)");
-            // Queue full: let the controller drain; a dead bus shows up as the link timeout.
-            check_link();
-            hal::CanFrame in;
-            if (bus_.receive(in, 200)) take(in);
+    // A held job (docs/cli.md, "Interrupt and resume"): the device must hold it, configured,
+    // with no span of it dropped; returns the index of the first span it has not accepted.
+    std::size_t continue_held(const pc::Status3& s) {
+        check_identity(s, false, device::DeviceState::kHolding);
+        const HeldJob& h = *options_.held;
+        if ((s.flags & pc::kFlagConfigured) == 0) {
+            fail("device lost its configuration: it restarted; resume from its rest instead");
         }
-        ++report_.frames_sent;
-        report_.bits_sent += pc::frame_bits_worst_case(f.length);
-    }
-
-    // Receives one frame from our node within `timeout_us`; false when none came.
-    bool next_frame(pc::Frame& out, std::uint32_t timeout_us) {
-        const auto deadline = Clock::now() + std::chrono::microseconds(timeout_us);
-        while (true) {
-            const auto left = std::chrono::duration_cast<std::chrono::microseconds>(deadline - Clock::now()).count();
-            hal::CanFrame in;
-            if (!bus_.receive(in, static_cast<std::uint32_t>(std::max<long long>(0, left)))) return false;
-            if (take(in)) {
-                out.id = in.id;
-                out.length = in.length;
-                std::copy(in.data, in.data + 8, out.data);
-                return true;
-            }
-            if (Clock::now() >= deadline) return false;
-        }
-    }
-
-    // True for a device -> host frame of our node (counted, and the link is alive).
-    bool take(const hal::CanFrame& in) {
-        if (in.extended || in.remote || pc::node_of(in.id) != node_) return false;
-        const std::uint32_t f = pc::function_of(in.id);
-        if (f != pc::kAckBase && f != pc::kStatusABase && f != pc::kStatusBBase &&
-            f != pc::kStatusCBase && f != pc::kStatusDBase) {
-            return false;
-        }
-        ++report_.frames_received;
-        report_.bits_received += pc::frame_bits_worst_case(in.length);
-        last_heard_ = Clock::now();
-        return true;
-    }
-
-    void check_link() const {
-        const double silent = std::chrono::duration<double>(Clock::now() - last_heard_).count();
-        if (bus_.state() == hal::CanBusState::kBusOff) fail("the host's CAN controller is bus-off: stopping");
-        if (silent > options_.link_timeout_seconds) {
+        if (s.last_accepted < h.job || s.last_accepted - h.job >= spans_.size() || s.last_completed + 1 < h.job) {
             std::ostringstream m;
-            m << "no answer from node " << unsigned(node_) << " for " << std::fixed;
-            m.precision(1);
-            m << silent << " s (device off the bus, bus-off, or not there): stopping; a device that was "
-                           "running holds by itself";
+            m << "device holds spans up to " << s.last_accepted << ", not job " << h.job << " of " << spans_.size()
+              << " spans";
             fail(m.str());
         }
+        base_ = h.job;
+        acknowledged_ = s.last_accepted;
+        const std::size_t completed = s.last_completed + 1 - h.job;
+        start_ticks_ = s.ticks_executed - static_cast<std::uint32_t>(prefix_ticks_[completed]);
+        return s.last_accepted + 1 - h.job;
     }
 
-    std::uint32_t ack_timeout_us() const { return options_.ack_timeout_ms * 1000u; }
-
-    // Waits for an ack of `kind` for `sequence`; false on timeout.
-    bool wait_ack(std::uint8_t kind, std::uint32_t sequence, pc::Ack& ack) {
-        const auto deadline = Clock::now() + std::chrono::microseconds(ack_timeout_us());
-        while (Clock::now() < deadline) {
-            pc::Frame f;
-            const auto left = std::chrono::duration_cast<std::chrono::microseconds>(deadline - Clock::now()).count();
-            if (!next_frame(f, static_cast<std::uint32_t>(std::max<long long>(0, left)))) break;
-            if (pc::function_of(f.id) != pc::kAckBase || !pc::decode_ack(f, ack)) continue;
-            if (ack.kind == kind && ack.sequence == sequence) return true;  // stale acks are ignored
-        }
-        ++report_.timeouts;
-        check_link();
-        return false;
+    void observe(const pc::Status3& s, const StreamInterrupt& interrupt) const {
+        if (!options_.observer) return;
+        StreamTrace t;
+        t.job = base_;
+        t.acknowledged = acknowledged_;
+        t.status = snapshot_of(s);
+        t.hold_requested = interrupt.hold_sent();
+        t.stop_requested = interrupt.stop_sent();
+        options_.observer(t);
     }
 
-    // ---- protocol steps ------------------------------------------------------------------
-
-    pc::Status3 request_status() {
-        while (true) {
-            send(pc::encode_command(node_, pc::kCommandStatusRequest));
-            ++report_.status_requests;
-            pc::Status3 s;
-            unsigned seen = 0;
-            const auto deadline = Clock::now() + std::chrono::microseconds(ack_timeout_us());
-            constexpr unsigned kAll = (1u << pc::kStatusFrames) - 1u;
-            while (seen != kAll && Clock::now() < deadline) {
-                pc::Frame f;
-                const auto left = std::chrono::duration_cast<std::chrono::microseconds>(deadline - Clock::now()).count();
-                if (!next_frame(f, static_cast<std::uint32_t>(std::max<long long>(0, left)))) break;
-                const std::uint32_t fn = pc::function_of(f.id);
-                if (pc::decode_status_part(f, s)) {
-                    seen |= fn == pc::kStatusABase   ? 1u
-                            : fn == pc::kStatusBBase ? 2u
-                            : fn == pc::kStatusCBase ? 4u
-                                                     : 8u;
-                }
-            }
-            if (seen == kAll) return s;
-            ++report_.timeouts;
-            check_link();
-        }
-    }
-
-    void check_identity(const pc::Status3& s) {
+    void check_identity(const pc::Status3& s, bool check_start = true,
+                        device::DeviceState wanted = device::DeviceState::kIdle) {
         std::ostringstream m;
         if (s.version != pc::kProtocolVersion) {
             m << "device speaks native CAN protocol version " << unsigned(s.version) << ", this host "
@@ -230,10 +165,24 @@ private:
             m << "device has " << unsigned(s.axes) << " axes, the plan " << axes_;
             fail(m.str());
         }
-        if (s.state != 0) {
-            m << "device is " << state_name(s.state) << fault_suffix(s.state, s.fault_code)
-              << ", not idle: reset or stop it first";
+        if (s.state != static_cast<std::uint8_t>(wanted)) {
+            m << "device is " << device_state_name(s.state) << fault_suffix(s.state, s.fault_code);
+            if (wanted == device::DeviceState::kIdle) {
+                m << ", not idle: reset or stop it first";
+            } else {
+                m << ", not holding the job";
+            }
             fail(m.str());
+        }
+        for (unsigned a = 0; a < axes_ && check_start; ++a) {
+            if (s.position[a] != plan_start_[a]) {
+                m << "device rests at";
+                for (unsigned b = 0; b < axes_; ++b) m << ' ' << s.position[b];
+                m << " LSB but the plan starts at";
+                for (unsigned b = 0; b < axes_; ++b) m << ' ' << plan_start_[b];
+                m << " LSB (--lead-in plans a pen-up move from where it rests)";
+                fail(m.str());
+            }
         }
         start_ticks_ = s.ticks_executed;
     }
@@ -251,24 +200,19 @@ private:
                                            static_cast<std::uint8_t>(axes_), l.pen_down_ticks));
         const std::uint8_t last_item = pc::kConfigItemPenDown;
         while (true) {
-            for (const pc::Frame& f : frames) send(f);
+            for (const pc::Frame& f : frames) link_.send(f);
             pc::Ack ack;
-            if (!wait_ack(pc::kAckConfig, last_item, ack)) continue;
+            if (!link_.wait_ack(pc::kAckConfig, last_item, ack)) continue;
             if (ack.result == pc::kResultIncomplete) continue;  // a configuration frame was lost
-            if (ack.result != 0) fail("device refused the configuration (tick rate and limits): " + result_name(ack.result));
+            if (ack.result != 0) fail("device refused the configuration (tick rate and limits): " + can_result_name(ack.result));
             return;
         }
     }
 
     void command(std::uint8_t c, bool tolerate_refusal) {
-        while (true) {
-            send(pc::encode_command(node_, c));
-            pc::Ack ack;
-            if (!wait_ack(pc::kAckCommand, c, ack)) continue;  // lost: commands are idempotent
-            if (ack.result != 0 && !tolerate_refusal) {
-                fail("device refused command " + std::to_string(c) + ": " + result_name(ack.result));
-            }
-            return;
+        const std::uint8_t result = link_.command(c);
+        if (result != 0 && !tolerate_refusal) {
+            fail("device refused command " + std::to_string(c) + ": " + can_result_name(result));
         }
     }
 
@@ -288,13 +232,13 @@ private:
         start.length = static_cast<std::uint16_t>(payload.size());
         for (bool first_try = true;; first_try = false) {
             if (!first_try) ++report_.retransmissions;
-            send(pc::encode_span_start(node_, start));
+            link_.send(pc::encode_span_start(node_, start));
             const std::size_t frames = pc::data_frames(payload.size());
             for (std::size_t i = 0; i < frames; ++i) {
-                send(pc::encode_span_data(node_, static_cast<std::uint8_t>(i), payload.data(), payload.size()));
+                link_.send(pc::encode_span_data(node_, static_cast<std::uint8_t>(i), payload.data(), payload.size()));
             }
             pc::Ack ack;
-            if (!wait_ack(pc::kAckSpans, first, ack)) continue;  // lost frames or a lost ack: again
+            if (!link_.wait_ack(pc::kAckSpans, first, ack)) continue;  // lost frames or a lost ack: again
             free_slots_ = ack.free_slots;
             if (ack.result == pc::kResultIncomplete) {
                 ++report_.incomplete;
@@ -304,7 +248,7 @@ private:
             if (ack.result != 0) {
                 std::ostringstream m;
                 m << "device refused spans " << first - base_ + 1 << ".." << first - base_ + count << ": "
-                  << result_name(ack.result);
+                  << can_result_name(ack.result);
                 if (ack.result == static_cast<std::uint8_t>(Status::kBadSequence)) {
                     m << " (it restarted, or another master streams to node " << unsigned(node_) << ")";
                 }
@@ -323,6 +267,7 @@ private:
     void encode_plan() {
         WirePlan w = encode_wire_plan(plan_);
         axes_ = w.axes;
+        for (unsigned a = 0; a < axes_; ++a) plan_start_[a] = w.start[a];
         spans_ = std::move(w.spans);
         prefix_ticks_ = std::move(w.prefix_ticks);
     }
@@ -344,7 +289,7 @@ private:
         }
         if (s.state == static_cast<std::uint8_t>(device::DeviceState::kFault) ||
             s.state == static_cast<std::uint8_t>(device::DeviceState::kEstop)) {
-            m << "device stopped in " << state_name(s.state) << fault_suffix(s.state, s.fault_code) << " after span "
+            m << "device stopped in " << device_state_name(s.state) << fault_suffix(s.state, s.fault_code) << " after span "
               << (s.last_completed >= base_ ? s.last_completed - base_ + 1 : 0);
             fail(m.str());
         }
@@ -370,20 +315,20 @@ private:
 
     const Plan& plan_;
     const MachineProfile& profile_;
-    hal::CanBus& bus_;
     const CanStreamOptions& options_;
     std::uint8_t node_;
-    Clock::time_point last_heard_;
+    CanStreamReport report_;
+    CanLink link_;
     unsigned axes_ = 0;
     std::vector<std::vector<std::uint8_t>> spans_;
     std::vector<std::uint64_t> prefix_ticks_;
     std::uint32_t base_ = 1;
     std::uint32_t acknowledged_ = 0;
     std::uint32_t start_ticks_ = 0;
+    std::int32_t plan_start_[8] = {};  // the plan's first point, LSB
     std::size_t free_slots_ = 0;
     Clock::time_point started_at_;
     bool seen_running_ = false;
-    CanStreamReport report_;
 };
 
 }  // namespace
@@ -428,6 +373,13 @@ CanTarget parse_can_target(const std::string& url) {
     }
     if (!have_node) throw std::invalid_argument(url + ": node=N (1..127) missing");
     return t;
+}
+
+std::vector<Lsb> can_rest_position(const MachineProfile& profile, hal::CanBus& bus,
+                                   const CanStreamOptions& options) {
+    const Plan none;
+    CanStreamer s(none, profile, bus, options);
+    return s.rest_position();
 }
 
 CanStreamReport stream_can(const Plan& plan, const MachineProfile& profile, hal::CanBus& bus,

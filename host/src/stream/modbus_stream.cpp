@@ -14,6 +14,8 @@
 #include "pathstream/device/wire_span.hpp"
 #include "pathstream/host/device_setup.hpp"
 #include "pathstream/host/wire_plan.hpp"
+#include "modbus_link.hpp"
+#include "stream_interrupt.hpp"
 #include "pathstream/hal/modbus_client.hpp"
 #include "pathstream/hal/modbus_error.hpp"
 #include "pathstream/status.hpp"
@@ -25,53 +27,17 @@ namespace mb = device::modbus;
 namespace st = device::modbus::status;
 using Clock = std::chrono::steady_clock;
 
-std::uint32_t u32(const std::uint16_t* r) { return (static_cast<std::uint32_t>(r[0]) << 16) | r[1]; }
-
-struct DeviceStatus {
-    std::uint16_t magic = 0, version = 0, state = 0, fault = 0, free_slots = 0, capacity = 0, axes = 0;
-    std::uint32_t last_accepted = 0, ticks = 0, last_completed = 0;
-    std::uint16_t underruns = 0, last_refusal = 0, duplicates = 0, queued = 0, flags = 0;
-    std::uint32_t finished_job = 0, finished_job_ticks = 0, epoch = 0;
-    std::int32_t position[8] = {};
-
-    static DeviceStatus parse(const std::uint16_t* r) {
-        DeviceStatus s;
-        s.magic = r[st::kMagic];
-        s.version = r[st::kVersion];
-        s.state = r[st::kState];
-        s.fault = r[st::kFaultCode];
-        s.free_slots = r[st::kFreeSlots];
-        s.capacity = r[st::kCapacity];
-        s.last_accepted = u32(&r[st::kLastAcceptedSequence]);
-        s.ticks = u32(&r[st::kTicksExecuted]);
-        for (unsigned a = 0; a < 8; ++a) s.position[a] = static_cast<std::int32_t>(u32(&r[st::kPositions + 2 * a]));
-        s.axes = r[st::kAxes];
-        s.underruns = r[st::kUnderruns];
-        s.last_completed = u32(&r[st::kLastCompletedSequence]);
-        s.last_refusal = r[st::kLastRefusal];
-        s.duplicates = r[st::kDuplicates];
-        s.queued = r[st::kQueuedSpans];
-        s.flags = r[st::kFlags];
-        s.finished_job = u32(&r[st::kFinishedJob]);
-        s.finished_job_ticks = u32(&r[st::kFinishedJobTicks]);
-        s.epoch = u32(&r[st::kEpoch]);
-        return s;
-    }
-};
-
-const char* state_name(std::uint16_t s) {
-    static const char* const names[] = {"idle", "running", "holding", "stopping", "fault", "e-stop"};
-    return s < 6 ? names[s] : "unknown";
-}
+using DeviceStatus = DeviceSnapshot;
 
 class Streamer {
 public:
     Streamer(const Plan& plan, const MachineProfile& profile, const StreamOptions& options)
-        : plan_(plan), profile_(profile), options_(options), client_(connect(options)) {}
+        : plan_(plan), profile_(profile), options_(options), link_(options) {}
 
     /// Identity and state checked, the device's rest position (LSB per axis).
     std::vector<Lsb> rest_position() {
-        last_ok_ = last_batch_ok_ = Clock::now();
+        link_.mark_alive();
+        last_batch_ok_ = Clock::now();
         axes_ = static_cast<unsigned>(profile_.axes.size());
         const DeviceStatus s = read_status();
         check_identity(s, false);
@@ -80,20 +46,34 @@ public:
 
     StreamReport run(const StreamProgress& progress) {
         const auto wall_start = Clock::now();
-        last_ok_ = last_batch_ok_ = Clock::now();
+        link_.mark_alive();
+        last_batch_ok_ = Clock::now();
         encode_plan();
         DeviceStatus s = read_status();
-        check_identity(s);
-        configure();
-        rate_ = profile_.tick_hz;
-        base_ = s.last_accepted + 1;
-        acknowledged_ = s.last_accepted;
-        const std::uint64_t lead_target = static_cast<std::uint64_t>(std::ceil(options_.lead_seconds * profile_.tick_hz));
         std::size_t next = 0;
+        if (options_.held != nullptr) {
+            next = continue_held(s);
+        } else {
+            check_identity(s);
+            configure();
+            base_ = s.last_accepted + 1;
+            acknowledged_ = s.last_accepted;
+        }
+        // A held job goes on with a resume (the device's own re-entry) instead of a start.
+        const device::Command go = options_.held != nullptr ? device::Command::kResume : device::Command::kStart;
+        rate_ = profile_.tick_hz;
+        const std::uint64_t lead_target = static_cast<std::uint64_t>(std::ceil(options_.lead_seconds * profile_.tick_hz));
         bool started = false;
+        StreamInterrupt interrupt(options_.interrupt);
         while (true) {
+            const StreamInterrupt::Action action = interrupt.next_action(started);
+            if (action == StreamInterrupt::Action::kHold) command(device::Command::kHold, true);
+            if (action == StreamInterrupt::Action::kStop) command(device::Command::kStop, true);
             const std::uint64_t lead = queued_ticks(s, next);
-            if (next < spans_.size() && s.free_slots > 0 && (lead < lead_target || !started)) {
+            if (interrupt.active()) {
+                std::this_thread::sleep_for(std::chrono::milliseconds(options_.poll_interval_ms));
+                s = read_status();
+            } else if (next < spans_.size() && s.free_slots > 0 && (lead < lead_target || !started)) {
                 s = send_batch(next, s.free_slots);
             } else {
                 bool predicted = false;
@@ -107,34 +87,41 @@ public:
                     s = read_status();
                 }
             }
+            observe(s, interrupt);
             observe_rate(s, started);
-            check_running(s, started);
+            check_running(s, started && !interrupt.stop_sent());
             // Start once the lead is queued, or everything is, or the device's queue is full
             // (a lead longer than the queue holds would otherwise never start).
-            if (!started && (queued_ticks(s, next) >= lead_target || next == spans_.size() || s.free_slots == 0)) {
-                command(device::Command::kStart, false);
+            if (!started && !interrupt.active() &&
+                (queued_ticks(s, next) >= lead_target || next == spans_.size() || s.free_slots == 0)) {
+                command(go, false);
                 started = true;
                 started_at_ = Clock::now();
             }
-            if (s.state == static_cast<std::uint16_t>(device::DeviceState::kHolding) && (s.flags & 2u) != 0 &&
-                s.queued > 0) {
+            if (!interrupt.active() && s.state == static_cast<std::uint16_t>(device::DeviceState::kHolding) &&
+                (s.flags & 2u) != 0 && s.queued > 0) {
                 command(device::Command::kResume, true);
             }
             if (progress) {
-                progress(static_cast<double>(s.ticks - start_ticks_) / static_cast<double>(plan_.total_ticks),
+                progress(static_cast<double>(s.ticks_executed - start_ticks_) / static_cast<double>(plan_.total_ticks),
                          static_cast<double>(queued_ticks(s, next)) / profile_.tick_hz);
             }
             // The plan is one job (its last span marks the end): done when the device reports
             // it finished, idle at its end point.
             if (job_finished(s)) break;
+            if (interrupt.active() && interrupt.settled(s)) {
+                report_.interrupted = interrupt.outcome();
+                break;
+            }
         }
+        report_.final_status = s;
         report_.ticks_executed = s.finished_job_ticks;
-        report_.job = s.finished_job;
+        report_.job = report_.interrupted != 0 ? base_ : s.finished_job;
         report_.last_completed = s.last_completed;
         report_.duplicates = s.duplicates;
         report_.underruns = s.underruns;
         for (unsigned a = 0; a < 8; ++a) report_.final_position[a] = s.position[a];
-        const auto& c = client_.counters();
+        const auto& c = link_.client().counters();
         report_.transactions = c.transactions;
         report_.retries = c.retries;
         report_.attempts = c.attempts;
@@ -147,30 +134,35 @@ public:
     }
 
 private:
-    static hal::ModbusClientOptions client_options(const StreamOptions& o) {
-        hal::ModbusClientOptions c;
-        c.response_timeout = std::chrono::milliseconds(o.response_timeout_ms);
-        // A response that lost a byte would otherwise wait libmodbus's 500 ms byte timeout
-        // for it, whatever the response timeout: one gap of that size is already a lost frame.
-        c.byte_timeout = c.response_timeout;
-        c.attempts = static_cast<int>(std::max(1u, o.attempts));
-        return c;
+    // A held job (docs/cli.md, "Interrupt and resume"): the device must hold it, configured,
+    // with no span of it dropped; returns the index of the first span it has not accepted.
+    std::size_t continue_held(const DeviceStatus& s) {
+        check_identity(s, false, device::DeviceState::kHolding);
+        const HeldJob& h = *options_.held;
+        if ((s.flags & 1u) == 0) fail("device lost its configuration: it restarted; resume from its rest instead");
+        if (s.last_accepted < h.job || s.last_accepted - h.job >= spans_.size() || s.last_completed + 1 < h.job) {
+            std::ostringstream m;
+            m << "device holds spans up to " << s.last_accepted << ", not job " << h.job << " of " << spans_.size()
+              << " spans";
+            fail(m.str());
+        }
+        base_ = h.job;
+        acknowledged_ = s.last_accepted;
+        configured_ = true;
+        const std::size_t completed = s.last_completed + 1 - h.job;
+        start_ticks_ = s.ticks_executed - static_cast<std::uint32_t>(prefix_ticks_[completed]);
+        return s.last_accepted + 1 - h.job;
     }
 
-    // The first connection, tried until link_timeout_seconds have passed (a device may still
-    // be starting); then a StreamError like every other dead link, not the transport's error.
-    static hal::ModbusClient connect(const StreamOptions& o) {
-        const auto begin = Clock::now();
-        while (true) {
-            try {
-                return hal::ModbusClient(o.target, client_options(o));
-            } catch (const hal::ModbusError& e) {
-                if (std::chrono::duration<double>(Clock::now() - begin).count() > o.link_timeout_seconds) {
-                    throw StreamError(o.target + ": cannot connect to the device (" + e.what() + ")");
-                }
-                std::this_thread::sleep_for(std::chrono::milliseconds(50));
-            }
-        }
+    void observe(const DeviceStatus& s, const StreamInterrupt& interrupt) const {
+        if (!options_.observer) return;
+        StreamTrace t;
+        t.job = base_;
+        t.acknowledged = acknowledged_;
+        t.status = s;
+        t.hold_requested = interrupt.hold_sent();
+        t.stop_requested = interrupt.stop_sent();
+        options_.observer(t);
     }
 
     DeviceLimitsLsb limits_or_fail() const {
@@ -181,45 +173,15 @@ private:
         }
     }
 
-    [[noreturn]] void fail(const std::string& what) const {
-        throw StreamError(options_.target + ": " + what);
-    }
-
-    // Runs one transaction; transient failures past the client's own tries reconnect and
-    // retry until link_timeout_seconds have passed without any success.
-    template <typename F>
-    void transact(F&& f) {
-        while (true) {
-            try {
-                f();
-                last_ok_ = Clock::now();
-                return;
-            } catch (const hal::ModbusError& e) {
-                if (!e.transient()) throw;
-                const double silent = std::chrono::duration<double>(Clock::now() - last_ok_).count();
-                if (silent > options_.link_timeout_seconds) {
-                    std::ostringstream m;
-                    m << "no answer for " << std::lround(silent) << " s (" << e.what() << ")";
-                    fail(m.str());
-                }
-                std::this_thread::sleep_for(std::chrono::milliseconds(20));
-                try {
-                    client_.reconnect();
-                } catch (const hal::ModbusError&) {
-                    // the next try reconnects again; the deadline above bounds it
-                }
-            }
-        }
-    }
+    [[noreturn]] void fail(const std::string& what) const { link_.fail(what); }
 
     DeviceStatus read_status() {
-        std::uint16_t r[st::kCount];
-        transact([&] { client_.read_input_registers(0, std::span<std::uint16_t>(r, st::kCount)); });
         ++report_.status_reads;
-        return DeviceStatus::parse(r);
+        return link_.read_status();
     }
 
-    void check_identity(const DeviceStatus& s, bool check_start = true) {
+    void check_identity(const DeviceStatus& s, bool check_start = true,
+                        device::DeviceState wanted = device::DeviceState::kIdle) {
         std::ostringstream m;
         if (s.magic != mb::kMagic) {
             m << "not a pathstream device (register 0 is 0x" << std::hex << s.magic << ", expected 0x5053)";
@@ -233,9 +195,13 @@ private:
             m << "device has " << s.axes << " axes, the plan " << axes_;
             fail(m.str());
         }
-        if (s.state != 0) {
-            m << "device is " << state_name(s.state) << fault_suffix(s.state, s.fault)
-              << ", not idle: reset or stop it first";
+        if (s.state != static_cast<unsigned>(wanted)) {
+            m << "device is " << device_state_name(s.state) << fault_suffix(s.state, s.fault_code);
+            if (wanted == device::DeviceState::kIdle) {
+                m << ", not idle: reset or stop it first";
+            } else {
+                m << ", not holding the job";
+            }
             fail(m.str());
         }
         for (unsigned a = 0; a < axes_ && check_start; ++a) {
@@ -248,7 +214,7 @@ private:
                 fail(m.str());
             }
         }
-        start_ticks_ = s.ticks;
+        start_ticks_ = s.ticks_executed;
     }
 
     void configure() {
@@ -266,7 +232,7 @@ private:
             r[mb::kConfigAxisBase + 4 * a + 3] = static_cast<std::uint16_t>(aa & 0xFFFFu);
         }
         try {
-            transact([&] { client_.write_registers(mb::kConfig, r); });
+            link_.transact([&] { link_.client().write_registers(mb::kConfig, r); });
         } catch (const hal::ModbusError& e) {
             fail(std::string("device refused the configuration (tick rate and limits): ") + e.what() + refusal());
         }
@@ -288,7 +254,7 @@ private:
 
     void command(device::Command c, bool tolerate_refusal) {
         try {
-            transact([&] { client_.write_register(mb::kCommand, static_cast<std::uint16_t>(c)); });
+            link_.write_command(c);
         } catch (const hal::ModbusError& e) {
             if (!tolerate_refusal) fail(std::string("device refused command ") + std::to_string(static_cast<int>(c)) + ": " + e.what() + refusal());
         }
@@ -304,7 +270,7 @@ private:
 
     // Ticks of motion sent but not yet executed, exact: the device counts path ticks.
     std::uint64_t queued_ticks(const DeviceStatus& s, std::size_t sent) const {
-        const std::uint64_t done = static_cast<std::uint32_t>(s.ticks - start_ticks_);
+        const std::uint64_t done = static_cast<std::uint32_t>(s.ticks_executed - start_ticks_);
         return done >= prefix_ticks_[sent] ? 0 : prefix_ticks_[sent] - done;
     }
 
@@ -330,9 +296,9 @@ private:
         }
         std::uint16_t r[st::kCount];
         const std::uint32_t last = first + static_cast<std::uint32_t>(count) - 1;
-        const std::uint64_t retries_before = client_.counters().retries;
+        const std::uint64_t retries_before = link_.client().counters().retries;
         try {
-            client_.write_read_registers(mb::kSpanWindow, window, 0, std::span<std::uint16_t>(r, st::kCount));
+            link_.client().write_read_registers(mb::kSpanWindow, window, 0, std::span<std::uint16_t>(r, st::kCount));
         } catch (const hal::ModbusError& e) {
             if (e.exception_code() == static_cast<std::uint8_t>(mb::Exception::kServerDeviceBusy)) {
                 return read_status();  // queue fuller than we knew: send later
@@ -359,15 +325,16 @@ private:
             }
             return s;
         }
-        last_ok_ = last_batch_ok_ = Clock::now();
-        if (client_.counters().retries != retries_before) {
+        link_.mark_alive();
+        last_batch_ok_ = Clock::now();
+        if (link_.client().counters().retries != retries_before) {
             shrink_batches(count);
         } else if (++clean_batches_ >= kCleanBatchesToGrow && batch_limit_ < device::kMaxBatchSpans) {
             batch_limit_ = std::min<std::size_t>(device::kMaxBatchSpans, 2 * batch_limit_);
             clean_batches_ = 0;
         }
         batch_done(next, count, last);
-        return DeviceStatus::parse(r);
+        return parse_modbus_status(r);
     }
 
     void batch_done(std::size_t& next, std::size_t count, std::uint32_t last) {
@@ -408,24 +375,24 @@ private:
     void observe_rate(const DeviceStatus& s, bool started) {
         const auto now = Clock::now();
         const double dt = std::chrono::duration<double>(now - rate_time_).count();
-        if (!started || s.state != static_cast<std::uint16_t>(device::DeviceState::kRunning) || s.ticks < rate_ticks_) {
+        if (!started || s.state != static_cast<std::uint16_t>(device::DeviceState::kRunning) || s.ticks_executed < rate_ticks_) {
             rate_time_ = now;
-            rate_ticks_ = s.ticks;
+            rate_ticks_ = s.ticks_executed;
             return;
         }
         if (dt < 0.02) return;
-        const double observed = static_cast<double>(s.ticks - rate_ticks_) / dt;
+        const double observed = static_cast<double>(s.ticks_executed - rate_ticks_) / dt;
         if (observed > 0) rate_ = std::max(rate_, observed);  // never assume slower than seen: no underrun
         rate_time_ = now;
-        rate_ticks_ = s.ticks;
+        rate_ticks_ = s.ticks_executed;
     }
 
     // A device whose sequence or tick count went backwards lost its queue: it restarted.
     void check_restart(const DeviceStatus& s) const {
         if (s.magic != mb::kMagic) fail("status block lost its magic number: not the same device");
-        if (s.last_accepted < acknowledged_ || s.ticks < start_ticks_ || (configured_ && (s.flags & 1u) == 0)) {
+        if (s.last_accepted < acknowledged_ || s.ticks_executed < start_ticks_ || (configured_ && (s.flags & 1u) == 0)) {
             std::ostringstream m;
-            m << "device restarted mid-stream (it reports sequence " << s.last_accepted << " and " << s.ticks
+            m << "device restarted mid-stream (it reports sequence " << s.last_accepted << " and " << s.ticks_executed
               << " ticks" << ((s.flags & 1u) == 0 ? ", unconfigured" : "") << "; it had acknowledged "
               << acknowledged_ << "): stopping; the drawing is incomplete, restart it from the beginning";
             fail(m.str());
@@ -437,7 +404,7 @@ private:
         check_restart(s);
         if (s.state == static_cast<std::uint16_t>(device::DeviceState::kFault) ||
             s.state == static_cast<std::uint16_t>(device::DeviceState::kEstop)) {
-            m << "device stopped in " << state_name(s.state) << fault_suffix(s.state, s.fault) << " after "
+            m << "device stopped in " << device_state_name(s.state) << fault_suffix(s.state, s.fault_code) << " after "
               << s.last_completed << " spans";
             fail(m.str());
         }
@@ -466,8 +433,7 @@ private:
     const Plan& plan_;
     const MachineProfile& profile_;
     const StreamOptions& options_;
-    hal::ModbusClient client_;
-    Clock::time_point last_ok_;
+    ModbusLink link_;
     unsigned axes_ = 0;
     std::int32_t start_[8] = {};
     std::vector<std::vector<std::uint8_t>> spans_;

@@ -30,7 +30,7 @@ public:
         return f == kCommandBase || f == kConfigBase || f == kSpanStartBase || f == kSpanDataBase;
     }
 
-    /// Handles one received frame; calls `send(const Frame&)` for each answer (0 to 4: a status request is answered by four frames).
+    /// Handles one received frame; calls `send(const Frame&)` for each answer (a status request is answered by 4 + Axes frames; anything else by 0 or 1).
     /// Frames for other nodes or functions are ignored. Cost: a batch's accept_batch when its
     /// last data frame arrives, O(1) otherwise.
     template <typename Send>
@@ -45,7 +45,8 @@ public:
         }
     }
 
-    /// Sends the status frames (A, B, C, D), every tick-side value from one status read.
+    /// Sends the status frames (A, B, C, D, then E for each axis), every tick-side value from
+    /// one status read.
     template <typename Send>
     void send_status(Send&& send) const {
         const DeviceStatus<Axes> d = device_.status();
@@ -53,6 +54,7 @@ public:
         s.state = static_cast<std::uint8_t>(d.state);
         s.flags = static_cast<std::uint8_t>((device_.configured() ? kFlagConfigured : 0) |
                                             (d.held_by_underrun() ? kFlagHeldByUnderrun : 0) |
+                                            (d.own_move() ? kFlagOwnMove : 0) |
                                             (bus_problem_ ? kFlagBusProblem : 0));
         s.free_slots = saturate8(device_.free_slots());
         s.queued = saturate8(device_.queued_spans());
@@ -69,6 +71,9 @@ public:
         Frame out[kStatusFrames];
         encode_status(node_, s, out);
         for (const Frame& o : out) send(o);
+        for (unsigned a = 0; a < Axes; ++a) {
+            send(encode_status_axis(node_, static_cast<std::uint8_t>(a), d.position[a], d.epoch));
+        }
     }
 
     /// The bus went error-passive or bus-off: the link to the host may be gone, so a running

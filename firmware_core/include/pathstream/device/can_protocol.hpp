@@ -11,6 +11,8 @@
 #include <cstddef>
 #include <cstdint>
 
+#include "pathstream/span.hpp"
+
 namespace pathstream::device::can {
 
 /// 2: job ends (wire flag kWireJobEnd, status frame D), continuity checked at every join.
@@ -29,13 +31,15 @@ inline constexpr std::uint32_t kConfigBase = 0x380;     ///< host -> device
 inline constexpr std::uint32_t kSpanStartBase = 0x400;  ///< host -> device
 inline constexpr std::uint32_t kSpanDataBase = 0x480;   ///< host -> device
 inline constexpr std::uint32_t kStatusDBase = 0x500;  ///< device -> host (jobs; added in version 2)
+/// device -> host, one frame per axis (position and queue epoch; added in version 2)
+inline constexpr std::uint32_t kStatusEBase = 0x580;
 
 /// Identifier of function `base` for node `node`. Constant, any context.
 constexpr std::uint32_t can_id(std::uint32_t base, std::uint8_t node) { return base + node; }
 /// Function base of identifier `id` (0 when `id` is not one of ours). Constant.
 constexpr std::uint32_t function_of(std::uint32_t id) {
     const std::uint32_t base = id & ~0x7Fu;
-    return (base >= kCommandBase && base <= kStatusDBase && (id & 0x7Fu) != 0) ? base : 0;
+    return (base >= kCommandBase && base <= kStatusEBase && (id & 0x7Fu) != 0) ? base : 0;
 }
 constexpr std::uint8_t node_of(std::uint32_t id) { return static_cast<std::uint8_t>(id & 0x7Fu); }
 
@@ -63,6 +67,8 @@ inline constexpr std::size_t kMaxTransferBytes = kDataBytesPerFrame * kMaxDataFr
 inline constexpr std::uint8_t kFlagConfigured = 1u << 0;
 inline constexpr std::uint8_t kFlagHeldByUnderrun = 1u << 1;
 inline constexpr std::uint8_t kFlagBusProblem = 1u << 2;  ///< the device saw error-passive or bus-off
+/// The last tick was a tick of the device's own stop or re-entry move (holding without it: at rest).
+inline constexpr std::uint8_t kFlagOwnMove = 1u << 3;
 
 /// Configuration items: 0 tick rate, 1 + 2a axis a's max velocity, 2 + 2a its acceleration,
 /// kConfigItemPenDown the pen-down delay in ticks. The pen-down delay is sent last: the device
@@ -89,7 +95,31 @@ struct Signal {
     const char* unit;
     const char* comment;
     std::int16_t mux = -1;  ///< multiplexed: present when the message's multiplexor equals this; -2: the multiplexor
+    /// DBC value table (`VAL_`): "0 \"idle\" 1 \"running\"", or nullptr. Host side only.
+    const char* values = nullptr;
 };
+
+// Value tables of the DBC, one per enumeration the frames carry.
+inline constexpr const char* kCommandValues =
+    "1 \"start\" 2 \"hold\" 3 \"resume\" 4 \"stop\" 5 \"reset\" 16 \"status request\"";
+inline constexpr const char* kStateValues =
+    "0 \"idle\" 1 \"running\" 2 \"holding\" 3 \"stopping\" 4 \"fault\" 5 \"e-stop\"";
+inline constexpr const char* kAckKindValues = "1 \"span batch\" 2 \"command\" 3 \"configuration\"";
+inline constexpr const char* kResultValues =
+    "0 \"ok\" 1 \"tick count out of range\" 2 \"control value out of range\" 3 \"curve leaves the position range\" "
+    "4 \"per-tick difference out of range\" 5 \"unknown basis\" 6 \"tick outside span\" 7 \"span queue full\" "
+    "8 \"discontinuous span\" 9 \"velocity limit\" 10 \"acceleration limit\" 11 \"bad limits\" "
+    "12 \"not configured\" 13 \"bad sequence\" 14 \"bad batch\" 15 \"wrong state\" 16 \"stop too long\" "
+    "17 \"nothing to resume\" 18 \"velocity step\" 19 \"job end moving\" 20 \"unknown command\" "
+    "128 \"incomplete transfer\" 129 \"bad frame\" 130 \"too long\"";
+inline constexpr const char* kFaultValues =
+    "0 \"none\" 1 \"external\" 2 \"stop failed\" 3 \"re-entry failed\" "
+    "256 \"limit axis 0 negative\" 257 \"limit axis 0 positive\" 258 \"limit axis 1 negative\" "
+    "259 \"limit axis 1 positive\" 260 \"limit axis 2 negative\" 261 \"limit axis 2 positive\" "
+    "262 \"limit axis 3 negative\" 263 \"limit axis 3 positive\" 264 \"limit axis 4 negative\" "
+    "265 \"limit axis 4 positive\" 266 \"limit axis 5 negative\" 267 \"limit axis 5 positive\" "
+    "268 \"limit axis 6 negative\" 269 \"limit axis 6 positive\" 270 \"limit axis 7 negative\" "
+    "271 \"limit axis 7 positive\"";
 
 struct Message {
     const char* name;
@@ -103,21 +133,24 @@ struct Message {
 
 // Signal indices below are used by the encoders: keep each table's order.
 inline constexpr Signal kCommandSignals[] = {
-    {"Command", 0, 1, false, "", "1 start, 2 hold, 3 resume, 4 stop, 5 reset, 16 status request"},
+    {"Command", 0, 1, false, "", "1 start, 2 hold, 3 resume, 4 stop, 5 reset, 16 status request", -1,
+     kCommandValues},
 };
 inline constexpr Signal kAckSignals[] = {
-    {"Kind", 0, 1, false, "", "1 span batch, 2 command, 3 configuration"},
-    {"Result", 1, 1, false, "", "core Status (0 ok, 7 queue full, 13 bad sequence, ...), 128 incomplete transfer, 129 bad frame, 130 too long"},
+    {"Kind", 0, 1, false, "", "1 span batch, 2 command, 3 configuration", -1, kAckKindValues},
+    {"Result", 1, 1, false, "", "core Status (0 ok, 7 queue full, 13 bad sequence, ...), 128 incomplete transfer, 129 bad frame, 130 too long",
+     -1, kResultValues},
     {"Sequence", 2, 4, false, "", "span batch: its first sequence number; command: the command"},
     {"FreeSlots", 6, 1, false, "span", "free span slots after this"},
-    {"State", 7, 1, false, "", "0 idle, 1 running, 2 holding, 3 stopping, 4 fault, 5 e-stop"},
+    {"State", 7, 1, false, "", "0 idle, 1 running, 2 holding, 3 stopping, 4 fault, 5 e-stop", -1, kStateValues},
 };
 inline constexpr Signal kStatusASignals[] = {
-    {"State", 0, 1, false, "", "0 idle, 1 running, 2 holding, 3 stopping, 4 fault, 5 e-stop"},
-    {"Flags", 1, 1, false, "", "bit 0 configured, bit 1 held by underrun, bit 2 bus problem seen"},
+    {"State", 0, 1, false, "", "0 idle, 1 running, 2 holding, 3 stopping, 4 fault, 5 e-stop", -1, kStateValues},
+    {"Flags", 1, 1, false, "", "bit 0 configured, bit 1 held by underrun, bit 2 bus problem seen, bit 3 own stop or re-entry move"},
     {"FreeSlots", 2, 1, false, "span", "free span slots"},
     {"Queued", 3, 1, false, "span", "spans queued"},
-    {"FaultCode", 4, 2, false, "", "0 none, 1 external, 2 stop failed, 3 re-entry failed, 0x01xx limit switch"},
+    {"FaultCode", 4, 2, false, "", "0 none, 1 external, 2 stop failed, 3 re-entry failed, 0x01xx limit switch", -1,
+     kFaultValues},
     {"Underruns", 6, 2, false, "", "controlled stops because the queue ran dry"},
 };
 inline constexpr Signal kStatusBSignals[] = {
@@ -134,6 +167,11 @@ inline constexpr Signal kStatusDSignals[] = {
     {"FinishedJob", 0, 4, false, "",
      "id (first span's sequence number) of the last job run to its end, 0 none"},
     {"FinishedJobTicks", 4, 4, false, "tick", "path ticks that job executed (low 32 bits)"},
+};
+inline constexpr Signal kStatusESignals[] = {
+    {"Axis", 0, 1, false, "", "axis index, 0 .. axes - 1"},
+    {"Position", 1, 4, true, "LSB", "setpoint the last tick output on that axis"},
+    {"Epoch", 5, 2, false, "", "queue epoch (low 16 bits): advanced by every queue drop"},
 };
 inline constexpr Signal kConfigSignals[] = {
     {"Item", 0, 1, false, "",
@@ -188,6 +226,8 @@ inline constexpr Message kMessages[] = {
     {"SpanData", kSpanDataBase, 8, false, "host -> device: 7 bytes of the batch's wire spans",
      kSpanDataSignals, 2},
     {"StatusD", kStatusDBase, 8, true, "device -> host: jobs", kStatusDSignals, 2},
+    {"StatusE", kStatusEBase, 8, true, "device -> host: one axis's position, and the queue epoch",
+     kStatusESignals, 3},
 };
 inline constexpr std::size_t kMessageCount = sizeof(kMessages) / sizeof(kMessages[0]);
 
@@ -224,9 +264,11 @@ struct Status3 {
     std::uint16_t duplicates = 0;
     std::uint8_t axes = 0, version = 0;
     std::uint32_t finished_job = 0, finished_job_ticks = 0;
+    std::int32_t position[kMaxAxes] = {};  ///< status E, per axis
+    std::uint16_t epoch = 0;               ///< status E (low 16 bits)
 };
 
-/// Status frames the device sends per status request.
+/// Status frames A to D the device sends per status request; then one frame E per axis.
 inline constexpr std::size_t kStatusFrames = 4;
 
 struct SpanStart {
@@ -285,7 +327,17 @@ constexpr void encode_status(std::uint8_t node, const Status3& s, Frame (&out)[k
     out[2] = c;
     out[3] = d;
 }
-/// Merges one status frame (A, B, C or D) into `s`; false when `f` is none of them.
+/// Status frame E: axis `axis`'s position and the queue epoch's low 16 bits.
+constexpr Frame encode_status_axis(std::uint8_t node, std::uint8_t axis, std::int32_t position,
+                                   std::uint32_t epoch) {
+    Frame e{can_id(kStatusEBase, node), 8, {}};
+    put(e, kStatusESignals[0], axis);
+    put(e, kStatusESignals[1], static_cast<std::uint32_t>(position));
+    put(e, kStatusESignals[2], epoch & 0xFFFFu);
+    return e;
+}
+/// Merges one status frame (A to E) into `s`; false when `f` is none of them (or names an
+/// axis beyond kMaxAxes).
 constexpr bool decode_status_part(const Frame& f, Status3& s) {
     if (f.length != 8) return false;
     switch (function_of(f.id)) {
@@ -301,6 +353,13 @@ constexpr bool decode_status_part(const Frame& f, Status3& s) {
             s.last_accepted = get(f, kStatusBSignals[0]);
             s.last_completed = get(f, kStatusBSignals[1]);
             return true;
+        case kStatusEBase: {
+            const std::uint32_t axis = get(f, kStatusESignals[0]);
+            if (axis >= kMaxAxes) return false;
+            s.position[axis] = static_cast<std::int32_t>(get(f, kStatusESignals[1]));
+            s.epoch = static_cast<std::uint16_t>(get(f, kStatusESignals[2]));
+            return true;
+        }
         case kStatusCBase:
             s.ticks_executed = get(f, kStatusCSignals[0]);
             s.duplicates = static_cast<std::uint16_t>(get(f, kStatusCSignals[1]));

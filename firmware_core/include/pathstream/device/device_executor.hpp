@@ -105,6 +105,12 @@ private:
         state_ = s;
         status_.state = static_cast<std::uint32_t>(s);
     }
+    // The own-move flag changes with the motion, never on a tick in the middle of a move.
+    void set_motion(Motion m) {
+        motion_ = m;
+        status_.flags = m == Motion::kGenerated ? (status_.flags | kStatusOwnMove)
+                                                : (status_.flags & ~kStatusOwnMove);
+    }
     void set_held_by_underrun(bool held) {
         status_.flags = held ? (status_.flags | kStatusHeldByUnderrun)
                              : (status_.flags & ~kStatusHeldByUnderrun);
@@ -170,7 +176,7 @@ private:
                 // Starting with nothing (current) queued does nothing.
                 drop_stale();
                 if (s == DeviceState::kIdle && channel_.queue.next_span() != nullptr) {
-                    motion_ = Motion::kStream;
+                    set_motion(Motion::kStream);
                     set_state(DeviceState::kRunning);
                 }
                 break;
@@ -251,7 +257,7 @@ private:
     // E-stop and faults: the axes stay at the last output; everything queued is dropped.
     void stop_at_once() {
         for (unsigned a = 0; a < Axes; ++a) rest_[a] = position_[a];
-        motion_ = Motion::kRest;
+        set_motion(Motion::kRest);
         generated_kind_ = Generated::kNone;
         hold_requested_ = stop_requested_ = resume_pending_ = false;
         drop_queue();
@@ -283,7 +289,7 @@ private:
         status_.finished_job_ticks =
             static_cast<std::uint32_t>(queue.ticks_executed() - job_start_ticks_);
         for (unsigned a = 0; a < Axes; ++a) rest_[a] = queue.resting_position(a);
-        motion_ = Motion::kRest;
+        set_motion(Motion::kRest);
         current_ = Current{};
         hold_requested_ = false;
         set_state(DeviceState::kIdle);
@@ -320,7 +326,7 @@ private:
         if (underrun) status_.underruns = status_.underruns + 1u;
         hold_requested_ = stop_requested_ = false;
         if (!moving) {
-            motion_ = Motion::kRest;
+            set_motion(Motion::kRest);
             if (stopping) {
                 drop_queue();
                 set_state(DeviceState::kIdle);
@@ -350,7 +356,7 @@ private:
         }
         set_held_by_underrun(false);
         if (at_boundary && !moving) {
-            motion_ = Motion::kStream;
+            set_motion(Motion::kStream);
             set_state(DeviceState::kRunning);
             return;
         }
@@ -380,7 +386,7 @@ private:
         generated_.restart_producer_at(from);
         if (generated_.push(span) != Status::kOk) return false;
         generated_left_ = span.ticks;
-        motion_ = Motion::kGenerated;
+        set_motion(Motion::kGenerated);
         return true;
     }
 
@@ -388,11 +394,11 @@ private:
         const Generated kind = generated_kind_;
         generated_kind_ = Generated::kNone;
         for (unsigned a = 0; a < Axes; ++a) rest_[a] = generated_.resting_position(a);
-        motion_ = Motion::kRest;
+        set_motion(Motion::kRest);
         if (kind == Generated::kReentry) {
             // The stream resumes at the boundary it left; a stop or hold requested meanwhile
             // is taken at the next boundary.
-            motion_ = Motion::kStream;
+            set_motion(Motion::kStream);
             return;
         }
         if (kind == Generated::kStopStop || stop_requested_) {

@@ -52,6 +52,9 @@ inline constexpr std::uint16_t kMaxBatchSpans = 64;
 inline constexpr std::uint32_t kStatusHeldByUnderrun = 1u
                                                        << 0;  ///< holding because the queue ran dry
 inline constexpr std::uint32_t kStatusPathTick = 1u << 1;     ///< the last tick was a path tick
+/// The last tick was a tick of the device's own move (a controlled stop or a re-entry): a
+/// holding device without it rests. Set and cleared only when the move starts and ends.
+inline constexpr std::uint32_t kStatusOwnMove = 1u << 2;
 
 /// Everything the tick side tells the task side, published whole by every tick and read whole
 /// by the task (StatusBoard, a sequence lock): no field is ever seen from two different ticks.
@@ -62,7 +65,7 @@ struct DeviceStatus {
     // Words a path tick changes: first, so that the tick publishes only these on a tick in
     // the middle of a span (StatusBoard's hot prefix, kHotWords).
     std::uint32_t tick_count = 0;  ///< ticks run since construction (wraps); == tick_check
-    std::uint32_t flags = 0;       ///< kStatusHeldByUnderrun, kStatusPathTick
+    std::uint32_t flags = 0;       ///< kStatusHeldByUnderrun, kStatusPathTick, kStatusOwnMove
     std::uint32_t outputs = 0;     ///< discrete outputs the last tick drove (kOutputPenDown)
     Lsb position[Axes] = {};       ///< setpoints the last tick output
     std::uint32_t ticks_executed_low = 0;  ///< path ticks executed (64 bits in two words)
@@ -95,6 +98,7 @@ struct DeviceStatus {
     FaultCode fault() const { return static_cast<FaultCode>(fault_code); }
     bool held_by_underrun() const { return (flags & kStatusHeldByUnderrun) != 0; }
     bool path_tick() const { return (flags & kStatusPathTick) != 0; }
+    bool own_move() const { return (flags & kStatusOwnMove) != 0; }
     std::uint64_t ticks_executed() const {
         return (static_cast<std::uint64_t>(ticks_executed_high) << 32) | ticks_executed_low;
     }

@@ -133,7 +133,8 @@ private:
         b[st::kOutputs] = static_cast<std::uint16_t>(s.outputs);
         b[st::kQueuedSpans] = static_cast<std::uint16_t>(device_.queued_spans());
         b[st::kFlags] = static_cast<std::uint16_t>((device_.configured() ? 1u : 0u) |
-                                                   (s.held_by_underrun() ? 2u : 0u));
+                                                   (s.held_by_underrun() ? 2u : 0u) |
+                                                   (s.own_move() ? 8u : 0u));
         put_u32(&b[st::kFinishedJob], s.finished_job);
         put_u32(&b[st::kFinishedJobTicks], s.finished_job_ticks);
         put_u32(&b[st::kEpoch], s.epoch);

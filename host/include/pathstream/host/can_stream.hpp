@@ -30,6 +30,9 @@ struct CanStreamOptions {
     unsigned ack_timeout_ms = 100;     ///< resend a batch, configuration or status request after this
     double link_timeout_seconds = 2;   ///< give up after this long without a frame from the device
     unsigned poll_interval_ms = 10;    ///< status requests (4 frames) while the queue is full enough
+    InterruptOptions interrupt;        ///< Ctrl-C handling
+    StreamObserver observer;           ///< called after every status read (may be empty)
+    const HeldJob* held = nullptr;     ///< continue a held job instead of starting one
 };
 
 /// What the device executed and what the bus carried.
@@ -51,10 +54,12 @@ struct CanStreamReport {
     std::uint64_t bits_received = 0;
     double wall_seconds = 0;
     std::int32_t final_position[8] = {};  ///< the plan's end point, which the device reached
+    int interrupted = 0;                  ///< as StreamReport::interrupted
+    DeviceSnapshot final_status;          ///< the last status read
 };
 
 /// Streams `plan` to node options.node on `bus` (native protocol): checks the device's
-/// identity (protocol version, axis count, idle), configures its tick rate and limits from
+/// identity (protocol version, axis count, idle) and that it rests at the plan's start, configures its tick rate and limits from
 /// `profile` (rounded up to whole LSB/s and LSB/s^2), sends batches of spans with sequence
 /// numbers keeping options.lead_seconds queued and never more spans than the device has free
 /// slots, starts it, resumes it after an underrun, resends batches lost on the bus (timeouts,
@@ -62,6 +67,12 @@ struct CanStreamReport {
 /// Throws StreamError (device refused a batch, restarted, faulted, the host's controller went
 /// bus-off, or nothing came from the device for link_timeout_seconds) and
 /// std::invalid_argument (plan not streamable).
+/// Where the device at options.node rests (LSB per axis, from status frame E), after checking
+/// its identity (protocol version, axis count = the profile's) and that it is idle: what
+/// `stream --lead-in` plans its pen-up move from. Throws StreamError like stream_can.
+std::vector<Lsb> can_rest_position(const MachineProfile& profile, hal::CanBus& bus,
+                                   const CanStreamOptions& options);
+
 CanStreamReport stream_can(const Plan& plan, const MachineProfile& profile, hal::CanBus& bus,
                            const CanStreamOptions& options, const StreamProgress& progress = {});
 

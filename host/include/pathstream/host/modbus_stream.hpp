@@ -1,11 +1,13 @@
 // Streaming a plan to a device that runs the core, over Modbus TCP or RTU (docs/modbus.md).
 #pragma once
 
+#include <atomic>
 #include <cstdint>
 #include <functional>
 #include <stdexcept>
 #include <string>
 
+#include "pathstream/host/device_link.hpp"
 #include "pathstream/host/machine.hpp"
 #include "pathstream/host/plan.hpp"
 
@@ -18,6 +20,32 @@ public:
     using std::runtime_error::runtime_error;
 };
 
+/// Where a stream stands after a status read: what a job journal and the events record.
+struct StreamTrace {
+    std::uint32_t job = 0;           ///< the job's id: the sequence number of its first span
+    std::uint32_t acknowledged = 0;  ///< last sequence number the device acknowledged (job - 1: none)
+    DeviceSnapshot status;           ///< the status just read
+    bool hold_requested = false;     ///< an interrupt asked the device to hold
+    bool stop_requested = false;     ///< a second interrupt (or the hold timeout) stopped it
+};
+using StreamObserver = std::function<void(const StreamTrace&)>;
+
+/// A job the device holds (after an interrupted stream): its spans are still queued, so the
+/// stream goes on from the last acknowledged span and ends with a resume instead of a start.
+struct HeldJob {
+    std::uint32_t job = 0;           ///< the held job's id; the plan streamed is that job's spans
+    std::uint32_t acknowledged = 0;  ///< the device's last accepted sequence number
+};
+
+/// How a stream reacts to an operator's interrupt (Ctrl-C, SIGTERM), shared by the clients.
+struct InterruptOptions {
+    /// 0: none; 1: hold (controlled stop at the next span boundary, queue kept, pen up), then
+    /// return once the device rests; 2 or more: stop (the queue is dropped), then return once
+    /// idle. Written by a signal handler, read by the streaming loop. Not owned.
+    const std::atomic<int>* request = nullptr;
+    double hold_timeout_seconds = 10;  ///< a hold not at rest by then becomes a stop
+};
+
 struct StreamOptions {
     std::string target;                 ///< modbus-tcp://HOST:PORT?unit=N or modbus-rtu:///dev/X?...
     double lead_seconds = 0.25;         ///< keep this much motion queued ahead of the device
@@ -25,6 +53,9 @@ struct StreamOptions {
     unsigned attempts = 3;              ///< tries per transaction (reconnect between TCP tries)
     double link_timeout_seconds = 5;    ///< give up after this long without a successful transaction
     unsigned poll_interval_ms = 2;      ///< status polling while the queue is full enough
+    InterruptOptions interrupt;         ///< Ctrl-C handling
+    StreamObserver observer;            ///< called after every status read (may be empty)
+    const HeldJob* held = nullptr;      ///< continue a held job instead of starting one
 };
 
 /// What the device executed and what the link carried.
@@ -46,6 +77,10 @@ struct StreamReport {
     std::uint64_t bytes_received = 0;
     double wall_seconds = 0;
     std::int32_t final_position[8] = {};
+    /// 0: the job ran to its end; 1: interrupted, the device holds at rest with the rest of
+    /// the job queued; 2: interrupted, the device stopped (queue dropped) and is idle.
+    int interrupted = 0;
+    DeviceSnapshot final_status;          ///< the last status read
 };
 
 /// Progress: fraction of the plan's ticks executed, and the device queue's lead in seconds.

@@ -130,6 +130,45 @@ struct RunSummary {
     std::vector<double> rms_following_error_mm;  ///< per axis
 };
 
+/// One axis of the report's table: peaks against the limits three ways, following error.
+struct AxisFigures {
+    std::string name;
+    bool checked = false;                ///< the planner check's figures (cubic, setpoints) are set
+    double velocity_fraction_cubic = 0;  ///< exact cubic peak / max velocity
+    double acceleration_fraction_cubic = 0;  ///< exact cubic peak / max acceleration
+    std::int64_t max_step = 0;               ///< LSB/tick, integer setpoints
+    double velocity_limit_lsb = 0;           ///< LSB/tick
+    std::int64_t max_second_difference = 0;  ///< LSB/tick^2, integer setpoints
+    double acceleration_limit_lsb = 0;       ///< LSB/tick^2
+    double executed_velocity = 0;            ///< mm/s, peak of the executed series
+    double executed_acceleration = 0;        ///< mm/s^2, peak of the executed series
+    double max_velocity = 0;                 ///< mm/s, the profile's limit (0: none)
+    double max_acceleration = 0;             ///< mm/s^2, the profile's limit (0: none)
+    bool following = false;                  ///< following error measured (servo plant)
+    double max_following_error_mm = 0;
+    double rms_following_error_mm = 0;
+    bool has_rms = false;  ///< rms_following_error_mm is set
+};
+
+/// Every figure of the one-screen report, before formatting (text_report prints these).
+struct ReportFigures {
+    double duration = 0;  ///< s, planned
+    std::uint64_t pen_downs = 0, pen_ups = 0;
+    std::uint64_t pen_down_ticks = 0;        ///< executed ticks with the pen down
+    std::uint64_t executed_ticks = 0;        ///< ticks in the executed series
+    std::uint64_t dwell_ticks = 0;           ///< ticks the plan holds still while the pen moves
+    double velocity_fraction_cubic = 0;      ///< max over axes of the exact cubic's peak
+    double acceleration_fraction_cubic = 0;  ///< max over axes of the exact cubic's peak
+    unsigned executed_half_window = 1;       ///< ticks, the executed differences' h
+    double executed_acceleration_noise = 0;  ///< mm/s^2, their rounding noise bound
+    std::vector<AxisFigures> axes;
+};
+
+/// The figures the report shows, for text_report and machine-readable output alike.
+ReportFigures report_figures(const Plan& plan, const PlanCheck* check,
+                             const MachineProfile& profile, const TickSeries& executed,
+                             const RunSummary& run);
+
 /// The one-screen report: duration, pen-down length and travel, the planner's maximum
 /// deviation (`check`, may be null: "not checked"), per axis the peak fraction of the velocity
 /// and acceleration limits (planner and executed setpoints) and the following error, ticks,

@@ -1,0 +1,81 @@
+// A device that runs the core, seen from the host through one bus: its status, read whole,
+// and its commands. The Modbus (TCP, RTU) and native CAN links implement the transport once;
+// the streamers and `pathstream ctl` use them.
+#pragma once
+
+#include <chrono>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "pathstream/device/device_state.hpp"
+#include "pathstream/hal/can_bus.hpp"
+#include "pathstream/span.hpp"
+#include "pathstream/status.hpp"
+#include "pathstream/units.hpp"
+
+namespace pathstream::hal {
+class ModbusClient;
+}
+
+namespace pathstream::host {
+
+struct StreamOptions;
+struct CanStreamOptions;
+
+/// One read of a device's status, whichever bus carried it; every tick-side field is from one
+/// tick (docs/device.md, "What the status says"). Fields a bus does not carry are 0 and named.
+struct DeviceSnapshot {
+    unsigned magic = 0;  ///< Modbus only: 0x5053 ("PS")
+    unsigned version = 0, axes = 0, state = 0;
+    std::uint16_t fault_code = 0;
+    unsigned free_slots = 0, queued = 0;
+    unsigned capacity = 0;  ///< Modbus only (0 over CAN)
+    unsigned flags = 0;     ///< bit 0 configured, bit 1 held by underrun
+    unsigned underruns = 0, duplicates = 0;
+    unsigned outputs = 0;       ///< Modbus only: bit 0 pen down on the last tick
+    unsigned last_refusal = 0;  ///< Modbus only: core Status of the last refused write
+    std::uint32_t last_accepted = 0, last_completed = 0, ticks_executed = 0;
+    std::uint32_t finished_job = 0, finished_job_ticks = 0;
+    std::uint32_t epoch = 0;  ///< CAN: low 16 bits only
+    std::int32_t position[kMaxAxes] = {};
+};
+
+/// "idle", "running", "holding", "stopping", "fault", "e-stop" (a DeviceState number), else
+/// "unknown".
+const char* device_state_name(unsigned state);
+
+/// A command's verb as `pathstream ctl` spells it ("start", "hold", ...).
+const char* command_verb(device::Command c);
+
+/// The transport to one device. Not thread-safe: one thread at a time.
+class DeviceLink {
+public:
+    virtual ~DeviceLink() = default;
+    /// One status read. Throws StreamError when nothing answers for the link timeout.
+    virtual DeviceSnapshot status() = 0;
+    /// Sends command `c` and returns the device's answer (kOk, or the core Status it refused
+    /// with). Throws StreamError when nothing answers for the link timeout.
+    virtual Status command(device::Command c) = 0;
+    /// The target as messages name it (its URL).
+    virtual const std::string& name() const = 0;
+};
+
+/// Timeouts of a link opened from a URL.
+struct LinkOptions {
+    unsigned response_timeout_ms =
+        500;                          ///< Modbus: per try; CAN: before asking again (at most 100)
+    unsigned attempts = 3;            ///< Modbus: tries per transaction
+    double link_timeout_seconds = 5;  ///< give up after this long without an answer
+};
+
+/// Opens modbus-tcp://, modbus-rtu:// or can://IFACE?node=N (native protocol; the link owns
+/// its SocketCAN socket). Throws std::invalid_argument (bad URL, CiA 402 target) and
+/// StreamError (cannot connect within the link timeout).
+std::unique_ptr<DeviceLink> open_device_link(const std::string& target, const LinkOptions& options);
+
+/// A native CAN link over a bus the caller owns (tests: a loopback endpoint).
+std::unique_ptr<DeviceLink> open_can_link(hal::CanBus& bus, const CanStreamOptions& options);
+
+}  // namespace pathstream::host

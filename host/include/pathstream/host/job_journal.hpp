@@ -1,0 +1,72 @@
+// A stream's record on disk, so that an interrupted drawing can be continued after a hold, a
+// stop, a fault reset, a device restart or a host crash (docs/cli.md, "Interrupt and
+// resume"). Two files: the job's spans (JOURNAL.plan, written once per job) and the journal
+// itself (JSON, rewritten as the stream goes). Both are written atomically.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "pathstream/host/device_setup.hpp"
+#include "pathstream/host/plan.hpp"
+
+namespace pathstream::host {
+
+/// The spans of one job as streamed, each with where it sits in the drawing.
+struct JobSpans {
+    Plan plan;  ///< Hermite spans, as encode_wire_plan takes them
+    std::vector<std::int64_t>
+        origin;  ///< per span: index in the drawing's plan, -1 for a re-entry span
+    std::vector<std::uint64_t> drawing_tick;  ///< per span: the drawing's tick at its start
+                                              ///< (re-entry: of the span it leads to)
+    std::size_t drawing_spans = 0;            ///< spans of the whole drawing
+    std::uint64_t drawing_ticks = 0;          ///< ticks of the whole drawing
+    std::size_t subpaths = 0;                 ///< pen-down subpaths of the whole drawing
+};
+
+/// A drawing's plan as the first job: every span its own origin.
+JobSpans job_from_plan(const Plan& plan);
+
+/// The job's spans from span `first` on (the first one not executed to its end), entered from
+/// rest at `rest`: a re-entry span (the core's plan_reentry, pen up) that arrives at span
+/// `first`'s start with its start velocity, and, when that span draws and `limits` has a
+/// pen-down delay, a straight approach along its start tangent lasting at least that delay,
+/// with the pen down, so the pen touches where the span starts. Re-entry spans of `job`
+/// itself are skipped. Throws std::invalid_argument when `first` is past the end and
+/// std::range_error when no re-entry fits the limits in one span.
+JobSpans resume_from(const JobSpans& job, std::size_t first, const std::vector<Lsb>& rest,
+                     const DeviceLimitsLsb& limits);
+
+/// Writes `job` to `path` atomically (one line per span); returns its FNV-1a 64 hash, hex.
+std::string write_job_spans(const JobSpans& job, const std::string& path);
+/// Reads what write_job_spans wrote. Throws InputError (`path:line:col: what`) for anything
+/// else, and when the contents do not hash to `expected_hash` (unless it is empty).
+JobSpans read_job_spans(const std::string& path, const std::string& expected_hash);
+
+/// The journal: what was streamed where, and how far the device got.
+struct JobJournal {
+    std::string target;     ///< the device's URL
+    std::string machine;    ///< the machine profile's path
+    std::string drawing;    ///< the drawing's path (for messages)
+    std::string plan_file;  ///< the job's spans (write_job_spans)
+    std::string plan_hash;
+    std::uint32_t job = 0;  ///< the device's id of the job (its first span's sequence number); 0
+                            ///< before the first batch
+    std::uint32_t acknowledged = 0;    ///< last sequence number the device acknowledged
+    std::uint32_t last_completed = 0;  ///< last sequence number executed to its end
+    std::uint32_t epoch = 0;           ///< the device's queue epoch at the last read
+    std::string state = "starting";    ///< the device's state at the last read
+    std::vector<Lsb> position;         ///< where the device was at the last read
+    /// "streaming", "held" (interrupted, the rest queued), "stopped" (interrupted, queue
+    /// dropped), "failed" (the stream ended with an error: `error`), "finished".
+    std::string outcome = "streaming";
+    std::string error;
+};
+
+/// Writes `journal` to `path` atomically (JSON).
+void write_journal(const JobJournal& journal, const std::string& path);
+/// Reads a journal. Throws InputError naming the file, line and column, or the missing key.
+JobJournal read_journal(const std::string& path);
+
+}  // namespace pathstream::host

@@ -1,0 +1,272 @@
+#include "ctl_command.hpp"
+
+#include <atomic>
+#include <chrono>
+#include <csignal>
+#include <cstdio>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <sstream>
+#include <stdexcept>
+#include <thread>
+
+#include "pathstream/host/device_setup.hpp"
+#include "pathstream/host/machine.hpp"
+#include "pathstream/host/modbus_stream.hpp"
+
+namespace pathstream::host {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+std::atomic<bool> g_interrupted{false};
+extern "C" void on_ctl_signal(int) {
+    g_interrupted.store(true);
+}
+
+struct VerbInfo {
+    const char* verb;
+    device::Command command;
+};
+constexpr VerbInfo kVerbs[] = {{"hold", device::Command::kHold},
+                               {"resume", device::Command::kResume},
+                               {"stop", device::Command::kStop},
+                               {"reset", device::Command::kReset}};
+
+// The axis names and mm scale, from the profile when one was given.
+struct Units {
+    std::optional<MachineProfile> profile;
+    std::string axis_name(unsigned a) const {
+        static const char* const names[] = {"x", "y", "z", "a", "b", "c", "u", "v"};
+        return profile && a < profile->axes.size() ? profile->axes[a].name : names[a % 8];
+    }
+};
+
+std::string flags_text(const DeviceSnapshot& s) {
+    std::string t = (s.flags & 1u) != 0 ? "configured" : "not configured";
+    if ((s.flags & 2u) != 0) t += ", held by underrun";
+    return t;
+}
+
+nlohmann::json to_json(const DeviceSnapshot& s, const Units& u, const std::string& target) {
+    nlohmann::json j;
+    j["target"] = target;
+    j["protocol_version"] = s.version;
+    j["axes"] = s.axes;
+    j["state"] = device_state_name(s.state);
+    j["state_code"] = s.state;
+    j["fault_code"] = s.fault_code;
+    j["fault"] = s.fault_code == 0 ? "none" : fault_text(s.fault_code);
+    j["configured"] = (s.flags & 1u) != 0;
+    j["held_by_underrun"] = (s.flags & 2u) != 0;
+    j["queued_spans"] = s.queued;
+    j["free_slots"] = s.free_slots;
+    j["ticks_executed"] = s.ticks_executed;
+    j["last_accepted_sequence"] = s.last_accepted;
+    j["last_completed_sequence"] = s.last_completed;
+    j["finished_job"] = s.finished_job;
+    j["finished_job_ticks"] = s.finished_job_ticks;
+    j["epoch"] = s.epoch;
+    j["underruns"] = s.underruns;
+    j["duplicates"] = s.duplicates;
+    nlohmann::json axes = nlohmann::json::array();
+    for (unsigned a = 0; a < s.axes && a < kMaxAxes; ++a) {
+        nlohmann::json axis{{"name", u.axis_name(a)}, {"position_lsb", s.position[a]}};
+        if (u.profile) axis["position_mm"] = s.position[a] * u.profile->mm_per_lsb;
+        axes.push_back(axis);
+    }
+    j["position"] = axes;
+    return j;
+}
+
+std::string position_text(const DeviceSnapshot& s, const Units& u) {
+    std::ostringstream m;
+    m.setf(std::ios::fixed);
+    m.precision(4);
+    for (unsigned a = 0; a < s.axes && a < kMaxAxes; ++a) {
+        m << (a ? "  " : "") << u.axis_name(a) << ' ';
+        if (u.profile) {
+            m << s.position[a] * u.profile->mm_per_lsb << " mm (" << s.position[a] << " LSB)";
+        } else {
+            m << s.position[a] << " LSB";
+        }
+    }
+    return m.str();
+}
+
+void print_status(const DeviceSnapshot& s, const Units& u, const std::string& target) {
+    std::printf("device        %s (protocol %u, %u axes, %s)\n", target.c_str(), s.version, s.axes,
+                flags_text(s).c_str());
+    std::printf("state         %s%s\n", device_state_name(s.state),
+                fault_suffix(s.state, s.fault_code).c_str());
+    std::printf("queue         %u spans queued, %u slots free\n", s.queued, s.free_slots);
+    std::printf("position      %s\n", position_text(s, u).c_str());
+    std::printf(
+        "ticks         %u path ticks executed; spans: last accepted %u, last completed %u\n",
+        s.ticks_executed, s.last_accepted, s.last_completed);
+    if (s.finished_job != 0) {
+        std::printf("job           last finished: job %u (%u path ticks)\n", s.finished_job,
+                    s.finished_job_ticks);
+    } else {
+        std::printf("job           none finished yet\n");
+    }
+    std::printf("counters      epoch %u, %u underruns, %u duplicate batches\n", s.epoch,
+                s.underruns, s.duplicates);
+}
+
+// One line per read for --watch: the fields that change.
+void print_watch_line(const DeviceSnapshot& s, const Units& u) {
+    std::printf("%-8s queue %3u  ticks %10u  last span %8u  %s\n", device_state_name(s.state),
+                s.queued, s.ticks_executed, s.last_completed, position_text(s, u).c_str());
+    std::fflush(stdout);
+}
+
+int run_status(DeviceLink& link, const CtlCommandOptions& o, const Units& u) {
+    if (o.watch_seconds <= 0) {
+        const DeviceSnapshot s = link.status();
+        if (o.json) {
+            std::printf("%s\n", to_json(s, u, link.name()).dump(2).c_str());
+        } else {
+            print_status(s, u, link.name());
+        }
+        return 0;
+    }
+    std::signal(SIGINT, on_ctl_signal);
+    std::signal(SIGTERM, on_ctl_signal);
+    for (unsigned n = 0; !g_interrupted.load() && (o.count == 0 || n < o.count); ++n) {
+        if (n > 0) std::this_thread::sleep_for(std::chrono::duration<double>(o.watch_seconds));
+        if (g_interrupted.load()) break;
+        const DeviceSnapshot s = link.status();
+        if (o.json) {
+            std::printf("%s\n", to_json(s, u, link.name()).dump().c_str());  // NDJSON: one per line
+            std::fflush(stdout);
+        } else {
+            print_watch_line(s, u);
+        }
+    }
+    return 0;
+}
+
+// Whether the device has reached what command `c` leads to (a hold: holding at rest needs
+// the stop to end, which the status does not say; holding is enough to stop waiting).
+bool settled(device::Command c, const DeviceSnapshot& s) {
+    using device::DeviceState;
+    const auto st = static_cast<DeviceState>(s.state);
+    switch (c) {
+        case device::Command::kHold:
+            return st != DeviceState::kRunning;
+        case device::Command::kResume:
+            return st != DeviceState::kHolding;
+        case device::Command::kStop:
+            return st != DeviceState::kRunning && st != DeviceState::kStopping &&
+                   st != DeviceState::kHolding;
+        case device::Command::kReset:
+            return st == DeviceState::kIdle;
+        default:
+            return true;
+    }
+}
+
+int run_command(DeviceLink& link, device::Command c, const CtlCommandOptions& o, const Units& u) {
+    const DeviceSnapshot before = link.status();
+    const Status r = link.command(c);
+    if (r != Status::kOk) {
+        std::ostringstream m;
+        m << link.name() << ": device refused " << command_verb(c) << " while "
+          << device_state_name(before.state) << fault_suffix(before.state, before.fault_code)
+          << ": " << status_name(r);
+        throw StreamError(m.str());
+    }
+    DeviceSnapshot s = link.status();
+    const auto deadline = Clock::now() + std::chrono::duration<double>(o.wait_seconds);
+    while (!settled(c, s) && Clock::now() < deadline) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(10));
+        s = link.status();
+    }
+    if (o.json) {
+        nlohmann::json j;
+        j["command"] = command_verb(c);
+        j["accepted"] = true;
+        j["state_before"] = device_state_name(before.state);
+        j["settled"] = settled(c, s);
+        j["status"] = to_json(s, u, link.name());
+        std::printf("%s\n", j.dump(2).c_str());
+    } else {
+        std::printf("%-13s accepted: %s -> %s%s\n", command_verb(c),
+                    device_state_name(before.state), device_state_name(s.state),
+                    fault_suffix(s.state, s.fault_code).c_str());
+        std::printf("position      %s\n", position_text(s, u).c_str());
+    }
+    if (!settled(c, s)) {
+        std::ostringstream m;
+        m << link.name() << ": " << command_verb(c) << " accepted, but the device is still "
+          << device_state_name(s.state) << " after " << o.wait_seconds << " s";
+        throw StreamError(m.str());
+    }
+    return 0;
+}
+
+}  // namespace
+
+void add_ctl_command(CLI::App& app, CtlCommandOptions& o) {
+    CLI::App* cmd = app.add_subcommand("ctl",
+                                       "Read a device's status or send it a command, over Modbus "
+                                       "TCP/RTU or native CAN (docs/cli.md)");
+    cmd->add_option("target", o.target,
+                    "device: modbus-tcp://HOST:PORT?unit=N, "
+                    "modbus-rtu:///dev/ttyX?baud=115200&parity=N&unit=1 "
+                    "or can://IFACE?node=N")
+        ->required();
+    cmd->add_option("verb", o.verb, "status, hold, resume, stop or reset")
+        ->required()
+        ->check(CLI::IsMember({"status", "hold", "resume", "stop", "reset"}));
+    cmd->add_option("--machine,-m", o.machine, "machine profile: positions in mm and axes by name")
+        ->check(CLI::ExistingFile);
+    cmd->add_flag("--json", o.json,
+                  "print one JSON document (with --watch: one JSON object per line)");
+    cmd->add_option("--watch", o.watch_seconds,
+                    "status: read again every this many seconds until Ctrl-C")
+        ->check(CLI::Range(0.01, 3600.0));
+    cmd->add_option("--count", o.count,
+                    "status --watch: stop after this many reads (0: until Ctrl-C)")
+        ->capture_default_str();
+    cmd->add_option(
+           "--wait", o.wait_seconds,
+           "commands: seconds to wait for the state the command leads to (hold: not running; stop, "
+           "reset: idle)")
+        ->capture_default_str()
+        ->check(CLI::Range(0.0, 600.0));
+    cmd->add_option(
+           "--timeout-ms", o.link.response_timeout_ms,
+           "Modbus: response timeout per try; native CAN: wait before asking again (at most 100)")
+        ->capture_default_str()
+        ->check(CLI::Range(10u, 60000u));
+    cmd->add_option("--link-timeout", o.link.link_timeout_seconds,
+                    "give up after this many seconds without an answer")
+        ->capture_default_str()
+        ->check(CLI::Range(0.1, 3600.0));
+}
+
+int run_ctl(const CtlCommandOptions& o) {
+    Units u;
+    if (!o.machine.empty()) u.profile = load_machine_profile(o.machine);
+    if (o.watch_seconds > 0 && o.verb != "status")
+        throw std::invalid_argument("--watch: only with status");
+    const std::unique_ptr<DeviceLink> link = open_device_link(o.target, o.link);
+    if (u.profile) {
+        const DeviceSnapshot s = link->status();
+        if (s.axes != u.profile->axes.size()) {
+            std::ostringstream m;
+            m << link->name() << ": device has " << s.axes << " axes, the profile " << o.machine
+              << ' ' << u.profile->axes.size();
+            throw StreamError(m.str());
+        }
+    }
+    if (o.verb == "status") return run_status(*link, o, u);
+    for (const VerbInfo& v : kVerbs) {
+        if (o.verb == v.verb) return run_command(*link, v.command, o, u);
+    }
+    throw std::invalid_argument("ctl: unknown verb '" + o.verb + "'");
+}
+
+}  // namespace pathstream::host

@@ -1,0 +1,143 @@
+// DeviceLink over Modbus and native CAN, opened from a target URL.
+#include "pathstream/host/device_link.hpp"
+
+#include <algorithm>
+#include <stdexcept>
+
+#include "can_link.hpp"
+#include "modbus_link.hpp"
+#include "pathstream/device/modbus_map.hpp"
+#include "pathstream/hal/socketcan_bus.hpp"
+
+namespace pathstream::host {
+
+const char* device_state_name(unsigned state) {
+    static const char* const names[] = {"idle",     "running", "holding",
+                                        "stopping", "fault",   "e-stop"};
+    return state < 6 ? names[state] : "unknown";
+}
+
+const char* command_verb(device::Command c) {
+    switch (c) {
+        case device::Command::kStart:
+            return "start";
+        case device::Command::kHold:
+            return "hold";
+        case device::Command::kResume:
+            return "resume";
+        case device::Command::kStop:
+            return "stop";
+        case device::Command::kReset:
+            return "reset";
+    }
+    return "unknown";
+}
+
+namespace {
+
+// Modbus: the status block and register 100; a refusal's reason is status register 30.
+class ModbusDeviceLink final : public DeviceLink {
+public:
+    explicit ModbusDeviceLink(StreamOptions options)
+        : options_(std::move(options)), link_(options_) {}
+
+    DeviceSnapshot status() override {
+        link_.mark_alive();
+        return link_.read_status();
+    }
+
+    Status command(device::Command c) override {
+        link_.mark_alive();
+        try {
+            link_.write_command(c);
+            return Status::kOk;
+        } catch (const hal::ModbusError& e) {
+            const DeviceSnapshot s = link_.read_status();
+            if (s.last_refusal != 0) return static_cast<Status>(s.last_refusal);
+            link_.fail(std::string("command ") + command_verb(c) + ": " + e.what());
+        }
+    }
+
+    const std::string& name() const override { return options_.target; }
+
+private:
+    StreamOptions options_;
+    ModbusLink link_;
+};
+
+// Native CAN: a status request (frames A to E) and the command frame with its ack.
+class CanDeviceLink final : public DeviceLink {
+public:
+    CanDeviceLink(hal::CanBus& bus, const CanStreamOptions& options)
+        : options_(options), link_(bus, options_, counters_) {}
+
+    DeviceSnapshot status() override {
+        link_.mark_alive();
+        return snapshot_of(link_.request_status());
+    }
+
+    Status command(device::Command c) override {
+        link_.mark_alive();
+        const std::uint8_t r = link_.command(static_cast<std::uint8_t>(c));
+        if (r >= pc::kResultIncomplete)
+            link_.fail(std::string("command ") + command_verb(c) + ": " + can_result_name(r));
+        return static_cast<Status>(r);
+    }
+
+    const std::string& name() const override { return options_.name; }
+
+private:
+    CanStreamOptions options_;
+    CanStreamReport counters_;
+    CanLink link_;
+};
+
+// A CAN link that owns its SocketCAN socket.
+class OwnedCanDeviceLink final : public DeviceLink {
+public:
+    OwnedCanDeviceLink(const std::string& interface_name, const CanStreamOptions& options)
+        : bus_(interface_name), link_(bus_, options) {}
+    DeviceSnapshot status() override { return link_.status(); }
+    Status command(device::Command c) override { return link_.command(c); }
+    const std::string& name() const override { return link_.name(); }
+
+private:
+    hal::SocketCanBus bus_;
+    CanDeviceLink link_;
+};
+
+}  // namespace
+
+std::unique_ptr<DeviceLink> open_can_link(hal::CanBus& bus, const CanStreamOptions& options) {
+    return std::make_unique<CanDeviceLink>(bus, options);
+}
+
+std::unique_ptr<DeviceLink> open_device_link(const std::string& target,
+                                             const LinkOptions& options) {
+    if (target.rfind("can://", 0) == 0) {
+        const CanTarget t = parse_can_target(target);
+        if (t.protocol != "native") {
+            throw std::invalid_argument(target +
+                                        ": ctl speaks the native CAN protocol, not CiA 402");
+        }
+        CanStreamOptions c;
+        c.node = t.node;
+        c.name = target;
+        c.ack_timeout_ms = std::min(options.response_timeout_ms, 100u);
+        c.link_timeout_seconds = options.link_timeout_seconds;
+        return std::make_unique<OwnedCanDeviceLink>(t.interface_name, c);
+    }
+    if (target.rfind("modbus-tcp://", 0) != 0 && target.rfind("modbus-rtu://", 0) != 0) {
+        throw std::invalid_argument(
+            "bad target URL '" + target +
+            "': unknown scheme (want modbus-tcp://, modbus-rtu:// or can://)");
+    }
+    StreamOptions m;
+    m.target = target;
+    m.response_timeout_ms = options.response_timeout_ms;
+    m.attempts = options.attempts;
+    m.link_timeout_seconds = options.link_timeout_seconds;
+    return std::make_unique<ModbusDeviceLink>(m);
+}
+
+}  // namespace pathstream::host

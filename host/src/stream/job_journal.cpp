@@ -1,0 +1,324 @@
+// Job journal: the job's spans, the progress record, and the re-entry that resumes a job.
+#include "pathstream/host/job_journal.hpp"
+
+#include <algorithm>
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+
+#include "pathstream/device/motion_limits.hpp"
+#include "pathstream/device/stop_spans.hpp"
+#include "pathstream/host/atomic_file.hpp"
+#include "pathstream/host/input_error.hpp"
+#include "pathstream/host/json_document.hpp"
+
+namespace pathstream::host {
+namespace {
+
+constexpr const char* kSpansHeader = "pathstream job spans 1";
+
+std::string fnv1a_hex(const std::string& text) {
+    std::uint64_t h = 1469598103934665603ull;
+    for (const unsigned char c : text) {
+        h ^= c;
+        h *= 1099511628211ull;
+    }
+    char out[17];
+    std::snprintf(out, sizeof out, "%016llx", static_cast<unsigned long long>(h));
+    return out;
+}
+
+// The core's plan_reentry for a run-time axis count.
+template <unsigned Axes>
+Status reentry_for(const std::vector<Lsb>& from, const std::vector<std::int32_t>& to,
+                   const std::vector<std::int32_t>& tangent, std::uint32_t ticks,
+                   const DeviceLimitsLsb& l, CoreSpan& out) {
+    device::MotionLimits<Axes> limits;
+    limits.tick_hz = l.tick_hz;
+    limits.pen_down_ticks = l.pen_down_ticks;
+    Lsb f[Axes], t[Axes];
+    std::int32_t g[Axes];
+    for (unsigned a = 0; a < Axes; ++a) {
+        limits.axis[a].max_velocity = l.max_velocity[a];
+        limits.axis[a].max_acceleration = l.max_acceleration[a];
+        f[a] = from[a];
+        t[a] = to[a];
+        g[a] = tangent[a];
+    }
+    Span<Axes> span;
+    const Status s = device::plan_reentry(f, t, g, ticks, limits, span);
+    if (s != Status::kOk) return s;
+    out.basis = Basis::kHermite;
+    out.ticks = span.ticks;
+    out.control.assign(Axes, {});
+    for (unsigned a = 0; a < Axes; ++a) {
+        for (unsigned k = 0; k < 4; ++k) out.control[a][k] = span.control[a][k];
+    }
+    return Status::kOk;
+}
+
+Status reentry(const std::vector<Lsb>& from, const std::vector<std::int32_t>& to,
+               const std::vector<std::int32_t>& tangent, std::uint32_t ticks,
+               const DeviceLimitsLsb& l, CoreSpan& out) {
+    switch (from.size()) {
+        case 1:
+            return reentry_for<1>(from, to, tangent, ticks, l, out);
+        case 2:
+            return reentry_for<2>(from, to, tangent, ticks, l, out);
+        case 3:
+            return reentry_for<3>(from, to, tangent, ticks, l, out);
+        case 4:
+            return reentry_for<4>(from, to, tangent, ticks, l, out);
+        case 5:
+            return reentry_for<5>(from, to, tangent, ticks, l, out);
+        case 6:
+            return reentry_for<6>(from, to, tangent, ticks, l, out);
+        case 7:
+            return reentry_for<7>(from, to, tangent, ticks, l, out);
+        case 8:
+            return reentry_for<8>(from, to, tangent, ticks, l, out);
+        default:
+            throw std::invalid_argument("1 to 8 axes");
+    }
+}
+
+// Subpaths of the drawing: its spans name them by index.
+std::size_t count_subpaths(const Plan& plan) {
+    std::size_t n = 0;
+    for (const CoreSpan& s : plan.spans) n = std::max(n, s.subpath + 1);
+    return n;
+}
+
+}  // namespace
+
+JobSpans job_from_plan(const Plan& plan) {
+    JobSpans j;
+    j.plan = plan;
+    std::uint64_t tick = 0;
+    for (std::size_t i = 0; i < plan.spans.size(); ++i) {
+        j.origin.push_back(static_cast<std::int64_t>(i));
+        j.drawing_tick.push_back(tick);
+        tick += plan.spans[i].ticks;
+    }
+    j.drawing_spans = plan.spans.size();
+    j.drawing_ticks = tick;
+    j.subpaths = count_subpaths(plan);
+    return j;
+}
+
+JobSpans resume_from(const JobSpans& job, std::size_t first, const std::vector<Lsb>& rest,
+                     const DeviceLimitsLsb& limits) {
+    while (first < job.origin.size() && job.origin[first] < 0) ++first;  // our own re-entry spans
+    if (first >= job.plan.spans.size())
+        throw std::invalid_argument("nothing left to draw: the job ran to its end");
+    const CoreSpan& target = job.plan.spans[first];
+    const std::size_t axes = target.control.size();
+    if (rest.size() != axes)
+        throw std::invalid_argument("the device's axis count differs from the job's");
+    std::vector<std::int32_t> entry(axes), tangent(axes);
+    for (std::size_t a = 0; a < axes; ++a) {
+        entry[a] = target.control[a][0];
+        tangent[a] = target.control[a][2];
+    }
+    JobSpans out;
+    out.drawing_spans = job.drawing_spans;
+    out.drawing_ticks = job.drawing_ticks;
+    out.subpaths = job.subpaths;
+    const auto add = [&](CoreSpan s, std::int64_t origin, std::uint64_t tick) {
+        out.plan.spans.push_back(std::move(s));
+        out.origin.push_back(origin);
+        out.drawing_tick.push_back(tick);
+    };
+    // The pen lands where the span starts: approach along its start tangent, pen down, for
+    // whole multiples of its length (k n ticks with tangent k T0: the same velocity, exactly).
+    std::vector<CoreSpan> approach;
+    if (target.pen_down && limits.pen_down_ticks > 0) {
+        const std::uint32_t k = (limits.pen_down_ticks + target.ticks - 1) / target.ticks;
+        CoreSpan a;
+        a.basis = Basis::kHermite;
+        a.ticks = k * target.ticks;
+        a.subpath = target.subpath;
+        a.pen_down = true;
+        a.control.assign(axes, {});
+        for (std::size_t i = 0; i < axes; ++i) {
+            const std::int64_t t = static_cast<std::int64_t>(tangent[i]) * k;
+            const std::int64_t start = static_cast<std::int64_t>(entry[i]) - t;
+            if (t > kMaxTangentLsb || t < -kMaxTangentLsb || start > kMaxPositionLsb ||
+                start < -kMaxPositionLsb) {
+                throw std::range_error(
+                    "the pen-down approach to the resume point leaves the position range");
+            }
+            a.control[i] = {static_cast<std::int32_t>(start), entry[i],
+                            static_cast<std::int32_t>(t), static_cast<std::int32_t>(t)};
+            entry[i] = static_cast<std::int32_t>(start);
+        }
+        approach.push_back(std::move(a));
+    }
+    CoreSpan r;
+    r.subpath = target.subpath;
+    r.pen_down = false;
+    if (const Status s = reentry(rest, entry, tangent, target.ticks, limits, r); s != Status::kOk) {
+        throw std::range_error(
+            std::string("no move from where the device rests back onto the drawing fits "
+                        "the limits in one span (") +
+            status_name(s) + ")");
+    }
+    const std::uint64_t tick = job.drawing_tick[first];
+    add(std::move(r), -1, tick);
+    for (CoreSpan& a : approach) add(std::move(a), -1, tick);
+    for (std::size_t i = first; i < job.plan.spans.size(); ++i) {
+        if (job.origin[i] >= 0) add(job.plan.spans[i], job.origin[i], job.drawing_tick[i]);
+    }
+    std::uint64_t total = 0;
+    for (const CoreSpan& s : out.plan.spans) total += s.ticks;
+    out.plan.total_ticks = total;
+    return out;
+}
+
+std::string write_job_spans(const JobSpans& job, const std::string& path) {
+    std::ostringstream text;
+    const std::size_t axes = job.plan.spans.empty() ? 0 : job.plan.spans.front().control.size();
+    text << kSpansHeader << '\n';
+    text << "axes " << axes << " spans " << job.plan.spans.size() << " drawing_spans "
+         << job.drawing_spans << " drawing_ticks " << job.drawing_ticks << " subpaths "
+         << job.subpaths << '\n';
+    for (std::size_t i = 0; i < job.plan.spans.size(); ++i) {
+        const CoreSpan& s = job.plan.spans[i];
+        text << job.origin[i] << ' ' << job.drawing_tick[i] << ' ' << s.subpath << ' '
+             << (s.pen_down ? 1 : 0) << ' ' << s.ticks;
+        for (const auto& c : s.control)
+            text << ' ' << c[0] << ' ' << c[1] << ' ' << c[2] << ' ' << c[3];
+        text << '\n';
+    }
+    const std::string contents = text.str();
+    AtomicFile f(path);
+    f.stream() << contents;
+    f.commit();
+    return fnv1a_hex(contents);
+}
+
+JobSpans read_job_spans(const std::string& path, const std::string& expected_hash) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw InputError(path, {}, "cannot open the job's spans");
+    std::ostringstream whole;
+    whole << in.rdbuf();
+    const std::string contents = whole.str();
+    if (!expected_hash.empty() && fnv1a_hex(contents) != expected_hash) {
+        throw InputError(path, {},
+                         "the job's spans changed since the journal was written (hash " +
+                             fnv1a_hex(contents) + ", journal " + expected_hash + ")");
+    }
+    std::istringstream lines(contents);
+    std::string line;
+    std::size_t number = 0;
+    const auto fail = [&](const std::string& what) -> void {
+        throw InputError(path, {number, 1}, what);
+    };
+    if (!std::getline(lines, line) || line != kSpansHeader) {
+        number = 1;
+        fail(std::string("not a job spans file (want \"") + kSpansHeader + "\")");
+    }
+    ++number;
+    JobSpans job;
+    std::size_t axes = 0, spans = 0;
+    {
+        std::getline(lines, line);
+        ++number;
+        std::istringstream h(line);
+        std::string k1, k2, k3, k4, k5;
+        if (!(h >> k1 >> axes >> k2 >> spans >> k3 >> job.drawing_spans >> k4 >>
+              job.drawing_ticks >> k5 >> job.subpaths) ||
+            k1 != "axes" || k2 != "spans" || axes < 1 || axes > 8) {
+            fail("bad header line");
+        }
+    }
+    std::uint64_t total = 0;
+    for (std::size_t i = 0; i < spans; ++i) {
+        if (!std::getline(lines, line))
+            fail("ends after " + std::to_string(i) + " of " + std::to_string(spans) + " spans");
+        ++number;
+        std::istringstream l(line);
+        CoreSpan s;
+        std::int64_t origin = 0;
+        std::uint64_t tick = 0;
+        int pen = 0;
+        s.basis = Basis::kHermite;
+        if (!(l >> origin >> tick >> s.subpath >> pen >> s.ticks) || s.ticks < 1 ||
+            (pen != 0 && pen != 1)) {
+            fail("bad span line");
+        }
+        s.pen_down = pen == 1;
+        s.control.assign(axes, {});
+        for (auto& c : s.control) {
+            if (!(l >> c[0] >> c[1] >> c[2] >> c[3]))
+                fail("bad span line: " + std::to_string(axes) + " axes expected");
+        }
+        total += s.ticks;
+        job.plan.spans.push_back(std::move(s));
+        job.origin.push_back(origin);
+        job.drawing_tick.push_back(tick);
+    }
+    job.plan.total_ticks = total;
+    return job;
+}
+
+void write_journal(const JobJournal& j, const std::string& path) {
+    nlohmann::json d;
+    d["format"] = "pathstream job journal 1";
+    d["target"] = j.target;
+    d["machine"] = j.machine;
+    d["drawing"] = j.drawing;
+    d["plan_file"] = j.plan_file;
+    d["plan_hash"] = j.plan_hash;
+    d["job"] = j.job;
+    d["acknowledged"] = j.acknowledged;
+    d["last_completed"] = j.last_completed;
+    d["epoch"] = j.epoch;
+    d["state"] = j.state;
+    d["position_lsb"] = j.position;
+    d["outcome"] = j.outcome;
+    if (!j.error.empty()) d["error"] = j.error;
+    AtomicFile f(path);
+    f.stream() << d.dump(2) << '\n';
+    f.commit();
+}
+
+JobJournal read_journal(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw InputError(path, {}, "cannot open the journal");
+    std::ostringstream whole;
+    whole << in.rdbuf();
+    const std::string text = whole.str();
+    const nlohmann::json d = parse_json_document(text, path);
+    const JsonChecker check(text, path);
+    if (!d.is_object() || d.value("format", "") != "pathstream job journal 1") {
+        check.fail("",
+                   "not a pathstream job journal (want \"format\": \"pathstream job journal 1\")");
+    }
+    JobJournal j;
+    const auto get = [&](const char* key, auto& out) {
+        if (!d.contains(key)) check.fail("", std::string("missing \"") + key + "\"");
+        try {
+            d.at(key).get_to(out);
+        } catch (const nlohmann::json::exception&) {
+            check.fail(std::string("/") + key, std::string("\"") + key + "\" has the wrong type");
+        }
+    };
+    get("target", j.target);
+    get("machine", j.machine);
+    get("drawing", j.drawing);
+    get("plan_file", j.plan_file);
+    get("plan_hash", j.plan_hash);
+    get("job", j.job);
+    get("acknowledged", j.acknowledged);
+    get("last_completed", j.last_completed);
+    get("epoch", j.epoch);
+    get("state", j.state);
+    get("position_lsb", j.position);
+    get("outcome", j.outcome);
+    if (d.contains("error")) get("error", j.error);
+    return j;
+}
+
+}  // namespace pathstream::host

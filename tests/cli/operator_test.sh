@@ -1,0 +1,112 @@
+#!/usr/bin/env bash
+# An operator's session with the real binaries over Modbus TCP: `pathstream device` serving,
+# `pathstream stream` interrupted by SIGINT at seeded moments (one Ctrl-C: hold; two: stop),
+# `pathstream stream --resume`, and `pathstream ctl` status and commands. Every run must end
+# with the device idle at the drawing's end and exactly the plan's path ticks executed, pen
+# down on exactly the plan's pen-down ticks (the device's record).
+#   operator_test.sh PATHSTREAM_BINARY SOURCE_DIR WORK_DIR [RUNS]
+set -u
+bin=$1 src=$2 work=$3 runs=${4:-${PATHSTREAM_OPERATOR_RUNS:-3}}
+rm -rf "$work" && mkdir -p "$work" && cd "$work" || exit 1
+machine=$src/examples/machines/pen_plotter.json
+drawing=$src/examples/rose.json
+failures=0 passed=0
+fail() { echo "FAIL $*"; failures=$((failures + 1)); }
+ok() { passed=$((passed + 1)); }
+device_pid=
+
+# Starts the simulated device at the drawing's start on a free port; sets $target.
+start_device() {
+  "$bin" device -m "$machine" --no-gpio --tcp 127.0.0.1:0 --position 139.322,100 --time-scale "$1" \
+    --record "$work/record.csv" --exit-after 300 > "$work/device.log" 2>&1 &
+  device_pid=$!
+  for _ in $(seq 100); do
+    target=$(sed -n 's/.*serving \(modbus-tcp:[^ ]*\).*/\1/p' "$work/device.log")
+    [ -n "$target" ] && return 0
+    sleep 0.05
+  done
+  fail "device did not start: $(cat "$work/device.log")"; return 1
+}
+stop_device() { kill -INT "$device_pid" 2>/dev/null; wait "$device_pid" 2>/dev/null; }
+
+# The plan's path ticks and pen-down ticks (the setpoints CSV: tick,...,pen columns).
+"$bin" plan "$drawing" -m "$machine" --out "$work/plan.csv" > /dev/null 2>&1 || fail "plan"
+plan_ticks=$(($(wc -l < "$work/plan.csv") - 2))  # header and the end point
+plan_pen=$(awk -F, 'NR > 1 { n += $NF } END { print n }' "$work/plan.csv")
+
+# ---- ctl: status, refusals, a hold and a resume of a running stream -------------------
+start_device 2 || exit 1
+out=$("$bin" ctl "$target" status -m "$machine" 2>&1)
+[[ "$out" == *"state         idle"* && "$out" == *"x 139.3220 mm (139322 LSB)"* ]] && ok || fail "ctl status: $out"
+out=$("$bin" ctl "$target" status --json 2>&1)
+echo "$out" | /usr/bin/python3 -c 'import json,sys; d=json.load(sys.stdin); assert d["state"]=="idle" and d["position"][0]["position_lsb"]==139322 and d["protocol_version"]==2' && ok || fail "ctl status --json: $out"
+out=$("$bin" ctl "$target" hold 2>&1); rc=$?
+[ $rc -eq 6 ] && [[ "$out" == *"device refused hold while idle: command not allowed in this state"* ]] && ok || fail "ctl hold idle: $rc $out"
+out=$("$bin" ctl "$target" jump 2>&1); rc=$?
+[ $rc -eq 2 ] && ok || fail "ctl bad verb: $rc $out"
+out=$("$bin" ctl "modbus-tcp://127.0.0.1:1?unit=1" status --link-timeout 0.2 2>&1); rc=$?
+[ $rc -eq 6 ] && [[ "$out" == *"cannot connect"* ]] && ok || fail "ctl dead target: $rc $out"
+"$bin" stream "$drawing" -m "$machine" -t "$target" --no-journal > "$work/stream0.log" 2>&1 &
+stream_pid=$!
+sleep 1
+out=$("$bin" ctl "$target" hold 2>&1)
+[[ "$out" == *"accepted: running -> holding"* ]] && ok || fail "ctl hold: $out"
+out=$("$bin" ctl "$target" status --watch 0.05 --count 3 2>&1)
+[ "$(echo "$out" | grep -c '^holding')" -eq 3 ] && ok || fail "ctl status --watch: $out"
+out=$("$bin" ctl "$target" resume 2>&1)
+[[ "$out" == *"accepted: holding -> running"* ]] && ok || fail "ctl resume: $out"
+wait "$stream_pid"; rc=$?
+[ $rc -eq 0 ] && ok || fail "stream held and resumed by ctl: exit $rc: $(cat "$work/stream0.log")"
+stop_device
+
+# ---- Ctrl-C at seeded moments, then --resume ---------------------------------------------
+check_record() {  # the whole drawing's path ticks once: count and pen-down count
+  local rows pen
+  rows=$(($(wc -l < "$work/record.csv") - 1))
+  pen=$(awk -F, 'NR > 1 { n += $NF } END { print n }' "$work/record.csv")
+  # A stop resumes with a re-entry (path ticks of its own, pen up, and a pen-down approach
+  # of whole spans): those come on top; a hold resumes on the device's own re-entry.
+  local extra_rows=$2 extra_pen=$3
+  if [ "$rows" -eq $((plan_ticks + extra_rows)) ] && [ "$pen" -eq $((plan_pen + extra_pen)) ]; then ok
+  else fail "$1: record has $rows path ticks ($pen pen down), plan $plan_ticks ($plan_pen) + $extra_rows ($extra_pen)"; fi
+}
+RANDOM=20261125
+for run in $(seq "$runs"); do
+  for presses in 1 2; do
+    start_device 4 || exit 1
+    delay=$(awk -v r=$RANDOM 'BEGIN { printf "%.2f", 0.3 + 3.0 * r / 32767 }')
+    "$bin" stream "$drawing" -m "$machine" -t "$target" --journal "$work/j.json" > "$work/stream1.log" 2>&1 &
+    stream_pid=$!
+    sleep "$delay"
+    kill -INT "$stream_pid"
+    [ "$presses" -eq 2 ] && { sleep 0.001; kill -INT "$stream_pid"; }
+    wait "$stream_pid"; rc=$?
+    name="run $run, $presses Ctrl-C after $delay s"
+    outcome=$(/usr/bin/python3 -c 'import json,sys; print(json.load(open(sys.argv[1]))["outcome"])' "$work/j.json")
+    if [ $rc -eq 7 ]; then
+      [[ "$(cat "$work/stream1.log")" == *"resume with   pathstream stream --resume $work/j.json"* ]] && ok ||
+        fail "$name: no resume hint: $(cat "$work/stream1.log")"
+      st=$("$bin" ctl "$target" status --json | /usr/bin/python3 -c 'import json,sys; d=json.load(sys.stdin); print(d["state"])')
+      want=holding; [ "$outcome" = stopped ] && want=idle
+      [ "$st" = "$want" ] && ok || fail "$name: device $st after the interrupt (journal: $outcome)"
+      "$bin" stream --resume "$work/j.json" > "$work/stream2.log" 2>&1; rc=$?
+      [ $rc -eq 0 ] && ok || fail "$name: resume exit $rc: $(cat "$work/stream2.log")"
+    elif [ $rc -eq 0 ]; then
+      ok  # the drawing ended before the interrupt arrived
+    else
+      fail "$name: stream exit $rc: $(cat "$work/stream1.log")"
+    fi
+    outcome=$(/usr/bin/python3 -c 'import json,sys; print(json.load(open(sys.argv[1]))["outcome"])' "$work/j.json")
+    [ "$outcome" = finished ] && ok || fail "$name: journal outcome $outcome"
+    stop_device
+    extra_rows=0 extra_pen=0
+    if [ -f "$work/j.json.plan" ] && grep -q '^-1 ' "$work/j.json.plan"; then
+      extra_rows=$(awk '$1 == -1 { n += $5 } END { print n + 0 }' "$work/j.json.plan")
+      extra_pen=$(awk '$1 == -1 && $4 == 1 { n += $5 } END { print n + 0 }' "$work/j.json.plan")
+    fi
+    check_record "$name" "$extra_rows" "$extra_pen"
+    rm -f "$work/j.json" "$work/j.json.plan" "$work/record.csv"
+  done
+done
+echo "operator: $passed passed, $failures failed"
+[ "$failures" -eq 0 ]

@@ -1,0 +1,468 @@
+// An interrupted drawing continued: a hold asked for while streaming, a host that dies
+// mid-stream, and a fault followed by a reset, each at seeded moments; the drawing's path
+// ticks of the interrupted run and of the resumed run together are the uninterrupted plan's,
+// tick for tick, pen included. Also `pathstream ctl`'s link: status and commands over Modbus
+// TCP and native CAN.
+#include <unistd.h>
+
+#include <atomic>
+#include <catch2/catch.hpp>
+#include <chrono>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <stdexcept>
+#include <thread>
+#include <vector>
+
+#include "pathstream/device/can_protocol.hpp"
+#include "pathstream/device/device_state.hpp"
+#include "pathstream/hal/modbus_server.hpp"
+#include "pathstream/host/can_stream.hpp"
+#include "pathstream/host/device_link.hpp"
+#include "pathstream/host/device_setup.hpp"
+#include "pathstream/host/job_journal.hpp"
+#include "pathstream/host/modbus_stream.hpp"
+#include "pathstream/sim/can_device.hpp"
+#include "pathstream/sim/can_loopback.hpp"
+#include "pathstream/sim/modbus_device.hpp"
+#include "stream_support.hpp"
+
+using namespace pathstream;
+using test::Job;
+using test::plan_example;
+using test::plan_setpoints;
+using test::start_of;
+
+namespace {
+
+using device::Command;
+using device::DeviceState;
+
+// The simulated Modbus device served over TCP and ticked on its own thread.
+struct ModbusDeviceThread {
+    std::unique_ptr<sim::SimulatedModbusDevice> device;
+    std::unique_ptr<hal::ModbusServer> server;
+    std::atomic<bool> stop{false};
+    std::thread thread;
+
+    explicit ModbusDeviceThread(const std::vector<Lsb>& start, double time_scale) {
+        device = sim::SimulatedModbusDevice::create(start);
+        device->record(true);
+        device->record_every_tick(true);
+        server = std::make_unique<hal::ModbusServer>(
+            hal::ModbusServer::tcp(device->handler(), {"127.0.0.1", 0, 4}));
+        thread = std::thread([this, time_scale] {
+            sim::DeviceLoopOptions o;
+            o.time_scale = time_scale;
+            sim::run_device_loop(
+                *device, [&](std::chrono::milliseconds w) { server->poll_once(w); }, o, stop);
+        });
+    }
+    std::string target() const {
+        return "modbus-tcp://127.0.0.1:" + std::to_string(server->port()) + "?unit=1";
+    }
+    void join() {
+        stop = true;
+        if (thread.joinable()) thread.join();
+    }
+    ~ModbusDeviceThread() { join(); }
+};
+
+host::StreamOptions options_for(const std::string& target) {
+    host::StreamOptions o;
+    o.target = target;
+    o.lead_seconds = 0.1;
+    return o;
+}
+
+// Waits until the device is in `state` (polling its status), at most 10 s.
+host::DeviceSnapshot wait_for(host::DeviceLink& link, DeviceState state) {
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+    host::DeviceSnapshot s = link.status();
+    while (s.state != static_cast<unsigned>(state) && std::chrono::steady_clock::now() < deadline) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(2));
+        s = link.status();
+    }
+    REQUIRE(std::string(host::device_state_name(s.state)) ==
+            host::device_state_name(static_cast<unsigned>(state)));
+    return s;
+}
+
+// The drawing's path ticks the device executed: the interrupted run's, up to the end of its
+// last completed span (`kept` ticks), then the resumed run's without its re-entry spans
+// (`reentry_ticks` path ticks at `resumed_from`).
+struct Executed {
+    std::vector<Lsb> setpoints;
+    std::vector<std::uint8_t> pen;
+};
+
+Executed drawing_ticks(const sim::SimulatedMotionDevice& d, std::size_t kept,
+                       std::size_t resumed_from, std::size_t reentry_ticks) {
+    const unsigned axes = d.axes();
+    Executed e;
+    const auto& s = d.recorded_setpoints();
+    const auto& t = d.recorded_ticks();
+    for (std::size_t k = 0; k < t.size(); ++k) {
+        if (k >= kept && k < resumed_from + reentry_ticks) continue;
+        e.setpoints.insert(e.setpoints.end(), s.begin() + static_cast<long>(k * axes),
+                           s.begin() + static_cast<long>((k + 1) * axes));
+        e.pen.push_back(static_cast<std::uint8_t>(t[k].outputs & kOutputPenDown));
+    }
+    return e;
+}
+
+// The executed ticks are the plan's, tick for tick, pen included (the end point is output by
+// the non-path tick that ends the job, so it is not among them).
+void check_equals_plan(const Executed& e, const host::Plan& plan) {
+    const std::size_t axes = plan.spans.front().control.size();
+    const std::vector<Lsb> expected = plan_setpoints(plan, axes);
+    REQUIRE(e.pen.size() == plan.total_ticks);
+    std::size_t k = 0, pen_down = 0;
+    for (const auto& span : plan.spans) {
+        for (std::uint32_t i = 0; i < span.ticks; ++i, ++k) {
+            INFO("tick " << k);
+            for (std::size_t a = 0; a < axes; ++a)
+                REQUIRE(e.setpoints[k * axes + a] == expected[k * axes + a]);
+            REQUIRE(e.pen[k] == (span.pen_down ? 1 : 0));
+            pen_down += span.pen_down ? 1 : 0;
+        }
+    }
+    CHECK(pen_down > 0);
+}
+
+// No tick the device output (path, stop, re-entry, rest) steps further than the limit allows
+// (one LSB of rounding on top of the exact velocity).
+void check_steps_within_limits(const sim::SimulatedMotionDevice& d,
+                               const host::MachineProfile& machine) {
+    const host::DeviceLimitsLsb l = host::device_limits(machine);
+    const auto& s = d.every_tick_setpoints();
+    const unsigned axes = d.axes();
+    for (unsigned a = 0; a < axes; ++a) {
+        const double max_step = static_cast<double>(l.max_velocity[a]) / l.tick_hz + 1.0;
+        for (std::size_t k = 1; k < s.size() / axes; ++k) {
+            const double step =
+                std::abs(static_cast<double>(s[k * axes + a]) - s[(k - 1) * axes + a]);
+            INFO("axis " << a << " tick " << k);
+            REQUIRE(step <= max_step);
+        }
+    }
+}
+
+std::size_t reentry_ticks(const host::JobSpans& job) {
+    std::size_t n = 0;
+    for (std::size_t i = 0; i < job.origin.size() && job.origin[i] < 0; ++i)
+        n += job.plan.spans[i].ticks;
+    return n;
+}
+
+// Seeds per scenario: 3 in CI, PATHSTREAM_RESUME_SEEDS=N on demand.
+unsigned seeds_to_run() {
+    const char* env = std::getenv("PATHSTREAM_RESUME_SEEDS");
+    return env != nullptr && std::atoi(env) > 0 ? static_cast<unsigned>(std::atoi(env)) : 3u;
+}
+
+}  // namespace
+
+TEST_CASE(
+    "a hold asked for at a seeded moment, then the held job streamed on and resumed: every drawing "
+    "tick "
+    "once, tick for tick",
+    "[resume][modbus][threads]") {
+    const Job job = plan_example("wave.json");
+    for (unsigned seed = 1; seed <= seeds_to_run(); ++seed) {
+        DYNAMIC_SECTION("seed " << seed) {
+            std::mt19937 rng(seed);
+            ModbusDeviceThread dt(start_of(job.plan), 4.0);
+            std::atomic<int> interrupt{0};
+            host::StreamOptions o = options_for(dt.target());
+            o.interrupt.request = &interrupt;
+            std::uint32_t job_id = 0;
+            std::uint64_t seen_ticks = 0;
+            const std::uint64_t at =
+                std::uniform_int_distribution<std::uint64_t>(50, job.plan.total_ticks - 50)(rng);
+            o.observer = [&](const host::StreamTrace& t) {
+                job_id = t.job;
+                seen_ticks = t.status.ticks_executed;
+                if (seen_ticks >= at) interrupt.store(1);
+            };
+            const host::StreamReport first = host::stream_modbus(job.plan, job.machine, o);
+            INFO("interrupted at path tick " << seen_ticks << " (asked at " << at << ")");
+            REQUIRE(first.interrupted == 1);
+            CHECK(first.final_status.state == static_cast<unsigned>(DeviceState::kHolding));
+            CHECK((first.final_status.flags & 8u) == 0);  // at rest
+            CHECK(first.final_status.outputs == 0);       // pen up
+            const host::HeldJob held{job_id, first.final_status.last_accepted};
+            host::StreamOptions again = options_for(dt.target());
+            again.held = &held;
+            const host::StreamReport second = host::stream_modbus(job.plan, job.machine, again);
+            CHECK(second.interrupted == 0);
+            CHECK(second.job == job_id);
+            dt.join();
+            check_equals_plan(drawing_ticks(*dt.device, dt.device->recorded_ticks().size(), 0, 0),
+                              job.plan);
+            check_steps_within_limits(*dt.device, job.machine);
+        }
+    }
+}
+
+TEST_CASE(
+    "the host dies at a seeded moment (the device holds by underrun), then the job goes on from "
+    "the "
+    "device's queue: every drawing tick once",
+    "[resume][modbus][threads]") {
+    const Job job = plan_example("wave.json");
+    for (unsigned seed = 11; seed < 11 + seeds_to_run(); ++seed) {
+        DYNAMIC_SECTION("seed " << seed) {
+            std::mt19937 rng(seed);
+            ModbusDeviceThread dt(start_of(job.plan), 4.0);
+            host::StreamOptions o = options_for(dt.target());
+            std::uint32_t job_id = 0;
+            const std::uint64_t at =
+                std::uniform_int_distribution<std::uint64_t>(50, job.plan.total_ticks / 2)(rng);
+            struct HostDied {};
+            o.observer = [&](const host::StreamTrace& t) {
+                job_id = t.job;
+                if (t.status.ticks_executed >= at)
+                    throw HostDied{};  // nothing more is sent or said
+            };
+            REQUIRE_THROWS_AS(host::stream_modbus(job.plan, job.machine, o), HostDied);
+            const std::unique_ptr<host::DeviceLink> link = host::open_device_link(dt.target(), {});
+            host::DeviceSnapshot s = wait_for(*link, DeviceState::kHolding);
+            while ((s.flags & 8u) != 0) s = link->status();  // the underrun's stop comes to rest
+            CHECK((s.flags & 2u) != 0);                      // held by underrun
+            const host::HeldJob held{job_id, s.last_accepted};
+            host::StreamOptions again = options_for(dt.target());
+            again.held = &held;
+            const host::StreamReport second = host::stream_modbus(job.plan, job.machine, again);
+            CHECK(second.interrupted == 0);
+            dt.join();
+            check_equals_plan(drawing_ticks(*dt.device, dt.device->recorded_ticks().size(), 0, 0),
+                              job.plan);
+            check_steps_within_limits(*dt.device, job.machine);
+        }
+    }
+}
+
+TEST_CASE(
+    "a stop (second Ctrl-C) or a fault at a seeded moment, then a reset and a resume from where "
+    "the device "
+    "rests: a re-entry, then the drawing from the first span not executed",
+    "[resume][modbus][threads]") {
+    const Job job = plan_example("wave.json");
+    const host::JobSpans whole = host::job_from_plan(job.plan);
+    const host::DeviceLimitsLsb limits = host::device_limits(job.machine);
+    for (unsigned seed = 21; seed < 21 + 2 * seeds_to_run(); ++seed) {
+        const bool fault = seed % 2 == 0;
+        DYNAMIC_SECTION("seed " << seed << (fault ? " fault" : " stop")) {
+            std::mt19937 rng(seed);
+            ModbusDeviceThread dt(start_of(job.plan), 4.0);
+            std::atomic<int> interrupt{0};
+            host::StreamOptions o = options_for(dt.target());
+            o.interrupt.request = &interrupt;
+            std::uint32_t job_id = 0;
+            const std::uint64_t at =
+                std::uniform_int_distribution<std::uint64_t>(50, job.plan.total_ticks - 50)(rng);
+            o.observer = [&](const host::StreamTrace& t) {
+                job_id = t.job;
+                if (t.status.ticks_executed < at) return;
+                if (fault) {
+                    dt.device->raise_fault();
+                } else {
+                    interrupt.store(2);
+                }
+            };
+            host::DeviceSnapshot s;
+            const std::unique_ptr<host::DeviceLink> link = host::open_device_link(dt.target(), {});
+            if (fault) {
+                REQUIRE_THROWS_AS(host::stream_modbus(job.plan, job.machine, o), host::StreamError);
+                wait_for(*link, DeviceState::kFault);
+                CHECK(link->command(Command::kReset) == Status::kOk);
+                s = wait_for(*link, DeviceState::kIdle);
+            } else {
+                const host::StreamReport r = host::stream_modbus(job.plan, job.machine, o);
+                REQUIRE(r.interrupted == 2);
+                s = r.final_status;
+                CHECK(s.state == static_cast<unsigned>(DeviceState::kIdle));
+            }
+            // The interrupted run's drawing ticks end with its last completed span; a fault
+            // froze the axes inside the next one, whose ticks the resume draws again.
+            const std::size_t done = s.last_completed + 1 - job_id;
+            std::size_t kept = 0;
+            for (std::size_t i = 0; i < done; ++i) kept += job.plan.spans[i].ticks;
+            const std::size_t executed = dt.device->recorded_ticks().size();
+            CHECK(executed - kept < (fault ? job.plan.spans[done].ticks : 1u));
+            const std::vector<Lsb> rest(s.position, s.position + 2);
+            const host::JobSpans resumed = host::resume_from(whole, done, rest, limits);
+            const host::StreamReport second =
+                host::stream_modbus(resumed.plan, job.machine, options_for(dt.target()));
+            CHECK(second.interrupted == 0);
+            dt.join();
+            check_equals_plan(drawing_ticks(*dt.device, kept, executed, reentry_ticks(resumed)),
+                              job.plan);
+            check_steps_within_limits(*dt.device, job.machine);
+        }
+    }
+}
+
+TEST_CASE(
+    "resume_from: a pen-down span is approached along its tangent for the pen-down delay, pen "
+    "down; "
+    "a pen-up one directly; errors",
+    "[resume]") {
+    const Job job = plan_example("wave.json");
+    const host::JobSpans whole = host::job_from_plan(job.plan);
+    const host::DeviceLimitsLsb limits = host::device_limits(job.machine);
+    REQUIRE(limits.pen_down_ticks > 0);
+    std::size_t drawing = 0;
+    while (!job.plan.spans[drawing].pen_down || job.plan.spans[drawing].control[0][2] == 0)
+        ++drawing;
+    const std::vector<Lsb> rest = {start_of(job.plan)[0] - 3000, start_of(job.plan)[1] + 2000};
+    const host::JobSpans r = host::resume_from(whole, drawing, rest, limits);
+    REQUIRE(r.origin.size() >= 2);
+    CHECK((r.origin[0] == -1 && r.origin[1] == -1 &&
+           r.origin[2] == static_cast<std::int64_t>(drawing)));
+    CHECK_FALSE(r.plan.spans[0].pen_down);
+    CHECK(r.plan.spans[1].pen_down);
+    CHECK(r.plan.spans[1].ticks >= limits.pen_down_ticks);
+    CHECK(r.plan.spans[1].ticks % job.plan.spans[drawing].ticks == 0);
+    for (std::size_t a = 0; a < 2; ++a) {
+        CHECK(r.plan.spans[0].control[a][0] == rest[a]);
+        CHECK(r.plan.spans[1].control[a][1] == job.plan.spans[drawing].control[a][0]);
+        // The same velocity at every join: tangent per tick.
+        const auto& s0 = r.plan.spans[0];
+        const auto& s1 = r.plan.spans[1];
+        const auto& d = job.plan.spans[drawing];
+        CHECK(static_cast<std::int64_t>(s0.control[a][3]) * s1.ticks ==
+              static_cast<std::int64_t>(s1.control[a][2]) * s0.ticks);
+        CHECK(static_cast<std::int64_t>(s1.control[a][3]) * d.ticks ==
+              static_cast<std::int64_t>(d.control[a][2]) * s1.ticks);
+    }
+    CHECK(r.plan.spans.size() == 2 + job.plan.spans.size() - drawing);
+    // Resuming a resumed job skips its re-entry spans; past the end there is nothing to do.
+    const host::JobSpans again = host::resume_from(r, 1, rest, limits);
+    CHECK(again.origin[again.origin.size() - (job.plan.spans.size() - drawing)] ==
+          static_cast<std::int64_t>(drawing));
+    CHECK_THROWS_AS(host::resume_from(whole, job.plan.spans.size(), rest, limits),
+                    std::invalid_argument);
+}
+
+TEST_CASE(
+    "job spans and journal files: written, read back the same, and refused when changed or damaged",
+    "[resume]") {
+    const Job job = plan_example("wave.json");
+    const host::JobSpans whole = host::job_from_plan(job.plan);
+    const std::string dir = std::filesystem::temp_directory_path().string() +
+                            "/pathstream_test_resume_" + std::to_string(::getpid());
+    std::filesystem::create_directories(dir);
+    const std::string spans_path = dir + "/wave.plan";
+    const std::string hash = host::write_job_spans(whole, spans_path);
+    const host::JobSpans back = host::read_job_spans(spans_path, hash);
+    REQUIRE(back.plan.spans.size() == whole.plan.spans.size());
+    CHECK(back.plan.total_ticks == job.plan.total_ticks);
+    CHECK(back.subpaths == whole.subpaths);
+    for (std::size_t i = 0; i < whole.plan.spans.size(); ++i) {
+        CHECK(back.plan.spans[i].control == whole.plan.spans[i].control);
+        CHECK(back.plan.spans[i].pen_down == whole.plan.spans[i].pen_down);
+    }
+    CHECK_THROWS_WITH(host::read_job_spans(spans_path, "0000000000000000"),
+                      Catch::Contains("changed since the journal was written"));
+    {
+        std::ofstream bad(dir + "/bad.plan");
+        bad << "pathstream job spans 1\naxes 2 spans 2 drawing_spans 2 drawing_ticks 16 subpaths "
+               "1\n0 0 0 1 8 1 2\n";
+    }
+    CHECK_THROWS_WITH(host::read_job_spans(dir + "/bad.plan", ""),
+                      Catch::Contains("bad.plan:3:1: bad span line"));
+    host::JobJournal j;
+    j.target = "modbus-tcp://127.0.0.1:1502";
+    j.machine = "m.json";
+    j.drawing = "wave.json";
+    j.plan_file = spans_path;
+    j.plan_hash = hash;
+    j.job = 7;
+    j.acknowledged = 70;
+    j.last_completed = 33;
+    j.position = {1, -2};
+    j.outcome = "held";
+    host::write_journal(j, dir + "/j.json");
+    const host::JobJournal r = host::read_journal(dir + "/j.json");
+    CHECK((r.target == j.target && r.job == 7 && r.acknowledged == 70 && r.last_completed == 33 &&
+           r.position == j.position && r.outcome == "held" && r.plan_hash == hash));
+    {
+        std::ofstream bad(dir + "/j2.json");
+        bad << "{\"format\": \"pathstream job journal 1\", \"target\": 3}";
+    }
+    CHECK_THROWS_WITH(host::read_journal(dir + "/j2.json"), Catch::Contains("j2.json:1:"));
+}
+
+TEST_CASE("ctl's link: status and every command over Modbus TCP, refusals by name",
+          "[ctl][modbus][threads]") {
+    const Job job = plan_example("wave.json");
+    ModbusDeviceThread dt(start_of(job.plan), 1.0);
+    const std::unique_ptr<host::DeviceLink> link = host::open_device_link(dt.target(), {});
+    host::DeviceSnapshot s = link->status();
+    CHECK((s.magic == 0x5053 && s.version == 2 && s.axes == 2 && s.state == 0));
+    CHECK((s.position[0] == start_of(job.plan)[0] && s.position[1] == start_of(job.plan)[1]));
+    CHECK(link->command(Command::kHold) == Status::kWrongState);  // idle: nothing to hold
+    CHECK(link->command(Command::kResume) == Status::kWrongState);
+    CHECK(link->command(Command::kStop) == Status::kOk);  // idle: drops the queue
+    host::DeviceSnapshot after = link->status();          // the next tick applies it
+    for (int i = 0; i < 500 && after.epoch == s.epoch; ++i) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(2));
+        after = link->status();
+    }
+    CHECK(after.epoch == s.epoch + 1);
+    CHECK(link->command(Command::kReset) == Status::kOk);  // already in effect
+    dt.device->raise_fault();
+    s = wait_for(*link, DeviceState::kFault);
+    CHECK(s.fault_code == 1);
+    CHECK(link->command(Command::kStop) == Status::kWrongState);
+    CHECK(link->command(Command::kReset) == Status::kOk);
+    wait_for(*link, DeviceState::kIdle);
+}
+
+TEST_CASE(
+    "ctl's link over native CAN: status with positions, commands, and a hold of a running stream",
+    "[ctl][can][threads]") {
+    const Job job = plan_example("wave.json");
+    sim::CanLoopback loop;
+    hal::CanBus& device_bus = loop.add_endpoint();
+    hal::CanBus& host_bus = loop.add_endpoint();
+    hal::CanBus& ctl_bus = loop.add_endpoint();
+    std::unique_ptr<sim::SimulatedCanDevice> device =
+        sim::SimulatedCanDevice::create(start_of(job.plan), 5);
+    device->record(true);
+    std::atomic<bool> stop{false};
+    std::thread t([&] {
+        sim::DeviceLoopOptions o;
+        o.time_scale = 4.0;
+        sim::run_can_device_loop(*device, device_bus, o, stop);
+    });
+    host::CanStreamOptions c;
+    c.node = 5;
+    c.ack_timeout_ms = 30;
+    c.name = "can://loop?node=5";
+    const std::unique_ptr<host::DeviceLink> link = host::open_can_link(ctl_bus, c);
+    host::DeviceSnapshot s = link->status();
+    CHECK((s.version == 2 && s.axes == 2 && s.state == 0));
+    CHECK((s.position[0] == start_of(job.plan)[0] && s.position[1] == start_of(job.plan)[1]));
+    CHECK(link->command(Command::kHold) == Status::kWrongState);
+    // A stream on the host bus; ctl holds it from another endpoint, the stream sees the hold
+    // and keeps waiting; ctl resumes it and the stream finishes.
+    host::CanStreamReport report;
+    std::thread streamer([&] { report = host::stream_can(job.plan, job.machine, host_bus, c); });
+    s = wait_for(*link, DeviceState::kRunning);
+    CHECK(link->command(Command::kHold) == Status::kOk);
+    s = wait_for(*link, DeviceState::kHolding);
+    while ((s.flags & pathstream::device::can::kFlagOwnMove) != 0) s = link->status();
+    const host::DeviceSnapshot rested = link->status();
+    CHECK((rested.position[0] == s.position[0] && rested.position[1] == s.position[1]));
+    CHECK(link->command(Command::kResume) == Status::kOk);
+    streamer.join();
+    CHECK(report.ticks_executed == job.plan.total_ticks);
+    stop = true;
+    t.join();
+    test::check_recorded(job.plan, *device, 0);
+}
