@@ -42,6 +42,16 @@ out=$("$bin" ctl "$target" status --json 2>&1)
 echo "$out" | /usr/bin/python3 -c 'import json,sys; d=json.load(sys.stdin); assert d["state"]=="idle" and d["position"][0]["position_lsb"]==139322 and d["protocol_version"]==2' && ok || fail "ctl status --json: $out"
 out=$("$bin" ctl "$target" hold 2>&1); rc=$?
 [ $rc -eq 6 ] && [[ "$out" == *"device refused hold while idle: command not allowed in this state"* ]] && ok || fail "ctl hold idle: $rc $out"
+out=$("$bin" ctl "$target" jog x 5.5 --feed 20 -m "$machine" 2>&1)
+[[ "$out" == *"jog           x by 5500 LSB: done in"* && "$out" == *"x 144.8220 mm"* ]] && ok || fail "ctl jog: $out"
+out=$("$bin" ctl "$target" jog 0 -5500lsb 2>&1)
+[[ "$out" == *"x 139322 LSB"* ]] && ok || fail "ctl jog back in LSB: $out"
+out=$("$bin" ctl "$target" jog x 5 2>&1); rc=$?
+[ $rc -eq 2 ] && [[ "$out" == *"no axis 'x'"* ]] && ok || fail "ctl jog by name without -m: $rc $out"
+out=$("$bin" ctl "$target" jog x 5 --feed 1000 -m "$machine" 2>&1); rc=$?
+[ $rc -eq 2 ] && [[ "$out" == *"above the axis's"* ]] && ok || fail "ctl jog too fast: $rc $out"
+out=$("$bin" ctl "$target" position y 100.0004 -m "$machine" 2>&1); rc=$?
+[ $rc -eq 2 ] && [[ "$out" == *"not a whole number of LSB"* ]] && ok || fail "ctl position not whole: $rc $out"
 out=$("$bin" ctl "$target" jump 2>&1); rc=$?
 [ $rc -eq 2 ] && ok || fail "ctl bad verb: $rc $out"
 out=$("$bin" ctl "modbus-tcp://127.0.0.1:1?unit=1" status --link-timeout 0.2 2>&1); rc=$?
@@ -79,7 +89,7 @@ for run in $(seq "$runs"); do
     stream_pid=$!
     sleep "$delay"
     kill -INT "$stream_pid"
-    [ "$presses" -eq 2 ] && { sleep 0.001; kill -INT "$stream_pid"; }
+    [ "$presses" -eq 2 ] && { sleep 0.001; kill -INT "$stream_pid" 2>/dev/null; }
     wait "$stream_pid"; rc=$?
     name="run $run, $presses Ctrl-C after $delay s"
     outcome=$(/usr/bin/python3 -c 'import json,sys; print(json.load(open(sys.argv[1]))["outcome"])' "$work/j.json")

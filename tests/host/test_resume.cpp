@@ -18,6 +18,7 @@
 
 #include "pathstream/device/can_protocol.hpp"
 #include "pathstream/device/device_state.hpp"
+#include "pathstream/device/jog.hpp"
 #include "pathstream/hal/modbus_server.hpp"
 #include "pathstream/host/can_stream.hpp"
 #include "pathstream/host/device_link.hpp"
@@ -47,8 +48,10 @@ struct ModbusDeviceThread {
     std::atomic<bool> stop{false};
     std::thread thread;
 
-    explicit ModbusDeviceThread(const std::vector<Lsb>& start, double time_scale) {
+    // `limits`: configured before the device thread starts (as a host's configuration would).
+    ModbusDeviceThread(const std::vector<Lsb>& start, double time_scale, const host::DeviceLimitsLsb* limits = nullptr) {
         device = sim::SimulatedModbusDevice::create(start);
+        if (limits != nullptr) REQUIRE(device->configure(*limits) == Status::kOk);
         device->record(true);
         device->record_every_tick(true);
         server = std::make_unique<hal::ModbusServer>(
@@ -400,7 +403,8 @@ TEST_CASE(
 TEST_CASE("ctl's link: status and every command over Modbus TCP, refusals by name",
           "[ctl][modbus][threads]") {
     const Job job = plan_example("wave.json");
-    ModbusDeviceThread dt(start_of(job.plan), 1.0);
+    const host::DeviceLimitsLsb limits = host::device_limits(job.machine);
+    ModbusDeviceThread dt(start_of(job.plan), 1.0, &limits);
     const std::unique_ptr<host::DeviceLink> link = host::open_device_link(dt.target(), {});
     host::DeviceSnapshot s = link->status();
     CHECK((s.magic == 0x5053 && s.version == 2 && s.axes == 2 && s.state == 0));
@@ -420,7 +424,18 @@ TEST_CASE("ctl's link: status and every command over Modbus TCP, refusals by nam
     CHECK(s.fault_code == 1);
     CHECK(link->command(Command::kStop) == Status::kWrongState);
     CHECK(link->command(Command::kReset) == Status::kOk);
-    wait_for(*link, DeviceState::kIdle);
+    s = wait_for(*link, DeviceState::kIdle);
+    // A jog and a set position through the link.
+    REQUIRE(link->command_with_arguments(device::kCommandJog, 1, -4321, 500) == Status::kOk);
+    const std::uint32_t jog_job = s.last_accepted + 1;
+    for (int i = 0; i < 5000 && !(s.state == 0 && s.finished_job == jog_job); ++i) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(2));
+        s = link->status();
+    }
+    CHECK((s.finished_job == jog_job && s.position[1] == start_of(job.plan)[1] - 4321));
+    CHECK(link->command_with_arguments(device::kCommandJog, 5, 1, 0) == Status::kControlValueOutOfRange);
+    CHECK(link->command_with_arguments(device::kCommandSetPosition, 0, 77, 0) == Status::kOk);
+    check_steps_within_limits(*dt.device, job.machine);
 }
 
 TEST_CASE(
@@ -449,6 +464,7 @@ TEST_CASE(
     CHECK((s.version == 2 && s.axes == 2 && s.state == 0));
     CHECK((s.position[0] == start_of(job.plan)[0] && s.position[1] == start_of(job.plan)[1]));
     CHECK(link->command(Command::kHold) == Status::kWrongState);
+    CHECK(link->command_with_arguments(device::kCommandSetPosition, 2, 0, 0) == Status::kControlValueOutOfRange);
     // A stream on the host bus; ctl holds it from another endpoint, the stream sees the hold
     // and keeps waiting; ctl resumes it and the stream finishes.
     host::CanStreamReport report;

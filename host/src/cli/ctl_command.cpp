@@ -1,5 +1,6 @@
 #include "ctl_command.hpp"
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <csignal>
@@ -10,9 +11,11 @@
 #include <stdexcept>
 #include <thread>
 
+#include "pathstream/device/jog.hpp"
 #include "pathstream/host/device_setup.hpp"
 #include "pathstream/host/machine.hpp"
 #include "pathstream/host/modbus_stream.hpp"
+#include "position_argument.hpp"
 
 namespace pathstream::host {
 namespace {
@@ -206,6 +209,131 @@ int run_command(DeviceLink& link, device::Command c, const CtlCommandOptions& o,
     return 0;
 }
 
+// An axis by name (with a profile) or by index.
+unsigned axis_argument(const std::string& text, const Units& u, unsigned axes) {
+    if (u.profile) {
+        for (unsigned a = 0; a < u.profile->axes.size(); ++a) {
+            if (u.profile->axes[a].name == text) return a;
+        }
+    }
+    std::size_t used = 0;
+    unsigned long index = 0;
+    try {
+        index = std::stoul(text, &used);
+    } catch (const std::exception&) {
+        used = 0;
+    }
+    if (used == 0 || used != text.size() || index >= axes) {
+        throw std::invalid_argument("ctl: no axis '" + text + "'" +
+                                    (u.profile ? " in the profile"
+                                               : " (an index 0.." + std::to_string(axes - 1) +
+                                                     ", or a name with --machine)"));
+    }
+    return static_cast<unsigned>(index);
+}
+
+// Waits until the device has run job `job` to its end (idle, finished_job), or stopped.
+DeviceSnapshot wait_for_job(DeviceLink& link, std::uint32_t job, double seconds) {
+    const auto deadline = Clock::now() + std::chrono::duration<double>(seconds);
+    DeviceSnapshot s = link.status();
+    while (!(s.state == 0 && s.finished_job == job) && s.state != 4 && s.state != 5 &&
+           Clock::now() < deadline) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(10));
+        s = link.status();
+    }
+    return s;
+}
+
+// jog AXIS DISTANCE [--feed MM/S]: a move the device plans and checks itself.
+int run_jog(DeviceLink& link, const CtlCommandOptions& o, const Units& u) {
+    if (o.arguments.size() != 2)
+        throw std::invalid_argument("ctl jog: want AXIS DISTANCE (mm, or LSB with lsb)");
+    const DeviceSnapshot before = link.status();
+    const unsigned axis = axis_argument(o.arguments[0], u, before.axes);
+    if (!u.profile && !is_lsb_argument(o.arguments[1])) {
+        throw std::invalid_argument(
+            "ctl jog: a distance in mm needs --machine (or give LSB: 500lsb)");
+    }
+    const Lsb distance =
+        parse_position_argument(o.arguments[1], u.profile ? u.profile->mm_per_lsb : 1.0, "ctl jog");
+    if (distance == 0) throw std::invalid_argument("ctl jog: the distance is 0");
+    std::uint16_t feed = 0;
+    if (o.feed > 0) {
+        if (!u.profile)
+            throw std::invalid_argument("ctl jog: --feed needs --machine (its axis limits)");
+        const double share = o.feed / u.profile->axes[axis].max_velocity;
+        if (share > 1.0 + 1e-9) {
+            throw std::invalid_argument(
+                "ctl jog: --feed " + std::to_string(o.feed) + " mm/s is above the axis's " +
+                std::to_string(u.profile->axes[axis].max_velocity) + " mm/s");
+        }
+        feed = static_cast<std::uint16_t>(std::clamp(std::lround(share * 1000.0), 1L, 1000L));
+    }
+    const Status r = link.command_with_arguments(device::kCommandJog, axis, distance, feed);
+    if (r != Status::kOk) {
+        throw StreamError(link.name() + ": device refused the jog while " +
+                          device_state_name(before.state) +
+                          fault_suffix(before.state, before.fault_code) + ": " + status_name(r));
+    }
+    const DeviceSnapshot s = wait_for_job(link, before.last_accepted + 1, o.wait_seconds);
+    const bool done = s.state == 0 && s.finished_job == before.last_accepted + 1;
+    if (o.json) {
+        nlohmann::json j;
+        j["command"] = "jog";
+        j["axis"] = u.axis_name(axis);
+        j["distance_lsb"] = distance;
+        j["feed_per_mille"] = feed == 0 ? 1000 : feed;
+        j["finished"] = done;
+        j["ticks"] = s.finished_job_ticks;
+        j["status"] = to_json(s, u, link.name());
+        std::printf("%s\n", j.dump(2).c_str());
+    } else {
+        std::printf("jog           %s by %d LSB: %s in %u ticks\n", u.axis_name(axis).c_str(),
+                    distance, done ? "done" : "NOT done", s.finished_job_ticks);
+        std::printf("position      %s\n", position_text(s, u).c_str());
+    }
+    if (!done) {
+        throw StreamError(link.name() + ": the jog did not finish within " +
+                          std::to_string(o.wait_seconds) + " s: the device is " +
+                          device_state_name(s.state) + fault_suffix(s.state, s.fault_code));
+    }
+    return 0;
+}
+
+// position AXIS VALUE: redefines the axis's coordinate at rest (idle only).
+int run_set_position(DeviceLink& link, const CtlCommandOptions& o, const Units& u) {
+    if (o.arguments.size() != 2)
+        throw std::invalid_argument("ctl position: want AXIS VALUE (mm, or LSB with lsb)");
+    const DeviceSnapshot before = link.status();
+    const unsigned axis = axis_argument(o.arguments[0], u, before.axes);
+    if (!u.profile && !is_lsb_argument(o.arguments[1])) {
+        throw std::invalid_argument(
+            "ctl position: a value in mm needs --machine (or give LSB: 12500lsb)");
+    }
+    const Lsb value = parse_position_argument(
+        o.arguments[1], u.profile ? u.profile->mm_per_lsb : 1.0, "ctl position");
+    const Status r = link.command_with_arguments(device::kCommandSetPosition, axis, value, 0);
+    if (r != Status::kOk) {
+        throw StreamError(link.name() + ": device refused set position while " +
+                          device_state_name(before.state) +
+                          fault_suffix(before.state, before.fault_code) + ": " + status_name(r));
+    }
+    DeviceSnapshot s = link.status();
+    const auto deadline = Clock::now() + std::chrono::duration<double>(o.wait_seconds);
+    while (s.position[axis] != value && Clock::now() < deadline) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(5));
+        s = link.status();
+    }
+    if (o.json) {
+        std::printf("%s\n", to_json(s, u, link.name()).dump(2).c_str());
+    } else {
+        std::printf("position      %s\n", position_text(s, u).c_str());
+    }
+    if (s.position[axis] != value)
+        throw StreamError(link.name() + ": the device did not take the new position");
+    return 0;
+}
+
 }  // namespace
 
 void add_ctl_command(CLI::App& app, CtlCommandOptions& o) {
@@ -217,9 +345,14 @@ void add_ctl_command(CLI::App& app, CtlCommandOptions& o) {
                     "modbus-rtu:///dev/ttyX?baud=115200&parity=N&unit=1 "
                     "or can://IFACE?node=N")
         ->required();
-    cmd->add_option("verb", o.verb, "status, hold, resume, stop or reset")
+    cmd->add_option("verb", o.verb,
+                    "status, hold, resume, stop, reset, jog AXIS DISTANCE or position AXIS VALUE")
         ->required()
-        ->check(CLI::IsMember({"status", "hold", "resume", "stop", "reset"}));
+        ->check(CLI::IsMember({"status", "hold", "resume", "stop", "reset", "jog", "position"}));
+    cmd->add_option("arguments", o.arguments,
+                    "jog: AXIS DISTANCE; position: AXIS VALUE (mm, or LSB with lsb)");
+    cmd->add_option("--feed", o.feed, "jog: mm/s (default: the axis's max velocity)")
+        ->check(CLI::Range(0.0, 1e6));
     cmd->add_option("--machine,-m", o.machine, "machine profile: positions in mm and axes by name")
         ->check(CLI::ExistingFile);
     cmd->add_flag("--json", o.json,
@@ -263,6 +396,9 @@ int run_ctl(const CtlCommandOptions& o) {
         }
     }
     if (o.verb == "status") return run_status(*link, o, u);
+    if (o.verb == "jog") return run_jog(*link, o, u);
+    if (o.verb == "position") return run_set_position(*link, o, u);
+    if (!o.arguments.empty()) throw std::invalid_argument("ctl " + o.verb + ": takes no arguments");
     for (const VerbInfo& v : kVerbs) {
         if (o.verb == v.verb) return run_command(*link, v.command, o, u);
     }

@@ -37,9 +37,15 @@ public:
     void mark_alive() { last_heard_ = Clock::now(); }
 
     /// Sends command `c` until its ack arrives (commands are idempotent); returns the result.
-    std::uint8_t command(std::uint8_t c) {
+    std::uint8_t command(std::uint8_t c) { return command_frame(pc::encode_command(node_, c), c); }
+
+    /// Sends `frame` (a command, or a command with arguments whose command byte is `c`) until
+    /// the command ack for `c` arrives; returns its result. A jog whose ack was lost and
+    /// that is sent again is refused (the device is no longer idle): the caller reads the
+    /// status to tell.
+    std::uint8_t command_frame(const pc::Frame& frame, std::uint8_t c) {
         while (true) {
-            send(pc::encode_command(node_, c));
+            send(frame);
             pc::Ack ack;
             if (!wait_ack(pc::kAckCommand, c, ack)) continue;
             return ack.result;

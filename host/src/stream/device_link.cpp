@@ -58,6 +58,23 @@ public:
         }
     }
 
+    Status command_with_arguments(std::uint8_t command, unsigned axis, std::int32_t value,
+                                  std::uint16_t feed) override {
+        link_.mark_alive();
+        const auto v = static_cast<std::uint32_t>(value);
+        const std::vector<std::uint16_t> r = {command, static_cast<std::uint16_t>(axis),
+                                              static_cast<std::uint16_t>(v >> 16),
+                                              static_cast<std::uint16_t>(v & 0xFFFFu), feed};
+        try {
+            link_.transact([&] { link_.client().write_registers(device::modbus::kCommand, r); });
+            return Status::kOk;
+        } catch (const hal::ModbusError& e) {
+            const DeviceSnapshot s = link_.read_status();
+            if (s.last_refusal != 0) return static_cast<Status>(s.last_refusal);
+            link_.fail(std::string("command ") + std::to_string(command) + ": " + e.what());
+        }
+    }
+
     const std::string& name() const override { return options_.target; }
 
 private:
@@ -84,6 +101,21 @@ public:
         return static_cast<Status>(r);
     }
 
+    Status command_with_arguments(std::uint8_t command, unsigned axis, std::int32_t value,
+                                  std::uint16_t feed) override {
+        link_.mark_alive();
+        pc::CommandArgs c;
+        c.command = command;
+        c.axis = static_cast<std::uint8_t>(axis);
+        c.value = value;
+        c.feed = feed;
+        const std::uint8_t r = link_.command_frame(pc::encode_command_args(options_.node, c), command);
+        if (r >= pc::kResultIncomplete) {
+            link_.fail("command " + std::to_string(command) + ": " + can_result_name(r));
+        }
+        return static_cast<Status>(r);
+    }
+
     const std::string& name() const override { return options_.name; }
 
 private:
@@ -99,6 +131,10 @@ public:
         : bus_(interface_name), link_(bus_, options) {}
     DeviceSnapshot status() override { return link_.status(); }
     Status command(device::Command c) override { return link_.command(c); }
+    Status command_with_arguments(std::uint8_t command, unsigned axis, std::int32_t value,
+                                  std::uint16_t feed) override {
+        return link_.command_with_arguments(command, axis, value, feed);
+    }
     const std::string& name() const override { return link_.name(); }
 
 private:

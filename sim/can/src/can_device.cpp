@@ -26,6 +26,12 @@ public:
     Device(const Lsb (&start)[Axes], std::uint8_t node)
         : MotionDeviceBase<Axes, kCanDeviceCapacity, SimulatedCanDevice>(start), node_(this->device_, node) {}
 
+    // The task's share of every loop turn comes first: a jog in progress is fed.
+    void tick() override {
+        node_.service();
+        MotionDeviceBase<Axes, kCanDeviceCapacity, SimulatedCanDevice>::tick();
+    }
+
     void serve(hal::CanBus& bus, std::chrono::microseconds wait) override {
         flush(bus);
         const hal::CanBusState s = bus.state();

@@ -51,6 +51,12 @@ public:
 
     hal::ModbusRegisterHandler& handler() override { return handler_; }
 
+    // The task's share of every loop turn comes first: a jog in progress is fed.
+    void tick() override {
+        map_.service();
+        MotionDeviceBase<Axes, kModbusDeviceCapacity, SimulatedModbusDevice>::tick();
+    }
+
 private:
     device::ModbusRegisterMap<Axes, kModbusDeviceCapacity> map_;
     MapHandler<Axes> handler_;

@@ -8,6 +8,7 @@
 #include <cstdint>
 
 #include "pathstream/device/can_protocol.hpp"
+#include "pathstream/device/jog.hpp"
 #include "pathstream/device/motion_device.hpp"
 #include "pathstream/status.hpp"
 
@@ -19,7 +20,10 @@ template <unsigned Axes, std::uint32_t Capacity>
 class CanNode {
 public:
     /// `node` must be kMinNode..kMaxNode (the caller checks it).
-    CanNode(MotionDevice<Axes, Capacity>& device, std::uint8_t node) : device_(device), node_(node) {}
+    CanNode(MotionDevice<Axes, Capacity>& device, std::uint8_t node) : device_(device), node_(node), jog_(device) {}
+
+    /// Task loop: feeds a jog in progress (call at least once per span period).
+    void service() { jog_.service(); }
 
     std::uint8_t node() const { return node_; }
 
@@ -27,7 +31,8 @@ public:
     bool addressed(std::uint32_t id) const {
         if (node_of(id) != node_) return false;
         const std::uint32_t f = function_of(id);
-        return f == kCommandBase || f == kConfigBase || f == kSpanStartBase || f == kSpanDataBase;
+        return f == kCommandBase || f == kConfigBase || f == kSpanStartBase || f == kSpanDataBase ||
+               f == kCommandArgsBase;
     }
 
     /// Handles one received frame; calls `send(const Frame&)` for each answer (a status request is answered by 4 + Axes frames; anything else by 0 or 1).
@@ -38,6 +43,7 @@ public:
         if (!addressed(f.id)) return;
         switch (function_of(f.id)) {
             case kCommandBase: on_command(f, send); break;
+            case kCommandArgsBase: on_command_args(f, send); break;
             case kConfigBase: on_config(f, send); break;
             case kSpanStartBase: on_span_start(f, send); break;
             case kSpanDataBase: on_span_data(f, send); break;
@@ -117,6 +123,20 @@ private:
         ack(kAckCommand, result, c, send);
     }
 
+    // Jog (6) or set position (7), answered like a command (ack kind 2, sequence = the command).
+    template <typename Send>
+    void on_command_args(const Frame& f, Send& send) {
+        CommandArgs c;
+        if (!decode_command_args(f, c)) return ack(kAckCommand, kResultBadFrame, 0, send);
+        Status s = Status::kUnknownCommand;
+        if (c.command == kCommandJog) {
+            s = jog_.start(c.axis, c.value, c.feed);
+        } else if (c.command == kCommandSetPosition) {
+            s = c.feed != 0 ? Status::kControlValueOutOfRange : set_axis_position(device_, c.axis, c.value);
+        }
+        ack(kAckCommand, static_cast<std::uint8_t>(s), c.command, send);
+    }
+
     template <typename Send>
     void on_config(const Frame& f, Send& send) {
         if (f.length != 6) return ack(kAckConfig, kResultBadFrame, 0, send);
@@ -186,6 +206,7 @@ private:
 
     MotionDevice<Axes, Capacity>& device_;
     std::uint8_t node_;
+    Jog<Axes, Capacity> jog_;
     MotionLimits<Axes> pending_{};
     std::uint32_t config_seen_ = 0;  // bit per configuration item received since item 0
     SpanStart transfer_{};

@@ -33,13 +33,15 @@ inline constexpr std::uint32_t kSpanDataBase = 0x480;   ///< host -> device
 inline constexpr std::uint32_t kStatusDBase = 0x500;  ///< device -> host (jobs; added in version 2)
 /// device -> host, one frame per axis (position and queue epoch; added in version 2)
 inline constexpr std::uint32_t kStatusEBase = 0x580;
+/// host -> device: a command with arguments, 6 jog or 7 set position (added in version 2)
+inline constexpr std::uint32_t kCommandArgsBase = 0x600;
 
 /// Identifier of function `base` for node `node`. Constant, any context.
 constexpr std::uint32_t can_id(std::uint32_t base, std::uint8_t node) { return base + node; }
 /// Function base of identifier `id` (0 when `id` is not one of ours). Constant.
 constexpr std::uint32_t function_of(std::uint32_t id) {
     const std::uint32_t base = id & ~0x7Fu;
-    return (base >= kCommandBase && base <= kStatusEBase && (id & 0x7Fu) != 0) ? base : 0;
+    return (base >= kCommandBase && base <= kCommandArgsBase && (id & 0x7Fu) != 0) ? base : 0;
 }
 constexpr std::uint8_t node_of(std::uint32_t id) { return static_cast<std::uint8_t>(id & 0x7Fu); }
 
@@ -198,6 +200,12 @@ inline constexpr Signal kConfigSignals[] = {
     {"PenDownDelay", 2, 4, false, "tick", "pen-down delay, 0..65535; the last item of a set",
      kConfigItemPenDown},
 };
+inline constexpr Signal kCommandArgsSignals[] = {
+    {"Command", 0, 1, false, "", "6 jog, 7 set position", -1, "6 \"jog\" 7 \"set position\""},
+    {"Axis", 1, 1, false, "", "axis index, 0 .. axes - 1"},
+    {"Value", 2, 4, true, "LSB", "jog: distance (signed, not 0); set position: the axis's new coordinate"},
+    {"Feed", 6, 2, false, "per mille", "jog: share of the axis's max velocity, 1..1000 (0: 1000); set position: 0"},
+};
 inline constexpr Signal kSpanStartSignals[] = {
     {"FirstSequence", 0, 4, false, "", "sequence number of the batch's first span"},
     {"Count", 4, 1, false, "span", "spans in the batch (1..64)"},
@@ -228,6 +236,9 @@ inline constexpr Message kMessages[] = {
     {"StatusD", kStatusDBase, 8, true, "device -> host: jobs", kStatusDSignals, 2},
     {"StatusE", kStatusEBase, 8, true, "device -> host: one axis's position, and the queue epoch",
      kStatusESignals, 3},
+    {"CommandArgs", kCommandArgsBase, 8, false,
+     "host -> device: a command with arguments (jog, set position), answered by a command ack",
+     kCommandArgsSignals, 4},
 };
 inline constexpr std::size_t kMessageCount = sizeof(kMessages) / sizeof(kMessages[0]);
 
@@ -281,6 +292,30 @@ constexpr Frame encode_command(std::uint8_t node, std::uint8_t command) {
     Frame f{can_id(kCommandBase, node), 1, {}};
     put(f, kCommandSignals[0], command);
     return f;
+}
+
+/// A command with arguments (kCommandArgsBase): jog (6) or set position (7).
+struct CommandArgs {
+    std::uint8_t command = 0;
+    std::uint8_t axis = 0;
+    std::int32_t value = 0;
+    std::uint16_t feed = 0;
+};
+constexpr Frame encode_command_args(std::uint8_t node, const CommandArgs& c) {
+    Frame f{can_id(kCommandArgsBase, node), 8, {}};
+    put(f, kCommandArgsSignals[0], c.command);
+    put(f, kCommandArgsSignals[1], c.axis);
+    put(f, kCommandArgsSignals[2], static_cast<std::uint32_t>(c.value));
+    put(f, kCommandArgsSignals[3], c.feed);
+    return f;
+}
+constexpr bool decode_command_args(const Frame& f, CommandArgs& c) {
+    if (f.length != 8) return false;
+    c.command = static_cast<std::uint8_t>(get(f, kCommandArgsSignals[0]));
+    c.axis = static_cast<std::uint8_t>(get(f, kCommandArgsSignals[1]));
+    c.value = static_cast<std::int32_t>(get(f, kCommandArgsSignals[2]));
+    c.feed = static_cast<std::uint16_t>(get(f, kCommandArgsSignals[3]));
+    return true;
 }
 
 constexpr Frame encode_ack(std::uint8_t node, const Ack& a) {

@@ -44,6 +44,10 @@ inline constexpr std::uint16_t kCount = 42;  ///< registers in the block
 
 /// Command register (holding, write-only in effect; reads return the last command written).
 inline constexpr std::uint16_t kCommand = 100;  ///< Command values (1 start ... 5 reset)
+/// A command with arguments (6 jog, 7 set position) is one FC16 of kCommandWithArguments
+/// registers at kCommand: +0 command, +1 axis, +2..3 value (i32: jog distance or position,
+/// LSB), +4 feed (jog: per mille of the axis's max velocity, 0 = 1000; set position: 0).
+inline constexpr std::uint16_t kCommandWithArguments = 5;
 
 /// Configuration block (holding), written whole in one FC16 at kConfig:
 ///   +0..1 tick rate (Hz, u32), +2 axes (must equal the device's), +3 pen-down delay (ticks,

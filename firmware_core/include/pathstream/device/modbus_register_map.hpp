@@ -5,6 +5,7 @@
 
 #include <cstdint>
 
+#include "pathstream/device/jog.hpp"
 #include "pathstream/device/modbus_map.hpp"
 #include "pathstream/device/motion_device.hpp"
 
@@ -19,7 +20,10 @@ class ModbusRegisterMap {
 public:
     using Exception = modbus::Exception;
 
-    explicit ModbusRegisterMap(MotionDevice<Axes, Capacity>& device) : device_(device) {}
+    explicit ModbusRegisterMap(MotionDevice<Axes, Capacity>& device) : device_(device), jog_(device) {}
+
+    /// Task loop: feeds a jog in progress (call at least once per span period).
+    void service() { jog_.service(); }
 
     /// FC4: registers of the status block. Addresses outside it: kIllegalDataAddress.
     Exception read_input_registers(std::uint16_t address, std::uint16_t count, std::uint16_t* out) {
@@ -60,6 +64,9 @@ public:
         if (address == modbus::kCommand && count == 1) {
             // Any value goes to the core, which refuses what is no command (kUnknownCommand).
             s = device_.command(static_cast<Command>(values[0]));
+            if (s == Status::kOk) last_command_ = values[0];
+        } else if (address == modbus::kCommand && count == modbus::kCommandWithArguments) {
+            s = command_with_arguments(values);
             if (s == Status::kOk) last_command_ = values[0];
         } else if (address == modbus::kConfig && count == modbus::config_registers(Axes)) {
             s = write_config(values, e);
@@ -152,6 +159,17 @@ private:
         }
     }
 
+    // 6 jog, 7 set position; any other command value here is kUnknownCommand.
+    Status command_with_arguments(const std::uint16_t* v) {
+        const std::int32_t value = static_cast<std::int32_t>(u32(&v[2]));
+        if (v[0] == kCommandJog) return jog_.start(v[1], value, v[4]);
+        if (v[0] == kCommandSetPosition) {
+            if (v[4] != 0) return Status::kControlValueOutOfRange;
+            return set_axis_position(device_, v[1], value);
+        }
+        return Status::kUnknownCommand;
+    }
+
     Status write_config(const std::uint16_t* v, Exception& e) {
         if (v[2] != Axes) {
             e = Exception::kIllegalDataValue;
@@ -201,6 +219,7 @@ private:
     }
 
     MotionDevice<Axes, Capacity>& device_;
+    Jog<Axes, Capacity> jog_;
     std::uint8_t payload_[2 * 123] = {};
     std::uint16_t last_command_ = 0;
     std::uint16_t last_refusal_ = 0;

@@ -58,6 +58,11 @@ public:
     /// Sends command `c` and returns the device's answer (kOk, or the core Status it refused
     /// with). Throws StreamError when nothing answers for the link timeout.
     virtual Status command(device::Command c) = 0;
+    /// A command with arguments (docs/device.md, "Jog and set position"): 6 jog `axis` by
+    /// `value` LSB at `feed` per mille of its max velocity, or 7 set `axis`'s position to
+    /// `value` (feed 0). Returns the device's answer. Throws StreamError on a dead link.
+    virtual Status command_with_arguments(std::uint8_t command, unsigned axis, std::int32_t value,
+                                          std::uint16_t feed) = 0;
     /// The target as messages name it (its URL).
     virtual const std::string& name() const = 0;
 };
