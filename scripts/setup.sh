@@ -13,6 +13,8 @@ packages=(
   libnewlib-arm-none-eabi qemu-system-arm
   # plots: SVG to PNG
   librsvg2-bin
+  # event stream tests: JSON Schema validation (tests/cli/events_test.sh)
+  python3-jsonschema
   # Modbus TCP/RTU (libmodbus) and an independent Modbus master for interoperability tests
   libmodbus-dev mbpoll
   # CAN and GPIO: SocketCAN tools and libgpiod 1.6 with its command-line tools

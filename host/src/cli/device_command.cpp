@@ -1,9 +1,12 @@
 #include "device_command.hpp"
 
+#include "position_argument.hpp"
+
 #include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <csignal>
+#include <functional>
 #include <iostream>
 #include <memory>
 #include <optional>
@@ -14,7 +17,10 @@
 #include "pathstream/hal/modbus_server.hpp"
 #include "pathstream/hal/socketcan_bus.hpp"
 #include "pathstream/host/atomic_file.hpp"
+#include "pathstream/host/core_span_conversion.hpp"
+#include "pathstream/host/device_link.hpp"
 #include "pathstream/host/device_setup.hpp"
+#include "pathstream/host/events.hpp"
 #include "pathstream/host/machine.hpp"
 #include "pathstream/host/modbus_stream.hpp"
 #include "pathstream/linux_device/machine_homing.hpp"
@@ -27,33 +33,6 @@ namespace {
 
 std::atomic<bool> g_stop{false};
 
-// One --position value: mm ("139.322"), or LSB with the suffix "lsb" ("139322lsb"); a whole
-// number of LSB within the core's position range, else std::invalid_argument (exit 2).
-Lsb parse_position(const std::string& text, double mm_per_lsb) {
-    const bool lsb = text.size() > 3 && text.compare(text.size() - 3, 3, "lsb") == 0;
-    const std::string number = lsb ? text.substr(0, text.size() - 3) : text;
-    double value = 0;
-    std::size_t used = 0;
-    try {
-        value = std::stod(number, &used);
-    } catch (const std::exception&) {
-        used = 0;
-    }
-    if (used == 0 || used != number.size() || !std::isfinite(value)) {
-        throw std::invalid_argument("--position: '" + text + "' is not a number of mm (or of LSB with the suffix lsb)");
-    }
-    const double in_lsb = lsb ? value : value / mm_per_lsb;
-    const double whole = std::round(in_lsb);
-    if (std::fabs(in_lsb - whole) > 1e-6 * std::max(1.0, std::fabs(whole))) {
-        throw std::invalid_argument("--position: '" + text + "' is not a whole number of LSB (" +
-                                    std::to_string(mm_per_lsb) + " mm each)");
-    }
-    if (std::fabs(whole) > static_cast<double>(kMaxPositionLsb)) {
-        throw std::invalid_argument("--position: '" + text + "' is outside the core's position range (+-" +
-                                    std::to_string(kMaxPositionLsb) + " LSB)");
-    }
-    return static_cast<Lsb>(whole);
-}
 extern "C" void on_signal(int) { g_stop.store(true); }
 
 void write_record(const sim::SimulatedMotionDevice& d, const std::string& path) {
@@ -73,56 +52,155 @@ void write_record(const sim::SimulatedMotionDevice& d, const std::string& path) 
     f.commit();
 }
 
-// Logs the transitions an operator must see (e-stop, faults with their names, the way back
-// to idle); a streaming host sees the same in the status block.
-class StateLog {
+// The device's log: one line per event on standard output, stamped with the time (ISO-8601
+// UTC, ms); text for people or, with --log-json, NDJSON whose `message` is the text.
+class DeviceLog {
 public:
+    explicit DeviceLog(bool json) : json_(json) {}
+
+    void operator()(const char* event, const std::string& text,
+                    const EventJson& fields = EventJson::object()) const {
+        const std::string time = iso8601_utc(std::chrono::system_clock::now());
+        if (!json_) {
+            std::cout << time << " pathstream device: " << text << std::endl;
+            return;
+        }
+        EventJson line;
+        line["time"] = time;
+        line["event"] = event;
+        for (auto it = fields.begin(); it != fields.end(); ++it) line[it.key()] = it.value();
+        line["message"] = text;
+        std::cout << line.dump(-1, ' ', false, EventJson::error_handler_t::replace) << std::endl;
+    }
+
+private:
+    bool json_;
+};
+
+// What the log follows of the device's status after every tick.
+struct DeviceView {
+    unsigned state = 0;
+    std::uint16_t fault_code = 0;
+    std::uint32_t job = 0;  ///< job of the span in progress or last played (0: none)
+    std::uint32_t finished_job = 0, finished_job_ticks = 0;
+};
+
+// A reader of `d`'s status as the log follows it.
+std::function<DeviceView()> status_reader(const sim::SimulatedMotionDevice& d) {
+    return [&d] { return DeviceView{d.state(), d.fault_code(), d.job(), d.finished_job(), d.finished_job_ticks()}; };
+}
+
+// Logs what an operator follows: client connections, jobs starting and finishing, every state
+// change and faults by name (the e-stop, fault and reset lines keep their words: tests and
+// scripts look for them); a streaming host sees the same in the status block.
+class DeviceWatch {
+public:
+    DeviceWatch(const DeviceLog& log, std::function<DeviceView()> read)
+        : log_(log), read_(std::move(read)), last_(read_()), started_job_(last_.job) {}
+
+    // After every tick: the job that ended, then the state, then the job that began.
     void after_tick(const sim::SimulatedMotionDevice& d) {
-        const std::uint8_t s = d.state();
-        if (s == last_) return;
-        const auto st = static_cast<device::DeviceState>(s);
-        const auto was = static_cast<device::DeviceState>(last_);
-        last_ = s;
-        if (st == device::DeviceState::kEstop) {
-            std::cout << "pathstream device: E-STOP at tick " << d.ticks_run() << ": axes held, drives disabled; "
-                      << "release the e-stop and send reset" << std::endl;
-        } else if (st == device::DeviceState::kFault) {
-            char name[64];
-            device::fault_name(static_cast<device::FaultCode>(d.fault_code()), name, sizeof name);
-            std::cout << "pathstream device: FAULT at tick " << d.ticks_run() << ": " << name
-                      << "; drives disabled until reset" << std::endl;
-        } else if (st == device::DeviceState::kIdle &&
-                   (was == device::DeviceState::kEstop || was == device::DeviceState::kFault)) {
-            std::cout << "pathstream device: reset: idle at tick " << d.ticks_run() << std::endl;
+        const DeviceView v = read_();
+        const std::uint64_t tick = d.ticks_run();
+        if (v.finished_job != last_.finished_job && v.finished_job != 0) job_end(v, tick);
+        const bool new_fault = v.state == kFault && v.fault_code != last_.fault_code;
+        if (v.state != last_.state || new_fault) state_change(v, tick);
+        if (v.state == kRunning && v.job != 0 && v.job != started_job_) job_start(v, tick);
+        last_ = v;
+    }
+
+    // After every Modbus poll: connections accepted and closed since the last one.
+    void after_poll(const hal::ModbusServer& server) {
+        const hal::ModbusServerCounters& c = server.counters();
+        const std::uint64_t closed = c.connections_closed.load(),
+                            accepted = c.connections_accepted.load();
+        while (accepted_ < accepted) {
+            ++accepted_;
+            log_("connect", "client connected (" + std::to_string(open()) + " open)",
+                 {{"open", open()}});
+        }
+        while (closed_ < closed && closed_ < accepted_) {
+            ++closed_;
+            log_("disconnect", "client disconnected (" + std::to_string(open()) + " open)",
+                 {{"open", open()}});
         }
     }
 
 private:
-    std::uint8_t last_ = static_cast<std::uint8_t>(device::DeviceState::kIdle);
+    static constexpr unsigned kRunning = static_cast<unsigned>(device::DeviceState::kRunning);
+    static constexpr unsigned kFault = static_cast<unsigned>(device::DeviceState::kFault);
+    static constexpr unsigned kEstop = static_cast<unsigned>(device::DeviceState::kEstop);
+    static constexpr unsigned kIdle = static_cast<unsigned>(device::DeviceState::kIdle);
+
+    std::uint64_t open() const { return accepted_ - closed_; }
+
+    void job_start(const DeviceView& v, std::uint64_t tick) {
+        started_job_ = v.job;
+        log_("job_start",
+             "job " + std::to_string(v.job) + " started at tick " + std::to_string(tick),
+             {{"job", v.job}, {"tick", tick}});
+    }
+
+    void job_end(const DeviceView& v, std::uint64_t tick) {
+        log_("job_end",
+             "job " + std::to_string(v.finished_job) + " finished at tick " + std::to_string(tick) +
+                 ": " + std::to_string(v.finished_job_ticks) + " path ticks",
+             {{"job", v.finished_job}, {"ticks", v.finished_job_ticks}, {"tick", tick}});
+    }
+
+    void state_change(const DeviceView& v, std::uint64_t tick) {
+        EventJson fields = {{"state", device_state_name(v.state)},
+                            {"code", v.state},
+                            {"was", device_state_name(last_.state)},
+                            {"tick", tick}};
+        const std::string at = " at tick " + std::to_string(tick);
+        std::string text;
+        if (v.state == kEstop) {
+            text =
+                "E-STOP" + at + ": axes held, drives disabled; release the e-stop and send reset";
+        } else if (v.state == kFault) {
+            fields["fault"] = fault_text(v.fault_code);
+            fields["fault_code"] = v.fault_code;
+            text = "FAULT" + at + ": " + fault_text(v.fault_code) + "; drives disabled until reset";
+        } else if (v.state == kIdle && (last_.state == kEstop || last_.state == kFault)) {
+            text = "reset: idle" + at;
+        } else {
+            text = std::string("state ") + device_state_name(v.state) + " (was " +
+                   device_state_name(last_.state) + ")" + at;
+        }
+        log_("state", text, fields);
+    }
+
+    const DeviceLog& log_;
+    std::function<DeviceView()> read_;
+    DeviceView last_;
+    std::uint32_t started_job_ = 0;
+    std::uint64_t accepted_ = 0, closed_ = 0;
 };
 
 // Homes in real time (times --time-scale), before any bus is served: a host cannot start a
 // job on a half-homed machine. SIGINT/SIGTERM end homing at the next tick (exit 6); the lines
 // are then released with enable and pen inactive (MachineLines).
-void home(sim::SimulatedMotionDevice& device, sim::DeviceIo& io, const MachineProfile& profile, double time_scale) {
+void home(sim::SimulatedMotionDevice& device, sim::DeviceIo& io, const MachineProfile& profile,
+          double time_scale, const DeviceLog& log, DeviceWatch& watch) {
     sim::DeviceLoopOptions loop;
     loop.time_scale = time_scale;
-    StateLog state_log;
     const auto run_until = [&](const std::function<bool()>& done) {
         std::atomic<bool> finished{false};
         sim::run_paced_loop(
             [&] {
                 device.tick();
-                state_log.after_tick(device);
+                watch.after_tick(device);
                 if (done() || g_stop.load()) finished.store(true);
             },
             [&] { return device.tick_hz(); }, [](std::chrono::microseconds w) { std::this_thread::sleep_for(w); },
             loop, finished);
         return done();
     };
-    const auto log = [](const std::string& line) { std::cout << "pathstream device: " << line << std::endl; };
+    const auto phase = [&log](const std::string& line) { log("homing", line); };
     try {
-        (void)linux_device::home_axes(device, io, homing_setups(profile), profile.mm_per_lsb, run_until, log);
+        (void)linux_device::home_axes(device, io, homing_setups(profile), profile.mm_per_lsb,
+                                      run_until, phase);
     } catch (const linux_device::HomingFailed& e) {
         throw StreamError(e.what());
     }
@@ -136,7 +214,8 @@ struct Machine {
 };
 
 Machine prepare_machine(sim::SimulatedMotionDevice& device, const DeviceCommandOptions& o,
-                        const std::optional<MachineProfile>& profile) {
+                        const std::optional<MachineProfile>& profile, const DeviceLog& log,
+                        DeviceWatch& watch) {
     Machine m;
     if (!profile) return m;
     m.profile = profile;
@@ -144,23 +223,24 @@ Machine prepare_machine(sim::SimulatedMotionDevice& device, const DeviceCommandO
     if (Status s = device.configure(limits); s != Status::kOk) {
         throw std::invalid_argument(profile->source + ": the device refused the profile's limits: " + status_name(s));
     }
-    std::cout << "pathstream device: configured from " << profile->source << ": " << limits.tick_hz << " Hz ticks";
+    std::string text =
+        "configured from " + profile->source + ": " + std::to_string(limits.tick_hz) + " Hz ticks";
     for (std::size_t a = 0; a < profile->axes.size(); ++a) {
-        std::cout << ", " << profile->axes[a].name << " " << limits.max_velocity[a] << " LSB/s "
-                  << limits.max_acceleration[a] << " LSB/s^2";
+        text += ", " + profile->axes[a].name + " " + std::to_string(limits.max_velocity[a]) +
+                " LSB/s " + std::to_string(limits.max_acceleration[a]) + " LSB/s^2";
     }
-    std::cout << std::endl;
+    log("configured", text, {{"tick_hz", limits.tick_hz}});
     if (profile->gpio.present && !o.no_gpio) {
         m.lines.emplace(linux_device::MachineLines::open(*profile));
         m.io = &device.attach_io(m.lines->wiring());
-        std::cout << "pathstream device: GPIO " << m.lines->summary() << std::endl;
+        log("gpio", "GPIO " + m.lines->summary());
     }
     if (o.home) {
         if (m.io == nullptr) {
             throw std::invalid_argument(profile->source + ": no \"gpio\" object: --home has no switches to home against");
         }
         if (profile->gpio.home.empty()) throw std::invalid_argument(profile->source + ": --home: gpio.home is empty");
-        home(device, *m.io, *profile, o.time_scale);
+        home(device, *m.io, *profile, o.time_scale, log, watch);
     }
     return m;
 }
@@ -176,23 +256,31 @@ int run_can_device(const DeviceCommandOptions& o, const std::vector<Lsb>& start,
                    const std::optional<MachineProfile>& profile) {
     auto device = sim::SimulatedCanDevice::create(start, static_cast<std::uint8_t>(o.node));
     device->record(!o.record.empty());
-    const Machine machine = prepare_machine(*device, o, profile);
+    const DeviceLog log(o.log_json);
+    DeviceWatch watch(log, status_reader(*device));
+    const Machine machine = prepare_machine(*device, o, profile, log, watch);
     hal::SocketCanBus bus(o.can_interface);
-    std::cout << "pathstream device: " << device->axes() << " axes, native CAN node " << o.node << " on "
-              << o.can_interface << " (can://" << o.can_interface << "?node=" << o.node << "&protocol=native)"
-              << std::endl;
-    StateLog log;
+    const std::string url =
+        "can://" + o.can_interface + "?node=" + std::to_string(o.node) + "&protocol=native";
+    log("serving",
+        std::to_string(device->axes()) + " axes, native CAN node " + std::to_string(o.node) +
+            " on " + o.can_interface + " (" + url + ")",
+        {{"url", url}, {"axes", device->axes()}});
     sim::run_paced_loop(
         [&] {
             device->tick();
-            log.after_tick(*device);
+            watch.after_tick(*device);
         },
-        [&] { return device->tick_hz(); }, [&](std::chrono::microseconds w) { device->serve(bus, w); },
-        loop_options(o), g_stop);
+        [&] { return device->tick_hz(); },
+        [&](std::chrono::microseconds w) { device->serve(bus, w); }, loop_options(o), g_stop);
     const hal::SocketCanCounters& c = bus.counters();
-    std::cout << "pathstream device: stopped after " << device->ticks_run() << " ticks, " << c.frames_received << " frames in, "
-              << c.frames_sent << " out, " << device->incomplete_transfers() << " incomplete and "
-              << device->refused_batches() << " refused batches, " << c.error_frames << " error frames" << std::endl;
+    log("stopped",
+        "stopped after " + std::to_string(device->ticks_run()) + " ticks, " +
+            std::to_string(c.frames_received) + " frames in, " + std::to_string(c.frames_sent) +
+            " out, " + std::to_string(device->incomplete_transfers()) + " incomplete and " +
+            std::to_string(device->refused_batches()) + " refused batches, " +
+            std::to_string(c.error_frames) + " error frames",
+        {{"ticks", device->ticks_run()}});
     if (!o.record.empty()) write_record(*device, o.record);
     return 0;
 }
@@ -201,7 +289,9 @@ int run_modbus_device(const DeviceCommandOptions& o, const std::vector<Lsb>& sta
                       const std::optional<MachineProfile>& profile) {
     auto device = sim::SimulatedModbusDevice::create(start);
     device->record(!o.record.empty());
-    const Machine machine = prepare_machine(*device, o, profile);
+    const DeviceLog log(o.log_json);
+    DeviceWatch watch(log, status_reader(*device));
+    const Machine machine = prepare_machine(*device, o, profile, log, watch);
     hal::ModbusServerOptions server_options;
     server_options.unit = o.unit;
     std::string url;
@@ -226,20 +316,24 @@ int run_modbus_device(const DeviceCommandOptions& o, const std::vector<Lsb>& sta
         url = "modbus-tcp://" + endpoint.host + ":" + std::to_string(s.port()) + "?unit=" + std::to_string(o.unit);
         return s;
     }();
-    std::cout << "pathstream device: " << device->axes() << " axes, serving " << url << std::endl;
-    StateLog log;
+    log("serving", std::to_string(device->axes()) + " axes, serving " + url,
+        {{"url", url}, {"axes", device->axes()}});
     sim::run_paced_loop(
         [&] {
             device->tick();
-            log.after_tick(*device);
+            watch.after_tick(*device);
         },
         [&] { return device->tick_hz(); },
         [&](std::chrono::microseconds w) {
             server.poll_once(std::chrono::duration_cast<std::chrono::milliseconds>(w));
+            watch.after_poll(server);
         },
         loop_options(o), g_stop);
-    std::cout << "pathstream device: stopped after " << device->ticks_run() << " ticks, " << server.counters().requests.load()
-              << " requests (" << server.counters().exceptions.load() << " refused)" << std::endl;
+    log("stopped",
+        "stopped after " + std::to_string(device->ticks_run()) + " ticks, " +
+            std::to_string(server.counters().requests.load()) + " requests (" +
+            std::to_string(server.counters().exceptions.load()) + " refused)",
+        {{"ticks", device->ticks_run()}, {"requests", server.counters().requests.load()}});
     if (!o.record.empty()) write_record(*device, o.record);
     return 0;
 }
@@ -276,6 +370,9 @@ void add_device_command(CLI::App& app, DeviceCommandOptions& o) {
     cmd->add_option("--record", o.record, "write every executed path tick to this CSV (tick,x,y,...,pen) at exit");
     cmd->add_option("--exit-after", o.exit_after, "stop after this many seconds (default: at SIGINT/SIGTERM)")
         ->check(CLI::Range(0.0, 1e6));
+    cmd->add_flag(
+        "--log-json", o.log_json,
+        "print the log as NDJSON (one JSON object per line, docs/events.md) instead of text");
     cmd->callback([cmd, &o] {
         if (o.home && o.machine.empty()) throw CLI::ValidationError("--home", "needs --machine (the profile's gpio.home)");
         if (o.no_gpio && o.machine.empty()) throw CLI::ValidationError("--no-gpio", "needs --machine");
@@ -301,7 +398,7 @@ int run_device(const DeviceCommandOptions& o) {
             return 2;
         }
         const double mm_per_lsb = profile ? profile->mm_per_lsb : 0.001;
-        for (unsigned a = 0; a < axes; ++a) start[a] = parse_position(o.position[a], mm_per_lsb);
+        for (unsigned a = 0; a < axes; ++a) start[a] = parse_position_argument(o.position[a], mm_per_lsb, "--position");
     }
     // Before homing: an interrupted homing must stop cleanly too.
     std::signal(SIGINT, on_signal);

@@ -27,6 +27,7 @@ struct DeviceCommandOptions {
     double time_scale = 1.0;
     std::string record;
     double exit_after = 0;  ///< seconds of wall time; 0 = until SIGINT/SIGTERM
+    bool log_json = false;  ///< --log-json: the log as NDJSON instead of text
 };
 
 void add_device_command(CLI::App& app, DeviceCommandOptions& options);

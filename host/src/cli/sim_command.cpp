@@ -1,9 +1,11 @@
 #include "sim_command.hpp"
 
+#include <algorithm>
 #include <filesystem>
 #include <iostream>
 #include <nlohmann/json.hpp>
 
+#include "pathstream/host/events.hpp"
 #include "pathstream/host/planner.hpp"
 #include "pathstream/host/plot.hpp"
 #include "pathstream/host/progress.hpp"
@@ -27,6 +29,20 @@ void add_sim_command(CLI::App& app, SimCommandOptions& o) {
     cmd->add_option("--damping", o.damping, "servo damping ratio")->capture_default_str()->check(CLI::Range(0.05, 20.0));
     cmd->add_flag("--y-up", o.y_up, "draw path.svg with +y upwards (default: downwards, like SVG and most plotters)");
     cmd->add_flag("--json", o.json, "print the report as one JSON document on standard output");
+    cmd->add_option(
+        "--events", o.events,
+        "write the run's events as NDJSON to this file (docs/events.md); -: standard output, the "
+        "text report then goes to standard error");
+    cmd->add_option("--events-rate", o.events_rate,
+                    "progress events per second of simulated time, at most (with --events)")
+        ->capture_default_str()
+        ->check(CLI::Range(0.1, 1000.0));
+    cmd->callback([&o] {
+        if (o.json && o.events == "-") {
+            throw CLI::ValidationError("--events",
+                                       "-: the standard output carries the --json document");
+        }
+    });
 }
 
 namespace {
@@ -151,28 +167,86 @@ void print_plots(const plot::WrittenPlots& written) {
     if (!written.note.empty()) std::cout << "note: " << written.note << '\n';
 }
 
-/// Runs the plan on the simulated device, with a progress bar on standard error.
-sim::SimulationResult simulate_job(const SimCommandOptions& o, const PlannedJob& job) {
+/// Subpaths of the drawing: its spans name them by index.
+std::size_t count_subpaths(const Plan& plan) {
+    std::size_t n = 0;
+    for (const CoreSpan& s : plan.spans) n = std::max(n, s.subpath + 1);
+    return n;
+}
+
+/// One simulated tick as the events see it: the device always runs, in simulated time.
+JobSample sim_sample(const sim::TickProbe& p, const PlannedJob& job, const JobEvents& events) {
+    const std::vector<std::uint64_t>& prefix = events.prefix_ticks();
+    const std::size_t spans = job.plan.spans.size();
+    JobSample s;
+    s.sim_seconds = static_cast<double>(p.tick + 1) / job.machine.tick_hz;
+    s.started = true;
+    s.next_span = std::min<std::size_t>(p.last_completed_tag, spans);
+    s.ticks = std::min(p.ticks_executed, job.plan.total_ticks);
+    const std::uint64_t queued_end =
+        prefix[std::min<std::size_t>(s.next_span + p.queued_spans, spans)];
+    s.queued_ticks = queued_end > s.ticks ? queued_end - s.ticks : 0;
+    s.queued_spans = p.queued_spans;
+    std::copy(p.setpoints, p.setpoints + job.machine.axes.size(), s.position);
+    return s;
+}
+
+/// Runs the plan on the simulated device, with a progress bar on standard error and, with
+/// --events, the run's events from every tick.
+sim::SimulationResult simulate_job(const SimCommandOptions& o, const PlannedJob& job,
+                                   JobEvents& events) {
     sim::SimOptions options;
     options.plant = o.plant == "ideal" ? sim::PlantModel::kIdeal : sim::PlantModel::kServo;
     options.servo.bandwidth_hz = o.bandwidth_hz;
     options.servo.damping = o.damping;
     options.realtime = o.realtime;
+    if (!o.events.empty()) {
+        options.tick_observer = [&](const sim::TickProbe& p) {
+            events.sample(sim_sample(p, job, events));
+        };
+    }
     ProgressBar bar(o.realtime ? "running (real time)" : "simulating");
-    return sim::simulate(job.plan, job.machine, options, [&](double f) { bar.update(f); });
+    events.start(std::nullopt);
+    try {
+        return sim::simulate(job.plan, job.machine, options, [&](double f) { bar.update(f); });
+    } catch (const std::exception& e) {
+        events.end("failed", e.what());
+        throw;
+    }
+}
+
+/// job_end of the run: finished, or failed with the reason run_sim exits with.
+void end_events(JobEvents& events, const sim::SimulationResult& result, bool failed) {
+    const std::uint64_t ticks = result.stream.ticks_executed;
+    if (result.underruns != 0) {
+        events.end(
+            "failed",
+            "the device ran dry " + std::to_string(result.underruns) + " times (a streaming bug)",
+            ticks);
+    } else if (failed) {
+        events.end("failed", "the plan failed its per-tick check (a planner bug)", ticks);
+    } else {
+        events.end("finished", "", ticks);
+    }
 }
 
 }  // namespace
 
 int run_sim(const SimCommandOptions& o) {
+    EventChannel channel;
+    channel.progress_hz = o.events_rate;
+    if (!o.events.empty()) channel.writer = NdjsonWriter::open(o.events);
     const PlannedJob job = plan_job(o.path, o.machine);
-    const sim::SimulationResult result = simulate_job(o, job);
+    JobEvents events(channel, job.plan, job.machine,
+                     {"sim", o.path.file, "sim", count_subpaths(job.plan)});
+    const sim::SimulationResult result = simulate_job(o, job, events);
     const plot::TickSeries executed = sim::setpoint_series(result);
     const plot::TickSeries plant = sim::plant_series(result);
     const plot::RunSummary run = sim::run_summary(result);
     const bool servo = result.plant == sim::PlantModel::kServo;
     const bool failed =
         result.underruns != 0 || !job.check.within_limits || job.check.drawing_while_pen_moves;
+    end_events(events, result, failed);
     // With --json, standard output holds the document or, on failure, nothing: the text
     // report the error message points to then goes to standard error.
     if (!o.json) std::cout << plot::text_report(job.plan, &job.check, job.machine, executed, run);

@@ -18,6 +18,8 @@ struct SimCommandOptions {
     double damping = 1.0;
     bool y_up = false;
     bool json = false;  ///< --json: one JSON document on standard output instead of text
+    std::string events;      ///< --events: NDJSON events to this file ("-": stdout)
+    double events_rate = 5;  ///< --events-rate: progress events per simulated second, at most
 };
 
 void add_sim_command(CLI::App& app, SimCommandOptions& options);

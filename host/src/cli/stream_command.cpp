@@ -8,8 +8,8 @@
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
-#include <memory>
 #include <iostream>
+#include <memory>
 #include <stdexcept>
 #include <string>
 
@@ -18,6 +18,7 @@
 #include "pathstream/host/cia402_master.hpp"
 #include "pathstream/host/device_link.hpp"
 #include "pathstream/host/device_setup.hpp"
+#include "pathstream/host/events.hpp"
 #include "pathstream/host/job_journal.hpp"
 #include "pathstream/host/progress.hpp"
 #include "plan_command.hpp"
@@ -72,6 +73,14 @@ void add_stream_command(CLI::App& app, StreamCommandOptions& o) {
                     "give up after this many seconds without an answer (Modbus, native CAN)")
         ->capture_default_str()
         ->check(CLI::Range(0.1, 3600.0));
+    cmd->add_option(
+        "--events", o.events,
+        "write the job's events as NDJSON to this file (docs/events.md); -: standard output, the "
+        "text report then goes to standard error");
+    cmd->add_option("--events-rate", o.events_rate,
+                    "progress events per second, at most (with --events)")
+        ->capture_default_str()
+        ->check(CLI::Range(0.1, 1000.0));
 }
 
 namespace {
@@ -137,8 +146,17 @@ struct StreamEnd {
     std::uint32_t job = 0;
 };
 
-StreamEnd stream_over_can(const Plan& plan, const MachineProfile& machine, const StreamCommandOptions& o,
-                          const StreamObserver& observer, const HeldJob* held) {
+// The progress bar's detail: the queue level, then where the job is and the device's state.
+std::string bar_detail(double queued, const JobEvents& events) {
+    char queue[32];
+    std::snprintf(queue, sizeof queue, "queue %.2f s", queued);
+    const std::string status = events.status_text();
+    return status.empty() ? std::string(queue) : std::string(queue) + ", " + status;
+}
+
+StreamEnd stream_over_can(const Plan& plan, const MachineProfile& machine,
+                          const StreamCommandOptions& o, const StreamObserver& observer,
+                          const HeldJob* held, const JobEvents& events) {
     const CanTarget t = parse_can_target(o.stream.target);
     hal::SocketCanBus bus(t.interface_name);
     CanStreamOptions c;
@@ -154,9 +172,7 @@ StreamEnd stream_over_can(const Plan& plan, const MachineProfile& machine, const
     {
         ProgressBar bar("streaming");
         r = stream_can(plan, machine, bus, c, [&](double fraction, double queued) {
-            char detail[48];
-            std::snprintf(detail, sizeof detail, "queue %.2f s", queued);
-            bar.update(fraction, detail);
+            bar.update(fraction, bar_detail(queued, events));
         });
     }
     if (r.interrupted != 0) return {r.interrupted, r.final_status, r.job};
@@ -178,8 +194,9 @@ StreamEnd stream_over_can(const Plan& plan, const MachineProfile& machine, const
     return {0, r.final_status, r.job};
 }
 
-StreamEnd stream_over_modbus(const Plan& plan, const MachineProfile& machine, const StreamCommandOptions& o,
-                             const StreamObserver& observer, const HeldJob* held) {
+StreamEnd stream_over_modbus(const Plan& plan, const MachineProfile& machine,
+                             const StreamCommandOptions& o, const StreamObserver& observer,
+                             const HeldJob* held, const JobEvents& events) {
     StreamOptions options = o.stream;
     options.observer = observer;
     options.held = held;
@@ -187,9 +204,7 @@ StreamEnd stream_over_modbus(const Plan& plan, const MachineProfile& machine, co
     {
         ProgressBar bar("streaming");
         r = stream_modbus(plan, machine, options, [&](double fraction, double queued) {
-            char detail[48];
-            std::snprintf(detail, sizeof detail, "queue %.2f s", queued);
-            bar.update(fraction, detail);
+            bar.update(fraction, bar_detail(queued, events));
         });
     }
     if (r.interrupted != 0) return {r.interrupted, r.final_status, r.job};
@@ -247,9 +262,11 @@ std::string default_journal_path(const std::string& drawing) {
     return std::filesystem::path(drawing).stem().string() + ".journal.json";
 }
 
-// Streams `job` (its spans as the plan), keeping the journal; returns the exit status.
-int stream_job(const JobSpans& job, const MachineProfile& machine, StreamCommandOptions o, JobJournal journal,
-               const std::string& journal_path, const HeldJob* held) {
+// Streams `job` (its spans as the plan), keeping the journal and writing the events; returns
+// the exit status.
+int stream_job(const JobSpans& job, const MachineProfile& machine, StreamCommandOptions o,
+               JobJournal journal, const std::string& journal_path, const HeldJob* held,
+               const EventChannel& channel) {
     const bool can = o.stream.target.rfind("can://", 0) == 0;
     if (!journal_path.empty()) {
         const std::string plan_file = std::filesystem::absolute(journal_path + ".plan").string();
@@ -263,29 +280,38 @@ int stream_job(const JobSpans& job, const MachineProfile& machine, StreamCommand
     g_interrupts.store(0);
     std::signal(SIGINT, on_stream_signal);
     std::signal(SIGTERM, on_stream_signal);
-    const StreamObserver observer = [&](const StreamTrace& t) { writer.trace(t); };
+    JobEvents events(channel, job.plan, machine,
+                     {"stream", journal.drawing, o.stream.target, job.subpaths});
+    // Every status read goes to both records: the journal and the events.
+    const StreamObserver observer = [&](const StreamTrace& t) {
+        writer.trace(t);
+        events.trace(t);
+    };
     StreamEnd end;
     try {
-        end = can ? stream_over_can(job.plan, machine, o, observer, held)
-                  : stream_over_modbus(job.plan, machine, o, observer, held);
+        end = can ? stream_over_can(job.plan, machine, o, observer, held, events)
+                  : stream_over_modbus(job.plan, machine, o, observer, held, events);
     } catch (const std::exception& e) {
         writer.finish("failed", e.what());
+        events.end("failed", e.what());
         throw;
     }
     std::signal(SIGINT, SIG_DFL);
     std::signal(SIGTERM, SIG_DFL);
     if (end.interrupted == 0) {
         writer.finish("finished");
+        events.end("finished", "", job.plan.total_ticks);
         return 0;
     }
     writer.finish(end.interrupted == 1 ? "held" : "stopped");
+    events.end(end.interrupted == 1 ? "held" : "stopped");
     print_interrupted(end, job, end.job, machine, writer.path());
     return kExitInterrupted;
 }
 
 // --resume: the device holds the job (go on streaming, then resume), or rests idle (a
 // re-entry from where it rests to the first span not executed, then the rest of the job).
-int run_resume(StreamCommandOptions o) {
+int run_resume(StreamCommandOptions o, const EventChannel& channel) {
     const JobJournal journal = read_journal(o.resume);
     if (o.machine.empty()) o.machine = journal.machine;
     if (o.stream.target.empty()) o.stream.target = journal.target;
@@ -316,7 +342,7 @@ int run_resume(StreamCommandOptions o) {
         std::printf("resume        the device holds job %u at span %u of %zu: streaming the rest, then resume\n",
                     journal.job, s.last_completed + 1 - journal.job, spans);
         const HeldJob held{journal.job, s.last_accepted};
-        return stream_job(job, machine, o, journal, o.resume, &held);
+        return stream_job(job, machine, o, journal, o.resume, &held, channel);
     }
     if (s.state != static_cast<unsigned>(device::DeviceState::kIdle)) {
         throw StreamError(o.stream.target + ": device is " + device_state_name(s.state) +
@@ -343,15 +369,42 @@ int run_resume(StreamCommandOptions o) {
     next.job = 0;
     next.outcome = "streaming";
     next.error.clear();
-    return stream_job(resumed, machine, o, next, o.resume, nullptr);
+    return stream_job(resumed, machine, o, next, o.resume, nullptr, channel);
+}
+
+// CiA 402 drives: no device status to follow, so the events are the job's start and end.
+int stream_cia402(const PlannedJob& planned, const std::string& url, const EventChannel& channel,
+                  const std::string& drawing) {
+    hal::SocketCanBus cia402_bus(parse_cia402_target(url, planned.machine.axes.size()).interface);
+    const JobSpans job = job_from_plan(planned.plan);
+    JobEvents events(channel, planned.plan, planned.machine,
+                     {"stream", drawing, url, job.subpaths});
+    events.start(std::nullopt);
+    try {
+        const int status = run_cia402_stream(planned.plan, planned.machine, url, cia402_bus);
+        events.end("finished", "", planned.plan.total_ticks);
+        return status;
+    } catch (const std::exception& e) {
+        events.end("failed", e.what());
+        throw;
+    }
+}
+
+// The events' file, opened before anything is planned or sent (so a bad path costs nothing).
+EventChannel open_events(const StreamCommandOptions& o) {
+    EventChannel channel;
+    channel.progress_hz = o.events_rate;
+    if (!o.events.empty()) channel.writer = NdjsonWriter::open(o.events);
+    return channel;
 }
 
 }  // namespace
 
 int run_stream(const StreamCommandOptions& o) {
+    const EventChannel channel = open_events(o);
     if (!o.resume.empty()) {
         if (o.lead_in) throw std::invalid_argument("--resume: --lead-in does not apply (the resume plans its own move)");
-        return run_resume(o);
+        return run_resume(o, channel);
     }
     if (o.path.file.empty()) throw std::invalid_argument("stream: FILE is required (or --resume JOURNAL)");
     if (o.machine.empty()) throw std::invalid_argument("stream: --machine is required (or --resume JOURNAL)");
@@ -389,15 +442,15 @@ int run_stream(const StreamCommandOptions& o) {
     const PlannedJob planned = plan_job(o.path, o.machine, o.lead_in ? &rest_mm : nullptr);
     if (url.rfind("can://", 0) == 0 && url.find("protocol=cia402") != std::string::npos) {
         // CiA 402 drives take one setpoint per cycle from the host: no device queue to hold.
-        hal::SocketCanBus cia402_bus(parse_cia402_target(url, planned.machine.axes.size()).interface);
-        return run_cia402_stream(planned.plan, planned.machine, url, cia402_bus);
+        return stream_cia402(planned, url, channel, o.path.file);
     }
     JobJournal journal;
     journal.target = url;
     journal.machine = std::filesystem::absolute(o.machine).string();
     journal.drawing = o.path.file;
     const std::string journal_path = o.no_journal ? "" : (o.journal.empty() ? default_journal_path(o.path.file) : o.journal);
-    return stream_job(job_from_plan(planned.plan), planned.machine, o, journal, journal_path, nullptr);
+    return stream_job(job_from_plan(planned.plan), planned.machine, o, journal, journal_path,
+                      nullptr, channel);
 }
 
 }  // namespace pathstream::host

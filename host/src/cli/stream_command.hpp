@@ -18,6 +18,8 @@ struct StreamCommandOptions {
     bool no_journal = false;
     std::string resume;    ///< continue the job of this journal
     double hold_timeout_seconds = 10;  ///< Ctrl-C: a hold not at rest by then becomes a stop
+    std::string events;                ///< --events: NDJSON events to this file ("-": stdout)
+    double events_rate = 5;            ///< --events-rate: progress events per second, at most
 };
 
 /// Exit status of a stream interrupted by Ctrl-C or SIGTERM: the device holds at rest or

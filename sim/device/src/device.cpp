@@ -142,6 +142,10 @@ SimulationResult run(const host::Plan& plan, const host::MachineProfile& profile
             }
         }
         r.ticks = k + 1;
+        if (options.tick_observer) {
+            options.tick_observer({k, stream->ticks_executed(), stream->last_completed_tag(),
+                                   stream->queued_spans(), out});
+        }
         if (progress && r.ticks % progress_stride == 0) {
             progress(
                 std::min(1.0, static_cast<double>(r.ticks) / static_cast<double>(expected_rows)));

@@ -20,6 +20,15 @@ namespace pathstream::sim {
 /// Span queue depth of the simulated device (SetpointStream<Axes, kQueueCapacity>).
 inline constexpr std::uint32_t kQueueCapacity = 32;
 
+/// One tick as the simulated device ran it: what live observers (sim --events) look at.
+struct TickProbe {
+    std::uint64_t tick = 0;                ///< the tick's number (0: the first)
+    std::uint64_t ticks_executed = 0;      ///< path ticks so far (SetpointStream::ticks_executed)
+    std::uint32_t last_completed_tag = 0;  ///< tag (span index + 1) of the last span done, 0: none
+    std::uint32_t queued_spans = 0;        ///< spans queued, the one in progress included
+    const Lsb* setpoints = nullptr;        ///< the tick's setpoints, one per axis
+};
+
 /// How to run.
 struct SimOptions {
     PlantModel plant = PlantModel::kIdeal;
@@ -31,6 +40,8 @@ struct SimOptions {
     /// larger intervals or small batches model a slow link (and can starve the queue).
     std::uint32_t producer_interval_ticks = 1;
     std::uint32_t max_pushes_per_run = 0;
+    /// Called after every tick when set: keep it cheap, it runs at the tick rate.
+    std::function<void(const TickProbe&)> tick_observer;
 };
 
 /// Following error of one axis, |setpoint - plant position| over every recorded tick.

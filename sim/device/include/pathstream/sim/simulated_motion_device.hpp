@@ -39,6 +39,11 @@ public:
     virtual std::uint16_t fault_code() const = 0;
     /// Setpoint of the last tick.
     virtual Lsb position(unsigned axis) const = 0;
+    /// Job of the span in progress or last played (0: none); docs/device.md, "Jobs".
+    virtual std::uint32_t job() const = 0;
+    /// The last job run to its end (0: none) and its path ticks.
+    virtual std::uint32_t finished_job() const = 0;
+    virtual std::uint32_t finished_job_ticks() const = 0;
     /// Raises an external fault (as a drive fault input would).
     virtual void raise_fault() = 0;
     /// Configures the device as a host's configuration would (idle only). Returns the
@@ -93,6 +98,9 @@ public:
     std::uint8_t state() const override { return static_cast<std::uint8_t>(device_.state()); }
     std::uint16_t fault_code() const override { return static_cast<std::uint16_t>(device_.fault_code()); }
     Lsb position(unsigned axis) const override { return device_.position(axis); }
+    std::uint32_t job() const override { return device_.status().job; }
+    std::uint32_t finished_job() const override { return device_.status().finished_job; }
+    std::uint32_t finished_job_ticks() const override { return device_.status().finished_job_ticks; }
     void raise_fault() override { device_.raise_fault(device::FaultCode::kExternal); }
     Status configure(const host::DeviceLimitsLsb& l) override {
         if (l.max_velocity.size() != Axes || l.max_acceleration.size() != Axes) return Status::kBadLimits;

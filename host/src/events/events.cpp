@@ -1,0 +1,311 @@
+// Machine-readable events: the NDJSON writer and a job's events (docs/events.md).
+#include "pathstream/host/events.hpp"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+#include <ctime>
+#include <iostream>
+#include <stdexcept>
+
+#include "pathstream/device/device_state.hpp"
+#include "pathstream/host/device_link.hpp"
+#include "pathstream/host/device_setup.hpp"
+
+namespace pathstream::host {
+namespace {
+
+constexpr unsigned kRunning = static_cast<unsigned>(device::DeviceState::kRunning);
+constexpr unsigned kFault = static_cast<unsigned>(device::DeviceState::kFault);
+
+// Times and lengths to a fixed resolution, so lines stay short and compare as printed.
+double rounded(double value, double per_unit) {
+    return std::round(value * per_unit) / per_unit;
+}
+
+// The standard output as a file of its own, with descriptor 1 moved to standard error: the
+// events own the standard output and every other line printed lands on standard error.
+std::FILE* take_standard_output() {
+    std::cout.flush();
+    std::fflush(stdout);
+    const int fd = dup(STDOUT_FILENO);
+    if (fd < 0 || dup2(STDERR_FILENO, STDOUT_FILENO) < 0) {
+        throw std::runtime_error(std::string("--events -: cannot take over the standard output: ") +
+                                 std::strerror(errno));
+    }
+    std::FILE* f = fdopen(fd, "w");
+    if (f == nullptr) throw std::runtime_error(std::string("--events -: ") + std::strerror(errno));
+    return f;
+}
+
+}  // namespace
+
+std::string iso8601_utc(std::chrono::system_clock::time_point t) {
+    const std::time_t seconds = std::chrono::system_clock::to_time_t(t);
+    std::tm utc{};
+    gmtime_r(&seconds, &utc);
+    char text[40];
+    const std::size_t n = std::strftime(text, sizeof text, "%Y-%m-%dT%H:%M:%S", &utc);
+    const auto ms =
+        std::chrono::duration_cast<std::chrono::milliseconds>(t.time_since_epoch()).count() % 1000;
+    std::snprintf(text + n, sizeof text - n, ".%03dZ", static_cast<int>(ms < 0 ? ms + 1000 : ms));
+    return text;
+}
+
+NdjsonWriter::NdjsonWriter(std::FILE* file) : NdjsonWriter(file, false) {}
+
+NdjsonWriter::NdjsonWriter(std::FILE* file, bool owned) : file_(file), owned_(owned) {}
+
+std::unique_ptr<NdjsonWriter> NdjsonWriter::open(const std::string& path) {
+    if (path == "-")
+        return std::unique_ptr<NdjsonWriter>(new NdjsonWriter(take_standard_output(), true));
+    std::FILE* f = std::fopen(path.c_str(), "w");
+    if (f == nullptr) {
+        throw std::runtime_error("--events: cannot write '" + path + "': " + std::strerror(errno));
+    }
+    return std::unique_ptr<NdjsonWriter>(new NdjsonWriter(f, true));
+}
+
+NdjsonWriter::~NdjsonWriter() {
+    if (owned_) std::fclose(file_);
+}
+
+void NdjsonWriter::write(const EventJson& object) {
+    std::string line = object.dump(-1, ' ', false, EventJson::error_handler_t::replace);
+    line += '\n';
+    std::fwrite(line.data(), 1, line.size(), file_);
+    std::fflush(file_);
+}
+
+JobEvents::JobEvents(const EventChannel& channel, const Plan& plan, const MachineProfile& machine,
+                     JobInfo info)
+    : channel_(channel), plan_(plan), machine_(machine), info_(std::move(info)) {
+    prefix_.reserve(plan.spans.size() + 1);
+    prefix_.push_back(0);
+    for (const CoreSpan& s : plan.spans) prefix_.push_back(prefix_.back() + s.ticks);
+}
+
+// Seconds since the command started, to the microsecond.
+double JobEvents::now() const {
+    const double t =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - channel_.start).count();
+    return rounded(t, 1e6);
+}
+
+// An event's common fields: its type, `t`, and for a simulated run the simulated time.
+EventJson JobEvents::event(const char* type) const {
+    EventJson e;
+    e["event"] = type;
+    e["t"] = now();
+    if (sim_seconds_) e["sim_t"] = rounded(*sim_seconds_, 1e6);
+    return e;
+}
+
+void JobEvents::emit(const EventJson& e) const {
+    if (channel_.writer) channel_.writer->write(e);
+}
+
+void JobEvents::start(std::optional<std::uint32_t> job) {
+    if (started_event_) return;
+    started_event_ = true;
+    job_ = job;
+    EventJson e = event("job_start");
+    start_t_ = e["t"].get<double>();
+    e["command"] = info_.command;
+    e["drawing"] = info_.drawing;
+    e["target"] = info_.target;
+    e["job"] = job ? EventJson(*job) : EventJson(nullptr);
+    e["plan_ticks"] = plan_.total_ticks;
+    e["duration_s"] = static_cast<double>(plan_.total_ticks) / machine_.tick_hz;
+    e["spans"] = plan_.spans.size();
+    e["subpaths"] = info_.subpaths;
+    e["tick_hz"] = machine_.tick_hz;
+    e["mm_per_lsb"] = machine_.mm_per_lsb;
+    EventJson axes = EventJson::array();
+    for (const AxisLimits& a : machine_.axes) axes.push_back(a.name);
+    e["axes"] = axes;
+    emit(e);
+}
+
+void JobEvents::sample(const JobSample& s) {
+    sim_seconds_ = s.sim_seconds;
+    if (first_sample_) {
+        // A held job continues: the spans before this one were entered in an earlier run.
+        entered_ = static_cast<long long>(s.next_span) - 1;
+        underruns_base_ = underruns_ = s.underruns.value_or(0);
+        first_sample_ = false;
+    }
+    on_requests(s);
+    on_state(s);
+    on_underruns(s);
+    ticks_ = s.ticks;
+    if (s.started) running_seen_ = true;
+    if (!running_seen_) return;
+    enter_spans(s);
+    on_progress(s);
+}
+
+// A state event at every change (and a fault event when the state is fault).
+void JobEvents::on_state(const JobSample& s) {
+    if (!s.state) return;
+    const bool fault = *s.state == kFault;
+    const bool new_fault = fault && (state_ != kFault || s.fault_code != fault_code_);
+    if (state_ == s.state && !new_fault) return;
+    EventJson e = event("state");
+    e["state"] = device_state_name(*s.state);
+    e["code"] = *s.state;
+    e["was"] = state_ ? EventJson(device_state_name(*state_)) : EventJson(nullptr);
+    if (fault) e["fault"] = fault_text(s.fault_code);
+    emit(e);
+    if (new_fault) {
+        EventJson f = event("fault");
+        f["code"] = s.fault_code;
+        f["name"] = fault_text(s.fault_code);
+        f["ticks"] = s.ticks;
+        emit(f);
+    }
+    state_ = s.state;
+    fault_code_ = s.fault_code;
+}
+
+// hold and stop, once each, when the interrupt handling asked the device for them.
+void JobEvents::on_requests(const JobSample& s) {
+    if (s.hold_requested && !hold_) {
+        EventJson e = event("hold");
+        e["ticks"] = s.ticks;
+        emit(e);
+        hold_ = true;
+    }
+    if (s.stop_requested && !stop_) {
+        EventJson e = event("stop");
+        e["ticks"] = s.ticks;
+        emit(e);
+        stop_ = true;
+    }
+}
+
+// An underrun event whenever the device's counter grew since the last sample.
+void JobEvents::on_underruns(const JobSample& s) {
+    if (!s.underruns || *s.underruns <= underruns_) return;
+    underruns_ = *s.underruns;
+    EventJson e = event("underrun");
+    e["count"] = underruns_ - underruns_base_;
+    e["device_count"] = underruns_;
+    e["ticks"] = s.ticks;
+    emit(e);
+}
+
+// subpath and pen events for every span the device entered since the last sample, in order:
+// a sample may come after several short spans, and none of their changes may be lost.
+void JobEvents::enter_spans(const JobSample& s) {
+    if (plan_.spans.empty()) return;
+    const long long last = static_cast<long long>(std::min(s.next_span, plan_.spans.size() - 1));
+    for (long long k = entered_ + 1; k <= last; ++k) {
+        const CoreSpan& span = plan_.spans[static_cast<std::size_t>(k)];
+        if (!subpath_ || *subpath_ != span.subpath) {
+            subpath_ = span.subpath;
+            EventJson e = event("subpath");
+            e["n"] = span.subpath + 1;
+            e["of"] = info_.subpaths;
+            e["span"] = k;
+            emit(e);
+        }
+        if (span.pen_down != pen_down_) {
+            pen_down_ = span.pen_down;
+            EventJson e = event("pen");
+            e["down"] = pen_down_;
+            e["span"] = k;
+            emit(e);
+        }
+    }
+    entered_ = std::max(entered_, last);
+}
+
+// A progress event at most progress_hz times a second (simulated seconds for sim).
+void JobEvents::on_progress(const JobSample& s) {
+    EventJson e = event("progress");
+    const double clock = s.sim_seconds ? e["sim_t"].get<double>() : e["t"].get<double>();
+    if (last_progress_ && clock - *last_progress_ < 1.0 / channel_.progress_hz) return;
+    last_progress_ = clock;
+    const double total = static_cast<double>(plan_.total_ticks);
+    const std::uint64_t left = plan_.total_ticks - std::min(s.ticks, plan_.total_ticks);
+    e["fraction"] = total > 0 ? rounded(static_cast<double>(s.ticks) / total, 1e6) : 1.0;
+    e["ticks"] = s.ticks;
+    e["plan_ticks"] = plan_.total_ticks;
+    e["eta_s"] = rounded(static_cast<double>(left) / machine_.tick_hz, 1e6);
+    e["queue_s"] = rounded(static_cast<double>(s.queued_ticks) / machine_.tick_hz, 1e6);
+    e["queue_spans"] = s.queued_spans ? EventJson(*s.queued_spans) : EventJson(nullptr);
+    e["position_mm"] = position_json(s.position);
+    emit(e);
+}
+
+EventJson JobEvents::position_json(const Lsb* position) const {
+    EventJson p = EventJson::object();
+    for (std::size_t a = 0; a < machine_.axes.size() && a < kMaxAxes; ++a) {
+        p[machine_.axes[a].name] = rounded(position[a] * machine_.mm_per_lsb, 1e6);
+    }
+    return p;
+}
+
+void JobEvents::trace(const StreamTrace& t) {
+    start(t.job);
+    const DeviceSnapshot& d = t.status;
+    const std::size_t spans = plan_.spans.size();
+    // Sequence numbers: span i of the job is sequence job + i.
+    const auto index_after = [&](std::uint32_t sequence) -> std::size_t {
+        if (t.job == 0 || sequence + 1 < t.job) return 0;
+        return std::min<std::size_t>(sequence + 1 - t.job, spans);
+    };
+    JobSample s;
+    s.state = d.state;
+    s.fault_code = d.fault_code;
+    s.next_span = index_after(d.last_completed);
+    if (!have_base_) {
+        // The device counts path ticks of every job: the job's tick 0 is where it stood then.
+        tick_base_ = d.ticks_executed - static_cast<std::uint32_t>(prefix_[s.next_span]);
+        first_ticks_ = prefix_[s.next_span];
+        have_base_ = true;
+    }
+    s.ticks = std::min<std::uint64_t>(static_cast<std::uint32_t>(d.ticks_executed - tick_base_),
+                                      plan_.total_ticks);
+    // Running, or it ran between two reads (a short job, or an underrun's hold in between).
+    s.started = d.state == kRunning || s.ticks > first_ticks_;
+    const std::uint64_t sent = prefix_[index_after(t.acknowledged)];
+    s.queued_ticks = sent > s.ticks ? sent - s.ticks : 0;
+    s.queued_spans = d.queued;
+    s.underruns = d.underruns;
+    std::copy(d.position, d.position + kMaxAxes, s.position);
+    s.hold_requested = t.hold_requested;
+    s.stop_requested = t.stop_requested;
+    sample(s);
+}
+
+void JobEvents::end(const std::string& outcome, const std::string& error,
+                    std::optional<std::uint64_t> ticks) {
+    if (ended_) return;
+    start(job_);
+    ended_ = true;
+    EventJson e = event("job_end");
+    e["outcome"] = outcome;
+    e["job"] = job_ ? EventJson(*job_) : EventJson(nullptr);
+    e["ticks"] = ticks.value_or(ticks_);
+    e["plan_ticks"] = plan_.total_ticks;
+    e["wall_s"] = rounded(e["t"].get<double>() - start_t_, 1e6);
+    if (!error.empty()) e["error"] = error;
+    emit(e);
+}
+
+std::string JobEvents::status_text() const {
+    std::string text;
+    const auto add = [&](const std::string& part) { text += (text.empty() ? "" : ", ") + part; };
+    if (subpath_)
+        add("subpath " + std::to_string(*subpath_ + 1) + "/" + std::to_string(info_.subpaths));
+    if (running_seen_) add(pen_down_ ? "pen down" : "pen up");
+    if (state_) add(device_state_name(*state_));
+    return text;
+}
+
+}  // namespace pathstream::host

@@ -1,0 +1,50 @@
+# An operator's session over native CAN on a real kernel (runs inside the VM; helpers from
+# sim/vm/vm_lib.sh): `pathstream device --can vcan0 --node 5` in the background, then
+# `pathstream ctl` status, jog and set position, a stream interrupted by SIGINT (the device
+# holds at rest, exit 7) and continued with `stream --resume`, and a `--lead-in` stream that
+# reads the device's rest position from status frame E.
+iface=vcan0
+data=/pathstream/data
+target="can://$iface?node=5"
+rx_ready() { [ "$(grep -c "^ *$iface " /proc/net/can/rcvlist_all)" -ge "$1" ]; }
+
+timeout -s KILL 40 pathstream device -m "$data/pen_plotter.json" --no-gpio --can "$iface" --node 5 \
+  --position 0,0 --exit-after 35 > device.out 2>&1 &
+dev=$!
+vm_wait 10 rx_ready 1 || vm_fail "pathstream device did not open $iface: $(cat device.out)"
+
+vm_expect 0 pathstream ctl "$target" status --json > status.json 2>&1 || { cat status.json; vm_fail "ctl status"; }
+grep -q '"state": "idle"' status.json || vm_fail "ctl status: not idle: $(cat status.json)"
+vm_expect 0 pathstream ctl "$target" jog x 2.5 -m "$data/pen_plotter.json" > jog.out 2>&1 || { cat jog.out; vm_fail "ctl jog"; }
+grep -q 'x 2.5000 mm' jog.out || vm_fail "ctl jog: $(cat jog.out)"
+vm_expect 0 pathstream ctl "$target" position x 0 -m "$data/pen_plotter.json" > pos.out 2>&1 || { cat pos.out; vm_fail "ctl position"; }
+grep -q 'x 0.0000 mm' pos.out || vm_fail "ctl position: $(cat pos.out)"
+vm_expect 6 pathstream ctl "$target" hold > hold.out 2>&1 || { cat hold.out; vm_fail "ctl hold while idle was not refused"; }
+
+# wave.json starts at 0,0: interrupt it part way, then resume from the journal.
+pathstream stream "$data/wave.json" -m "$data/pen_plotter.json" -t "$target" --journal j.json > s1.out 2>&1 &
+s1=$!
+sleep 0.6
+kill -INT "$s1"
+wait "$s1"; rc=$?
+cat s1.out
+if [ "$rc" = 7 ]; then
+  grep -q '"outcome": "held"' j.json || vm_fail "journal after the interrupt: $(cat j.json)"
+  vm_expect 0 pathstream ctl "$target" status > held.out 2>&1
+  grep -q '^state         holding' held.out || vm_fail "device not holding after the interrupt: $(cat held.out)"
+  vm_expect 0 pathstream stream --resume j.json > s2.out 2>&1 || { cat s2.out; vm_fail "stream --resume failed"; }
+  cat s2.out
+  grep -q "^job .*finished" s2.out || vm_fail "resumed stream did not finish"
+elif [ "$rc" != 0 ]; then
+  vm_fail "interrupted stream exited $rc"
+fi
+grep -q '"outcome": "finished"' j.json || vm_fail "journal at the end: $(cat j.json)"
+
+# The device rests at wave.json's end (60, 0): a lead-in from there over CAN.
+vm_expect 0 pathstream stream "$data/wave.json" -m "$data/pen_plotter.json" -t "$target" --lead-in --no-journal \
+  > s3.out 2>&1 || { cat s3.out; vm_fail "--lead-in over CAN failed"; }
+grep -q '^lead-in       from the device.s rest position x 60.0000 mm y 0.0000 mm' s3.out || vm_fail "lead-in: $(cat s3.out)"
+
+kill -INT "$dev"
+wait "$dev"
+vm_log "native CAN operator session: ctl status/jog/position, interrupt and resume, lead-in: ok"
