@@ -109,6 +109,14 @@ start_device() {
   done
   fail "device did not start: $(cat "$work/$1.ndjson" "$work/$1.err")"; return 1
 }
+# Waits (up to 60 s) until the device at $target runs: planning may take long (sanitizers).
+wait_running() {
+  for _ in $(seq 1200); do
+    "$bin" ctl "$target" status --json 2>/dev/null | grep -q '"state": "running"' && return 0
+    sleep 0.05
+  done
+  fail "the device never ran"; return 1
+}
 stop_device() { kill -INT "$device_pid" 2>/dev/null; wait "$device_pid" 2>/dev/null; }
 
 # ---- sim: events on standard output, the report on standard error -------------------------
@@ -139,7 +147,8 @@ start_device device2 || exit 1
 "$bin" stream "$src/examples/rose.json" -m "$machine" -t "$target" --journal "$work/j.json" \
   --events stream2.ndjson --events-rate 10 > stream2.log 2>&1 &
 stream_pid=$!
-sleep 1.5
+wait_running
+sleep 0.5
 kill -INT "$stream_pid"
 wait "$stream_pid"; rc=$?
 [ $rc -eq 7 ] && ok || fail "stream interrupted: exit $rc (want 7): $(cat stream2.log)"

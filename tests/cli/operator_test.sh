@@ -27,6 +27,14 @@ start_device() {
   done
   fail "device did not start: $(cat "$work/device.log")"; return 1
 }
+# Waits (up to 60 s) until the device at $target runs: planning may take long (sanitizers).
+wait_running() {
+  for _ in $(seq 1200); do
+    "$bin" ctl "$target" status --json 2>/dev/null | grep -q '"state": "running"' && return 0
+    sleep 0.05
+  done
+  fail "the device never ran"; return 1
+}
 stop_device() { kill -INT "$device_pid" 2>/dev/null; wait "$device_pid" 2>/dev/null; }
 
 # The plan's path ticks and pen-down ticks (the setpoints CSV: tick,...,pen columns).
@@ -58,7 +66,7 @@ out=$("$bin" ctl "modbus-tcp://127.0.0.1:1?unit=1" status --link-timeout 0.2 2>&
 [ $rc -eq 6 ] && [[ "$out" == *"cannot connect"* ]] && ok || fail "ctl dead target: $rc $out"
 "$bin" stream "$drawing" -m "$machine" -t "$target" --no-journal > "$work/stream0.log" 2>&1 &
 stream_pid=$!
-sleep 1
+wait_running
 out=$("$bin" ctl "$target" hold 2>&1)
 [[ "$out" == *"accepted: running -> holding"* ]] && ok || fail "ctl hold: $out"
 out=$("$bin" ctl "$target" status --watch 0.05 --count 3 2>&1)
@@ -84,9 +92,10 @@ RANDOM=20261125
 for run in $(seq "$runs"); do
   for presses in 1 2; do
     start_device 4 || exit 1
-    delay=$(awk -v r=$RANDOM 'BEGIN { printf "%.2f", 0.3 + 3.0 * r / 32767 }')
+    delay=$(awk -v r=$RANDOM 'BEGIN { printf "%.2f", 3.0 * r / 32767 }')
     "$bin" stream "$drawing" -m "$machine" -t "$target" --journal "$work/j.json" > "$work/stream1.log" 2>&1 &
     stream_pid=$!
+    wait_running
     sleep "$delay"
     kill -INT "$stream_pid"
     [ "$presses" -eq 2 ] && { sleep 0.001; kill -INT "$stream_pid" 2>/dev/null; }

@@ -277,7 +277,6 @@ int stream_job(const JobSpans& job, const MachineProfile& machine, StreamCommand
     JournalWriter writer(journal_path, journal);
     o.stream.interrupt.request = &g_interrupts;
     o.stream.interrupt.hold_timeout_seconds = o.hold_timeout_seconds;
-    g_interrupts.store(0);
     std::signal(SIGINT, on_stream_signal);
     std::signal(SIGTERM, on_stream_signal);
     JobEvents events(channel, job.plan, machine,
@@ -296,8 +295,7 @@ int stream_job(const JobSpans& job, const MachineProfile& machine, StreamCommand
         events.end("failed", e.what());
         throw;
     }
-    std::signal(SIGINT, SIG_DFL);
-    std::signal(SIGTERM, SIG_DFL);
+    // The handler stays: a late second Ctrl-C must not cut the report of where it stopped.
     if (end.interrupted == 0) {
         writer.finish("finished");
         events.end("finished", "", job.plan.total_ticks);
@@ -410,6 +408,10 @@ int run_stream(const StreamCommandOptions& o) {
     if (o.machine.empty()) throw std::invalid_argument("stream: --machine is required (or --resume JOURNAL)");
     if (o.stream.target.empty()) throw std::invalid_argument("stream: --target is required (or --resume JOURNAL)");
     const std::string& url = o.stream.target;
+    // From here a Ctrl-C is ours: one during planning ends the command before anything is sent
+    // (a background job's SIGINT, ignored by default, would otherwise be lost).
+    std::signal(SIGINT, on_stream_signal);
+    std::signal(SIGTERM, on_stream_signal);
     if (url.rfind("modbus-tcp://", 0) != 0 && url.rfind("modbus-rtu://", 0) != 0 &&
         url.rfind("can://", 0) != 0) {
         throw std::invalid_argument(
@@ -440,7 +442,13 @@ int run_stream(const StreamCommandOptions& o) {
         std::printf("\n");
     }
     const PlannedJob planned = plan_job(o.path, o.machine, o.lead_in ? &rest_mm : nullptr);
+    if (g_interrupts.load() > 0) {
+        std::printf("interrupted   while planning: nothing was sent to the device\n");
+        return kExitInterrupted;
+    }
     if (url.rfind("can://", 0) == 0 && url.find("protocol=cia402") != std::string::npos) {
+        std::signal(SIGINT, SIG_DFL);  // CiA 402 streams have no hold: Ctrl-C ends the process
+        std::signal(SIGTERM, SIG_DFL);
         // CiA 402 drives take one setpoint per cycle from the host: no device queue to hold.
         return stream_cia402(planned, url, channel, o.path.file);
     }
