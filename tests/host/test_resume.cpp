@@ -49,7 +49,8 @@ struct ModbusDeviceThread {
     std::thread thread;
 
     // `limits`: configured before the device thread starts (as a host's configuration would).
-    ModbusDeviceThread(const std::vector<Lsb>& start, double time_scale, const host::DeviceLimitsLsb* limits = nullptr) {
+    ModbusDeviceThread(const std::vector<Lsb>& start, double time_scale,
+                       const host::DeviceLimitsLsb* limits = nullptr) {
         device = sim::SimulatedModbusDevice::create(start);
         if (limits != nullptr) REQUIRE(device->configure(*limits) == Status::kOk);
         device->record(true);
@@ -168,11 +169,8 @@ unsigned seeds_to_run() {
 
 }  // namespace
 
-TEST_CASE(
-    "a hold asked for at a seeded moment, then the held job streamed on and resumed: every drawing "
-    "tick "
-    "once, tick for tick",
-    "[resume][modbus][threads]") {
+TEST_CASE("resume: a hold at a seeded moment, the held job streamed on: every drawing tick once",
+          "[resume][modbus][threads]") {
     const Job job = plan_example("wave.json");
     for (unsigned seed = 1; seed <= seeds_to_run(); ++seed) {
         DYNAMIC_SECTION("seed " << seed) {
@@ -210,11 +208,8 @@ TEST_CASE(
     }
 }
 
-TEST_CASE(
-    "the host dies at a seeded moment (the device holds by underrun), then the job goes on from "
-    "the "
-    "device's queue: every drawing tick once",
-    "[resume][modbus][threads]") {
+TEST_CASE("resume: the host dies at a seeded moment, the job goes on from the device's queue",
+          "[resume][modbus][threads]") {
     const Job job = plan_example("wave.json");
     for (unsigned seed = 11; seed < 11 + seeds_to_run(); ++seed) {
         DYNAMIC_SECTION("seed " << seed) {
@@ -248,11 +243,8 @@ TEST_CASE(
     }
 }
 
-TEST_CASE(
-    "a stop (second Ctrl-C) or a fault at a seeded moment, then a reset and a resume from where "
-    "the device "
-    "rests: a re-entry, then the drawing from the first span not executed",
-    "[resume][modbus][threads]") {
+TEST_CASE("resume: a stop or a fault at a seeded moment, then a re-entry from where it rests",
+          "[resume][modbus][threads]") {
     const Job job = plan_example("wave.json");
     const host::JobSpans whole = host::job_from_plan(job.plan);
     const host::DeviceLimitsLsb limits = host::device_limits(job.machine);
@@ -309,11 +301,7 @@ TEST_CASE(
     }
 }
 
-TEST_CASE(
-    "resume_from: a pen-down span is approached along its tangent for the pen-down delay, pen "
-    "down; "
-    "a pen-up one directly; errors",
-    "[resume]") {
+TEST_CASE("resume_from: the pen-down approach along the tangent, and errors", "[resume]") {
     const Job job = plan_example("wave.json");
     const host::JobSpans whole = host::job_from_plan(job.plan);
     const host::DeviceLimitsLsb limits = host::device_limits(job.machine);
@@ -351,9 +339,7 @@ TEST_CASE(
                     std::invalid_argument);
 }
 
-TEST_CASE(
-    "job spans and journal files: written, read back the same, and refused when changed or damaged",
-    "[resume]") {
+TEST_CASE("job spans and journal files: round trip, changed or damaged files refused", "[resume]") {
     const Job job = plan_example("wave.json");
     const host::JobSpans whole = host::job_from_plan(job.plan);
     const std::string dir = std::filesystem::temp_directory_path().string() +
@@ -433,14 +419,14 @@ TEST_CASE("ctl's link: status and every command over Modbus TCP, refusals by nam
         s = link->status();
     }
     CHECK((s.finished_job == jog_job && s.position[1] == start_of(job.plan)[1] - 4321));
-    CHECK(link->command_with_arguments(device::kCommandJog, 5, 1, 0) == Status::kControlValueOutOfRange);
+    CHECK(link->command_with_arguments(device::kCommandJog, 5, 1, 0) ==
+          Status::kControlValueOutOfRange);
     CHECK(link->command_with_arguments(device::kCommandSetPosition, 0, 77, 0) == Status::kOk);
     check_steps_within_limits(*dt.device, job.machine);
 }
 
-TEST_CASE(
-    "ctl's link over native CAN: status with positions, commands, and a hold of a running stream",
-    "[ctl][can][threads]") {
+TEST_CASE("ctl's link over native CAN: status, commands, a hold of a running stream",
+          "[ctl][can][threads]") {
     const Job job = plan_example("wave.json");
     sim::CanLoopback loop;
     hal::CanBus& device_bus = loop.add_endpoint();
@@ -464,7 +450,8 @@ TEST_CASE(
     CHECK((s.version == 2 && s.axes == 2 && s.state == 0));
     CHECK((s.position[0] == start_of(job.plan)[0] && s.position[1] == start_of(job.plan)[1]));
     CHECK(link->command(Command::kHold) == Status::kWrongState);
-    CHECK(link->command_with_arguments(device::kCommandSetPosition, 2, 0, 0) == Status::kControlValueOutOfRange);
+    CHECK(link->command_with_arguments(device::kCommandSetPosition, 2, 0, 0) ==
+          Status::kControlValueOutOfRange);
     // A stream on the host bus; ctl holds it from another endpoint, the stream sees the hold
     // and keeps waiting; ctl resumes it and the stream finishes.
     host::CanStreamReport report;
