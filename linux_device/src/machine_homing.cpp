@@ -60,18 +60,31 @@ std::string failure(const sim::SimulatedMotionDevice& d, const sim::DeviceIo& io
 
 }  // namespace
 
+void set_homing_plan(sim::DeviceIo& io, const std::vector<host::HomingSetup>& setups) {
+    std::vector<device::HomingAxis> plan;
+    for (const host::HomingSetup& s : setups) plan.push_back({s.config, s.side});
+    if (io.set_homing_plan(plan.data(), static_cast<unsigned>(plan.size())) == Status::kOk) return;
+    for (const host::HomingSetup& s : setups) {
+        device::HomingAxis one{s.config, s.side};
+        if (io.set_homing_plan(&one, 1) != Status::kOk) {
+            (void)io.set_homing_plan(nullptr, 0);
+            throw HomingFailed("homing " + s.axis_name + ": switch " + s.switch_name + " is not wired");
+        }
+    }
+    (void)io.set_homing_plan(nullptr, 0);
+    throw HomingFailed("gpio.home: an axis is homed twice, or beyond the device's axes");
+}
+
 std::vector<HomedAxis> home_axes(sim::SimulatedMotionDevice& device, sim::DeviceIo& io, const std::vector<host::HomingSetup>& setups,
                                  double mm_per_lsb, const RunTicksUntil& run_until, const HomingLog& log) {
+    set_homing_plan(io, setups);
     std::vector<HomedAxis> homed;
     for (const host::HomingSetup& s : setups) {
         const device::HomingConfig& c = s.config;
         log("homing " + s.axis_name + " toward switch " + s.switch_name + ": search at " +
             mm(c.search_velocity, mm_per_lsb) + "/s for at most " + mm(c.max_travel, mm_per_lsb) + ", latch at " +
             mm(c.latch_velocity, mm_per_lsb) + "/s");
-        if (Status st = io.start_homing(c, s.side); st != Status::kOk) {
-            if (st == Status::kBadLimits && io.homing_phase() != device::HomingPhase::kError) {
-                throw HomingFailed("homing " + s.axis_name + ": switch " + s.switch_name + " is not wired");
-            }
+        if (Status st = io.start_homing_run(1u << c.axis); st != Status::kOk) {
             throw HomingFailed(failure(device, io, s, mm_per_lsb));
         }
         const std::uint64_t t0 = device.ticks_run();
@@ -82,7 +95,7 @@ std::vector<HomedAxis> home_axes(sim::SimulatedMotionDevice& device, sim::Device
                 shown = p;
                 if (const char* t = phase_text(p)) log("  " + s.axis_name + ": " + t);
             }
-            return !io.homing_busy();
+            return !io.homing_run_busy();
         });
         if (!finished) throw HomingFailed("homing " + s.axis_name + ": interrupted");
         if (io.homing_phase() != device::HomingPhase::kDone) throw HomingFailed(failure(device, io, s, mm_per_lsb));

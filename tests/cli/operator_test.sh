@@ -47,7 +47,7 @@ start_device 2 || exit 1
 out=$("$bin" ctl "$target" status -m "$machine" 2>&1)
 [[ "$out" == *"state         idle"* && "$out" == *"x 139.3220 mm (139322 LSB)"* ]] && ok || fail "ctl status: $out"
 out=$("$bin" ctl "$target" status --json 2>&1)
-echo "$out" | /usr/bin/python3 -c 'import json,sys; d=json.load(sys.stdin); assert d["state"]=="idle" and d["position"][0]["position_lsb"]==139322 and d["protocol_version"]==2' && ok || fail "ctl status --json: $out"
+echo "$out" | /usr/bin/python3 -c 'import json,sys; d=json.load(sys.stdin); assert d["state"]=="idle" and d["position"][0]["position_lsb"]==139322 and d["protocol_version"]==3 and d["pen_down"] is False and d["position"][0]["homing"]=="not homed"' && ok || fail "ctl status --json: $out"
 out=$("$bin" ctl "$target" hold 2>&1); rc=$?
 [ $rc -eq 6 ] && [[ "$out" == *"device refused hold while idle: command not allowed in this state"* ]] && ok || fail "ctl hold idle: $rc $out"
 out=$("$bin" ctl "$target" jog x 5.5 --feed 20 -m "$machine" 2>&1)
@@ -60,6 +60,20 @@ out=$("$bin" ctl "$target" jog x 5 --feed 1000 -m "$machine" 2>&1); rc=$?
 [ $rc -eq 2 ] && [[ "$out" == *"above the axis's"* ]] && ok || fail "ctl jog too fast: $rc $out"
 out=$("$bin" ctl "$target" position y 100.0004 -m "$machine" 2>&1); rc=$?
 [ $rc -eq 2 ] && [[ "$out" == *"not a whole number of LSB"* ]] && ok || fail "ctl position not whole: $rc $out"
+# The operator's pen: down at rest, carried by a jog (it draws), up again; home without
+# switches is refused by name.
+out=$("$bin" ctl "$target" pen down 2>&1)
+[[ "$out" == *"pen           down"* ]] && ok || fail "ctl pen down: $out"
+out=$("$bin" ctl "$target" jog y 2 -m "$machine" 2>&1)
+out=$("$bin" ctl "$target" status --json 2>&1)
+echo "$out" | /usr/bin/python3 -c 'import json,sys; d=json.load(sys.stdin); assert d["pen_down"] is True and d["position"][1]["position_lsb"]==102000' && ok || fail "pen down after a jog: $out"
+out=$("$bin" ctl "$target" pen up 2>&1)
+[[ "$out" == *"pen           up"* ]] && ok || fail "ctl pen up: $out"
+out=$("$bin" ctl "$target" pen sideways 2>&1); rc=$?
+[ $rc -eq 2 ] && [[ "$out" == *"want up or down"* ]] && ok || fail "ctl pen sideways: $rc $out"
+out=$("$bin" ctl "$target" home 2>&1); rc=$?
+[ $rc -eq 6 ] && [[ "$out" == *"device refused home while idle: no homing switch for that axis"* ]] && ok || fail "ctl home without switches: $rc $out"
+"$bin" ctl "$target" jog y -2 -m "$machine" > /dev/null 2>&1 || fail "jog y back"
 out=$("$bin" ctl "$target" jump 2>&1); rc=$?
 [ $rc -eq 2 ] && ok || fail "ctl bad verb: $rc $out"
 out=$("$bin" ctl "modbus-tcp://127.0.0.1:1?unit=1" status --link-timeout 0.2 2>&1); rc=$?

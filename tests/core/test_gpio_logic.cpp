@@ -55,7 +55,7 @@ TEST_CASE("fault names say which switch, on which axis and side", "[device][gpio
     CHECK(untouched == 'z');
 }
 
-TEST_CASE("enables are asserted only while the device may move; the pen only then too", "[device][gpio]") {
+TEST_CASE("enables are asserted only while the device may move; the pen then or by the operator", "[device][gpio]") {
     CHECK_FALSE(enable_asserted(DeviceState::kIdle));
     CHECK(enable_asserted(DeviceState::kRunning));
     CHECK(enable_asserted(DeviceState::kHolding));
@@ -65,7 +65,10 @@ TEST_CASE("enables are asserted only while the device may move; the pen only the
     CHECK(pen_down(DeviceState::kRunning, kOutputPenDown));
     CHECK_FALSE(pen_down(DeviceState::kRunning, 0));
     CHECK(pen_down(DeviceState::kHolding, kOutputPenDown));
-    for (DeviceState s : {DeviceState::kIdle, DeviceState::kFault, DeviceState::kEstop}) {
+    // Idle outputs are only the operator's pen (set_pen); fault and e-stop always lift it.
+    CHECK(pen_down(DeviceState::kIdle, kOutputPenDown));
+    CHECK_FALSE(pen_down(DeviceState::kIdle, 0));
+    for (DeviceState s : {DeviceState::kFault, DeviceState::kEstop}) {
         CHECK_FALSE(pen_down(s, kOutputPenDown));
     }
 }

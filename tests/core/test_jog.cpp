@@ -129,7 +129,7 @@ TEST_CASE("jog and set position refusals leave the device as it was", "[device][
           Ex::kIllegalDataValue);  // feed above 1000 per mille
     CHECK(write(jog_registers(0, kMaxPositionLsb + 1, 0)) ==
           Ex::kIllegalDataValue);                                        // end off the range
-    CHECK(write(jog_registers(0, 100, 0, 9)) == Ex::kIllegalDataValue);  // no such command
+    CHECK(write(jog_registers(0, 100, 0, 10)) == Ex::kIllegalDataValue);  // no such command
     CHECK(refusal() == Status::kUnknownCommand);
     const std::uint16_t plain_jog = kCommandJog;  // a jog without its arguments
     CHECK(m.write_holding_registers(modbus::kCommand, 1, &plain_jog) == Ex::kIllegalDataValue);

@@ -29,6 +29,7 @@ enum class [[nodiscard]] Status : std::uint8_t{
     kVelocityStep = 18,           ///< a span starts at another velocity than the previous one ends
     kJobEndMoving = 19,           ///< the last span of a job must end at rest (end tangents 0)
     kUnknownCommand = 20,         ///< a command value the device does not know
+    kNoHoming = 21,               ///< home: no homing switch for a requested axis
 };
 
 /// Short stable name of a status, for logs and host messages. Never null.
@@ -59,6 +60,8 @@ constexpr const char* status_name(Status s) {
             return "the last span of a job must end at rest";
         case Status::kUnknownCommand:
             return "unknown command";
+        case Status::kNoHoming:
+            return "no homing switch for that axis";
     }
     return "unknown status";
 }

@@ -11,7 +11,7 @@
 #include <stdexcept>
 #include <thread>
 
-#include "pathstream/device/jog.hpp"
+#include "pathstream/device/operator_commands.hpp"
 #include "pathstream/host/device_setup.hpp"
 #include "pathstream/host/machine.hpp"
 #include "pathstream/host/modbus_stream.hpp"
@@ -46,8 +46,27 @@ struct Units {
 };
 
 std::string flags_text(const DeviceSnapshot& s) {
-    std::string t = (s.flags & 1u) != 0 ? "configured" : "not configured";
-    if ((s.flags & 2u) != 0) t += ", held by underrun";
+    std::string t = s.configured() ? "configured" : "not configured";
+    if (s.held_by_underrun()) t += ", held by underrun";
+    if (s.homing_runs()) t += ", homing";
+    return t;
+}
+
+// The --wait of a command, or its default.
+double wait_seconds(const CtlCommandOptions& o, double fallback) {
+    return o.wait_seconds >= 0 ? o.wait_seconds : fallback;
+}
+
+// "x homed, y not homed" (with the reason of a failure).
+std::string homing_text(const DeviceSnapshot& s, const Units& u) {
+    std::string t;
+    for (unsigned a = 0; a < s.axes && a < kMaxAxes; ++a) {
+        if (a) t += ", ";
+        t += u.axis_name(a) + " " + axis_homing_name(s.homing[a].state);
+        if (s.homing[a].state == device::AxisHoming::kFailed) {
+            t += std::string(" (") + homing_error_name(s.homing[a].error) + ")";
+        }
+    }
     return t;
 }
 
@@ -60,8 +79,10 @@ nlohmann::json to_json(const DeviceSnapshot& s, const Units& u, const std::strin
     j["state_code"] = s.state;
     j["fault_code"] = s.fault_code;
     j["fault"] = s.fault_code == 0 ? "none" : fault_text(s.fault_code);
-    j["configured"] = (s.flags & 1u) != 0;
-    j["held_by_underrun"] = (s.flags & 2u) != 0;
+    j["configured"] = s.configured();
+    j["held_by_underrun"] = s.held_by_underrun();
+    j["homing"] = s.homing_runs();
+    j["pen_down"] = s.pen_down();
     j["queued_spans"] = s.queued;
     j["free_slots"] = s.free_slots;
     j["ticks_executed"] = s.ticks_executed;
@@ -74,7 +95,11 @@ nlohmann::json to_json(const DeviceSnapshot& s, const Units& u, const std::strin
     j["duplicates"] = s.duplicates;
     nlohmann::json axes = nlohmann::json::array();
     for (unsigned a = 0; a < s.axes && a < kMaxAxes; ++a) {
-        nlohmann::json axis{{"name", u.axis_name(a)}, {"position_lsb", s.position[a]}};
+        nlohmann::json axis{{"name", u.axis_name(a)},
+                            {"position_lsb", s.position[a]},
+                            {"homing", axis_homing_name(s.homing[a].state)}};
+        if (s.homing[a].state == device::AxisHoming::kFailed)
+            axis["homing_error"] = homing_error_name(s.homing[a].error);
         if (u.profile) axis["position_mm"] = s.position[a] * u.profile->mm_per_lsb;
         axes.push_back(axis);
     }
@@ -104,6 +129,8 @@ void print_status(const DeviceSnapshot& s, const Units& u, const std::string& ta
                 fault_suffix(s.state, s.fault_code).c_str());
     std::printf("queue         %u spans queued, %u slots free\n", s.queued, s.free_slots);
     std::printf("position      %s\n", position_text(s, u).c_str());
+    std::printf("pen           %s\n", s.pen_down() ? "down" : "up");
+    std::printf("homing        %s\n", homing_text(s, u).c_str());
     std::printf(
         "ticks         %u path ticks executed; spans: last accepted %u, last completed %u\n",
         s.ticks_executed, s.last_accepted, s.last_completed);
@@ -181,7 +208,8 @@ int run_command(DeviceLink& link, device::Command c, const CtlCommandOptions& o,
         throw StreamError(m.str());
     }
     DeviceSnapshot s = link.status();
-    const auto deadline = Clock::now() + std::chrono::duration<double>(o.wait_seconds);
+    const double wait = wait_seconds(o, 5);
+    const auto deadline = Clock::now() + std::chrono::duration<double>(wait);
     while (!settled(c, s) && Clock::now() < deadline) {
         std::this_thread::sleep_for(std::chrono::milliseconds(10));
         s = link.status();
@@ -203,7 +231,7 @@ int run_command(DeviceLink& link, device::Command c, const CtlCommandOptions& o,
     if (!settled(c, s)) {
         std::ostringstream m;
         m << link.name() << ": " << command_verb(c) << " accepted, but the device is still "
-          << device_state_name(s.state) << " after " << o.wait_seconds << " s";
+          << device_state_name(s.state) << " after " << wait << " s";
         throw StreamError(m.str());
     }
     return 0;
@@ -275,7 +303,7 @@ int run_jog(DeviceLink& link, const CtlCommandOptions& o, const Units& u) {
                           device_state_name(before.state) +
                           fault_suffix(before.state, before.fault_code) + ": " + status_name(r));
     }
-    const DeviceSnapshot s = wait_for_job(link, before.last_accepted + 1, o.wait_seconds);
+    const DeviceSnapshot s = wait_for_job(link, before.last_accepted + 1, wait_seconds(o, 5));
     const bool done = s.state == 0 && s.finished_job == before.last_accepted + 1;
     if (o.json) {
         nlohmann::json j;
@@ -294,7 +322,7 @@ int run_jog(DeviceLink& link, const CtlCommandOptions& o, const Units& u) {
     }
     if (!done) {
         throw StreamError(link.name() + ": the jog did not finish within " +
-                          std::to_string(o.wait_seconds) + " s: the device is " +
+                          std::to_string(wait_seconds(o, 5)) + " s: the device is " +
                           device_state_name(s.state) + fault_suffix(s.state, s.fault_code));
     }
     return 0;
@@ -319,7 +347,7 @@ int run_set_position(DeviceLink& link, const CtlCommandOptions& o, const Units& 
                           fault_suffix(before.state, before.fault_code) + ": " + status_name(r));
     }
     DeviceSnapshot s = link.status();
-    const auto deadline = Clock::now() + std::chrono::duration<double>(o.wait_seconds);
+    const auto deadline = Clock::now() + std::chrono::duration<double>(wait_seconds(o, 5));
     while (s.position[axis] != value && Clock::now() < deadline) {
         std::this_thread::sleep_for(std::chrono::milliseconds(5));
         s = link.status();
@@ -331,6 +359,111 @@ int run_set_position(DeviceLink& link, const CtlCommandOptions& o, const Units& 
     }
     if (s.position[axis] != value)
         throw StreamError(link.name() + ": the device did not take the new position");
+    return 0;
+}
+
+// home [AXES]: the device homes the axes (all it can: none named) one after another against
+// their switches, each with its homing sequence; progress is printed as each axis's state
+// changes.
+int run_home(DeviceLink& link, const CtlCommandOptions& o, const Units& u) {
+    const DeviceSnapshot before = link.status();
+    unsigned mask = 0;
+    for (const std::string& list : o.arguments) {
+        std::size_t from = 0;
+        while (from <= list.size()) {
+            const std::size_t comma = std::min(list.find(',', from), list.size());
+            const std::string name = list.substr(from, comma - from);
+            if (!name.empty()) mask |= 1u << axis_argument(name, u, before.axes);
+            from = comma + 1;
+        }
+    }
+    const Status r = link.command_with_arguments(device::kCommandHome, mask, 0, 0);
+    if (r != Status::kOk) {
+        throw StreamError(link.name() + ": device refused home while " +
+                          device_state_name(before.state) +
+                          fault_suffix(before.state, before.fault_code) + ": " + status_name(r));
+    }
+    const double wait = wait_seconds(o, 300);
+    const auto deadline = Clock::now() + std::chrono::duration<double>(wait);
+    DeviceSnapshot s = link.status();
+    device::HomingReport shown[kMaxAxes];
+    std::copy(before.homing, before.homing + kMaxAxes, shown);
+    const auto show_changes = [&] {
+        for (unsigned a = 0; a < s.axes && a < kMaxAxes; ++a) {
+            if (s.homing[a].state == shown[a].state && s.homing[a].error == shown[a].error) continue;
+            shown[a] = s.homing[a];
+            if (!o.json) {
+                std::printf("home          %s %s\n", u.axis_name(a).c_str(),
+                            axis_homing_name(s.homing[a].state));
+                std::fflush(stdout);
+            }
+        }
+    };
+    // A homing run that is started shows in the very next status; one that was over before
+    // the first read (an axis already on a stuck switch) shows in its reports.
+    while (s.homing_runs() && !g_interrupted.load() && Clock::now() < deadline) {
+        show_changes();
+        std::this_thread::sleep_for(std::chrono::milliseconds(20));
+        s = link.status();
+    }
+    if (g_interrupted.load() && s.homing_runs()) {
+        // The operator gave up: the homing must not go on unattended.
+        const Status stop = link.command(device::Command::kStop);
+        throw StreamError(link.name() + ": homing interrupted; " +
+                          (stop == Status::kOk ? std::string("stop sent")
+                                               : std::string("stop refused: ") + status_name(stop)));
+    }
+    show_changes();
+    std::string failed;
+    for (unsigned a = 0; a < s.axes && a < kMaxAxes; ++a) {
+        if ((mask == 0 || (mask & (1u << a)) != 0) && s.homing[a].state == device::AxisHoming::kFailed) {
+            failed += (failed.empty() ? "" : "; ") + u.axis_name(a) + ": " + homing_error_name(s.homing[a].error);
+        }
+    }
+    if (o.json) {
+        nlohmann::json j;
+        j["command"] = "home";
+        j["finished"] = !s.homing_runs();
+        j["failed"] = !failed.empty();
+        j["status"] = to_json(s, u, link.name());
+        std::printf("%s\n", j.dump(2).c_str());
+    } else {
+        std::printf("homing        %s\n", homing_text(s, u).c_str());
+        std::printf("position      %s\n", position_text(s, u).c_str());
+    }
+    if (s.homing_runs()) {
+        throw StreamError(link.name() + ": homing did not finish within " + std::to_string(wait) +
+                          " s; it goes on (ctl stop ends it)");
+    }
+    if (!failed.empty()) throw StreamError(link.name() + ": homing failed: " + failed);
+    return 0;
+}
+
+// pen up|down: the operator's pen at rest (idle only); a jog then carries it.
+int run_pen(DeviceLink& link, const CtlCommandOptions& o, const Units& u) {
+    if (o.arguments.size() != 1 || (o.arguments[0] != "up" && o.arguments[0] != "down"))
+        throw std::invalid_argument("ctl pen: want up or down");
+    const bool down = o.arguments[0] == "down";
+    const DeviceSnapshot before = link.status();
+    const Status r = link.command_with_arguments(device::kCommandPen, 0, down ? 1 : 0, 0);
+    if (r != Status::kOk) {
+        throw StreamError(link.name() + ": device refused pen " + o.arguments[0] + " while " +
+                          device_state_name(before.state) +
+                          fault_suffix(before.state, before.fault_code) + ": " + status_name(r));
+    }
+    DeviceSnapshot s = link.status();
+    const auto deadline = Clock::now() + std::chrono::duration<double>(wait_seconds(o, 5));
+    while (s.pen_down() != down && Clock::now() < deadline) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(5));
+        s = link.status();
+    }
+    if (o.json) {
+        std::printf("%s\n", to_json(s, u, link.name()).dump(2).c_str());
+    } else {
+        std::printf("pen           %s\n", s.pen_down() ? "down" : "up");
+    }
+    if (s.pen_down() != down)
+        throw StreamError(link.name() + ": the device did not " + (down ? "lower" : "raise") + " the pen");
     return 0;
 }
 
@@ -346,11 +479,14 @@ void add_ctl_command(CLI::App& app, CtlCommandOptions& o) {
                     "or can://IFACE?node=N")
         ->required();
     cmd->add_option("verb", o.verb,
-                    "status, hold, resume, stop, reset, jog AXIS DISTANCE or position AXIS VALUE")
+                    "status, hold, resume, stop, reset, home [AXES], jog AXIS DISTANCE, pen up|down "
+                    "or position AXIS VALUE")
         ->required()
-        ->check(CLI::IsMember({"status", "hold", "resume", "stop", "reset", "jog", "position"}));
+        ->check(CLI::IsMember(
+            {"status", "hold", "resume", "stop", "reset", "home", "jog", "pen", "position"}));
     cmd->add_option("arguments", o.arguments,
-                    "jog: AXIS DISTANCE; position: AXIS VALUE (mm, or LSB with lsb)");
+                    "home: axes by name or index (none: every axis the device can home); jog: AXIS "
+                    "DISTANCE; position: AXIS VALUE (mm, or LSB with lsb); pen: up or down");
     cmd->add_option("--feed", o.feed, "jog: mm/s (default: the axis's max velocity)")
         ->check(CLI::Range(0.0, 1e6));
     cmd->add_option("--machine,-m", o.machine, "machine profile: positions in mm and axes by name")
@@ -366,8 +502,7 @@ void add_ctl_command(CLI::App& app, CtlCommandOptions& o) {
     cmd->add_option(
            "--wait", o.wait_seconds,
            "commands: seconds to wait for the state the command leads to (hold: not running; stop, "
-           "reset: idle)")
-        ->capture_default_str()
+           "reset: idle; home: every axis ended; default 5, home 300)")
         ->check(CLI::Range(0.0, 600.0));
     cmd->add_option(
            "--timeout-ms", o.link.response_timeout_ms,
@@ -398,6 +533,12 @@ int run_ctl(const CtlCommandOptions& o) {
     if (o.verb == "status") return run_status(*link, o, u);
     if (o.verb == "jog") return run_jog(*link, o, u);
     if (o.verb == "position") return run_set_position(*link, o, u);
+    if (o.verb == "home") {
+        std::signal(SIGINT, on_ctl_signal);
+        std::signal(SIGTERM, on_ctl_signal);
+        return run_home(*link, o, u);
+    }
+    if (o.verb == "pen") return run_pen(*link, o, u);
     if (!o.arguments.empty()) throw std::invalid_argument("ctl " + o.verb + ": takes no arguments");
     for (const VerbInfo& v : kVerbs) {
         if (o.verb == v.verb) return run_command(*link, v.command, o, u);

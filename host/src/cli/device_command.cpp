@@ -234,6 +234,12 @@ Machine prepare_machine(sim::SimulatedMotionDevice& device, const DeviceCommandO
         m.lines.emplace(linux_device::MachineLines::open(*profile));
         m.io = &device.attach_io(m.lines->wiring());
         log("gpio", "GPIO " + m.lines->summary());
+        // The bus's home command homes these (pathstream ctl TARGET home).
+        try {
+            linux_device::set_homing_plan(*m.io, homing_setups(*profile));
+        } catch (const linux_device::HomingFailed& e) {
+            throw std::invalid_argument(profile->source + ": " + e.what());
+        }
     }
     if (o.home) {
         if (m.io == nullptr) {

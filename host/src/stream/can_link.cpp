@@ -29,7 +29,9 @@ DeviceSnapshot snapshot_of(const pc::Status3& s) {
     d.fault_code = s.fault_code;
     d.free_slots = s.free_slots;
     d.queued = s.queued;
-    d.flags = s.flags;
+    // Status A's flags agree with the snapshot's bits; its pen flag is the snapshot's output.
+    d.flags = s.flags & ~unsigned{pc::kFlagPenDown};
+    d.outputs = (s.flags & pc::kFlagPenDown) != 0 ? kOutputPenDown : 0u;
     d.underruns = s.underruns;
     d.duplicates = s.duplicates;
     d.last_accepted = s.last_accepted;
@@ -39,6 +41,10 @@ DeviceSnapshot snapshot_of(const pc::Status3& s) {
     d.finished_job_ticks = s.finished_job_ticks;
     d.epoch = s.epoch;
     std::copy(s.position, s.position + kMaxAxes, d.position);
+    for (unsigned a = 0; a < kMaxAxes; ++a) {
+        d.homing[a].state = static_cast<device::AxisHoming>(s.homing[a] & 0x0Fu);
+        d.homing[a].error = static_cast<device::HomingError>(s.homing[a] >> 4);
+    }
     return d;
 }
 

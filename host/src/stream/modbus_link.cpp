@@ -72,6 +72,10 @@ DeviceSnapshot parse_modbus_status(const std::uint16_t* r) {
     s.finished_job = u32(&r[st::kFinishedJob]);
     s.finished_job_ticks = u32(&r[st::kFinishedJobTicks]);
     s.epoch = u32(&r[st::kEpoch]);
+    for (unsigned a = 0; a < kMaxAxes; ++a) {
+        s.homing[a].state = static_cast<device::AxisHoming>(r[st::kHoming + a] & 0xFFu);
+        s.homing[a].error = static_cast<device::HomingError>(r[st::kHoming + a] >> 8);
+    }
     return s;
 }
 

@@ -52,14 +52,11 @@ public:
         if (state == DeviceState::kIdle || state == DeviceState::kFault ||
             state == DeviceState::kEstop)
             return true;
-        return !stop_sent_ && state == DeviceState::kHolding && (s.flags & kSnapshotOwnMove) == 0;
+        return !stop_sent_ && state == DeviceState::kHolding && !s.own_move();
     }
 
     /// 1: held (the job's rest still queued), 2: stopped.
     int outcome() const { return stop_sent_ ? 2 : 1; }
-
-    /// DeviceSnapshot::flags bit: the device's own stop or re-entry move is under way.
-    static constexpr unsigned kSnapshotOwnMove = 8u;
 
 private:
     using Clock = std::chrono::steady_clock;

@@ -27,6 +27,8 @@ public:
         : MotionDeviceBase<Axes, kCanDeviceCapacity, SimulatedCanDevice>(start), node_(this->device_, node) {}
 
     // The task's share of every loop turn comes first: a jog in progress is fed.
+    void connect_homing(const device::HomingPort& port) override { node_.operator_commands().set_homing(port); }
+
     void tick() override {
         node_.service();
         MotionDeviceBase<Axes, kCanDeviceCapacity, SimulatedCanDevice>::tick();

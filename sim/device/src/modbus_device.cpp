@@ -52,6 +52,8 @@ public:
     hal::ModbusRegisterHandler& handler() override { return handler_; }
 
     // The task's share of every loop turn comes first: a jog in progress is fed.
+    void connect_homing(const device::HomingPort& port) override { map_.operator_commands().set_homing(port); }
+
     void tick() override {
         map_.service();
         MotionDeviceBase<Axes, kModbusDeviceCapacity, SimulatedModbusDevice>::tick();

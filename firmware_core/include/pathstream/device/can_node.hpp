@@ -8,7 +8,7 @@
 #include <cstdint>
 
 #include "pathstream/device/can_protocol.hpp"
-#include "pathstream/device/jog.hpp"
+#include "pathstream/device/operator_commands.hpp"
 #include "pathstream/device/motion_device.hpp"
 #include "pathstream/status.hpp"
 
@@ -20,10 +20,14 @@ template <unsigned Axes, std::uint32_t Capacity>
 class CanNode {
 public:
     /// `node` must be kMinNode..kMaxNode (the caller checks it).
-    CanNode(MotionDevice<Axes, Capacity>& device, std::uint8_t node) : device_(device), node_(node), jog_(device) {}
+    CanNode(MotionDevice<Axes, Capacity>& device, std::uint8_t node)
+        : device_(device), node_(node), operator_(device) {}
 
     /// Task loop: feeds a jog in progress (call at least once per span period).
-    void service() { jog_.service(); }
+    void service() { operator_.service(); }
+
+    /// The commands with arguments (the port connects its homing here).
+    OperatorCommands<Axes, Capacity>& operator_commands() { return operator_; }
 
     std::uint8_t node() const { return node_; }
 
@@ -61,6 +65,8 @@ public:
         s.flags = static_cast<std::uint8_t>((device_.configured() ? kFlagConfigured : 0) |
                                             (d.held_by_underrun() ? kFlagHeldByUnderrun : 0) |
                                             (d.own_move() ? kFlagOwnMove : 0) |
+                                            (operator_.homing() ? kFlagHoming : 0) |
+                                            ((d.outputs & kOutputPenDown) != 0 ? kFlagPenDown : 0) |
                                             (bus_problem_ ? kFlagBusProblem : 0));
         s.free_slots = saturate8(device_.free_slots());
         s.queued = saturate8(device_.queued_spans());
@@ -78,7 +84,10 @@ public:
         encode_status(node_, s, out);
         for (const Frame& o : out) send(o);
         for (unsigned a = 0; a < Axes; ++a) {
-            send(encode_status_axis(node_, static_cast<std::uint8_t>(a), d.position[a], d.epoch));
+            const HomingReport h = operator_.homing_report(a);
+            const auto homing = static_cast<std::uint8_t>(static_cast<unsigned>(h.state) |
+                                                          (static_cast<unsigned>(h.error) << 4));
+            send(encode_status_axis(node_, static_cast<std::uint8_t>(a), d.position[a], d.epoch, homing));
         }
     }
 
@@ -123,17 +132,18 @@ private:
         ack(kAckCommand, result, c, send);
     }
 
-    // Jog (6) or set position (7), answered like a command (ack kind 2, sequence = the command).
+    // Jog, set position, home or pen, answered like a command (ack kind 2, sequence = the
+    // command).
     template <typename Send>
     void on_command_args(const Frame& f, Send& send) {
         CommandArgs c;
         if (!decode_command_args(f, c)) return ack(kAckCommand, kResultBadFrame, 0, send);
-        Status s = Status::kUnknownCommand;
-        if (c.command == kCommandJog) {
-            s = jog_.start(c.axis, c.value, c.feed);
-        } else if (c.command == kCommandSetPosition) {
-            s = c.feed != 0 ? Status::kControlValueOutOfRange : set_axis_position(device_, c.axis, c.value);
-        }
+        OperatorCommand o;
+        o.command = c.command;
+        o.axis = c.axis;
+        o.value = c.value;
+        o.feed = c.feed;
+        const Status s = operator_.execute(o);
         ack(kAckCommand, static_cast<std::uint8_t>(s), c.command, send);
     }
 
@@ -206,7 +216,7 @@ private:
 
     MotionDevice<Axes, Capacity>& device_;
     std::uint8_t node_;
-    Jog<Axes, Capacity> jog_;
+    OperatorCommands<Axes, Capacity> operator_;
     MotionLimits<Axes> pending_{};
     std::uint32_t config_seen_ = 0;  // bit per configuration item received since item 0
     SpanStart transfer_{};

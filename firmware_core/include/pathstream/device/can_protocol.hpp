@@ -16,7 +16,9 @@
 namespace pathstream::device::can {
 
 /// 2: job ends (wire flag kWireJobEnd, status frame D), continuity checked at every join.
-inline constexpr std::uint8_t kProtocolVersion = 2;
+/// 3: home and pen commands (CommandArgs 8, 9), the homing and pen flags (status A), each
+/// axis's homing state (status E).
+inline constexpr std::uint8_t kProtocolVersion = 3;
 inline constexpr std::uint8_t kMinNode = 1;
 inline constexpr std::uint8_t kMaxNode = 127;
 
@@ -33,7 +35,8 @@ inline constexpr std::uint32_t kSpanDataBase = 0x480;   ///< host -> device
 inline constexpr std::uint32_t kStatusDBase = 0x500;  ///< device -> host (jobs; added in version 2)
 /// device -> host, one frame per axis (position and queue epoch; added in version 2)
 inline constexpr std::uint32_t kStatusEBase = 0x580;
-/// host -> device: a command with arguments, 6 jog or 7 set position (added in version 2)
+/// host -> device: a command with arguments: 6 jog, 7 set position (added in version 2),
+/// 8 home, 9 pen (version 3)
 inline constexpr std::uint32_t kCommandArgsBase = 0x600;
 
 /// Identifier of function `base` for node `node`. Constant, any context.
@@ -71,6 +74,10 @@ inline constexpr std::uint8_t kFlagHeldByUnderrun = 1u << 1;
 inline constexpr std::uint8_t kFlagBusProblem = 1u << 2;  ///< the device saw error-passive or bus-off
 /// The last tick was a tick of the device's own stop or re-entry move (holding without it: at rest).
 inline constexpr std::uint8_t kFlagOwnMove = 1u << 3;
+/// A homing run goes on (the device's own moves, axis by axis).
+inline constexpr std::uint8_t kFlagHoming = 1u << 4;
+/// The pen output is down (the status's outputs; while idle only by the operator's pen).
+inline constexpr std::uint8_t kFlagPenDown = 1u << 5;
 
 /// Configuration items: 0 tick rate, 1 + 2a axis a's max velocity, 2 + 2a its acceleration,
 /// kConfigItemPenDown the pen-down delay in ticks. The pen-down delay is sent last: the device
@@ -113,6 +120,7 @@ inline constexpr const char* kResultValues =
     "8 \"discontinuous span\" 9 \"velocity limit\" 10 \"acceleration limit\" 11 \"bad limits\" "
     "12 \"not configured\" 13 \"bad sequence\" 14 \"bad batch\" 15 \"wrong state\" 16 \"stop too long\" "
     "17 \"nothing to resume\" 18 \"velocity step\" 19 \"job end moving\" 20 \"unknown command\" "
+    "21 \"no homing switch\" "
     "128 \"incomplete transfer\" 129 \"bad frame\" 130 \"too long\"";
 inline constexpr const char* kFaultValues =
     "0 \"none\" 1 \"external\" 2 \"stop failed\" 3 \"re-entry failed\" "
@@ -122,6 +130,14 @@ inline constexpr const char* kFaultValues =
     "265 \"limit axis 4 positive\" 266 \"limit axis 5 negative\" 267 \"limit axis 5 positive\" "
     "268 \"limit axis 6 negative\" 269 \"limit axis 6 positive\" 270 \"limit axis 7 negative\" "
     "271 \"limit axis 7 positive\"";
+
+inline constexpr const char* kHomingValues =
+    "0 \"not homed\" 1 \"homing\" 2 \"homed\" 3 \"failed\"";
+inline constexpr const char* kHomingErrorValues =
+    "0 \"none\" 1 \"bad configuration\" 2 \"device refused\" 3 \"switch not found\" "
+    "4 \"switch stuck\" 5 \"latch not found\" 6 \"interrupted\"";
+inline constexpr const char* kCommandArgsValues =
+    "6 \"jog\" 7 \"set position\" 8 \"home\" 9 \"pen\"";
 
 struct Message {
     const char* name;
@@ -148,7 +164,9 @@ inline constexpr Signal kAckSignals[] = {
 };
 inline constexpr Signal kStatusASignals[] = {
     {"State", 0, 1, false, "", "0 idle, 1 running, 2 holding, 3 stopping, 4 fault, 5 e-stop", -1, kStateValues},
-    {"Flags", 1, 1, false, "", "bit 0 configured, bit 1 held by underrun, bit 2 bus problem seen, bit 3 own stop or re-entry move"},
+    {"Flags", 1, 1, false, "",
+     "bit 0 configured, bit 1 held by underrun, bit 2 bus problem seen, bit 3 own stop or re-entry move, bit 4 homing, "
+     "bit 5 pen down"},
     {"FreeSlots", 2, 1, false, "span", "free span slots"},
     {"Queued", 3, 1, false, "span", "spans queued"},
     {"FaultCode", 4, 2, false, "", "0 none, 1 external, 2 stop failed, 3 re-entry failed, 0x01xx limit switch", -1,
@@ -174,6 +192,7 @@ inline constexpr Signal kStatusESignals[] = {
     {"Axis", 0, 1, false, "", "axis index, 0 .. axes - 1"},
     {"Position", 1, 4, true, "LSB", "setpoint the last tick output on that axis"},
     {"Epoch", 5, 2, false, "", "queue epoch (low 16 bits): advanced by every queue drop"},
+    {"Homing", 7, 1, false, "", "low nibble: 0 not homed, 1 homing, 2 homed, 3 failed; high nibble: why it failed"},
 };
 inline constexpr Signal kConfigSignals[] = {
     {"Item", 0, 1, false, "",
@@ -201,10 +220,11 @@ inline constexpr Signal kConfigSignals[] = {
      kConfigItemPenDown},
 };
 inline constexpr Signal kCommandArgsSignals[] = {
-    {"Command", 0, 1, false, "", "6 jog, 7 set position", -1, "6 \"jog\" 7 \"set position\""},
-    {"Axis", 1, 1, false, "", "axis index, 0 .. axes - 1"},
-    {"Value", 2, 4, true, "LSB", "jog: distance (signed, not 0); set position: the axis's new coordinate"},
-    {"Feed", 6, 2, false, "per mille", "jog: share of the axis's max velocity, 1..1000 (0: 1000); set position: 0"},
+    {"Command", 0, 1, false, "", "6 jog, 7 set position, 8 home, 9 pen", -1, kCommandArgsValues},
+    {"Axis", 1, 1, false, "", "jog, set position: axis index, 0 .. axes - 1; home: axis bit mask (0: all); pen: 0"},
+    {"Value", 2, 4, true, "LSB",
+     "jog: distance (signed, not 0); set position: the axis's new coordinate; pen: 1 down, 0 up; home: 0"},
+    {"Feed", 6, 2, false, "per mille", "jog: share of the axis's max velocity, 1..1000 (0: 1000); others: 0"},
 };
 inline constexpr Signal kSpanStartSignals[] = {
     {"FirstSequence", 0, 4, false, "", "sequence number of the batch's first span"},
@@ -234,10 +254,10 @@ inline constexpr Message kMessages[] = {
     {"SpanData", kSpanDataBase, 8, false, "host -> device: 7 bytes of the batch's wire spans",
      kSpanDataSignals, 2},
     {"StatusD", kStatusDBase, 8, true, "device -> host: jobs", kStatusDSignals, 2},
-    {"StatusE", kStatusEBase, 8, true, "device -> host: one axis's position, and the queue epoch",
-     kStatusESignals, 3},
+    {"StatusE", kStatusEBase, 8, true, "device -> host: one axis's position and homing, and the queue epoch",
+     kStatusESignals, 4},
     {"CommandArgs", kCommandArgsBase, 8, false,
-     "host -> device: a command with arguments (jog, set position), answered by a command ack",
+     "host -> device: a command with arguments (jog, set position, home, pen), answered by a command ack",
      kCommandArgsSignals, 4},
 };
 inline constexpr std::size_t kMessageCount = sizeof(kMessages) / sizeof(kMessages[0]);
@@ -277,6 +297,7 @@ struct Status3 {
     std::uint32_t finished_job = 0, finished_job_ticks = 0;
     std::int32_t position[kMaxAxes] = {};  ///< status E, per axis
     std::uint16_t epoch = 0;               ///< status E (low 16 bits)
+    std::uint8_t homing[kMaxAxes] = {};    ///< status E, per axis: AxisHoming | HomingError << 4
 };
 
 /// Status frames A to D the device sends per status request; then one frame E per axis.
@@ -294,7 +315,7 @@ constexpr Frame encode_command(std::uint8_t node, std::uint8_t command) {
     return f;
 }
 
-/// A command with arguments (kCommandArgsBase): jog (6) or set position (7).
+/// A command with arguments (kCommandArgsBase): jog (6), set position (7), home (8), pen (9).
 struct CommandArgs {
     std::uint8_t command = 0;
     std::uint8_t axis = 0;
@@ -362,13 +383,15 @@ constexpr void encode_status(std::uint8_t node, const Status3& s, Frame (&out)[k
     out[2] = c;
     out[3] = d;
 }
-/// Status frame E: axis `axis`'s position and the queue epoch's low 16 bits.
+/// Status frame E: axis `axis`'s position, the queue epoch's low 16 bits and the axis's
+/// homing byte (AxisHoming in the low nibble, HomingError in the high one).
 constexpr Frame encode_status_axis(std::uint8_t node, std::uint8_t axis, std::int32_t position,
-                                   std::uint32_t epoch) {
+                                   std::uint32_t epoch, std::uint8_t homing = 0) {
     Frame e{can_id(kStatusEBase, node), 8, {}};
     put(e, kStatusESignals[0], axis);
     put(e, kStatusESignals[1], static_cast<std::uint32_t>(position));
     put(e, kStatusESignals[2], epoch & 0xFFFFu);
+    put(e, kStatusESignals[3], homing);
     return e;
 }
 /// Merges one status frame (A to E) into `s`; false when `f` is none of them (or names an
@@ -393,6 +416,7 @@ constexpr bool decode_status_part(const Frame& f, Status3& s) {
             if (axis >= kMaxAxes) return false;
             s.position[axis] = static_cast<std::int32_t>(get(f, kStatusESignals[1]));
             s.epoch = static_cast<std::uint16_t>(get(f, kStatusESignals[2]));
+            s.homing[axis] = static_cast<std::uint8_t>(get(f, kStatusESignals[3]));
             return true;
         }
         case kStatusCBase:

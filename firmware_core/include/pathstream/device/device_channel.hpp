@@ -98,12 +98,21 @@ private:
     std::atomic<std::uint32_t> words_[kWords] = {};
 };
 
+/// Command-word values that only the task side posts (never bus values): the operator's pen
+/// (lowered or raised at rest while idle), and a start that keeps that pen (the device's own
+/// jog); a plain start raises it.
+inline constexpr std::uint32_t kMailboxValueMask = 0x7Fu;
+inline constexpr std::uint32_t kMailboxKeepPen = 0x80u;
+inline constexpr std::uint32_t kMailboxPenUp = 0x40u;
+inline constexpr std::uint32_t kMailboxPenDown = 0x41u;
+
 /// Requests to the tick. Who writes each field and when is part of its contract.
 template <unsigned Axes>
 struct DeviceMailbox {
-    /// Command word: (request number << 8) | Command value. Written by the task side
-    /// (DeviceReceiver::command) in one store; the tick takes each new word once. A second
-    /// request before that tick replaces the first.
+    /// Command word: (request number << 8) | Command value, or a mailbox-only value
+    /// (kMailboxPenUp, kMailboxPenDown), possibly with kMailboxKeepPen on a start. Written by
+    /// the task side (DeviceReceiver::command, start_keeping_pen, set_pen) in one store; the
+    /// tick takes each new word once. A second request before that tick replaces the first.
     std::atomic<std::uint32_t> command{0};
     /// Fault request: 0 or a FaultCode. Written by any context (raise_fault, first code kept)
     /// and cleared by the tick when a reset leaves the fault.

@@ -80,7 +80,7 @@ public:
             case Motion::kRest:
             default:
                 for (unsigned a = 0; a < Axes; ++a) out[a] = rest_[a];
-                outputs_ = 0;
+                outputs_ = state_ == DeviceState::kIdle ? manual_pen_ : std::uint8_t{0};
                 break;
         }
         for (unsigned a = 0; a < Axes; ++a) position_[a] = out[a];
@@ -171,8 +171,17 @@ private:
         const bool position = apply_position_request(s);
         if (command == status_.command_applied) return position;
         status_.command_applied = command;
-        switch (static_cast<Command>(command & 0xFFu)) {
+        const std::uint32_t value = command & kMailboxValueMask;
+        if (value == kMailboxPenUp || value == kMailboxPenDown) {
+            if (s == DeviceState::kIdle && motion_ == Motion::kRest) {
+                manual_pen_ = value == kMailboxPenDown ? kOutputPenDown : std::uint8_t{0};
+            }
+            return true;
+        }
+        switch (static_cast<Command>(value)) {
             case Command::kStart:
+                // Only the device's own jog keeps the operator's pen: a job's pen is its spans'.
+                if ((command & kMailboxKeepPen) == 0) manual_pen_ = 0;
                 // Starting with nothing (current) queued does nothing.
                 drop_stale();
                 if (s == DeviceState::kIdle && channel_.queue.next_span() != nullptr) {
@@ -193,6 +202,7 @@ private:
                 }
                 break;
             case Command::kStop:
+                manual_pen_ = 0;
                 if (s == DeviceState::kRunning) {
                     stop_requested_ = true;
                 } else if (s == DeviceState::kHolding) {
@@ -256,6 +266,7 @@ private:
 
     // E-stop and faults: the axes stay at the last output; everything queued is dropped.
     void stop_at_once() {
+        manual_pen_ = 0;
         for (unsigned a = 0; a < Axes; ++a) rest_[a] = position_[a];
         set_motion(Motion::kRest);
         generated_kind_ = Generated::kNone;
@@ -423,6 +434,7 @@ private:
     bool stop_requested_ = false;
     bool resume_pending_ = false;
     std::uint8_t outputs_ = 0;
+    std::uint8_t manual_pen_ = 0;  // the operator's pen at rest while idle (set_pen)
     std::uint8_t pen_lead_outputs_ = 0;
     std::uint32_t pen_lead_ticks_ = 0;
     std::uint32_t generated_left_ = 0;  // ticks of the generated span still to output

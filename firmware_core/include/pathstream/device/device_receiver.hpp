@@ -116,7 +116,31 @@ public:
     /// kNothingToResume (start with nothing queued, or resume after an underrun with nothing
     /// queued: nothing would move). Repeating a command already in effect is kOk and posts
     /// nothing. Cost: one status read.
-    [[nodiscard]] Status command(Command c) {
+    [[nodiscard]] Status command(Command c) { return post_command(c, 0); }
+
+    /// A start that keeps the operator's pen (set_pen) down: the device's own jog, whose
+    /// spans carry that pen. Otherwise as command(Command::kStart).
+    [[nodiscard]] Status start_keeping_pen() { return post_command(Command::kStart, kMailboxKeepPen); }
+
+    /// The operator's pen: lowered (`down`) or raised at rest. Idle with nothing queued only
+    /// (kWrongState otherwise). The tick keeps it until a plain start, a stop, a fault or the
+    /// e-stop raises it; it shows in the outputs while idle. Posted like a command (a command
+    /// before the next tick replaces it). Cost: one status read.
+    [[nodiscard]] Status set_pen(bool down) {
+        if (status().device_state() != DeviceState::kIdle || channel_.queue.queued_spans() != 0) {
+            return Status::kWrongState;
+        }
+        post(down ? kMailboxPenDown : kMailboxPenUp);
+        return Status::kOk;
+    }
+
+    /// True from a command() that posted a request until the tick that takes it.
+    bool command_pending() const {
+        return channel_.mailbox.command.load(std::memory_order_relaxed) != status().command_applied;
+    }
+
+private:
+    Status post_command(Command c, std::uint32_t modifier) {
         const std::uint32_t value = static_cast<std::uint32_t>(c);
         if (!is_command(value)) return Status::kUnknownCommand;
         const DeviceStatus<Axes> s = status();
@@ -155,17 +179,18 @@ public:
                 }
                 break;
         }
-        // One store carries the request number and the value: the tick can never pair a new
-        // number with an old value.
-        request_number_ = (request_number_ + 1u) & 0xFFFFFFu;
-        channel_.mailbox.command.store((request_number_ << 8) | value, std::memory_order_release);
+        post(value | modifier);
         return Status::kOk;
     }
 
-    /// True from a command() that posted a request until the tick that takes it.
-    bool command_pending() const {
-        return channel_.mailbox.command.load(std::memory_order_relaxed) != status().command_applied;
+    // One store carries the request number and the value: the tick can never pair a new
+    // number with an old value.
+    void post(std::uint32_t value) {
+        request_number_ = (request_number_ + 1u) & 0xFFFFFFu;
+        channel_.mailbox.command.store((request_number_ << 8) | value, std::memory_order_release);
     }
+
+public:
 
     /// Any context (a GPIO edge interrupt too): raises a fault; the next tick freezes every
     /// axis where it is, drops the queue and enters kFault. The first fault's code is kept

@@ -45,10 +45,12 @@ constexpr bool enable_asserted(DeviceState state) {
 /// The pen-lift output: `outputs` are those the device's last tick drove (MotionDevice::
 /// outputs): the playing span's on a path tick (the planner's pen events sit at span
 /// boundaries), none on any other tick (stop, re-entry except its pen-down lead, rest), so the
-/// device's own moves never draw; pen up when idle, in fault and in e-stop, so a frozen axis
-/// does not leave a blot.
+/// device's own stop and re-entry moves never draw. Idle, the pen is down only where the
+/// operator lowered it (set_pen: the tick's idle outputs are that pen and nothing else); in
+/// fault and in e-stop it is always up, so a frozen axis does not leave a blot.
 constexpr bool pen_down(DeviceState state, std::uint8_t outputs) {
-    return enable_asserted(state) && (outputs & kOutputPenDown) != 0;
+    return (enable_asserted(state) || state == DeviceState::kIdle) &&
+           (outputs & kOutputPenDown) != 0;
 }
 
 /// Writes a NUL-terminated English name of `code` into out[0..capacity): "none", "external

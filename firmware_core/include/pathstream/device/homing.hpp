@@ -56,6 +56,20 @@ enum class HomingError : std::uint8_t {
     kInterrupted,     ///< the device went to fault or e-stop, or was stopped from outside
 };
 
+/// Where one axis stands with homing, as the bus status reports it.
+enum class AxisHoming : std::uint8_t {
+    kNotHomed = 0,  ///< never homed since the device started
+    kHoming = 1,    ///< homing now, or waiting its turn in a homing run
+    kHomed = 2,     ///< its last homing ended with zero set
+    kFailed = 3,    ///< its last homing ended in an error (HomingReport::error)
+};
+
+/// One axis's homing state and, when it failed, why.
+struct HomingReport {
+    AxisHoming state = AxisHoming::kNotHomed;
+    HomingError error = HomingError::kNone;
+};
+
 /// A rest-to-rest move of one axis as constant-acceleration spans: ramp up, cruise, ramp down,
 /// and (for the remainder the ramps cannot cover exactly) one short rest-to-rest creep span.
 /// Tangents are even, so every span's end point is an exact integer. Freestanding, no heap.

@@ -31,7 +31,8 @@ public:
     explicit Jog(MotionDevice<Axes, Capacity>& device) : device_(device) {}
 
     /// Jogs `axis` by `distance` LSB (signed, not 0) at up to `feed` per mille of its max
-    /// velocity. Refusals: kNotConfigured; kWrongState unless idle with nothing queued;
+    /// velocity, with the operator's pen as it is (set_pen: a jog with the pen down draws, as a
+    /// plotter's manual walk does, and leaves it down). Refusals: kNotConfigured; kWrongState unless idle with nothing queued;
     /// kControlValueOutOfRange for an axis >= Axes, distance 0, an end point outside
     /// +-kMaxPositionLsb or a feed above 1000; kBadLimits when the limits allow no move. On kOk
     /// the job is queued (as much as fits) and started: it takes the next sequence numbers and
@@ -57,6 +58,7 @@ public:
             s != Status::kOk) {
             return s;
         }
+        pen_ = static_cast<std::uint8_t>(device_.outputs() & kOutputPenDown);
         epoch_ = device_.epoch();
         job_ = device_.last_accepted_sequence() + 1u;
         active_ = true;
@@ -64,7 +66,7 @@ public:
             active_ = false;
             return s;
         }
-        return device_.command(Command::kStart);
+        return device_.start_keeping_pen();
     }
 
     /// Queues more of the jog as room frees; gives up when the device dropped the jog (stop,
@@ -99,6 +101,7 @@ private:
                 WireSpan w;
                 if (!move_.next(w)) return Status::kAccelerationLimit;
                 if (!move_.pending()) w.flags |= kWireJobEnd;
+                w.outputs = pen_;
                 length += encode_wire_span(w, Axes, bytes + length, sizeof bytes - length);
                 ++count;
             }
@@ -116,6 +119,7 @@ private:
     AxisMove<Axes> move_;
     std::uint32_t epoch_ = 0;
     std::uint32_t job_ = 0;
+    std::uint8_t pen_ = 0;  // the operator's pen when the jog started: every span carries it
     bool active_ = false;
 };
 

@@ -10,7 +10,9 @@ namespace pathstream::device::modbus {
 inline constexpr std::uint16_t kMagic = 0x5053;  ///< "PS"
 /// 2: job ends (wire flag kWireJobEnd, registers 36-39), the queue epoch (40-41), the
 /// pen-down delay in the configuration (+3), continuity checked at every join.
-inline constexpr std::uint16_t kProtocolVersion = 2;
+/// 3: operator commands with arguments (jog, set position, home, pen), the homing flag and
+/// per-axis homing registers (42-49).
+inline constexpr std::uint16_t kProtocolVersion = 3;
 
 /// Status block: input registers (FC4) from 0, mirrored read-only in holding registers
 /// (FC3/FC23) at the same addresses so one FC23 can write spans and read the status.
@@ -34,19 +36,33 @@ inline constexpr std::uint16_t kRefusals = 31;       ///< refused writes (wraps)
 inline constexpr std::uint16_t kDuplicates = 32;     ///< batches acknowledged as retries (wraps)
 inline constexpr std::uint16_t kOutputs = 33;        ///< discrete outputs in force
 inline constexpr std::uint16_t kQueuedSpans = 34;
-inline constexpr std::uint16_t kFlags = 35;          ///< bit 0: configured, bit 1: held by underrun
+/// bit 0: configured, bit 1: held by underrun, bit 3: the device's own stop or re-entry
+/// move, bit 4: homing runs
+inline constexpr std::uint16_t kFlags = 35;
 inline constexpr std::uint16_t kFinishedJob =
     36;  ///< u32: id of the last job run to its end (0: none)
 inline constexpr std::uint16_t kFinishedJobTicks = 38;  ///< u32: path ticks that job executed
 inline constexpr std::uint16_t kEpoch = 40;  ///< u32: queue epoch (advanced by every queue drop)
-inline constexpr std::uint16_t kCount = 42;  ///< registers in the block
+/// One register per axis, up to 8: low byte AxisHoming (0 not homed, 1 homing, 2 homed,
+/// 3 failed), high byte the HomingError of a failure.
+inline constexpr std::uint16_t kHoming = 42;
+inline constexpr std::uint16_t kCount = 50;  ///< registers in the block
 }  // namespace status
+
+/// Status flag bits (register status::kFlags).
+namespace flags {
+inline constexpr std::uint16_t kConfigured = 1u << 0;
+inline constexpr std::uint16_t kHeldByUnderrun = 1u << 1;
+inline constexpr std::uint16_t kOwnMove = 1u << 3;
+inline constexpr std::uint16_t kHoming = 1u << 4;
+}  // namespace flags
 
 /// Command register (holding, write-only in effect; reads return the last command written).
 inline constexpr std::uint16_t kCommand = 100;  ///< Command values (1 start ... 5 reset)
-/// A command with arguments (6 jog, 7 set position) is one FC16 of kCommandWithArguments
-/// registers at kCommand: +0 command, +1 axis, +2..3 value (i32: jog distance or position,
-/// LSB), +4 feed (jog: per mille of the axis's max velocity, 0 = 1000; set position: 0).
+/// A command with arguments (6 jog, 7 set position, 8 home, 9 pen) is one FC16 of
+/// kCommandWithArguments registers at kCommand: +0 command, +1 axis (home: axis bit mask,
+/// 0 = all), +2..3 value (i32: jog distance or position in LSB; pen: 1 down, 0 up), +4 feed
+/// (jog: per mille of the axis's max velocity, 0 = 1000; others: 0).
 inline constexpr std::uint16_t kCommandWithArguments = 5;
 
 /// Configuration block (holding), written whole in one FC16 at kConfig:

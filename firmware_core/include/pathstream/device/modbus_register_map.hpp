@@ -5,7 +5,7 @@
 
 #include <cstdint>
 
-#include "pathstream/device/jog.hpp"
+#include "pathstream/device/operator_commands.hpp"
 #include "pathstream/device/modbus_map.hpp"
 #include "pathstream/device/motion_device.hpp"
 
@@ -20,10 +20,13 @@ class ModbusRegisterMap {
 public:
     using Exception = modbus::Exception;
 
-    explicit ModbusRegisterMap(MotionDevice<Axes, Capacity>& device) : device_(device), jog_(device) {}
+    explicit ModbusRegisterMap(MotionDevice<Axes, Capacity>& device) : device_(device), operator_(device) {}
 
     /// Task loop: feeds a jog in progress (call at least once per span period).
-    void service() { jog_.service(); }
+    void service() { operator_.service(); }
+
+    /// The commands with arguments (the port connects its homing here).
+    OperatorCommands<Axes, Capacity>& operator_commands() { return operator_; }
 
     /// FC4: registers of the status block. Addresses outside it: kIllegalDataAddress.
     Exception read_input_registers(std::uint16_t address, std::uint16_t count, std::uint16_t* out) {
@@ -139,12 +142,19 @@ private:
         b[st::kDuplicates] = static_cast<std::uint16_t>(device_.duplicates() & 0xFFFFu);
         b[st::kOutputs] = static_cast<std::uint16_t>(s.outputs);
         b[st::kQueuedSpans] = static_cast<std::uint16_t>(device_.queued_spans());
-        b[st::kFlags] = static_cast<std::uint16_t>((device_.configured() ? 1u : 0u) |
-                                                   (s.held_by_underrun() ? 2u : 0u) |
-                                                   (s.own_move() ? 8u : 0u));
+        b[st::kFlags] = static_cast<std::uint16_t>(
+            (device_.configured() ? modbus::flags::kConfigured : 0u) |
+            (s.held_by_underrun() ? modbus::flags::kHeldByUnderrun : 0u) |
+            (s.own_move() ? modbus::flags::kOwnMove : 0u) |
+            (operator_.homing() ? modbus::flags::kHoming : 0u));
         put_u32(&b[st::kFinishedJob], s.finished_job);
         put_u32(&b[st::kFinishedJobTicks], s.finished_job_ticks);
         put_u32(&b[st::kEpoch], s.epoch);
+        for (unsigned a = 0; a < Axes; ++a) {
+            const HomingReport h = operator_.homing_report(a);
+            b[st::kHoming + a] = static_cast<std::uint16_t>(static_cast<unsigned>(h.state) |
+                                                            (static_cast<unsigned>(h.error) << 8));
+        }
     }
 
     void fill_config(std::uint16_t (&b)[modbus::config_registers(kMaxAxes)]) const {
@@ -159,15 +169,15 @@ private:
         }
     }
 
-    // 6 jog, 7 set position; any other command value here is kUnknownCommand.
+    // 6 jog, 7 set position, 8 home, 9 pen; any other value here is kUnknownCommand.
     Status command_with_arguments(const std::uint16_t* v) {
-        const std::int32_t value = static_cast<std::int32_t>(u32(&v[2]));
-        if (v[0] == kCommandJog) return jog_.start(v[1], value, v[4]);
-        if (v[0] == kCommandSetPosition) {
-            if (v[4] != 0) return Status::kControlValueOutOfRange;
-            return set_axis_position(device_, v[1], value);
-        }
-        return Status::kUnknownCommand;
+        if (v[0] > 0xFFu) return Status::kUnknownCommand;
+        OperatorCommand c;
+        c.command = static_cast<std::uint8_t>(v[0]);
+        c.axis = v[1];
+        c.value = static_cast<std::int32_t>(u32(&v[2]));
+        c.feed = v[4];
+        return operator_.execute(c);
     }
 
     Status write_config(const std::uint16_t* v, Exception& e) {
@@ -219,7 +229,7 @@ private:
     }
 
     MotionDevice<Axes, Capacity>& device_;
-    Jog<Axes, Capacity> jog_;
+    OperatorCommands<Axes, Capacity> operator_;
     std::uint8_t payload_[2 * 123] = {};
     std::uint16_t last_command_ = 0;
     std::uint16_t last_refusal_ = 0;

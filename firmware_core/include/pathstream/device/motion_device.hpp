@@ -54,6 +54,10 @@ public:
     }
     /// DeviceReceiver::command. Task context.
     [[nodiscard]] Status command(Command c) { return receiver_.command(c); }
+    /// DeviceReceiver::start_keeping_pen (the device's own jog). Task context.
+    [[nodiscard]] Status start_keeping_pen() { return receiver_.start_keeping_pen(); }
+    /// DeviceReceiver::set_pen: the operator's pen at rest while idle. Task context.
+    [[nodiscard]] Status set_pen(bool down) { return receiver_.set_pen(down); }
     /// True until the tick has taken the last command posted. Task context.
     bool command_pending() const { return receiver_.command_pending(); }
     /// DeviceReceiver::raise_fault. Any context.
@@ -84,7 +88,8 @@ public:
     /// Setpoint output by the last tick, per axis.
     Lsb position(unsigned axis) const { return status().position[axis]; }
     /// Discrete outputs the last tick drove: the playing span's on a path tick, none on any
-    /// other tick (except the pen-down lead at the end of a re-entry).
+    /// other tick (except the pen-down lead at the end of a re-entry, and the operator's pen
+    /// at rest while idle, set_pen).
     std::uint8_t outputs() const { return static_cast<std::uint8_t>(status().outputs); }
     std::uint32_t underruns() const { return status().underruns; }
     std::uint32_t duplicates() const { return receiver_.duplicates(); }

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "pathstream/device/device_state.hpp"
+#include "pathstream/device/homing.hpp"
 #include "pathstream/hal/can_bus.hpp"
 #include "pathstream/span.hpp"
 #include "pathstream/status.hpp"
@@ -32,15 +33,33 @@ struct DeviceSnapshot {
     std::uint16_t fault_code = 0;
     unsigned free_slots = 0, queued = 0;
     unsigned capacity = 0;  ///< Modbus only (0 over CAN)
-    unsigned flags = 0;     ///< bit 0 configured, bit 1 held by underrun
+    unsigned flags = 0;     ///< kSnapshot* bits (the same on both buses)
     unsigned underruns = 0, duplicates = 0;
-    unsigned outputs = 0;       ///< Modbus only: bit 0 pen down on the last tick
+    unsigned outputs = 0;       ///< bit 0 pen down on the last tick (CAN: from its pen flag)
     unsigned last_refusal = 0;  ///< Modbus only: core Status of the last refused write
     std::uint32_t last_accepted = 0, last_completed = 0, ticks_executed = 0;
     std::uint32_t finished_job = 0, finished_job_ticks = 0;
     std::uint32_t epoch = 0;  ///< CAN: low 16 bits only
     std::int32_t position[kMaxAxes] = {};
+    device::HomingReport homing[kMaxAxes] = {};  ///< each axis's homing state
+
+    bool configured() const { return (flags & kSnapshotConfigured) != 0; }
+    bool held_by_underrun() const { return (flags & kSnapshotHeldByUnderrun) != 0; }
+    bool own_move() const { return (flags & kSnapshotOwnMove) != 0; }
+    bool homing_runs() const { return (flags & kSnapshotHoming) != 0; }
+    bool pen_down() const { return (outputs & kOutputPenDown) != 0; }
+
+    /// DeviceSnapshot::flags bits: Modbus register 35's and CAN status A's agree on these.
+    static constexpr unsigned kSnapshotConfigured = 1u << 0;
+    static constexpr unsigned kSnapshotHeldByUnderrun = 1u << 1;
+    static constexpr unsigned kSnapshotOwnMove = 1u << 3;
+    static constexpr unsigned kSnapshotHoming = 1u << 4;
 };
+
+/// "not homed", "homing", "homed", "failed".
+const char* axis_homing_name(device::AxisHoming h);
+/// Why homing failed: "switch not found", ... ("none" for kNone).
+const char* homing_error_name(device::HomingError e);
 
 /// "idle", "running", "holding", "stopping", "fault", "e-stop" (a DeviceState number), else
 /// "unknown".
@@ -58,9 +77,10 @@ public:
     /// Sends command `c` and returns the device's answer (kOk, or the core Status it refused
     /// with). Throws StreamError when nothing answers for the link timeout.
     virtual Status command(device::Command c) = 0;
-    /// A command with arguments (docs/device.md, "Jog and set position"): 6 jog `axis` by
-    /// `value` LSB at `feed` per mille of its max velocity, or 7 set `axis`'s position to
-    /// `value` (feed 0). Returns the device's answer. Throws StreamError on a dead link.
+    /// A command with arguments (docs/device.md, "Operator commands"): 6 jog `axis` by
+    /// `value` LSB at `feed` per mille of its max velocity, 7 set `axis`'s position to
+    /// `value`, 8 home the axes of bit mask `axis` (0: all), 9 pen (`value` 1 down, 0 up).
+    /// Returns the device's answer. Throws StreamError on a dead link.
     virtual Status command_with_arguments(std::uint8_t command, unsigned axis, std::int32_t value,
                                           std::uint16_t feed) = 0;
     /// The target as messages name it (its URL).

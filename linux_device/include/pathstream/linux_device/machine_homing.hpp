@@ -35,7 +35,12 @@ using RunTicksUntil = std::function<bool(const std::function<bool()>& done)>;
 /// Receives one line of progress (phase changes) at a time.
 using HomingLog = std::function<void(const std::string& line)>;
 
-/// Homes `setups` in order. `device` must be configured and idle, `io` attached to it.
+/// Gives `io` the axes a bus's home command may home (`setups`, in order). Throws
+/// HomingFailed naming the switch when one is not wired.
+void set_homing_plan(sim::DeviceIo& io, const std::vector<host::HomingSetup>& setups);
+
+/// Homes `setups` in order, each as a homing run of one axis (so the bus status reports it).
+/// Sets the plan (set_homing_plan) first. `device` must be configured and idle, `io` attached to it.
 /// Throws HomingFailed (with the device stopped: idle, or in fault/e-stop if that ended it).
 std::vector<HomedAxis> home_axes(sim::SimulatedMotionDevice& device, sim::DeviceIo& io, const std::vector<host::HomingSetup>& setups,
                                  double mm_per_lsb, const RunTicksUntil& run_until, const HomingLog& log);

@@ -112,10 +112,14 @@ public:
     }
     DeviceIo& attach_io(const MachineWiring& wiring) override {
         io_ = std::make_unique<DeviceIoFor<Axes, Capacity>>(device_, wiring);
+        connect_homing(io_->homing_port());
         return *io_;
     }
 
 protected:
+    /// Hands the I/O's homing to the bus protocol's commands (home over the bus).
+    virtual void connect_homing(const device::HomingPort& port) = 0;
+
     device::MotionDevice<Axes, Capacity> device_;
     std::unique_ptr<DeviceIo> io_;
 };

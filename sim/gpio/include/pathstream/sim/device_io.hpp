@@ -8,6 +8,8 @@
 #include <memory>
 
 #include "pathstream/device/homing.hpp"
+#include "pathstream/device/homing_run.hpp"
+#include "pathstream/device/operator_commands.hpp"
 #include "pathstream/device/motion_device.hpp"
 #include "pathstream/sim/device_gpio.hpp"
 
@@ -46,6 +48,28 @@ public:
     /// How far the search stop ran past the switch (LSB).
     virtual std::int64_t search_overshoot() const = 0;
 
+    /// The axes a bus's home command may home, in order (init: the profile's gpio.home).
+    /// kBadLimits for more axes than the device has, a repeated axis, or an unwired switch.
+    [[nodiscard]] virtual Status set_homing_plan(const device::HomingAxis* axes, unsigned count) = 0;
+    /// Starts a homing run (a bus's home command, through homing_port()): the plan's axes in
+    /// `mask` (0: all), one after another; each later one starts when the one before ends
+    /// homed. kWrongState unless idle with nothing queued and no homing going on; kNoHoming
+    /// for an axis outside the plan; the first axis's start refusal otherwise.
+    [[nodiscard]] virtual Status start_homing_run(unsigned mask) = 0;
+    /// True while a homing run goes on.
+    virtual bool homing_run_busy() const = 0;
+    /// Axis `axis`'s homing state, as the bus status reports it.
+    virtual device::HomingReport homing_report(unsigned axis) const = 0;
+    /// The run as the core's commands reach it (valid while this object lives).
+    device::HomingPort homing_port() {
+        device::HomingPort p;
+        p.context = this;
+        p.start = [](void* c, std::uint8_t mask) { return static_cast<DeviceIo*>(c)->start_homing_run(mask); };
+        p.busy = [](const void* c) { return static_cast<const DeviceIo*>(c)->homing_run_busy(); };
+        p.report = [](const void* c, unsigned axis) { return static_cast<const DeviceIo*>(c)->homing_report(axis); };
+        return p;
+    }
+
     virtual std::uint32_t estop_edges() const = 0;
     virtual std::uint32_t limit_trips() const = 0;
 };
@@ -55,14 +79,51 @@ class DeviceIoFor final : public DeviceIo {
 public:
     /// `device` and the wired lines must outlive this object.
     DeviceIoFor(device::MotionDevice<Axes, Capacity>& device, const MachineWiring& wiring)
-        : glue_(device, narrow(wiring)), homing_(device), wiring_(wiring) {}
+        : device_(device), glue_(device, narrow(wiring)), homing_(device), wiring_(wiring) {}
 
     void before_tick() override { glue_.poll_inputs(); }
     void after_tick() override {
         glue_.update_outputs();
         if (!homing_.busy()) return;
         homing_.poll(glue_.limit_active(homing_axis_, homing_side_));
-        if (!homing_.busy()) glue_.mask_limit(homing_axis_, homing_side_, false);
+        if (homing_.busy()) return;
+        glue_.mask_limit(homing_axis_, homing_side_, false);
+        if (!run_.busy()) return;
+        run_.finished(homing_.phase() == device::HomingPhase::kDone ? device::HomingError::kNone : homing_.error());
+        (void)start_next_axis();
+    }
+
+    Status set_homing_plan(const device::HomingAxis* axes, unsigned count) override {
+        for (unsigned i = 0; i < count; ++i) {
+            const unsigned a = axes[i].config.axis;
+            if (a < Axes && wiring_.limit[a][static_cast<unsigned>(axes[i].side)] == nullptr) {
+                return Status::kBadLimits;
+            }
+        }
+        return run_.set_plan(axes, count);
+    }
+
+    Status start_homing_run(unsigned mask) override {
+        if (homing_.busy() || run_.busy() || device_.state() != device::DeviceState::kIdle ||
+            device_.queued_spans() != 0) {
+            return Status::kWrongState;
+        }
+        if (Status s = run_.begin(mask); s != Status::kOk) return s;
+        return start_next_axis();
+    }
+    bool homing_run_busy() const override { return run_.busy(); }
+    device::HomingReport homing_report(unsigned axis) const override { return run_.report(axis); }
+
+    // The run's next axis: started, or (refused) recorded as failed, which ends the run.
+    Status start_next_axis() {
+        const device::HomingAxis* next = run_.next();
+        if (next == nullptr) return Status::kOk;
+        const Status s = start_homing(next->config, next->side);
+        if (s != Status::kOk) {
+            run_.finished(homing_.error() != device::HomingError::kNone ? homing_.error()
+                                                                         : device::HomingError::kDeviceRefused);
+        }
+        return s;
     }
 
     Status start_homing(const device::HomingConfig& config, device::LimitSide side) override {
@@ -97,8 +158,10 @@ private:
         return d;
     }
 
+    device::MotionDevice<Axes, Capacity>& device_;
     DeviceGpio<Axes, Capacity> glue_;
     device::HomingSequencer<Axes, Capacity> homing_;
+    device::HomingRun<Axes> run_;
     MachineWiring wiring_;
     unsigned homing_axis_ = 0;
     device::LimitSide homing_side_ = device::LimitSide::kNegative;
