@@ -60,6 +60,44 @@ std::string failure(const sim::SimulatedMotionDevice& d, const sim::DeviceIo& io
 
 }  // namespace
 
+HomingRunLog::HomingRunLog(const sim::SimulatedMotionDevice& device, const sim::DeviceIo& io,
+                           std::vector<host::HomingSetup> setups, double mm_per_lsb)
+    : device_(device), io_(io), setups_(std::move(setups)), mm_per_lsb_(mm_per_lsb) {}
+
+void HomingRunLog::after_tick(const HomingLog& log) {
+    const bool busy = io_.homing_run_busy();
+    if (busy && !busy_) log("homing run started by a bus command");
+    const auto setup_of = [&](unsigned axis) -> const host::HomingSetup* {
+        for (const host::HomingSetup& s : setups_) {
+            if (s.config.axis == axis) return &s;
+        }
+        return nullptr;
+    };
+    const bool sequencer_busy = io_.homing_busy();
+    const unsigned axis = io_.homing_axis();
+    // An axis's sequence ended (the next axis may have started in the same tick).
+    if (sequencer_busy_ && (!sequencer_busy || axis != axis_)) {
+        if (const host::HomingSetup* s = setup_of(axis_)) {
+            if (io_.homing_report(axis_).state == device::AxisHoming::kHomed) {
+                log("  " + s->axis_name + ": homed: switch point = " + mm(s->config.home_position, mm_per_lsb_) +
+                    ", now at " + mm(device_.position(axis_), mm_per_lsb_));
+            } else {
+                log(failure(device_, io_, *s, mm_per_lsb_));
+            }
+        }
+    }
+    if (sequencer_busy && (!sequencer_busy_ || axis != axis_ || io_.homing_phase() != phase_)) {
+        phase_ = io_.homing_phase();
+        const host::HomingSetup* s = setup_of(axis);
+        const char* t = phase_text(phase_);
+        if (s != nullptr && t != nullptr) log("  " + s->axis_name + ": " + t);
+    }
+    if (!busy && busy_) log("homing run ended");
+    axis_ = axis;
+    sequencer_busy_ = sequencer_busy;
+    busy_ = busy;
+}
+
 void set_homing_plan(sim::DeviceIo& io, const std::vector<host::HomingSetup>& setups) {
     std::vector<device::HomingAxis> plan;
     for (const host::HomingSetup& s : setups) plan.push_back({s.config, s.side});

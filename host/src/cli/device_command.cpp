@@ -211,6 +211,12 @@ struct Machine {
     std::optional<MachineProfile> profile;
     std::optional<linux_device::MachineLines> lines;
     sim::DeviceIo* io = nullptr;
+    std::optional<linux_device::HomingRunLog> homing_log;  ///< homing runs a bus command starts
+
+    // After every tick while serving: the log's lines of a homing run.
+    void after_tick(const DeviceLog& log) {
+        if (homing_log) homing_log->after_tick([&log](const std::string& line) { log("homing", line); });
+    }
 };
 
 Machine prepare_machine(sim::SimulatedMotionDevice& device, const DeviceCommandOptions& o,
@@ -248,6 +254,9 @@ Machine prepare_machine(sim::SimulatedMotionDevice& device, const DeviceCommandO
         if (profile->gpio.home.empty()) throw std::invalid_argument(profile->source + ": --home: gpio.home is empty");
         home(device, *m.io, *profile, o.time_scale, log, watch);
     }
+    if (m.io != nullptr && !profile->gpio.home.empty()) {
+        m.homing_log.emplace(device, *m.io, homing_setups(*profile), profile->mm_per_lsb);
+    }
     return m;
 }
 
@@ -264,7 +273,7 @@ int run_can_device(const DeviceCommandOptions& o, const std::vector<Lsb>& start,
     device->record(!o.record.empty());
     const DeviceLog log(o.log_json);
     DeviceWatch watch(log, status_reader(*device));
-    const Machine machine = prepare_machine(*device, o, profile, log, watch);
+    Machine machine = prepare_machine(*device, o, profile, log, watch);
     hal::SocketCanBus bus(o.can_interface);
     const std::string url =
         "can://" + o.can_interface + "?node=" + std::to_string(o.node) + "&protocol=native";
@@ -276,6 +285,7 @@ int run_can_device(const DeviceCommandOptions& o, const std::vector<Lsb>& start,
         [&] {
             device->tick();
             watch.after_tick(*device);
+            machine.after_tick(log);
         },
         [&] { return device->tick_hz(); },
         [&](std::chrono::microseconds w) { device->serve(bus, w); }, loop_options(o), g_stop);
@@ -297,7 +307,7 @@ int run_modbus_device(const DeviceCommandOptions& o, const std::vector<Lsb>& sta
     device->record(!o.record.empty());
     const DeviceLog log(o.log_json);
     DeviceWatch watch(log, status_reader(*device));
-    const Machine machine = prepare_machine(*device, o, profile, log, watch);
+    Machine machine = prepare_machine(*device, o, profile, log, watch);
     hal::ModbusServerOptions server_options;
     server_options.unit = o.unit;
     std::string url;
@@ -328,6 +338,7 @@ int run_modbus_device(const DeviceCommandOptions& o, const std::vector<Lsb>& sta
         [&] {
             device->tick();
             watch.after_tick(*device);
+            machine.after_tick(log);
         },
         [&] { return device->tick_hz(); },
         [&](std::chrono::microseconds w) {

@@ -49,7 +49,7 @@ hal::ModbusClient connect(const StreamOptions& o) {
 ModbusLink::ModbusLink(const StreamOptions& options)
     : options_(options), client_(connect(options)) {}
 
-DeviceSnapshot parse_modbus_status(const std::uint16_t* r) {
+DeviceSnapshot parse_modbus_status(const std::uint16_t* r, std::size_t count) {
     DeviceSnapshot s;
     s.magic = r[st::kMagic];
     s.version = r[st::kVersion];
@@ -72,18 +72,19 @@ DeviceSnapshot parse_modbus_status(const std::uint16_t* r) {
     s.finished_job = u32(&r[st::kFinishedJob]);
     s.finished_job_ticks = u32(&r[st::kFinishedJobTicks]);
     s.epoch = u32(&r[st::kEpoch]);
-    for (unsigned a = 0; a < kMaxAxes; ++a) {
+    for (unsigned a = 0; a < kMaxAxes && st::kHoming + a < count; ++a) {
         s.homing[a].state = static_cast<device::AxisHoming>(r[st::kHoming + a] & 0xFFu);
         s.homing[a].error = static_cast<device::HomingError>(r[st::kHoming + a] >> 8);
     }
     return s;
 }
 
-DeviceSnapshot ModbusLink::read_status() {
-    std::uint16_t r[st::kCount];
-    transact([&] { client_.read_input_registers(0, std::span<std::uint16_t>(r, st::kCount)); });
+DeviceSnapshot ModbusLink::read_status(std::uint16_t count) {
+    std::uint16_t r[st::kCount] = {};
+    count = std::min(count, st::kCount);
+    transact([&] { client_.read_input_registers(0, std::span<std::uint16_t>(r, count)); });
     ++status_reads_;
-    return parse_modbus_status(r);
+    return parse_modbus_status(r, count);
 }
 
 void ModbusLink::write_command(device::Command c) {

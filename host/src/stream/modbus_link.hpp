@@ -12,12 +12,14 @@
 #include "pathstream/hal/modbus_client.hpp"
 #include "pathstream/hal/modbus_error.hpp"
 #include "pathstream/host/device_link.hpp"
+#include "pathstream/device/modbus_map.hpp"
 #include "pathstream/host/modbus_stream.hpp"
 
 namespace pathstream::host {
 
-/// The status block `r` (status::kCount registers from 0) as a snapshot.
-DeviceSnapshot parse_modbus_status(const std::uint16_t* r);
+/// The status block's first `count` registers `r` (status::kStreamingCount or kCount) as a
+/// snapshot; the homing states only when `count` covers them (else not homed).
+DeviceSnapshot parse_modbus_status(const std::uint16_t* r, std::size_t count);
 
 class ModbusLink {
 public:
@@ -60,8 +62,9 @@ public:
         }
     }
 
-    /// The whole status block (FC4), parsed. Counts status_reads.
-    DeviceSnapshot read_status();
+    /// The status block's first `count` registers (FC4), parsed: the whole block by default,
+    /// status::kStreamingCount while streaming. Counts status_reads.
+    DeviceSnapshot read_status(std::uint16_t count = device::modbus::status::kCount);
     /// Writes command register 100; a refusal throws the ModbusError (non-transient).
     void write_command(device::Command c);
     /// Restarts the link-timeout clock (before a first transaction).

@@ -177,7 +177,7 @@ private:
 
     DeviceStatus read_status() {
         ++report_.status_reads;
-        return link_.read_status();
+        return link_.read_status(st::kStreamingCount);
     }
 
     void check_identity(const DeviceStatus& s, bool check_start = true,
@@ -294,11 +294,12 @@ private:
             const std::uint16_t low = i + 1 < payload.size() ? payload[i + 1] : 0;
             window.push_back(static_cast<std::uint16_t>((payload[i] << 8) | low));
         }
-        std::uint16_t r[st::kCount];
+        std::uint16_t r[st::kStreamingCount];
         const std::uint32_t last = first + static_cast<std::uint32_t>(count) - 1;
         const std::uint64_t retries_before = link_.client().counters().retries;
         try {
-            link_.client().write_read_registers(mb::kSpanWindow, window, 0, std::span<std::uint16_t>(r, st::kCount));
+            link_.client().write_read_registers(mb::kSpanWindow, window, 0,
+                                                std::span<std::uint16_t>(r, st::kStreamingCount));
         } catch (const hal::ModbusError& e) {
             if (e.exception_code() == static_cast<std::uint8_t>(mb::Exception::kServerDeviceBusy)) {
                 return read_status();  // queue fuller than we knew: send later
@@ -334,7 +335,7 @@ private:
             clean_batches_ = 0;
         }
         batch_done(next, count, last);
-        return parse_modbus_status(r);
+        return parse_modbus_status(r, st::kStreamingCount);
     }
 
     void batch_done(std::size_t& next, std::size_t count, std::uint32_t last) {

@@ -7,6 +7,7 @@
 # 2. --home with a switch that never closes: exit 6, "not found within 1.000 mm".
 # 3. --home with the switch played from the device's own phase log: search, back-off, latch,
 #    pull-off, homed; then it serves, and the re-armed x- switch faults by name.
+# 4. `ctl home` and `ctl pen` over CAN while the device serves: the same homing, the pen line.
 sim=$GPIO_SIM_SYSFS
 data=/pathstream/data
 profile=$data/gpio_vm_profile.json
@@ -77,4 +78,40 @@ kill -INT "$dev"
 wait "$dev" || { cat dev3.out; vm_fail "the device failed"; }
 cat dev3.out
 released
-vm_log "gpio cli: stream + e-stop, homing error, homing + armed switch through pathstream device --machine"
+
+# 4. Homing and the pen as bus commands: `ctl home` while the device serves, the switch played
+#    from the device's log as in 3; then `ctl pen down` lowers the real pen line at rest.
+timeout -s KILL 60 pathstream device -m "$profile" --can "$iface" --node 3 > dev4.out 2>&1 &
+dev=$!
+vm_wait 10 rx_ready 1 || { cat dev4.out; vm_fail "the device did not open $iface"; }
+target="can://$iface?node=3&protocol=native"
+timeout -s KILL 60 pathstream ctl "$target" home -m "$profile" > ctl4.out 2>&1 &
+ctl=$!
+vm_wait 10 logged "x: searching" dev4.out || { cat dev4.out ctl4.out; vm_fail "ctl home did not start homing"; }
+vm_wait 5 line_is 1 1 || vm_fail "enable not high while homing over the bus"
+usleep 300000
+pull 3 pull-up
+vm_wait 10 logged "x: backing off" dev4.out || { cat dev4.out; vm_fail "no back-off (ctl home)"; }
+pull 3 pull-down
+vm_wait 10 logged "x: approaching slowly" dev4.out || { cat dev4.out; vm_fail "no slow approach (ctl home)"; }
+usleep 300000
+pull 3 pull-up
+vm_wait 10 logged "x: pulling off the switch" dev4.out || { cat dev4.out; vm_fail "no pull-off (ctl home)"; }
+pull 3 pull-down
+wait "$ctl"
+rc=$?
+cat ctl4.out
+[ "$rc" = 0 ] || { cat dev4.out; vm_fail "ctl home exited $rc"; }
+logged "homing        x homed" ctl4.out || vm_fail "ctl home did not report x homed"
+logged "x: homed: switch point = 0.000 mm" dev4.out || { cat dev4.out; vm_fail "the device did not log x homed"; }
+[ "$(value 0)" = 0 ] || vm_fail "pen down before ctl pen down"
+pathstream ctl "$target" pen down > ctl5.out 2>&1 || { cat ctl5.out; vm_fail "ctl pen down failed"; }
+vm_wait 5 line_is 0 1 || vm_fail "ctl pen down did not lower the pen line"
+[ "$(value 1)" = 0 ] || vm_fail "enable high with only the pen down (idle)"
+pathstream ctl "$target" pen up > ctl5.out 2>&1 || { cat ctl5.out; vm_fail "ctl pen up failed"; }
+vm_wait 5 line_is 0 0 || vm_fail "ctl pen up did not raise the pen line"
+kill -INT "$dev"
+wait "$dev" || { cat dev4.out; vm_fail "the device failed"; }
+cat dev4.out
+released
+vm_log "gpio cli: stream + e-stop, homing error, homing + armed switch through pathstream device --machine, ctl home and pen over CAN"

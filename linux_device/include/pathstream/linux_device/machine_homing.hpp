@@ -35,6 +35,27 @@ using RunTicksUntil = std::function<bool(const std::function<bool()>& done)>;
 /// Receives one line of progress (phase changes) at a time.
 using HomingLog = std::function<void(const std::string& line)>;
 
+/// Follows homing runs a bus command starts (`pathstream ctl TARGET home`) and describes them
+/// in home_axes's words, one line per phase and one per axis at its end. Task context: after
+/// every tick.
+class HomingRunLog {
+public:
+    /// `setups` are the plan's axes (set_homing_plan). `device` and `io` must outlive it.
+    HomingRunLog(const sim::SimulatedMotionDevice& device, const sim::DeviceIo& io,
+                 std::vector<host::HomingSetup> setups, double mm_per_lsb);
+    void after_tick(const HomingLog& log);
+
+private:
+    const sim::SimulatedMotionDevice& device_;
+    const sim::DeviceIo& io_;
+    std::vector<host::HomingSetup> setups_;
+    double mm_per_lsb_;
+    bool busy_ = false;
+    bool sequencer_busy_ = false;
+    unsigned axis_ = 0;
+    device::HomingPhase phase_ = device::HomingPhase::kIdle;
+};
+
 /// Gives `io` the axes a bus's home command may home (`setups`, in order). Throws
 /// HomingFailed naming the switch when one is not wired.
 void set_homing_plan(sim::DeviceIo& io, const std::vector<host::HomingSetup>& setups);

@@ -58,6 +58,8 @@ public:
     [[nodiscard]] virtual Status start_homing_run(unsigned mask) = 0;
     /// True while a homing run goes on.
     virtual bool homing_run_busy() const = 0;
+    /// The axis the sequencer homes or homed last.
+    virtual unsigned homing_axis() const = 0;
     /// Axis `axis`'s homing state, as the bus status reports it.
     virtual device::HomingReport homing_report(unsigned axis) const = 0;
     /// The run as the core's commands reach it (valid while this object lives).
@@ -112,6 +114,7 @@ public:
         return start_next_axis();
     }
     bool homing_run_busy() const override { return run_.busy(); }
+    unsigned homing_axis() const override { return homing_axis_; }
     device::HomingReport homing_report(unsigned axis) const override { return run_.report(axis); }
 
     // The run's next axis: started, or (refused) recorded as failed, which ends the run.
