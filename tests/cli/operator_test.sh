@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # An operator's session with the real binaries over Modbus TCP: `pathstream device` serving,
-# `pathstream stream` interrupted by SIGINT at seeded moments (one Ctrl-C: hold; two: stop),
-# `pathstream stream --resume`, and `pathstream ctl` status and commands. Every run must end
+# `pathstream stream` interrupted by SIGINT at seeded moments (one Ctrl-C: hold; two: stop) or
+# killed (SIGKILL: the host dies, the device runs out its queue), `pathstream stream --resume`,
+# and `pathstream ctl` status and commands (pen, jog, position, home refused without switches). Every run must end
 # with the device idle at the drawing's end and exactly the plan's path ticks executed, pen
 # down on exactly the plan's pen-down ticks (the device's record).
 #   operator_test.sh PATHSTREAM_BINARY SOURCE_DIR WORK_DIR [RUNS]
@@ -91,7 +92,7 @@ wait "$stream_pid"; rc=$?
 [ $rc -eq 0 ] && ok || fail "stream held and resumed by ctl: exit $rc: $(cat "$work/stream0.log")"
 stop_device
 
-# ---- Ctrl-C at seeded moments, then --resume ---------------------------------------------
+# ---- Ctrl-C (once, twice) or SIGKILL at seeded moments, then --resume --------------------
 check_record() {  # the whole drawing's path ticks once: count and pen-down count
   local rows pen
   rows=$(($(wc -l < "$work/record.csv") - 1))
@@ -104,17 +105,22 @@ check_record() {  # the whole drawing's path ticks once: count and pen-down coun
 }
 RANDOM=20261125
 for run in $(seq "$runs"); do
-  for presses in 1 2; do
+  for presses in 1 2 kill; do
     start_device 4 || exit 1
     delay=$(awk -v r=$RANDOM 'BEGIN { printf "%.2f", 3.0 * r / 32767 }')
     "$bin" stream "$drawing" -m "$machine" -t "$target" --journal "$work/j.json" > "$work/stream1.log" 2>&1 &
     stream_pid=$!
     wait_running
     sleep "$delay"
-    kill -INT "$stream_pid"
-    [ "$presses" -eq 2 ] && { sleep 0.001; kill -INT "$stream_pid" 2>/dev/null; }
+    if [ "$presses" = kill ]; then
+      kill -KILL "$stream_pid"  # the host dies: no hold, no journal update after this
+    else
+      kill -INT "$stream_pid"
+      [ "$presses" = 2 ] && { sleep 0.001; kill -INT "$stream_pid" 2>/dev/null; }
+    fi
     wait "$stream_pid"; rc=$?
     name="run $run, $presses Ctrl-C after $delay s"
+    [ "$presses" = kill ] && name="run $run, SIGKILL after $delay s"
     outcome=$(/usr/bin/python3 -c 'import json,sys; print(json.load(open(sys.argv[1]))["outcome"])' "$work/j.json")
     if [ $rc -eq 7 ]; then
       [[ "$(cat "$work/stream1.log")" == *"resume with   pathstream stream --resume $work/j.json"* ]] && ok ||
@@ -122,6 +128,11 @@ for run in $(seq "$runs"); do
       st=$("$bin" ctl "$target" status --json | /usr/bin/python3 -c 'import json,sys; d=json.load(sys.stdin); print(d["state"])')
       want=holding; [ "$outcome" = stopped ] && want=idle
       [ "$st" = "$want" ] && ok || fail "$name: device $st after the interrupt (journal: $outcome)"
+      "$bin" stream --resume "$work/j.json" > "$work/stream2.log" 2>&1; rc=$?
+      [ $rc -eq 0 ] && ok || fail "$name: resume exit $rc: $(cat "$work/stream2.log")"
+    elif [ $rc -eq 137 ]; then
+      # Killed: the device runs out its queue and holds (or ends the job); --resume waits
+      # for that, then streams the rest.
       "$bin" stream --resume "$work/j.json" > "$work/stream2.log" 2>&1; rc=$?
       [ $rc -eq 0 ] && ok || fail "$name: resume exit $rc: $(cat "$work/stream2.log")"
     elif [ $rc -eq 0 ]; then

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <thread>
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
@@ -324,17 +325,49 @@ int run_resume(StreamCommandOptions o, const EventChannel& channel) {
     l.attempts = o.stream.attempts;
     l.link_timeout_seconds = o.stream.link_timeout_seconds;
     DeviceSnapshot s;
+    const std::size_t spans = job.plan.spans.size();
+    const auto ours_now = [&] {
+        return journal.job != 0 && s.last_accepted >= journal.job && s.last_accepted - journal.job < spans &&
+               s.last_completed + 1 >= journal.job;
+    };
     {
         const std::unique_ptr<DeviceLink> link = open_device_link(o.stream.target, l);
         s = link->status();
+        // A host that died mid-stream leaves the device running out what it had queued: it
+        // then holds (underrun) or, with the whole job queued, ends it. Wait for either (at
+        // most the queue's length in time, bounded by the link timeout per quiet read).
+        if (s.state == static_cast<unsigned>(device::DeviceState::kRunning) && ours_now()) {
+            std::printf("resume        the device still runs job %u from its queue: waiting until it holds or ends\n",
+                        journal.job);
+            std::fflush(stdout);
+            const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(600);
+            while ((s.state == static_cast<unsigned>(device::DeviceState::kRunning) ||
+                    (s.state == static_cast<unsigned>(device::DeviceState::kHolding) && s.own_move())) &&
+                   std::chrono::steady_clock::now() < deadline) {
+                std::this_thread::sleep_for(std::chrono::milliseconds(20));
+                s = link->status();
+            }
+        }
     }
     if (s.axes != machine.axes.size()) {
         throw StreamError(o.stream.target + ": device has " + std::to_string(s.axes) + " axes, the profile " +
                           std::to_string(machine.axes.size()));
     }
-    const std::size_t spans = job.plan.spans.size();
-    const bool ours = journal.job != 0 && s.last_accepted >= journal.job && s.last_accepted - journal.job < spans &&
-                      s.last_completed + 1 >= journal.job;
+    const bool ours = ours_now();
+    if (s.state == static_cast<unsigned>(device::DeviceState::kIdle) && journal.job != 0 &&
+        s.finished_job == journal.job && s.epoch == journal.epoch &&
+        s.last_completed + 1 - journal.job == spans) {
+        // Everything was queued before the host died, and the device ran it to its end.
+        JobJournal done = journal;
+        done.outcome = "finished";
+        done.last_completed = s.last_completed;
+        done.state = device_state_name(s.state);
+        done.position.assign(s.position, s.position + machine.axes.size());
+        write_journal(done, o.resume);
+        std::printf("resume        the device ran job %u to its end after the host stopped; nothing to do\n",
+                    journal.job);
+        return 0;
+    }
     if (s.state == static_cast<unsigned>(device::DeviceState::kHolding) && ours && s.epoch == journal.epoch &&
         (s.flags & 1u) != 0) {
         std::printf("resume        the device holds job %u at span %u of %zu: streaming the rest, then resume\n",
