@@ -46,7 +46,7 @@ public:
             const std::string ptr = "/axes/" + std::to_string(i);
             const json& a = axes[i];
             if (!a.is_object()) fail(ptr, "axis must be an object with name, max_velocity, max_acceleration");
-            only_keys(a, ptr, {"name", "max_velocity", "max_acceleration"});
+            only_keys(a, ptr, {"name", "max_velocity", "max_acceleration", "travel"});
             for (const char* key : {"name", "max_velocity", "max_acceleration"}) {
                 if (!a.contains(key)) fail(ptr, std::string("axis has no \"") + key + "\"");
             }
@@ -59,6 +59,16 @@ public:
             limits.max_velocity = number(a["max_velocity"], ptr + "/max_velocity", "max_velocity", 0, 1e5, true, "mm/s");
             limits.max_acceleration =
                 number(a["max_acceleration"], ptr + "/max_acceleration", "max_acceleration", 0, 1e7, true, "mm/s^2");
+            if (a.contains("travel")) {
+                const json& t = a["travel"];
+                if (!t.is_array() || t.size() != 2) fail(ptr + "/travel", "travel must be [min, max] in mm");
+                limits.travel_min = number(t[0], ptr + "/travel/0", "travel min", -1e5, 1e5, false, "mm");
+                limits.travel_max = number(t[1], ptr + "/travel/1", "travel max", -1e5, 1e5, false, "mm");
+                if (limits.travel_max <= limits.travel_min) {
+                    fail(ptr + "/travel", "travel max must be above travel min");
+                }
+                limits.has_travel = true;
+            }
             p.axes.push_back(limits);
         }
         if (root.contains("mm_per_lsb")) p.mm_per_lsb = number(root["mm_per_lsb"], "/mm_per_lsb", "mm_per_lsb", 1e-6, 10, false, "mm");

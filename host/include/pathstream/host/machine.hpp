@@ -13,6 +13,10 @@ struct AxisLimits {
     std::string name;                  ///< "x", "y", ...
     double max_velocity = 0;           ///< mm/s, > 0
     double max_acceleration = 0;       ///< mm/s^2, > 0
+    /// The work area along this axis ("travel": [min, max] in mm, min < max): a job whose path
+    /// leaves it is refused, and the device checks every span against it. Absent: no limit.
+    bool has_travel = false;
+    double travel_min = 0, travel_max = 0;
 };
 
 /// One GPIO line of the profile's "gpio" object (docs/formats.md, docs/gpio.md).
