@@ -32,6 +32,19 @@ DeviceLimitsLsb device_limits(const MachineProfile& profile) {
         l.max_velocity.push_back(fit_u32(std::ceil(a.max_velocity / profile.mm_per_lsb), "axis " + a.name + " max_velocity"));
         l.max_acceleration.push_back(
             fit_u32(std::ceil(a.max_acceleration / profile.mm_per_lsb), "axis " + a.name + " max_acceleration"));
+        const double range = static_cast<double>(kMaxPositionLsb);
+        double low = -range, high = range;
+        if (a.has_travel) {
+            // Inward, with a nanometre of slack for a travel given in mm that is a whole LSB.
+            low = std::ceil(a.travel_min / profile.mm_per_lsb - 1e-9);
+            high = std::floor(a.travel_max / profile.mm_per_lsb + 1e-9);
+            if (low < -range || high > range || low >= high) {
+                throw std::range_error("axis " + a.name + " travel does not fit the device's position range (+-" +
+                                       std::to_string(kMaxPositionLsb) + " LSB)");
+            }
+        }
+        l.min_position.push_back(static_cast<std::int32_t>(low));
+        l.max_position.push_back(static_cast<std::int32_t>(high));
     }
     const std::uint64_t pen = delay_ticks(profile.pen_down_delay, profile.tick_hz);
     if (pen > 65535)

@@ -99,7 +99,18 @@ TEST_CASE("configuration, commands and batches through registers", "[device][mod
     std::vector<std::uint16_t> back(config.size());
     REQUIRE(m.read_holding_registers(modbus::kConfig, static_cast<std::uint16_t>(back.size()), back.data()) ==
             Ex::kNone);
-    CHECK(back == config);
+    // Travel written as zeros (no soft limits) reads back as the whole position range.
+    auto expected = config;
+    for (unsigned a = 0; a < kAxes; ++a) {
+        const std::uint16_t t = modbus::config_travel_register(kAxes, a);
+        const auto low = static_cast<std::uint32_t>(-kMaxPositionLsb);
+        const auto high = static_cast<std::uint32_t>(kMaxPositionLsb);
+        expected[t] = static_cast<std::uint16_t>(low >> 16);
+        expected[t + 1] = static_cast<std::uint16_t>(low & 0xFFFFu);
+        expected[t + 2] = static_cast<std::uint16_t>(high >> 16);
+        expected[t + 3] = static_cast<std::uint16_t>(high & 0xFFFFu);
+    }
+    CHECK(back == expected);
 
     auto corrupt = batch;
     corrupt[7] ^= 0x0100;  // one payload bit: the check value no longer matches

@@ -30,6 +30,7 @@ enum class [[nodiscard]] Status : std::uint8_t{
     kJobEndMoving = 19,           ///< the last span of a job must end at rest (end tangents 0)
     kUnknownCommand = 20,         ///< a command value the device does not know
     kNoHoming = 21,               ///< home: no homing switch for a requested axis
+    kOutsideTravel = 22,          ///< the span could leave an axis's travel (its soft limits)
 };
 
 /// Short stable name of a status, for logs and host messages. Never null.
@@ -62,6 +63,8 @@ constexpr const char* status_name(Status s) {
             return "unknown command";
         case Status::kNoHoming:
             return "no homing switch for that axis";
+        case Status::kOutsideTravel:
+            return "span leaves an axis's travel (soft limits)";
     }
     return "unknown status";
 }

@@ -59,6 +59,27 @@ Status check_axis_limits(const TickCubic& cubic, const SpanTiming& timing, const
     return Status::kOk;
 }
 
+Status check_axis_travel(const TickCubic& cubic, const SpanTiming& timing,
+                         const AxisLimits& limits) {
+    // p(u) = (a u^3 + b u^2 + c u + d) / s: its Bernstein coefficients times 3s are 3d,
+    // 3d + c, 3d + 2c + b and 3(a + b + c + d); each against 3s min and 3s max. The
+    // coefficients are below 2^40 and s below 2^20, so every product fits 128 bits.
+    const std::uint64_t n = timing.ticks;
+    const std::int64_t scale = static_cast<std::int64_t>(timing.denominator / (n * n * n));
+    const Int128 d3 = Int128::from(cubic.d) * 3;
+    const Int128 c = Int128::from(cubic.c);
+    const Int128 hull[4] = {d3, d3 + c, d3 + c * 2 + Int128::from(cubic.b),
+                            (Int128::from(cubic.a) + Int128::from(cubic.b) + c +
+                             Int128::from(cubic.d)) *
+                                3};
+    const Int128 low = Int128::from(limits.min_position) * (3 * scale);
+    const Int128 high = Int128::from(limits.max_position) * (3 * scale);
+    for (const Int128& h : hull) {
+        if (h < low || h > high) return Status::kOutsideTravel;
+    }
+    return Status::kOk;
+}
+
 Status check_join(std::int32_t start_tangent, std::uint32_t ticks,
                   std::int32_t previous_end_tangent, std::uint32_t previous_ticks,
                   const AxisLimits& limits, std::uint32_t tick_hz) {

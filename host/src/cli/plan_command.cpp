@@ -11,6 +11,7 @@
 #include "pathstream/host/input_error.hpp"
 #include "pathstream/host/planner.hpp"
 #include "pathstream/host/progress.hpp"
+#include "pathstream/host/work_area.hpp"
 
 namespace pathstream::host {
 
@@ -35,6 +36,7 @@ PlannedJob plan_job(const PathOptions& path_options, const std::string& machine_
                                                std::to_string(job.path.axes));
     }
     job.segments = to_bezier_segments(job.path);
+    check_work_area(job.segments, job.path, job.machine, path_options.file);
     if (lead_in_from != nullptr) prepend_lead_in(job.segments, *lead_in_from);
     const auto t0 = std::chrono::steady_clock::now();
     {
@@ -43,6 +45,7 @@ PlannedJob plan_job(const PathOptions& path_options, const std::string& machine_
     }
     job.planning_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     job.check = check_plan(job.plan, job.segments, job.machine);
+    check_plan_travel(job.plan, job.path, job.machine, path_options.file);
     return job;
 }
 

@@ -195,6 +195,10 @@ private:
                                                l.max_velocity[a]));
             frames.push_back(pc::encode_config(node_, pc::config_item_acceleration(a),
                                                static_cast<std::uint8_t>(axes_), l.max_acceleration[a]));
+            frames.push_back(pc::encode_config(node_, pc::config_item_min_position(a), static_cast<std::uint8_t>(axes_),
+                                               static_cast<std::uint32_t>(l.min_position[a])));
+            frames.push_back(pc::encode_config(node_, pc::config_item_max_position(a), static_cast<std::uint8_t>(axes_),
+                                               static_cast<std::uint32_t>(l.max_position[a])));
         }
         frames.push_back(pc::encode_config(node_, pc::kConfigItemPenDown,
                                            static_cast<std::uint8_t>(axes_), l.pen_down_ticks));

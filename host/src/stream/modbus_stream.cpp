@@ -230,6 +230,13 @@ private:
             r[mb::kConfigAxisBase + 4 * a + 1] = static_cast<std::uint16_t>(vv & 0xFFFFu);
             r[mb::kConfigAxisBase + 4 * a + 2] = static_cast<std::uint16_t>(aa >> 16);
             r[mb::kConfigAxisBase + 4 * a + 3] = static_cast<std::uint16_t>(aa & 0xFFFFu);
+            const std::uint16_t t = mb::config_travel_register(axes_, a);
+            const auto lo = static_cast<std::uint32_t>(l.min_position[a]);
+            const auto hi = static_cast<std::uint32_t>(l.max_position[a]);
+            r[t] = static_cast<std::uint16_t>(lo >> 16);
+            r[t + 1] = static_cast<std::uint16_t>(lo & 0xFFFFu);
+            r[t + 2] = static_cast<std::uint16_t>(hi >> 16);
+            r[t + 3] = static_cast<std::uint16_t>(hi & 0xFFFFu);
         }
         try {
             link_.transact([&] { link_.client().write_registers(mb::kConfig, r); });

@@ -154,24 +154,34 @@ private:
         const std::uint8_t axes = static_cast<std::uint8_t>(get(f, kConfigSignals[1]));
         const std::uint32_t value = get(f, kConfigSignals[2]);
         if (axes != Axes) return ack(kAckConfig, static_cast<std::uint8_t>(Status::kBadLimits), item, send);
-        if (item > 2 * Axes && item != kConfigItemPenDown) {
+        const bool travel_item = item >= config_item_min_position(0) && item < config_item_min_position(Axes);
+        if (item > 2 * Axes && item != kConfigItemPenDown && !travel_item) {
             return ack(kAckConfig, kResultBadFrame, item, send);
         }
         if (item == 0) {
             config_seen_ = 0;
+            pending_ = MotionLimits<Axes>{};  // travel items are optional: the whole range
             pending_.tick_hz = value;
         } else if (item == kConfigItemPenDown) {
             pending_.pen_down_ticks = value;
+        } else if (travel_item) {
+            const unsigned axis = (item - config_item_min_position(0)) / 2u;
+            if ((item - config_item_min_position(0)) % 2u == 0) {
+                pending_.axis[axis].min_position = static_cast<std::int32_t>(value);
+            } else {
+                pending_.axis[axis].max_position = static_cast<std::int32_t>(value);
+            }
         } else if (item % 2 == 1) {
             pending_.axis[(item - 1) / 2].max_velocity = value;
         } else {
             pending_.axis[(item - 2) / 2].max_acceleration = value;
         }
-        config_seen_ |= 1u << item;
+        config_seen_ |= std::uint64_t{1} << item;
         // Items before the last (the pen-down delay) are not acknowledged: one ack per set.
         if (item != kConfigItemPenDown) return;
-        const std::uint32_t all = ((1u << (2 * Axes + 1)) - 1u) | (1u << kConfigItemPenDown);
-        const std::uint8_t result = config_seen_ == all
+        const std::uint64_t all = ((std::uint64_t{1} << (2 * Axes + 1)) - 1u) |
+                                  (std::uint64_t{1} << kConfigItemPenDown);
+        const std::uint8_t result = (config_seen_ & all) == all
                                         ? static_cast<std::uint8_t>(device_.configure(pending_))
                                         : kResultIncomplete;
         config_seen_ = 0;
@@ -218,7 +228,7 @@ private:
     std::uint8_t node_;
     OperatorCommands<Axes, Capacity> operator_;
     MotionLimits<Axes> pending_{};
-    std::uint32_t config_seen_ = 0;  // bit per configuration item received since item 0
+    std::uint64_t config_seen_ = 0;  // bit per configuration item received since item 0
     SpanStart transfer_{};
     bool active_ = false;
     std::size_t received_ = 0;

@@ -80,11 +80,15 @@ inline constexpr std::uint8_t kFlagHoming = 1u << 4;
 inline constexpr std::uint8_t kFlagPenDown = 1u << 5;
 
 /// Configuration items: 0 tick rate, 1 + 2a axis a's max velocity, 2 + 2a its acceleration,
-/// kConfigItemPenDown the pen-down delay in ticks. The pen-down delay is sent last: the device
-/// applies the set when it arrives after all the others (item 0 starts a set).
+/// 18 + 2a its travel min, 19 + 2a its travel max (LSB, signed; optional: without them the
+/// whole position range), kConfigItemPenDown the
+/// pen-down delay in ticks. The pen-down delay is sent last: the device applies the set when
+/// it arrives after all the others (item 0 starts a set).
 inline constexpr std::uint8_t kConfigItemPenDown = 17;
 constexpr std::uint8_t config_item_velocity(unsigned axis) { return static_cast<std::uint8_t>(1 + 2 * axis); }
 constexpr std::uint8_t config_item_acceleration(unsigned axis) { return static_cast<std::uint8_t>(2 + 2 * axis); }
+constexpr std::uint8_t config_item_min_position(unsigned axis) { return static_cast<std::uint8_t>(18 + 2 * axis); }
+constexpr std::uint8_t config_item_max_position(unsigned axis) { return static_cast<std::uint8_t>(19 + 2 * axis); }
 
 /// A frame as the protocol sees it (the HAL's CanFrame without the flags it never uses).
 struct Frame {
@@ -196,7 +200,8 @@ inline constexpr Signal kStatusESignals[] = {
 };
 inline constexpr Signal kConfigSignals[] = {
     {"Item", 0, 1, false, "",
-     "0 tick rate, 1+2a axis a max velocity, 2+2a axis a max acceleration, 17 pen-down delay (last)",
+     "0 tick rate, 1+2a axis a max velocity, 2+2a axis a max acceleration, 18+2a / 19+2a axis a travel min / max, "
+     "17 pen-down delay (last)",
      -2},
     {"Axes", 1, 1, false, "", "axis count (must match the device)"},
     {"TickRate", 2, 4, false, "Hz", "device tick rate", 0},
@@ -218,6 +223,22 @@ inline constexpr Signal kConfigSignals[] = {
     {"MaxAcceleration7", 2, 4, false, "LSB/s^2", "axis 7", 16},
     {"PenDownDelay", 2, 4, false, "tick", "pen-down delay, 0..65535; the last item of a set",
      kConfigItemPenDown},
+    {"MinPosition0", 2, 4, true, "LSB", "axis 0 travel min", 18},
+    {"MaxPosition0", 2, 4, true, "LSB", "axis 0 travel max", 19},
+    {"MinPosition1", 2, 4, true, "LSB", "axis 1 travel min", 20},
+    {"MaxPosition1", 2, 4, true, "LSB", "axis 1 travel max", 21},
+    {"MinPosition2", 2, 4, true, "LSB", "axis 2 travel min", 22},
+    {"MaxPosition2", 2, 4, true, "LSB", "axis 2 travel max", 23},
+    {"MinPosition3", 2, 4, true, "LSB", "axis 3 travel min", 24},
+    {"MaxPosition3", 2, 4, true, "LSB", "axis 3 travel max", 25},
+    {"MinPosition4", 2, 4, true, "LSB", "axis 4 travel min", 26},
+    {"MaxPosition4", 2, 4, true, "LSB", "axis 4 travel max", 27},
+    {"MinPosition5", 2, 4, true, "LSB", "axis 5 travel min", 28},
+    {"MaxPosition5", 2, 4, true, "LSB", "axis 5 travel max", 29},
+    {"MinPosition6", 2, 4, true, "LSB", "axis 6 travel min", 30},
+    {"MaxPosition6", 2, 4, true, "LSB", "axis 6 travel max", 31},
+    {"MinPosition7", 2, 4, true, "LSB", "axis 7 travel min", 32},
+    {"MaxPosition7", 2, 4, true, "LSB", "axis 7 travel max", 33},
 };
 inline constexpr Signal kCommandArgsSignals[] = {
     {"Command", 0, 1, false, "", "6 jog, 7 set position, 8 home, 9 pen", -1, kCommandArgsValues},
@@ -247,8 +268,8 @@ inline constexpr Message kMessages[] = {
     {"StatusB", kStatusBBase, 8, true, "device -> host: span sequence numbers", kStatusBSignals, 2},
     {"StatusC", kStatusCBase, 8, true, "device -> host: progress and identity", kStatusCSignals, 4},
     {"Config", kConfigBase, 6, false,
-     "host -> device: tick rate, per-axis limits and pen-down delay, one item per frame",
-     kConfigSignals, 20},
+     "host -> device: tick rate, per-axis limits and travel, and pen-down delay, one item per frame",
+     kConfigSignals, 36},
     {"SpanStart", kSpanStartBase, 8, false, "host -> device: starts a span batch transfer",
      kSpanStartSignals, 4},
     {"SpanData", kSpanDataBase, 8, false, "host -> device: 7 bytes of the batch's wire spans",

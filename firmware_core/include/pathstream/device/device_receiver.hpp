@@ -50,6 +50,12 @@ public:
     bool configured() const { return configured_; }
     const MotionLimits<Axes>& limits() const { return limits_; }
 
+    /// Whether accept_batch refuses spans that could leave an axis's travel (on by default).
+    /// Homing turns it off while it searches for a switch the soft limits know nothing of
+    /// (the coordinates are not yet defined); it turns it on again when it ends.
+    void enforce_travel(bool on) { enforce_travel_ = on; }
+    bool travel_enforced() const { return enforce_travel_; }
+
     /// Accepts a batch of `count` wire spans (payload[0..length)) whose first span has sequence
     /// number `first_sequence`. All or nothing: every span is decoded, validated by the core,
     /// checked against the limits, for continuity of position and velocity at every join
@@ -316,6 +322,12 @@ private:
                 st != Status::kOk) {
                 return st;
             }
+            if (enforce_travel_) {
+                if (Status st = check_axis_travel(v.cubic[a], v.timing, limits_.axis[a]);
+                    st != Status::kOk) {
+                    return st;
+                }
+            }
         }
         for (unsigned a = 0; a < Axes; ++a) {
             if (Status st = check_join(w.start_tangent[a], w.ticks, chain.tangent[a], chain.ticks,
@@ -335,6 +347,7 @@ private:
     DeviceChannel<Axes, Capacity>& channel_;
     MotionLimits<Axes> limits_;
     bool configured_ = false;
+    bool enforce_travel_ = true;
     std::uint32_t next_sequence_ = 1;
     std::uint32_t accepted_spans_ = 0;
     std::uint32_t duplicates_ = 0;

@@ -236,11 +236,20 @@ public:
         // The first move is chosen by the first poll, which knows the switch: a machine
         // already standing on it backs off first.
         phase_ = HomingPhase::kStarting;
+        // The switch lies wherever it lies: the soft limits hold again once homing ends.
+        device_.enforce_travel(false);
         return Status::kOk;
     }
 
     /// Advances the sequence; `switch_active` is the homing switch's level now. Task context.
     void poll(bool switch_active) {
+        advance(switch_active);
+        if (!busy()) device_.enforce_travel(true);
+    }
+
+private:
+    // One step of the sequence (poll's body).
+    void advance(bool switch_active) {
         const DeviceState s = device_.state();
         if (phase_ == HomingPhase::kIdle || phase_ == HomingPhase::kDone || phase_ == HomingPhase::kError) return;
         if (s == DeviceState::kFault || s == DeviceState::kEstop) {
@@ -345,6 +354,7 @@ public:
         }
     }
 
+public:
     HomingPhase phase() const { return phase_; }
     HomingError error() const { return error_; }
     /// The device's Status behind kDeviceRefused (or kOk).

@@ -49,6 +49,13 @@ public:
         for (unsigned a = 0; a < Axes; ++a) from[a] = device_.position(a);
         const std::int64_t end = static_cast<std::int64_t>(from[axis]) + distance;
         if (end > kMaxPositionLsb || end < -kMaxPositionLsb) return Status::kControlValueOutOfRange;
+        // The travel (soft limits): the jog must end inside it. One that starts outside (after
+        // a set position, or homing's pull-off past a limit) may come back in: its spans are
+        // then let through without the travel check, since they start outside by definition.
+        const AxisLimits& travel = device_.limits().axis[axis];
+        if (end < travel.min_position || end > travel.max_position) return Status::kOutsideTravel;
+        const bool from_outside =
+            from[axis] < travel.min_position || from[axis] > travel.max_position;
         const std::uint64_t max_velocity = device_.limits().axis[axis].max_velocity;
         const std::uint16_t per_mille = feed == 0 ? kJogFeedFull : feed;
         std::uint64_t velocity = max_velocity * per_mille / kJogFeedFull;
@@ -62,8 +69,10 @@ public:
         epoch_ = device_.epoch();
         job_ = device_.last_accepted_sequence() + 1u;
         active_ = true;
+        travel_off_ = from_outside;
+        if (travel_off_) device_.enforce_travel(false);
         if (Status s = feed_spans(); s != Status::kOk) {
-            active_ = false;
+            end_jog();
             return s;
         }
         return device_.start_keeping_pen();
@@ -76,10 +85,10 @@ public:
         const DeviceState state = device_.state();
         if (device_.epoch() != epoch_ || state == DeviceState::kStopping ||
             state == DeviceState::kFault || state == DeviceState::kEstop) {
-            active_ = false;
+            end_jog();
             return;
         }
-        if (feed_spans() != Status::kOk) active_ = false;
+        if (feed_spans() != Status::kOk) end_jog();
     }
 
     /// Spans of the jog still to be queued.
@@ -89,6 +98,13 @@ public:
 
 private:
     static constexpr unsigned kFeedSpans = 8;  // spans per accept_batch: a small stack buffer
+
+    // The jog is fed no more; the travel check holds again.
+    void end_jog() {
+        active_ = false;
+        if (travel_off_) device_.enforce_travel(true);
+        travel_off_ = false;
+    }
 
     Status feed_spans() {
         while (move_.pending()) {
@@ -111,7 +127,7 @@ private:
                 return s;
             }
         }
-        active_ = false;
+        end_jog();
         return Status::kOk;
     }
 
@@ -120,6 +136,7 @@ private:
     std::uint32_t epoch_ = 0;
     std::uint32_t job_ = 0;
     std::uint8_t pen_ = 0;  // the operator's pen when the jog started: every span carries it
+    bool travel_off_ = false;  // this jog started outside the travel and turned its check off
     bool active_ = false;
 };
 

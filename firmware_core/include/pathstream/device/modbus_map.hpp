@@ -72,13 +72,19 @@ inline constexpr std::uint16_t kCommandWithArguments = 5;
 /// Configuration block (holding), written whole in one FC16 at kConfig:
 ///   +0..1 tick rate (Hz, u32), +2 axes (must equal the device's), +3 pen-down delay (ticks,
 ///   the re-entry's pen lead), +4..9 reserved (0),
-///   +10 + 4a .. : axis a max velocity (LSB/s, u32), max acceleration (LSB/s^2, u32).
+///   +10 + 4a .. : axis a max velocity (LSB/s, u32), max acceleration (LSB/s^2, u32),
+///   +10 + 4 axes + 4a .. : axis a travel (soft limits): min position, max position (LSB, i32;
+///   0 and 0: no limits, the whole position range).
 /// Accepted only idle with nothing queued; read back with FC3.
 inline constexpr std::uint16_t kConfig = 110;
 inline constexpr std::uint16_t kConfigPenDownTicks = 3;
 inline constexpr std::uint16_t kConfigAxisBase = 10;
 constexpr std::uint16_t config_registers(unsigned axes) {
-    return static_cast<std::uint16_t>(kConfigAxisBase + 4 * axes);
+    return static_cast<std::uint16_t>(kConfigAxisBase + 8 * axes);
+}
+/// First register of axis `axis`'s travel (min, then max) in a device of `axes` axes.
+constexpr std::uint16_t config_travel_register(unsigned axes, unsigned axis) {
+    return static_cast<std::uint16_t>(kConfigAxisBase + 4 * axes + 4 * axis);
 }
 
 /// Span window (holding): one FC16 (or the write half of an FC23) at kSpanWindow carries

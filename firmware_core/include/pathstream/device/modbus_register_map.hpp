@@ -166,6 +166,9 @@ private:
         for (unsigned a = 0; a < Axes; ++a) {
             put_u32(&b[modbus::kConfigAxisBase + 4 * a], l.axis[a].max_velocity);
             put_u32(&b[modbus::kConfigAxisBase + 4 * a + 2], l.axis[a].max_acceleration);
+            const std::uint16_t t = modbus::config_travel_register(Axes, a);
+            put_u32(&b[t], static_cast<std::uint32_t>(l.axis[a].min_position));
+            put_u32(&b[t + 2], static_cast<std::uint32_t>(l.axis[a].max_position));
         }
     }
 
@@ -197,6 +200,12 @@ private:
         for (unsigned a = 0; a < Axes; ++a) {
             l.axis[a].max_velocity = u32(&v[modbus::kConfigAxisBase + 4 * a]);
             l.axis[a].max_acceleration = u32(&v[modbus::kConfigAxisBase + 4 * a + 2]);
+            const std::uint16_t t = modbus::config_travel_register(Axes, a);
+            // 0, 0: no travel limits (a host that does not set them writes zeros).
+            if (u32(&v[t]) != 0 || u32(&v[t + 2]) != 0) {
+                l.axis[a].min_position = static_cast<std::int32_t>(u32(&v[t]));
+                l.axis[a].max_position = static_cast<std::int32_t>(u32(&v[t + 2]));
+            }
         }
         return device_.configure(l);
     }

@@ -43,6 +43,8 @@ public:
         return receiver_.configure(limits);
     }
     bool configured() const { return receiver_.configured(); }
+    /// DeviceReceiver::enforce_travel (homing turns the soft limits off while it runs). Task.
+    void enforce_travel(bool on) { receiver_.enforce_travel(on); }
     const MotionLimits<Axes>& limits() const { return receiver_.limits(); }
     /// DeviceReceiver::accept_batch. Task context.
     template <typename Between = NoInterleave>

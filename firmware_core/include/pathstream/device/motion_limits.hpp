@@ -16,10 +16,13 @@ namespace pathstream::device {
 /// Highest tick rate the limit arithmetic is proven for (and a sane device accepts).
 inline constexpr std::uint32_t kMaxTickHz = 100000;
 
-/// Limits of one axis in LSB per second and LSB per second squared (both >= 1).
+/// Limits of one axis in LSB per second and LSB per second squared (both >= 1), and its
+/// travel (the work area's soft limits, LSB; the default is the whole position range).
 struct AxisLimits {
     std::uint32_t max_velocity = 0;      ///< LSB/s
     std::uint32_t max_acceleration = 0;  ///< LSB/s^2
+    std::int32_t min_position = -static_cast<std::int32_t>(kMaxPositionLsb);
+    std::int32_t max_position = static_cast<std::int32_t>(kMaxPositionLsb);
 };
 
 /// The device's motion configuration: tick rate, each axis's limits, and the pen-down delay
@@ -44,7 +47,10 @@ template <unsigned Axes>
     if (limits.tick_hz < 1 || limits.tick_hz > kMaxTickHz) return Status::kBadLimits;
     if (limits.pen_down_ticks > kMaxPenDownTicks) return Status::kBadLimits;
     for (unsigned a = 0; a < Axes; ++a) {
-        if (limits.axis[a].max_velocity < 1 || limits.axis[a].max_acceleration < 1) {
+        const AxisLimits& l = limits.axis[a];
+        if (l.max_velocity < 1 || l.max_acceleration < 1) return Status::kBadLimits;
+        if (l.min_position >= l.max_position || l.min_position < -kMaxPositionLsb ||
+            l.max_position > kMaxPositionLsb) {
             return Status::kBadLimits;
         }
     }
@@ -59,6 +65,14 @@ template <unsigned Axes>
 /// Task context.
 [[nodiscard]] Status check_axis_limits(const TickCubic& cubic, const SpanTiming& timing,
                                        const AxisLimits& limits, std::uint32_t tick_hz);
+
+/// Checks that one axis's exact cubic stays within its travel [min_position, max_position]
+/// for u in [0, 1], by proof: its four Bernstein (Bezier) coefficients lie within it, and the
+/// curve lies within their hull. Exact integer arithmetic, no tolerance; conservative only
+/// where a control value pokes out while the curve turns back inside (a span grazing the
+/// edge). Returns kOk or kOutsideTravel. Cost: a few 128-bit products. Task context.
+[[nodiscard]] Status check_axis_travel(const TickCubic& cubic, const SpanTiming& timing,
+                                       const AxisLimits& limits);
 
 /// Checks one axis at the join of two Hermite spans: a span of `ticks` ticks starting with
 /// tangent `start_tangent` may follow one of `previous_ticks` ticks that ended with tangent

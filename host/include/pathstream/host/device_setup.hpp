@@ -21,12 +21,17 @@ struct DeviceLimitsLsb {
     std::vector<std::uint32_t> max_velocity;
     std::vector<std::uint32_t> max_acceleration;
     std::uint32_t pen_down_ticks = 0;
+    /// Per axis, the travel (soft limits) in LSB: the profile's "travel" rounded inward, or
+    /// the whole position range (+-2^27) without one.
+    std::vector<std::int32_t> min_position;
+    std::vector<std::int32_t> max_position;
 };
 
 /// The profile's limits rounded up to whole LSB (the planner works to the profile's limits
-/// exactly, so the device must allow them), and its pen_down_delay in ticks as the planner
-/// counts it (delay_ticks). Throws std::range_error naming the axis when a limit does not fit
-/// 32 bits, or when the pen-down delay exceeds 65535 ticks.
+/// exactly, so the device must allow them), its pen_down_delay in ticks as the planner
+/// counts it (delay_ticks), and each axis's travel rounded inward to whole LSB. Throws
+/// std::range_error naming the axis when a limit does not fit 32 bits, a travel leaves the
+/// position range (+-2^27 LSB), or the pen-down delay exceeds 65535 ticks.
 DeviceLimitsLsb device_limits(const MachineProfile& profile);
 
 /// Index of the axis called `name` in the profile. Throws std::invalid_argument if none.

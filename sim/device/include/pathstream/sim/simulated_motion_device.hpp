@@ -106,7 +106,14 @@ public:
         if (l.max_velocity.size() != Axes || l.max_acceleration.size() != Axes) return Status::kBadLimits;
         device::MotionLimits<Axes> m;
         m.tick_hz = l.tick_hz;
-        for (unsigned a = 0; a < Axes; ++a) m.axis[a] = {l.max_velocity[a], l.max_acceleration[a]};
+        for (unsigned a = 0; a < Axes; ++a) {
+            m.axis[a].max_velocity = l.max_velocity[a];
+            m.axis[a].max_acceleration = l.max_acceleration[a];
+            if (l.min_position.size() == Axes && l.max_position.size() == Axes) {
+                m.axis[a].min_position = l.min_position[a];
+                m.axis[a].max_position = l.max_position[a];
+            }
+        }
         m.pen_down_ticks = l.pen_down_ticks;
         return device_.configure(m);
     }
