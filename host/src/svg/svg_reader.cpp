@@ -61,8 +61,18 @@ struct State {
 class Reader {
 public:
     Reader(const std::string& text, const std::string& file, double tolerance_mm)
-        : text_(text), file_(file), tolerance_mm_(tolerance_mm) {}
+        : text_(text), file_(file), tolerance_mm_(tolerance_mm), locator_(text) {}
 
+    Path read(svg::SvgReadInfo* info) {
+        Path path = read();
+        if (info) {
+            info->location_bytes_scanned = locator_.bytes_scanned();
+            info->locations = locator_.lookups();
+        }
+        return path;
+    }
+
+private:
     Path read() {
         const pugi::xml_parse_result result =
             doc_.load_buffer(text_.data(), text_.size(), pugi::parse_default, pugi::encoding_utf8);
@@ -85,24 +95,10 @@ public:
         return std::move(path_);
     }
 
-private:
     // ---- places ----------------------------------------------------------------------------
 
     // Line and column (1-based, columns in characters of UTF-8) of a byte offset.
-    SourceLocation locate(std::size_t offset) const {
-        SourceLocation at{1, 1};
-        std::size_t i = text_.compare(0, 3, "\xEF\xBB\xBF") == 0 ? 3 : 0;  // a byte order mark
-        for (; i < offset && i < text_.size(); ++i) {
-            const auto c = static_cast<unsigned char>(text_[i]);
-            if (c == '\n') {
-                ++at.line;
-                at.column = 1;
-            } else if ((c & 0xC0) != 0x80) {
-                ++at.column;
-            }
-        }
-        return at;
-    }
+    SourceLocation locate(std::size_t offset) const { return locator_.locate(offset); }
 
     // Byte offset of an element's '<' (pugixml gives the offset of its name).
     std::size_t element_offset(pugi::xml_node n) const {
@@ -526,6 +522,7 @@ private:
     const std::string& text_;
     const std::string& file_;
     double tolerance_mm_;
+    mutable svg::TextLocator locator_;  // lookups only count their cost
     pugi::xml_document doc_;
     Path path_;
     std::unordered_map<std::string, pugi::xml_node> ids_;
@@ -536,13 +533,14 @@ private:
 
 }  // namespace
 
-Path parse_svg_path(const std::string& text, const std::string& file, double tolerance_mm) {
+Path parse_svg_path(const std::string& text, const std::string& file, double tolerance_mm,
+                    svg::SvgReadInfo* info) {
     if (!(tolerance_mm > 0) || !std::isfinite(tolerance_mm)) {
         throw InputError(
             file, {},
             "tolerance must be positive and finite (got " + number_text(tolerance_mm) + " mm)");
     }
-    return Reader(text, file, tolerance_mm).read();
+    return Reader(text, file, tolerance_mm).read(info);
 }
 
 Path load_svg_path(const std::string& file, double tolerance_mm) {

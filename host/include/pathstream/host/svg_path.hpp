@@ -14,6 +14,10 @@
 
 namespace pathstream::host {
 
+namespace svg {
+struct SvgReadInfo;
+}
+
 /// Parses an SVG document. `file` names the source in error messages.
 /// Returns a Path with axes = 2 whose subpaths are open Bezier chains (P0 C C P1 C C P2 ...,
 /// 3k + 1 points, basis kBezier, closed = false, feed 0), one per SVG subpath or shape, in
@@ -28,7 +32,9 @@ namespace pathstream::host {
 /// numbers, negative sizes, coordinates beyond 1e6 mm, and a document without drawable
 /// geometry ("no drawable paths"). `tolerance_mm` must be positive and finite (else InputError
 /// without a location).
-Path parse_svg_path(const std::string& text, const std::string& file, double tolerance_mm = 0.01);
+/// When `info` is given, it receives what the read found and cost beyond the path.
+Path parse_svg_path(const std::string& text, const std::string& file, double tolerance_mm = 0.01,
+                    svg::SvgReadInfo* info = nullptr);
 
 /// Reads and parses an SVG file as parse_svg_path does. Throws InputError, also when the file
 /// cannot be opened or read.
@@ -37,6 +43,44 @@ Path load_svg_path(const std::string& file, double tolerance_mm = 0.01);
 /// Building blocks of the SVG reader, exposed for its tests. Coordinates are in SVG user units
 /// unless a name says mm.
 namespace svg {
+
+/// What one read found beside the geometry, and what it cost (tests and benches check that
+/// reading stays linear in the document's size).
+struct SvgReadInfo {
+    /// The computed CSS `stroke` of each subpath's element, parallel to Path::subpaths
+    /// (lower-cased as written, "none" when unset), for a later split by colour.
+    std::vector<std::string> strokes;
+    /// Bytes the line:column lookups scanned, building the index excluded.
+    std::size_t location_bytes_scanned = 0;
+    /// Line:column lookups made.
+    std::size_t locations = 0;
+    /// Rules read from <style> elements (one per selector of a selector list).
+    std::size_t style_rules = 0;
+};
+
+/// Line and column (1-based; columns count UTF-8 characters; a leading byte order mark does
+/// not count) of byte offsets in one text. One pass at construction records the place of every
+/// kStride-th byte, so each lookup scans fewer than kStride bytes whatever the text's size.
+class TextLocator {
+public:
+    static constexpr std::size_t kStride = 256;
+
+    /// Indexes `text`, which must outlive the locator.
+    explicit TextLocator(std::string_view text);
+    /// The place of byte `offset` (clamped to the text's end).
+    SourceLocation locate(std::size_t offset);
+    /// Bytes scanned by locate() so far.
+    std::size_t bytes_scanned() const { return scanned_; }
+    /// Calls of locate() so far.
+    std::size_t lookups() const { return lookups_; }
+
+private:
+    std::string_view text_;
+    std::size_t begin_ = 0;                   // after the byte order mark
+    std::vector<SourceLocation> checkpoints_;  // place of byte k * kStride
+    std::size_t scanned_ = 0;
+    std::size_t lookups_ = 0;
+};
 
 /// A point in the plane.
 struct Point {
