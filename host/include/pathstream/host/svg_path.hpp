@@ -4,9 +4,11 @@
 
 #include <array>
 #include <cstddef>
+#include <cstdint>
 #include <stdexcept>
 #include <string>
 #include <string_view>
+#include <unordered_map>
 #include <utility>
 #include <vector>
 
@@ -168,11 +170,80 @@ private:
 /// prefixed with `what`.
 std::vector<double> parse_number_list(std::string_view text, const std::string& what);
 
+/// One CSS declaration `name: value` and where it is in the text it was parsed from.
+struct CssDeclaration {
+    std::string name;   // lower-cased
+    std::string value;  // trimmed, without "!important", as written
+    bool important = false;
+    std::size_t name_offset = 0;   // byte offset of the name
+    std::size_t value_offset = 0;  // byte offset of the value's first character
+};
+
+/// Malformed CSS that error recovery cannot skip (an unclosed comment or block, too many
+/// rules): the message and the byte offset of the problem in the text parsed.
+class CssError : public std::runtime_error {
+public:
+    CssError(const std::string& what, std::size_t at) : std::runtime_error(what), offset(at) {}
+    std::size_t offset;
+};
+
+/// Parses a declaration list (a style attribute, a rule's block); `base` is added to the
+/// offsets. As CSS error recovery says, a declaration without ':' or a name is dropped, and
+/// comments count as whitespace. Throws CssError on an unclosed comment.
+std::vector<CssDeclaration> parse_css_declarations(std::string_view text, std::size_t base = 0);
+
+/// The rules of a document's <style> elements, for the properties the reader uses (display,
+/// visibility, stroke, transform, transform-origin). A selector is a compound of an optional
+/// type (or *) and any number of .class and #id; selector lists are split into one rule per
+/// selector. Other selectors (combinators, attributes, pseudo-classes, escapes) never match;
+/// at-rules (@media, @import, ...) are skipped with their blocks.
+class StyleSheet {
+public:
+    /// Rules per document, counting every selector of a list: more are refused.
+    static constexpr std::size_t kMaxRules = 10000;
+
+    /// Adds the rules of one style sheet text whose first byte is at `base` in the document.
+    /// Throws CssError on an unclosed comment or block, a '}' without a rule, or more than
+    /// kMaxRules rules in all.
+    void add(std::string_view css, std::size_t base = 0);
+    /// Declarations of the rules that match an element of this type, id and class attribute,
+    /// in cascade order: ascending specificity (id > class > type), then document order.
+    std::vector<const CssDeclaration*> match(std::string_view type, std::string_view id,
+                                             std::string_view classes) const;
+    /// Rules read, including those whose selectors never match.
+    std::size_t rules() const { return count_; }
+    /// True when no rule can match anything.
+    bool empty() const { return rules_.empty(); }
+
+private:
+    struct Rule {
+        std::string type;  // "" for any
+        std::string id;
+        std::vector<std::string> classes;
+        std::uint32_t specificity = 0;
+        std::size_t block = 0;  // index into blocks_
+    };
+    void add_rule(std::string_view selector, std::size_t block);
+
+    std::vector<std::vector<CssDeclaration>> blocks_;
+    std::vector<Rule> rules_;  // in document order
+    std::size_t count_ = 0;
+    // Each rule is indexed once, by its id, else its first class, else its type, else "*".
+    std::unordered_map<std::string, std::vector<std::size_t>> by_id_, by_class_, by_type_;
+};
+
 /// Parses a transform attribute: a list of matrix(a b c d e f), translate(x [y]),
 /// scale(x [y]), rotate(a [cx cy]), skewX(a), skewY(a), separated by whitespace or commas;
 /// angles in degrees. Returns their product (the leftmost applied last). Empty text is the
 /// identity. Throws ValueError "transform: ..." on anything else.
-Affine parse_transform(std::string_view text);
+/// With `css`, the CSS transform property's syntax too: "none", translateX/Y, scaleX/Y,
+/// skew(ax [ay]), and units on numbers (lengths: px mm cm in pt pc; angles: deg rad grad turn).
+Affine parse_transform(std::string_view text, bool css = false);
+
+/// Parses transform-origin ("x [y [z]]": lengths, percentages of `width` / `height` (NaN:
+/// no viewport, an error), keywords left center right top bottom; z is ignored) into a point
+/// in user units. Throws ValueError "transform-origin: ...".
+Point parse_transform_origin(std::string_view text, double width, double height);
 
 /// Parses a length: a number with an optional unit mm, cm, in, pt, pc, px or % (none: px;
 /// 96 px per inch), and returns it in px. `percent_base` is the value of 100% in px; NaN when
