@@ -74,7 +74,7 @@ std::string circles_document(std::size_t n) {
                       "    <circle class=\"dot\" id=\"c%zu\" cx=\"%.6f\" cy=\"%.6f\" r=\"%.6f\" "
                       "style=\"fill:none;stroke:#000000;stroke-width:0.1;stroke-opacity:1;"
                       "stroke-linecap:round;stroke-linejoin:round;stroke-miterlimit:4;"
-                      "stroke-dasharray:none\"/>\n",
+                      "stroke-dasharray:none;fill-opacity:1;paint-order:normal\"/>\n",
                       i, u(rng), u(rng), r(rng));
         s += buf;
     }
