@@ -66,7 +66,8 @@ TEST_CASE("svg: location lookups scan a bounded number of bytes", "[svg]") {
     CHECK(small.location_bytes_scanned < small.locations * svg::TextLocator::kStride);
     CHECK(large.location_bytes_scanned < large.locations * svg::TextLocator::kStride);
     // Four times the elements, at most a little over four times the scanning.
-    CHECK(large.location_bytes_scanned <= 4.2 * static_cast<double>(small.location_bytes_scanned));
+    CHECK(static_cast<double>(large.location_bytes_scanned) <=
+          4.2 * static_cast<double>(small.location_bytes_scanned));
 }
 
 TEST_CASE("svg: a 2 MB padded document reads as its original", "[svg]") {
