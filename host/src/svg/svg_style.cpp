@@ -181,7 +181,6 @@ void StyleSheet::add(std::string_view css, std::size_t base) {
 
 void StyleSheet::add_rule(std::string_view selector, std::size_t block) {
     Rule r;
-    r.block = block;
     std::size_t i = 0;
     if (i < selector.size() && selector[i] == '*') {
         ++i;
@@ -206,14 +205,27 @@ void StyleSheet::add_rule(std::string_view selector, std::size_t block) {
     if (i == 0) return;  // empty selector
     r.specificity = std::min<std::uint32_t>(ids, 1023) << 20 |
                     std::min<std::uint32_t>(classes, 1023) << 10 | (r.type.empty() ? 0 : 1);
-    const std::size_t index = rules_.size();
-    if (!r.id.empty())
-        by_id_[r.id].push_back(index);
-    else if (!r.classes.empty())
-        by_class_[r.classes.front()].push_back(index);
-    else
-        by_type_[r.type.empty() ? "*" : r.type].push_back(index);
-    rules_.push_back(std::move(r));
+    std::vector<std::string> sorted = r.classes;
+    std::sort(sorted.begin(), sorted.end());
+    std::string key = std::to_string(r.specificity) + " " + r.type + "#" + r.id;
+    for (const std::string& c : sorted) key += "." + c;
+    auto [it, fresh] = by_selector_.emplace(key, rules_.size());
+    if (fresh) {
+        const std::size_t index = rules_.size();
+        if (!r.id.empty())
+            by_id_[r.id].push_back(index);
+        else if (!r.classes.empty())
+            by_class_[r.classes.front()].push_back(index);
+        else
+            by_type_[r.type.empty() ? "*" : r.type].push_back(index);
+        rules_.push_back(std::move(r));
+    }
+    Rule& rule = rules_[it->second];
+    for (const CssDeclaration& d : blocks_[block]) {
+        const auto p = static_cast<std::size_t>(
+            std::find(std::begin(kUsed), std::end(kUsed), d.name) - std::begin(kUsed));
+        rule.slots[p][d.important ? 1 : 0] = {&d, ++declarations_};
+    }
 }
 
 std::vector<const CssDeclaration*> StyleSheet::match(std::string_view type, std::string_view id,
@@ -238,22 +250,33 @@ std::vector<const CssDeclaration*> StyleSheet::match(std::string_view type, std:
     gather(by_type_, std::string(type));
     gather(by_type_, "*");
 
-    std::vector<std::size_t> matched;
+    std::array<std::array<Slot, 2>, 5> best{};
+    std::array<std::array<std::uint32_t, 2>, 5> best_specificity{};
     for (const std::size_t k : candidates) {
         const Rule& r = rules_[k];
         bool ok = (r.type.empty() || r.type == type) && (r.id.empty() || r.id == id);
         for (const std::string& c : r.classes)
             ok = ok && std::binary_search(own.begin(), own.end(), c);
-        if (ok) matched.push_back(k);
+        if (!ok) continue;
+        for (std::size_t p = 0; p < best.size(); ++p) {
+            for (std::size_t imp = 0; imp < 2; ++imp) {
+                const Slot& s = r.slots[p][imp];
+                if (!s.declaration) continue;
+                Slot& b = best[p][imp];
+                std::uint32_t& bs = best_specificity[p][imp];
+                if (!b.declaration || r.specificity > bs ||
+                    (r.specificity == bs && s.order > b.order)) {
+                    b = s;
+                    bs = r.specificity;
+                }
+            }
+        }
     }
-    std::sort(matched.begin(), matched.end(), [&](std::size_t a, std::size_t b) {
-        return rules_[a].specificity != rules_[b].specificity
-                   ? rules_[a].specificity < rules_[b].specificity
-                   : a < b;
-    });
     std::vector<const CssDeclaration*> out;
-    for (const std::size_t k : matched) {
-        for (const CssDeclaration& d : blocks_[rules_[k].block]) out.push_back(&d);
+    for (const auto& slot : best) {
+        for (const Slot& s : slot) {
+            if (s.declaration) out.push_back(s.declaration);
+        }
     }
     return out;
 }

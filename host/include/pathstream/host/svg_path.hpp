@@ -206,8 +206,9 @@ public:
     /// Throws CssError on an unclosed comment or block, a '}' without a rule, or more than
     /// kMaxRules rules in all.
     void add(std::string_view css, std::size_t base = 0);
-    /// Declarations of the rules that match an element of this type, id and class attribute,
-    /// in cascade order: ascending specificity (id > class > type), then document order.
+    /// The winning declaration of each property (normal and !important apart) among the rules
+    /// matching an element of this type, id and class attribute, by specificity (id > class >
+    /// type), then document order; at most one per property and importance.
     std::vector<const CssDeclaration*> match(std::string_view type, std::string_view id,
                                              std::string_view classes) const;
     /// Rules read, including those whose selectors never match.
@@ -216,18 +217,26 @@ public:
     bool empty() const { return rules_.empty(); }
 
 private:
+    // One distinct selector; rules repeating it are merged, each declaration keeping its
+    // document order, so a sheet repeating one selector costs one candidate per element.
+    struct Slot {
+        const CssDeclaration* declaration = nullptr;
+        std::size_t order = 0;
+    };
     struct Rule {
         std::string type;  // "" for any
         std::string id;
         std::vector<std::string> classes;
         std::uint32_t specificity = 0;
-        std::size_t block = 0;  // index into blocks_
+        std::array<std::array<Slot, 2>, 5> slots{};  // per used property, normal and !important
     };
     void add_rule(std::string_view selector, std::size_t block);
 
     std::vector<std::vector<CssDeclaration>> blocks_;
-    std::vector<Rule> rules_;  // in document order
+    std::vector<Rule> rules_;
+    std::unordered_map<std::string, std::size_t> by_selector_;  // canonical selector -> rule
     std::size_t count_ = 0;
+    std::size_t declarations_ = 0;  // document order of declarations
     // Each rule is indexed once, by its id, else its first class, else its type, else "*".
     std::unordered_map<std::string, std::vector<std::size_t>> by_id_, by_class_, by_type_;
 };
