@@ -56,13 +56,40 @@ struct State {
     double width = kNoBase;  // viewport size in user units, for percentages
     double height = kNoBase;
     bool visible = true;  // inherited 'visibility'
+    std::string stroke = "none";  // inherited 'stroke', kept for SvgReadInfo::strokes
+};
+
+// One property's cascaded value: from a presentation attribute, or from CSS (a <style> rule or
+// the style attribute) with the byte offset of the declaration, for error places.
+struct Cascaded {
+    std::string value;
+    bool set = false;
+    bool css = false;
+    std::size_t offset = 0;
+};
+
+// The properties the reader uses, after the cascade.
+struct Style {
+    Cascaded display, visibility, stroke, transform, origin;
 };
 
 class Reader {
 public:
     Reader(const std::string& text, const std::string& file, double tolerance_mm)
-        : text_(text), file_(file), tolerance_mm_(tolerance_mm) {}
+        : text_(text), file_(file), tolerance_mm_(tolerance_mm), locator_(text) {}
 
+    Path read(svg::SvgReadInfo* info) {
+        Path path = read();
+        if (info) {
+            info->strokes = std::move(strokes_);
+            info->style_rules = sheet_.rules();
+            info->location_bytes_scanned = locator_.bytes_scanned();
+            info->locations = locator_.lookups();
+        }
+        return path;
+    }
+
+private:
     Path read() {
         const pugi::xml_parse_result result =
             doc_.load_buffer(text_.data(), text_.size(), pugi::parse_default, pugi::encoding_utf8);
@@ -78,6 +105,7 @@ public:
             throw InputError(file_, element_location(root),
                              "root element is <" + std::string(root.name()) + ">, expected <svg>");
         }
+        style_sheets(root);
         root_svg(root);
         if (path_.subpaths.empty())
             throw InputError(file_, element_location(root), "no drawable paths");
@@ -85,24 +113,10 @@ public:
         return std::move(path_);
     }
 
-private:
     // ---- places ----------------------------------------------------------------------------
 
     // Line and column (1-based, columns in characters of UTF-8) of a byte offset.
-    SourceLocation locate(std::size_t offset) const {
-        SourceLocation at{1, 1};
-        std::size_t i = text_.compare(0, 3, "\xEF\xBB\xBF") == 0 ? 3 : 0;  // a byte order mark
-        for (; i < offset && i < text_.size(); ++i) {
-            const auto c = static_cast<unsigned char>(text_[i]);
-            if (c == '\n') {
-                ++at.line;
-                at.column = 1;
-            } else if ((c & 0xC0) != 0x80) {
-                ++at.column;
-            }
-        }
-        return at;
-    }
+    SourceLocation locate(std::size_t offset) const { return locator_.locate(offset); }
 
     // Byte offset of an element's '<' (pugixml gives the offset of its name).
     std::size_t element_offset(pugi::xml_node n) const {
@@ -114,6 +128,13 @@ private:
 
     // Where an attribute's name starts in the element's start tag; the element if not found.
     SourceLocation attribute_location(pugi::xml_node n, const char* name) const {
+        return locate(attribute_offsets(n, name).first);
+    }
+
+    // Byte offsets of an attribute's name and of its value's first character in the start
+    // tag; the element's '<' for both if not found.
+    std::pair<std::size_t, std::size_t> attribute_offsets(pugi::xml_node n,
+                                                          const char* name) const {
         const std::string_view t = text_;
         const std::size_t start = element_offset(n);
         std::size_t i = start + 1;
@@ -123,6 +144,7 @@ private:
             while (i < t.size() && is_space(t[i])) ++i;
             if (i >= t.size() || t[i] == '>' || t[i] == '/') break;
             const std::size_t name_at = i;
+            std::size_t value_at = i;
             while (i < t.size() && !stop(t[i])) ++i;
             const std::string_view attribute = t.substr(name_at, i - name_at);
             while (i < t.size() && is_space(t[i])) ++i;
@@ -131,14 +153,15 @@ private:
                 while (i < t.size() && is_space(t[i])) ++i;
                 if (i < t.size() && (t[i] == '"' || t[i] == '\'')) {
                     const char quote = t[i++];
+                    value_at = i;
                     while (i < t.size() && t[i] != quote) ++i;
                     ++i;
                 }
             }
-            if (attribute == name) return locate(name_at);
+            if (attribute == name) return {name_at, value_at};
             if (i == name_at) break;  // cannot happen in a document pugixml accepted
         }
-        return locate(start);
+        return {start, start};
     }
 
     [[noreturn]] void fail_at(pugi::xml_node n, const char* attribute,
@@ -174,32 +197,118 @@ private:
         return "";
     }
 
-    // A property from the style attribute (the last declaration wins), else the presentation
-    // attribute of the same name; trimmed and lower-cased, without "!important".
-    static std::string property(pugi::xml_node n, const std::string& name) {
-        std::string value;
-        bool found = false;
-        std::istringstream style{std::string(n.attribute("style").value())};
-        std::string declaration;
-        while (std::getline(style, declaration, ';')) {
-            const auto colon = declaration.find(':');
-            if (colon == std::string::npos) continue;
-            if (lower(trim(std::string_view(declaration).substr(0, colon))) != name) continue;
-            value = lower(trim(std::string_view(declaration).substr(colon + 1)));
-            found = true;
+    // Reads every <style> element (SVG namespace, type text/css or none), wherever it is:
+    // CSS applies to the whole document.
+    void style_sheets(pugi::xml_node root) {
+        std::vector<pugi::xml_node> todo{root};
+        while (!todo.empty()) {
+            const pugi::xml_node e = todo.back();
+            todo.pop_back();
+            if (svg_name(e) == "style") {
+                const std::string type = lower(trim(e.attribute("type").value()));
+                if (!type.empty() && type != "text/css") continue;
+                for (pugi::xml_node c = e.first_child(); c; c = c.next_sibling()) {
+                    if (c.type() != pugi::node_pcdata && c.type() != pugi::node_cdata) continue;
+                    const std::ptrdiff_t at = c.offset_debug();
+                    try {
+                        sheet_.add(c.value(), at > 0 ? static_cast<std::size_t>(at) : 0);
+                    } catch (const svg::CssError& error) {
+                        throw InputError(file_, locate(error.offset), error.what());
+                    }
+                }
+                continue;
+            }
+            for (pugi::xml_node c = e.last_child(); c; c = c.previous_sibling()) {
+                if (c.type() == pugi::node_element) todo.push_back(c);
+            }
         }
-        if (!found) value = lower(trim(n.attribute(name.c_str()).value()));
-        if (const auto bang = value.find("!important"); bang != std::string::npos)
-            value = trim(value.substr(0, bang));
-        return value;
+    }
+
+    // The cascade for the properties the reader uses: presentation attribute < <style> rules
+    // (by specificity, then order) < style attribute, and !important declarations above all
+    // normal ones. Keywords are lower-cased; transform values keep their case.
+    Style style(pugi::xml_node n) const {
+        Style st;
+        const auto attribute = [&](Cascaded& slot, const char* name) {
+            if (const pugi::xml_attribute a = n.attribute(name)) {
+                std::string v = trim(a.value());
+                if (const auto bang = v.find("!important"); bang != std::string::npos)
+                    v = trim(v.substr(0, bang));
+                slot = {v, true, false, 0};
+            }
+        };
+        attribute(st.display, "display");
+        attribute(st.visibility, "visibility");
+        attribute(st.stroke, "stroke");
+        attribute(st.transform, "transform");
+        attribute(st.origin, "transform-origin");
+        std::vector<const svg::CssDeclaration*> sheet;
+        if (!sheet_.empty()) {
+            sheet = sheet_.match(svg_name(n), n.attribute("id").value(),
+                                 n.attribute("class").value());
+        }
+        std::vector<svg::CssDeclaration> inline_style;
+        if (const pugi::xml_attribute a = n.attribute("style")) {
+            try {
+                inline_style = svg::parse_css_declarations(a.value(),
+                                                           attribute_offsets(n, "style").second);
+            } catch (const svg::CssError& error) {
+                throw InputError(file_, locate(error.offset), error.what());
+            }
+        }
+        const auto apply = [&](const svg::CssDeclaration& d) {
+            Cascaded* slot = d.name == "display"            ? &st.display
+                             : d.name == "visibility"       ? &st.visibility
+                             : d.name == "stroke"           ? &st.stroke
+                             : d.name == "transform"        ? &st.transform
+                             : d.name == "transform-origin" ? &st.origin
+                                                            : nullptr;
+            if (slot) *slot = {d.value, true, true, d.name_offset};
+        };
+        for (const bool important : {false, true}) {
+            for (const svg::CssDeclaration* d : sheet) {
+                if (d->important == important) apply(*d);
+            }
+            for (const svg::CssDeclaration& d : inline_style) {
+                if (d.important == important) apply(d);
+            }
+        }
+        for (Cascaded* keyword : {&st.display, &st.visibility, &st.stroke})
+            keyword->value = lower(keyword->value);
+        return st;
+    }
+
+    // Applies a computed visibility and stroke to the inherited state.
+    static void inherit(const Style& st, State& state) {
+        if (st.visibility.value == "hidden" || st.visibility.value == "collapse")
+            state.visible = false;
+        if (st.visibility.value == "visible") state.visible = true;
+        if (st.stroke.set && st.stroke.value != "inherit" && !st.stroke.value.empty())
+            state.stroke = st.stroke.value;
     }
 
     // ---- values -----------------------------------------------------------------------------
 
-    Affine transform(pugi::xml_node n) const {
-        if (!n.attribute("transform")) return {};
-        return with_attribute(n, "transform",
-                              [](std::string_view v) { return svg::parse_transform(v); });
+    // The element's transform (CSS property, else attribute) about its transform-origin, whose
+    // percentages and keywords refer to the viewport `width` x `height` in user units.
+    Affine transform(pugi::xml_node n, const Style& st, double width, double height) const {
+        if (!st.transform.set) return {};
+        const auto parse = [&](const Cascaded& c, const char* attribute, auto&& f) {
+            if (!c.css) return with_attribute(n, attribute, [&](std::string_view) { return f(c.value); });
+            try {
+                return f(c.value);
+            } catch (const svg::ValueError& e) {
+                throw InputError(file_, locate(c.offset), e.what());
+            }
+        };
+        const Affine m = parse(st.transform, "transform", [&](std::string_view v) {
+            return svg::parse_transform(v, st.transform.css);
+        });
+        if (!st.origin.set) return m;
+        const Point o = parse(st.origin, "transform-origin", [&](std::string_view v) {
+            return svg::parse_transform_origin(v, width, height);
+        });
+        return Affine::translate(o.x, o.y) * m * Affine::translate(-o.x, -o.y);
     }
 
     // A length attribute in user units; `fallback` when absent.
@@ -258,9 +367,9 @@ private:
 
     void root_svg(pugi::xml_node n) {
         State state;
-        state.visible =
-            property(n, "visibility") != "hidden" && property(n, "visibility") != "collapse";
-        if (property(n, "display") == "none") return;
+        const Style st = style(n);
+        inherit(st, state);
+        if (st.display.value == "none") return;
         // Width and height in px; percentages mean "no size given" for the outermost <svg>.
         const auto given = [&](const char* attribute) {
             const std::string v = trim(n.attribute(attribute).value());
@@ -287,7 +396,7 @@ private:
             state.height = height;
         }
         if (width == 0 || height == 0) return;  // a zero-sized drawing draws nothing
-        state.to_mm = Affine::scale(kMmPerPx, kMmPerPx) * transform(n) * view;
+        state.to_mm = Affine::scale(kMmPerPx, kMmPerPx) * transform(n, st, width, height) * view;
         if (state.to_mm.determinant() == 0) return;
         children(n, state);
     }
@@ -305,14 +414,20 @@ private:
 
     void element(pugi::xml_node n, const State& parent) {
         const std::string name = svg_name(n);
-        if (name.empty() || property(n, "display") == "none") return;
+        if (name.empty()) return;
+        const Style st = style(n);
+        if (st.display.value == "none") return;
         State state = parent;
-        const std::string visibility = property(n, "visibility");
-        if (visibility == "hidden" || visibility == "collapse") state.visible = false;
-        if (visibility == "visible") state.visible = true;
+        inherit(st, state);
+        static const char* const kDrawn[] = {"g",    "a",    "switch",  "svg",  "use",
+                                             "path", "rect", "circle",  "ellipse",
+                                             "line", "polyline", "polygon"};
+        if (std::find(std::begin(kDrawn), std::end(kDrawn), name) == std::end(kDrawn))
+            return;  // defs, symbol, text, image, metadata, title, style, ...
+        const Affine own = transform(n, st, parent.width, parent.height);
 
         if (name == "g" || name == "a" || name == "switch") {
-            state.to_mm = parent.to_mm * transform(n);
+            state.to_mm = parent.to_mm * own;
             if (state.to_mm.determinant() == 0) return;
             if (name != "switch") return children(n, state);
             for (pugi::xml_node child = n.first_child(); child; child = child.next_sibling()) {
@@ -323,23 +438,18 @@ private:
             }
             return;
         }
-        if (name == "svg") return nested_svg(n, parent, state);
-        if (name == "use") return use(n, parent, state);
-        static const char* const kShapes[] = {"path", "rect",     "circle", "ellipse",
-                                              "line", "polyline", "polygon"};
-        bool shape = false;
-        for (const char* s : kShapes) shape = shape || name == s;
-        if (!shape) return;  // defs, symbol, text, image, metadata, title, style, ...
-        state.to_mm = parent.to_mm * transform(n);
+        if (name == "svg") return nested_svg(n, parent, own, state);
+        if (name == "use") return use(n, parent, own, state);
+        state.to_mm = parent.to_mm * own;
         if (state.to_mm.determinant() == 0 || !state.visible) return;
         geometry(n, name, state);
     }
 
-    void nested_svg(pugi::xml_node n, const State& parent, State state) {
+    void nested_svg(pugi::xml_node n, const State& parent, const Affine& own, State state) {
         const double x = length(n, "x", parent.width, 0), y = length(n, "y", parent.height, 0);
         const double width = size(n, "width", parent.width, parent.width);
         const double height = size(n, "height", parent.height, parent.height);
-        viewport(n, parent.to_mm * transform(n) * Affine::translate(x, y), width, height, state);
+        viewport(n, parent.to_mm * own * Affine::translate(x, y), width, height, state);
     }
 
     // Enters the viewport of a nested <svg> or of a <symbol> drawn by <use>: `n`'s viewBox and
@@ -365,7 +475,7 @@ private:
 
     // <use href="#id">: the element with that id, drawn here, moved by x and y. A <symbol>
     // gets a viewport of the use's width and height. Other files' content is not drawn.
-    void use(pugi::xml_node n, const State& parent, State state) {
+    void use(pugi::xml_node n, const State& parent, const Affine& own, State state) {
         const char* const href_name = n.attribute("href") ? "href" : "xlink:href";
         const std::string href = trim(n.attribute(href_name).value());
         if (href.size() < 2 || href[0] != '#') return;
@@ -383,19 +493,20 @@ private:
                     "too many <use> copies (more than " + std::to_string(kMaxUses) + ")");
         }
         const double x = length(n, "x", parent.width, 0), y = length(n, "y", parent.height, 0);
-        const Affine to_mm = parent.to_mm * transform(n) * Affine::translate(x, y);
+        const Affine to_mm = parent.to_mm * own * Affine::translate(x, y);
         if (to_mm.determinant() == 0) return;
         use_stack_.push_back(target);
         if (svg_name(target) == "symbol") {
-            if (property(target, "display") != "none") {
-                const std::string visibility = property(target, "visibility");
-                if (visibility == "hidden" || visibility == "collapse") state.visible = false;
-                if (visibility == "visible") state.visible = true;
+            const Style target_style = style(target);
+            if (target_style.display.value != "none") {
+                inherit(target_style, state);
                 const auto side = [&](const char* attribute, double base) {
                     if (n.attribute(attribute)) return size(n, attribute, base, base);
                     return size(target, attribute, base, base);
                 };
-                viewport(target, to_mm * transform(target), side("width", parent.width),
+                viewport(target,
+                         to_mm * transform(target, target_style, parent.width, parent.height),
+                         side("width", parent.width),
                          side("height", parent.height), state);
             }
         } else {
@@ -432,7 +543,7 @@ private:
             const CubicSubpaths pieces = with_attribute(n, "d", [&](std::string_view d) {
                 return svg::parse_path_data(d, m, tolerance_mm_);
             });
-            return emit(pieces, m, attribute_location(n, "d"));
+            return emit(pieces, state, attribute_location(n, "d"));
         }
         if (name == "polyline" || name == "polygon") {
             const std::vector<Point> points = with_attribute(n, "points", [](std::string_view v) {
@@ -446,14 +557,14 @@ private:
                     out.push_back({numbers[i], numbers[i + 1]});
                 return out;
             });
-            return emit(CubicSubpaths{svg::polyline_cubics(points, name == "polygon")}, m,
+            return emit(CubicSubpaths{svg::polyline_cubics(points, name == "polygon")}, state,
                         attribute_location(n, "points"));
         }
         const SourceLocation at = element_location(n);
         if (name == "line") {
             const Point a{length(n, "x1", w, 0), length(n, "y1", h, 0)};
             const Point b{length(n, "x2", w, 0), length(n, "y2", h, 0)};
-            return emit(CubicSubpaths{std::vector<svg::Cubic>{svg::line_cubic(a, b)}}, m, at);
+            return emit(CubicSubpaths{std::vector<svg::Cubic>{svg::line_cubic(a, b)}}, state, at);
         }
         if (name == "rect") {
             const double x = length(n, "x", w, 0), y = length(n, "y", h, 0);
@@ -469,8 +580,8 @@ private:
             rx = std::min(rx, width / 2);
             ry = std::min(ry, height / 2);
             return emit(
-                CubicSubpaths{svg::rect_cubics(x, y, width, height, rx, ry, m, tolerance_mm_)}, m,
-                at);
+                CubicSubpaths{svg::rect_cubics(x, y, width, height, rx, ry, m, tolerance_mm_)},
+                state, at);
         }
         const Point center{length(n, "cx", w, 0), length(n, "cy", h, 0)};
         double rx = 0, ry = 0;
@@ -483,11 +594,12 @@ private:
             if (std::isnan(ry)) ry = rx;
         }
         if (rx == 0 || ry == 0) return;
-        emit(CubicSubpaths{svg::ellipse_cubics(center, rx, ry, m, tolerance_mm_)}, m, at);
+        emit(CubicSubpaths{svg::ellipse_cubics(center, rx, ry, m, tolerance_mm_)}, state, at);
     }
 
     // Maps pieces to mm and appends them as Bezier subpaths.
-    void emit(const CubicSubpaths& subpaths, const Affine& to_mm, SourceLocation at) {
+    void emit(const CubicSubpaths& subpaths, const State& state, SourceLocation at) {
+        const Affine& to_mm = state.to_mm;
         for (const auto& pieces : subpaths) {
             Subpath sp;
             sp.basis = PathBasis::kBezier;
@@ -508,7 +620,9 @@ private:
                     sp.points.push_back({mm[k].x, mm[k].y});
                 }
             }
-            if (!sp.points.empty()) path_.subpaths.push_back(std::move(sp));
+            if (sp.points.empty()) continue;
+            path_.subpaths.push_back(std::move(sp));
+            strokes_.push_back(state.stroke);
         }
     }
 
@@ -526,23 +640,27 @@ private:
     const std::string& text_;
     const std::string& file_;
     double tolerance_mm_;
+    mutable svg::TextLocator locator_;  // lookups only count their cost
     pugi::xml_document doc_;
     Path path_;
     std::unordered_map<std::string, pugi::xml_node> ids_;
     bool ids_built_ = false;
     std::vector<pugi::xml_node> use_stack_;  // targets of the <use> elements being drawn
     std::size_t use_count_ = 0;
+    svg::StyleSheet sheet_;
+    std::vector<std::string> strokes_;  // parallel to path_.subpaths
 };
 
 }  // namespace
 
-Path parse_svg_path(const std::string& text, const std::string& file, double tolerance_mm) {
+Path parse_svg_path(const std::string& text, const std::string& file, double tolerance_mm,
+                    svg::SvgReadInfo* info) {
     if (!(tolerance_mm > 0) || !std::isfinite(tolerance_mm)) {
         throw InputError(
             file, {},
             "tolerance must be positive and finite (got " + number_text(tolerance_mm) + " mm)");
     }
-    return Reader(text, file, tolerance_mm).read();
+    return Reader(text, file, tolerance_mm).read(info);
 }
 
 Path load_svg_path(const std::string& file, double tolerance_mm) {

@@ -4,15 +4,21 @@
 
 #include <array>
 #include <cstddef>
+#include <cstdint>
 #include <stdexcept>
 #include <string>
 #include <string_view>
+#include <unordered_map>
 #include <utility>
 #include <vector>
 
 #include "pathstream/host/path.hpp"
 
 namespace pathstream::host {
+
+namespace svg {
+struct SvgReadInfo;
+}
 
 /// Parses an SVG document. `file` names the source in error messages.
 /// Returns a Path with axes = 2 whose subpaths are open Bezier chains (P0 C C P1 C C P2 ...,
@@ -28,7 +34,9 @@ namespace pathstream::host {
 /// numbers, negative sizes, coordinates beyond 1e6 mm, and a document without drawable
 /// geometry ("no drawable paths"). `tolerance_mm` must be positive and finite (else InputError
 /// without a location).
-Path parse_svg_path(const std::string& text, const std::string& file, double tolerance_mm = 0.01);
+/// When `info` is given, it receives what the read found and cost beyond the path.
+Path parse_svg_path(const std::string& text, const std::string& file, double tolerance_mm = 0.01,
+                    svg::SvgReadInfo* info = nullptr);
 
 /// Reads and parses an SVG file as parse_svg_path does. Throws InputError, also when the file
 /// cannot be opened or read.
@@ -37,6 +45,44 @@ Path load_svg_path(const std::string& file, double tolerance_mm = 0.01);
 /// Building blocks of the SVG reader, exposed for its tests. Coordinates are in SVG user units
 /// unless a name says mm.
 namespace svg {
+
+/// What one read found beside the geometry, and what it cost (tests and benches check that
+/// reading stays linear in the document's size).
+struct SvgReadInfo {
+    /// The computed CSS `stroke` of each subpath's element, parallel to Path::subpaths
+    /// (lower-cased as written, "none" when unset), for a later split by colour.
+    std::vector<std::string> strokes;
+    /// Bytes the line:column lookups scanned, building the index excluded.
+    std::size_t location_bytes_scanned = 0;
+    /// Line:column lookups made.
+    std::size_t locations = 0;
+    /// Rules read from <style> elements (one per selector of a selector list).
+    std::size_t style_rules = 0;
+};
+
+/// Line and column (1-based; columns count UTF-8 characters; a leading byte order mark does
+/// not count) of byte offsets in one text. One pass at construction records the place of every
+/// kStride-th byte, so each lookup scans fewer than kStride bytes whatever the text's size.
+class TextLocator {
+public:
+    static constexpr std::size_t kStride = 256;
+
+    /// Indexes `text`, which must outlive the locator.
+    explicit TextLocator(std::string_view text);
+    /// The place of byte `offset` (clamped to the text's end).
+    SourceLocation locate(std::size_t offset);
+    /// Bytes scanned by locate() so far.
+    std::size_t bytes_scanned() const { return scanned_; }
+    /// Calls of locate() so far.
+    std::size_t lookups() const { return lookups_; }
+
+private:
+    std::string_view text_;
+    std::size_t begin_ = 0;                   // after the byte order mark
+    std::vector<SourceLocation> checkpoints_;  // place of byte k * kStride
+    std::size_t scanned_ = 0;
+    std::size_t lookups_ = 0;
+};
 
 /// A point in the plane.
 struct Point {
@@ -124,11 +170,89 @@ private:
 /// prefixed with `what`.
 std::vector<double> parse_number_list(std::string_view text, const std::string& what);
 
+/// One CSS declaration `name: value` and where it is in the text it was parsed from.
+struct CssDeclaration {
+    std::string name;   // lower-cased
+    std::string value;  // trimmed, without "!important", as written
+    bool important = false;
+    std::size_t name_offset = 0;   // byte offset of the name
+    std::size_t value_offset = 0;  // byte offset of the value's first character
+};
+
+/// Malformed CSS that error recovery cannot skip (an unclosed comment or block, too many
+/// rules): the message and the byte offset of the problem in the text parsed.
+class CssError : public std::runtime_error {
+public:
+    CssError(const std::string& what, std::size_t at) : std::runtime_error(what), offset(at) {}
+    std::size_t offset;
+};
+
+/// Parses a declaration list (a style attribute, a rule's block); `base` is added to the
+/// offsets. As CSS error recovery says, a declaration without ':' or a name is dropped, and
+/// comments count as whitespace. Throws CssError on an unclosed comment.
+std::vector<CssDeclaration> parse_css_declarations(std::string_view text, std::size_t base = 0);
+
+/// The rules of a document's <style> elements, for the properties the reader uses (display,
+/// visibility, stroke, transform, transform-origin). A selector is a compound of an optional
+/// type (or *) and any number of .class and #id; selector lists are split into one rule per
+/// selector. Other selectors (combinators, attributes, pseudo-classes, escapes) never match;
+/// at-rules (@media, @import, ...) are skipped with their blocks.
+class StyleSheet {
+public:
+    /// Rules per document, counting every selector of a list: more are refused.
+    static constexpr std::size_t kMaxRules = 10000;
+
+    /// Adds the rules of one style sheet text whose first byte is at `base` in the document.
+    /// Throws CssError on an unclosed comment or block, a '}' without a rule, or more than
+    /// kMaxRules rules in all.
+    void add(std::string_view css, std::size_t base = 0);
+    /// The winning declaration of each property (normal and !important apart) among the rules
+    /// matching an element of this type, id and class attribute, by specificity (id > class >
+    /// type), then document order; at most one per property and importance.
+    std::vector<const CssDeclaration*> match(std::string_view type, std::string_view id,
+                                             std::string_view classes) const;
+    /// Rules read, including those whose selectors never match.
+    std::size_t rules() const { return count_; }
+    /// True when no rule can match anything.
+    bool empty() const { return rules_.empty(); }
+
+private:
+    // One distinct selector; rules repeating it are merged, each declaration keeping its
+    // document order, so a sheet repeating one selector costs one candidate per element.
+    struct Slot {
+        const CssDeclaration* declaration = nullptr;
+        std::size_t order = 0;
+    };
+    struct Rule {
+        std::string type;  // "" for any
+        std::string id;
+        std::vector<std::string> classes;
+        std::uint32_t specificity = 0;
+        std::array<std::array<Slot, 2>, 5> slots{};  // per used property, normal and !important
+    };
+    void add_rule(std::string_view selector, std::size_t block);
+
+    std::vector<std::vector<CssDeclaration>> blocks_;
+    std::vector<Rule> rules_;
+    std::unordered_map<std::string, std::size_t> by_selector_;  // canonical selector -> rule
+    std::size_t count_ = 0;
+    std::size_t declarations_ = 0;  // document order of declarations
+    // Each rule is indexed once, by its id, else its first class, else its type, else "*".
+    std::unordered_map<std::string, std::vector<std::size_t>> by_id_, by_class_, by_type_;
+};
+
 /// Parses a transform attribute: a list of matrix(a b c d e f), translate(x [y]),
 /// scale(x [y]), rotate(a [cx cy]), skewX(a), skewY(a), separated by whitespace or commas;
 /// angles in degrees. Returns their product (the leftmost applied last). Empty text is the
 /// identity. Throws ValueError "transform: ..." on anything else.
-Affine parse_transform(std::string_view text);
+/// With `css`, the CSS transform property's syntax too: "none", translateX/Y, scaleX/Y,
+/// skew(ax [ay]), and units on numbers (lengths: px mm cm in pt pc; angles: deg rad grad turn).
+Affine parse_transform(std::string_view text, bool css = false);
+
+/// Parses transform-origin ("x [y [z]]": lengths, percentages of `width` / `height` (NaN:
+/// no viewport, an error), keywords left center right top bottom; z is ignored) into a point
+/// in user units. Throws ValueError "transform-origin: ...".
+Point parse_transform_origin(std::string_view text, double width, double height);
 
 /// Parses a length: a number with an optional unit mm, cm, in, pt, pc, px or % (none: px;
 /// 96 px per inch), and returns it in px. `percent_base` is the value of 100% in px; NaN when
