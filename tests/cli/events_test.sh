@@ -97,7 +97,8 @@ sys.exit(1 if errors else 0)
 PY
 }
 
-# Starts the simulated device (--log-json) at rose.json's start on a free port; sets $target.
+# Starts the simulated device (--log-json) at rose.json's start on a free port; sets $target. The
+# streams below pass --keep-order: the device rests at the file's first point, which ordering moves.
 start_device() {
   "$bin" device -m "$machine" --no-gpio --tcp 127.0.0.1:0 --position 139.322,100 --time-scale 4 \
     --exit-after 120 --log-json > "$work/$1.ndjson" 2> "$work/$1.err" &
@@ -134,7 +135,7 @@ out=$("$bin" sim "$src/examples/wave.json" -m "$machine" --events "$work/no/such
 
 # ---- stream: a full run, events on standard output ----------------------------------------
 start_device device1 || exit 1
-"$bin" stream "$src/examples/rose.json" -m "$machine" -t "$target" --no-journal --events - \
+"$bin" stream "$src/examples/rose.json" --keep-order -m "$machine" -t "$target" --no-journal --events - \
   > stream1.ndjson 2> stream1.err; rc=$?
 [ $rc -eq 0 ] && ok || fail "stream --events -: exit $rc: $(cat stream1.err)"
 grep -q "^job           1 finished" stream1.err && ok || fail "stream: the text report is not on stderr"
@@ -144,7 +145,7 @@ check_device_log device1.ndjson && ok || fail "device --log-json lines"
 
 # ---- stream: Ctrl-C mid-stream holds the job -----------------------------------------------
 start_device device2 || exit 1
-"$bin" stream "$src/examples/rose.json" -m "$machine" -t "$target" --journal "$work/j.json" \
+"$bin" stream "$src/examples/rose.json" --keep-order -m "$machine" -t "$target" --journal "$work/j.json" \
   --events stream2.ndjson --events-rate 10 > stream2.log 2>&1 &
 stream_pid=$!
 wait_running

@@ -39,7 +39,7 @@ wait_running() {
 stop_device() { kill -INT "$device_pid" 2>/dev/null; wait "$device_pid" 2>/dev/null; }
 
 # The plan's path ticks and pen-down ticks (the setpoints CSV: tick,...,pen columns).
-"$bin" plan "$drawing" -m "$machine" --out "$work/plan.csv" > /dev/null 2>&1 || fail "plan"
+"$bin" plan "$drawing" --keep-order -m "$machine" --out "$work/plan.csv" > /dev/null 2>&1 || fail "plan"
 plan_ticks=$(($(wc -l < "$work/plan.csv") - 2))  # header and the end point
 plan_pen=$(awk -F, 'NR > 1 { n += $NF } END { print n }' "$work/plan.csv")
 
@@ -79,7 +79,7 @@ out=$("$bin" ctl "$target" jump 2>&1); rc=$?
 [ $rc -eq 2 ] && ok || fail "ctl bad verb: $rc $out"
 out=$("$bin" ctl "modbus-tcp://127.0.0.1:1?unit=1" status --link-timeout 0.2 2>&1); rc=$?
 [ $rc -eq 6 ] && [[ "$out" == *"cannot connect"* ]] && ok || fail "ctl dead target: $rc $out"
-"$bin" stream "$drawing" -m "$machine" -t "$target" --no-journal > "$work/stream0.log" 2>&1 &
+"$bin" stream "$drawing" --keep-order -m "$machine" -t "$target" --no-journal > "$work/stream0.log" 2>&1 &
 stream_pid=$!
 wait_running
 out=$("$bin" ctl "$target" hold 2>&1)
@@ -108,7 +108,7 @@ for run in $(seq "$runs"); do
   for presses in 1 2 kill; do
     start_device 4 || exit 1
     delay=$(awk -v r=$RANDOM 'BEGIN { printf "%.2f", 3.0 * r / 32767 }')
-    "$bin" stream "$drawing" -m "$machine" -t "$target" --journal "$work/j.json" > "$work/stream1.log" 2>&1 &
+    "$bin" stream "$drawing" --keep-order -m "$machine" -t "$target" --journal "$work/j.json" > "$work/stream1.log" 2>&1 &
     stream_pid=$!
     wait_running
     sleep "$delay"

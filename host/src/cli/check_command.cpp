@@ -6,6 +6,8 @@
 #include <iostream>
 #include <limits>
 #include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
 
 #include "pathstream/host/geometry.hpp"
 
@@ -15,6 +17,8 @@ void add_check_command(CLI::App& app, CheckOptions& o) {
     CLI::App* cmd = app.add_subcommand("check", "Validate a path file and print a summary: subpaths, spans, length, bounding box");
     add_path_options(*cmd, o.path);
     cmd->add_flag("--json", o.json, "print the summary as one JSON document on standard output");
+    cmd->add_option("--machine,-m", o.machine, "machine profile (JSON): its work area serves --fit area")
+        ->check(CLI::ExistingFile);
 }
 
 namespace {
@@ -92,6 +96,32 @@ CheckFigures measure(const Path& path) {
     return f;
 }
 
+/// "x 1.000 .. 2.000, y 3.000 .. 4.000 mm", or "empty".
+std::string box_text(const std::optional<Box2>& box) {
+    if (!box) return "empty";
+    char text[160];
+    std::snprintf(text, sizeof text, "x %.3f .. %.3f, y %.3f .. %.3f mm", box->x_min, box->x_max, box->y_min,
+                  box->y_max);
+    return text;
+}
+
+/// The placement and order lines (only for what ran).
+void print_load_report(const LoadedPath& loaded) {
+    if (loaded.placed) {
+        std::printf("  placement: %s -> %s (scale %g)\n", box_text(loaded.placement.before).c_str(),
+                    box_text(loaded.placement.after).c_str(), loaded.placement.scale);
+    }
+    if (loaded.ordered) {
+        const OrderReport& r = loaded.order;
+        const double change = r.travel_before > 0 ? 100 * (r.travel_after - r.travel_before) / r.travel_before : 0.0;
+        std::printf("  order: pen-up travel from the start %.1f mm -> %.1f mm (%+.0f %%), %zu subpaths -> %zu "
+                    "(merged %zu)\n",
+                    r.travel_before, r.travel_after, change, r.subpaths_before, r.subpaths_after, r.merged);
+    } else {
+        std::printf("  order: as in the file (--keep-order)\n");
+    }
+}
+
 /// The human summary (the first 20 subpaths; the rest are counted).
 void print_text(const CheckOptions& o, const Path& path, const CheckFigures& f) {
     std::printf("%s: valid, %zu axes, units %s\n", o.path.file.c_str(), path.axes, path.units.c_str());
@@ -124,9 +154,15 @@ nlohmann::ordered_json subpaths_json(const Path& path) {
     return list;
 }
 
+/// {"x": {"min", "max"}, "y": {...}} or null.
+nlohmann::ordered_json box_json(const std::optional<Box2>& box) {
+    if (!box) return nullptr;
+    return {{"x", {{"min", box->x_min}, {"max", box->x_max}}}, {"y", {{"min", box->y_min}, {"max", box->y_max}}}};
+}
+
 /// The summary for machines: the same figures, unrounded (an empty drawing's box is null).
-nlohmann::ordered_json summary_json(const CheckOptions& o, const Path& path,
-                                    const CheckFigures& f) {
+nlohmann::ordered_json summary_json(const CheckOptions& o, const LoadedPath& loaded, const CheckFigures& f) {
+    const Path& path = loaded.path;
     nlohmann::ordered_json box = nlohmann::ordered_json::object();
     for (std::size_t a = 0; a < path.axes; ++a) {
         box[axis_column_name(a)] = {{"min", f.lo[a]}, {"max", f.hi[a]}};
@@ -143,18 +179,32 @@ nlohmann::ordered_json summary_json(const CheckOptions& o, const Path& path,
     j["drawn_length_mm"] = f.drawn;
     j["travel_length_mm"] = f.travel;
     j["bounding_box_mm"] = box;
+    j["placement"] = loaded.placed ? nlohmann::ordered_json{{"scale", loaded.placement.scale},
+                                                            {"box_before_mm", box_json(loaded.placement.before)},
+                                                            {"box_after_mm", box_json(loaded.placement.after)}}
+                                   : nlohmann::ordered_json(nullptr);
+    const OrderReport& r = loaded.order;
+    j["order"] = loaded.ordered ? nlohmann::ordered_json{{"travel_before_mm", r.travel_before},
+                                                         {"travel_after_mm", r.travel_after},
+                                                         {"subpaths_before", r.subpaths_before},
+                                                         {"subpaths_after", r.subpaths_after},
+                                                         {"merged", r.merged}}
+                                : nlohmann::ordered_json(nullptr);
     return j;
 }
 
 }  // namespace
 
 int run_check(const CheckOptions& o) {
-    const Path path = load_path(o.path);
-    const CheckFigures figures = measure(path);
+    const std::optional<MachineProfile> machine =
+        o.machine.empty() ? std::nullopt : std::optional<MachineProfile>(load_machine_profile(o.machine));
+    const LoadedPath loaded = load_path_report(o.path, machine ? &*machine : nullptr);
+    const CheckFigures figures = measure(loaded.path);
     if (o.json) {
-        std::cout << summary_json(o, path, figures).dump(2) << '\n';
+        std::cout << summary_json(o, loaded, figures).dump(2) << '\n';
     } else {
-        print_text(o, path, figures);
+        print_text(o, loaded.path, figures);
+        print_load_report(loaded);
     }
     return 0;
 }

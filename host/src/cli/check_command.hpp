@@ -10,6 +10,7 @@ namespace pathstream::host {
 struct CheckOptions {
     PathOptions path;
     bool json = false;  ///< --json: one JSON document on standard output instead of text
+    std::string machine;  ///< optional profile: its work area serves --fit area
 };
 
 void add_check_command(CLI::App& app, CheckOptions& options);

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <iostream>
+#include <optional>
 #include <stdexcept>
 
 #include "pathstream/host/atomic_file.hpp"
@@ -61,8 +62,10 @@ std::size_t write_rows(const Path& path, const std::vector<CoreSpan>& spans, dou
 }  // namespace
 
 int run_eval(const EvalOptions& o) {
-    const Path path = load_path(o.path);
-    const double lsb = o.machine.empty() ? o.mm_per_lsb : load_machine_profile(o.machine).mm_per_lsb;
+    const std::optional<MachineProfile> machine =
+        o.machine.empty() ? std::nullopt : std::optional<MachineProfile>(load_machine_profile(o.machine));
+    const Path path = load_path(o.path, machine ? &*machine : nullptr);
+    const double lsb = machine ? machine->mm_per_lsb : o.mm_per_lsb;
     const std::vector<CoreSpan> spans = uniform_core_spans(path, o.path.file, lsb, o.samples_per_span);
     std::size_t rows = 0;
     if (o.output.empty()) {

@@ -3,6 +3,9 @@
 #include <algorithm>
 #include <charconv>
 #include <cctype>
+#include <cmath>
+#include <stdexcept>
+#include <utility>
 
 #include "pathstream/host/csv_path.hpp"
 #include "pathstream/host/gcode_path.hpp"
@@ -29,6 +32,36 @@ void add_path_options(CLI::App& command, PathOptions& o) {
     command.add_option("--tolerance", o.tolerance, "mm: arcs (SVG, G-code) become cubics within this")
         ->capture_default_str()
         ->check(CLI::Range(1e-6, 10.0));
+    // Placement (applied in this order: rotate, flip-y, scale or fit, align, translate).
+    command.add_option("--rotate", o.placement.rotate, "placement: rotate by 90, 180 or 270 degrees about the origin (x towards y)")
+        ->check(CLI::IsMember({0, 90, 180, 270}));
+    command.add_flag("--flip-y", o.placement.flip_y, "placement: mirror y (y -> -y)");
+    command.add_option("--scale", o.placement.scale, "placement: scale x and y by this factor about the origin")
+        ->check(CLI::PositiveNumber);
+    command.add_option("--fit", o.placement.fit,
+                       "placement: scale (keeping the aspect) and align into: area (the machine's work area, needs "
+                       "--machine) or a paper a0..a6, letter, legal, tabloid (add -landscape)");
+    command.add_option("--margin", o.placement.margin, "placement: mm kept free on every side with --fit")
+        ->check(CLI::NonNegativeNumber);
+    command.add_option("--align", o.placement.align,
+                       "placement: where in the --fit box (default center); without --fit, that point of the drawing "
+                       "goes to (0, 0)")
+        ->check(CLI::IsMember({"center", "top-left", "top", "top-right", "left", "right", "bottom-left", "bottom",
+                               "bottom-right"}));
+    command.add_option("--origin", o.placement.origin,
+                       "placement: the machine's origin corner, top-left (y down, as SVG) or bottom-left (y up); "
+                       "decides what top means for --align")
+        ->capture_default_str()
+        ->check(CLI::IsMember({"top-left", "bottom-left"}));
+    command.add_option("--translate", o.translate, "placement: X,Y mm added last");
+    // Order (docs/path-order.md).
+    command.add_flag("--keep-order", o.keep_order, "draw the subpaths in file order, as given (no reordering)");
+    command.add_option("--merge-tolerance", o.merge_tolerance,
+                       "mm: open polyline/Bezier subpaths whose ends are this close are joined (0: exact only)")
+        ->capture_default_str()
+        ->check(CLI::Range(0.0, 10.0));
+    command.add_option("--order-start", o.order_start,
+                       "X,Y mm: where the pen is before the first subpath, for the order (default: the origin)");
 }
 
 namespace {
@@ -40,7 +73,66 @@ PathBasis basis_from_name(const std::string& name) {
 }
 }  // namespace
 
-Path load_path(const PathOptions& o) {
+namespace {
+/// Comma-separated finite numbers ("10,-2.5"); `option` names it in errors.
+std::vector<double> parse_numbers(const std::string& text, const std::string& option) {
+    std::vector<double> values;
+    std::size_t at = 0;
+    while (at <= text.size()) {
+        const std::size_t comma = std::min(text.find(',', at), text.size());
+        const std::string item = text.substr(at, comma - at);
+        double v = 0;
+        const auto [end, error] = std::from_chars(item.data(), item.data() + item.size(), v);
+        if (item.empty() || error != std::errc() || end != item.data() + item.size() || !std::isfinite(v)) {
+            throw std::invalid_argument(option + ": \"" + text + "\" is not a comma-separated list of numbers (mm)");
+        }
+        values.push_back(v);
+        at = comma + 1;
+    }
+    return values;
+}
+
+/// The file as its reader gives it, by extension.
+Path read_path(const PathOptions& o);
+}  // namespace
+
+LoadedPath load_path_report(const PathOptions& o, const MachineProfile* machine, const std::vector<double>* start) {
+    LoadedPath loaded;
+    Path path = read_path(o);
+    PlacementOptions placement = o.placement;
+    if (!o.translate.empty()) {
+        const std::vector<double> xy = parse_numbers(o.translate, "--translate");
+        if (xy.size() != 2) throw std::invalid_argument("--translate: give X,Y (2 numbers), got \"" + o.translate + "\"");
+        placement.translate = std::make_pair(xy[0], xy[1]);
+    }
+    loaded.placed = placement.active();
+    const std::optional<Box2> area = machine != nullptr ? work_area(*machine) : std::nullopt;
+    path = place_path(path, placement, area, &loaded.placement);
+    if (!o.keep_order) {
+        OrderOptions order;
+        order.merge_tolerance = o.merge_tolerance;
+        if (!o.order_start.empty()) {
+            order.start = parse_numbers(o.order_start, "--order-start");
+            if (order.start.size() != path.axes) {
+                throw std::invalid_argument("--order-start: give " + std::to_string(path.axes) +
+                                            " coordinates (one per axis of the path), got \"" + o.order_start + "\"");
+            }
+        } else if (start != nullptr && start->size() == path.axes) {
+            order.start = *start;
+        }
+        path = order_path(path, order, &loaded.order);
+        loaded.ordered = true;
+    }
+    loaded.path = std::move(path);
+    return loaded;
+}
+
+Path load_path(const PathOptions& o, const MachineProfile* machine, const std::vector<double>* start) {
+    return load_path_report(o, machine, start).path;
+}
+
+namespace {
+Path read_path(const PathOptions& o) {
     std::string ext = o.file.substr(o.file.find_last_of('.') == std::string::npos ? o.file.size()
                                                                                  : o.file.find_last_of('.'));
     std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
@@ -58,6 +150,7 @@ Path load_path(const PathOptions& o) {
         o.file, {},
         "unknown file type \"" + ext + "\" (expected .json, .csv, .svg, .gcode, .ngc, .nc or .gc)");
 }
+}  // namespace
 
 const char* axis_column_name(std::size_t axis) {
     static const char* const kNames[] = {"x", "y", "z", "a", "b", "c", "v", "w"};

@@ -2,9 +2,14 @@
 #pragma once
 
 #include <CLI/CLI.hpp>
+#include <optional>
 #include <string>
+#include <vector>
 
+#include "pathstream/host/machine.hpp"
 #include "pathstream/host/path.hpp"
+#include "pathstream/host/path_order.hpp"
+#include "pathstream/host/placement.hpp"
 
 namespace pathstream::host {
 
@@ -15,13 +20,36 @@ struct PathOptions {
     std::string gcode_pen = "z";        ///< "z" or "spindle" (M3/M5)
     double gcode_z_down = 0.0;          ///< pen down when Z <= this (mm)
     double tolerance = 0.01;            ///< mm, arcs to cubics (SVG, G-code)
+    PlacementOptions placement;         ///< --rotate, --flip-y, --scale, --fit, ... (placement.hpp)
+    std::string translate;              ///< --translate "X,Y" (mm), parsed by load_path
+    bool keep_order = false;            ///< --keep-order: draw the subpaths as the file lists them
+    double merge_tolerance = 0.01;      ///< --merge-tolerance: mm between ends that are joined
+    std::string order_start;            ///< --order-start "X,Y,..." (mm); empty: the origin
+};
+
+/// A loaded path and what placement and ordering did to it (for check).
+struct LoadedPath {
+    Path path;
+    PlacementReport placement;
+    bool placed = false;   ///< a placement option was given
+    OrderReport order;
+    bool ordered = false;  ///< ordering ran (not --keep-order)
 };
 
 /// Adds the FILE argument and the format options to a subcommand.
 void add_path_options(CLI::App& command, PathOptions& options);
 
-/// Reads the path: .json, .csv, .svg, .gcode/.ngc/.nc/.gc by extension. Throws InputError.
-Path load_path(const PathOptions& options);
+/// Reads the path: .json, .csv, .svg, .gcode/.ngc/.nc/.gc by extension, then places it and
+/// orders its subpaths (unless keep_order). `machine` (optional): its work area serves --fit
+/// area. `start` (optional, mm per axis): where the pen is before the path, when
+/// --order-start does not say. Throws InputError for bad files, std::invalid_argument for bad
+/// placement or order options.
+LoadedPath load_path_report(const PathOptions& options, const MachineProfile* machine = nullptr,
+                            const std::vector<double>* start = nullptr);
+
+/// load_path_report's path alone.
+Path load_path(const PathOptions& options, const MachineProfile* machine = nullptr,
+               const std::vector<double>* start = nullptr);
 
 /// Column names of the axes in CSV output: x y z a b c v w (u is taken by the parameter).
 const char* axis_column_name(std::size_t axis);

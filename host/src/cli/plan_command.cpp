@@ -28,8 +28,9 @@ void add_plan_command(CLI::App& app, PlanCommandOptions& o) {
 PlannedJob plan_job(const PathOptions& path_options, const std::string& machine_file,
                     const std::vector<double>* lead_in_from) {
     PlannedJob job;
-    job.path = load_path(path_options);
     job.machine = load_machine_profile(machine_file);
+    // The work area serves --fit area; the lead-in's origin is where the order starts from.
+    job.path = load_path(path_options, &job.machine, lead_in_from);
     if (job.machine.axes.size() != job.path.axes) {
         throw InputError(machine_file, {}, "the machine has " + std::to_string(job.machine.axes.size()) +
                                                " axes but " + path_options.file + " has " +
