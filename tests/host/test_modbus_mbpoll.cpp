@@ -96,6 +96,7 @@ std::string config_values() {
     v << "0 1000 2 0 0 0 0 0 0 0";
     for (int a = 0; a < 2; ++a) v << ' ' << (250000 >> 16) << ' ' << (250000 & 0xFFFF) << ' ' << (3000000 >> 16) << ' '
                                   << (3000000 & 0xFFFF);
+    v << " 0 0 0 0 0 0 0 0";  // travel of both axes: 0, 0 = no soft limits
     return v.str();
 }
 
@@ -148,7 +149,7 @@ void check_device(const std::string& program, const std::string& link) {
     const std::string written =
         mbpoll(program, link + " -r " + std::to_string(mb::kConfig + 1) + " -t 4 -1 " + config_values());
     INFO("mbpoll output:\n" << written);
-    CHECK_THAT(written, Contains("Written 18 references"));
+    CHECK_THAT(written, Contains("Written 26 references"));
     const auto hz = values(mbpoll(program, link + " -r " + std::to_string(mb::kConfig + 1) + " -c 2 -t 4:int -B -1"));
     CHECK(hz.at(mb::kConfig + 1) == 1000);
     const auto flags = values(mbpoll(program, link + " -r " + std::to_string(st::kFlags + 1) + " -c 1 -t 3 -1"));
