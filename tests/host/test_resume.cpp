@@ -1,7 +1,7 @@
 // An interrupted drawing continued: a hold asked for while streaming, a host that dies
 // mid-stream, and a fault followed by a reset, each at seeded moments; the drawing's path
 // ticks of the interrupted run and of the resumed run together are the uninterrupted plan's,
-// tick for tick, pen included. Also `pathstream ctl`'s link: status and commands over Modbus
+// tick for tick, pen included (over TCP and RTU). Also `pathstream ctl`'s link: status and commands over Modbus
 // TCP and native CAN.
 #include <unistd.h>
 
@@ -41,7 +41,8 @@ namespace {
 using device::Command;
 using device::DeviceState;
 
-// The simulated Modbus device served over TCP and ticked on its own thread.
+// The simulated Modbus device served over TCP (or RTU on a pty pair) and ticked on its own
+// thread.
 struct ModbusDeviceThread {
     std::unique_ptr<sim::SimulatedModbusDevice> device;
     std::unique_ptr<hal::ModbusServer> server;
@@ -49,14 +50,18 @@ struct ModbusDeviceThread {
     std::thread thread;
 
     // `limits`: configured before the device thread starts (as a host's configuration would).
+    bool rtu = false;
+
     ModbusDeviceThread(const std::vector<Lsb>& start, double time_scale,
-                       const host::DeviceLimitsLsb* limits = nullptr) {
+                       const host::DeviceLimitsLsb* limits = nullptr, bool over_rtu = false)
+        : rtu(over_rtu) {
         device = sim::SimulatedModbusDevice::create(start);
         if (limits != nullptr) REQUIRE(device->configure(*limits) == Status::kOk);
         device->record(true);
         device->record_every_tick(true);
         server = std::make_unique<hal::ModbusServer>(
-            hal::ModbusServer::tcp(device->handler(), {"127.0.0.1", 0, 4}));
+            rtu ? hal::ModbusServer::rtu_pty(device->handler())
+                : hal::ModbusServer::tcp(device->handler(), {"127.0.0.1", 0, 4}));
         thread = std::thread([this, time_scale] {
             sim::DeviceLoopOptions o;
             o.time_scale = time_scale;
@@ -65,6 +70,7 @@ struct ModbusDeviceThread {
         });
     }
     std::string target() const {
+        if (rtu) return "modbus-rtu://" + server->client_device() + "?baud=115200&parity=N&unit=1";
         return "modbus-tcp://127.0.0.1:" + std::to_string(server->port()) + "?unit=1";
     }
     void join() {
@@ -194,6 +200,41 @@ TEST_CASE("resume: a hold at a seeded moment, the held job streamed on: every dr
             CHECK(first.final_status.state == static_cast<unsigned>(DeviceState::kHolding));
             CHECK((first.final_status.flags & 8u) == 0);  // at rest
             CHECK(first.final_status.outputs == 0);       // pen up
+            const host::HeldJob held{job_id, first.final_status.last_accepted};
+            host::StreamOptions again = options_for(dt.target());
+            again.held = &held;
+            const host::StreamReport second = host::stream_modbus(job.plan, job.machine, again);
+            CHECK(second.interrupted == 0);
+            CHECK(second.job == job_id);
+            dt.join();
+            check_equals_plan(drawing_ticks(*dt.device, dt.device->recorded_ticks().size(), 0, 0),
+                              job.plan);
+            check_steps_within_limits(*dt.device, job.machine);
+        }
+    }
+}
+
+TEST_CASE("resume over RTU: a hold at a seeded moment, the held job streamed on",
+          "[resume][rtu][threads]") {
+    const Job job = plan_example("wave.json");
+    for (unsigned seed = 31; seed < 31 + seeds_to_run(); ++seed) {
+        DYNAMIC_SECTION("seed " << seed) {
+            std::mt19937 rng(seed);
+            ModbusDeviceThread dt(start_of(job.plan), 4.0, nullptr, true);
+            std::atomic<int> interrupt{0};
+            host::StreamOptions o = options_for(dt.target());
+            o.interrupt.request = &interrupt;
+            std::uint32_t job_id = 0;
+            const std::uint64_t at =
+                std::uniform_int_distribution<std::uint64_t>(50, job.plan.total_ticks - 50)(rng);
+            o.observer = [&](const host::StreamTrace& t) {
+                job_id = t.job;
+                if (t.status.ticks_executed >= at) interrupt.store(1);
+            };
+            const host::StreamReport first = host::stream_modbus(job.plan, job.machine, o);
+            REQUIRE(first.interrupted == 1);
+            CHECK(first.final_status.state == static_cast<unsigned>(DeviceState::kHolding));
+            CHECK(first.final_status.outputs == 0);  // pen up
             const host::HeldJob held{job_id, first.final_status.last_accepted};
             host::StreamOptions again = options_for(dt.target());
             again.held = &held;
