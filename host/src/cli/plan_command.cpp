@@ -21,7 +21,7 @@ void add_plan_command(CLI::App& app, PlanCommandOptions& o) {
                 "CSV tick,t,x,y,...,pen in mm");
     add_path_options(*cmd, o.path);
     cmd->add_option("--machine,-m", o.machine, "machine profile (JSON, docs/formats.md)")->required()->check(CLI::ExistingFile);
-    cmd->add_option("--out,-o", o.output, "CSV output file (default: only the summary)");
+    cmd->add_option("--out,-o", o.output, "CSV output file, - for standard output (the summary then goes to standard error; default: only the summary)");
     cmd->add_flag("--json", o.json, "print the summary as one JSON document on standard output");
 }
 
@@ -134,10 +134,8 @@ nlohmann::ordered_json plan_summary_json(const PlanCommandOptions& o, const Plan
     return j;
 }
 
-/// Writes every executed tick as CSV (atomically: a failed run leaves no file).
-void write_plan_csv(const PlannedJob& job, const std::string& output) {
-    AtomicFile file(output);
-    std::ostream& csv = file.stream();
+/// Writes every executed tick as CSV to `csv`.
+void write_plan_rows(const PlannedJob& job, std::ostream& csv) {
     csv << "tick,t";
     for (std::size_t a = 0; a < job.path.axes; ++a) csv << ',' << axis_column_name(a);
     csv << ",pen\n";
@@ -148,18 +146,34 @@ void write_plan_csv(const PlannedJob& job, const std::string& output) {
         }
         csv << ',' << (t.pen_down ? 1 : 0) << '\n';
     });
+}
+
+/// Writes every executed tick as CSV: to a file atomically (a failed run leaves no file), or
+/// to standard output for "-".
+void write_plan_csv(const PlannedJob& job, const std::string& output) {
+    if (output == "-") {
+        write_plan_rows(job, std::cout);
+        std::cout.flush();
+        if (!std::cout) throw std::runtime_error("standard output: write failed");
+        return;
+    }
+    AtomicFile file(output);
+    write_plan_rows(job, file.stream());
     file.commit();
 }
 
 }  // namespace
 
 int run_plan(const PlanCommandOptions& o) {
+    if (o.json && o.output == "-") {
+        throw std::invalid_argument("--json and -o -: both would be written to standard output");
+    }
     const PlannedJob job = plan_job(o.path, o.machine);
     if (!o.output.empty()) write_plan_csv(job, o.output);
     const bool failed = !job.check.within_limits || job.check.drawing_while_pen_moves;
     // With --json, standard output holds the document or, on failure, nothing: the text
     // summary the error message points to then goes to standard error.
-    std::ostream& text = o.json ? std::cerr : std::cout;
+    std::ostream& text = o.json || o.output == "-" ? std::cerr : std::cout;
     if (!o.json || failed) {
         text << "pathstream plan: " << o.path.file << " on " << o.machine
              << (o.output.empty() ? "" : " -> " + o.output) << '\n';
