@@ -452,7 +452,12 @@ int run_stream(const StreamCommandOptions& o) {
             "': unknown scheme (want modbus-tcp://, modbus-rtu:// or can://)");
     }
     std::vector<double> rest_mm;
-    if (o.lead_in) {
+    // The path order starts where the device rests (its first subpath is the one nearest to
+    // it), so the drawing begins where the pen is: read it first, as --lead-in does.
+    PathOptions path = o.path;
+    const bool cia402 = url.rfind("can://", 0) == 0 && url.find("protocol=cia402") != std::string::npos;
+    const bool order_from_rest = !cia402 && !path.keep_order && path.order_start.empty();
+    if (o.lead_in || order_from_rest) {
         const MachineProfile machine = load_machine_profile(o.machine);
         std::vector<Lsb> rest;
         if (o.stream.target.rfind("can://", 0) == 0) {
@@ -468,13 +473,19 @@ int run_stream(const StreamCommandOptions& o) {
             rest = modbus_rest_position(machine, o.stream);
         }
         for (const Lsb p : rest) rest_mm.push_back(p * machine.mm_per_lsb);
-        std::printf("lead-in       from the device's rest position");
-        for (std::size_t a = 0; a < rest_mm.size(); ++a) {
-            std::printf(" %s %.4f mm", machine.axes[a].name.c_str(), rest_mm[a]);
+        if (o.lead_in) {
+            std::printf("lead-in       from the device's rest position");
+            for (std::size_t a = 0; a < rest_mm.size(); ++a) {
+                std::printf(" %s %.4f mm", machine.axes[a].name.c_str(), rest_mm[a]);
+            }
+            std::printf("\n");
+        } else {
+            for (std::size_t a = 0; a < rest_mm.size(); ++a) {
+                path.order_start += (a ? "," : "") + exact_decimal(rest_mm[a]);
+            }
         }
-        std::printf("\n");
     }
-    const PlannedJob planned = plan_job(o.path, o.machine, o.lead_in ? &rest_mm : nullptr);
+    const PlannedJob planned = plan_job(path, o.machine, o.lead_in ? &rest_mm : nullptr);
     if (g_interrupts.load() > 0) {
         std::printf("interrupted   while planning: nothing was sent to the device\n");
         return kExitInterrupted;

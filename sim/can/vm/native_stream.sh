@@ -50,7 +50,8 @@ for id in 105 185 205 285 305 385 405 485 505; do
 done
 
 vm_expect 0 pathstream plan "$data/wave.json" --machine "$data/pen_plotter.json" --out plan.csv > /dev/null
-vm_expect 0 pathstream plan wave_back.json --machine "$data/pen_plotter.json" --out plan2.csv > /dev/null
+# The stream orders from where the device rests (60, 0): the file order; the origin would reverse it.
+vm_expect 0 pathstream plan wave_back.json --machine "$data/pen_plotter.json" --keep-order --out plan2.csv > /dev/null
 # plan*.csv: tick,t,x,y,pen in mm (0.001 mm per LSB), ticks 0..N (N: the end point after the
 # last tick); rec.csv: tick,x,y,pen in LSB, the executed path ticks of both jobs. The second
 # plan's ticks follow the first's N1 (its tick 0 is the first's end point, the same point).
