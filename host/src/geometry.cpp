@@ -1,6 +1,7 @@
 // Path -> cubic Bezier segments in millimetres (the planner's input), and Bezier evaluation.
 #include "pathstream/host/geometry.hpp"
 
+#include <cmath>
 #include <stdexcept>
 #include <string>
 
@@ -196,6 +197,26 @@ void prepend_lead_in(std::vector<BezierSegment>& segments, const PathPoint& from
     travel.p[0] = from;
     travel.p[3] = to;  // exactly the path's start: consecutive segments share end points
     segments.insert(segments.begin(), travel);
+}
+
+std::vector<double> extreme_parameters(const BezierSegment& s, std::size_t axis) {
+    const double p0 = s.p[0][axis], p1 = s.p[1][axis], p2 = s.p[2][axis], p3 = s.p[3][axis];
+    // derivative / 3 = A u^2 + B u + C
+    const double A = -p0 + 3 * p1 - 3 * p2 + p3, B = 2 * (p0 - 2 * p1 + p2), C = p1 - p0;
+    std::vector<double> us{0.0, 1.0};
+    const auto keep = [&us](double u) {
+        if (u > 0 && u < 1) us.push_back(u);
+    };
+    if (std::fabs(A) > 1e-15) {
+        const double disc = B * B - 4 * A * C;
+        if (disc >= 0) {
+            keep((-B + std::sqrt(disc)) / (2 * A));
+            keep((-B - std::sqrt(disc)) / (2 * A));
+        }
+    } else if (std::fabs(B) > 1e-15) {
+        keep(-C / B);
+    }
+    return us;
 }
 
 }  // namespace pathstream::host

@@ -173,80 +173,57 @@ unsigned seeds_to_run() {
     return env != nullptr && std::atoi(env) > 0 ? static_cast<unsigned>(std::atoi(env)) : 3u;
 }
 
+
+// Holds the job at a seeded path tick, then streams the held job on; every drawing tick once.
+// The hold is asked in the first half of the drawing so that a slow bus (RTU polls take
+// longer) still sees the moment before the drawing ends.
+void hold_then_resume(const Job& job, unsigned seed, bool rtu) {
+    std::mt19937 rng(seed);
+    ModbusDeviceThread dt(start_of(job.plan), 4.0, nullptr, rtu);
+    std::atomic<int> interrupt{0};
+    host::StreamOptions o = options_for(dt.target());
+    o.interrupt.request = &interrupt;
+    std::uint32_t job_id = 0;
+    std::uint64_t seen_ticks = 0;
+    const std::uint64_t at =
+        std::uniform_int_distribution<std::uint64_t>(50, job.plan.total_ticks / 2)(rng);
+    o.observer = [&](const host::StreamTrace& t) {
+        job_id = t.job;
+        seen_ticks = t.status.ticks_executed;
+        if (seen_ticks >= at) interrupt.store(1);
+    };
+    const host::StreamReport first = host::stream_modbus(job.plan, job.machine, o);
+    INFO("interrupted at path tick " << seen_ticks << " (asked at " << at << ")");
+    REQUIRE(first.interrupted == 1);
+    CHECK(first.final_status.state == static_cast<unsigned>(DeviceState::kHolding));
+    CHECK((first.final_status.flags & 8u) == 0);  // at rest
+    CHECK(first.final_status.outputs == 0);       // pen up
+    const host::HeldJob held{job_id, first.final_status.last_accepted};
+    host::StreamOptions again = options_for(dt.target());
+    again.held = &held;
+    const host::StreamReport second = host::stream_modbus(job.plan, job.machine, again);
+    CHECK(second.interrupted == 0);
+    CHECK(second.job == job_id);
+    dt.join();
+    check_equals_plan(drawing_ticks(*dt.device, dt.device->recorded_ticks().size(), 0, 0),
+                      job.plan);
+    check_steps_within_limits(*dt.device, job.machine);
+}
+
 }  // namespace
 
 TEST_CASE("resume: a hold at a seeded moment, the held job streamed on: every drawing tick once",
           "[resume][modbus][threads]") {
     const Job job = plan_example("wave.json");
-    for (unsigned seed = 1; seed <= seeds_to_run(); ++seed) {
-        DYNAMIC_SECTION("seed " << seed) {
-            std::mt19937 rng(seed);
-            ModbusDeviceThread dt(start_of(job.plan), 4.0);
-            std::atomic<int> interrupt{0};
-            host::StreamOptions o = options_for(dt.target());
-            o.interrupt.request = &interrupt;
-            std::uint32_t job_id = 0;
-            std::uint64_t seen_ticks = 0;
-            const std::uint64_t at =
-                std::uniform_int_distribution<std::uint64_t>(50, job.plan.total_ticks - 50)(rng);
-            o.observer = [&](const host::StreamTrace& t) {
-                job_id = t.job;
-                seen_ticks = t.status.ticks_executed;
-                if (seen_ticks >= at) interrupt.store(1);
-            };
-            const host::StreamReport first = host::stream_modbus(job.plan, job.machine, o);
-            INFO("interrupted at path tick " << seen_ticks << " (asked at " << at << ")");
-            REQUIRE(first.interrupted == 1);
-            CHECK(first.final_status.state == static_cast<unsigned>(DeviceState::kHolding));
-            CHECK((first.final_status.flags & 8u) == 0);  // at rest
-            CHECK(first.final_status.outputs == 0);       // pen up
-            const host::HeldJob held{job_id, first.final_status.last_accepted};
-            host::StreamOptions again = options_for(dt.target());
-            again.held = &held;
-            const host::StreamReport second = host::stream_modbus(job.plan, job.machine, again);
-            CHECK(second.interrupted == 0);
-            CHECK(second.job == job_id);
-            dt.join();
-            check_equals_plan(drawing_ticks(*dt.device, dt.device->recorded_ticks().size(), 0, 0),
-                              job.plan);
-            check_steps_within_limits(*dt.device, job.machine);
-        }
-    }
+    for (unsigned seed = 1; seed <= seeds_to_run(); ++seed)
+        DYNAMIC_SECTION("seed " << seed) { hold_then_resume(job, seed, false); }
 }
 
 TEST_CASE("resume over RTU: a hold at a seeded moment, the held job streamed on",
           "[resume][rtu][threads]") {
     const Job job = plan_example("wave.json");
-    for (unsigned seed = 31; seed < 31 + seeds_to_run(); ++seed) {
-        DYNAMIC_SECTION("seed " << seed) {
-            std::mt19937 rng(seed);
-            ModbusDeviceThread dt(start_of(job.plan), 4.0, nullptr, true);
-            std::atomic<int> interrupt{0};
-            host::StreamOptions o = options_for(dt.target());
-            o.interrupt.request = &interrupt;
-            std::uint32_t job_id = 0;
-            const std::uint64_t at =
-                std::uniform_int_distribution<std::uint64_t>(50, job.plan.total_ticks - 50)(rng);
-            o.observer = [&](const host::StreamTrace& t) {
-                job_id = t.job;
-                if (t.status.ticks_executed >= at) interrupt.store(1);
-            };
-            const host::StreamReport first = host::stream_modbus(job.plan, job.machine, o);
-            REQUIRE(first.interrupted == 1);
-            CHECK(first.final_status.state == static_cast<unsigned>(DeviceState::kHolding));
-            CHECK(first.final_status.outputs == 0);  // pen up
-            const host::HeldJob held{job_id, first.final_status.last_accepted};
-            host::StreamOptions again = options_for(dt.target());
-            again.held = &held;
-            const host::StreamReport second = host::stream_modbus(job.plan, job.machine, again);
-            CHECK(second.interrupted == 0);
-            CHECK(second.job == job_id);
-            dt.join();
-            check_equals_plan(drawing_ticks(*dt.device, dt.device->recorded_ticks().size(), 0, 0),
-                              job.plan);
-            check_steps_within_limits(*dt.device, job.machine);
-        }
-    }
+    for (unsigned seed = 31; seed < 31 + seeds_to_run(); ++seed)
+        DYNAMIC_SECTION("seed " << seed) { hold_then_resume(job, seed, true); }
 }
 
 TEST_CASE("resume: the host dies at a seeded moment, the job goes on from the device's queue",

@@ -47,21 +47,7 @@ double segment_length(const BezierSegment& s) {
 /// Exact per-axis extent of a cubic: its ends and the roots of its derivative in (0, 1).
 void extend_box(const BezierSegment& s, std::vector<double>& lo, std::vector<double>& hi) {
     for (std::size_t a = 0; a < lo.size(); ++a) {
-        const double p0 = s.p[0][a], p1 = s.p[1][a], p2 = s.p[2][a], p3 = s.p[3][a];
-        // derivative / 3 = A u^2 + B u + C
-        const double A = -p0 + 3 * p1 - 3 * p2 + p3, B = 2 * (p0 - 2 * p1 + p2), C = p1 - p0;
-        std::vector<double> us{0.0, 1.0};
-        if (std::fabs(A) > 1e-15) {
-            const double disc = B * B - 4 * A * C;
-            if (disc >= 0) {
-                us.push_back((-B + std::sqrt(disc)) / (2 * A));
-                us.push_back((-B - std::sqrt(disc)) / (2 * A));
-            }
-        } else if (std::fabs(B) > 1e-15) {
-            us.push_back(-C / B);
-        }
-        for (double u : us) {
-            if (u < 0 || u > 1) continue;
+        for (double u : extreme_parameters(s, a)) {
             const double v = bezier_point(s, u)[a];
             lo[a] = std::min(lo[a], v);
             hi[a] = std::max(hi[a], v);

@@ -37,20 +37,7 @@ struct Affine {
 /// Extends the box by a cubic's exact extent: its ends and the roots of its derivative.
 void extend(const BezierSegment& s, Box2& box) {
     for (std::size_t axis = 0; axis < 2; ++axis) {
-        const double p0 = s.p[0][axis], p1 = s.p[1][axis], p2 = s.p[2][axis], p3 = s.p[3][axis];
-        const double A = -p0 + 3 * p1 - 3 * p2 + p3, B = 2 * (p0 - 2 * p1 + p2), C = p1 - p0;
-        std::vector<double> us{0.0, 1.0};
-        if (std::fabs(A) > 1e-15) {
-            const double disc = B * B - 4 * A * C;
-            if (disc >= 0) {
-                us.push_back((-B + std::sqrt(disc)) / (2 * A));
-                us.push_back((-B - std::sqrt(disc)) / (2 * A));
-            }
-        } else if (std::fabs(B) > 1e-15) {
-            us.push_back(-C / B);
-        }
-        for (double u : us) {
-            if (u < 0 || u > 1) continue;
+        for (double u : extreme_parameters(s, axis)) {
             const double v = bezier_point(s, u)[axis];
             double& lo = axis == 0 ? box.x_min : box.y_min;
             double& hi = axis == 0 ? box.x_max : box.y_max;

@@ -11,37 +11,6 @@
 namespace pathstream::host {
 namespace {
 
-// One axis of a cubic Bezier at t.
-double bezier(const std::array<PathPoint, 4>& p, std::size_t axis, double t) {
-    const double s = 1 - t;
-    return s * s * s * p[0][axis] + 3 * s * s * t * p[1][axis] + 3 * s * t * t * p[2][axis] +
-           t * t * t * p[3][axis];
-}
-
-// The parameters where one axis of the segment can be extreme: the ends and the roots of its
-// derivative inside (0, 1).
-std::vector<double> extreme_parameters(const std::array<PathPoint, 4>& p, std::size_t axis) {
-    std::vector<double> t{0.0, 1.0};
-    // d/dt = 3 (A t^2 + B t + C) with A = -p0 + 3p1 - 3p2 + p3, B = 2(p0 - 2p1 + p2), C = p1 - p0.
-    const double a = -p[0][axis] + 3 * p[1][axis] - 3 * p[2][axis] + p[3][axis];
-    const double b = 2 * (p[0][axis] - 2 * p[1][axis] + p[2][axis]);
-    const double c = p[1][axis] - p[0][axis];
-    const auto keep = [&t](double r) {
-        if (r > 0 && r < 1) t.push_back(r);
-    };
-    if (std::fabs(a) < 1e-15) {
-        if (std::fabs(b) > 1e-15) keep(-c / b);
-    } else {
-        const double d = b * b - 4 * a * c;
-        if (d >= 0) {
-            const double q = -0.5 * (b + std::copysign(std::sqrt(d), b));
-            if (q != 0) keep(c / q);
-            keep(q / a);
-        }
-    }
-    return t;
-}
-
 std::string mm(double v) {
     std::ostringstream s;
     s.setf(std::ios::fixed);
@@ -50,9 +19,10 @@ std::string mm(double v) {
     return s.str();
 }
 
-std::string point_text(const std::array<PathPoint, 4>& p, double t, std::size_t axes) {
+std::string point_text(const BezierSegment& s, double t, std::size_t axes) {
+    const PathPoint p = bezier_point(s, t);
     std::string text = "(";
-    for (std::size_t a = 0; a < axes; ++a) text += (a ? ", " : "") + mm(bezier(p, a, t));
+    for (std::size_t a = 0; a < axes; ++a) text += (a ? ", " : "") + mm(p[a]);
     return text + ") mm";
 }
 
@@ -70,13 +40,13 @@ void check_work_area(const std::vector<BezierSegment>& segments, const Path& pat
         for (std::size_t a = 0; a < axes && a < s.p[0].size(); ++a) {
             const AxisLimits& l = profile.axes[a];
             if (!l.has_travel) continue;
-            for (double t : extreme_parameters(s.p, a)) {
-                const double v = bezier(s.p, a, t);
+            for (double t : extreme_parameters(s, a)) {
+                const double v = bezier_point(s, t)[a];
                 if (v >= l.travel_min - 1e-6 && v <= l.travel_max + 1e-6) continue;
                 throw InputError(file, location_of(path, s.subpath),
                                  "subpath " + std::to_string(s.subpath + 1) +
                                      " leaves the work area: it reaches " + l.name + " = " + mm(v) +
-                                     " mm at " + point_text(s.p, t, axes) + "; " + l.name +
+                                     " mm at " + point_text(s, t, axes) + "; " + l.name +
                                      " travel is " + mm(l.travel_min) + " .. " + mm(l.travel_max) +
                                      " mm (" + profile.source + ")");
             }

@@ -34,6 +34,10 @@ void prepend_lead_in(std::vector<BezierSegment>& segments, const PathPoint& from
 /// Point of a segment at parameter u in [0, 1] (de Casteljau), and its first and second
 /// derivatives with respect to u.
 PathPoint bezier_point(const BezierSegment& s, double u);
+
+/// The parameters in [0, 1] where axis `axis` of `s` can be extreme: 0, 1 and the roots of its
+/// derivative inside (0, 1). Evaluating there gives the segment's exact extent on that axis.
+std::vector<double> extreme_parameters(const BezierSegment& s, std::size_t axis);
 PathPoint bezier_d1(const BezierSegment& s, double u);
 PathPoint bezier_d2(const BezierSegment& s, double u);
 
