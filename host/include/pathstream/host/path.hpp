@@ -32,12 +32,25 @@ struct Subpath {
     std::vector<PathPoint> points;
     double feed = 0;          ///< requested speed along it, mm/s; 0: the machine profile's feed
     SourceLocation location;  ///< where the subpath starts in the file
+    std::size_t layer = 0;    ///< index into Path::layers (0 when the file has no layers)
+    /// The machine pauses before drawing this subpath: it lifts the pen, comes to rest where
+    /// the previous subpath ended and holds until the operator resumes (a pen change between
+    /// layers, G-code M0/M1). Path order never moves a subpath across a pause.
+    bool pause_before = false;
+};
+
+/// A named group of subpaths plotted with one pen (an Inkscape layer, a stroke colour).
+struct PathLayer {
+    std::string name;         ///< the layer's label, or the colour ("#ff0000"), or "1", "2"...
+    SourceLocation location;  ///< where the layer starts in the file (line 0: no element)
+    double feed = 0;          ///< mm/s for its subpaths that set none; 0: the profile's
 };
 
 /// A whole path. Every point of every subpath has `axes` coordinates.
 struct Path {
     std::size_t axes = 2;
     std::vector<Subpath> subpaths;
+    std::vector<PathLayer> layers;  ///< empty: one unnamed layer; else every subpath's layer
     std::string units = "mm";  ///< the file's own unit, for output in it ("mm" or "in")
     double mm_per_unit = 1.0;  ///< coordinates above are already in mm; this converts back
 };
