@@ -37,6 +37,10 @@ struct Subpath {
     /// the previous subpath ended and holds until the operator resumes (a pen change between
     /// layers, G-code M0/M1). Path order never moves a subpath across a pause.
     bool pause_before = false;
+    /// Seconds the machine rests at this subpath's start before drawing it (G-code G4), with
+    /// the pen down (after the pen-down delay) or up (before the pen goes down).
+    double dwell_before = 0;
+    bool dwell_pen_down = false;
 };
 
 /// A named group of subpaths plotted with one pen (an Inkscape layer, a stroke colour).
