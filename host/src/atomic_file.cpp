@@ -1,5 +1,7 @@
 #include "pathstream/host/atomic_file.hpp"
 
+#include <iostream>
+
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -32,6 +34,18 @@ void AtomicFile::commit() {
         throw std::runtime_error(path_ + ": cannot rename output into place: " + std::strerror(errno));
     }
     committed_ = true;
+}
+
+void write_output(const std::string& output, const std::function<void(std::ostream&)>& write) {
+    if (output.empty() || output == "-") {
+        write(std::cout);
+        std::cout.flush();
+        if (!std::cout) throw std::runtime_error("standard output: write failed");
+        return;
+    }
+    AtomicFile file(output);
+    write(file.stream());
+    file.commit();
 }
 
 }  // namespace pathstream::host

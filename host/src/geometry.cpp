@@ -135,6 +135,7 @@ std::vector<BezierSegment> to_bezier_segments(const Path& path) {
             travel.subpath = s;
             out.push_back(std::move(travel));
         }
+        const std::size_t first = out.size();
         for (auto& p : segments) {
             BezierSegment seg;
             seg.p = std::move(p);
@@ -143,6 +144,9 @@ std::vector<BezierSegment> to_bezier_segments(const Path& path) {
             seg.feed = sp.feed;
             out.push_back(std::move(seg));
         }
+        out[first].pause_before = sp.pause_before;
+        out[first].dwell_before = sp.dwell_before;
+        out[first].dwell_pen_down = sp.dwell_pen_down;
     }
     return out;
 }

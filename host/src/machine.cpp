@@ -5,6 +5,8 @@
 #include <nlohmann/json.hpp>
 #include <set>
 #include <sstream>
+#include <string>
+#include <utility>
 
 #include "pathstream/host/input_error.hpp"
 #include "pathstream/host/json_document.hpp"
@@ -12,6 +14,13 @@
 
 namespace pathstream::host {
 namespace {
+
+// A JSON object key as a JSON pointer token (RFC 6901: ~ as ~0, / as ~1).
+std::string json_pointer_token(const std::string& key) {
+    std::string out;
+    for (const char c : key) out += c == '~' ? std::string("~0") : c == '/' ? std::string("~1") : std::string(1, c);
+    return out;
+}
 
 using nlohmann::json;
 
@@ -37,7 +46,7 @@ public:
     MachineProfile read(const json& root) const {
         if (!root.is_object()) fail("", "a machine profile must be a JSON object");
         only_keys(root, "", {"axes", "mm_per_lsb", "tick_hz", "ticks_per_span", "feed", "travel_feed",
-                             "pen_down_delay", "pen_up_delay", "chord_tolerance", "gpio"});
+                             "pen_down_delay", "pen_up_delay", "chord_tolerance", "gpio", "layer_feeds"});
         MachineProfile p;
         if (!root.contains("axes")) fail("", "machine profile has no \"axes\"");
         const json& axes = root["axes"];
@@ -95,6 +104,14 @@ public:
             fail(root.contains("chord_tolerance") ? "/chord_tolerance" : "/mm_per_lsb", m.str());
         }
         if (root.contains("gpio")) p.gpio = gpio(root["gpio"], p);
+        if (root.contains("layer_feeds")) {
+            const json& f = root["layer_feeds"];
+            if (!f.is_object()) fail("/layer_feeds", "layer_feeds must be an object like {\"red\": 20} (mm/s per layer)");
+            for (const auto& [name, value] : f.items()) {
+                const std::string ptr = "/layer_feeds/" + json_pointer_token(name);
+                p.layer_feeds.emplace_back(name, number(value, ptr, "layer feed", 0, 1e5, true, "mm/s"));
+            }
+        }
         return p;
     }
 

@@ -74,5 +74,20 @@ expect device-home-needs-machine 2 "--home: needs --machine" -- "$bin" device --
 expect stream-lead-in-can 6 "nosuchcan0: no such interface" -- "$bin" stream "$src/examples/rose.json" -m "$machine" -t "can://nosuchcan0?node=1" --lead-in
 expect device-axes-and-machine 2 "the axis count comes from --machine" -- "$bin" device -m "$machine" --axes 3
 
+# Layers and pen changes; one CLI: standard input and -o - everywhere.
+expect layers-plan 0 'layers: 2 ("outline" 2 subpaths' -- "$bin" plan "$src/examples/two_pens.svg" -m "$machine"
+expect layers-pause 0 '1 pause for the operator' -- "$bin" plan "$src/examples/two_pens.svg" -m "$machine"
+expect layers-one 0 'layers: 2 ("outline" 0 subpaths 0.0 mm, "accent" 2 subpaths' -- "$bin" check "$src/examples/two_pens.svg" --layer accent
+expect layers-no-pause 0 '0 pauses for the operator' -- "$bin" check "$src/examples/two_pens.svg" --no-pause
+expect layers-unknown 2 '--layer 3: no such layer (the drawing has 1: "outline", 2: "accent")' -- "$bin" check "$src/examples/two_pens.svg" --layer 3
+expect stdin-json 0 '<stdin>: valid, 2 axes' -- bash -c "\"$bin\" check - < \"$src/examples/rose.json\""
+expect stdin-svg 0 'layers: 2' -- bash -c "cat \"$src/examples/two_pens.svg\" | \"$bin\" check -"
+expect stdin-bad 1 '<stdin>:1:2: invalid JSON' -- bash -c "echo '{oops' | \"$bin\" check -"
+expect stdin-empty 1 'standard input is empty' -- bash -c "\"$bin\" check - < /dev/null"
+expect format-option 1 'rose.json' -- "$bin" check "$src/examples/rose.json" --format svg
+expect setpoints-svg 0 'every setpoint' -- "$bin" setpoints "$src/examples/two_pens.svg" -m "$machine" -o -
+expect eval-stdout 0 'span,u,x,y' -- "$bin" eval "$src/examples/rose.json" -o -
+[ ! -e "$src/-" ] && [ ! -e ./- ] && passed=$((passed + 1)) || { echo "FAIL: a file named - was written"; failures=$((failures + 1)); }
+
 echo "cli: $passed passed, $failures failed"
 [ "$failures" -eq 0 ]

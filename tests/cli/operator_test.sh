@@ -2,7 +2,8 @@
 # An operator's session with the real binaries over Modbus TCP: `pathstream device` serving,
 # `pathstream stream` interrupted by SIGINT at seeded moments (one Ctrl-C: hold; two: stop) or
 # killed (SIGKILL: the host dies, the device runs out its queue), `pathstream stream --resume`,
-# and `pathstream ctl` status and commands (pen, jog, position, home refused without switches). Every run must end
+# and `pathstream ctl` status and commands (pen, jog, position, home refused without switches),
+# and a two-layer drawing's pen-change pause resumed by `ctl resume`. Every run must end
 # with the device idle at the drawing's end and exactly the plan's path ticks executed, pen
 # down on exactly the plan's pen-down ticks (the device's record).
 #   operator_test.sh PATHSTREAM_BINARY SOURCE_DIR WORK_DIR [RUNS]
@@ -48,7 +49,7 @@ start_device 2 || exit 1
 out=$("$bin" ctl "$target" status -m "$machine" 2>&1)
 [[ "$out" == *"state         idle"* && "$out" == *"x 139.3220 mm (139322 LSB)"* ]] && ok || fail "ctl status: $out"
 out=$("$bin" ctl "$target" status --json 2>&1)
-echo "$out" | /usr/bin/python3 -c 'import json,sys; d=json.load(sys.stdin); assert d["state"]=="idle" and d["position"][0]["position_lsb"]==139322 and d["protocol_version"]==3 and d["pen_down"] is False and d["position"][0]["homing"]=="not homed"' && ok || fail "ctl status --json: $out"
+echo "$out" | /usr/bin/python3 -c 'import json,sys; d=json.load(sys.stdin); assert d["state"]=="idle" and d["position"][0]["position_lsb"]==139322 and d["protocol_version"]==4 and d["pen_down"] is False and d["position"][0]["homing"]=="not homed"' && ok || fail "ctl status --json: $out"
 out=$("$bin" ctl "$target" hold 2>&1); rc=$?
 [ $rc -eq 6 ] && [[ "$out" == *"device refused hold while idle: command not allowed in this state"* ]] && ok || fail "ctl hold idle: $rc $out"
 out=$("$bin" ctl "$target" jog x 5.5 --feed 20 -m "$machine" 2>&1)
@@ -90,6 +91,30 @@ out=$("$bin" ctl "$target" resume 2>&1)
 [[ "$out" == *"accepted: holding -> running"* ]] && ok || fail "ctl resume: $out"
 wait "$stream_pid"; rc=$?
 [ $rc -eq 0 ] && ok || fail "stream held and resumed by ctl: exit $rc: $(cat "$work/stream0.log")"
+stop_device
+
+# ---- Two layers: the device pauses pen up between them until `ctl resume` ---------------
+start_device 2 || exit 1
+"$bin" stream "$src/examples/two_pens.svg" -m "$machine" -t "$target" --no-journal \
+  --events "$work/pause.ndjson" < /dev/null > "$work/stream_pause.log" 2>&1 &
+stream_pid=$!
+paused=
+for _ in $(seq 1200); do
+  out=$("$bin" ctl "$target" status --json 2>/dev/null)
+  echo "$out" | grep -q '"paused": true' && { paused=1; break; }
+  sleep 0.05
+done
+[ -n "$paused" ] && ok || fail "the device never paused between the layers: $(cat "$work/stream_pause.log")"
+echo "$out" | /usr/bin/python3 -c 'import json,sys; d=json.load(sys.stdin); assert d["state"]=="holding" and d["pen_down"] is False' && ok || fail "paused: $out"
+sleep 0.5
+"$bin" ctl "$target" status --json | grep -q '"paused": true' && ok || fail "the pause ended without the operator"
+grep -q 'paused for a pen change, layer "accent" next: go on with `pathstream ctl' "$work/stream_pause.log" && ok ||
+  fail "no pause message: $(cat "$work/stream_pause.log")"
+out=$("$bin" ctl "$target" resume 2>&1)
+[[ "$out" == *"accepted: holding -> running"* ]] && ok || fail "ctl resume at the pause: $out"
+wait "$stream_pid"; rc=$?
+[ $rc -eq 0 ] && ok || fail "stream with a pause: exit $rc: $(cat "$work/stream_pause.log")"
+grep -q '"event":"pause".*"next":"layer \\"accent\\""' "$work/pause.ndjson" && ok || fail "no pause event: $(cat "$work/pause.ndjson")"
 stop_device
 
 # ---- Ctrl-C (once, twice) or SIGKILL at seeded moments, then --resume --------------------

@@ -24,7 +24,9 @@
 #include "pathstream/host/device_link.hpp"
 #include "pathstream/host/device_setup.hpp"
 #include "pathstream/host/job_journal.hpp"
+#include "pathstream/host/layers.hpp"
 #include "pathstream/host/modbus_stream.hpp"
+#include "pathstream/host/svg_path.hpp"
 #include "pathstream/sim/can_device.hpp"
 #include "pathstream/sim/can_loopback.hpp"
 #include "pathstream/sim/modbus_device.hpp"
@@ -486,4 +488,45 @@ TEST_CASE("ctl's link over native CAN: status, commands, a hold of a running str
     stop = true;
     t.join();
     test::check_recorded(job.plan, *device, 0);
+}
+
+TEST_CASE("pause: a two-layer drawing holds pen up between its layers, resumed from the host",
+          "[resume][pause][threads]") {
+    Job job;
+    job.machine = host::load_machine_profile(std::string(PATHSTREAM_SOURCE_DIR) +
+                                             "/examples/machines/pen_plotter.json");
+    host::Path path =
+        host::load_svg_path(std::string(PATHSTREAM_SOURCE_DIR) + "/examples/two_pens.svg");
+    REQUIRE(path.layers.size() == 2);
+    path = host::group_by_layer(path);
+    host::pause_between_layers(path);
+    job.plan = host::plan_path(host::to_bezier_segments(path), job.machine);
+    REQUIRE(job.plan.pauses.size() == 1);
+    const host::PlanPause pause = job.plan.pauses.front();
+    CHECK(path.subpaths.at(pause.subpath).layer == 1);
+    ModbusDeviceThread dt(start_of(job.plan), 4.0);
+    host::StreamOptions o = options_for(dt.target());
+    std::vector<std::size_t> pauses_seen;
+    int paused_reads = 0;
+    o.interrupt.on_pause = [&](std::size_t index) { pauses_seen.push_back(index); };
+    // The operator presses Enter after the host has seen the pause twenty times.
+    o.interrupt.resume_requested = [&] { return ++paused_reads > 20; };
+    std::uint64_t held_at_ticks = 0;
+    bool pen_down_while_paused = false;
+    o.observer = [&](const host::StreamTrace& t) {
+        if (!t.status.paused()) return;
+        held_at_ticks = t.status.ticks_executed;
+        pen_down_while_paused = pen_down_while_paused || t.status.pen_down();
+        CHECK(t.status.state == static_cast<unsigned>(DeviceState::kHolding));
+    };
+    const host::StreamReport r = host::stream_modbus(job.plan, job.machine, o);
+    CHECK(r.interrupted == 0);
+    REQUIRE(pauses_seen == std::vector<std::size_t>{0});
+    CHECK(paused_reads > 20);
+    CHECK(held_at_ticks == pause.tick);
+    CHECK_FALSE(pen_down_while_paused);
+    dt.join();
+    check_equals_plan(drawing_ticks(*dt.device, dt.device->recorded_ticks().size(), 0, 0),
+                      job.plan);
+    check_steps_within_limits(*dt.device, job.machine);
 }

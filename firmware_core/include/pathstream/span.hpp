@@ -39,6 +39,7 @@ struct SpanStamp {
     std::uint32_t job = 0;
     std::int32_t end_tangent[Axes] = {};  ///< Hermite T1 per axis (LSB per span)
     bool job_end = false;
+    bool pause_after = false;  ///< the device holds at this span's end (it ends at rest)
 };
 
 /// A span validated and converted to forward-differencing state at its first tick.

@@ -31,6 +31,7 @@ enum class [[nodiscard]] Status : std::uint8_t{
     kUnknownCommand = 20,         ///< a command value the device does not know
     kNoHoming = 21,               ///< home: no homing switch for a requested axis
     kOutsideTravel = 22,          ///< the span could leave an axis's travel (its soft limits)
+    kPauseMoving = 23,            ///< a span with a pause after it must end at rest
 };
 
 /// Short stable name of a status, for logs and host messages. Never null.
@@ -65,6 +66,8 @@ constexpr const char* status_name(Status s) {
             return "no homing switch for that axis";
         case Status::kOutsideTravel:
             return "span leaves an axis's travel (soft limits)";
+        case Status::kPauseMoving:
+            return "a span followed by a pause must end at rest";
     }
     return "unknown status";
 }

@@ -9,6 +9,7 @@
 #include <optional>
 #include <string>
 
+#include "pathstream/host/layers.hpp"
 #include "pathstream/host/geometry.hpp"
 
 namespace pathstream::host {
@@ -110,7 +111,7 @@ void print_load_report(const LoadedPath& loaded) {
 
 /// The human summary (the first 20 subpaths; the rest are counted).
 void print_text(const CheckOptions& o, const Path& path, const CheckFigures& f) {
-    std::printf("%s: valid, %zu axes, units %s\n", o.path.file.c_str(), path.axes, path.units.c_str());
+    std::printf("%s: valid, %zu axes, units %s\n", path_display_name(o.path.file).c_str(), path.axes, path.units.c_str());
     std::printf("  subpaths: %zu\n", path.subpaths.size());
     for (std::size_t i = 0; i < path.subpaths.size() && i < 20; ++i) {
         const Subpath& sp = path.subpaths[i];
@@ -154,7 +155,7 @@ nlohmann::ordered_json summary_json(const CheckOptions& o, const LoadedPath& loa
         box[axis_column_name(a)] = {{"min", f.lo[a]}, {"max", f.hi[a]}};
     }
     nlohmann::ordered_json j;
-    j["file"] = o.path.file;
+    j["file"] = path_display_name(o.path.file);
     j["valid"] = true;
     j["axes"] = path.axes;
     j["units"] = path.units;
@@ -169,6 +170,8 @@ nlohmann::ordered_json summary_json(const CheckOptions& o, const LoadedPath& loa
                                                             {"box_before_mm", box_json(loaded.placement.before)},
                                                             {"box_after_mm", box_json(loaded.placement.after)}}
                                    : nlohmann::ordered_json(nullptr);
+    j["layers"] = layers_json(path);
+    j["pauses"] = count_pauses(path);
     const OrderReport& r = loaded.order;
     j["order"] = loaded.ordered ? nlohmann::ordered_json{{"travel_before_mm", r.travel_before},
                                                          {"travel_after_mm", r.travel_after},
@@ -191,6 +194,8 @@ int run_check(const CheckOptions& o) {
     } else {
         print_text(o, loaded.path, figures);
         print_load_report(loaded);
+        const std::string layers = layers_text(loaded.path);
+        if (!layers.empty()) std::printf("  %s\n", layers.c_str());
     }
     return 0;
 }

@@ -49,6 +49,7 @@ std::string flags_text(const DeviceSnapshot& s) {
     std::string t = s.configured() ? "configured" : "not configured";
     if (s.held_by_underrun()) t += ", held by underrun";
     if (s.homing_runs()) t += ", homing";
+    if (s.paused()) t += ", paused (a programmed pause: resume goes on)";
     return t;
 }
 
@@ -82,6 +83,7 @@ nlohmann::json to_json(const DeviceSnapshot& s, const Units& u, const std::strin
     j["configured"] = s.configured();
     j["held_by_underrun"] = s.held_by_underrun();
     j["homing"] = s.homing_runs();
+    j["paused"] = s.paused();
     j["pen_down"] = s.pen_down();
     j["queued_spans"] = s.queued;
     j["free_slots"] = s.free_slots;

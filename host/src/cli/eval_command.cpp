@@ -20,7 +20,7 @@ void add_eval_command(CLI::App& app, EvalOptions& o) {
     cmd->add_option("--samples-per-span,-n", o.samples_per_span, "N: samples per span")
         ->capture_default_str()
         ->check(CLI::Range(1u, kMaxSpanTicks));
-    cmd->add_option("--out,-o", o.output, "CSV output file (default: standard output)");
+    cmd->add_option("--out,-o", o.output, "CSV output file; - or none: standard output");
     cmd->add_option("--lsb", o.mm_per_lsb, "millimetres per LSB")->capture_default_str()->check(CLI::Range(1e-6, 10.0));
     cmd->add_option("--machine,-m", o.machine,
                     "machine profile (JSON): takes the LSB size from it (instead of --lsb)")
@@ -66,20 +66,12 @@ int run_eval(const EvalOptions& o) {
         o.machine.empty() ? std::nullopt : std::optional<MachineProfile>(load_machine_profile(o.machine));
     const Path path = load_path(o.path, machine ? &*machine : nullptr);
     const double lsb = machine ? machine->mm_per_lsb : o.mm_per_lsb;
-    const std::vector<CoreSpan> spans = uniform_core_spans(path, o.path.file, lsb, o.samples_per_span);
+    const std::vector<CoreSpan> spans = uniform_core_spans(path, path_display_name(o.path.file), lsb, o.samples_per_span);
     std::size_t rows = 0;
-    if (o.output.empty()) {
-        rows = write_rows(path, spans, lsb, o.samples_per_span, std::cout);
-        std::cout.flush();
-        if (!std::cout) throw std::runtime_error("standard output: write failed");
-    } else {
-        AtomicFile file(o.output);
-        rows = write_rows(path, spans, lsb, o.samples_per_span, file.stream());
-        file.commit();
-    }
-    std::cerr << "pathstream eval: " << o.path.file << ": " << rows << " samples of " << path.subpaths.size()
+    write_output(o.output, [&](std::ostream& csv) { rows = write_rows(path, spans, lsb, o.samples_per_span, csv); });
+    std::cerr << "pathstream eval: " << path_display_name(o.path.file) << ": " << rows << " samples of " << path.subpaths.size()
               << " subpath(s) in " << path.units << ", exact to one LSB (" << lsb << " mm)"
-              << (o.output.empty() ? "" : ", written to " + o.output) << '\n';
+              << (o.output.empty() || o.output == "-" ? "" : ", written to " + o.output) << '\n';
     return 0;
 }
 

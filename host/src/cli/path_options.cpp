@@ -4,11 +4,14 @@
 #include <charconv>
 #include <cctype>
 #include <cmath>
+#include <iostream>
+#include <sstream>
 #include <stdexcept>
 #include <utility>
 
 #include "pathstream/host/csv_path.hpp"
 #include "pathstream/host/gcode_path.hpp"
+#include "pathstream/host/layers.hpp"
 #include "pathstream/host/input_error.hpp"
 #include "pathstream/host/json_path.hpp"
 #include "pathstream/host/svg_path.hpp"
@@ -18,9 +21,11 @@ namespace pathstream::host {
 void add_path_options(CLI::App& command, PathOptions& o) {
     command
         .add_option("file", o.file,
-                    "path file: .json, .csv, .svg, .gcode/.ngc/.nc/.gc (docs/formats.md)")
+                    "path file: .json, .csv, .svg, .gcode/.ngc/.nc/.gc (docs/formats.md); -: standard input")
         ->required()
-        ->check(CLI::ExistingFile);
+        ->check(CLI::IsMember({"-"}) | CLI::ExistingFile);
+    command.add_option("--format", o.format, "the path file's format when its name does not tell (or for -)")
+        ->check(CLI::IsMember({"json", "csv", "svg", "gcode"}));
     command.add_option("--csv-basis", o.csv_basis, "basis of CSV points")
         ->capture_default_str()
         ->check(CLI::IsMember({"bspline", "catmull-rom", "bezier", "polyline"}));
@@ -62,6 +67,11 @@ void add_path_options(CLI::App& command, PathOptions& o) {
         ->check(CLI::Range(0.0, 10.0));
     command.add_option("--order-start", o.order_start,
                        "X,Y mm: where the pen is before the first subpath, for the order (default: the origin)");
+    command.add_option("--layer", o.layers,
+                       "plot only this layer (its name, or its number from 1; repeatable); placement still "
+                       "uses the whole drawing, so layers plotted in separate runs line up");
+    command.add_flag("--no-pause", o.no_pause,
+                     "no pause for a pen change between layers (they plot one after the other)");
 }
 
 namespace {
@@ -94,6 +104,15 @@ std::vector<double> parse_numbers(const std::string& text, const std::string& op
 
 /// The file as its reader gives it, by extension.
 Path read_path(const PathOptions& o);
+
+/// The G-code reader's options from the command line's.
+GcodeOptions gcode_options(const PathOptions& o) {
+    GcodeOptions g;
+    g.pen = o.gcode_pen == "spindle" ? PenControl::kSpindle : PenControl::kZ;
+    g.z_down_max = o.gcode_z_down;
+    g.arc_tolerance_mm = o.tolerance;
+    return g;
+}
 }  // namespace
 
 LoadedPath load_path_report(const PathOptions& o, const MachineProfile* machine, const std::vector<double>* start) {
@@ -108,6 +127,9 @@ LoadedPath load_path_report(const PathOptions& o, const MachineProfile* machine,
     loaded.placed = placement.active();
     const std::optional<Box2> area = machine != nullptr ? work_area(*machine) : std::nullopt;
     path = place_path(path, placement, area, &loaded.placement);
+    path = group_by_layer(select_layers(path, o.layers));
+    if (!o.no_pause) pause_between_layers(path);
+    if (machine != nullptr) apply_layer_feeds(path, *machine);
     if (!o.keep_order) {
         OrderOptions order;
         order.merge_tolerance = o.merge_tolerance;
@@ -120,7 +142,7 @@ LoadedPath load_path_report(const PathOptions& o, const MachineProfile* machine,
         } else if (start != nullptr && start->size() == path.axes) {
             order.start = *start;
         }
-        path = order_path(path, order, &loaded.order);
+        path = order_sections(path, order, &loaded.order);
         loaded.ordered = true;
     }
     loaded.path = std::move(path);
@@ -132,20 +154,42 @@ Path load_path(const PathOptions& o, const MachineProfile* machine, const std::v
 }
 
 namespace {
+// The format standard input holds, from its first characters: SVG starts with '<', JSON with
+// '{' or '[', CSV has a comma on its first line, anything else is taken as G-code.
+std::string sniff_format(const std::string& text) {
+    const std::size_t first = text.find_first_not_of(" \t\r\n\xEF\xBB\xBF");
+    if (first == std::string::npos) return "";
+    if (text[first] == '<') return "svg";
+    if (text[first] == '{' || text[first] == '[') return "json";
+    const std::string line = text.substr(first, text.find('\n', first) - first);
+    if (line.find(',') != std::string::npos) return "csv";
+    return "gcode";
+}
+
+// The path on standard input, named "<stdin>" in messages.
+Path read_stdin_path(const PathOptions& o) {
+    std::ostringstream buffer;
+    buffer << std::cin.rdbuf();
+    const std::string text = buffer.str();
+    const std::string name = path_display_name("-");
+    const std::string format = o.format.empty() ? sniff_format(text) : o.format;
+    if (format.empty()) throw InputError(name, {}, "standard input is empty: no path to read");
+    if (format == "json") return parse_json_path(text, name);
+    if (format == "svg") return parse_svg_path(text, name, o.tolerance);
+    if (format == "csv") return parse_csv_path(text, name, basis_from_name(o.csv_basis), o.csv_closed);
+    return parse_gcode_path(text, name, gcode_options(o));
+}
+
 Path read_path(const PathOptions& o) {
-    std::string ext = o.file.substr(o.file.find_last_of('.') == std::string::npos ? o.file.size()
-                                                                                 : o.file.find_last_of('.'));
+    if (o.file == "-") return read_stdin_path(o);
+    std::string ext = !o.format.empty() ? "." + o.format
+                      : o.file.substr(o.file.find_last_of('.') == std::string::npos ? o.file.size()
+                                                                                   : o.file.find_last_of('.'));
     std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
     if (ext == ".json") return load_json_path(o.file);
     if (ext == ".svg") return load_svg_path(o.file, o.tolerance);
     if (ext == ".csv") return load_csv_path(o.file, basis_from_name(o.csv_basis), o.csv_closed);
-    if (ext == ".gcode" || ext == ".ngc" || ext == ".nc" || ext == ".gc") {
-        GcodeOptions g;
-        g.pen = o.gcode_pen == "spindle" ? PenControl::kSpindle : PenControl::kZ;
-        g.z_down_max = o.gcode_z_down;
-        g.arc_tolerance_mm = o.tolerance;
-        return load_gcode_path(o.file, g);
-    }
+    if (ext == ".gcode" || ext == ".ngc" || ext == ".nc" || ext == ".gc") return load_gcode_path(o.file, gcode_options(o));
     throw InputError(
         o.file, {},
         "unknown file type \"" + ext + "\" (expected .json, .csv, .svg, .gcode, .ngc, .nc or .gc)");

@@ -14,7 +14,8 @@
 namespace pathstream::host {
 
 struct PathOptions {
-    std::string file;
+    std::string file;                   ///< the path file; "-": standard input
+    std::string format;                 ///< --format: json, csv, svg or gcode; empty: by extension
     std::string csv_basis = "bspline";  ///< basis for CSV point files
     bool csv_closed = false;
     std::string gcode_pen = "z";        ///< "z" or "spindle" (M3/M5)
@@ -25,6 +26,8 @@ struct PathOptions {
     bool keep_order = false;            ///< --keep-order: draw the subpaths as the file lists them
     double merge_tolerance = 0.01;      ///< --merge-tolerance: mm between ends that are joined
     std::string order_start;            ///< --order-start "X,Y,..." (mm); empty: the origin
+    std::vector<std::string> layers;    ///< --layer NAME|N (repeatable): plot only these layers
+    bool no_pause = false;              ///< --no-pause: no pen-change pause between layers
 };
 
 /// A loaded path and what placement and ordering did to it (for check).
@@ -50,6 +53,9 @@ LoadedPath load_path_report(const PathOptions& options, const MachineProfile* ma
 /// load_path_report's path alone.
 Path load_path(const PathOptions& options, const MachineProfile* machine = nullptr,
                const std::vector<double>* start = nullptr);
+
+/// How messages name the path file: "<stdin>" for "-", else the file name.
+inline std::string path_display_name(const std::string& file) { return file == "-" ? "<stdin>" : file; }
 
 /// Column names of the axes in CSV output: x y z a b c v w (u is taken by the parameter).
 const char* axis_column_name(std::size_t axis);

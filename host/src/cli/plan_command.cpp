@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 
+#include "pathstream/host/layers.hpp"
 #include "pathstream/host/atomic_file.hpp"
 #include "pathstream/host/core_playback.hpp"
 #include "pathstream/host/input_error.hpp"
@@ -63,6 +64,7 @@ void print_plan_summary(const PlannedJob& job, std::ostream& out) {
                   job.plan.duration, static_cast<unsigned long long>(job.plan.total_ticks), job.machine.tick_hz,
                   job.plan.spans.size(), job.plan.pen.size());
     out << line;
+    if (const std::string layers = layers_text(job.path); !layers.empty()) out << "  " << layers << '\n';
     std::snprintf(line, sizeof line, "  path: %.3f mm drawn, %.3f mm travel; planned in %.3f s\n", job.plan.path_length,
                   job.plan.travel_length, job.planning_seconds);
     out << line;
@@ -112,7 +114,7 @@ nlohmann::ordered_json plan_axes_json(const PlannedJob& job) {
 nlohmann::ordered_json plan_summary_json(const PlanCommandOptions& o, const PlannedJob& job) {
     const PlanCheck& c = job.check;
     nlohmann::ordered_json j;
-    j["file"] = o.path.file;
+    j["file"] = path_display_name(o.path.file);
     j["machine"] = o.machine;
     j["output"] =
         o.output.empty() ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(o.output);
@@ -121,6 +123,8 @@ nlohmann::ordered_json plan_summary_json(const PlanCommandOptions& o, const Plan
     j["tick_hz"] = job.machine.tick_hz;
     j["spans"] = job.plan.spans.size();
     j["pen_changes"] = job.plan.pen.size();
+    j["pauses"] = job.plan.pauses.size();
+    j["layers"] = layers_json(job.path);
     j["drawn_length_mm"] = job.plan.path_length;
     j["travel_length_mm"] = job.plan.travel_length;
     j["planning_time_s"] = job.planning_seconds;
@@ -151,15 +155,7 @@ void write_plan_rows(const PlannedJob& job, std::ostream& csv) {
 /// Writes every executed tick as CSV: to a file atomically (a failed run leaves no file), or
 /// to standard output for "-".
 void write_plan_csv(const PlannedJob& job, const std::string& output) {
-    if (output == "-") {
-        write_plan_rows(job, std::cout);
-        std::cout.flush();
-        if (!std::cout) throw std::runtime_error("standard output: write failed");
-        return;
-    }
-    AtomicFile file(output);
-    write_plan_rows(job, file.stream());
-    file.commit();
+    write_output(output, [&](std::ostream& csv) { write_plan_rows(job, csv); });
 }
 
 }  // namespace
@@ -175,7 +171,7 @@ int run_plan(const PlanCommandOptions& o) {
     // summary the error message points to then goes to standard error.
     std::ostream& text = o.json || o.output == "-" ? std::cerr : std::cout;
     if (!o.json || failed) {
-        text << "pathstream plan: " << o.path.file << " on " << o.machine
+        text << "pathstream plan: " << path_display_name(o.path.file) << " on " << o.machine
              << (o.output.empty() ? "" : " -> " + o.output) << '\n';
         print_plan_summary(job, text);
     }

@@ -13,7 +13,7 @@
 #include "pathstream/host/core_playback.hpp"
 #include "pathstream/host/core_spans.hpp"
 #include "pathstream/host/input_error.hpp"
-#include "pathstream/host/json_path.hpp"
+#include "pathstream/host/machine.hpp"
 
 namespace pathstream::host {
 namespace {
@@ -47,36 +47,32 @@ void add_setpoints_command(CLI::App& app, SetpointsOptions& o) {
         "setpoints",
         "Run a path through the firmware core (exact forward differencing) and write every "
         "tick's setpoints as CSV: tick,span,subpath,pen,x,y,... in LSB");
-    cmd->add_option("file", o.input, "path file (JSON, see docs/formats.md)")->required()->check(CLI::ExistingFile);
-    cmd->add_option("--out,-o", o.output, "CSV output file (default: standard output)");
-    cmd->add_option("--ticks-per-span", o.ticks_per_span, "ticks each span lasts")
-        ->capture_default_str()
+    add_path_options(*cmd, o.path);
+    cmd->add_option("--out,-o", o.output, "CSV output file; - or none: standard output");
+    cmd->add_option("--ticks-per-span", o.ticks_per_span, "ticks each span lasts (default 32, or the profile's)")
         ->check(CLI::Range(1u, kMaxSpanTicks));
-    cmd->add_option("--lsb", o.mm_per_lsb, "millimetres per LSB (position resolution)")
-        ->capture_default_str()
+    cmd->add_option("--lsb", o.mm_per_lsb, "millimetres per LSB (default 0.001, or the profile's)")
         ->check(CLI::Range(1e-6, 10.0));
+    cmd->add_option("--machine,-m", o.machine,
+                    "machine profile (JSON): its mm_per_lsb and ticks_per_span, its work area for --fit area")
+        ->check(CLI::ExistingFile);
 }
 
 int run_setpoints(const SetpointsOptions& o) {
     const auto t0 = std::chrono::steady_clock::now();
-    const Path path = load_json_path(o.input);
-    const std::vector<CoreSpan> spans = uniform_core_spans(path, o.input, o.mm_per_lsb, o.ticks_per_span);
-
+    const std::optional<MachineProfile> machine =
+        o.machine.empty() ? std::nullopt : std::optional<MachineProfile>(load_machine_profile(o.machine));
+    const Path path = load_path(o.path, machine ? &*machine : nullptr);
+    const double lsb = o.mm_per_lsb ? *o.mm_per_lsb : machine ? machine->mm_per_lsb : 0.001;
+    const std::uint32_t ticks = o.ticks_per_span ? *o.ticks_per_span : machine ? machine->ticks_per_span : 32;
+    const std::vector<CoreSpan> spans = uniform_core_spans(path, path_display_name(o.path.file), lsb, ticks);
     RunSummary summary;
-    if (o.output.empty()) {
-        summary = write_setpoints(path, spans, std::cout);
-        std::cout.flush();
-        if (!std::cout) throw std::runtime_error("standard output: write failed");
-    } else {
-        AtomicFile file(o.output);
-        summary = write_setpoints(path, spans, file.stream());
-        file.commit();
-    }
+    write_output(o.output, [&](std::ostream& csv) { summary = write_setpoints(path, spans, csv); });
     const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-    std::cerr << "pathstream setpoints: " << o.input << ": " << path.subpaths.size() << " subpath(s), "
-              << summary.spans << " spans x " << o.ticks_per_span << " ticks, " << path.axes
+    std::cerr << "pathstream setpoints: " << path_display_name(o.path.file) << ": " << path.subpaths.size() << " subpath(s), "
+              << summary.spans << " spans x " << ticks << " ticks, " << path.axes
               << " axes -> " << summary.ticks << " ticks"
-              << (o.output.empty() ? "" : " written to " + o.output) << "\n"
+              << (o.output.empty() || o.output == "-" ? "" : " written to " + o.output) << "\n"
               << "  every setpoint (" << summary.verified
               << ") equals the core's 128-bit Horner value: exact, rounded once; " << ms << " ms\n";
     return 0;

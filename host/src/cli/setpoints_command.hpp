@@ -3,15 +3,19 @@
 
 #include <CLI/CLI.hpp>
 #include <cstdint>
+#include <optional>
 #include <string>
+
+#include "path_options.hpp"
 
 namespace pathstream::host {
 
 struct SetpointsOptions {
-    std::string input;
+    PathOptions path;
+    std::string machine;  ///< -m: mm_per_lsb and ticks_per_span from the profile
     std::string output;
-    std::uint32_t ticks_per_span = 32;
-    double mm_per_lsb = 0.001;
+    std::optional<std::uint32_t> ticks_per_span;  ///< default: the profile's, else 32
+    std::optional<double> mm_per_lsb;             ///< default: the profile's, else 0.001
 };
 
 /// Registers the subcommand and its options on `app`.

@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "pathstream/host/events.hpp"
+#include "pathstream/host/layers.hpp"
 #include "pathstream/host/planner.hpp"
 #include "pathstream/host/plot.hpp"
 #include "pathstream/host/progress.hpp"
@@ -80,7 +81,7 @@ Json axis_json(const plot::AxisFigures& x) {
 void machine_json(const SimCommandOptions& o, const PlannedJob& job, const plot::RunSummary& run,
                   Json& j) {
     j["target"] = run.target;
-    j["file"] = o.path.file;
+    j["file"] = path_display_name(o.path.file);
     j["machine"] = {{"file", o.machine},
                     {"axes", job.machine.axes.size()},
                     {"tick_hz", job.machine.tick_hz},
@@ -145,6 +146,8 @@ Json report_json(const SimCommandOptions& o, const PlannedJob& job,
     machine_json(o, job, run, j);
     run_json(job, run, f, j);
     limits_json(job, f, j);
+    j["layers"] = layers_json(job.path);
+    j["pauses"] = job.plan.pauses.size();
     return j;
 }
 
@@ -155,7 +158,9 @@ plot::WrittenPlots write_sim_plots(const SimCommandOptions& o, const PlannedJob&
     std::filesystem::create_directories(o.plot_dir);
     plot::Options plot_options;
     plot_options.y_up = o.y_up;
-    plot_options.title = o.path.file;
+    plot_options.title = path_display_name(o.path.file);
+    for (const PathLayer& l : job.path.layers) plot_options.layers.push_back(l.name);
+    for (const Subpath& s : job.path.subpaths) plot_options.subpath_layers.push_back(s.layer);
     return plot::write_plots(o.plot_dir, job.segments, executed, plant, job.machine, plot_options);
 }
 
@@ -238,7 +243,7 @@ int run_sim(const SimCommandOptions& o) {
     if (!o.events.empty()) channel.writer = NdjsonWriter::open(o.events);
     const PlannedJob job = plan_job(o.path, o.machine);
     JobEvents events(channel, job.plan, job.machine,
-                     {"sim", o.path.file, "sim", count_subpaths(job.plan)});
+                     {"sim", path_display_name(o.path.file), "sim", count_subpaths(job.plan)});
     const sim::SimulationResult result = simulate_job(o, job, events);
     const plot::TickSeries executed = sim::setpoint_series(result);
     const plot::TickSeries plant = sim::plant_series(result);
@@ -249,7 +254,11 @@ int run_sim(const SimCommandOptions& o) {
     end_events(events, result, failed);
     // With --json, standard output holds the document or, on failure, nothing: the text
     // report the error message points to then goes to standard error.
-    if (!o.json) std::cout << plot::text_report(job.plan, &job.check, job.machine, executed, run);
+    if (!o.json) {
+        std::cout << plot::text_report(job.plan, &job.check, job.machine, executed, run);
+        if (const std::string layers = layers_text(job.path); !layers.empty())
+            std::cout << "  " << layers << " (the operator's time is not in the durations)\n";
+    }
     if (o.json && failed)
         std::cerr << plot::text_report(job.plan, &job.check, job.machine, executed, run);
     Json document;

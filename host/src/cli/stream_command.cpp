@@ -1,8 +1,10 @@
 #include "stream_command.hpp"
 
+#include <poll.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <cstring>
 #include <atomic>
 #include <chrono>
 #include <thread>
@@ -260,7 +262,30 @@ void print_interrupted(const StreamEnd& end, const JobSpans& job, std::uint32_t 
 }
 
 std::string default_journal_path(const std::string& drawing) {
+    if (drawing == "-") return "stdin.journal.json";
     return std::filesystem::path(drawing).stem().string() + ".journal.json";
+}
+
+// A line typed at the terminal (Enter) since the last look; never waits.
+bool enter_pressed() {
+    pollfd p{STDIN_FILENO, POLLIN, 0};
+    if (::poll(&p, 1, 0) <= 0 || (p.revents & POLLIN) == 0) return false;
+    char buffer[256];
+    const ssize_t n = ::read(STDIN_FILENO, buffer, sizeof buffer);
+    return n > 0 && std::memchr(buffer, '\n', static_cast<std::size_t>(n)) != nullptr;
+}
+
+// The operator's side of programmed pauses: a message (and an event) at each, and Enter at
+// the terminal resumes when standard input is one that no path is read from.
+void handle_pauses(InterruptOptions& interrupt, const JobJournal& journal, JobEvents& events,
+                   const std::string& target, bool terminal) {
+    interrupt.on_pause = [&journal, &events, target, terminal](std::size_t index) {
+        const std::string next = index < journal.pauses.size() ? journal.pauses[index] : "the rest of the job";
+        std::fprintf(stderr, "\npathstream: paused for a pen change, %s next: %s `pathstream ctl %s resume`\n",
+                     next.c_str(), terminal ? "press Enter to go on, or" : "go on with", target.c_str());
+        events.pause(index, next);
+    };
+    if (terminal) interrupt.resume_requested = enter_pressed;
 }
 
 // Streams `job` (its spans as the plan), keeping the journal and writing the events; returns
@@ -282,6 +307,8 @@ int stream_job(const JobSpans& job, const MachineProfile& machine, StreamCommand
     std::signal(SIGTERM, on_stream_signal);
     JobEvents events(channel, job.plan, machine,
                      {"stream", journal.drawing, o.stream.target, job.subpaths});
+    handle_pauses(o.stream.interrupt, journal, events, o.stream.target,
+                  o.path.file != "-" && ::isatty(STDIN_FILENO) == 1);
     // Every status read goes to both records: the journal and the events.
     const StreamObserver observer = [&](const StreamTrace& t) {
         writer.trace(t);
@@ -403,9 +430,32 @@ int run_resume(StreamCommandOptions o, const EventChannel& channel) {
     return stream_job(resumed, machine, o, next, o.resume, nullptr, channel);
 }
 
+// What comes after each programmed pause: the next layer's name where the layer changes,
+// else the subpath and where it is in the file.
+std::vector<std::string> pause_descriptions(const Path& path, const Plan& plan) {
+    std::vector<std::string> out;
+    for (const PlanPause& p : plan.pauses) {
+        const Subpath& s = path.subpaths.at(p.subpath);
+        const bool new_layer = !path.layers.empty() && (p.subpath == 0 || path.subpaths[p.subpath - 1].layer != s.layer);
+        if (new_layer) {
+            out.push_back("layer \"" + path.layers.at(s.layer).name + "\"");
+        } else {
+            out.push_back("subpath " + std::to_string(p.subpath + 1) +
+                          (s.location.line > 0 ? " (line " + std::to_string(s.location.line) + ")" : ""));
+        }
+    }
+    return out;
+}
+
 // CiA 402 drives: no device status to follow, so the events are the job's start and end.
 int stream_cia402(const PlannedJob& planned, const std::string& url, const EventChannel& channel,
                   const std::string& drawing) {
+    if (!planned.plan.pauses.empty()) {
+        throw std::invalid_argument(
+            "CiA 402 targets cannot pause the job (" + std::to_string(planned.plan.pauses.size()) +
+            " programmed pauses: pen changes or M0/M1): plot one layer at a time with --layer, or "
+            "turn the pen-change pauses off with --no-pause");
+    }
     hal::SocketCanBus cia402_bus(parse_cia402_target(url, planned.machine.axes.size()).interface);
     const JobSpans job = job_from_plan(planned.plan);
     JobEvents events(channel, planned.plan, planned.machine,
@@ -494,12 +544,13 @@ int run_stream(const StreamCommandOptions& o) {
         std::signal(SIGINT, SIG_DFL);  // CiA 402 streams have no hold: Ctrl-C ends the process
         std::signal(SIGTERM, SIG_DFL);
         // CiA 402 drives take one setpoint per cycle from the host: no device queue to hold.
-        return stream_cia402(planned, url, channel, o.path.file);
+        return stream_cia402(planned, url, channel, path_display_name(o.path.file));
     }
     JobJournal journal;
+    journal.pauses = pause_descriptions(planned.path, planned.plan);
     journal.target = url;
     journal.machine = std::filesystem::absolute(o.machine).string();
-    journal.drawing = o.path.file;
+    journal.drawing = path_display_name(o.path.file);
     const std::string journal_path = o.no_journal ? "" : (o.journal.empty() ? default_journal_path(o.path.file) : o.journal);
     return stream_job(job_from_plan(planned.plan), planned.machine, o, journal, journal_path,
                       nullptr, channel);

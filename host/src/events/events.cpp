@@ -283,6 +283,16 @@ void JobEvents::trace(const StreamTrace& t) {
     sample(s);
 }
 
+void JobEvents::pause(std::size_t index, const std::string& next) {
+    start(job_);
+    EventJson e = event("pause");
+    e["pause"] = index + 1;
+    e["pauses"] = plan_.pauses.size();
+    e["ticks"] = ticks_;
+    e["next"] = next;
+    emit(e);
+}
+
 void JobEvents::end(const std::string& outcome, const std::string& error,
                     std::optional<std::uint64_t> ticks) {
     if (ended_) return;

@@ -88,11 +88,28 @@ public:
         pen_ = down;
     }
 
+    // Before a subpath's pen goes down: its programmed pause (the device holds at the end of
+    // the last span, which must be a still pen-up one) and its pen-up rest.
+    void before_pen_down(const Run& run) {
+        if (run.pause_before) {
+            if (plan_.spans.empty() || plan_.spans.back().pen_down) dwell(1, run.subpath, false);
+            plan_.spans.back().pause_after = true;
+            plan_.pauses.push_back({plan_.total_ticks, run.subpath});
+        }
+        if (run.dwell_before > 0 && !run.dwell_pen_down) {
+            dwell(delay_ticks(run.dwell_before, profile_.tick_hz), run.subpath, false);
+        }
+    }
+
     Plan run(const std::vector<PieceMotion>& motion, PlanStats* stats) {
         if (g_.runs.empty()) return plan_;
         pos_ = quantise(g_.runs.front().start);
         for (const Run& run : g_.runs) {
+            if (run.pen_down && !pen_) before_pen_down(run);
             if (run.pen_down != pen_) pen(run.pen_down, run.subpath, false);
+            if (run.pen_down && run.dwell_before > 0 && run.dwell_pen_down) {
+                dwell(delay_ticks(run.dwell_before, profile_.tick_hz), run.subpath, true);
+            }
             for (std::size_t p : run.pieces) {
                 const PieceMotion& m = motion[p];
                 const LsbVec start = quantise(m.start.q);

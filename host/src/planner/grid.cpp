@@ -124,6 +124,9 @@ struct Builder {
         run.subpath = segments[first_seg].subpath;
         run.first_segment = first_seg;
         run.last_segment = last_seg;
+        run.pause_before = segments[first_seg].pause_before;
+        run.dwell_before = segments[first_seg].dwell_before;
+        run.dwell_pen_down = segments[first_seg].dwell_pen_down;
         run.start = out.cubics[first_seg].p[0];
         run.end = out.cubics[last_seg].p[3];
         const double feed = run.pen_down ? (segments[first_seg].feed > 0 ? segments[first_seg].feed : profile.feed)

@@ -148,6 +148,9 @@ struct Run {
     bool pen_down = true;
     std::size_t subpath = 0;
     std::size_t first_segment = 0, last_segment = 0;
+    bool pause_before = false;  ///< the first segment's pause and rest (BezierSegment)
+    double dwell_before = 0;
+    bool dwell_pen_down = false;
     std::vector<std::size_t> pieces;
     Vec start{}, end{};  ///< mm
 };

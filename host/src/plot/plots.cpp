@@ -291,6 +291,23 @@ std::vector<Point> decimate_min_max(const std::vector<double>& x, const std::vec
     return out;
 }
 
+// A layer's colour: its name when that is a colour ("#rrggbb"), else one of a palette that
+// reads on white and differs from the setpoints' colour.
+std::string layer_colour(const Options& o, std::size_t layer) {
+    const std::string& name = o.layers.at(layer);
+    if (name.size() == 7 && name[0] == '#' &&
+        name.find_first_not_of("0123456789abcdefABCDEF", 1) == std::string::npos) {
+        return name;
+    }
+    static const char* const kPalette[] = {"#1b9e77", "#d95f02", "#7570b3", "#e7298a", "#66a61e", "#e6ab02"};
+    return kPalette[layer % 6];
+}
+
+// The layer of a segment's subpath (0 without layers).
+std::size_t layer_of(const Options& o, const BezierSegment& s) {
+    return s.subpath < o.subpath_layers.size() ? o.subpath_layers[s.subpath] : 0;
+}
+
 std::string path_svg(const std::vector<BezierSegment>& path, const TickSeries& executed,
                      const TickSeries* plant, const MachineProfile& profile,
                      const Options& options) {
@@ -339,19 +356,27 @@ std::string path_svg(const std::vector<BezierSegment>& path, const TickSeries& e
     c.begin_series("ideal-path");
     std::vector<Point> run;
     bool run_down = true;
+    std::size_t run_layer = 0;
+    const bool layered = !options.layers.empty();
     const auto flush = [&] {
-        c.polyline_px(run, detail::kIdealColour, run_down ? 5 : 2, run_down ? "" : kTravelDash,
-                      run_down ? "pen-down" : "pen-up");
+        const std::string colour =
+            layered && run_down ? layer_colour(options, run_layer) : std::string(detail::kIdealColour);
+        const std::string cls = !run_down ? "pen-up"
+                                : layered ? "pen-down layer-" + std::to_string(run_layer + 1)
+                                          : "pen-down";
+        c.polyline_px(run, colour, run_down ? 5 : 2, run_down ? "" : kTravelDash, cls);
         run.clear();
     };
     for (const BezierSegment& seg : path) {
         if (seg.p[0].size() <= ay) continue;
-        if (!run.empty() && seg.pen_down != run_down) {
+        const std::size_t layer = layer_of(options, seg);
+        if (!run.empty() && (seg.pen_down != run_down || (seg.pen_down && layer != run_layer))) {
             const Point joint = run.back();
             flush();
             run.push_back(joint);
         }
         run_down = seg.pen_down;
+        run_layer = layer;
         const double len_px = polygon_length(seg, ax, ay) * scale;
         const int samples = static_cast<int>(std::clamp(std::ceil(len_px / 1.5), 2.0, 4000.0));
         for (int i = run.empty() ? 0 : 1; i <= samples; ++i) {
@@ -369,7 +394,11 @@ std::string path_svg(const std::vector<BezierSegment>& path, const TickSeries& e
     draw_executed(c, executed, ax, ay, detail::kSetpointColour, 1.6);
     c.end_group();
     std::vector<LegendEntry> legend;
-    if (!path.empty()) {
+    if (!path.empty() && layered) {
+        for (std::size_t l = 0; l < options.layers.size(); ++l)
+            legend.push_back({"layer " + options.layers[l], layer_colour(options, l), "", 5});
+        legend.push_back({"ideal travel (pen up)", detail::kIdealColour, kTravelDash, 2});
+    } else if (!path.empty()) {
         legend.push_back({"ideal path", detail::kIdealColour, "", 5});
         legend.push_back({"ideal travel (pen up)", detail::kIdealColour, kTravelDash, 2});
     }

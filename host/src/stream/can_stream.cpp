@@ -62,6 +62,7 @@ public:
             static_cast<std::uint64_t>(std::ceil(options_.lead_seconds * profile_.tick_hz));
         bool started = false;
         StreamInterrupt interrupt(options_.interrupt);
+        PauseWatch pauses(options_.interrupt, plan_.pauses);
         while (true) {
             const StreamInterrupt::Action action = interrupt.next_action(started);
             if (action == StreamInterrupt::Action::kHold) command(static_cast<std::uint8_t>(device::Command::kHold), true);
@@ -85,6 +86,9 @@ public:
             }
             if (!interrupt.active() && s.state == static_cast<std::uint8_t>(device::DeviceState::kHolding) &&
                 (s.flags & pc::kFlagHeldByUnderrun) != 0 && s.queued > 0) {
+                command(static_cast<std::uint8_t>(device::Command::kResume), true);
+            }
+            if (pauses.observe(snapshot_of(s), s.ticks_executed - start_ticks_) && !interrupt.active()) {
                 command(static_cast<std::uint8_t>(device::Command::kResume), true);
             }
             if (progress) {

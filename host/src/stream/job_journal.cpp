@@ -90,6 +90,18 @@ std::size_t count_subpaths(const Plan& plan) {
     return n;
 }
 
+// The plan's programmed pauses, from its spans' pause marks.
+std::vector<PlanPause> pauses_of(const std::vector<CoreSpan>& spans) {
+    std::vector<PlanPause> out;
+    std::uint64_t tick = 0;
+    for (std::size_t i = 0; i < spans.size(); ++i) {
+        tick += spans[i].ticks;
+        if (spans[i].pause_after)
+            out.push_back({tick, i + 1 < spans.size() ? spans[i + 1].subpath : spans[i].subpath});
+    }
+    return out;
+}
+
 }  // namespace
 
 JobSpans job_from_plan(const Plan& plan) {
@@ -173,6 +185,7 @@ JobSpans resume_from(const JobSpans& job, std::size_t first, const std::vector<L
     std::uint64_t total = 0;
     for (const CoreSpan& s : out.plan.spans) total += s.ticks;
     out.plan.total_ticks = total;
+    out.plan.pauses = pauses_of(out.plan.spans);
     return out;
 }
 
@@ -186,7 +199,7 @@ std::string write_job_spans(const JobSpans& job, const std::string& path) {
     for (std::size_t i = 0; i < job.plan.spans.size(); ++i) {
         const CoreSpan& s = job.plan.spans[i];
         text << job.origin[i] << ' ' << job.drawing_tick[i] << ' ' << s.subpath << ' '
-             << (s.pen_down ? 1 : 0) << ' ' << s.ticks;
+             << ((s.pen_down ? 1 : 0) | (s.pause_after ? 2 : 0)) << ' ' << s.ticks;
         for (const auto& c : s.control)
             text << ' ' << c[0] << ' ' << c[1] << ' ' << c[2] << ' ' << c[3];
         text << '\n';
@@ -242,13 +255,14 @@ JobSpans read_job_spans(const std::string& path, const std::string& expected_has
         CoreSpan s;
         std::int64_t origin = 0;
         std::uint64_t tick = 0;
-        int pen = 0;
+        int marks = 0;  // bit 0: pen down, bit 1: a pause follows
         s.basis = Basis::kHermite;
-        if (!(l >> origin >> tick >> s.subpath >> pen >> s.ticks) || s.ticks < 1 ||
-            (pen != 0 && pen != 1)) {
+        if (!(l >> origin >> tick >> s.subpath >> marks >> s.ticks) || s.ticks < 1 ||
+            marks < 0 || marks > 3) {
             fail("bad span line");
         }
-        s.pen_down = pen == 1;
+        s.pen_down = (marks & 1) != 0;
+        s.pause_after = (marks & 2) != 0;
         s.control.assign(axes, {});
         for (auto& c : s.control) {
             if (!(l >> c[0] >> c[1] >> c[2] >> c[3]))
@@ -260,6 +274,7 @@ JobSpans read_job_spans(const std::string& path, const std::string& expected_has
         job.drawing_tick.push_back(tick);
     }
     job.plan.total_ticks = total;
+    job.plan.pauses = pauses_of(job.plan.spans);
     return job;
 }
 
@@ -279,6 +294,7 @@ void write_journal(const JobJournal& j, const std::string& path) {
     d["position_lsb"] = j.position;
     d["outcome"] = j.outcome;
     if (!j.error.empty()) d["error"] = j.error;
+    if (!j.pauses.empty()) d["pauses"] = j.pauses;
     AtomicFile f(path);
     f.stream() << d.dump(2) << '\n';
     f.commit();
@@ -318,6 +334,7 @@ JobJournal read_journal(const std::string& path) {
     get("position_lsb", j.position);
     get("outcome", j.outcome);
     if (d.contains("error")) get("error", j.error);
+    if (d.contains("pauses")) get("pauses", j.pauses);
     return j;
 }
 

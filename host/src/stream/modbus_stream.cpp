@@ -65,6 +65,7 @@ public:
         const std::uint64_t lead_target = static_cast<std::uint64_t>(std::ceil(options_.lead_seconds * profile_.tick_hz));
         bool started = false;
         StreamInterrupt interrupt(options_.interrupt);
+        PauseWatch pauses(options_.interrupt, plan_.pauses);
         while (true) {
             const StreamInterrupt::Action action = interrupt.next_action(started);
             if (action == StreamInterrupt::Action::kHold) command(device::Command::kHold, true);
@@ -100,6 +101,9 @@ public:
             }
             if (!interrupt.active() && s.state == static_cast<std::uint16_t>(device::DeviceState::kHolding) &&
                 (s.flags & 2u) != 0 && s.queued > 0) {
+                command(device::Command::kResume, true);
+            }
+            if (pauses.observe(s, s.ticks_executed - start_ticks_) && !interrupt.active()) {
                 command(device::Command::kResume, true);
             }
             if (progress) {

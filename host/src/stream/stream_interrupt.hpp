@@ -2,7 +2,10 @@
 // device's state; the Modbus and CAN streamers share it.
 #pragma once
 
+#include <algorithm>
 #include <chrono>
+#include <cstdint>
+#include <vector>
 
 #include "pathstream/device/device_state.hpp"
 #include "pathstream/host/device_link.hpp"
@@ -64,6 +67,43 @@ private:
     bool hold_sent_ = false;
     bool stop_sent_ = false;
     Clock::time_point hold_at_;
+};
+
+/// Programmed pauses seen by a stream: tells the operator once per pause and sends the resume
+/// when they ask for it at the terminal.
+class PauseWatch {
+public:
+    PauseWatch(const InterruptOptions& options, const std::vector<PlanPause>& pauses)
+        : options_(options), pauses_(pauses) {}
+
+    /// After each status read. `plan_ticks`: path ticks of the plan executed so far. True when
+    /// the resume should be sent now.
+    bool observe(const DeviceSnapshot& s, std::uint64_t plan_ticks) {
+        const bool paused = s.paused() && s.state == static_cast<unsigned>(device::DeviceState::kHolding);
+        if (paused && !was_paused_) {
+            resume_sent_ = false;
+            if (options_.on_pause) options_.on_pause(index_at(plan_ticks));
+        }
+        was_paused_ = paused;
+        if (!paused || resume_sent_ || !options_.resume_requested) return false;
+        resume_sent_ = options_.resume_requested();
+        return resume_sent_;
+    }
+
+private:
+    // The pause the device rests at: the first one at or after the ticks executed (a pause's
+    // tick is the end of the span it follows).
+    std::size_t index_at(std::uint64_t plan_ticks) const {
+        const auto it = std::lower_bound(pauses_.begin(), pauses_.end(), plan_ticks,
+                                         [](const PlanPause& p, std::uint64_t t) { return p.tick < t; });
+        if (it == pauses_.end()) return pauses_.empty() ? 0 : pauses_.size() - 1;
+        return static_cast<std::size_t>(it - pauses_.begin());
+    }
+
+    const InterruptOptions& options_;
+    const std::vector<PlanPause>& pauses_;
+    bool was_paused_ = false;
+    bool resume_sent_ = false;
 };
 
 }  // namespace pathstream::host

@@ -38,6 +38,14 @@ WirePlan encode_wire_plan(const Plan& plan) {
             previous_tangent[a] = c.control[a][3];
         }
         w.flags = continues ? device::kWireContinueTangent : 0;
+        if (c.pause_after) {
+            for (unsigned a = 0; a < out.axes; ++a) {
+                if (c.control[a][3] != 0)
+                    throw std::invalid_argument("plan span " + std::to_string(i) +
+                                                " is followed by a pause but does not end at rest");
+            }
+            w.flags = static_cast<std::uint8_t>(w.flags | device::kWirePause);
+        }
         if (i + 1 == plan.spans.size()) {
             // The plan is one job: its last span marks the end, where the device idles.
             for (unsigned a = 0; a < out.axes; ++a) {

@@ -24,6 +24,7 @@ constexpr double kDegenerateMm = 1e-9;    // pieces smaller than this are droppe
 constexpr std::size_t kMaxUses = 100000;  // <use> copies per document: stops exponential nesting
 constexpr double kMmPerPx = 25.4 / 96.0;
 constexpr double kNoBase = std::numeric_limits<double>::quiet_NaN();
+constexpr std::size_t kNoLayer = static_cast<std::size_t>(-1);
 constexpr const char* kSvgNamespace = "http://www.w3.org/2000/svg";
 
 bool is_space(char c) {
@@ -57,6 +58,7 @@ struct State {
     double height = kNoBase;
     bool visible = true;  // inherited 'visibility'
     std::string stroke = "none";  // inherited 'stroke', kept for SvgReadInfo::strokes
+    std::size_t layer = kNoLayer;  // the Inkscape layer the element is in (index in layers_)
 };
 
 // One property's cascaded value: from a presentation attribute, or from CSS (a <style> rule or
@@ -81,7 +83,7 @@ public:
     Path read(svg::SvgReadInfo* info) {
         Path path = read();
         if (info) {
-            info->strokes = std::move(strokes_);
+            info->strokes = strokes_;
             info->style_rules = sheet_.rules();
             info->location_bytes_scanned = locator_.bytes_scanned();
             info->locations = locator_.lookups();
@@ -110,7 +112,67 @@ private:
         if (path_.subpaths.empty())
             throw InputError(file_, element_location(root), "no drawable paths");
         path_.axes = 2;
+        assign_layers();
         return std::move(path_);
+    }
+
+    // ---- layers ----------------------------------------------------------------------------
+
+    // Inkscape layers when the drawing has any (drawn content outside them goes to a layer of
+    // its own, first); else one layer per stroke colour when there are several; else none.
+    void assign_layers() {
+        bool outside = false;
+        for (std::size_t i = 0; i < path_.subpaths.size(); ++i)
+            outside = outside || subpath_layers_[i] == kNoLayer;
+        if (!layers_.empty()) {
+            const std::size_t shift = outside ? 1 : 0;
+            if (outside) path_.layers.push_back({"(outside layers)", {}, 0});
+            for (PathLayer& l : layers_) path_.layers.push_back(std::move(l));
+            for (std::size_t i = 0; i < path_.subpaths.size(); ++i) {
+                path_.subpaths[i].layer = subpath_layers_[i] == kNoLayer ? 0 : subpath_layers_[i] + shift;
+            }
+            return;
+        }
+        std::vector<std::string> colours;
+        for (std::size_t i = 0; i < path_.subpaths.size(); ++i) {
+            const std::string colour = normal_colour(strokes_[i]);
+            const auto at = std::find(colours.begin(), colours.end(), colour);
+            path_.subpaths[i].layer = static_cast<std::size_t>(at - colours.begin());
+            if (at == colours.end()) {
+                colours.push_back(colour);
+                path_.layers.push_back({colour, path_.subpaths[i].location, 0});
+            }
+        }
+        if (colours.size() < 2) {
+            path_.layers.clear();
+            for (Subpath& s : path_.subpaths) s.layer = 0;
+        }
+    }
+
+    // One spelling per colour: lower case, #rgb as #rrggbb, CSS's basic colour names as hex.
+    static std::string normal_colour(std::string c) {
+        c = lower(trim(c));
+        if (c.size() == 4 && c[0] == '#') c = std::string("#") + c[1] + c[1] + c[2] + c[2] + c[3] + c[3];
+        static const std::pair<const char*, const char*> kNamed[] = {
+            {"black", "#000000"},  {"silver", "#c0c0c0"}, {"gray", "#808080"},   {"grey", "#808080"},
+            {"white", "#ffffff"},  {"maroon", "#800000"}, {"red", "#ff0000"},    {"purple", "#800080"},
+            {"fuchsia", "#ff00ff"}, {"magenta", "#ff00ff"}, {"green", "#008000"}, {"lime", "#00ff00"},
+            {"olive", "#808000"},  {"yellow", "#ffff00"}, {"navy", "#000080"},   {"blue", "#0000ff"},
+            {"teal", "#008080"},   {"aqua", "#00ffff"},   {"cyan", "#00ffff"},   {"orange", "#ffa500"}};
+        for (const auto& [name, hex] : kNamed)
+            if (c == name) return hex;
+        return c.empty() ? "none" : c;
+    }
+
+    // A top-level Inkscape layer (<g inkscape:groupmode="layer">; sublayers belong to theirs):
+    // named by its label, else its id, else its number.
+    void enter_layer(pugi::xml_node n, State& state) {
+        if (state.layer != kNoLayer || std::string(n.attribute("inkscape:groupmode").value()) != "layer") return;
+        std::string name = trim(n.attribute("inkscape:label").value());
+        if (name.empty()) name = trim(n.attribute("id").value());
+        if (name.empty()) name = std::to_string(layers_.size() + 1);
+        state.layer = layers_.size();
+        layers_.push_back({name, element_location(n), 0});
     }
 
     // ---- places ----------------------------------------------------------------------------
@@ -426,6 +488,7 @@ private:
             return;  // defs, symbol, text, image, metadata, title, style, ...
         const Affine own = transform(n, st, parent.width, parent.height);
 
+        if (name == "g") enter_layer(n, state);
         if (name == "g" || name == "a" || name == "switch") {
             state.to_mm = parent.to_mm * own;
             if (state.to_mm.determinant() == 0) return;
@@ -623,6 +686,7 @@ private:
             if (sp.points.empty()) continue;
             path_.subpaths.push_back(std::move(sp));
             strokes_.push_back(state.stroke);
+            subpath_layers_.push_back(state.layer);
         }
     }
 
@@ -649,6 +713,8 @@ private:
     std::size_t use_count_ = 0;
     svg::StyleSheet sheet_;
     std::vector<std::string> strokes_;  // parallel to path_.subpaths
+    std::vector<std::size_t> subpath_layers_;  // parallel to path_.subpaths: index in layers_
+    std::vector<PathLayer> layers_;            // Inkscape layers in document order
 };
 
 }  // namespace

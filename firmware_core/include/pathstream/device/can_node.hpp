@@ -65,6 +65,7 @@ public:
         s.flags = static_cast<std::uint8_t>((device_.configured() ? kFlagConfigured : 0) |
                                             (d.held_by_underrun() ? kFlagHeldByUnderrun : 0) |
                                             (d.own_move() ? kFlagOwnMove : 0) |
+                                            (d.paused() ? kFlagPaused : 0) |
                                             (operator_.homing() ? kFlagHoming : 0) |
                                             ((d.outputs & kOutputPenDown) != 0 ? kFlagPenDown : 0) |
                                             (bus_problem_ ? kFlagBusProblem : 0));

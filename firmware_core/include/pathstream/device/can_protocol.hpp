@@ -18,7 +18,8 @@ namespace pathstream::device::can {
 /// 2: job ends (wire flag kWireJobEnd, status frame D), continuity checked at every join.
 /// 3: home and pen commands (CommandArgs 8, 9), the homing and pen flags (status A), each
 /// axis's homing state (status E).
-inline constexpr std::uint8_t kProtocolVersion = 3;
+/// 4: programmed pauses (wire flag kWirePause) and the paused flag (status A bit 6).
+inline constexpr std::uint8_t kProtocolVersion = 4;
 inline constexpr std::uint8_t kMinNode = 1;
 inline constexpr std::uint8_t kMaxNode = 127;
 
@@ -78,6 +79,8 @@ inline constexpr std::uint8_t kFlagOwnMove = 1u << 3;
 inline constexpr std::uint8_t kFlagHoming = 1u << 4;
 /// The pen output is down (the status's outputs; while idle only by the operator's pen).
 inline constexpr std::uint8_t kFlagPenDown = 1u << 5;
+/// Holding at a programmed pause (a span with kWirePause ended); resume continues the job.
+inline constexpr std::uint8_t kFlagPaused = 1u << 6;
 
 /// Configuration items: 0 tick rate, 1 + 2a axis a's max velocity, 2 + 2a its acceleration,
 /// 18 + 2a its travel min, 19 + 2a its travel max (LSB, signed; optional: without them the

@@ -97,6 +97,7 @@ private:
         std::int32_t tangent[Axes] = {};
         std::uint32_t ticks = 1;
         bool job_end = false;
+        bool pause_after = false;
     };
 
     const MotionLimits<Axes>& limits() const { return channel_.mailbox.limits; }
@@ -110,6 +111,9 @@ private:
         motion_ = m;
         status_.flags = m == Motion::kGenerated ? (status_.flags | kStatusOwnMove)
                                                 : (status_.flags & ~kStatusOwnMove);
+    }
+    void set_paused(bool paused) {
+        status_.flags = paused ? (status_.flags | kStatusPaused) : (status_.flags & ~kStatusPaused);
     }
     void set_held_by_underrun(bool held) {
         status_.flags = held ? (status_.flags | kStatusHeldByUnderrun)
@@ -253,6 +257,7 @@ private:
         for (unsigned a = 0; a < Axes; ++a) status_.origin[a] = rest_[a];
         current_ = Current{};
         set_held_by_underrun(false);
+        set_paused(false);
     }
 
     // Between spans: spans of an older epoch at the head of the queue are never played.
@@ -286,6 +291,7 @@ private:
         for (unsigned a = 0; a < Axes; ++a) current_.tangent[a] = next.stamp.end_tangent[a];
         current_.ticks = next.ticks;
         current_.job_end = next.stamp.job_end;
+        current_.pause_after = next.stamp.pause_after;
         if (next.stamp.job != status_.job) {
             status_.job = next.stamp.job;
             job_start_ticks_ = channel_.queue.ticks_executed();
@@ -317,6 +323,12 @@ private:
         if (current_.job_end) {
             finish_job();
             return false;
+        }
+        if (current_.pause_after) {
+            // The span ended at rest (the receiver checked): hold here like a hold command.
+            current_.pause_after = false;
+            hold_requested_ = true;
+            set_paused(true);
         }
         const PreparedSpan<Axes>* next = queue.next_span();
         bool moving = false;
@@ -366,6 +378,7 @@ private:
             moving = moving || boundary_tangent_[a] != 0;
         }
         set_held_by_underrun(false);
+        set_paused(false);
         if (at_boundary && !moving) {
             set_motion(Motion::kStream);
             set_state(DeviceState::kRunning);

@@ -287,15 +287,19 @@ private:
                 for (unsigned a = 0; a < Axes; ++a) w.start_tangent[a] = chain.tangent[a];
             }
             const bool job_end = (w.flags & kWireJobEnd) != 0;
+            const bool pause = (w.flags & kWirePause) != 0;
             const std::uint32_t sequence = next_sequence_ + i;
             const Span<Axes> span = to_core_span<Axes>(w, chain.start, sequence);
             if (!push) {
-                if (Status st = check_span(span, w, chain, job_end); st != Status::kOk) return st;
+                if (Status st = check_span(span, w, chain, job_end, pause); st != Status::kOk) {
+                    return st;
+                }
             } else {
                 SpanStamp<Axes> stamp;
                 stamp.epoch = producer_epoch_;
                 stamp.job = chain.job;
                 stamp.job_end = job_end;
+                stamp.pause_after = pause;
                 for (unsigned a = 0; a < Axes; ++a) stamp.end_tangent[a] = w.end_tangent[a];
                 between();
                 if (Status st = channel_.queue.push(span, stamp); st != Status::kOk) return st;
@@ -311,9 +315,9 @@ private:
     }
 
     // The core's validation, the exact limit check, the join with the previous span, and a
-    // job end at rest.
+    // job end or a pause at rest.
     Status check_span(const Span<Axes>& span, const WireSpan& w, const Chain& chain,
-                      bool job_end) const {
+                      bool job_end, bool pause) const {
         ValidatedSpan<Axes> v;
         if (Status st = validate_span(span, v); st != Status::kOk) return st;
         for (unsigned a = 0; a < Axes; ++a) {
@@ -336,10 +340,10 @@ private:
                 return st;
             }
         }
-        if (job_end) {
-            for (unsigned a = 0; a < Axes; ++a) {
-                if (w.end_tangent[a] != 0) return Status::kJobEndMoving;
-            }
+        for (unsigned a = 0; a < Axes; ++a) {
+            if (w.end_tangent[a] == 0) continue;
+            if (job_end) return Status::kJobEndMoving;
+            if (pause) return Status::kPauseMoving;
         }
         return Status::kOk;
     }

@@ -55,6 +55,9 @@ inline constexpr std::uint32_t kStatusPathTick = 1u << 1;     ///< the last tick
 /// The last tick was a tick of the device's own move (a controlled stop or a re-entry): a
 /// holding device without it rests. Set and cleared only when the move starts and ends.
 inline constexpr std::uint32_t kStatusOwnMove = 1u << 2;
+/// Holding at a programmed pause (a span with kWirePause ended): the job waits for the
+/// operator's resume. Cleared when the hold ends (resume, stop, fault, reset).
+inline constexpr std::uint32_t kStatusPaused = 1u << 3;
 
 /// Everything the tick side tells the task side, published whole by every tick and read whole
 /// by the task (StatusBoard, a sequence lock): no field is ever seen from two different ticks.
@@ -99,6 +102,7 @@ struct DeviceStatus {
     bool held_by_underrun() const { return (flags & kStatusHeldByUnderrun) != 0; }
     bool path_tick() const { return (flags & kStatusPathTick) != 0; }
     bool own_move() const { return (flags & kStatusOwnMove) != 0; }
+    bool paused() const { return (flags & kStatusPaused) != 0; }
     std::uint64_t ticks_executed() const {
         return (static_cast<std::uint64_t>(ticks_executed_high) << 32) | ticks_executed_low;
     }

@@ -12,7 +12,8 @@ inline constexpr std::uint16_t kMagic = 0x5053;  ///< "PS"
 /// pen-down delay in the configuration (+3), continuity checked at every join.
 /// 3: operator commands with arguments (jog, set position, home, pen), the homing flag and
 /// per-axis homing registers (42-49).
-inline constexpr std::uint16_t kProtocolVersion = 3;
+/// 4: programmed pauses (wire flag kWirePause) and the paused flag (bit 6).
+inline constexpr std::uint16_t kProtocolVersion = 4;
 
 /// Status block: input registers (FC4) from 0, mirrored read-only in holding registers
 /// (FC3/FC23) at the same addresses so one FC23 can write spans and read the status.
@@ -37,7 +38,7 @@ inline constexpr std::uint16_t kDuplicates = 32;     ///< batches acknowledged a
 inline constexpr std::uint16_t kOutputs = 33;        ///< discrete outputs in force
 inline constexpr std::uint16_t kQueuedSpans = 34;
 /// bit 0: configured, bit 1: held by underrun, bit 3: the device's own stop or re-entry
-/// move, bit 4: homing runs
+/// move, bit 4: homing runs, bit 6: paused at a programmed pause (the bits agree with CAN status A)
 inline constexpr std::uint16_t kFlags = 35;
 inline constexpr std::uint16_t kFinishedJob =
     36;  ///< u32: id of the last job run to its end (0: none)
@@ -59,6 +60,7 @@ inline constexpr std::uint16_t kConfigured = 1u << 0;
 inline constexpr std::uint16_t kHeldByUnderrun = 1u << 1;
 inline constexpr std::uint16_t kOwnMove = 1u << 3;
 inline constexpr std::uint16_t kHoming = 1u << 4;
+inline constexpr std::uint16_t kPaused = 1u << 6;  ///< holding at a programmed pause (kWirePause)
 }  // namespace flags
 
 /// Command register (holding, write-only in effect; reads return the last command written).

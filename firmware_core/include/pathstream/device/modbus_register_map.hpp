@@ -146,6 +146,7 @@ private:
             (device_.configured() ? modbus::flags::kConfigured : 0u) |
             (s.held_by_underrun() ? modbus::flags::kHeldByUnderrun : 0u) |
             (s.own_move() ? modbus::flags::kOwnMove : 0u) |
+            (s.paused() ? modbus::flags::kPaused : 0u) |
             (operator_.homing() ? modbus::flags::kHoming : 0u));
         put_u32(&b[st::kFinishedJob], s.finished_job);
         put_u32(&b[st::kFinishedJobTicks], s.finished_job_ticks);

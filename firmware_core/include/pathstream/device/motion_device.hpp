@@ -98,6 +98,8 @@ public:
     std::uint32_t queued_spans() const { return receiver_.queued_spans(); }
     /// True while holding because the queue ran dry (not because of a hold command).
     bool held_by_underrun() const { return status().held_by_underrun(); }
+    /// True while holding at a programmed pause (kWirePause), until resumed or stopped.
+    bool paused() const { return status().paused(); }
     /// Id (sequence number of its first span) of the last job run to its end; 0 before.
     std::uint32_t finished_job() const { return status().finished_job; }
     /// Path ticks the last finished job executed (low 32 bits).

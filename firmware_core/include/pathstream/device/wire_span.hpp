@@ -5,7 +5,7 @@
 //   u16 ticks - 1 | u8 flags | u8 outputs | per axis: i32 P1, i32 T1 [, i32 T0]
 // T0 is present unless flags has kWireContinueTangent, in which case it equals the previous
 // span's T1 (the planner shares tangents between spans of equal length, so most spans omit it).
-// kWireJobEnd marks the last span of a job.
+// kWireJobEnd marks the last span of a job; kWirePause a programmed pause after a span.
 #pragma once
 
 #include <cstddef>
@@ -22,8 +22,11 @@ inline constexpr std::uint8_t kWireContinueTangent = 1u << 0;
 /// Flag: the last span of a job. It must end at rest (every T1 = 0); the device runs it to its
 /// end, reports the job finished and becomes idle there (docs/device.md, "Jobs").
 inline constexpr std::uint8_t kWireJobEnd = 1u << 1;
+/// Flag: a programmed pause after this span (a pen change, G-code M0). It must end at rest;
+/// the device holds there with the pen up, as after a hold command, until it is resumed.
+inline constexpr std::uint8_t kWirePause = 1u << 2;
 /// Flags a receiver understands; any other bit set makes the span invalid.
-inline constexpr std::uint8_t kWireKnownFlags = kWireContinueTangent | kWireJobEnd;
+inline constexpr std::uint8_t kWireKnownFlags = kWireContinueTangent | kWireJobEnd | kWirePause;
 
 /// Bytes of one wire span for `axes` axes. Constant, any context.
 constexpr std::size_t wire_span_bytes(unsigned axes, bool continue_tangent) {
@@ -33,7 +36,7 @@ constexpr std::size_t wire_span_bytes(unsigned axes, bool continue_tangent) {
 /// A Hermite span in wire terms, all axes (unused axes ignored).
 struct WireSpan {
     std::uint32_t ticks = 1;  ///< 1..kMaxSpanTicks
-    std::uint8_t flags = 0;   ///< kWireContinueTangent, kWireJobEnd or 0
+    std::uint8_t flags = 0;   ///< kWireContinueTangent | kWireJobEnd | kWirePause
     std::uint8_t outputs = 0;
     std::int32_t end[kMaxAxes] = {};           ///< P1
     std::int32_t end_tangent[kMaxAxes] = {};   ///< T1

@@ -2,6 +2,8 @@
 #pragma once
 
 #include <fstream>
+#include <functional>
+#include <ostream>
 #include <string>
 
 namespace pathstream::host {
@@ -25,5 +27,10 @@ private:
     std::ofstream out_;
     bool committed_ = false;
 };
+
+/// Runs `write` on standard output when `output` is "-" (or empty: the command's default
+/// there), else on an AtomicFile committed after it returns. Throws std::runtime_error when
+/// the write fails; an exception from `write` leaves no file.
+void write_output(const std::string& output, const std::function<void(std::ostream&)>& write);
 
 }  // namespace pathstream::host

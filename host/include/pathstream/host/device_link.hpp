@@ -47,6 +47,8 @@ struct DeviceSnapshot {
     bool held_by_underrun() const { return (flags & kSnapshotHeldByUnderrun) != 0; }
     bool own_move() const { return (flags & kSnapshotOwnMove) != 0; }
     bool homing_runs() const { return (flags & kSnapshotHoming) != 0; }
+    /// Holding at a programmed pause (a pen change, M0): the operator's resume continues.
+    bool paused() const { return (flags & kSnapshotPaused) != 0; }
     bool pen_down() const { return (outputs & kOutputPenDown) != 0; }
 
     /// DeviceSnapshot::flags bits: Modbus register 35's and CAN status A's agree on these.
@@ -54,6 +56,7 @@ struct DeviceSnapshot {
     static constexpr unsigned kSnapshotHeldByUnderrun = 1u << 1;
     static constexpr unsigned kSnapshotOwnMove = 1u << 3;
     static constexpr unsigned kSnapshotHoming = 1u << 4;
+    static constexpr unsigned kSnapshotPaused = 1u << 6;
 };
 
 /// "not homed", "homing", "homed", "failed".

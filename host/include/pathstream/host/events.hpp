@@ -92,6 +92,9 @@ public:
     void sample(const JobSample& s);
     /// A stream's status read (StreamObserver): job_start at the first, then its sample.
     void trace(const StreamTrace& t);
+    /// `pause`: the device came to programmed pause `index` (Plan::pauses) and holds, pen up,
+    /// for the operator; `next` says what comes after it (e.g. `layer "blue"`).
+    void pause(std::size_t index, const std::string& next);
     /// job_end, once: `outcome` "finished", "held", "stopped" or "failed" (with `error`);
     /// job_start first if it has not been written. `ticks`: the job's path ticks executed, when
     /// known better than from the last sample.

@@ -17,6 +17,11 @@ struct BezierSegment {
     std::size_t subpath = 0;  ///< index into Path::subpaths (travel: the subpath it leads to)
     double feed = 0;          ///< requested speed, mm/s (Subpath::feed); 0: the machine profile's
                               ///< feed (travel_feed for pen-up travel)
+    /// Set on a subpath's first drawing segment only (Subpath's fields of the same names): a
+    /// programmed pause, and a rest in seconds with the pen down or up, before it draws.
+    bool pause_before = false;
+    double dwell_before = 0;
+    bool dwell_pen_down = false;
 };
 
 /// Converts every subpath to Bezier segments (B-spline and Catmull-Rom spans exactly, with the

@@ -62,6 +62,9 @@ struct JobJournal {
     /// dropped), "failed" (the stream ended with an error: `error`), "finished".
     std::string outcome = "streaming";
     std::string error;
+    /// Per programmed pause of the drawing (Plan::pauses, in order): what comes after it, for
+    /// the operator (`layer "blue"`). Optional in the file.
+    std::vector<std::string> pauses;
 };
 
 /// Writes `journal` to `path` atomically (JSON).

@@ -65,6 +65,9 @@ struct MachineProfile {
     double pen_up_delay = 0.05;        ///< s the pen needs to lift
     double chord_tolerance = 0.005;    ///< mm: max distance of executed ticks from the path
     GpioConfig gpio;                   ///< optional "gpio" object
+    /// Optional "layer_feeds": pen-down speed (mm/s) per layer name (an Inkscape layer's label,
+    /// a stroke colour such as "#ff0000"), for subpaths that set no feed of their own.
+    std::vector<std::pair<std::string, double>> layer_feeds;
     std::string source;                ///< file it came from, for messages
 
     double tick_seconds() const { return 1.0 / tick_hz; }

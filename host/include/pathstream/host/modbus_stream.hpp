@@ -44,6 +44,12 @@ struct InterruptOptions {
     /// idle. Written by a signal handler, read by the streaming loop. Not owned.
     const std::atomic<int>* request = nullptr;
     double hold_timeout_seconds = 10;  ///< a hold not at rest by then becomes a stop
+    /// Called once each time the device comes to a programmed pause (Plan::pauses; the index
+    /// of the pause in it). May be empty.
+    std::function<void(std::size_t pause)> on_pause;
+    /// Polled while the device is paused; true sends the resume (e.g. Enter at a terminal).
+    /// Empty: the operator resumes the device (`pathstream ctl TARGET resume`).
+    std::function<bool()> resume_requested;
 };
 
 struct StreamOptions {

@@ -16,10 +16,18 @@ struct PenEvent {
     bool down = false;
 };
 
+/// A programmed pause (a pen change between layers, G-code M0): the device holds, pen up, at
+/// the end of tick `tick - 1` until the operator resumes; subpath `subpath` is drawn next.
+struct PlanPause {
+    std::uint64_t tick = 0;
+    std::size_t subpath = 0;
+};
+
 /// What `plan` produces and what every target executes: spans of whole ticks for the core.
 struct Plan {
     std::vector<CoreSpan> spans;    ///< consecutive, continuous (each starts where the last ends)
     std::vector<PenEvent> pen;      ///< in tick order; the pen starts up
+    std::vector<PlanPause> pauses;  ///< in tick order; the span ending at each has pause_after
     std::uint64_t total_ticks = 0;  ///< sum of span ticks
     double duration = 0;            ///< s = total_ticks / tick_hz
     double path_length = 0;         ///< mm, pen-down length of the geometric path

@@ -69,10 +69,16 @@ struct Options {
     unsigned half_window_ticks = 0;  ///< differencing half window (0: automatic)
     bool png = true;                 ///< also write PNG copies when rsvg-convert is found
     std::string title;               ///< shown on every plot (e.g. the input file name)
+    /// The drawing's layers (Path::layers' names) and each subpath's layer (by
+    /// BezierSegment::subpath): path.svg draws each layer's pen-down path in its own colour,
+    /// the layer's own when its name is one ("#rrggbb"). Empty: one colour.
+    std::vector<std::string> layers;
+    std::vector<std::size_t> subpath_layers;
 };
 
 /// path.svg as text: the ideal path (Bezier segments sampled densely; pen-down solid, pen-up
-/// travel dashed, grey and wide underneath) and the executed positions of `executed` and, if
+/// travel dashed, grey and wide underneath; with layers, each layer's pen-down path in its
+/// colour with a legend entry) and the executed positions of `executed` and, if
 /// given, `plant` (pen-down solid, pen-up dashed), axes 0 and 1 at equal scale with mm ticks
 /// and a legend above the plot. One axis: position against time instead.
 /// Series are SVG groups with ids "ideal-path", "setpoints" (executed) and "plant".
