@@ -78,7 +78,9 @@ expect device-axes-and-machine 2 "the axis count comes from --machine" -- "$bin"
 expect layers-plan 0 'layers: 2 ("outline" 2 subpaths' -- "$bin" plan "$src/examples/two_pens.svg" -m "$machine"
 expect layers-pause 0 '1 pause for the operator' -- "$bin" plan "$src/examples/two_pens.svg" -m "$machine"
 expect layers-one 0 'layers: 2 ("outline" 0 subpaths 0.0 mm, "accent" 2 subpaths' -- "$bin" check "$src/examples/two_pens.svg" --layer accent
-expect layers-no-pause 0 '0 pauses for the operator' -- "$bin" check "$src/examples/two_pens.svg" --no-pause
+expect layers-no-pause 0 '0 pauses for the operator' -- "$bin" check "$src/examples/two_pens.svg" --pause none
+expect layers-same-pen 0 '0 pauses for the operator' -- "$bin" check "$src/examples/landscape.svg"
+expect layers-every 0 '6 pauses for the operator' -- "$bin" check "$src/examples/landscape.svg" --pause layer
 expect layers-unknown 2 '--layer 3: no such layer (the drawing has 1: "outline", 2: "accent")' -- "$bin" check "$src/examples/two_pens.svg" --layer 3
 expect stdin-json 0 '<stdin>: valid, 2 axes' -- bash -c "\"$bin\" check - < \"$src/examples/rose.json\""
 expect stdin-svg 0 'layers: 2' -- bash -c "cat \"$src/examples/two_pens.svg\" | \"$bin\" check -"

@@ -95,7 +95,7 @@ stop_device
 
 # ---- Two layers: the device pauses pen up between them until `ctl resume` ---------------
 start_device 2 || exit 1
-"$bin" stream "$src/examples/two_pens.svg" -m "$machine" -t "$target" --no-journal \
+"$bin" stream "$src/examples/two_pens.svg" -m "$machine" -t "$target" --no-journal --lead-in \
   --events "$work/pause.ndjson" < /dev/null > "$work/stream_pause.log" 2>&1 &
 stream_pid=$!
 paused=

@@ -5,6 +5,8 @@
 #include <vector>
 
 #include "core/device_fixture.hpp"
+#include "pathstream/device/can_node.hpp"
+#include "pathstream/device/modbus_register_map.hpp"
 #include "pathstream/device/motion_device.hpp"
 
 using namespace pathstream;
@@ -111,4 +113,36 @@ TEST_CASE("pause: a span marked for a pause must end at rest", "[device][pause]"
     CHECK(send_all(d, spans) == Status::kPauseMoving);
     CHECK(d.queued_spans() == 0);
     CHECK(d.last_accepted_sequence() == 0);
+}
+
+TEST_CASE("pause: the paused flag on Modbus (register 35 bit 6) and CAN (status A bit 6)", "[device][pause]") {
+    const Lsb start[kAxes] = {0, 0};
+    Device d(start);
+    REQUIRE(d.configure(test_limits<kAxes>()) == Status::kOk);
+    ModbusRegisterMap<kAxes, 64> map(d);
+    can::CanNode<kAxes, 64> node{d, 5};
+    const auto flags = [&] {
+        std::uint16_t modbus_flags = 0;
+        REQUIRE(map.read_input_registers(modbus::status::kFlags, 1, &modbus_flags) == modbus::Exception::kNone);
+        std::vector<can::Frame> out;
+        node.handle(can::encode_command(5, can::kCommandStatusRequest), [&](const can::Frame& f) { out.push_back(f); });
+        can::Status3 s;
+        for (const can::Frame& f : out) REQUIRE(can::decode_status_part(f, s));
+        return std::make_pair(modbus_flags & modbus::flags::kPaused, s.flags & can::kFlagPaused);
+    };
+    std::size_t first = 0;
+    const std::vector<WireSpan> spans = two_moves(start, first);
+    REQUIRE(send_all(d, spans) == Status::kOk);
+    REQUIRE(d.command(Command::kStart) == Status::kOk);
+    CHECK(flags() == std::make_pair(0, 0));
+    for (int i = 0; i < 5000 && !d.paused(); ++i) {
+        Lsb p[kAxes];
+        d.tick(p);
+    }
+    REQUIRE(d.paused());
+    CHECK(flags() == std::make_pair(int{modbus::flags::kPaused}, int{can::kFlagPaused}));
+    REQUIRE(d.command(Command::kResume) == Status::kOk);
+    Lsb p[kAxes];
+    d.tick(p);
+    CHECK(flags() == std::make_pair(0, 0));
 }

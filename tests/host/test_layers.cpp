@@ -102,9 +102,28 @@ TEST_CASE("layers: the profile's layer feeds, for subpaths without their own", "
     CHECK(layers_json(p)[0]["feed_mm_s"].is_null());
 }
 
-TEST_CASE("layers: the path order keeps layers and pauses in place", "[layers][order]") {
+TEST_CASE("layers: a pause where the pen changes, at every layer, or never", "[layers]") {
+    const Path p = group_by_layer(parse_svg_path(kLayered, "layered.svg"));
+    // Pens: "#000000", "mixed" (black and blue), "#ff0000", "" (no stroke: any pen).
+    std::vector<std::string> pens;
+    for (const PathLayer& l : p.layers) pens.push_back(l.pen);
+    CHECK(pens == std::vector<std::string>{"#000000", "mixed", "#ff0000", ""});
+    const auto pauses_at = [&](LayerPause when) {
+        Path q = p;
+        pause_between_layers(q, when);
+        std::vector<std::size_t> at;
+        for (std::size_t i = 0; i < q.subpaths.size(); ++i)
+            if (q.subpaths[i].pause_before) at.push_back(i);
+        return at;
+    };
+    CHECK(pauses_at(LayerPause::kPenChange) == std::vector<std::size_t>{1, 3});
+    CHECK(pauses_at(LayerPause::kEveryLayer) == std::vector<std::size_t>{1, 3, 5});
+    CHECK(pauses_at(LayerPause::kNone).empty());
+}
+
+TEST_CASE("layers: the path order keeps pauses in place", "[layers][order]") {
     Path p = group_by_layer(parse_svg_path(kLayered, "layered.svg"));
-    pause_between_layers(p);
+    pause_between_layers(p, LayerPause::kEveryLayer);
     OrderReport r;
     const Path ordered = order_sections(p, {}, &r);
     REQUIRE(ordered.subpaths.size() + r.merged == p.subpaths.size());

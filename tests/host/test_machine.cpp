@@ -52,7 +52,7 @@ TEST_CASE("impossible profiles are refused with the place and the reason", "[hos
     CHECK(error_of(std::string("{") + kAxes + ", \"chord_tolerance\": 0.0001}") ==
           "m.json:1:93: chord_tolerance 0.0001 mm is below half an LSB (0.0005 mm): integer setpoints cannot meet it");
     CHECK(error_of(std::string("{") + kAxes + ", \"speed\": 3}") ==
-          "m.json:1:83: unknown key \"speed\" (expected one of: axes, chord_tolerance, feed, gpio, mm_per_lsb, "
+          "m.json:1:83: unknown key \"speed\" (expected one of: axes, chord_tolerance, feed, gpio, layer_feeds, mm_per_lsb, "
           "pen_down_delay, pen_up_delay, tick_hz, ticks_per_span, travel_feed)");
     CHECK(error_of(R"({"axes": [{"name": "x", "max_velocity": 1, "max_acceleration": 1},
                               {"name": "x", "max_velocity": 1, "max_acceleration": 1}]})") ==

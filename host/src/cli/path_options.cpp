@@ -70,8 +70,11 @@ void add_path_options(CLI::App& command, PathOptions& o) {
     command.add_option("--layer", o.layers,
                        "plot only this layer (its name, or its number from 1; repeatable); placement still "
                        "uses the whole drawing, so layers plotted in separate runs line up");
-    command.add_flag("--no-pause", o.no_pause,
-                     "no pause for a pen change between layers (they plot one after the other)");
+    command.add_option("--pause", o.pause,
+                       "pause for a pen change between layers: pen (where their stroke colours differ), layer "
+                       "(between every two), none")
+        ->capture_default_str()
+        ->check(CLI::IsMember({"pen", "layer", "none"}));
 }
 
 namespace {
@@ -128,7 +131,9 @@ LoadedPath load_path_report(const PathOptions& o, const MachineProfile* machine,
     const std::optional<Box2> area = machine != nullptr ? work_area(*machine) : std::nullopt;
     path = place_path(path, placement, area, &loaded.placement);
     path = group_by_layer(select_layers(path, o.layers));
-    if (!o.no_pause) pause_between_layers(path);
+    pause_between_layers(path, o.pause == "layer"  ? LayerPause::kEveryLayer
+                               : o.pause == "none" ? LayerPause::kNone
+                                                   : LayerPause::kPenChange);
     if (machine != nullptr) apply_layer_feeds(path, *machine);
     if (!o.keep_order) {
         OrderOptions order;

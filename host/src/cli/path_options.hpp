@@ -27,7 +27,7 @@ struct PathOptions {
     double merge_tolerance = 0.01;      ///< --merge-tolerance: mm between ends that are joined
     std::string order_start;            ///< --order-start "X,Y,..." (mm); empty: the origin
     std::vector<std::string> layers;    ///< --layer NAME|N (repeatable): plot only these layers
-    bool no_pause = false;              ///< --no-pause: no pen-change pause between layers
+    std::string pause = "pen";          ///< --pause: pen (between layers with other pens), layer, none
 };
 
 /// A loaded path and what placement and ordering did to it (for check).

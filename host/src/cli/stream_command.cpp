@@ -454,7 +454,7 @@ int stream_cia402(const PlannedJob& planned, const std::string& url, const Event
         throw std::invalid_argument(
             "CiA 402 targets cannot pause the job (" + std::to_string(planned.plan.pauses.size()) +
             " programmed pauses: pen changes or M0/M1): plot one layer at a time with --layer, or "
-            "turn the pen-change pauses off with --no-pause");
+            "turn the pen-change pauses off with --pause none");
     }
     hal::SocketCanBus cia402_bus(parse_cia402_target(url, planned.machine.axes.size()).interface);
     const JobSpans job = job_from_plan(planned.plan);

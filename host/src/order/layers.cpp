@@ -51,10 +51,10 @@ double subpath_length(const Subpath& s, std::size_t axes) {
     return length;
 }
 
-// A section of the path starts at a layer change, a pause or a rest: order_sections keeps them.
+// A section of the path starts at a pause or a rest: order_sections keeps them in place.
 bool starts_section(const Path& path, std::size_t i) {
     const Subpath& s = path.subpaths[i];
-    return i == 0 || s.pause_before || s.dwell_before > 0 || s.layer != path.subpaths[i - 1].layer;
+    return i == 0 || s.pause_before || s.dwell_before > 0;
 }
 
 }  // namespace
@@ -79,9 +79,18 @@ Path group_by_layer(const Path& path) {
     return out;
 }
 
-void pause_between_layers(Path& path) {
+void pause_between_layers(Path& path, LayerPause when) {
+    if (when == LayerPause::kNone) return;
     for (std::size_t i = 1; i < path.subpaths.size(); ++i) {
-        if (path.subpaths[i].layer != path.subpaths[i - 1].layer) path.subpaths[i].pause_before = true;
+        const std::size_t a = path.subpaths[i - 1].layer, b = path.subpaths[i].layer;
+        if (a == b) continue;
+        if (when == LayerPause::kEveryLayer || a >= path.layers.size() || b >= path.layers.size()) {
+            path.subpaths[i].pause_before = true;
+            continue;
+        }
+        const std::string& p = path.layers[a].pen;
+        const std::string& q = path.layers[b].pen;
+        if (p == "mixed" || q == "mixed" || (!p.empty() && !q.empty() && p != q)) path.subpaths[i].pause_before = true;
     }
 }
 

@@ -126,10 +126,14 @@ private:
             outside = outside || subpath_layers_[i] == kNoLayer;
         if (!layers_.empty()) {
             const std::size_t shift = outside ? 1 : 0;
-            if (outside) path_.layers.push_back({"(outside layers)", {}, 0});
+            if (outside) path_.layers.push_back({"(outside layers)", {}, 0, ""});
             for (PathLayer& l : layers_) path_.layers.push_back(std::move(l));
             for (std::size_t i = 0; i < path_.subpaths.size(); ++i) {
                 path_.subpaths[i].layer = subpath_layers_[i] == kNoLayer ? 0 : subpath_layers_[i] + shift;
+                const std::string colour = normal_colour(strokes_[i]);
+                std::string& pen = path_.layers[path_.subpaths[i].layer].pen;
+                if (colour == "none") continue;
+                pen = pen.empty() || pen == colour ? colour : "mixed";
             }
             return;
         }
@@ -140,7 +144,7 @@ private:
             path_.subpaths[i].layer = static_cast<std::size_t>(at - colours.begin());
             if (at == colours.end()) {
                 colours.push_back(colour);
-                path_.layers.push_back({colour, path_.subpaths[i].location, 0});
+                path_.layers.push_back({colour, path_.subpaths[i].location, 0, colour == "none" ? "" : colour});
             }
         }
         if (colours.size() < 2) {
@@ -172,7 +176,7 @@ private:
         if (name.empty()) name = trim(n.attribute("id").value());
         if (name.empty()) name = std::to_string(layers_.size() + 1);
         state.layer = layers_.size();
-        layers_.push_back({name, element_location(n), 0});
+        layers_.push_back({name, element_location(n), 0, ""});
     }
 
     // ---- places ----------------------------------------------------------------------------

@@ -173,7 +173,7 @@ inline constexpr Signal kStatusASignals[] = {
     {"State", 0, 1, false, "", "0 idle, 1 running, 2 holding, 3 stopping, 4 fault, 5 e-stop", -1, kStateValues},
     {"Flags", 1, 1, false, "",
      "bit 0 configured, bit 1 held by underrun, bit 2 bus problem seen, bit 3 own stop or re-entry move, bit 4 homing, "
-     "bit 5 pen down"},
+     "bit 5 pen down, bit 6 paused at a programmed pause"},
     {"FreeSlots", 2, 1, false, "span", "free span slots"},
     {"Queued", 3, 1, false, "span", "spans queued"},
     {"FaultCode", 4, 2, false, "", "0 none, 1 external, 2 stop failed, 3 re-entry failed, 0x01xx limit switch", -1,

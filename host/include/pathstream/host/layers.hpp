@@ -21,18 +21,26 @@ Path select_layers(const Path& path, const std::vector<std::string>& chosen);
 /// they had (stable). A path without layers is returned as it is.
 Path group_by_layer(const Path& path);
 
-/// Sets Subpath::pause_before on the first subpath of every layer after the first (the path
-/// grouped by layer): the device pauses there, pen up, for a pen change.
-void pause_between_layers(Path& path);
+/// When a job pauses between layers for a pen change.
+enum class LayerPause {
+    kPenChange,   ///< between layers whose pens differ (PathLayer::pen; "mixed" differs from all)
+    kEveryLayer,  ///< between every two layers
+    kNone,
+};
+
+/// Sets Subpath::pause_before on the first subpath of a layer that follows another (the path
+/// grouped by layer) when `when` says so: the device pauses there, pen up, for a pen change.
+void pause_between_layers(Path& path, LayerPause when = LayerPause::kPenChange);
 
 /// Each layer's feed is the profile's layer_feeds entry for its name (entries naming no layer
 /// of this drawing are unused; `check` lists every layer's feed), and subpaths with no feed of
 /// their own get their layer's.
 void apply_layer_feeds(Path& path, const MachineProfile& machine);
 
-/// order_path within each section of the path: runs of subpaths of one layer between pauses
-/// and rests (Subpath::pause_before, dwell_before), which keep their place at a section's
-/// start; each section starts where the previous one ended. `report` covers the whole path.
+/// order_path within each section of the path: the runs of subpaths between pauses and rests
+/// (Subpath::pause_before, dwell_before), which keep their place at a section's start; each
+/// section starts where the previous one ended. Layers drawn with one pen (no pause between
+/// them) are ordered together. `report` covers the whole path.
 Path order_sections(const Path& path, const OrderOptions& options, OrderReport* report = nullptr);
 
 /// Per layer: its name, subpath count and pen-down length (mm), for reports.

@@ -48,6 +48,9 @@ struct PathLayer {
     std::string name;         ///< the layer's label, or the colour ("#ff0000"), or "1", "2"...
     SourceLocation location;  ///< where the layer starts in the file (line 0: no element)
     double feed = 0;          ///< mm/s for its subpaths that set none; 0: the profile's
+    /// The pen it needs: its subpaths' stroke colour ("#rrggbb"), "" when none of them has
+    /// one (any pen), "mixed" when they have several.
+    std::string pen;
 };
 
 /// A whole path. Every point of every subpath has `axes` coordinates.
