@@ -4,6 +4,7 @@
 #include <charconv>
 #include <cctype>
 #include <cmath>
+#include <iostream>
 #include <stdexcept>
 #include <utility>
 
@@ -25,9 +26,13 @@ void add_path_options(CLI::App& command, PathOptions& o) {
         ->capture_default_str()
         ->check(CLI::IsMember({"bspline", "catmull-rom", "bezier", "polyline"}));
     command.add_flag("--csv-closed", o.csv_closed, "CSV points form a closed curve");
-    command.add_option("--gcode-pen", o.gcode_pen, "G-code pen control: z (down at Z <= --gcode-z-down) or spindle (M3/M5)")
+    command.add_option("--gcode-pen", o.gcode_pen, "G-code pen control: z (down at Z <= --gcode-z-down), spindle (M3/M5), "
+                                                   "motion (G1 draws, G0 travels) or auto (chosen from the file)")
         ->capture_default_str()
-        ->check(CLI::IsMember({"z", "spindle"}));
+        ->check(CLI::IsMember({"z", "spindle", "motion", "auto"}));
+    command.add_option("--ignore-code", o.gcode_ignore,
+                       "G-code: skip this G or M code with a warning, like M300 (repeatable; M6, M7-M9 and "
+                       "others are skipped already)");
     command.add_option("--gcode-z-down", o.gcode_z_down, "G-code: highest Z (mm) with the pen down")->capture_default_str();
     command.add_option("--tolerance", o.tolerance, "mm: arcs (SVG, G-code) become cubics within this")
         ->capture_default_str()
@@ -92,13 +97,13 @@ std::vector<double> parse_numbers(const std::string& text, const std::string& op
     return values;
 }
 
-/// The file as its reader gives it, by extension.
-Path read_path(const PathOptions& o);
+/// The file as its reader gives it, by extension; `gcode_pen` gets the G-code pen mode note.
+Path read_path(const PathOptions& o, std::string& gcode_pen);
 }  // namespace
 
 LoadedPath load_path_report(const PathOptions& o, const MachineProfile* machine, const std::vector<double>* start) {
     LoadedPath loaded;
-    Path path = read_path(o);
+    Path path = read_path(o, loaded.gcode_pen);
     PlacementOptions placement = o.placement;
     if (!o.translate.empty()) {
         const std::vector<double> xy = parse_numbers(o.translate, "--translate");
@@ -132,7 +137,7 @@ Path load_path(const PathOptions& o, const MachineProfile* machine, const std::v
 }
 
 namespace {
-Path read_path(const PathOptions& o) {
+Path read_path(const PathOptions& o, std::string& gcode_pen) {
     std::string ext = o.file.substr(o.file.find_last_of('.') == std::string::npos ? o.file.size()
                                                                                  : o.file.find_last_of('.'));
     std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
@@ -141,10 +146,18 @@ Path read_path(const PathOptions& o) {
     if (ext == ".csv") return load_csv_path(o.file, basis_from_name(o.csv_basis), o.csv_closed);
     if (ext == ".gcode" || ext == ".ngc" || ext == ".nc" || ext == ".gc") {
         GcodeOptions g;
-        g.pen = o.gcode_pen == "spindle" ? PenControl::kSpindle : PenControl::kZ;
+        g.pen = o.gcode_pen == "spindle" ? PenControl::kSpindle
+                : o.gcode_pen == "motion" ? PenControl::kMotion
+                : o.gcode_pen == "auto"   ? PenControl::kAuto
+                                          : PenControl::kZ;
         g.z_down_max = o.gcode_z_down;
         g.arc_tolerance_mm = o.tolerance;
-        return load_gcode_path(o.file, g);
+        g.ignore_codes = o.gcode_ignore;
+        GcodeReadInfo info;
+        Path path = load_gcode_path(o.file, g, &info);
+        for (const std::string& warning : info.warnings) std::cerr << "pathstream: warning: " << warning << '\n';
+        gcode_pen = std::string(pen_control_name(info.pen)) + " (" + info.pen_reason + ")";
+        return path;
     }
     throw InputError(
         o.file, {},
