@@ -217,3 +217,32 @@ TEST_CASE("G-code: unsupported planes and cycles", "[gcode]") {
     CHECK(error_of("G81 X1 Y1 Z-1 R1\n") == "t.ngc:1:1: canned cycles (G81) are not supported");
     CHECK(error_of("G1 Z-1\nG1 X1\nM2\nG1 X[1/0]\n") == "no error");  // nothing after M2 is read
 }
+
+TEST_CASE("G-code: pen mode motion", "[gcode]") {
+    GcodeOptions o;
+    o.pen = PenControl::kMotion;
+    const Path p = run("G0 X1 Y1\nG1 X5\nG1 Y5\nG0 X10\nG2 X20 I5\n", o);
+    REQUIRE(p.subpaths.size() == 2);
+    CHECK(p.subpaths[0].points.front() == PathPoint{1, 1});
+    CHECK(p.subpaths[1].points.front() == PathPoint{10, 5});
+}
+
+TEST_CASE("G-code: pen mode auto says why", "[gcode]") {
+    GcodeOptions o;
+    o.pen = PenControl::kAuto;
+    GcodeReadInfo info;
+    run("G0 Z5\nG1 X1\nG1 Z-1\nG1 X5\n", o, &info);
+    CHECK(info.pen == PenControl::kZ);
+    CHECK(info.pen_reason == "Z goes both above and to or below 0 mm (--gcode-z-down)");
+    const Path s = run("G0 Z5\nG1 X1\nM3\nG1 X5\nM5\nG1 X9\n", o, &info);
+    CHECK(info.pen == PenControl::kSpindle);
+    CHECK(info.pen_reason == "M3/M4 appear and Z never crosses 0 mm");
+    REQUIRE(s.subpaths.size() == 1);
+    CHECK(s.subpaths[0].points.back() == PathPoint{5, 0});
+    const Path m = run("G0 X1\nG1 X5\nG0 X7\nG1 X9\n", o, &info);
+    CHECK(info.pen == PenControl::kMotion);
+    CHECK(info.pen_reason == "no M3/M4 and Z never crosses 0 mm: G1 draws, G0 travels");
+    CHECK(m.subpaths.size() == 2);
+    run("G1 Z-1\nG1 X5\n", {}, &info);
+    CHECK(info.pen_reason == "--gcode-pen z");
+}
