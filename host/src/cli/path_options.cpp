@@ -141,7 +141,7 @@ Path read_path(const PathOptions& o, std::string& gcode_pen) {
     std::string ext = o.file.substr(o.file.find_last_of('.') == std::string::npos ? o.file.size()
                                                                                  : o.file.find_last_of('.'));
     std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
-    if (ext == ".json") return load_json_path(o.file);
+    if (ext == ".json") return load_json_path(o.file, o.tolerance);
     if (ext == ".svg") return load_svg_path(o.file, o.tolerance);
     if (ext == ".csv") return load_csv_path(o.file, basis_from_name(o.csv_basis), o.csv_closed);
     if (ext == ".gcode" || ext == ".ngc" || ext == ".nc" || ext == ".gc") {
