@@ -1,7 +1,7 @@
 // NURBS input (JSON "basis": "nurbs" and G-code G5.2/G5.3) against an independent de Boor
 // evaluation: exact where the reader claims exactness, within the tolerance elsewhere.
-#include <catch2/catch.hpp>
 #include <algorithm>
+#include <catch2/catch.hpp>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -67,12 +67,14 @@ double segment_distance(const std::vector<double>& p, const std::vector<double>&
 }
 
 /// Largest distance from any point of one dense polyline to the other (both directions).
-double hausdorff(const std::vector<std::vector<double>>& a, const std::vector<std::vector<double>>& b) {
+double hausdorff(const std::vector<std::vector<double>>& a,
+                 const std::vector<std::vector<double>>& b) {
     auto one_way = [](const auto& from, const auto& to) {
         double worst = 0;
         for (const auto& p : from) {
             double best = std::numeric_limits<double>::infinity();
-            for (std::size_t i = 0; i + 1 < to.size(); ++i) best = std::min(best, segment_distance(p, to[i], to[i + 1]));
+            for (std::size_t i = 0; i + 1 < to.size(); ++i)
+                best = std::min(best, segment_distance(p, to[i], to[i + 1]));
             worst = std::max(worst, best);
         }
         return worst;
@@ -84,16 +86,19 @@ std::vector<std::vector<double>> dense_curve(const Curve& c, std::size_t samples
     const double lo = c.knots[static_cast<std::size_t>(c.degree)], hi = c.knots[c.points.size()];
     std::vector<std::vector<double>> out;
     for (std::size_t s = 0; s <= samples; ++s) {
-        out.push_back(de_boor(c, lo + (hi - lo) * static_cast<double>(s) / static_cast<double>(samples)));
+        out.push_back(
+            de_boor(c, lo + (hi - lo) * static_cast<double>(s) / static_cast<double>(samples)));
     }
     return out;
 }
 
-std::vector<std::vector<double>> dense_chain(const std::vector<PathPoint>& q, std::size_t per_piece) {
+std::vector<std::vector<double>> dense_chain(const std::vector<PathPoint>& q,
+                                             std::size_t per_piece) {
     std::vector<std::vector<double>> out;
     const std::size_t pieces = (q.size() - 1) / 3;
     for (std::size_t k = 0; k < pieces; ++k) {
-        for (std::size_t s = 0; s < per_piece; ++s) out.push_back(bezier_at(q, k, static_cast<double>(s) / static_cast<double>(per_piece)));
+        for (std::size_t s = 0; s < per_piece; ++s)
+            out.push_back(bezier_at(q, k, static_cast<double>(s) / static_cast<double>(per_piece)));
     }
     out.push_back({q.back()[0], q.back()[1]});
     return out;
@@ -109,8 +114,9 @@ std::string json_of(const Curve& c) {
     std::string pts = "[";
     for (std::size_t i = 0; i < c.points.size(); ++i) pts += (i ? ", " : "") + list(c.points[i]);
     pts += "]";
-    std::string s = "{\"subpaths\": [{\"basis\": \"nurbs\", \"degree\": " + std::to_string(c.degree) +
-                    ", \"knots\": " + list(c.knots) + ", \"points\": " + pts;
+    std::string s =
+        "{\"subpaths\": [{\"basis\": \"nurbs\", \"degree\": " + std::to_string(c.degree) +
+        ", \"knots\": " + list(c.knots) + ", \"points\": " + pts;
     if (!c.weights.empty()) s += ", \"weights\": " + list(c.weights);
     return s + "}]}";
 }
@@ -130,17 +136,30 @@ double exact_error(const Curve& c, const std::vector<PathPoint>& chain) {
     for (std::size_t j = 0; j + 1 < breaks.size(); ++j) {
         for (int s = 0; s <= 20; ++s) {
             const double t = s / 20.0;
-            worst = std::max(worst, dist(bezier_at(chain, j, t), de_boor(c, breaks[j] + t * (breaks[j + 1] - breaks[j]))));
+            worst = std::max(worst, dist(bezier_at(chain, j, t),
+                                         de_boor(c, breaks[j] + t * (breaks[j + 1] - breaks[j]))));
         }
     }
     return worst;
 }
 
-const Curve kUnclampedCubic{3, {{0, 0}, {10, 20}, {20, -10}, {30, 15}, {45, 0}, {50, 30}}, {}, {0, 1, 2, 3, 4, 5, 6, 7, 8, 9}};
-const Curve kDoubleKnotCubic{3, {{0, 0}, {5, 10}, {10, 0}, {15, 10}, {20, 0}, {25, 10}}, {}, {0, 0, 0, 0, 1, 1, 2, 2, 2, 2}};
-const Curve kQuarterCircle{2, {{10, 0}, {10, 10}, {0, 10}}, {1, std::sqrt(0.5), 1}, {0, 0, 0, 1, 1, 1}};
-const Curve kQuintic{5, {{0, 0}, {10, 30}, {20, -30}, {30, 30}, {40, -30}, {50, 30}, {60, 0}, {70, 10}}, {}, {0, 0, 0, 0, 0, 0, 1, 2, 3, 3, 3, 3, 3, 3}};
-const Curve kRationalQuartic{4, {{0, 0}, {20, 40}, {40, -20}, {60, 40}, {80, 0}, {100, 20}}, {1, 3, 0.5, 2, 1, 1}, {0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10}};
+const Curve kUnclampedCubic{3,
+                            {{0, 0}, {10, 20}, {20, -10}, {30, 15}, {45, 0}, {50, 30}},
+                            {},
+                            {0, 1, 2, 3, 4, 5, 6, 7, 8, 9}};
+const Curve kDoubleKnotCubic{
+    3, {{0, 0}, {5, 10}, {10, 0}, {15, 10}, {20, 0}, {25, 10}}, {}, {0, 0, 0, 0, 1, 1, 2, 2, 2, 2}};
+const Curve kQuarterCircle{
+    2, {{10, 0}, {10, 10}, {0, 10}}, {1, std::sqrt(0.5), 1}, {0, 0, 0, 1, 1, 1}};
+const Curve kQuintic{
+    5,
+    {{0, 0}, {10, 30}, {20, -30}, {30, 30}, {40, -30}, {50, 30}, {60, 0}, {70, 10}},
+    {},
+    {0, 0, 0, 0, 0, 0, 1, 2, 3, 3, 3, 3, 3, 3}};
+const Curve kRationalQuartic{4,
+                             {{0, 0}, {20, 40}, {40, -20}, {60, 40}, {80, 0}, {100, 20}},
+                             {1, 3, 0.5, 2, 1, 1},
+                             {0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10}};
 
 }  // namespace
 
@@ -166,12 +185,14 @@ TEST_CASE("NURBS: rational and quintic curves within the tolerance", "[gcode][nu
             const double deviation = hausdorff(dense_curve(c, 3000), dense_chain(chain, 200));
             INFO("degree " << c.degree << ", " << (chain.size() - 1) / 3 << " pieces");
             CHECK(deviation <= tolerance);
-            CHECK(dist({chain.front()[0], chain.front()[1]}, de_boor(c, c.knots[static_cast<std::size_t>(c.degree)])) < 1e-9);
+            CHECK(dist({chain.front()[0], chain.front()[1]},
+                       de_boor(c, c.knots[static_cast<std::size_t>(c.degree)])) < 1e-9);
         }
     }
     // The quarter circle against the circle itself: every sample within 0.001 of radius 10.
     const Path p = read_json(kQuarterCircle, 0.001);
-    for (const auto& q : dense_chain(p.subpaths[0].points, 100)) CHECK(std::fabs(std::hypot(q[0], q[1]) - 10) <= 0.001);
+    for (const auto& q : dense_chain(p.subpaths[0].points, 100))
+        CHECK(std::fabs(std::hypot(q[0], q[1]) - 10) <= 0.001);
 }
 
 TEST_CASE("NURBS: JSON errors", "[gcode][nurbs]") {
@@ -187,18 +208,21 @@ TEST_CASE("NURBS: JSON errors", "[gcode][nurbs]") {
     CHECK(error("{\"basis\": \"nurbs\", " + pts + "}") == "no error");  // cubic, clamped uniform
     CHECK(error("{\"basis\": \"nurbs\", \"degree\": 6, " + pts + "}") ==
           "t.json:1:44: degree must be a whole number from 1 to 5");
-    CHECK(error("{\"basis\": \"nurbs\", \"knots\": [0, 0, 0, 1, 1, 1], " + pts + "}").find(
-              "nurbs: needs 8 knots (points + degree + 1), got 6") != std::string::npos);
-    CHECK(error("{\"basis\": \"nurbs\", \"knots\": [0, 0, 0, 0, 2, 1, 1, 1], " + pts + "}").find(
-              "knots must not decrease") != std::string::npos);
-    CHECK(error("{\"basis\": \"nurbs\", \"weights\": [1, 0, 1, 1], " + pts + "}").find(
-              "weight 0 must be positive and finite") != std::string::npos);
-    CHECK(error("{\"basis\": \"nurbs\", \"closed\": true, " + pts + "}").find(
-              "a nurbs subpath is open") != std::string::npos);
-    CHECK(error("{\"basis\": \"nurbs\", \"degree\": 1, \"knots\": [0, 0, 1, 1, 2, 2], " + pts + "}").find(
-              "knot 1 is repeated 2 times (at most degree = 1 inside the curve)") != std::string::npos);
-    CHECK(error("{\"basis\": \"bezier\", \"knots\": [0], \"points\": [[0, 0], [1, 1], [2, 0], [3, 1]]}").find(
-              "unknown key") != std::string::npos);
+    CHECK(error("{\"basis\": \"nurbs\", \"knots\": [0, 0, 0, 1, 1, 1], " + pts + "}")
+              .find("nurbs: needs 8 knots (points + degree + 1), got 6") != std::string::npos);
+    CHECK(error("{\"basis\": \"nurbs\", \"knots\": [0, 0, 0, 0, 2, 1, 1, 1], " + pts + "}")
+              .find("knots must not decrease") != std::string::npos);
+    CHECK(error("{\"basis\": \"nurbs\", \"weights\": [1, 0, 1, 1], " + pts + "}")
+              .find("weight 0 must be positive and finite") != std::string::npos);
+    CHECK(error("{\"basis\": \"nurbs\", \"closed\": true, " + pts + "}")
+              .find("a nurbs subpath is open") != std::string::npos);
+    CHECK(error("{\"basis\": \"nurbs\", \"degree\": 1, \"knots\": [0, 0, 1, 1, 2, 2], " + pts + "}")
+              .find("knot 1 is repeated 2 times (at most degree = 1 inside the curve)") !=
+          std::string::npos);
+    CHECK(
+        error(
+            "{\"basis\": \"bezier\", \"knots\": [0], \"points\": [[0, 0], [1, 1], [2, 0], [3, 1]]}")
+            .find("unknown key") != std::string::npos);
 }
 
 TEST_CASE("NURBS: G5.2 with weights and order", "[gcode][nurbs]") {
@@ -206,13 +230,17 @@ TEST_CASE("NURBS: G5.2 with weights and order", "[gcode][nurbs]") {
     const Path p = parse_gcode_path(
         "G0 X0 Y0 Z-1\nG5.2 X10 Y20 P1 L4\nX20 Y-20 P2\nX30 Y0\nX40 Y10\nG5.3\nG1 X50\n", "t.ngc");
     REQUIRE(p.subpaths.size() == 1);
-    const Curve c{3, {{0, 0}, {10, 20}, {20, -20}, {30, 0}, {40, 10}}, {1, 1, 2, 1, 1}, {0, 0, 0, 0, 1, 2, 2, 2, 2}};
+    const Curve c{3,
+                  {{0, 0}, {10, 20}, {20, -20}, {30, 0}, {40, 10}},
+                  {1, 1, 2, 1, 1},
+                  {0, 0, 0, 0, 1, 2, 2, 2, 2}};
     std::vector<PathPoint> chain = p.subpaths[0].points;
     chain.resize(chain.size() - 3);  // the G1 after the curve
     CHECK(hausdorff(dense_curve(c, 3000), dense_chain(chain, 200)) <= 0.01);
     CHECK(chain.back() == PathPoint{40, 10});
     // Equal weights, order 4: exact, one span per knot interval.
-    const Path q = parse_gcode_path("G0 X0 Y0 Z-1\nG5.2 X10 Y20 L4\nX20 Y-20\nX30 Y0\nX40 Y10\nG5.3\n", "t.ngc");
+    const Path q = parse_gcode_path(
+        "G0 X0 Y0 Z-1\nG5.2 X10 Y20 L4\nX20 Y-20\nX30 Y0\nX40 Y10\nG5.3\n", "t.ngc");
     const Curve e{3, c.points, {}, c.knots};
     CHECK(exact_error(e, q.subpaths[0].points) < 1e-9);
     // Without L the order is 3 (quadratic).
@@ -233,11 +261,14 @@ TEST_CASE("NURBS: G5.2 errors", "[gcode][nurbs]") {
     CHECK(error("G0 Z-1\nG5.2 X1 Y1 L4\nX2 Y0\nG5.3\n") ==
           "t.ngc:2:1: G5.2 curve of order L4 needs at least 4 control points (the start point "
           "included), got 3");
-    CHECK(error("G5.2 X1 Y1 L7\n") == "t.ngc:1:12: G5.2 order L must be a whole number from 2 to 6 (degree + 1)");
+    CHECK(error("G5.2 X1 Y1 L7\n") ==
+          "t.ngc:1:12: G5.2 order L must be a whole number from 2 to 6 (degree + 1)");
     CHECK(error("G5.2 X1 Y1 Z1\n") == "t.ngc:1:12: Z is not allowed with G5.2 (XY plane only)");
     CHECK(error("G5.2 X1 Y1 P0\n") == "t.ngc:1:12: G5.2 weight P must be positive");
     CHECK(error("G5.2 X1 Y1\nG1 X2\n") ==
-          "t.ngc:2:1: the G5.2 curve must end with G5.3 before other motion or G4, G28, G30, G53, G92");
-    CHECK(error("G5.2 X1 Y1\nX2 Y0\nM2\n") == "t.ngc:3:1: program ends inside a G5.2 curve (no G5.3)");
+          "t.ngc:2:1: the G5.2 curve must end with G5.3 before other motion or G4, G28, G30, G53, "
+          "G92");
+    CHECK(error("G5.2 X1 Y1\nX2 Y0\nM2\n") ==
+          "t.ngc:3:1: program ends inside a G5.2 curve (no G5.3)");
     CHECK(error("G5.3\n") == "t.ngc:1:1: G5.3 without a G5.2 curve to end");
 }
