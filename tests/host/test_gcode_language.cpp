@@ -246,3 +246,13 @@ TEST_CASE("G-code: pen mode auto says why", "[gcode]") {
     run("G1 Z-1\nG1 X5\n", {}, &info);
     CHECK(info.pen_reason == "--gcode-pen z");
 }
+
+TEST_CASE("G-code: loop and piece budgets", "[gcode]") {
+    // The inner loop's passes count too: 2000 x 1000 passes are too many.
+    CHECK(error_of("G1 Z-1\no1 repeat [2000]\no2 repeat [1000]\no2 endrepeat\no1 endrepeat\n") ==
+          "t.ngc:3:1: O2 repeat: more than 1000000 loop passes in all (the reader's limit; a "
+          "loop that never ends?)");
+    // Four lines a pass: the 500,001st pass draws the 2,000,001st piece.
+    CHECK(error_of("G1 Z-1\no1 repeat [600000]\nG1 X1\nX0\nX1\nX0\no1 endrepeat\n") ==
+          "t.ngc:3:1: more than 2000000 curve pieces drawn (the reader's limit)");
+}

@@ -205,11 +205,11 @@ void Interpreter::travel(Vec2 to, double z_to) {
 }
 
 void Interpreter::non_modal(const Command& c) {
-    const double unit = scale();
+    // As LinuxCNC, these parameters are in the machine's units (mm here), whatever G20/G21.
     auto store_offset = [&] {
-        parameters_.set(numbered(kG92Offset), offset_.x / unit);
-        parameters_.set(numbered(kG92Offset + 1), offset_.y / unit);
-        parameters_.set(numbered(kG92Offset + 2), z_offset_ / unit);
+        parameters_.set(numbered(kG92Offset), offset_.x);
+        parameters_.set(numbered(kG92Offset + 1), offset_.y);
+        parameters_.set(numbered(kG92Offset + 2), z_offset_);
     };
     switch (c.non_modal) {
         case NonModal::kSetOffset: {
@@ -235,17 +235,17 @@ void Interpreter::non_modal(const Command& c) {
             parameters_.set(numbered(kG92Applied), 0);
             break;
         case NonModal::kRestoreOffset:
-            offset_ = {*parameters_.get(numbered(kG92Offset)) * unit,
-                       *parameters_.get(numbered(kG92Offset + 1)) * unit};
-            z_offset_ = *parameters_.get(numbered(kG92Offset + 2)) * unit;
+            offset_ = {*parameters_.get(numbered(kG92Offset)),
+                       *parameters_.get(numbered(kG92Offset + 1))};
+            z_offset_ = *parameters_.get(numbered(kG92Offset + 2));
             parameters_.set(numbered(kG92Applied), 1);
             break;
         case NonModal::kSetHome:
         case NonModal::kSetHome2: {
             const long base = c.non_modal == NonModal::kSetHome ? kG28Position : kG30Position;
-            parameters_.set(numbered(base), position_.x / unit);
-            parameters_.set(numbered(base + 1), position_.y / unit);
-            parameters_.set(numbered(base + 2), z_ / unit);
+            parameters_.set(numbered(base), position_.x);
+            parameters_.set(numbered(base + 1), position_.y);
+            parameters_.set(numbered(base + 2), z_);
             break;
         }
         case NonModal::kHome:
@@ -260,7 +260,7 @@ void Interpreter::non_modal(const Command& c) {
             travel(via, z_via);
             auto home = [&](char letter, long n, double current) {
                 if (!all && !c.value(letter)) return current;
-                const double v = *parameters_.get(numbered(n)) * unit;
+                const double v = *parameters_.get(numbered(n));
                 if (std::fabs(v) > kMaxCoordinateMm) {
                     fail(c.non_modal_at, "#" + std::to_string(n) + " " + number(v) +
                                              " mm is out of range (|value| <= " +

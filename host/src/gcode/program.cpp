@@ -30,10 +30,13 @@ public:
         frames_.push_back(Frame{});
         std::size_t pc = 0;
         while (pc < lines_.size()) {
-            if (++blocks_ > kMaxBlocksRun) {
+            characters_ += lines_[pc].size();
+            if (++blocks_ > kMaxBlocksRun || characters_ > kMaxCharactersRun) {
                 throw InputError(file_, SourceLocation{pc + 1, 1},
-                                 "more than " + std::to_string(kMaxBlocksRun) +
-                                     " lines run (the reader's limit; a loop that never ends?)");
+                                 "more than " + std::to_string(kMaxBlocksRun) + " lines or " +
+                                     std::to_string(kMaxCharactersRun) +
+                                     " characters run (the reader's limit; a loop that never "
+                                     "ends?)");
             }
             if (structure_.olines[pc]) {
                 pc = control(pc);
@@ -126,6 +129,7 @@ private:
                 const std::vector<double> v = arguments(pc, 1);
                 if (frames_.size() == 1) fail(line, oline_text(line) + " outside a call");
                 if (!v.empty()) parameters_.set(ParameterRef{0, "_value"}, v[0]);
+                parameters_.set(ParameterRef{0, "_value_returned"}, v.empty() ? 0 : 1);
                 const std::size_t back = frames_.back().return_to;
                 frames_.pop_back();
                 parameters_.leave_call();
@@ -219,6 +223,7 @@ private:
     std::vector<Frame> frames_;
     std::set<std::string> warned_;
     std::size_t blocks_ = 0;
+    std::size_t characters_ = 0;
     std::size_t loop_passes_ = 0;
 };
 

@@ -14,9 +14,10 @@
 namespace pathstream::host::gcode {
 
 /// Budgets that keep a hostile program's cost bounded (docs/formats-gcode.md, "Budgets").
-constexpr std::size_t kMaxBlocksRun = 10'000'000;  ///< lines run, loops counted each pass
-constexpr std::size_t kMaxLoopPasses = 1'000'000;  ///< loop passes in all
-constexpr std::size_t kMaxCallDepth = 10;          ///< LinuxCNC's INTERP_SUB_ROUTINE_LEVELS
+constexpr std::size_t kMaxBlocksRun = 10'000'000;       ///< lines run, loops counted each pass
+constexpr std::size_t kMaxCharactersRun = 500'000'000;  ///< characters of the lines run
+constexpr std::size_t kMaxLoopPasses = 1'000'000;       ///< loop passes in all
+constexpr std::size_t kMaxCallDepth = 10;               ///< LinuxCNC's INTERP_SUB_ROUTINE_LEVELS
 
 /// Runs `lines` (the program's lines, without line breaks) through `interpreter`. Codes in
 /// `ignored` are skipped; the first time each is met, a warning "file:line:col: ..." is

@@ -13,7 +13,7 @@ namespace pathstream::host::gcode {
 class RunBuilder {
 public:
     /// At most this many pieces in all: bounds the memory a hostile program can take.
-    static constexpr std::size_t kMaxPieces = 4'000'000;
+    static constexpr std::size_t kMaxPieces = 2'000'000;
 
     /// Appends a pen-down piece drawn at `feed_mm_s` (0: the machine's feed). A piece whose
     /// four points are all equal is dropped. The piece starts a new subpath (located at `at`)
