@@ -256,3 +256,21 @@ TEST_CASE("G-code: loop and piece budgets", "[gcode]") {
     CHECK(error_of("G1 Z-1\no1 repeat [600000]\nG1 X1\nX0\nX1\nX0\no1 endrepeat\n") ==
           "t.ngc:3:1: more than 2000000 curve pieces drawn (the reader's limit)");
 }
+
+TEST_CASE("G-code: a setting's own line reads the old value", "[gcode]") {
+    const Path p = run("#1=10\n#1=20 G1 Z-1 Y#1\nG1 X#1\n");
+    REQUIRE(p.subpaths.size() == 1);
+    CHECK(p.subpaths[0].points.front() == PathPoint{0, 10});
+    CHECK(last_point(p) == std::make_pair(20.0, 10.0));
+}
+
+TEST_CASE("G-code: G92.2 and G92.3, G28.1 and G30.1", "[gcode]") {
+    // G92.2 drops the offset but keeps #5211..; G92.3 takes it back from them.
+    const Path p = run("G0 X10 Z-1\nG92 X0\nG92.2\nG1 X1\nG92.3\nG1 X1\n");
+    CHECK(p.subpaths[0].points[3] == PathPoint{1, 0});
+    CHECK(p.subpaths[0].points[6] == PathPoint{11, 0});
+    // G28.1 stores where the machine is (mm, also under G20); G28 goes back there.
+    const Path q = run("G20 G0 X1 Y2 Z-1\nG28.1\nG0 X0 Y0\nG28\nG1 X[#5161/25.4 + 1]\n");
+    CHECK(q.subpaths[0].points.front() == PathPoint{25.4, 50.8});
+    CHECK(last_point(q).first == Approx(50.8));
+}
