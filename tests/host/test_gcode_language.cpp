@@ -274,3 +274,9 @@ TEST_CASE("G-code: G92.2 and G92.3, G28.1 and G30.1", "[gcode]") {
     CHECK(q.subpaths[0].points.front() == PathPoint{25.4, 50.8});
     CHECK(last_point(q).first == Approx(50.8));
 }
+
+TEST_CASE("G-code: O-word nesting budget", "[gcode]") {
+    std::string deep;
+    for (int k = 0; k < 1001; ++k) deep += "o" + std::to_string(k) + " if [1]\n";
+    CHECK(error_of(deep) == "t.ngc:1001:1: O-word blocks nested more than 1000 deep");
+}

@@ -41,6 +41,7 @@ enum class Op {
     kXor
 };
 
+// Binding strength: higher binds tighter (LinuxCNC's five levels).
 int precedence(Op op) {
     switch (op) {
         case Op::kPower:
@@ -64,13 +65,16 @@ int precedence(Op op) {
     }
 }
 
+// RS274NGC angles are in degrees.
 double radians(double degrees) {
     return degrees * std::numbers::pi / 180.0;
 }
+// RS274NGC angles are in degrees.
 double degrees(double radians_value) {
     return radians_value * 180.0 / std::numbers::pi;
 }
 
+// Six significant digits: enough to recognise a value in a message.
 std::string number_text(double v) {
     char buffer[32];
     std::snprintf(buffer, sizeof buffer, "%.6g", v);
@@ -82,6 +86,7 @@ public:
     ValueReader(LineCursor& cursor, const Parameters& parameters, char letter, std::size_t word_at)
         : c_(cursor), parameters_(parameters), letter_(letter), word_at_(word_at) {}
 
+    // One value: number, [expression], #parameter, function, or a signed one of these.
     double value() {
         const Depth depth(*this);
         c_.skip_blanks();
@@ -117,6 +122,7 @@ public:
         return finite(v, at);
     }
 
+    // The parameter named after a '#': a number, a <name>, or a value giving the number.
     ParameterRef parameter_ref() {
         const Depth depth(*this);
         const std::size_t at = c_.i++;  // the '#'
@@ -172,15 +178,18 @@ private:
         return false;
     }
 
+    // Which word or O-word the value belongs to, for messages.
     std::string where() const {
         return letter_ ? std::string("in the value of ") + letter_
                        : std::string("in the expression");
     }
+    // The message for a value that is not there.
     std::string missing() const {
         return letter_ ? std::string("missing number after ") + letter_
                        : std::string("missing value");
     }
 
+    // Infinite or NaN values would poison every later computation: stop at their source.
     double finite(double v, std::size_t at) const {
         if (!std::isfinite(v)) c_.fail(at, "value is not finite (" + number_text(v) + ")");
         return v;
@@ -236,6 +245,7 @@ private:
         return negative ? -v : v;
     }
 
+    // "[expression]"; the cursor is on the '['.
     double bracketed() {
         const std::size_t open = c_.i++;
         ++brackets_;
@@ -251,6 +261,7 @@ private:
         return v;
     }
 
+    // Precedence climbing: operators of one level group left to right, as LinuxCNC.
     double expression(int min_precedence) {
         double left = value();
         while (true) {
@@ -298,6 +309,7 @@ private:
         return std::nullopt;
     }
 
+    // LinuxCNC's execute_binary, with its errors.
     double apply(Op op, double a, double b, std::size_t at) const {
         switch (op) {
             case Op::kPower:
@@ -344,6 +356,7 @@ private:
         return 0;
     }
 
+    // NAME[value], ATAN[y]/[x], EXISTS[#<name>]; LinuxCNC's execute_unary, with its errors.
     double function() {
         const std::size_t at = c_.i;
         std::string name;

@@ -16,6 +16,7 @@ namespace pathstream::host {
 
 namespace {
 
+// Lines without their LF or CR LF; views into `text`.
 std::vector<std::string_view> split_lines(const std::string& text) {
     std::vector<std::string_view> lines;
     std::string_view rest(text);
@@ -30,6 +31,7 @@ std::vector<std::string_view> split_lines(const std::string& text) {
     return lines;
 }
 
+// The shortest usual form of a length, for messages.
 std::string mm_text(double v) {
     std::ostringstream s;
     s << v;

@@ -18,12 +18,14 @@ constexpr long kG30Position = 5181;
 constexpr long kG92Applied = 5210;
 constexpr long kG92Offset = 5211;
 
+// The shortest usual form of a number, for messages.
 std::string number(double v) {
     std::ostringstream s;
     s << v;
     return s.str();
 }
 
+// A reference to numbered parameter #n.
 ParameterRef numbered(long n) {
     return ParameterRef{n, {}};
 }

@@ -29,6 +29,8 @@ constexpr KeywordName kKeywords[] = {
     {"continue", OKind::kContinue},
 };
 
+constexpr std::size_t kMaxNesting = 1000;  // open blocks at once: bounds the label searches
+
 bool is_loop(OKind k) {
     return k == OKind::kWhile || k == OKind::kDo || k == OKind::kRepeat;
 }
@@ -44,7 +46,12 @@ public:
         s_.closes_do.assign(lines_.size(), false);
         for (std::size_t k = 0; k < lines_.size(); ++k) {
             s_.olines[k] = scan_oword(lines_[k], k + 1, file_);
-            if (s_.olines[k]) statement(k, *s_.olines[k]);
+            if (!s_.olines[k]) continue;
+            statement(k, *s_.olines[k]);
+            if (open_.size() > kMaxNesting) {
+                fail(*s_.olines[k],
+                     "O-word blocks nested more than " + std::to_string(kMaxNesting) + " deep");
+            }
         }
         if (!open_.empty()) {
             const OLine& o = *s_.olines[open_.back()];
