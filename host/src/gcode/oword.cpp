@@ -41,20 +41,17 @@ public:
         : lines_(lines), file_(file) {}
 
     ProgramStructure scan() {
-        s_.olines.resize(lines_.size());
-        s_.partner.assign(lines_.size(), ProgramStructure::kNone);
-        s_.closes_do.assign(lines_.size(), false);
         for (std::size_t k = 0; k < lines_.size(); ++k) {
-            s_.olines[k] = scan_oword(lines_[k], k + 1, file_);
-            if (!s_.olines[k]) continue;
-            statement(k, *s_.olines[k]);
+            std::optional<OLine> found = scan_oword(lines_[k], k + 1, file_);
+            if (!found) continue;
+            const OLine& o = s_.olines.emplace(k, std::move(*found)).first->second;
+            statement(k, o);
             if (open_.size() > kMaxNesting) {
-                fail(*s_.olines[k],
-                     "O-word blocks nested more than " + std::to_string(kMaxNesting) + " deep");
+                fail(o, "O-word blocks nested more than " + std::to_string(kMaxNesting) + " deep");
             }
         }
         if (!open_.empty()) {
-            const OLine& o = *s_.olines[open_.back()];
+            const OLine& o = line(open_.back());
             fail(o, oline_text(o) + " is never closed (no " + closer(o.kind) + ")");
         }
         return std::move(s_);
@@ -80,7 +77,8 @@ private:
         }
     }
 
-    const OLine& open_line(std::size_t i) const { return *s_.olines[open_[i]]; }
+    OLine& line(std::size_t k) { return s_.olines.at(k); }
+    const OLine& open_line(std::size_t i) const { return s_.olines.at(open_[i]); }
 
     // The innermost open statement must be `kind` with the label of `o`.
     std::size_t close(std::size_t k, const OLine& o, OKind kind) {
@@ -98,8 +96,8 @@ private:
         }
         const std::size_t opener = open_.back();
         if (kind != OKind::kIf) open_.pop_back();
-        s_.partner[opener] = k;
-        s_.partner[k] = opener;
+        line(opener).partner = k;
+        line(k).partner = opener;
         return opener;
     }
 
@@ -132,9 +130,9 @@ private:
             case OKind::kElseif:
             case OKind::kElse: {
                 const std::size_t opener = close(k, o, OKind::kIf);
-                s_.partner[opener] = ProgramStructure::kNone;
+                line(opener).partner = ProgramStructure::kNone;
                 auto& branches = s_.branches[opener];
-                if (!branches.empty() && s_.olines[branches.back()]->kind == OKind::kElse) {
+                if (!branches.empty() && line(branches.back()).kind == OKind::kElse) {
                     fail(o, oline_text(o) + " after the else of its if");
                 }
                 branches.push_back(k);
@@ -144,7 +142,7 @@ private:
                 const std::size_t opener = close(k, o, OKind::kIf);
                 open_.pop_back();
                 if (const auto found = s_.branches.find(opener); found != s_.branches.end()) {
-                    for (std::size_t branch : found->second) s_.partner[branch] = k;
+                    for (std::size_t branch : found->second) line(branch).partner = k;
                 }
                 break;
             }
@@ -152,7 +150,7 @@ private:
                 if (!open_.empty() && open_line(open_.size() - 1).kind == OKind::kDo &&
                     open_line(open_.size() - 1).label == o.label) {
                     close(k, o, OKind::kDo);
-                    s_.closes_do[k] = true;
+                    line(k).closes_do = true;
                 } else {
                     open_.push_back(k);
                 }
@@ -169,7 +167,7 @@ private:
                     const OLine& candidate = open_line(i);
                     if (candidate.kind == OKind::kSub) break;
                     if (is_loop(candidate.kind) && candidate.label == o.label) {
-                        s_.partner[k] = open_[i];
+                        line(k).partner = open_[i];
                         return;
                     }
                 }

@@ -7,6 +7,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <unordered_map>
 #include <vector>
 
 #include "pathstream/host/path.hpp"
@@ -40,6 +41,10 @@ struct OLine {
     OKind kind = OKind::kSub;
     SourceLocation at;           ///< where the O is
     std::size_t args_begin = 0;  ///< index in the line just after the keyword
+    /// sub <-> endsub, if/elseif/else -> endif, while <-> endwhile, do <-> its closing while,
+    /// repeat <-> endrepeat, break/continue -> the loop's first line (0-based line index).
+    std::size_t partner = static_cast<std::size_t>(-1);
+    bool closes_do = false;  ///< a while that ends a do
 };
 
 /// "O100 while", "O<name> sub": how messages name a statement.
@@ -53,12 +58,9 @@ std::optional<OLine> scan_oword(std::string_view text, std::size_t line_number,
 /// Every O-word of a program and how they pair up. Indices are 0-based line indices.
 struct ProgramStructure {
     static constexpr std::size_t kNone = static_cast<std::size_t>(-1);
-    std::vector<std::optional<OLine>> olines;  ///< per line
-    /// sub <-> endsub, if/elseif/else -> endif, while <-> endwhile, do <-> its closing while,
-    /// repeat <-> endrepeat, break/continue -> the loop's first line.
-    std::vector<std::size_t> partner;
+    /// Line index -> its O-word; only lines that hold one (memory follows the O-words).
+    std::unordered_map<std::size_t, OLine> olines;
     std::map<std::size_t, std::vector<std::size_t>> branches;  ///< if -> its elseif/else lines
-    std::vector<bool> closes_do;                               ///< a while that ends a do
     std::map<std::string, std::size_t> subs;                   ///< label -> sub line
 };
 

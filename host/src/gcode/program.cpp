@@ -38,7 +38,7 @@ public:
                                      " characters run (the reader's limit; a loop that never "
                                      "ends?)");
             }
-            if (structure_.olines[pc]) {
+            if (structure_.olines.count(pc) != 0) {
                 pc = control(pc);
                 continue;
             }
@@ -67,7 +67,7 @@ private:
         std::map<std::size_t, long> repeats_left;  ///< repeat line -> passes still to run
     };
 
-    const OLine& o(std::size_t pc) const { return *structure_.olines[pc]; }
+    const OLine& o(std::size_t pc) const { return structure_.olines.at(pc); }
 
     [[noreturn]] void fail(const OLine& line, const std::string& message) const {
         throw InputError(file_, line.at, message);
@@ -120,7 +120,7 @@ private:
     // Runs the O-word on line pc; returns the next line to run.
     std::size_t control(std::size_t pc) {
         const OLine& line = o(pc);
-        const std::size_t partner = structure_.partner[pc];
+        const std::size_t partner = line.partner;
         switch (line.kind) {
             case OKind::kSub:
                 return partner + 1;  // a definition: skipped until called
@@ -160,7 +160,7 @@ private:
                 arguments(pc, 0);
                 return pc + 1;
             case OKind::kWhile:
-                if (structure_.closes_do[pc]) {
+                if (line.closes_do) {
                     if (condition(pc) == 0) return pc + 1;
                     loop_pass(partner);
                     return partner + 1;
@@ -188,11 +188,11 @@ private:
             }
             case OKind::kBreak:
                 arguments(pc, 0);
-                return structure_.partner[partner] + 1;
+                return o(partner).partner + 1;
             case OKind::kContinue: {
                 arguments(pc, 0);
                 // While: test again; do: its closing while tests; repeat: endrepeat counts.
-                return o(partner).kind == OKind::kWhile ? partner : structure_.partner[partner];
+                return o(partner).kind == OKind::kWhile ? partner : o(partner).partner;
             }
         }
         return pc + 1;
@@ -210,7 +210,7 @@ private:
                 if (condition(branch) != 0) return branch + 1;
             }
         }
-        return structure_.partner[if_line] + 1;
+        return o(if_line).partner + 1;
     }
 
     const std::vector<std::string_view>& lines_;
