@@ -243,10 +243,14 @@ TEST_CASE("NURBS: G5.2 with weights and order", "[gcode][nurbs]") {
         "G0 X0 Y0 Z-1\nG5.2 X10 Y20 L4\nX20 Y-20\nX30 Y0\nX40 Y10\nG5.3\n", "t.ngc");
     const Curve e{3, c.points, {}, c.knots};
     CHECK(exact_error(e, q.subpaths[0].points) < 1e-9);
-    // Without L the order is 3 (quadratic).
-    const Path r = parse_gcode_path("G0 X0 Y0 Z-1\nG5.2 X10 Y20\nX20 Y0\nG5.3\n", "t.ngc");
+    // Without L (or with L3 or less, as LinuxCNC) the order is 3: a quadratic. L may come on
+    // any line of the curve, and a second G5.2 continues it.
+    const Path r = parse_gcode_path("G0 X0 Y0 Z-1\nG5.2 X10 Y20 L2\nX20 Y0\nG5.3\n", "t.ngc");
     const Curve quad{2, {{0, 0}, {10, 20}, {20, 0}}, {}, {0, 0, 0, 1, 1, 1}};
     CHECK(exact_error(quad, r.subpaths[0].points) < 1e-9);
+    const Path late = parse_gcode_path(
+        "G0 X0 Y0 Z-1\nG5.2 X10 Y20\nG5.2 X20 Y-20 P1\nX30 Y0 L4\nX40 Y10\nG5.3\n", "t.ngc");
+    CHECK(exact_error(e, late.subpaths[0].points) < 1e-9);
 }
 
 TEST_CASE("NURBS: G5.2 errors", "[gcode][nurbs]") {
@@ -262,7 +266,11 @@ TEST_CASE("NURBS: G5.2 errors", "[gcode][nurbs]") {
           "t.ngc:2:1: G5.2 curve of order L4 needs at least 4 control points (the start point "
           "included), got 3");
     CHECK(error("G5.2 X1 Y1 L7\n") ==
-          "t.ngc:1:12: G5.2 order L must be a whole number from 2 to 6 (degree + 1)");
+          "t.ngc:1:12: G5.2 order L must be a whole number up to 6 (degree + 1; 3 or less leaves "
+          "the order at 3)");
+    CHECK(error("G5.2 X1 Y1\nX2\nG5.3\n") == "t.ngc:2:1: a G5.2 control point needs both X and Y");
+    CHECK(error("G5.2 X1 Y1\nG5.2 P2\nG5.3\n") ==
+          "t.ngc:2:1: a G5.2 control point needs X and Y (P alone weighs only the start point)");
     CHECK(error("G5.2 X1 Y1 Z1\n") == "t.ngc:1:12: Z is not allowed with G5.2 (XY plane only)");
     CHECK(error("G5.2 X1 Y1 P0\n") == "t.ngc:1:12: G5.2 weight P must be positive");
     CHECK(error("G5.2 X1 Y1\nG1 X2\n") ==

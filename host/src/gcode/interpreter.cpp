@@ -116,7 +116,7 @@ bool Interpreter::execute(const Command& c) {
     }
     if (c.motion) {
         motion_ = *c.motion;
-        if (motion_ == Motion::kNurbs) nurbs_at_ = c.motion_at;
+        if (motion_ == Motion::kNurbs && nurbs_.empty()) nurbs_at_ = c.motion_at;
     }
 
     const bool axis_words = c.value('X') || c.value('Y') || c.value('Z');
@@ -173,7 +173,7 @@ void Interpreter::check_words_used(const Command& c, Motion move, bool moving) c
         {'R', arc},
         {'P', arc || cubic || nurbs || c.non_modal == NonModal::kDwell || c.path_control},
         {'Q', cubic || c.path_control},
-        {'L', nurbs && c.motion == Motion::kNurbs},
+        {'L', nurbs},
     };
     for (const auto& u : uses) {
         if (const Word* w = c.value(u.letter); w && !u.used) {

@@ -16,27 +16,28 @@ double weight(const Word* p) {
 }
 }  // namespace
 
+// As LinuxCNC's convert_nurbs: the first block of a curve also takes the current point (its
+// weight from a P without X Y); an L above 3 on any block sets the order, lower ones do not.
 void Interpreter::nurbs_point(const Command& c, Vec2 to, SourceLocation at) {
-    const Word *x = c.value('X'), *y = c.value('Y'), *p = c.value('P');
+    const Word *x = c.value('X'), *y = c.value('Y'), *p = c.value('P'), *l = c.value('L');
     if (const Word* z = c.value('Z')) fail(z->at, "Z is not allowed with G5.2 (XY plane only)");
     if (p && !(p->value > 0)) fail(p->at, "G5.2 weight P must be positive");
-    if (c.motion == Motion::kNurbs) {
-        if (!nurbs_.empty()) fail(at, "G5.2 inside a G5.2 curve (end it with G5.3 first)");
+    if (nurbs_.empty()) {
         nurbs_order_ = kDefaultOrder;
-        if (const Word* l = c.value('L')) {
-            if (l->value != std::floor(l->value) || l->value < 2 ||
-                l->value > nurbs::kMaxDegree + 1) {
-                fail(l->at, "G5.2 order L must be a whole number from 2 to " +
-                                std::to_string(nurbs::kMaxDegree + 1) + " (degree + 1)");
-            }
-            nurbs_order_ = static_cast<int>(l->value);
-        }
-        // The current point is the first control point; P without X Y is its weight.
         nurbs_.push_back({position_, x || y ? 1.0 : weight(p)});
-        if (!x && !y) return;
     } else if (!x && !y) {
-        fail(at, "a G5.2 control point needs X or Y");
+        fail(at, "a G5.2 control point needs X and Y (P alone weighs only the start point)");
     }
+    if (l) {
+        if (l->value != std::floor(l->value) || l->value < 0 || l->value > nurbs::kMaxDegree + 1) {
+            fail(l->at, "G5.2 order L must be a whole number up to " +
+                            std::to_string(nurbs::kMaxDegree + 1) +
+                            " (degree + 1; 3 or less leaves the order at 3)");
+        }
+        if (l->value > kDefaultOrder) nurbs_order_ = static_cast<int>(l->value);
+    }
+    if (!x && !y) return;
+    if (!x || !y) fail(at, "a G5.2 control point needs both X and Y");
     nurbs_.push_back({to, weight(p)});
     position_ = to;
 }
