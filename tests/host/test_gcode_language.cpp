@@ -107,7 +107,7 @@ TEST_CASE("G-code: subroutines with arguments", "[gcode]") {
     CHECK(last_point(p) == std::make_pair(99.0, 20.0));
     CHECK(error_of("o100 call\n") == "t.ngc:1:1: O100 call: no such subroutine in this file");
     CHECK(error_of("o1 sub\no1 call\no1 endsub\nG1 Z-1\no1 call\n") ==
-          "t.ngc:2:1: O1 call: calls nested more than 10 deep");
+          "t.ngc:2:1: O1 call: calls nested more than 9 deep");
     CHECK(error_of("o1 sub\no2 sub\no2 endsub\no1 endsub\n") ==
           "t.ngc:2:1: O2 sub inside another block (define subroutines at the top level)");
     CHECK(error_of("o1 endsub\n") == "t.ngc:1:1: O1 endsub without an open O1 sub");
@@ -279,4 +279,21 @@ TEST_CASE("G-code: O-word nesting budget", "[gcode]") {
     std::string deep;
     for (int k = 0; k < 1001; ++k) deep += "o" + std::to_string(k) + " if [1]\n";
     CHECK(error_of(deep) == "t.ngc:1001:1: O-word blocks nested more than 1000 deep");
+}
+
+TEST_CASE("G-code: call arguments zero the rest; repeat rounds", "[gcode]") {
+    // #2 is 7 before the call; the call gives only #1, so #2 reads 0 inside and 7 after.
+    const Path p = run("o1 sub\nG1 X#1 Y#2\no1 endsub\n#2=7\nG1 Z-1\no1 call [3]\nG1 Y#2\n");
+    REQUIRE(p.subpaths.size() == 1);
+    CHECK(p.subpaths[0].points[3] == PathPoint{3, 0});
+    CHECK(last_point(p) == std::make_pair(3.0, 7.0));
+    // repeat [2.6] runs 3 times, [2.5] twice (halves to even), [0.4] never.
+    auto passes = [](const std::string& count) {
+        return last_point(
+                   run("G1 Z-1\nG1 Y1\nG91\no1 repeat [" + count + "]\nG1 X1\no1 endrepeat\n"))
+            .first;
+    };
+    CHECK(passes("2.6") == 3);
+    CHECK(passes("2.5") == 2);
+    CHECK(passes("0.4") == 0);
 }

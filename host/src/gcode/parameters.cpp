@@ -37,8 +37,10 @@ void Parameters::enter_call(const std::vector<double>& arguments) {
     std::array<double, kCallArguments> saved{};
     for (std::size_t k = 0; k < kCallArguments; ++k) saved[k] = numbered_[k + 1];
     saved_arguments_.push_back(saved);
-    // As LinuxCNC: the parameters after the last argument keep the caller's values.
-    for (std::size_t k = 0; k < arguments.size(); ++k) numbered_[k + 1] = arguments[k];
+    // As LinuxCNC's execute_call: all 30 are set, those after the last argument to 0.
+    for (std::size_t k = 0; k < kCallArguments; ++k) {
+        numbered_[k + 1] = k < arguments.size() ? arguments[k] : 0.0;
+    }
     locals_.emplace_back();
 }
 

@@ -31,8 +31,8 @@ public:
     /// Whether a named parameter is defined (EXISTS).
     bool exists(const std::string& name) const;
 
-    /// Enters a subroutine: saves #1..#30, sets #1..#n to `arguments` (n <= 30) and opens a
-    /// fresh local scope.
+    /// Enters a subroutine: saves #1..#30, sets #1..#n to `arguments` (n <= 30) and the rest
+    /// of #1..#30 to 0, and opens a fresh local scope.
     void enter_call(const std::vector<double>& arguments);
     /// Leaves the innermost call: restores #1..#30 and drops its locals.
     void leave_call();

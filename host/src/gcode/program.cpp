@@ -171,7 +171,8 @@ private:
                 loop_pass(partner);
                 return partner;
             case OKind::kRepeat: {
-                const double n = std::floor(condition(pc));
+                // As LinuxCNC: the count is rounded to the nearest whole number.
+                const double n = std::nearbyint(condition(pc));
                 if (n < 1) return partner + 1;
                 frames_.back().repeats_left[pc] = n > static_cast<double>(kMaxLoopPasses)
                                                       ? static_cast<long>(kMaxLoopPasses) + 1

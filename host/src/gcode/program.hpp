@@ -17,7 +17,8 @@ namespace pathstream::host::gcode {
 constexpr std::size_t kMaxBlocksRun = 10'000'000;       ///< lines run, loops counted each pass
 constexpr std::size_t kMaxCharactersRun = 500'000'000;  ///< characters of the lines run
 constexpr std::size_t kMaxLoopPasses = 1'000'000;       ///< loop passes in all
-constexpr std::size_t kMaxCallDepth = 10;               ///< LinuxCNC's INTERP_SUB_ROUTINE_LEVELS
+/// Calls nested at most: LinuxCNC's INTERP_SUB_ROUTINE_LEVELS (10) counts the main program.
+constexpr std::size_t kMaxCallDepth = 9;
 
 /// Runs `lines` (the program's lines, without line breaks) through `interpreter`. Codes in
 /// `ignored` are skipped; the first time each is met, a warning "file:line:col: ..." is
