@@ -49,10 +49,10 @@ expect eval-unknown-type 1 "unknown file type" -- "$bin" eval "$src/README.md"
 machine="$src/examples/machines/pen_plotter.json"
 expect check 0 "subpaths: 2" -- "$bin" check "$src/examples/rose.json"
 expect check-gcode 0 "valid" -- "$bin" check "$src/examples/leaf.ngc"
-expect check-gcode-pen 0 "G-code pen: z (Z goes both above and to or below 0 mm (--gcode-z-down))" -- \
+expect check-gcode-pen 0 "G-code pen: z (auto: Z goes both above and to or below --gcode-z-down 0 mm)" -- \
   "$bin" check "$src/examples/leaf.ngc" --gcode-pen auto
 printf 'M300 S440\nG0 X1\nG1 X5 Y5\n' > "$work/nopen.ngc"
-expect check-gcode-motion 0 "G-code pen: motion (no M3/M4 and Z never crosses 0 mm: G1 draws, G0 travels)" -- \
+expect check-gcode-motion 0 "G-code pen: motion (auto: no M3/M4 and Z never crosses --gcode-z-down 0 mm, so G1 draws and G0 travels)" -- \
   "$bin" check "$work/nopen.ngc" --gcode-pen auto
 expect check-gcode-warning 0 "pathstream: warning: $work/nopen.ngc:1:1: M300 skipped" -- \
   "$bin" check "$work/nopen.ngc" --gcode-pen motion

@@ -233,18 +233,19 @@ TEST_CASE("G-code: pen mode auto says why", "[gcode]") {
     GcodeReadInfo info;
     run("G0 Z5\nG1 X1\nG1 Z-1\nG1 X5\n", o, &info);
     CHECK(info.pen == PenControl::kZ);
-    CHECK(info.pen_reason == "Z goes both above and to or below 0 mm (--gcode-z-down)");
+    CHECK(info.pen_reason == "auto: Z goes both above and to or below --gcode-z-down 0 mm");
     const Path s = run("G0 Z5\nG1 X1\nM3\nG1 X5\nM5\nG1 X9\n", o, &info);
     CHECK(info.pen == PenControl::kSpindle);
-    CHECK(info.pen_reason == "M3/M4 appear and Z never crosses 0 mm");
+    CHECK(info.pen_reason == "auto: M3/M4 appear and Z never crosses --gcode-z-down 0 mm");
     REQUIRE(s.subpaths.size() == 1);
     CHECK(s.subpaths[0].points.back() == PathPoint{5, 0});
     const Path m = run("G0 X1\nG1 X5\nG0 X7\nG1 X9\n", o, &info);
     CHECK(info.pen == PenControl::kMotion);
-    CHECK(info.pen_reason == "no M3/M4 and Z never crosses 0 mm: G1 draws, G0 travels");
+    CHECK(info.pen_reason ==
+          "auto: no M3/M4 and Z never crosses --gcode-z-down 0 mm, so G1 draws and G0 travels");
     CHECK(m.subpaths.size() == 2);
     run("G1 Z-1\nG1 X5\n", {}, &info);
-    CHECK(info.pen_reason == "--gcode-pen z");
+    CHECK(info.pen_reason == "as asked");
 }
 
 TEST_CASE("G-code: loop and piece budgets", "[gcode]") {

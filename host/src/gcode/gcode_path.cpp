@@ -40,16 +40,16 @@ std::string mm_text(double v) {
 
 // The mode the evidence of a run in Z mode points to, and why.
 PenControl choose_pen(const gcode::PenEvidence& e, double z_down_max, std::string& reason) {
-    const std::string z = mm_text(z_down_max) + " mm";
+    const std::string z = "--gcode-z-down " + mm_text(z_down_max) + " mm";
     if (e.z_low && e.z_high) {
-        reason = "Z goes both above and to or below " + z + " (--gcode-z-down)";
+        reason = "auto: Z goes both above and to or below " + z;
         return PenControl::kZ;
     }
     if (e.spindle) {
-        reason = "M3/M4 appear and Z never crosses " + z;
+        reason = "auto: M3/M4 appear and Z never crosses " + z;
         return PenControl::kSpindle;
     }
-    reason = "no M3/M4 and Z never crosses " + z + ": G1 draws, G0 travels";
+    reason = "auto: no M3/M4 and Z never crosses " + z + ", so G1 draws and G0 travels";
     return PenControl::kMotion;
 }
 
@@ -113,7 +113,7 @@ Path parse_gcode_path(const std::string& text, const std::string& file, const Gc
             path = run(lines, file, chosen, ignored, false, nullptr, again);
         }
     } else {
-        out.pen_reason = std::string("--gcode-pen ") + pen_control_name(options.pen);
+        out.pen_reason = "as asked";
         path = run(lines, file, chosen, ignored, false, nullptr, out.warnings);
     }
     out.pen = chosen.pen;
