@@ -4,11 +4,13 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <set>
+#include <stdexcept>
 #include <sstream>
 
 #include "pathstream/host/input_error.hpp"
 #include "pathstream/host/json_document.hpp"
 #include "pathstream/host/json_locate.hpp"
+#include "nurbs/nurbs.hpp"
 
 namespace pathstream::host {
 
@@ -21,7 +23,8 @@ constexpr double kMaxCoordinateMm = 1e6;  // 1 km: beyond any plotter; catches u
 
 class Reader : public JsonChecker {
 public:
-    using JsonChecker::JsonChecker;
+    Reader(const std::string& text, const std::string& file, double nurbs_tolerance_mm)
+        : JsonChecker(text, file), nurbs_tolerance_mm_(nurbs_tolerance_mm) {}
 
     PathBasis basis(const json& v, const std::string& pointer) const {
         if (!v.is_string()) fail(pointer, "basis must be a string");
@@ -30,7 +33,10 @@ public:
         if (s == "catmull-rom") return PathBasis::kCatmullRom;
         if (s == "bezier") return PathBasis::kBezier;
         if (s == "polyline") return PathBasis::kPolyline;
-        fail(pointer, "unknown basis \"" + s + "\" (expected bspline, catmull-rom, bezier or polyline)");
+        if (s == "nurbs") {
+            fail(pointer, "basis nurbs is given per subpath, with its degree and knots");
+        }
+        fail(pointer, "unknown basis \"" + s + "\" (expected bspline, catmull-rom, bezier, polyline or nurbs)");
     }
 
     bool boolean(const json& v, const std::string& pointer, const char* what) const {
@@ -59,6 +65,7 @@ public:
         sp.closed = default_closed;
         sp.location = locate_json_pointer(text(), pointer);
         if (!v.is_object()) fail(pointer, "subpath must be an object with \"points\"");
+        if (v.contains("basis") && v["basis"] == "nurbs") return nurbs_subpath(v, pointer, sp, scale, axes);
         only_keys(v, pointer, {"basis", "closed", "points"});
         if (v.contains("basis")) sp.basis = basis(v["basis"], pointer + "/basis");
         if (v.contains("closed")) sp.closed = boolean(v["closed"], pointer + "/closed", "closed");
@@ -92,6 +99,59 @@ public:
             out.push_back(std::move(point));
         }
         return out;
+    }
+
+    /// A list of finite numbers ("knots", "weights").
+    std::vector<double> numbers(const json& v, const std::string& pointer, const char* what) const {
+        if (!v.is_array()) fail(pointer, std::string(what) + " must be an array of numbers");
+        std::vector<double> out;
+        for (std::size_t i = 0; i < v.size(); ++i) {
+            if (!v[i].is_number() || !std::isfinite(v[i].get<double>())) {
+                fail(pointer + "/" + std::to_string(i), std::string(what) + " must be finite numbers");
+            }
+            out.push_back(v[i].get<double>());
+        }
+        return out;
+    }
+
+    // A NURBS subpath becomes an open Bezier chain here, exact or within the tolerance.
+    Subpath nurbs_subpath(const json& v, const std::string& pointer, Subpath sp, double scale,
+                          std::size_t& axes) const {
+        only_keys(v, pointer, {"basis", "closed", "points", "degree", "knots", "weights"});
+        if (v.contains("closed") && boolean(v["closed"], pointer + "/closed", "closed")) {
+            fail(pointer + "/closed",
+                 "a nurbs subpath is open (repeat its first control points to close it)");
+        }
+        if (!v.contains("points")) fail(pointer, "subpath has no \"points\"");
+        nurbs::Nurbs curve;
+        if (v.contains("degree")) {
+            const json& d = v["degree"];
+            if (!d.is_number_integer() || d.get<long>() < 1 || d.get<long>() > nurbs::kMaxDegree) {
+                fail(pointer + "/degree", "degree must be a whole number from 1 to 5");
+            }
+            curve.degree = static_cast<int>(d.get<long>());
+        }
+        curve.points = points(v["points"], pointer + "/points", scale, axes);
+        if (curve.points.size() < static_cast<std::size_t>(curve.degree) + 1) {
+            fail(pointer + "/points", "degree " + std::to_string(curve.degree) + " needs at least " +
+                                          std::to_string(curve.degree + 1) + " control points, got " +
+                                          std::to_string(curve.points.size()));
+        }
+        curve.knots = v.contains("knots") ? numbers(v["knots"], pointer + "/knots", "knots")
+                                          : nurbs::clamped_uniform_knots(curve.points.size(), curve.degree);
+        if (v.contains("weights")) curve.weights = numbers(v["weights"], pointer + "/weights", "weights");
+        if (const std::string problem = nurbs::nurbs_problem(curve); !problem.empty()) {
+            fail(pointer, "nurbs: " + problem);
+        }
+        try {
+            sp.points = nurbs::nurbs_to_bezier(curve, nurbs_tolerance_mm_);
+        } catch (const std::length_error& e) {
+            fail(pointer, e.what());
+        }
+        if (sp.points.empty()) fail(pointer, "nurbs: the curve is a single point");
+        sp.basis = PathBasis::kBezier;
+        sp.closed = false;
+        return sp;
     }
 
     void check_count(const Subpath& sp, const std::string& pointer) const {
@@ -143,21 +203,27 @@ public:
         }
         return path;
     }
+
+private:
+    double nurbs_tolerance_mm_;
 };
 
 }  // namespace
 
-Path parse_json_path(const std::string& text, const std::string& file) {
-    return Reader(text, file).path(parse_json_document(text, file));
+Path parse_json_path(const std::string& text, const std::string& file, double nurbs_tolerance_mm) {
+    if (!(nurbs_tolerance_mm > 0) || !std::isfinite(nurbs_tolerance_mm)) {
+        throw std::invalid_argument("parse_json_path: the NURBS tolerance must be positive and finite");
+    }
+    return Reader(text, file, nurbs_tolerance_mm).path(parse_json_document(text, file));
 }
 
-Path load_json_path(const std::string& file) {
+Path load_json_path(const std::string& file, double nurbs_tolerance_mm) {
     std::ifstream in(file, std::ios::binary);
     if (!in) throw InputError(file, {}, "cannot open file");
     std::ostringstream buffer;
     buffer << in.rdbuf();
     if (in.bad()) throw InputError(file, {}, "cannot read file");
-    return parse_json_path(buffer.str(), file);
+    return parse_json_path(buffer.str(), file, nurbs_tolerance_mm);
 }
 
 }  // namespace pathstream::host

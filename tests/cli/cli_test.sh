@@ -49,6 +49,16 @@ expect eval-unknown-type 1 "unknown file type" -- "$bin" eval "$src/README.md"
 machine="$src/examples/machines/pen_plotter.json"
 expect check 0 "subpaths: 2" -- "$bin" check "$src/examples/rose.json"
 expect check-gcode 0 "valid" -- "$bin" check "$src/examples/leaf.ngc"
+expect check-gcode-pen 0 "G-code pen: z (auto: Z goes both above and to or below --gcode-z-down 0 mm)" -- \
+  "$bin" check "$src/examples/leaf.ngc" --gcode-pen auto
+printf 'M300 S440\nG0 X1\nG1 X5 Y5\n' > "$work/nopen.ngc"
+expect check-gcode-motion 0 "G-code pen: motion (auto: no M3/M4 and Z never crosses --gcode-z-down 0 mm, so G1 draws and G0 travels)" -- \
+  "$bin" check "$work/nopen.ngc" --gcode-pen auto
+expect check-gcode-warning 0 "pathstream: warning: $work/nopen.ngc:1:1: M300 skipped" -- \
+  "$bin" check "$work/nopen.ngc" --gcode-pen motion
+expect check-gcode-ignore 1 "m301.ngc:1:1: unsupported M code M301" -- \
+  bash -c "sed 's/M300/M301/' '$work/nopen.ngc' > '$work/m301.ngc' && '$bin' check '$work/m301.ngc' --gcode-pen motion"
+expect check-gcode-ignored 0 "M301 skipped" -- "$bin" check "$work/m301.ngc" --gcode-pen motion --ignore-code M301
 expect plan 0 "within limits; no motion while the pen moves" -- "$bin" plan "$src/examples/rose.json" -m "$machine" --out "$work/plan.csv"
 if [ "$(head -1 "$work/plan.csv")" != "tick,t,x,y,pen" ] || [ "$(sed -n 2p "$work/plan.csv" | cut -d, -f1-2)" != "0,0" ]; then
   echo "FAIL plan csv: $(head -2 "$work/plan.csv" | tr '\n' ' ')"; failures=$((failures + 1))

@@ -56,7 +56,9 @@ TEST_CASE("broken documents name file, line, column and the problem", "[host][js
     CHECK(error_of("{\"basis\": \"bezier\", \"points\": [[0,0],[1,1],[2,2]]}") ==
           "t.json:1:31: open bezier needs 3k + 1 points (k >= 1), got 3");
     CHECK(error_of("{\"basis\": \"nurbs\", \"points\": [[0,0],[1,1]]}") ==
-          "t.json:1:11: unknown basis \"nurbs\" (expected bspline, catmull-rom, bezier or polyline)");
+          "t.json:1:11: basis nurbs is given per subpath, with its degree and knots");
+    CHECK(error_of("{\"basis\": \"spline\", \"points\": [[0,0],[1,1]]}") ==
+          "t.json:1:11: unknown basis \"spline\" (expected bspline, catmull-rom, bezier, polyline or nurbs)");
     CHECK(error_of("{\"points\": [[0,0],[1,1,1]]}") == "t.json:1:19: point has 3 coordinates, expected 2");
     CHECK(error_of("{\"points\": [[0,0],[1,1]], \"subpaths\": []}") ==
           "t.json:1:1: give either \"points\" (one subpath) or \"subpaths\", not both or neither");

@@ -94,6 +94,7 @@ std::string box_text(const std::optional<Box2>& box) {
 
 /// The placement and order lines (only for what ran).
 void print_load_report(const LoadedPath& loaded) {
+    if (!loaded.gcode_pen.empty()) std::printf("  G-code pen: %s\n", loaded.gcode_pen.c_str());
     if (loaded.placed) {
         std::printf("  placement: %s -> %s (scale %g)\n", box_text(loaded.placement.before).c_str(),
                     box_text(loaded.placement.after).c_str(), loaded.placement.scale);
@@ -172,6 +173,7 @@ nlohmann::ordered_json summary_json(const CheckOptions& o, const LoadedPath& loa
                                    : nlohmann::ordered_json(nullptr);
     j["layers"] = layers_json(path);
     j["pauses"] = count_pauses(path);
+    if (!loaded.gcode_pen.empty()) j["gcode_pen"] = loaded.gcode_pen;
     const OrderReport& r = loaded.order;
     j["order"] = loaded.ordered ? nlohmann::ordered_json{{"travel_before_mm", r.travel_before},
                                                          {"travel_after_mm", r.travel_after},

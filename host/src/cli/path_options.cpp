@@ -30,9 +30,13 @@ void add_path_options(CLI::App& command, PathOptions& o) {
         ->capture_default_str()
         ->check(CLI::IsMember({"bspline", "catmull-rom", "bezier", "polyline"}));
     command.add_flag("--csv-closed", o.csv_closed, "CSV points form a closed curve");
-    command.add_option("--gcode-pen", o.gcode_pen, "G-code pen control: z (down at Z <= --gcode-z-down) or spindle (M3/M5)")
+    command.add_option("--gcode-pen", o.gcode_pen, "G-code pen control: z (down at Z <= --gcode-z-down), spindle (M3/M5), "
+                                                   "motion (G1 draws, G0 travels) or auto (chosen from the file)")
         ->capture_default_str()
-        ->check(CLI::IsMember({"z", "spindle"}));
+        ->check(CLI::IsMember({"z", "spindle", "motion", "auto"}));
+    command.add_option("--ignore-code", o.gcode_ignore,
+                       "G-code: skip this G or M code with a warning, like M300 (repeatable; M6, M7-M9 and "
+                       "others are skipped already)");
     command.add_option("--gcode-z-down", o.gcode_z_down, "G-code: highest Z (mm) with the pen down")->capture_default_str();
     command.add_option("--tolerance", o.tolerance, "mm: arcs (SVG, G-code) become cubics within this")
         ->capture_default_str()
@@ -105,22 +109,37 @@ std::vector<double> parse_numbers(const std::string& text, const std::string& op
     return values;
 }
 
-/// The file as its reader gives it, by extension.
-Path read_path(const PathOptions& o);
+/// The file as its reader gives it, by extension; `gcode_pen` gets the G-code pen mode note.
+Path read_path(const PathOptions& o, std::string& gcode_pen);
 
 /// The G-code reader's options from the command line's.
 GcodeOptions gcode_options(const PathOptions& o) {
     GcodeOptions g;
-    g.pen = o.gcode_pen == "spindle" ? PenControl::kSpindle : PenControl::kZ;
+    g.pen = o.gcode_pen == "spindle" ? PenControl::kSpindle
+            : o.gcode_pen == "motion" ? PenControl::kMotion
+            : o.gcode_pen == "auto"   ? PenControl::kAuto
+                                      : PenControl::kZ;
     g.z_down_max = o.gcode_z_down;
     g.arc_tolerance_mm = o.tolerance;
+    g.ignore_codes = o.gcode_ignore;
     return g;
+}
+
+/// A G-code program from the file, or from `text` when given: its warnings printed, its pen
+/// mode noted in `gcode_pen`.
+Path read_gcode(const PathOptions& o, const std::string* text, std::string& gcode_pen) {
+    GcodeReadInfo info;
+    Path path = text != nullptr ? parse_gcode_path(*text, path_display_name(o.file), gcode_options(o), &info)
+                                : load_gcode_path(o.file, gcode_options(o), &info);
+    for (const std::string& warning : info.warnings) std::cerr << "pathstream: warning: " << warning << '\n';
+    gcode_pen = std::string(pen_control_name(info.pen)) + " (" + info.pen_reason + ")";
+    return path;
 }
 }  // namespace
 
 LoadedPath load_path_report(const PathOptions& o, const MachineProfile* machine, const std::vector<double>* start) {
     LoadedPath loaded;
-    Path path = read_path(o);
+    Path path = read_path(o, loaded.gcode_pen);
     PlacementOptions placement = o.placement;
     if (!o.translate.empty()) {
         const std::vector<double> xy = parse_numbers(o.translate, "--translate");
@@ -172,29 +191,29 @@ std::string sniff_format(const std::string& text) {
 }
 
 // The path on standard input, named "<stdin>" in messages.
-Path read_stdin_path(const PathOptions& o) {
+Path read_stdin_path(const PathOptions& o, std::string& gcode_pen) {
     std::ostringstream buffer;
     buffer << std::cin.rdbuf();
     const std::string text = buffer.str();
     const std::string name = path_display_name("-");
     const std::string format = o.format.empty() ? sniff_format(text) : o.format;
     if (format.empty()) throw InputError(name, {}, "standard input is empty: no path to read");
-    if (format == "json") return parse_json_path(text, name);
+    if (format == "json") return parse_json_path(text, name, o.tolerance);
     if (format == "svg") return parse_svg_path(text, name, o.tolerance);
     if (format == "csv") return parse_csv_path(text, name, basis_from_name(o.csv_basis), o.csv_closed);
-    return parse_gcode_path(text, name, gcode_options(o));
+    return read_gcode(o, &text, gcode_pen);
 }
 
-Path read_path(const PathOptions& o) {
-    if (o.file == "-") return read_stdin_path(o);
+Path read_path(const PathOptions& o, std::string& gcode_pen) {
+    if (o.file == "-") return read_stdin_path(o, gcode_pen);
     std::string ext = !o.format.empty() ? "." + o.format
                       : o.file.substr(o.file.find_last_of('.') == std::string::npos ? o.file.size()
                                                                                    : o.file.find_last_of('.'));
     std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
-    if (ext == ".json") return load_json_path(o.file);
+    if (ext == ".json") return load_json_path(o.file, o.tolerance);
     if (ext == ".svg") return load_svg_path(o.file, o.tolerance);
     if (ext == ".csv") return load_csv_path(o.file, basis_from_name(o.csv_basis), o.csv_closed);
-    if (ext == ".gcode" || ext == ".ngc" || ext == ".nc" || ext == ".gc") return load_gcode_path(o.file, gcode_options(o));
+    if (ext == ".gcode" || ext == ".ngc" || ext == ".nc" || ext == ".gc") return read_gcode(o, nullptr, gcode_pen);
     throw InputError(
         o.file, {},
         "unknown file type \"" + ext + "\" (expected .json, .csv, .svg, .gcode, .ngc, .nc or .gc)");

@@ -18,8 +18,9 @@ struct PathOptions {
     std::string format;                 ///< --format: json, csv, svg or gcode; empty: by extension
     std::string csv_basis = "bspline";  ///< basis for CSV point files
     bool csv_closed = false;
-    std::string gcode_pen = "z";        ///< "z" or "spindle" (M3/M5)
+    std::string gcode_pen = "z";        ///< "z", "spindle" (M3/M5), "motion" (G1 draws) or "auto"
     double gcode_z_down = 0.0;          ///< pen down when Z <= this (mm)
+    std::vector<std::string> gcode_ignore;  ///< --ignore-code: more G/M codes to skip
     double tolerance = 0.01;            ///< mm, arcs to cubics (SVG, G-code)
     PlacementOptions placement;         ///< --rotate, --flip-y, --scale, --fit, ... (placement.hpp)
     std::string translate;              ///< --translate "X,Y" (mm), parsed by load_path
@@ -37,6 +38,7 @@ struct LoadedPath {
     bool placed = false;   ///< a placement option was given
     OrderReport order;
     bool ordered = false;  ///< ordering ran (not --keep-order)
+    std::string gcode_pen;  ///< G-code files: the pen mode used and why; empty otherwise
 };
 
 /// Adds the FILE argument and the format options to a subcommand.

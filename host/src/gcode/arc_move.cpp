@@ -1,5 +1,6 @@
 // G2/G3: the arc's center from I J (offsets, or absolute under G90.1) or from R, LinuxCNC's
 // checks on it, then Bezier pieces (docs/formats-gcode.md, "Arcs").
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <numbers>
@@ -14,12 +15,14 @@ namespace {
 // LinuxCNC's defaults (interp_internal.hh): radii below this are zero; an R arc may be this
 // much too short for its chord.
 constexpr double kRadiusToleranceMm = 0.00005 * 25.4;
-// LinuxCNC's defaults for how far the end may be off the start's circle: the end point's
-// radius may differ from the start point's by at most this much (in the program's units) and
-// by at most 0.1 %.
+// LinuxCNC's defaults for how far the end may be off the start's circle
+// (CENTER_ARC_RADIUS_TOLERANCE_MM / _INCH and SPIRAL_RELATIVE_TOLERANCE in interp_internal.hh),
+// in the program's units: enough for end points and centers rounded to 0.01 mm or 0.001 in.
 constexpr double kSpiralToleranceMm = 2 * 0.01 * std::numbers::sqrt2;
 constexpr double kSpiralToleranceInch = 2 * 0.001 * std::numbers::sqrt2;
 constexpr double kSpiralRelativeTolerance = 0.001;
+// arc_data_ijk refuses any difference above this many times the small bound, relative or not.
+constexpr double kSpiralHardLimitFactor = 100;
 constexpr int kMaxTurns = 100;
 
 std::string fixed(double v, int decimals) {
@@ -29,6 +32,25 @@ std::string fixed(double v, int decimals) {
 }
 
 }  // namespace
+
+// LinuxCNC's arc_data_ijk: a large difference always fails; a small one only when it is also
+// large relative to the radius, so tiny arcs rounded to a few decimals still pass.
+void Interpreter::check_end_radius(double r0_mm, double r1_mm, SourceLocation at) const {
+    const double abs_err = std::fabs(r0_mm - r1_mm);
+    const double rel_err = abs_err / std::max(r0_mm, r1_mm);
+    const double small_bound = inch_ ? kSpiralToleranceInch * 25.4 : kSpiralToleranceMm;
+    const double large_bound = kSpiralHardLimitFactor * small_bound;
+    const bool too_far = abs_err > large_bound;
+    if (!too_far && !(abs_err > small_bound && rel_err > kSpiralRelativeTolerance)) return;
+    const double unit = scale();
+    const char* unit_name = inch_ ? " in" : " mm";
+    auto in_units = [&](double mm) { return fixed(mm / unit, 6) + unit_name; };
+    const std::string why = too_far ? "more than " + in_units(large_bound)
+                                    : "more than " + in_units(small_bound) +
+                                          " and more than 0.1% (" + fixed(rel_err * 100, 4) + "%)";
+    fail(at, "radius to end of arc differs from radius to start: " + in_units(r0_mm) + " vs " +
+                 in_units(r1_mm) + ", difference " + in_units(abs_err) + " is " + why);
+}
 
 void Interpreter::arc(const Command& c, Motion move, Vec2 to, SourceLocation at) {
     const char* name = move == Motion::kArcCw ? "G2" : "G3";
@@ -86,14 +108,7 @@ void Interpreter::arc(const Command& c, Motion move, Vec2 to, SourceLocation at)
         if (r0 < kRadiusToleranceMm || r1 < kRadiusToleranceMm) {
             fail(at, "zero-radius arc (the center is at the start or end point)");
         }
-        const double abs_err = std::fabs(r0 - r1);
-        const double rel_err = abs_err / std::max(r0, r1);
-        const double abs_tolerance = inch_ ? kSpiralToleranceInch * 25.4 : kSpiralToleranceMm;
-        if (abs_err > abs_tolerance || rel_err > kSpiralRelativeTolerance) {
-            fail(at, "radius to end of arc differs from radius to start: " + fixed(r0, 4) +
-                         " mm vs " + fixed(r1, 4) + " mm (allowed: " + fixed(abs_tolerance, 4) +
-                         " mm and 0.1%)");
-        }
+        check_end_radius(r0, r1, at);
     }
 
     const bool ccw = move == Motion::kArcCcw;

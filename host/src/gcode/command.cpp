@@ -1,8 +1,11 @@
 // G and M codes by modal group (docs/formats-gcode.md, "Codes").
 #include "command.hpp"
 
+#include <charconv>
 #include <cmath>
+#include <string_view>
 
+#include "cursor.hpp"
 #include "pathstream/host/input_error.hpp"
 
 namespace pathstream::host::gcode {
@@ -32,20 +35,43 @@ struct Seen {
     std::string name;
 };
 
+constexpr std::string_view kSupportedLetters = "FGIJLMNPQRSTXYZ";
+
 class Decoder {
 public:
-    explicit Decoder(const std::string& file) : file_(file) {}
+    Decoder(const std::string& file, const std::set<std::string>& ignored)
+        : file_(file), ignored_(ignored) {}
 
     Command decode(const Block& block) {
         Command c;
         c.start = block.start;
+        const Word* unsupported = nullptr;
+        bool meaningful = false;  // a code or an axis word that is not skipped
         for (const Word& w : block.words) {
-            if (w.letter == 'G')
-                g_word(w, c);
-            else if (w.letter == 'M')
-                m_word(w, c);
-            else
+            if (w.letter == 'G' || w.letter == 'M') {
+                if (const auto name = code_name(w); name && ignored_.count(*name)) {
+                    c.ignored.push_back({*name, w.at});
+                    continue;
+                }
+                meaningful = true;
+                if (w.letter == 'G')
+                    g_word(w, c);
+                else
+                    m_word(w, c);
+            } else if (kSupportedLetters.find(w.letter) == std::string_view::npos) {
+                if (!unsupported) unsupported = &w;
+            } else {
+                if (w.letter == 'X' || w.letter == 'Y' || w.letter == 'Z') meaningful = true;
                 value_word(w, c);
+            }
+        }
+        if (!c.ignored.empty() && !meaningful) {
+            c.skip = true;
+            return c;
+        }
+        if (unsupported) {
+            fail(*unsupported, std::string("unsupported word letter '") + unsupported->letter +
+                                   "' (supported: F G I J L M N P Q R S T X Y Z)");
         }
         return c;
     }
@@ -63,6 +89,23 @@ private:
         groups_[g] = {true, name};
     }
 
+public:
+    // "M6", "G92.1" for a word that is a code LinuxCNC could know; nullopt otherwise.
+    static std::optional<std::string> code_name(const Word& w) {
+        if (w.letter == 'G') {
+            const double tenths_exact = w.value * 10;
+            const long tenths = w.value >= 0 && w.value < 1000 ? std::lround(tenths_exact) : -1;
+            if (tenths < 0 || std::fabs(tenths_exact - static_cast<double>(tenths)) > 1e-6) {
+                return std::nullopt;
+            }
+            return g_code_name(tenths);
+        }
+        const long code = w.value >= 0 && w.value < 100000 ? std::lround(w.value) : -1;
+        if (code < 0 || std::fabs(w.value - static_cast<double>(code)) > 1e-9) return std::nullopt;
+        return "M" + std::to_string(code);
+    }
+
+private:
     void g_word(const Word& w, Command& c) {
         const double tenths_exact = w.value * 10;
         const long tenths = w.value >= 0 && w.value < 1000 ? std::lround(tenths_exact) : -1;
@@ -70,6 +113,11 @@ private:
             fail(w, "unsupported G code G" + w.text);
         }
         const std::string name = g_code_name(tenths);
+        auto non_modal = [&](NonModal code) {
+            claim(kNonModal, w, name);
+            c.non_modal = code;
+            c.non_modal_at = w.at;
+        };
         auto motion = [&](Motion m) {
             claim(kMotionGroup, w, name);
             c.motion = m;
@@ -94,14 +142,58 @@ private:
             case 51:
                 motion(Motion::kQuadratic);
                 break;
+            case 52:
+                motion(Motion::kNurbs);
+                break;
+            case 53:
+                claim(kMotionGroup, w, name);
+                c.nurbs_end = true;
+                break;
             case 800:
                 motion(Motion::kNone);
                 break;
             case 40:
-                claim(kNonModal, w, name);
-                c.dwell = true;
-                c.dwell_at = w.at;
+                non_modal(NonModal::kDwell);
                 break;
+            case 280:
+                non_modal(NonModal::kHome);
+                break;
+            case 281:
+                non_modal(NonModal::kSetHome);
+                break;
+            case 300:
+                non_modal(NonModal::kHome2);
+                break;
+            case 301:
+                non_modal(NonModal::kSetHome2);
+                break;
+            case 530:
+                non_modal(NonModal::kMachineCoords);
+                break;
+            case 920:
+                non_modal(NonModal::kSetOffset);
+                break;
+            case 921:
+                non_modal(NonModal::kClearOffset);
+                break;
+            case 922:
+                non_modal(NonModal::kSuspendOffset);
+                break;
+            case 923:
+                non_modal(NonModal::kRestoreOffset);
+                break;
+            case 730:
+            case 760:
+            case 810:
+            case 820:
+            case 830:
+            case 840:
+            case 850:
+            case 860:
+            case 870:
+            case 880:
+            case 890:
+                fail(w, "canned cycles (" + name + ") are not supported");
             case 170:
                 claim(kPlane, w, name);
                 break;
@@ -158,12 +250,17 @@ private:
     }
 
     void m_word(const Word& w, Command& c) {
-        const long code = w.value >= 0 && w.value < 1000 ? std::lround(w.value) : -1;
+        const long code = w.value >= 0 && w.value < 100000 ? std::lround(w.value) : -1;
         if (code < 0 || std::fabs(w.value - static_cast<double>(code)) > 1e-9) {
             fail(w, "unsupported M code M" + w.text);
         }
         const std::string name = "M" + std::to_string(code);
         switch (code) {
+            case 0:
+            case 1:
+                claim(kStopping, w, name);
+                c.pause = true;
+                break;
             case 2:
             case 30:
                 claim(kStopping, w, name);
@@ -179,7 +276,8 @@ private:
                 c.spindle_on = false;
                 break;
             default:
-                fail(w, "unsupported M code " + name);
+                fail(w, "unsupported M code " + name + " (skip it with --ignore-code " + name +
+                            " if it means nothing here)");
         }
     }
 
@@ -190,6 +288,7 @@ private:
     }
 
     const std::string& file_;
+    const std::set<std::string>& ignored_;
     Seen groups_[kGroupCount];
 };
 
@@ -201,8 +300,32 @@ std::string g_code_name(long tenths) {
     return name;
 }
 
-Command decode_block(const Block& block, const std::string& file) {
-    return Decoder(file).decode(block);
+const std::set<std::string>& default_ignored_codes() {
+    static const std::set<std::string> codes{"M6",   "M7",   "M8",   "M9",   "M17",  "M18",  "M84",
+                                             "M106", "M107", "M117", "M300", "M888", "M2000"};
+    return codes;
+}
+
+std::optional<std::string> normalise_code_name(const std::string& text) {
+    if (text.size() < 2) return std::nullopt;
+    const char letter = upper(text[0]);
+    if (letter != 'G' && letter != 'M') return std::nullopt;
+    const std::string number = text.substr(1);
+    double value = 0;
+    const auto result = std::from_chars(number.data(), number.data() + number.size(), value);
+    if (result.ec != std::errc() || result.ptr != number.data() + number.size() ||
+        number.find_first_not_of("0123456789.") != std::string::npos) {
+        return std::nullopt;
+    }
+    Word w;
+    w.letter = letter;
+    w.value = value;
+    return Decoder::code_name(w);
+}
+
+Command decode_block(const Block& block, const std::string& file,
+                     const std::set<std::string>& ignored) {
+    return Decoder(file, ignored).decode(block);
 }
 
 }  // namespace pathstream::host::gcode

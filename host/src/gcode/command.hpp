@@ -5,7 +5,9 @@
 
 #include <array>
 #include <optional>
+#include <set>
 #include <string>
+#include <vector>
 
 #include "lexer.hpp"
 #include "pathstream/host/path.hpp"
@@ -13,22 +15,49 @@
 namespace pathstream::host::gcode {
 
 /// Motion modes (modal group 1). kNone: no motion mode yet, or G80.
-enum class Motion { kNone, kRapid, kLine, kArcCw, kArcCcw, kCubic, kQuadratic };
+enum class Motion { kNone, kRapid, kLine, kArcCw, kArcCcw, kCubic, kQuadratic, kNurbs };
+
+/// The non-modal codes of group 0 (one per block).
+enum class NonModal {
+    kNone,
+    kDwell,          ///< G4
+    kSetOffset,      ///< G92
+    kClearOffset,    ///< G92.1
+    kSuspendOffset,  ///< G92.2
+    kRestoreOffset,  ///< G92.3
+    kHome,           ///< G28
+    kSetHome,        ///< G28.1
+    kHome2,          ///< G30
+    kSetHome2,       ///< G30.1
+    kMachineCoords,  ///< G53
+};
+
+/// A code the reader skips (it has no meaning for the machine), where it first appeared.
+struct IgnoredCode {
+    std::string name;  ///< "M6", "G43"
+    SourceLocation at;
+};
 
 /// One block, decoded. Codes the reader accepts and ignores (G17, G40, G49, G54, G61, G61.1,
 /// G64, G94, S, T) leave no trace here apart from `path_control` (G64 may carry P and Q).
 struct Command {
-    SourceLocation start;                 ///< the block's first word
-    std::optional<Motion> motion;         ///< G0 G1 G2 G3 G5 G5.1 G80
-    SourceLocation motion_at;             ///< where that G word is
-    std::optional<bool> inch;             ///< G20 (true) / G21 (false)
-    std::optional<bool> incremental;      ///< G91 (true) / G90 (false)
-    std::optional<bool> arc_incremental;  ///< G91.1 (true) / G90.1 (false)
-    bool dwell = false;                   ///< G4 (takes P)
-    SourceLocation dwell_at;              ///< where the G4 word is
-    bool path_control = false;            ///< G64 (may take P and Q)
-    std::optional<bool> spindle_on;       ///< M3, M4 (true) / M5 (false)
-    bool end_program = false;             ///< M2, M30
+    SourceLocation start;                  ///< the block's first word
+    std::optional<Motion> motion;          ///< G0 G1 G2 G3 G5 G5.1 G80
+    SourceLocation motion_at;              ///< where that G word is
+    std::optional<bool> inch;              ///< G20 (true) / G21 (false)
+    std::optional<bool> incremental;       ///< G91 (true) / G90 (false)
+    std::optional<bool> arc_incremental;   ///< G91.1 (true) / G90.1 (false)
+    NonModal non_modal = NonModal::kNone;  ///< G4, G28, G30, G53, G92...
+    SourceLocation non_modal_at;           ///< where that G word is
+    bool nurbs_end = false;                ///< G5.3
+    bool path_control = false;             ///< G64 (may take P and Q)
+    std::optional<bool> spindle_on;        ///< M3, M4 (true) / M5 (false)
+    bool end_program = false;              ///< M2, M30
+    bool pause = false;                    ///< M0, M1
+    /// Codes skipped in this block; when `skip` the whole block is skipped (it held only
+    /// skipped codes and their words).
+    std::vector<IgnoredCode> ignored;
+    bool skip = false;
     /// The value words (F I J P Q R S T X Y Z), indexed by letter - 'A'.
     std::array<std::optional<Word>, 26> values;
 
@@ -39,10 +68,21 @@ struct Command {
     }
 };
 
-/// Decodes a block. Throws InputError at the offending word for: an unsupported G or M code
-/// (G18/G19: "only the XY plane (G17) is supported"), two codes of one modal group, and a
-/// value letter given twice.
-Command decode_block(const Block& block, const std::string& file);
+/// Codes skipped when no --ignore-code is given: M6 (tool change), M7 M8 M9 (coolant),
+/// M17 M18 M84 (stepper power), M106 M107 (fan), M117 (display text), M300 (beep),
+/// M888 M2000 (DexArm modes).
+const std::set<std::string>& default_ignored_codes();
+
+/// "M6", "G43", "G92.1": a code as the user names it, normalised (upper case, no leading
+/// zeros); nullopt when `text` is no G or M code.
+std::optional<std::string> normalise_code_name(const std::string& text);
+
+/// Decodes a block. Codes named in `ignored` are listed in Command::ignored and skipped; a
+/// block of only such codes and non-axis words is skipped whole. Throws InputError at the
+/// offending word for: an unsupported letter, G or M code (G18/G19: "only the XY plane (G17)
+/// is supported"; canned cycles), two codes of one modal group, and a letter given twice.
+Command decode_block(const Block& block, const std::string& file,
+                     const std::set<std::string>& ignored);
 
 /// "G1", "G90.1": the name of a G code given in tenths (10, 901).
 std::string g_code_name(long tenths);

@@ -1,49 +1,132 @@
-// parse_gcode_path / load_gcode_path: lines -> blocks -> commands -> path.
+// parse_gcode_path / load_gcode_path: lines -> program run -> path; the pen mode choice.
 #include "pathstream/host/gcode_path.hpp"
 
 #include <cmath>
 #include <fstream>
+#include <set>
 #include <sstream>
 #include <stdexcept>
 #include <string_view>
 
-#include "command.hpp"
 #include "interpreter.hpp"
-#include "lexer.hpp"
 #include "pathstream/host/input_error.hpp"
+#include "program.hpp"
 
 namespace pathstream::host {
 
-Path parse_gcode_path(const std::string& text, const std::string& file,
-                      const GcodeOptions& options) {
+namespace {
+
+// Lines without their LF or CR LF; views into `text`.
+std::vector<std::string_view> split_lines(const std::string& text) {
+    std::vector<std::string_view> lines;
+    std::string_view rest(text);
+    if (rest.substr(0, 3) == "\xEF\xBB\xBF") rest.remove_prefix(3);  // UTF-8 byte order mark
+    while (!rest.empty()) {
+        const std::size_t end = rest.find('\n');
+        std::string_view current = rest.substr(0, end);
+        rest.remove_prefix(end == std::string_view::npos ? rest.size() : end + 1);
+        if (!current.empty() && current.back() == '\r') current.remove_suffix(1);
+        lines.push_back(current);
+    }
+    return lines;
+}
+
+// The shortest usual form of a length, for messages.
+std::string mm_text(double v) {
+    std::ostringstream s;
+    s << v;
+    return s.str();
+}
+
+// The mode the evidence of a run in Z mode points to, and why.
+PenControl choose_pen(const gcode::PenEvidence& e, double z_down_max, std::string& reason) {
+    const std::string z = "--gcode-z-down " + mm_text(z_down_max) + " mm";
+    if (e.z_low && e.z_high) {
+        reason = "auto: Z goes both above and to or below " + z;
+        return PenControl::kZ;
+    }
+    if (e.spindle) {
+        reason = "auto: M3/M4 appear and Z never crosses " + z;
+        return PenControl::kSpindle;
+    }
+    reason = "auto: no M3/M4 and Z never crosses " + z + ", so G1 draws and G0 travels";
+    return PenControl::kMotion;
+}
+
+// One run of the whole program in one pen mode.
+Path run(const std::vector<std::string_view>& lines, const std::string& file,
+         const GcodeOptions& options, const std::set<std::string>& ignored, bool allow_empty,
+         gcode::PenEvidence* evidence, std::vector<std::string>& warnings) {
+    gcode::Parameters parameters;
+    gcode::Interpreter interpreter(file, options, parameters);
+    gcode::run_program(lines, file, ignored, interpreter, parameters, warnings);
+    if (evidence) *evidence = interpreter.evidence();
+    return interpreter.finish(allow_empty);
+}
+
+}  // namespace
+
+const char* pen_control_name(PenControl pen) {
+    switch (pen) {
+        case PenControl::kZ:
+            return "z";
+        case PenControl::kSpindle:
+            return "spindle";
+        case PenControl::kMotion:
+            return "motion";
+        case PenControl::kAuto:
+            return "auto";
+    }
+    return "?";
+}
+
+Path parse_gcode_path(const std::string& text, const std::string& file, const GcodeOptions& options,
+                      GcodeReadInfo* info) {
     if (!std::isfinite(options.z_down_max)) {
         throw std::invalid_argument("GcodeOptions::z_down_max must be finite");
     }
     if (!(options.arc_tolerance_mm >= 1e-6) || !std::isfinite(options.arc_tolerance_mm)) {
         throw std::invalid_argument("GcodeOptions::arc_tolerance_mm must be finite and >= 1e-6");
     }
-    gcode::Interpreter interpreter(file, options);
-    std::string_view rest(text);
-    if (rest.substr(0, 3) == "\xEF\xBB\xBF") rest.remove_prefix(3);  // UTF-8 byte order mark
-    for (std::size_t line = 1; !rest.empty(); ++line) {
-        const std::size_t end = rest.find('\n');
-        std::string_view current = rest.substr(0, end);
-        rest.remove_prefix(end == std::string_view::npos ? rest.size() : end + 1);
-        if (!current.empty() && current.back() == '\r') current.remove_suffix(1);
-        const auto block = gcode::lex_line(current, line, file);
-        if (!block) continue;
-        if (!interpreter.execute(gcode::decode_block(*block, file))) break;
+    std::set<std::string> ignored = gcode::default_ignored_codes();
+    for (const std::string& code : options.ignore_codes) {
+        const auto name = gcode::normalise_code_name(code);
+        if (!name) {
+            throw std::invalid_argument("ignore code \"" + code +
+                                        "\" is not a G or M code (like M300 or G43)");
+        }
+        ignored.insert(*name);
     }
-    return interpreter.finish();
+    const std::vector<std::string_view> lines = split_lines(text);
+    GcodeReadInfo local;
+    GcodeReadInfo& out = info ? *info : local;
+    out = {};
+    GcodeOptions chosen = options;
+    Path path;
+    if (options.pen == PenControl::kAuto) {
+        gcode::PenEvidence evidence;
+        chosen.pen = PenControl::kZ;
+        path = run(lines, file, chosen, ignored, true, &evidence, out.warnings);
+        chosen.pen = choose_pen(evidence, options.z_down_max, out.pen_reason);
+        if (chosen.pen != PenControl::kZ || path.subpaths.empty()) {
+            std::vector<std::string> again;  // the warnings of the first run stand
+            path = run(lines, file, chosen, ignored, false, nullptr, again);
+        }
+    } else {
+        out.pen_reason = "as asked";
+        path = run(lines, file, chosen, ignored, false, nullptr, out.warnings);
+    }
+    out.pen = chosen.pen;
+    return path;
 }
 
-Path load_gcode_path(const std::string& file, const GcodeOptions& options) {
+Path load_gcode_path(const std::string& file, const GcodeOptions& options, GcodeReadInfo* info) {
     std::ifstream in(file, std::ios::binary);
     if (!in) throw InputError(file, {}, "cannot open file");
     std::ostringstream buffer;
     buffer << in.rdbuf();
     if (in.bad()) throw InputError(file, {}, "cannot read file");
-    return parse_gcode_path(buffer.str(), file, options);
+    return parse_gcode_path(buffer.str(), file, options, info);
 }
 
 }  // namespace pathstream::host

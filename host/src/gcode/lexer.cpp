@@ -1,162 +1,119 @@
-// G-code line syntax: words, comments, numbers (docs/formats-gcode.md, "Syntax").
+// G-code line syntax: words, comments, parameter settings (docs/formats-gcode.md, "Syntax").
 #include "lexer.hpp"
 
-#include <cctype>
-#include <charconv>
-#include <cstdio>
-#include <string_view>
-
-#include "pathstream/host/input_error.hpp"
+#include "cursor.hpp"
+#include "expression.hpp"
 
 namespace pathstream::host::gcode {
 
 namespace {
 
-bool is_blank(char c) {
-    return c == ' ' || c == '\t' || c == '\r' || c == '\f' || c == '\v';
-}
-bool is_digit(char c) {
-    return c >= '0' && c <= '9';
-}
-
-std::string describe(char c) {
-    const auto u = static_cast<unsigned char>(c);
-    if (u >= 0x21 && u < 0x7f) return std::string("'") + c + "'";
-    char buffer[8];
-    std::snprintf(buffer, sizeof buffer, "\\x%02X", u);
-    return std::string("byte ") + buffer;
-}
-
 class LineLexer {
 public:
-    LineLexer(std::string_view text, std::size_t line, const std::string& file)
-        : text_(text), line_(line), file_(file) {}
+    LineLexer(std::string_view text, std::size_t line, const std::string& file,
+              const Parameters& parameters)
+        : c_{text, line, file, 0}, parameters_(parameters) {}
 
     std::optional<Block> block() {
-        skip_blanks();
-        if (i_ < text_.size() && text_[i_] == '%') return std::nullopt;
-        if (i_ < text_.size() && text_[i_] == '/') fail(i_, "block delete '/' is not supported");
+        c_.skip_blanks();
+        if (c_.peek() == '%') return std::nullopt;
+        if (c_.peek() == '/') c_.fail(c_.i, "block delete '/' is not supported");
         Block b;
+        if (c_.peek() == '$') {
+            b.dollar = true;
+            b.start = c_.at(c_.i);
+            return b;
+        }
         while (true) {
             skip_blanks_and_comments();
-            if (i_ >= text_.size() || text_[i_] == ';') break;
-            const std::size_t at = i_;
+            if (c_.done() || c_.peek() == ';') break;
+            if (c_.peek() == '#') {
+                if (b.words.empty() && b.assignments.empty() && !seen_n_) b.start = c_.at(c_.i);
+                b.assignments.push_back(assignment());
+                continue;
+            }
+            const std::size_t at = c_.i;
             Word w = word();
-            if (b.words.empty() && !seen_n_) b.start = w.at;
+            if (b.words.empty() && b.assignments.empty() && !seen_n_) b.start = w.at;
             if (w.letter == 'N') {
-                if (!b.words.empty() || seen_n_) fail(at, "line number N must start the block");
+                if (!b.words.empty() || !b.assignments.empty() || seen_n_) {
+                    c_.fail(at, "line number N must start the block");
+                }
                 seen_n_ = true;
                 continue;
             }
             b.words.push_back(std::move(w));
         }
-        if (b.words.empty()) return std::nullopt;
+        if (b.words.empty() && b.assignments.empty()) return std::nullopt;
         return b;
     }
 
 private:
-    [[noreturn]] void fail(std::size_t index, const std::string& message) const {
-        throw InputError(file_, SourceLocation{line_, index + 1}, message);
-    }
-
-    void skip_blanks() {
-        while (i_ < text_.size() && is_blank(text_[i_])) ++i_;
-    }
-
     void skip_blanks_and_comments() {
-        while (i_ < text_.size()) {
-            if (is_blank(text_[i_])) {
-                ++i_;
-            } else if (text_[i_] == '(') {
-                const auto close = text_.find(')', i_);
-                if (close == std::string_view::npos) fail(i_, "unclosed comment '('");
-                i_ = close + 1;
+        while (!c_.done()) {
+            if (is_blank(c_.peek())) {
+                ++c_.i;
+            } else if (c_.peek() == '(') {
+                const auto close = c_.text.find(')', c_.i);
+                if (close == std::string_view::npos) c_.fail(c_.i, "unclosed comment '('");
+                c_.i = close + 1;
             } else {
                 return;
             }
         }
     }
 
+    // "#ref = value"; the reference's own expression is read with the old values too.
+    Assignment assignment() {
+        Assignment a;
+        a.at = c_.at(c_.i);
+        a.target = read_parameter_ref(c_, parameters_);
+        c_.skip_blanks();
+        if (c_.peek() != '=') {
+            c_.fail(c_.i, "expected '=' after " + parameter_text(a.target) +
+                              " (a parameter is read only inside a value)");
+        }
+        ++c_.i;
+        a.value = read_value(c_, parameters_, 0);
+        return a;
+    }
+
     Word word() {
-        const std::size_t at = i_;
-        const char c = text_[i_];
-        if (c == '#') fail(at, "parameters (#) are not supported");
-        if (c == '[') fail(at, "expressions ([ ]) are not supported");
-        if (!std::isalpha(static_cast<unsigned char>(c))) {
-            fail(at,
-                 "unexpected character " + describe(c) + " (expected a word: letter and number)");
+        const std::size_t at = c_.i;
+        const char ch = c_.peek();
+        if (ch == '@' || ch == '^') {
+            c_.fail(at, std::string("polar coordinates ('") + ch + "' words) are not supported");
         }
-        const char letter = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
-        if (letter == 'O') fail(at, "O-words (subroutines and control flow) are not supported");
-        if (std::string_view("FGIJMNPQRSTXYZ").find(letter) == std::string_view::npos) {
-            fail(at, std::string("unsupported word letter '") + letter +
-                         "' (supported: F G I J M N P Q R S T X Y Z)");
+        if (!is_letter(ch)) {
+            c_.fail(at, "unexpected character " + describe_char(ch) +
+                            " (expected a word: letter and number)");
         }
-        ++i_;
-        skip_blanks();
-        const std::size_t begin = i_;
-        while (i_ < text_.size() &&
-               (is_digit(text_[i_]) || text_[i_] == '.' || text_[i_] == '+' || text_[i_] == '-')) {
-            ++i_;
+        const char letter = upper(ch);
+        if (letter == 'O') c_.fail(at, "an O-word must be the first word of its line");
+        ++c_.i;
+        c_.skip_blanks();
+        if (c_.done() || c_.peek() == ';' || c_.peek() == '(') {
+            c_.fail(at, std::string("missing number after ") + letter);
         }
-        const std::string_view token = text_.substr(begin, i_ - begin);
-        if (token.empty()) fail(at, std::string("missing number after ") + letter);
+        const std::size_t begin = c_.i;
         Word w;
         w.letter = letter;
-        w.text = std::string(token);
-        w.at = SourceLocation{line_, at + 1};
-        w.value = number(token, at, letter);
+        w.at = c_.at(at);
+        w.value = read_value(c_, parameters_, letter, at);
+        w.text = std::string(c_.text.substr(begin, c_.i - begin));
         return w;
     }
 
-    // [+-] digits [. digits] or [+-] . digits: what LinuxCNC reads, without its expressions.
-    double number(std::string_view token, std::size_t at, char letter) const {
-        std::size_t k = 0;
-        bool negative = false;
-        if (token[k] == '+' || token[k] == '-') negative = token[k++] == '-';
-        std::size_t digits = 0, points = 0;
-        bool nonzero_integer_digit = false;
-        for (std::size_t j = k; j < token.size(); ++j) {
-            if (is_digit(token[j])) {
-                ++digits;
-                if (points == 0 && token[j] != '0') nonzero_integer_digit = true;
-            } else if (token[j] == '.') {
-                ++points;
-            } else {
-                digits = 0;  // a sign inside the number
-                break;
-            }
-        }
-        if (digits == 0 || points > 1) {
-            fail(at, "malformed number \"" + std::string(token) + "\" after " + letter);
-        }
-        const std::string_view body = token.substr(k);
-        double value = 0;
-        const auto result = std::from_chars(body.data(), body.data() + body.size(), value);
-        if (result.ec == std::errc::result_out_of_range) {
-            if (nonzero_integer_digit) {
-                fail(at, std::string("number after ") + letter +
-                             " is out of range (not finite as a double)");
-            }
-            value = 0;  // underflow: closer to zero than any double
-        } else if (result.ec != std::errc() || result.ptr != body.data() + body.size()) {
-            fail(at, "malformed number \"" + std::string(token) + "\" after " + letter);
-        }
-        return negative ? -value : value;
-    }
-
-    std::string_view text_;
-    std::size_t line_;
-    const std::string& file_;
-    std::size_t i_ = 0;
+    LineCursor c_;
+    const Parameters& parameters_;
     bool seen_n_ = false;
 };
 
 }  // namespace
 
 std::optional<Block> lex_line(std::string_view text, std::size_t line_number,
-                              const std::string& file) {
-    return LineLexer(text, line_number, file).block();
+                              const std::string& file, const Parameters& parameters) {
+    return LineLexer(text, line_number, file, parameters).block();
 }
 
 }  // namespace pathstream::host::gcode

@@ -2,6 +2,9 @@
 #include "runs.hpp"
 
 #include <stdexcept>
+#include <string>
+
+#include "pathstream/host/input_error.hpp"
 
 namespace pathstream::host::gcode {
 
@@ -11,16 +14,28 @@ PathPoint point(Vec2 v) {
 }
 }  // namespace
 
-void RunBuilder::draw(const Cubic& piece, double feed_mm_s, SourceLocation at) {
+void RunBuilder::draw(const Cubic& piece, double feed_mm_s, SourceLocation at,
+                      const std::string& file) {
     const Vec2 p0 = piece.p[0];
     if (piece.p[1] == p0 && piece.p[2] == p0 && piece.p[3] == p0) return;  // zero length
-    if (open_ && done_.back().feed != feed_mm_s) open_ = false;            // one feed per subpath
+    if (++pieces_ > kMaxPieces) {
+        throw InputError(
+            file, at,
+            "more than " + std::to_string(kMaxPieces) + " curve pieces drawn (the reader's limit)");
+    }
+    if (open_ && done_.back().feed != feed_mm_s) open_ = false;  // one feed per subpath
     if (!open_) {
         Subpath sp;
         sp.basis = PathBasis::kBezier;
         sp.closed = false;
         sp.feed = feed_mm_s;
         sp.location = at;
+        sp.pause_before = pause_next_;
+        sp.dwell_before = dwell_next_;
+        sp.dwell_pen_down = dwell_pen_down_;
+        pause_next_ = false;
+        dwell_next_ = 0;
+        dwell_pen_down_ = false;
         sp.points.push_back(point(p0));
         done_.push_back(std::move(sp));
         open_ = true;

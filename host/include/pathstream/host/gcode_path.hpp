@@ -3,6 +3,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "pathstream/host/path.hpp"
 
@@ -10,15 +11,32 @@ namespace pathstream::host {
 
 /// What lowers the pen.
 enum class PenControl {
-    kZ,        ///< down during G1/G2/G3/G5/G5.1 moves made at Z <= GcodeOptions::z_down_max
-    kSpindle,  ///< down during G1/G2/G3/G5/G5.1 moves made between M3 (or M4) and M5
+    kZ,        ///< down during feed moves (G1 G2 G3 G5 G5.1 G5.2) at Z <= z_down_max
+    kSpindle,  ///< down during feed moves made between M3 (or M4) and M5
+    kMotion,   ///< down during every feed move: G1 draws, G0 travels (files with no pen codes)
+    kAuto,     ///< one of the above, chosen from what the program does (GcodeReadInfo says why)
 };
+
+/// "z", "spindle", "motion", "auto": the name the CLI uses.
+const char* pen_control_name(PenControl pen);
 
 /// How to read a G-code program.
 struct GcodeOptions {
     PenControl pen = PenControl::kZ;  ///< what lowers the pen
     double z_down_max = 0.0;          ///< kZ: highest Z (mm) at which the pen is down; finite
     double arc_tolerance_mm = 0.01;  ///< largest distance of an arc's Beziers from the arc; >= 1e-6
+    /// G and M codes skipped with a warning, besides the default ones (M6, M7, ...):
+    /// "M300", "G43", "m05" (case and leading zeros do not matter).
+    std::vector<std::string> ignore_codes;
+};
+
+/// What a read found beside the path.
+struct GcodeReadInfo {
+    PenControl pen = PenControl::kZ;  ///< the pen mode used (never kAuto)
+    std::string pen_reason;           ///< why that mode, one line ("asked for", or the evidence)
+    /// One per skipped code (and for grbl '$' lines), at its first use:
+    /// "file:line:col: M6 skipped (...); later ones are skipped without a warning".
+    std::vector<std::string> warnings;
 };
 
 /// Parses a G-code program into a 2-axis path (X, Y in mm): one subpath (basis kBezier, open,
@@ -28,12 +46,15 @@ struct GcodeOptions {
 /// Throws InputError ("file:line:col: what is wrong") at the offending word for syntax errors,
 /// unsupported words and codes, missing or repeated words, out-of-range numbers (> 1e6 mm) and
 /// impossible arcs; and ("file: no pen-down moves ...") when nothing is drawn.
-/// Throws std::invalid_argument when `options` is out of range.
+/// Runs parameters, expressions and O-word control flow as LinuxCNC does, within budgets.
+/// Throws std::invalid_argument when `options` is out of range (also an ignore_codes entry
+/// that is no G or M code). When `info` is given it receives the pen mode and the warnings.
 Path parse_gcode_path(const std::string& text, const std::string& file,
-                      const GcodeOptions& options = {});
+                      const GcodeOptions& options = {}, GcodeReadInfo* info = nullptr);
 
 /// Reads and parses a G-code file. Throws as parse_gcode_path, and InputError when the file
 /// cannot be read.
-Path load_gcode_path(const std::string& file, const GcodeOptions& options = {});
+Path load_gcode_path(const std::string& file, const GcodeOptions& options = {},
+                     GcodeReadInfo* info = nullptr);
 
 }  // namespace pathstream::host

@@ -7,12 +7,16 @@
 
 namespace pathstream::host {
 
-/// Parses a JSON path document. `file` names the source in error messages.
+/// Parses a JSON path document. `file` names the source in error messages. Subpaths with
+/// basis "nurbs" become open Bezier chains (kBezier): exact for non-rational curves of degree
+/// 1 to 3, else within `nurbs_tolerance_mm` (> 0).
 /// Throws InputError ("file:line:col: what is wrong") on malformed JSON, unknown keys,
-/// wrong types, non-finite or out-of-range numbers, too few points and unknown bases.
-Path parse_json_path(const std::string& text, const std::string& file);
+/// wrong types, non-finite or out-of-range numbers, too few points, unknown bases and
+/// unusable NURBS (degree, knots, weights). Throws std::invalid_argument for a bad tolerance.
+Path parse_json_path(const std::string& text, const std::string& file,
+                     double nurbs_tolerance_mm = 0.01);
 
 /// Reads and parses a JSON path file. Throws InputError, also when it cannot be read.
-Path load_json_path(const std::string& file);
+Path load_json_path(const std::string& file, double nurbs_tolerance_mm = 0.01);
 
 }  // namespace pathstream::host

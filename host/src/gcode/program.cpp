@@ -1,0 +1,239 @@
+// Program flow: O-word calls, branches and loops, budgets, skipped codes
+// (docs/formats-gcode.md, "O-words" and "Budgets").
+#include "program.hpp"
+
+#include <cmath>
+#include <map>
+
+#include "cursor.hpp"
+#include "expression.hpp"
+#include "lexer.hpp"
+
+namespace pathstream::host::gcode {
+
+namespace {
+
+class Runner {
+public:
+    Runner(const std::vector<std::string_view>& lines, const std::string& file,
+           const std::set<std::string>& ignored, Interpreter& interpreter, Parameters& parameters,
+           std::vector<std::string>& warnings)
+        : lines_(lines),
+          file_(file),
+          ignored_(ignored),
+          interpreter_(interpreter),
+          parameters_(parameters),
+          warnings_(warnings),
+          structure_(scan_structure(lines, file)) {}
+
+    void run() {
+        frames_.push_back(Frame{});
+        std::size_t pc = 0;
+        while (pc < lines_.size()) {
+            characters_ += lines_[pc].size();
+            if (++blocks_ > kMaxBlocksRun || characters_ > kMaxCharactersRun) {
+                throw InputError(file_, SourceLocation{pc + 1, 1},
+                                 "more than " + std::to_string(kMaxBlocksRun) + " lines or " +
+                                     std::to_string(kMaxCharactersRun) +
+                                     " characters run (the reader's limit; a loop that never "
+                                     "ends?)");
+            }
+            if (structure_.olines.count(pc) != 0) {
+                pc = control(pc);
+                continue;
+            }
+            const auto block = lex_line(lines_[pc], pc + 1, file_, parameters_);
+            ++pc;
+            if (!block) continue;
+            if (block->dollar) {
+                warn("$", block->start, "grbl '$' line skipped");
+                continue;
+            }
+            const Command command = decode_block(*block, file_, ignored_);
+            for (const IgnoredCode& code : command.ignored) {
+                warn(code.name, code.at, code.name + " skipped (it means nothing to this machine)");
+            }
+            // As LinuxCNC: the line's values were read with the old parameters; the settings
+            // take effect before the block runs.
+            for (const Assignment& a : block->assignments) parameters_.set(a.target, a.value);
+            if (command.skip) continue;
+            if (!interpreter_.execute(command)) return;
+        }
+    }
+
+private:
+    struct Frame {
+        std::size_t return_to = 0;
+        std::map<std::size_t, long> repeats_left;  ///< repeat line -> passes still to run
+    };
+
+    const OLine& o(std::size_t pc) const { return structure_.olines.at(pc); }
+
+    [[noreturn]] void fail(const OLine& line, const std::string& message) const {
+        throw InputError(file_, line.at, message);
+    }
+
+    void warn(const std::string& code, SourceLocation at, const std::string& what) {
+        if (!warned_.insert(code).second) return;
+        warnings_.push_back(file_ + ":" + std::to_string(at.line) + ":" +
+                            std::to_string(at.column) + ": " + what +
+                            "; later ones are skipped without a warning");
+    }
+
+    // The [ ] values after an O-word's keyword, at most `most`.
+    std::vector<double> arguments(std::size_t pc, std::size_t most) {
+        LineCursor c{lines_[pc], pc + 1, file_, o(pc).args_begin};
+        std::vector<double> values;
+        while (true) {
+            c.skip_blanks();
+            if (c.peek() == '(') {
+                const auto close = c.text.find(')', c.i);
+                if (close == std::string_view::npos) c.fail(c.i, "unclosed comment '('");
+                c.i = close + 1;
+                continue;
+            }
+            if (c.done() || c.peek() == ';') break;
+            if (c.peek() != '[' || values.size() == most) {
+                c.fail(c.i, "unexpected " + describe_char(c.peek()) + " after " +
+                                oline_text(o(pc)) + (most ? " (values are written in [ ])" : ""));
+            }
+            values.push_back(read_value(c, parameters_, 0));
+        }
+        return values;
+    }
+
+    double condition(std::size_t pc) {
+        const std::vector<double> v = arguments(pc, 1);
+        if (v.empty()) fail(o(pc), oline_text(o(pc)) + " needs a value in [ ]");
+        return v[0];
+    }
+
+    void loop_pass(std::size_t loop_line) {
+        if (++loop_passes_ > kMaxLoopPasses) {
+            fail(o(loop_line), oline_text(o(loop_line)) + ": more than " +
+                                   std::to_string(kMaxLoopPasses) +
+                                   " loop passes in all (the reader's limit; a loop that never "
+                                   "ends?)");
+        }
+    }
+
+    // Runs the O-word on line pc; returns the next line to run.
+    std::size_t control(std::size_t pc) {
+        const OLine& line = o(pc);
+        const std::size_t partner = line.partner;
+        switch (line.kind) {
+            case OKind::kSub:
+                return partner + 1;  // a definition: skipped until called
+            case OKind::kEndsub:
+            case OKind::kReturn: {
+                const std::vector<double> v = arguments(pc, 1);
+                if (frames_.size() == 1) fail(line, oline_text(line) + " outside a call");
+                if (!v.empty()) parameters_.set(ParameterRef{0, "_value"}, v[0]);
+                parameters_.set(ParameterRef{0, "_value_returned"}, v.empty() ? 0 : 1);
+                const std::size_t back = frames_.back().return_to;
+                frames_.pop_back();
+                parameters_.leave_call();
+                return back;
+            }
+            case OKind::kCall: {
+                const auto sub = structure_.subs.find(line.label);
+                if (sub == structure_.subs.end()) {
+                    fail(line, oline_text(line) + ": no such subroutine in this file");
+                }
+                const std::vector<double> args = arguments(pc, Parameters::kCallArguments);
+                if (frames_.size() > kMaxCallDepth) {
+                    fail(line, oline_text(line) + ": calls nested more than " +
+                                   std::to_string(kMaxCallDepth) + " deep");
+                }
+                parameters_.enter_call(args);
+                frames_.push_back(Frame{pc + 1, {}});
+                return sub->second + 1;
+            }
+            case OKind::kIf:
+                if (condition(pc) != 0) return pc + 1;
+                return next_branch(pc);
+            case OKind::kElseif:
+            case OKind::kElse:
+                return partner + 1;  // the branch before ran: leave the if
+            case OKind::kEndif:
+            case OKind::kDo:
+                arguments(pc, 0);
+                return pc + 1;
+            case OKind::kWhile:
+                if (line.closes_do) {
+                    if (condition(pc) == 0) return pc + 1;
+                    loop_pass(partner);
+                    return partner + 1;
+                }
+                return condition(pc) != 0 ? pc + 1 : partner + 1;
+            case OKind::kEndwhile:
+                arguments(pc, 0);
+                loop_pass(partner);
+                return partner;
+            case OKind::kRepeat: {
+                // As LinuxCNC: the count is rounded to the nearest whole number.
+                const double n = std::nearbyint(condition(pc));
+                if (n < 1) return partner + 1;
+                frames_.back().repeats_left[pc] = n > static_cast<double>(kMaxLoopPasses)
+                                                      ? static_cast<long>(kMaxLoopPasses) + 1
+                                                      : static_cast<long>(n) - 1;
+                return pc + 1;
+            }
+            case OKind::kEndrepeat: {
+                arguments(pc, 0);
+                long& left = frames_.back().repeats_left[partner];
+                if (left <= 0) return pc + 1;
+                --left;
+                loop_pass(partner);
+                return partner + 1;
+            }
+            case OKind::kBreak:
+                arguments(pc, 0);
+                return o(partner).partner + 1;
+            case OKind::kContinue: {
+                arguments(pc, 0);
+                // While: test again; do: its closing while tests; repeat: endrepeat counts.
+                return o(partner).kind == OKind::kWhile ? partner : o(partner).partner;
+            }
+        }
+        return pc + 1;
+    }
+
+    // After a false if (or elseif): the first branch whose condition holds, else the endif.
+    std::size_t next_branch(std::size_t if_line) {
+        const auto found = structure_.branches.find(if_line);
+        if (found != structure_.branches.end()) {
+            for (std::size_t branch : found->second) {
+                if (o(branch).kind == OKind::kElse) {
+                    arguments(branch, 0);
+                    return branch + 1;
+                }
+                if (condition(branch) != 0) return branch + 1;
+            }
+        }
+        return o(if_line).partner + 1;
+    }
+
+    const std::vector<std::string_view>& lines_;
+    const std::string& file_;
+    const std::set<std::string>& ignored_;
+    Interpreter& interpreter_;
+    Parameters& parameters_;
+    std::vector<std::string>& warnings_;
+    ProgramStructure structure_;
+    std::vector<Frame> frames_;
+    std::set<std::string> warned_;
+    std::size_t blocks_ = 0;
+    std::size_t characters_ = 0;
+    std::size_t loop_passes_ = 0;
+};
+
+}  // namespace
+
+void run_program(const std::vector<std::string_view>& lines, const std::string& file,
+                 const std::set<std::string>& ignored, Interpreter& interpreter,
+                 Parameters& parameters, std::vector<std::string>& warnings) {
+    Runner(lines, file, ignored, interpreter, parameters, warnings).run();
+}
+
+}  // namespace pathstream::host::gcode

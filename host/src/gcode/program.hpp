@@ -1,0 +1,31 @@
+// Runs a whole G-code program: the lines in the order O-words (calls, branches, loops) give,
+// within budgets, each block lexed with the parameters of the moment, decoded and executed.
+#pragma once
+
+#include <set>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "interpreter.hpp"
+#include "oword.hpp"
+#include "parameters.hpp"
+
+namespace pathstream::host::gcode {
+
+/// Budgets that keep a hostile program's cost bounded (docs/formats-gcode.md, "Budgets").
+constexpr std::size_t kMaxBlocksRun = 10'000'000;       ///< lines run, loops counted each pass
+constexpr std::size_t kMaxCharactersRun = 500'000'000;  ///< characters of the lines run
+constexpr std::size_t kMaxLoopPasses = 1'000'000;       ///< loop passes in all
+/// Calls nested at most: LinuxCNC's INTERP_SUB_ROUTINE_LEVELS (10) counts the main program.
+constexpr std::size_t kMaxCallDepth = 9;
+
+/// Runs `lines` (the program's lines, without line breaks) through `interpreter`. Codes in
+/// `ignored` are skipped; the first time each is met, a warning "file:line:col: ..." is
+/// appended to `warnings` (also for grbl '$' lines). Throws InputError as the stages do and
+/// for O-word errors (an unknown subroutine, a missing condition) and spent budgets.
+void run_program(const std::vector<std::string_view>& lines, const std::string& file,
+                 const std::set<std::string>& ignored, Interpreter& interpreter,
+                 Parameters& parameters, std::vector<std::string>& warnings);
+
+}  // namespace pathstream::host::gcode
