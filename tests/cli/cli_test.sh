@@ -84,6 +84,14 @@ expect device-home-needs-machine 2 "--home: needs --machine" -- "$bin" device --
 expect stream-lead-in-can 6 "nosuchcan0: no such interface" -- "$bin" stream "$src/examples/rose.json" -m "$machine" -t "can://nosuchcan0?node=1" --lead-in
 expect device-axes-and-machine 2 "the axis count comes from --machine" -- "$bin" device -m "$machine" --axes 3
 
+# The work area: a drawing larger than the A3 plotter's travel is refused at its element with
+# the offending point; --fit a4 places it; the profile's per-layer feed shows in check.
+a3="$src/examples/machines/a3_plotter.json"
+printf '<svg xmlns="http://www.w3.org/2000/svg" width="2000mm" height="900mm" viewBox="0 0 2000 900">\n<rect x="10" y="10" width="1980" height="880" fill="none" stroke="black"/>\n</svg>\n' > "$work/big.svg"
+expect work-area 1 'big.svg:2:1: subpath 1 leaves the work area: it reaches x = 1990.000 mm at (1990.000, 10.000) mm; x travel is 0.000 .. 430.000 mm' -- "$bin" plan "$work/big.svg" -m "$a3"
+expect work-area-fit 0 'every tick checked' -- "$bin" plan "$work/big.svg" -m "$a3" --fit a4
+expect layer-feed 0 '"accent" 2 subpaths 88.0 mm at 40.0 mm/s' -- "$bin" check "$src/examples/two_pens.svg" -m "$a3"
+
 # Layers and pen changes; one CLI: standard input and -o - everywhere.
 expect layers-plan 0 'layers: 2 ("outline" 2 subpaths' -- "$bin" plan "$src/examples/two_pens.svg" -m "$machine"
 expect layers-pause 0 '1 pause for the operator' -- "$bin" plan "$src/examples/two_pens.svg" -m "$machine"
