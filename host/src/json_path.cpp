@@ -8,7 +8,6 @@
 
 #include "pathstream/host/input_error.hpp"
 #include "pathstream/host/json_document.hpp"
-#include "pathstream/host/json_locate.hpp"
 
 namespace pathstream::host {
 
@@ -57,7 +56,7 @@ public:
         Subpath sp;
         sp.basis = default_basis;
         sp.closed = default_closed;
-        sp.location = locate_json_pointer(text(), pointer);
+        sp.location = locate(pointer);
         if (!v.is_object()) fail(pointer, "subpath must be an object with \"points\"");
         only_keys(v, pointer, {"basis", "closed", "points"});
         if (v.contains("basis")) sp.basis = basis(v["basis"], pointer + "/basis");
@@ -124,7 +123,7 @@ public:
             Subpath sp;
             sp.basis = default_basis;
             sp.closed = default_closed;
-            sp.location = locate_json_pointer(text(), "/points");
+            sp.location = locate("/points");
             sp.points = points(root["points"], "/points", scale, axes);
             check_count(sp, "/points");
             path.subpaths.push_back(std::move(sp));
