@@ -40,11 +40,13 @@ public:
     }
 
     /// Handles one received frame; calls `send(const Frame&)` for each answer (a status request is answered by 4 + Axes frames; anything else by 0 or 1).
-    /// Frames for other nodes or functions are ignored. Cost: a batch's accept_batch when its
-    /// last data frame arrives, O(1) otherwise.
+    /// Frames for other nodes or functions are ignored; a frame claiming more than 8 data bytes
+    /// is refused (kResultBadFrame, and a transfer in progress is dropped) whatever the driver
+    /// filled in. Cost: a batch's accept_batch when its last data frame arrives, O(1) otherwise.
     template <typename Send>
     void handle(const Frame& f, Send&& send) {
         if (!addressed(f.id)) return;
+        if (f.length > sizeof f.data) return refuse_oversized(f, send);
         switch (function_of(f.id)) {
             case kCommandBase: on_command(f, send); break;
             case kCommandArgsBase: on_command_args(f, send); break;
@@ -115,6 +117,23 @@ private:
         a.free_slots = saturate8(device_.free_slots());
         a.state = static_cast<std::uint8_t>(device_.state());
         send(encode_ack(node_, a));
+    }
+
+    // Never read past Frame::data: a corrupt length is the driver's or the bus's fault, so the
+    // node answers it like any malformed frame of that function.
+    template <typename Send>
+    void refuse_oversized(const Frame& f, Send& send) {
+        switch (function_of(f.id)) {
+            case kConfigBase: config_seen_ = 0; return ack(kAckConfig, kResultBadFrame, 0, send);
+            case kSpanStartBase:
+            case kSpanDataBase: {
+                const std::uint32_t sequence = active_ ? transfer_.first_sequence : 0;
+                if (active_) ++refused_;
+                active_ = false;
+                return ack(kAckSpans, kResultBadFrame, sequence, send);
+            }
+            default: return ack(kAckCommand, kResultBadFrame, 0, send);
+        }
     }
 
     template <typename Send>
@@ -208,6 +227,7 @@ private:
         if (!active_ || f.length < 2) return;  // no transfer (its start was lost): the host times out
         const std::uint8_t index = f.data[0];
         const std::size_t n = static_cast<std::size_t>(f.length) - 1;
+        if (n > sizeof f.data - 1) return refuse_oversized(f, send);  // handle() checks too: keep local
         if (index != next_index_ || received_ + n > transfer_.length) {
             // A frame was lost: refuse now rather than let the host wait for its timeout.
             active_ = false;
