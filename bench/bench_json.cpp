@@ -47,7 +47,8 @@ Result measure(const std::string& text, int runs) {
         const auto t0 = std::chrono::steady_clock::now();
         const Path p = parse_json_path(text, "bench.json");
         const double ms =
-            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
+                .count();
         best.ms = std::min(best.ms, ms);
         best.scanned = json_bytes_scanned() - before;
         best.subpaths = p.subpaths.size();
@@ -94,9 +95,12 @@ int main(int argc, char** argv) {
         try {
             const Result r = measure(text, runs);
             ms[k] = r.ms;
-            const double per_byte = static_cast<double>(r.scanned) / static_cast<double>(text.size());
-            std::printf("%6zu subpaths %8zu bytes: %9.2f ms, %zu subpaths read, %.2f bytes scanned per byte\n",
-                        sizes[k], text.size(), r.ms, r.subpaths, per_byte);
+            const double per_byte =
+                static_cast<double>(r.scanned) / static_cast<double>(text.size());
+            std::printf(
+                "%6zu subpaths %8zu bytes: %9.2f ms, %zu subpaths read, %.2f bytes scanned per "
+                "byte\n",
+                sizes[k], text.size(), r.ms, r.subpaths, per_byte);
             if (per_byte > 4.0 || r.subpaths != sizes[k]) met = false;
         } catch (const InputError& e) {
             std::fprintf(stderr, "%s\n", e.what());

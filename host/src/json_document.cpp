@@ -14,7 +14,8 @@ void check_strict(const std::string& text, const std::string& file, const JsonIn
     }
     if (const auto at = index.trailing_byte()) {
         const std::string what = text[*at] == '\0' ? "a NUL byte" : "bytes";
-        throw InputError(file, index.location_of(*at), "invalid JSON: " + what + " after the document");
+        throw InputError(file, index.location_of(*at),
+                         "invalid JSON: " + what + " after the document");
     }
 }
 
@@ -29,7 +30,8 @@ nlohmann::json parse_json_document(const std::string& text, const std::string& f
         // nlohmann reports the byte just past the offending token; point at that token.
         const std::size_t offset = e.byte > 0 ? e.byte - 1 : 0;
         std::string message = e.what();
-        if (const auto at = message.find("syntax error"); at != std::string::npos) message = message.substr(at);
+        if (const auto at = message.find("syntax error"); at != std::string::npos)
+            message = message.substr(at);
         throw InputError(file, JsonIndex(text).location_of(offset), "invalid JSON: " + message);
     } catch (const json::out_of_range& e) {
         // A number too large for a double (e.g. 1e400): nlohmann names the token, not where.
@@ -38,8 +40,9 @@ nlohmann::json parse_json_document(const std::string& text, const std::string& f
         if (open != std::string::npos && close > open) {
             const std::string token = message.substr(open + 1, close - open - 1);
             const auto at = text.find(token);
-            throw InputError(file, at == std::string::npos ? SourceLocation{} : JsonIndex(text).location_of(at),
-                             "number " + token + " is out of range (not finite as a double)");
+            throw InputError(
+                file, at == std::string::npos ? SourceLocation{} : JsonIndex(text).location_of(at),
+                "number " + token + " is out of range (not finite as a double)");
         }
         throw InputError(file, {}, "invalid JSON: " + message);
     }
@@ -62,7 +65,8 @@ void JsonChecker::only_keys(const nlohmann::json& object, const std::string& poi
         if (!allowed.count(key)) {
             std::string list;
             for (const auto& k : allowed) list += (list.empty() ? "" : ", ") + k;
-            fail(pointer + "/" + key, "unknown key \"" + key + "\" (expected one of: " + list + ")");
+            fail(pointer + "/" + key,
+                 "unknown key \"" + key + "\" (expected one of: " + list + ")");
         }
     }
 }

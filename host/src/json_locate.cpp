@@ -10,10 +10,14 @@ namespace pathstream::host {
 namespace {
 thread_local std::size_t bytes_scanned = 0;
 
-bool is_space(char c) { return c == ' ' || c == '\t' || c == '\n' || c == '\r'; }
+bool is_space(char c) {
+    return c == ' ' || c == '\t' || c == '\n' || c == '\r';
+}
 }  // namespace
 
-std::size_t json_bytes_scanned() { return bytes_scanned; }
+std::size_t json_bytes_scanned() {
+    return bytes_scanned;
+}
 
 // One forgiving pass over text nlohmann::json has accepted: it only needs where each value
 // starts, so it skips strings and scalars without validating them. Iterative, so a deeply
@@ -68,7 +72,8 @@ private:
         skip_string();
         const std::string_view raw = text_.substr(start, std::min(pos_, text_.size()) - start);
         if (raw.size() < 2) return std::string(raw);
-        if (raw.find('\\') == std::string_view::npos) return std::string(raw.substr(1, raw.size() - 2));
+        if (raw.find('\\') == std::string_view::npos)
+            return std::string(raw.substr(1, raw.size() - 2));
         const auto decoded = nlohmann::json::parse(raw, nullptr, false);
         return decoded.is_string() ? decoded.get<std::string>() : std::string(raw);
     }
@@ -163,7 +168,9 @@ private:
     std::vector<Open> open_;
 };
 
-JsonIndex::JsonIndex(std::string_view text) { JsonIndexBuilder(text, *this).build(); }
+JsonIndex::JsonIndex(std::string_view text) {
+    JsonIndexBuilder(text, *this).build();
+}
 
 std::optional<std::size_t> JsonIndex::offset_of(const std::string& pointer) const {
     if (nodes_.empty()) return std::nullopt;
@@ -174,7 +181,8 @@ std::optional<std::size_t> JsonIndex::offset_of(const std::string& pointer) cons
         const std::size_t end = std::min(pointer.find('/', at + 1), pointer.size());
         std::string token;
         for (std::size_t i = at + 1; i < end; ++i) {  // RFC 6901: ~1 -> /, ~0 -> ~
-            if (pointer[i] == '~' && i + 1 < end && (pointer[i + 1] == '0' || pointer[i + 1] == '1')) {
+            if (pointer[i] == '~' && i + 1 < end &&
+                (pointer[i + 1] == '0' || pointer[i + 1] == '1')) {
                 token += pointer[++i] == '1' ? '/' : '~';
             } else {
                 token += pointer[i];
@@ -190,7 +198,8 @@ std::optional<std::size_t> JsonIndex::offset_of(const std::string& pointer) cons
             node = n.children[i];
         } else {
             if (token.empty() || token.size() > 18 ||
-                !std::all_of(token.begin(), token.end(), [](char c) { return c >= '0' && c <= '9'; })) {
+                !std::all_of(token.begin(), token.end(),
+                             [](char c) { return c >= '0' && c <= '9'; })) {
                 return std::nullopt;
             }
             const std::size_t i = std::stoull(token);

@@ -39,8 +39,8 @@ private:
     struct Node {
         std::size_t offset = 0;
         bool object = false;
-        std::vector<std::string> keys;       ///< members' keys (objects), in file order
-        std::vector<std::size_t> children;   ///< members' or elements' node indices
+        std::vector<std::string> keys;      ///< members' keys (objects), in file order
+        std::vector<std::size_t> children;  ///< members' or elements' node indices
     };
     std::vector<Node> nodes_;
     std::vector<std::size_t> line_starts_;
