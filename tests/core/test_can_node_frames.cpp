@@ -1,7 +1,6 @@
 // The CAN node never trusts a frame's length field: a frame claiming more than 8 data bytes is
 // refused with kResultBadFrame before any byte is read, and drops the transfer it belongs to.
 #include <catch2/catch.hpp>
-
 #include <cstdint>
 #include <vector>
 
@@ -96,4 +95,26 @@ TEST_CASE("CAN node refuses oversized commands and configuration", "[can]") {
     CHECK(n.last_ack().kind == pc::kAckCommand);
     CHECK(n.last_ack().result == pc::kResultBadFrame);
     CHECK_FALSE(n.dev.configured());
+}
+
+TEST_CASE("CAN node refuses a resend with other bytes under the same sequence", "[can]") {
+    Node n;
+    n.configure();
+    const auto p = two_spans();
+    auto other = p;
+    other[7] ^= 1;  // the first span's end moves by one LSB
+    const auto send = [&](const std::vector<std::uint8_t>& payload) {
+        n.feed(pc::encode_span_start(5, {1, 2, static_cast<std::uint16_t>(payload.size())}));
+        for (std::size_t i = 0; i < pc::data_frames(payload.size()); ++i) {
+            n.feed(pc::encode_span_data(5, static_cast<std::uint8_t>(i), payload.data(),
+                                        payload.size()));
+        }
+        return n.last_ack();
+    };
+    CHECK(send(p).result == 0);
+    CHECK(send(other).result == static_cast<std::uint8_t>(Status::kBadSequence));
+    CHECK(n.dev.duplicates() == 0);
+    CHECK(send(p).result == 0);
+    CHECK(n.dev.duplicates() == 1);
+    CHECK(n.dev.queued_spans() == 2);
 }
