@@ -135,7 +135,7 @@ host::StreamReport stream_once(const Job& job, double time_scale, const host::St
     std::thread loop([&] {
         sim::DeviceLoopOptions o;
         o.time_scale = time_scale;
-        sim::run_device_loop(*device, [&](std::chrono::milliseconds w) { server.poll_once(w); }, o, stop);
+        sim::run_device_loop(*device, [&](std::chrono::microseconds w) { server.poll_once(w); }, o, stop);
     });
     host::StreamOptions o = base;
     o.target = target_of(server);

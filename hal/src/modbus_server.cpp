@@ -16,6 +16,7 @@
 #include <thread>
 #include <vector>
 
+#include "mbap_assembler.hpp"
 #include "modbus_dispatch.hpp"
 #include "pathstream/hal/pseudo_terminal.hpp"
 
@@ -76,6 +77,13 @@ std::uint16_t bound_port(int fd) {
     return ntohs(reinterpret_cast<sockaddr_in*>(&addr)->sin_port);
 }
 
+// poll(2) with a microsecond timeout: a 1 kHz device waits 0.6 ms, not 0 ms (a busy loop).
+int poll_for(pollfd* fds, std::size_t count, std::chrono::microseconds wait) {
+    const auto us = std::max<std::int64_t>(0, wait.count());
+    const timespec t{static_cast<time_t>(us / 1'000'000), static_cast<long>(us % 1'000'000) * 1000};
+    return ::ppoll(fds, count, &t, nullptr);
+}
+
 void set_timeouts(modbus_t* ctx, std::chrono::milliseconds byte_timeout) {
     const auto us = std::chrono::duration_cast<std::chrono::microseconds>(byte_timeout).count();
     const auto sec = static_cast<std::uint32_t>(us / 1'000'000);
@@ -91,7 +99,10 @@ void set_timeouts(modbus_t* ctx, std::chrono::milliseconds byte_timeout) {
 struct ModbusServer::Impl {
     struct Client {
         int fd;
-        Clock::time_point last_active;
+        Clock::time_point last_active;  ///< the last request answered (at first: accepted)
+        Clock::time_point last_byte;    ///< of the frame in progress
+        std::uint64_t requests = 0;     ///< answered on this connection
+        detail::MbapAssembler frame;
     };
 
     Impl(ModbusRegisterHandler& h, ModbusFraming f, const ModbusServerOptions& o)
@@ -124,11 +135,13 @@ struct ModbusServer::Impl {
     detail::DispatchScratch scratch;
     std::uint8_t frame[MODBUS_TCP_MAX_ADU_LENGTH] = {};
 
-    std::size_t poll_tcp(std::chrono::milliseconds max_wait);
-    std::size_t poll_rtu(std::chrono::milliseconds max_wait);
+    std::size_t poll_tcp(std::chrono::microseconds max_wait);
+    std::size_t poll_rtu(std::chrono::microseconds max_wait);
     void accept_clients();
     void close_client(std::size_t index);
-    bool serve_one_tcp(Client& client);  // false: close the connection
+    std::size_t evictee() const;
+    bool read_tcp(Client& client, std::size_t& handled);  // false: close the connection
+    bool serve_one_tcp(Client& client);                   // false: close the connection
     std::size_t serve_one_rtu();
     void count(const detail::DispatchOutcome& outcome);
 };
@@ -141,23 +154,29 @@ void ModbusServer::Impl::close_client(std::size_t index) {
 
 void ModbusServer::Impl::accept_clients() {
     for (;;) {
-        const int fd = ::accept4(listen_fd, nullptr, nullptr, SOCK_CLOEXEC);
+        const int fd = ::accept4(listen_fd, nullptr, nullptr, SOCK_CLOEXEC | SOCK_NONBLOCK);
         if (fd < 0) return;  // EAGAIN: none pending; other errors: that peer already left
         const int on = 1;
         // Requests and responses are single small segments: Nagle + delayed ACK would add
         // tens of milliseconds to every transaction.
         setsockopt(fd, IPPROTO_TCP, TCP_NODELAY, &on, sizeof on);
-        if (clients.size() >= max_clients) {
-            // Full: the longest-idle connection is most likely a master that vanished
-            // without a FIN; the newcomer is most likely that master coming back.
-            const auto idle = std::min_element(
-                clients.begin(), clients.end(),
-                [](const Client& a, const Client& b) { return a.last_active < b.last_active; });
-            close_client(static_cast<std::size_t>(idle - clients.begin()));
-        }
-        clients.push_back({fd, Clock::now()});
+        if (clients.size() >= max_clients) close_client(evictee());
+        const Clock::time_point now = Clock::now();
+        clients.push_back({fd, now, now, 0, {}});
         bump(counters.connections_accepted);
     }
+}
+
+std::size_t ModbusServer::Impl::evictee() const {
+    // Full: a connection that never completed a request (a scan, a flood, a dribbler) goes
+    // first, so a master that is streaming keeps its slot; among equals the longest idle, most
+    // likely a master that vanished without a FIN and is the newcomer coming back.
+    const auto victim =
+        std::min_element(clients.begin(), clients.end(), [](const Client& a, const Client& b) {
+            if ((a.requests == 0) != (b.requests == 0)) return a.requests == 0;
+            return a.last_active < b.last_active;
+        });
+    return static_cast<std::size_t>(victim - clients.begin());
 }
 
 void ModbusServer::Impl::count(const detail::DispatchOutcome& outcome) {
@@ -167,53 +186,82 @@ void ModbusServer::Impl::count(const detail::DispatchOutcome& outcome) {
     if (outcome.sent > 0) bump(counters.adu_bytes_sent, static_cast<std::uint64_t>(outcome.sent));
 }
 
-bool ModbusServer::Impl::serve_one_tcp(Client& client) {
-    modbus_set_socket(ctx, client.fd);
-    const int length = modbus_receive(ctx, frame);
-    if (length <= 0) {
-        // 0 is not produced on TCP; -1 with ECONNRESET is the peer closing. Anything else
-        // (an incomplete or oversize frame) leaves the stream out of step: close it, the
-        // master reconnects.
-        if (length < 0 && errno != ECONNRESET) bump(counters.bad_frames);
-        return false;
+// Reads what the socket holds, up to the end of the frame in progress, without waiting;
+// answers the frame once whole. At most one request per call.
+bool ModbusServer::Impl::read_tcp(Client& client, std::size_t& handled) {
+    for (;;) {
+        const ssize_t n =
+            ::recv(client.fd, client.frame.write_pointer(), client.frame.wanted(), MSG_DONTWAIT);
+        if (n == 0) return false;  // the peer closed
+        if (n < 0) return errno == EAGAIN || errno == EWOULDBLOCK || errno == EINTR;
+        client.last_byte = Clock::now();
+        switch (client.frame.added(static_cast<std::size_t>(n))) {
+            case detail::MbapAssembler::State::kPartial:
+                continue;
+            case detail::MbapAssembler::State::kBad:
+                // Out of step for good (not MBAP, or a length no request has): the master
+                // reconnects.
+                bump(counters.bad_frames);
+                return false;
+            case detail::MbapAssembler::State::kComplete: {
+                const bool keep = serve_one_tcp(client);
+                client.frame.clear();
+                ++handled;
+                return keep;
+            }
+        }
     }
+}
+
+bool ModbusServer::Impl::serve_one_tcp(Client& client) {
+    const int length = static_cast<int>(client.frame.size());
     client.last_active = Clock::now();
+    ++client.requests;
     bump(counters.adu_bytes_received, static_cast<std::uint64_t>(length));
+    // libmodbus only frames the reply here: it gets the whole request we assembled.
+    std::copy(client.frame.frame(), client.frame.frame() + length, frame);
+    modbus_set_socket(ctx, client.fd);
     const detail::DispatchOutcome outcome =
         detail::dispatch_modbus_request(ctx, framing, frame, length, handler, scratch);
     count(outcome);
-    if (outcome.sent < 0) return false;
-    // libmodbus sizes an unknown function's frame as the bare function code: the rest the
-    // MBAP length announced would be read as the next header. Drop it.
-    const int announced = (frame[4] << 8 | frame[5]) + 6;
-    if (announced != length) modbus_flush(ctx);
-    return true;
+    // A failed send (the peer's window full: it is not reading its replies) closes it; the
+    // socket is non-blocking, so such a peer never holds the server.
+    return outcome.sent >= 0;
 }
 
-std::size_t ModbusServer::Impl::poll_tcp(std::chrono::milliseconds max_wait) {
+std::size_t ModbusServer::Impl::poll_tcp(std::chrono::microseconds max_wait) {
     std::vector<pollfd> fds;
     fds.reserve(clients.size() + 1);
     fds.push_back({listen_fd, POLLIN, 0});
-    for (const Client& c : clients) fds.push_back({c.fd, POLLIN, 0});
-    const int ready = ::poll(fds.data(), fds.size(), static_cast<int>(max_wait.count()));
-    if (ready <= 0) return 0;  // timeout, or EINTR: the caller polls again
+    const Clock::time_point start = Clock::now();
+    Clock::time_point wake = start + max_wait;
+    for (const Client& c : clients) {
+        fds.push_back({c.fd, POLLIN, 0});
+        // A frame in progress must not outlive its byte timeout even on a quiet server.
+        if (!c.frame.empty()) wake = std::min(wake, c.last_byte + options.byte_timeout);
+    }
+    const int ready = poll_for(fds.data(), fds.size(),
+                               std::chrono::ceil<std::chrono::microseconds>(wake - start));
 
     std::size_t handled = 0;
     // Serve existing connections first (indices stay valid: accepting appends at the end).
     std::vector<int> to_close;
+    const Clock::time_point now = Clock::now();
     for (std::size_t i = 1; i < fds.size(); ++i) {
-        if (fds[i].revents == 0) continue;
         Client& client = clients[i - 1];
-        const std::uint64_t before = counters.requests.load(std::memory_order_relaxed);
-        if (!serve_one_tcp(client)) to_close.push_back(client.fd);
-        handled += counters.requests.load(std::memory_order_relaxed) - before;
+        if (ready > 0 && fds[i].revents != 0 && !read_tcp(client, handled)) {
+            to_close.push_back(client.fd);
+        } else if (!client.frame.empty() && now - client.last_byte > options.byte_timeout) {
+            bump(counters.bad_frames);  // a frame stalled mid-way: the master resends it
+            to_close.push_back(client.fd);
+        }
     }
     for (const int fd : to_close) {
         const auto it = std::find_if(clients.begin(), clients.end(),
                                      [fd](const Client& c) { return c.fd == fd; });
         if (it != clients.end()) close_client(static_cast<std::size_t>(it - clients.begin()));
     }
-    if (fds[0].revents != 0) accept_clients();
+    if (ready > 0 && fds[0].revents != 0) accept_clients();
     return handled;
 }
 
@@ -235,9 +283,9 @@ std::size_t ModbusServer::Impl::serve_one_rtu() {
     return 1;
 }
 
-std::size_t ModbusServer::Impl::poll_rtu(std::chrono::milliseconds max_wait) {
+std::size_t ModbusServer::Impl::poll_rtu(std::chrono::microseconds max_wait) {
     pollfd fd{serial_fd, POLLIN, 0};
-    const int ready = ::poll(&fd, 1, static_cast<int>(max_wait.count()));
+    const int ready = poll_for(&fd, 1, max_wait);
     if (ready <= 0) return 0;
     if ((fd.revents & POLLIN) == 0) {
         // Hang-up or error without data (a USB adapter unplugged): nothing to read, and
@@ -314,8 +362,8 @@ ModbusServer ModbusServer::rtu_pty(ModbusRegisterHandler& handler,
     return ModbusServer(std::move(impl));
 }
 
-std::size_t ModbusServer::poll_once(std::chrono::milliseconds max_wait) {
-    if (max_wait.count() < 0) max_wait = std::chrono::milliseconds(0);
+std::size_t ModbusServer::poll_once(std::chrono::microseconds max_wait) {
+    if (max_wait.count() < 0) max_wait = std::chrono::microseconds(0);
     return impl_->framing == ModbusFraming::kTcp ? impl_->poll_tcp(max_wait)
                                                  : impl_->poll_rtu(max_wait);
 }
@@ -324,7 +372,7 @@ std::size_t ModbusServer::serve_for(std::chrono::milliseconds duration) {
     const Clock::time_point end = Clock::now() + duration;
     std::size_t handled = 0;
     for (;;) {
-        const auto left = std::chrono::ceil<std::chrono::milliseconds>(end - Clock::now());
+        const auto left = std::chrono::ceil<std::chrono::microseconds>(end - Clock::now());
         if (left.count() <= 0) return handled;
         handled += poll_once(left);
     }

@@ -9,7 +9,6 @@
 
 #include "pathstream/host/input_error.hpp"
 #include "pathstream/host/json_document.hpp"
-#include "pathstream/host/json_locate.hpp"
 #include "nurbs/nurbs.hpp"
 
 namespace pathstream::host {
@@ -63,7 +62,7 @@ public:
         Subpath sp;
         sp.basis = default_basis;
         sp.closed = default_closed;
-        sp.location = locate_json_pointer(text(), pointer);
+        sp.location = locate(pointer);
         if (!v.is_object()) fail(pointer, "subpath must be an object with \"points\"");
         if (v.contains("basis") && v["basis"] == "nurbs") return nurbs_subpath(v, pointer, sp, scale, axes);
         only_keys(v, pointer, {"basis", "closed", "points"});
@@ -184,7 +183,7 @@ public:
             Subpath sp;
             sp.basis = default_basis;
             sp.closed = default_closed;
-            sp.location = locate_json_pointer(text(), "/points");
+            sp.location = locate("/points");
             sp.points = points(root["points"], "/points", scale, axes);
             check_count(sp, "/points");
             path.subpaths.push_back(std::move(sp));

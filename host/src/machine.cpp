@@ -8,6 +8,7 @@
 #include <string>
 #include <utility>
 
+#include "pathstream/device/motion_limits.hpp"
 #include "pathstream/host/input_error.hpp"
 #include "pathstream/host/json_document.hpp"
 #include "pathstream/units.hpp"
@@ -81,7 +82,11 @@ public:
             p.axes.push_back(limits);
         }
         if (root.contains("mm_per_lsb")) p.mm_per_lsb = number(root["mm_per_lsb"], "/mm_per_lsb", "mm_per_lsb", 1e-6, 10, false, "mm");
-        if (root.contains("tick_hz")) p.tick_hz = number(root["tick_hz"], "/tick_hz", "tick_hz", 10, 100000, false, "Hz");
+        if (root.contains("tick_hz")) {
+            // The device's own range: a profile never asks for a rate the device refuses.
+            p.tick_hz = number(root["tick_hz"], "/tick_hz", "tick_hz", device::kMinTickHz,
+                               device::kMaxTickHz, false, "Hz");
+        }
         if (root.contains("ticks_per_span")) {
             const json& v = root["ticks_per_span"];
             if (!v.is_number_integer()) fail("/ticks_per_span", "ticks_per_span must be a whole number");

@@ -152,3 +152,44 @@ TEST_CASE("configuration, commands and batches through registers", "[device][mod
           Ex::kServerDeviceBusy);
     CHECK(status(m)[modbus::status::kRefusals] >= 5);
 }
+
+TEST_CASE("a resend with other bytes under the same sequence is refused", "[device][modbus]") {
+    const Lsb start[kAxes] = {0, 0};
+    Device d(start);
+    Map m(d);
+    auto config = config_block(1000, 200000, 2000000);
+    REQUIRE(m.write_holding_registers(modbus::kConfig, static_cast<std::uint16_t>(config.size()), config.data()) ==
+            Ex::kNone);
+    const auto batch = window(1, test::trapezoid_move<kAxes>(start, 20000, 8), 0, 6);
+    const auto other = window(1, test::trapezoid_move<kAxes>(start, 10000, 8), 0, 6);
+    REQUIRE(batch != other);
+    REQUIRE(m.write_holding_registers(modbus::kSpanWindow, static_cast<std::uint16_t>(batch.size()), batch.data()) ==
+            Ex::kNone);
+    CHECK(m.write_holding_registers(modbus::kSpanWindow, static_cast<std::uint16_t>(other.size()), other.data()) ==
+          Ex::kIllegalDataValue);
+    CHECK(status(m)[modbus::status::kLastRefusal] == static_cast<std::uint16_t>(Status::kBadSequence));
+    CHECK(status(m)[modbus::status::kDuplicates] == 0);
+    CHECK(d.queued_spans() == 6);
+    // The true resend is still acknowledged as a duplicate.
+    CHECK(m.write_holding_registers(modbus::kSpanWindow, static_cast<std::uint16_t>(batch.size()), batch.data()) ==
+          Ex::kNone);
+    CHECK(status(m)[modbus::status::kDuplicates] == 1);
+    CHECK(d.queued_spans() == 6);
+}
+
+TEST_CASE("tick rates below the profile's range are refused", "[device][modbus]") {
+    const Lsb start[kAxes] = {0, 0};
+    Device d(start);
+    Map m(d);
+    auto slow = config_block(kMinTickHz - 1, 200000, 2000000);
+    CHECK(m.write_holding_registers(modbus::kConfig, static_cast<std::uint16_t>(slow.size()), slow.data()) ==
+          Ex::kIllegalDataValue);
+    auto five = config_block(5, 200000, 2000000);
+    CHECK(m.write_holding_registers(modbus::kConfig, static_cast<std::uint16_t>(five.size()), five.data()) ==
+          Ex::kIllegalDataValue);
+    CHECK_FALSE(d.configured());
+    auto lowest = config_block(kMinTickHz, 200000, 2000000);
+    CHECK(m.write_holding_registers(modbus::kConfig, static_cast<std::uint16_t>(lowest.size()), lowest.data()) ==
+          Ex::kNone);
+    CHECK(d.configured());
+}

@@ -166,7 +166,7 @@ struct ModbusRig {
             sim::run_paced_loop(
                 [&] { rig->tick(); }, [&] { return device->tick_hz(); },
                 [&](std::chrono::microseconds w) {
-                    server->poll_once(std::chrono::duration_cast<std::chrono::milliseconds>(w));
+                    server->poll_once(w);
                 },
                 o, stop);
         });

@@ -94,7 +94,7 @@ void run_device(Runner& r, sim::SimulatedModbusDevice& device, hal::ModbusServer
     r.thread = std::thread([&r, &device, &server, time_scale] {
         sim::DeviceLoopOptions o;
         o.time_scale = time_scale;
-        sim::run_device_loop(device, [&](std::chrono::milliseconds w) { server.poll_once(w); }, o, r.stop);
+        sim::run_device_loop(device, [&](std::chrono::microseconds w) { server.poll_once(w); }, o, r.stop);
     });
 }
 
@@ -422,7 +422,7 @@ TEST_CASE("a device power-cycled mid-stream (TCP server gone and back on the sam
         lo.time_scale = 10.0;
         std::atomic<bool> restart{false};
         // Phase 1: the first device until it has accepted 20 spans.
-        sim::run_device_loop(*first, [&](std::chrono::milliseconds w) {
+        sim::run_device_loop(*first, [&](std::chrono::microseconds w) {
             server->poll_once(w);
             if (status_u32(*first, st::kLastAcceptedSequence) >= 20 || loop.stop) restart = true;
         }, lo, restart);
@@ -431,7 +431,7 @@ TEST_CASE("a device power-cycled mid-stream (TCP server gone and back on the sam
         server.reset();
         second = sim::SimulatedModbusDevice::create(start_of(job.plan));
         server.emplace(hal::ModbusServer::tcp(second->handler(), {"127.0.0.1", port, 4}));
-        sim::run_device_loop(*second, [&](std::chrono::milliseconds w) { server->poll_once(w); }, lo, loop.stop);
+        sim::run_device_loop(*second, [&](std::chrono::microseconds w) { server->poll_once(w); }, lo, loop.stop);
     });
     host::StreamOptions o;
     o.target = tcp_target(port);
@@ -466,12 +466,12 @@ TEST_CASE("a device restarted behind a link that stays up (RTU): the host stops 
         sim::DeviceLoopOptions lo;
         lo.time_scale = 10.0;
         std::atomic<bool> restart{false};
-        sim::run_device_loop(*first, [&](std::chrono::milliseconds w) {
+        sim::run_device_loop(*first, [&](std::chrono::microseconds w) {
             server.poll_once(w);
             if (status_u32(*first, st::kLastAcceptedSequence) >= 20 || loop.stop) restart = true;
         }, lo, restart);
         handler.device = second.get();
-        sim::run_device_loop(*second, [&](std::chrono::milliseconds w) { server.poll_once(w); }, lo, loop.stop);
+        sim::run_device_loop(*second, [&](std::chrono::microseconds w) { server.poll_once(w); }, lo, loop.stop);
     });
     host::StreamOptions o;
     o.target = "modbus-rtu://" + server.client_device() + "?baud=115200&parity=N&unit=1";
@@ -503,7 +503,7 @@ TEST_CASE("the queue runs dry: the device stops within its limits, reports the u
     loop.thread = std::thread([&] {
         sim::DeviceLoopOptions lo;
         lo.time_scale = 10.0;
-        sim::run_device_loop(*device, [&](std::chrono::milliseconds w) {
+        sim::run_device_loop(*device, [&](std::chrono::microseconds w) {
             server.poll_once(w);
             if (status_u16(*device, st::kState) == static_cast<std::uint16_t>(device::DeviceState::kHolding) &&
                 (status_u16(*device, st::kFlags) & 2u) != 0) {

@@ -72,7 +72,7 @@ struct DeviceThread {
     std::thread thread;
     void run() {
         thread = std::thread([this] {
-            sim::run_device_loop(*device, [&](std::chrono::milliseconds w) { server->poll_once(w); }, {}, stop);
+            sim::run_device_loop(*device, [&](std::chrono::microseconds w) { server->poll_once(w); }, {}, stop);
         });
     }
     void halt() {

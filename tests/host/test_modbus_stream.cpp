@@ -38,7 +38,7 @@ struct DeviceThread {
         thread = std::thread([this, &server, time_scale] {
             sim::DeviceLoopOptions o;
             o.time_scale = time_scale;
-            sim::run_device_loop(*device, [&](std::chrono::milliseconds w) { server.poll_once(w); }, o, stop);
+            sim::run_device_loop(*device, [&](std::chrono::microseconds w) { server.poll_once(w); }, o, stop);
         });
     }
     ~DeviceThread() {

@@ -68,7 +68,7 @@ struct ModbusDeviceThread {
             sim::DeviceLoopOptions o;
             o.time_scale = time_scale;
             sim::run_device_loop(
-                *device, [&](std::chrono::milliseconds w) { server->poll_once(w); }, o, stop);
+                *device, [&](std::chrono::microseconds w) { server->poll_once(w); }, o, stop);
         });
     }
     std::string target() const {

@@ -342,7 +342,7 @@ int run_modbus_device(const DeviceCommandOptions& o, const std::vector<Lsb>& sta
         },
         [&] { return device->tick_hz(); },
         [&](std::chrono::microseconds w) {
-            server.poll_once(std::chrono::duration_cast<std::chrono::milliseconds>(w));
+            server.poll_once(w);
             watch.after_poll(server);
         },
         loop_options(o), g_stop);

@@ -100,12 +100,10 @@ std::uint64_t run_paced_loop(const std::function<void()>& tick, const std::funct
 }
 
 std::uint64_t run_device_loop(SimulatedModbusDevice& device,
-                              const std::function<void(std::chrono::milliseconds)>& server_poll,
+                              const std::function<void(std::chrono::microseconds)>& server_poll,
                               const DeviceLoopOptions& options, const std::atomic<bool>& stop) {
     return run_paced_loop([&] { device.tick(); }, [&] { return device.tick_hz(); },
-                          [&](std::chrono::microseconds wait) {
-                              server_poll(std::chrono::duration_cast<std::chrono::milliseconds>(wait));
-                          },
+                          server_poll,
                           options, stop);
 }
 

@@ -1,13 +1,15 @@
 // The device end of the native CAN protocol (can_protocol.hpp): assembles span batches from
 // span-start and span-data frames and feeds MotionDevice::accept_batch (all or nothing,
-// duplicates acknowledged), applies commands and the configuration, answers with acks and
-// status frames. Freestanding: no heap, storage inline (one batch buffer).
+// duplicates acknowledged, a resend with other bytes refused), applies commands and the
+// configuration, answers with acks and status frames. Freestanding: no heap, storage inline
+// (the batch being received and the last one queued: 2 x 1792 bytes).
 #pragma once
 
 #include <cstddef>
 #include <cstdint>
 
 #include "pathstream/device/can_protocol.hpp"
+#include "pathstream/device/last_batch.hpp"
 #include "pathstream/device/operator_commands.hpp"
 #include "pathstream/device/motion_device.hpp"
 #include "pathstream/status.hpp"
@@ -40,11 +42,13 @@ public:
     }
 
     /// Handles one received frame; calls `send(const Frame&)` for each answer (a status request is answered by 4 + Axes frames; anything else by 0 or 1).
-    /// Frames for other nodes or functions are ignored. Cost: a batch's accept_batch when its
-    /// last data frame arrives, O(1) otherwise.
+    /// Frames for other nodes or functions are ignored; a frame claiming more than 8 data bytes
+    /// is refused (kResultBadFrame, and a transfer in progress is dropped) whatever the driver
+    /// filled in. Cost: a batch's accept_batch when its last data frame arrives, O(1) otherwise.
     template <typename Send>
     void handle(const Frame& f, Send&& send) {
         if (!addressed(f.id)) return;
+        if (f.length > sizeof f.data) return refuse_oversized(f, send);
         switch (function_of(f.id)) {
             case kCommandBase: on_command(f, send); break;
             case kCommandArgsBase: on_command_args(f, send); break;
@@ -116,6 +120,23 @@ private:
         a.free_slots = saturate8(device_.free_slots());
         a.state = static_cast<std::uint8_t>(device_.state());
         send(encode_ack(node_, a));
+    }
+
+    // Never read past Frame::data: a corrupt length is the driver's or the bus's fault, so the
+    // node answers it like any malformed frame of that function.
+    template <typename Send>
+    void refuse_oversized(const Frame& f, Send& send) {
+        switch (function_of(f.id)) {
+            case kConfigBase: config_seen_ = 0; return ack(kAckConfig, kResultBadFrame, 0, send);
+            case kSpanStartBase:
+            case kSpanDataBase: {
+                const std::uint32_t sequence = active_ ? transfer_.first_sequence : 0;
+                if (active_) ++refused_;
+                active_ = false;
+                return ack(kAckSpans, kResultBadFrame, sequence, send);
+            }
+            default: return ack(kAckCommand, kResultBadFrame, 0, send);
+        }
     }
 
     template <typename Send>
@@ -209,6 +230,7 @@ private:
         if (!active_ || f.length < 2) return;  // no transfer (its start was lost): the host times out
         const std::uint8_t index = f.data[0];
         const std::size_t n = static_cast<std::size_t>(f.length) - 1;
+        if (n > sizeof f.data - 1) return refuse_oversized(f, send);  // handle() checks too: keep local
         if (index != next_index_ || received_ + n > transfer_.length) {
             // A frame was lost: refuse now rather than let the host wait for its timeout.
             active_ = false;
@@ -220,7 +242,18 @@ private:
         ++next_index_;
         if (received_ < transfer_.length) return;
         active_ = false;
+        // A resend of the last batch must carry its bytes: the core compares sequence numbers only.
+        if (last_batch_.conflicts(transfer_.first_sequence, transfer_.count, buffer_, received_,
+                                  device_.last_accepted_sequence())) {
+            ++refused_;
+            const auto result = static_cast<std::uint8_t>(Status::kBadSequence);
+            return ack(kAckSpans, result, transfer_.first_sequence, send);
+        }
+        const std::uint32_t duplicates = device_.duplicates();
         const Status st = device_.accept_batch(transfer_.first_sequence, transfer_.count, buffer_, received_);
+        if (st == Status::kOk && device_.duplicates() == duplicates) {
+            last_batch_.remember(transfer_.first_sequence, transfer_.count, buffer_, received_);
+        }
         if (st != Status::kOk) ++refused_;
         ack(kAckSpans, static_cast<std::uint8_t>(st), transfer_.first_sequence, send);
     }
@@ -238,6 +271,7 @@ private:
     std::uint32_t refused_ = 0;
     bool bus_problem_ = false;
     std::uint8_t buffer_[kMaxTransferBytes] = {};
+    LastBatch<kMaxTransferBytes> last_batch_;  // the last batch queued, to compare resends with
 };
 
 }  // namespace pathstream::device::can

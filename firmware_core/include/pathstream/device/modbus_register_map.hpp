@@ -5,6 +5,7 @@
 
 #include <cstdint>
 
+#include "pathstream/device/last_batch.hpp"
 #include "pathstream/device/operator_commands.hpp"
 #include "pathstream/device/modbus_map.hpp"
 #include "pathstream/device/motion_device.hpp"
@@ -14,7 +15,9 @@ namespace pathstream::device {
 /// Serves MotionDevice<Axes, Capacity> as Modbus registers. Methods mirror a transport's
 /// register handler (hal::ModbusRegisterHandler): addresses and counts already checked for
 /// shape by the transport; the map decides meaning. Task context (the bus server), the same
-/// task that owns the device's producer side. No allocation; a 246-byte payload buffer inline.
+/// task that owns the device's producer side. No allocation; two 246-byte payload buffers
+/// inline (the batch being written and the last one queued: a resend is compared byte for
+/// byte, and one under the same sequence numbers with other bytes is refused).
 template <unsigned Axes, std::uint32_t Capacity>
 class ModbusRegisterMap {
 public:
@@ -235,12 +238,22 @@ private:
             e = Exception::kIllegalDataValue;
             return Status::kBadBatch;
         }
-        return device_.accept_batch(first, spans, payload_, bytes);
+        // The core acknowledges a resend of its last batch by sequence numbers alone; a
+        // different payload under those numbers is a master out of step, not a retry.
+        const std::uint32_t last = device_.last_accepted_sequence();
+        if (last_batch_.conflicts(first, spans, payload_, bytes, last)) return Status::kBadSequence;
+        const std::uint32_t duplicates = device_.duplicates();
+        const Status st = device_.accept_batch(first, spans, payload_, bytes);
+        if (st == Status::kOk && device_.duplicates() == duplicates) {
+            last_batch_.remember(first, spans, payload_, bytes);
+        }
+        return st;
     }
 
     MotionDevice<Axes, Capacity>& device_;
     OperatorCommands<Axes, Capacity> operator_;
     std::uint8_t payload_[2 * 123] = {};
+    LastBatch<sizeof payload_> last_batch_;
     std::uint16_t last_command_ = 0;
     std::uint16_t last_refusal_ = 0;
     std::uint16_t refusals_ = 0;

@@ -15,6 +15,9 @@ namespace pathstream::device {
 
 /// Highest tick rate the limit arithmetic is proven for (and a sane device accepts).
 inline constexpr std::uint32_t kMaxTickHz = 100000;
+/// Lowest tick rate a device accepts: the machine profile's lower bound too, so a device
+/// never runs a rate no profile can describe.
+inline constexpr std::uint32_t kMinTickHz = 10;
 
 /// Limits of one axis in LSB per second and LSB per second squared (both >= 1), and its
 /// travel (the work area's soft limits, LSB; the default is the whole position range).
@@ -29,7 +32,7 @@ struct AxisLimits {
 /// the device allows for when it brings the pen back onto the paper after a re-entry.
 template <unsigned Axes>
 struct MotionLimits {
-    std::uint32_t tick_hz = 0;  ///< 1..kMaxTickHz
+    std::uint32_t tick_hz = 0;  ///< kMinTickHz..kMaxTickHz
     AxisLimits axis[Axes] = {};
     /// Ticks from switching the pen output on to the pen touching (0..kMaxPenDownTicks): a
     /// re-entry onto a pen-down span switches the pen on this many ticks before it reaches
@@ -40,11 +43,11 @@ struct MotionLimits {
 /// Longest pen-down delay, in ticks: what one 16-bit Modbus register holds.
 inline constexpr std::uint32_t kMaxPenDownTicks = 65535;
 
-/// kOk when tick_hz is 1..kMaxTickHz, every limit is >= 1 and pen_down_ticks is at most
+/// kOk when tick_hz is kMinTickHz..kMaxTickHz, every limit is >= 1 and pen_down_ticks is at most
 /// kMaxPenDownTicks; kBadLimits otherwise. Cost: a loop over the axes. Any context.
 template <unsigned Axes>
 [[nodiscard]] Status check_limits(const MotionLimits<Axes>& limits) {
-    if (limits.tick_hz < 1 || limits.tick_hz > kMaxTickHz) return Status::kBadLimits;
+    if (limits.tick_hz < kMinTickHz || limits.tick_hz > kMaxTickHz) return Status::kBadLimits;
     if (limits.pen_down_ticks > kMaxPenDownTicks) return Status::kBadLimits;
     for (unsigned a = 0; a < Axes; ++a) {
         const AxisLimits& l = limits.axis[a];

@@ -18,7 +18,7 @@ namespace pathstream::hal {
 struct ModbusTcpEndpoint {
     std::string host = "127.0.0.1";  ///< address or name to bind; "0.0.0.0" / "::" for all
     std::uint16_t port = 0;          ///< 0 = an ephemeral port (read it back with port())
-    std::size_t max_clients = 4;     ///< connections kept at once; see ModbusServer
+    std::size_t max_clients = 16;    ///< connections kept at once; see ModbusServer
 };
 
 /// Settings common to both transports.
@@ -28,8 +28,9 @@ struct ModbusServerOptions {
     /// TCP: not used; every unit id is answered and echoed (the MBAP unit id addresses
     /// devices behind a gateway; this server is the device).
     int unit = 1;
-    /// Longest gap allowed inside one request before it is dropped as incomplete. Bounds
-    /// how long a half-sent frame can stall poll_once().
+    /// Longest gap allowed inside one request before it is dropped as incomplete. RTU: bounds
+    /// how long a half-sent frame can stall poll_once(). TCP: a connection whose frame stalls
+    /// longer is closed (nothing ever waits for it).
     std::chrono::milliseconds byte_timeout{100};
 };
 
@@ -57,10 +58,14 @@ struct ModbusServerCounters {
 /// serve_for() touches the handler and the descriptors; nothing runs in the background.
 /// counters() may be read from any thread. Not copyable; movable.
 ///
-/// TCP: up to max_clients connections at once, each answered in turn. A peer that closes or
-/// errors loses only its connection. When a new client arrives and all slots are taken,
-/// the connection idle the longest is closed for it, so a master reconnecting after a
-/// silent link loss (no FIN ever seen) always gets in.
+/// TCP: up to max_clients connections at once. Each connection's bytes are read without
+/// waiting into its own frame buffer (MBAP framing done here, libmodbus only frames replies),
+/// so a peer sending one byte at a time, or not reading its replies (non-blocking sends: it
+/// is closed), never holds the server or the ticks around poll_once(). A peer that closes or
+/// errors loses only its connection. When a new client arrives and all slots are taken, a
+/// connection that never completed a request is closed for it, else the one idle the longest:
+/// a streaming master keeps its slot against a connection flood, and a master reconnecting
+/// after a silent link loss (no FIN ever seen) still gets in.
 ///
 /// RTU: one serial line (a device path, or a pty this server creates for tests and
 /// simulators). A corrupt frame is counted and the input flushed; the master's retry finds
@@ -82,12 +87,13 @@ public:
     ModbusServer& operator=(ModbusServer&&) noexcept;
     ~ModbusServer();  ///< closes every descriptor; the handler is not called
 
-    /// Waits up to `max_wait` for activity (poll(2)), then accepts new TCP connections and
-    /// answers at most one request per connection (RTU: one request). Returns the number of
-    /// requests handled (answered, broadcast or refused with an exception). Worst-case
-    /// duration: max_wait + byte_timeout per ready connection (an incomplete frame) + handler
-    /// time. max_wait 0 = do not wait (check and return).
-    std::size_t poll_once(std::chrono::milliseconds max_wait);
+    /// Waits up to `max_wait` for activity (ppoll(2), microsecond resolution: an idle device
+    /// sleeps until its next tick), then accepts new TCP connections and answers at most one
+    /// request per connection (RTU: one request). Returns the number of requests handled
+    /// (answered, broadcast or refused with an exception). Worst-case duration: TCP, max_wait
+    /// + handler time per ready connection (reads never wait); RTU, max_wait + byte_timeout
+    /// (an incomplete frame) + handler time. max_wait 0 = do not wait (check and return).
+    std::size_t poll_once(std::chrono::microseconds max_wait);
 
     /// poll_once() repeatedly until `duration` has passed. Returns requests handled.
     std::size_t serve_for(std::chrono::milliseconds duration);

@@ -51,12 +51,13 @@ std::uint64_t run_paced_loop(const std::function<void()>& tick, const std::funct
                              const std::function<void(std::chrono::microseconds)>& serve,
                              const DeviceLoopOptions& options, const std::atomic<bool>& stop);
 
-/// Serves `server_poll` (a function polling the Modbus server for up to the given wait) and
+/// Serves `server_poll` (a function polling the Modbus server for up to the given wait, to the
+/// microsecond: an idle device sleeps until its next tick) and
 /// ticks `device` on the steady clock until `stop` becomes true or run_for passes. Ticks that
 /// fall due while a request is served run right after it (the count never drifts).
 /// Returns the ticks run.
 std::uint64_t run_device_loop(SimulatedModbusDevice& device,
-                              const std::function<void(std::chrono::milliseconds)>& server_poll,
+                              const std::function<void(std::chrono::microseconds)>& server_poll,
                               const DeviceLoopOptions& options, const std::atomic<bool>& stop);
 
 }  // namespace pathstream::sim

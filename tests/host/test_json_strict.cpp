@@ -1,0 +1,81 @@
+// Strict JSON: what nlohmann::json lets pass is refused with file:line:col, and locating
+// values costs a bounded number of passes over the document, however many there are.
+#include <catch2/catch.hpp>
+
+#include "pathstream/host/input_error.hpp"
+#include "pathstream/host/json_locate.hpp"
+#include "pathstream/host/json_path.hpp"
+
+using namespace pathstream::host;
+
+namespace {
+std::string error_of(const std::string& text) {
+    try {
+        parse_json_path(text, "t.json");
+    } catch (const InputError& e) {
+        return e.what();
+    }
+    return "no error";
+}
+
+// `count` subpaths of three points, one subpath a line: about 46 bytes each.
+std::string subpaths_document(std::size_t count) {
+    std::string text = "{\"subpaths\": [\n";
+    for (std::size_t i = 0; i < count; ++i) {
+        const std::string x = std::to_string(i % 1000);
+        text += "  {\"points\": [[" + x + ", 0], [" + x + ", 1], [" + x + ", 2]]}";
+        text += i + 1 < count ? ",\n" : "\n";
+    }
+    return text + "]}\n";
+}
+}  // namespace
+
+TEST_CASE("duplicate keys are errors", "[host][json]") {
+    CHECK(error_of("{\"points\": [[0, 0], [1, 1]],\n \"points\": [[0, 0], [2, 2]]}") ==
+          "t.json:2:2: duplicate key in one object");
+    // Escapes decode before comparing: "\u0062asis" is "basis".
+    CHECK(error_of("{\"subpaths\": [{\"basis\": \"bezier\", \"\\u0062asis\": \"polyline\", "
+                   "\"points\": [[0,0],[1,1]]}]}") == "t.json:1:35: duplicate key in one object");
+    // The same key in two objects is fine.
+    CHECK(error_of("{\"subpaths\": [{\"points\": [[0,0],[1,1]]}, {\"points\": [[0,0],[1,1]]}]}") ==
+          "no error");
+}
+
+TEST_CASE("bytes after the document are errors, after a NUL too", "[host][json]") {
+    CHECK(error_of(std::string("{\"points\": [[0, 0], [1, 1]]}\n\0{\"x\": 1}", 37)) ==
+          "t.json:2:1: invalid JSON: a NUL byte after the document");
+    CHECK(error_of("{\"points\": [[0, 0], [1, 1]]}  \n  x")
+              .rfind("t.json:2:3: invalid JSON: syntax error", 0) == 0);
+    CHECK(error_of("{\"points\": [[0, 0], [1, 1]]}\n\t \r\n") == "no error");
+    // A NUL inside the document ends it early: a syntax error where it sits.
+    CHECK(error_of(std::string("{\"points\": [[0, 0]\0, [1, 1]]}", 29))
+              .rfind("t.json:1:19: invalid JSON: syntax error", 0) == 0);
+}
+
+TEST_CASE("reading 20000 subpaths scans the text a bounded number of times", "[host][json]") {
+    const std::string text = subpaths_document(20000);
+    const std::size_t before = json_bytes_scanned();
+    const Path path = parse_json_path(text, "t.json");
+    const std::size_t scanned = json_bytes_scanned() - before;
+    REQUIRE(path.subpaths.size() == 20000);
+    CHECK(path.subpaths[19999].location.line == 20001);
+    CHECK(path.subpaths[19999].location.column == 3);
+    // Strictness checks and locations: one index, plus one for the checks; never one per subpath.
+    CHECK(scanned <= 4 * text.size());
+    CHECK(scanned >= text.size());
+}
+
+TEST_CASE("a JSON index finds values by pointer and bytes by line", "[host][json]") {
+    const JsonIndex index("{\"a/b\": [1, {\"~k\": \"v\"}],\n \"c\": {}}");
+    CHECK(index.locate("").column == 1);
+    CHECK(index.locate("/a~1b/1/~0k").column == 20);
+    CHECK(index.locate("/c").line == 2);
+    CHECK(index.locate("/c").column == 7);
+    CHECK(index.locate("/a~1b/2").line == 0);
+    CHECK(index.locate("/zz").line == 0);
+    CHECK(index.location_of(26).line == 2);
+    CHECK(index.location_of(26).column == 1);
+    CHECK(index.location_of(25).line == 1);
+    CHECK_FALSE(index.duplicate_key());
+    CHECK_FALSE(index.trailing_byte());
+}
