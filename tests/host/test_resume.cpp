@@ -442,6 +442,7 @@ TEST_CASE("ctl's link: status and every command over Modbus TCP, refusals by nam
     CHECK(link->command_with_arguments(device::kCommandJog, 5, 1, 0) ==
           Status::kControlValueOutOfRange);
     CHECK(link->command_with_arguments(device::kCommandSetPosition, 0, 77, 0) == Status::kOk);
+    dt.join();  // the recorded ticks are the device thread's until it stops
     check_steps_within_limits(*dt.device, job.machine);
 }
 
