@@ -22,6 +22,13 @@ using svg::Point;
 constexpr double kMaxCoordinateMm = 1e6;  // as the JSON reader: catches unit mix-ups
 constexpr double kDegenerateMm = 1e-9;    // pieces smaller than this are dropped
 constexpr std::size_t kMaxUses = 100000;  // <use> copies per document: stops exponential nesting
+// Elements nested within one another, <use> targets included: far beyond what drawing programs
+// write, and well within the stack (the walk recurses once per level).
+constexpr std::size_t kMaxDepth = 500;
+// Curve pieces a document may expand to: a base plus 16 per byte of the file, so that copies
+// (<use>) cannot turn a small file into unbounded geometry (about 200 bytes of memory a piece).
+constexpr std::size_t kPiecesBase = 250000;
+constexpr std::size_t kPiecesPerByte = 16;
 constexpr double kMmPerPx = 25.4 / 96.0;
 constexpr double kNoBase = std::numeric_limits<double>::quiet_NaN();
 constexpr std::size_t kNoLayer = static_cast<std::size_t>(-1);
@@ -478,7 +485,19 @@ private:
         return !n.attribute("requiredExtensions") && !n.attribute("systemLanguage");
     }
 
+    // Counts one level of nesting for the walk below it.
+    struct DepthGuard {
+        std::size_t& depth;
+        ~DepthGuard() { --depth; }
+    };
+
     void element(pugi::xml_node n, const State& parent) {
+        if (depth_ >= kMaxDepth) {
+            fail_at(n, nullptr, "elements nested more than " + std::to_string(kMaxDepth) +
+                                    " deep (the reader's limit)");
+        }
+        ++depth_;
+        const DepthGuard guard{depth_};
         const std::string name = svg_name(n);
         if (name.empty()) return;
         const Style st = style(n);
@@ -546,6 +565,11 @@ private:
         const char* const href_name = n.attribute("href") ? "href" : "xlink:href";
         const std::string href = trim(n.attribute(href_name).value());
         if (href.size() < 2 || href[0] != '#') return;
+        // Every copy counts, of nothing too: a reference to nothing costs a lookup.
+        if (++use_count_ > kMaxUses) {
+            fail_at(n, nullptr,
+                    "too many <use> copies (more than " + std::to_string(kMaxUses) + ")");
+        }
         const pugi::xml_node target = element_by_id(href.substr(1));
         if (!target) return;  // SVG: a reference to nothing draws nothing
         for (const pugi::xml_node& active : use_stack_) {
@@ -554,10 +578,6 @@ private:
                     n, href_name,
                     "<use> refers to " + href + ", which contains this <use> (circular reference)");
             }
-        }
-        if (++use_count_ > kMaxUses) {
-            fail_at(n, nullptr,
-                    "too many <use> copies (more than " + std::to_string(kMaxUses) + ")");
         }
         const double x = length(n, "x", parent.width, 0), y = length(n, "y", parent.height, 0);
         const Affine to_mm = parent.to_mm * own * Affine::translate(x, y);
@@ -667,7 +687,15 @@ private:
     // Maps pieces to mm and appends them as Bezier subpaths.
     void emit(const CubicSubpaths& subpaths, const State& state, SourceLocation at) {
         const Affine& to_mm = state.to_mm;
+        const std::size_t budget = kPiecesBase + kPiecesPerByte * text_.size();
         for (const auto& pieces : subpaths) {
+            pieces_ += pieces.size();
+            if (pieces_ > budget) {
+                throw InputError(file_, at,
+                                 "the drawing expands to more than " + std::to_string(budget) +
+                                     " curve pieces (the reader's limit for a file of " +
+                                     std::to_string(text_.size()) + " bytes; <use> copies count)");
+            }
             Subpath sp;
             sp.basis = PathBasis::kBezier;
             sp.closed = false;
@@ -715,6 +743,8 @@ private:
     bool ids_built_ = false;
     std::vector<pugi::xml_node> use_stack_;  // targets of the <use> elements being drawn
     std::size_t use_count_ = 0;
+    std::size_t depth_ = 0;   // elements being walked, nested
+    std::size_t pieces_ = 0;  // curve pieces emitted so far
     svg::StyleSheet sheet_;
     std::vector<std::string> strokes_;  // parallel to path_.subpaths
     std::vector<std::size_t> subpath_layers_;  // parallel to path_.subpaths: index in layers_
