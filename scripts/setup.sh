@@ -6,6 +6,8 @@ set -euo pipefail
 packages=(
   # host toolchain and test framework
   build-essential cmake ninja-build pkg-config catch2
+  # fuzz targets: clang with its libFuzzer runtime (scripts/test.sh preset fuzz)
+  clang libclang-rt-14-dev
   # host libraries (CLI, data, math baseline for the bench)
   libcli11-dev nlohmann-json3-dev libeigen3-dev libpugixml-dev
   # Cortex-M proof: cross toolchain, C++ headers, emulator with TCG plugin support

@@ -3,6 +3,8 @@
 #   default  release build with the Cortex-M images under qemu and the real-kernel VM tests
 #   asan     AddressSanitizer + UBSan build of the host tests
 #   tsan     ThreadSanitizer build of the test cases that run threads (Catch2 tag [threads])
+#   fuzz     the libFuzzer targets (clang, ASan + UBSan), each run PATHSTREAM_FUZZ_SECONDS
+#            (default 5) from its seed corpus by fuzz/run.sh (docs/fuzzing.md)
 # Every preset runs even when an earlier one failed; a summary of all of them comes last, and
 # the exit status is non-zero when any failed. When one to three tests of a preset fail, each
 # is run once more alone; one that then passes is named FLAKY in the summary (and does not
@@ -14,7 +16,7 @@
 set -uo pipefail
 cd "$(dirname "$0")/.."
 
-all_presets=(default asan tsan)
+all_presets=(default asan tsan fuzz)
 if [ "${1:-}" = "--quick" ]; then
   presets=(default)
 elif [ $# -gt 0 ]; then
@@ -37,6 +39,18 @@ start_all=$SECONDS
 for p in "${presets[@]}"; do
   echo "=== test.sh: preset $p: configure, build, test ==="
   t0=$SECONDS
+  if [ "$p" = fuzz ]; then
+    # No ctest here: each target runs for a bounded time; fuzz/run.sh prints one line each.
+    { cmake --preset fuzz && cmake --build --preset fuzz &&
+        fuzz/run.sh "${PATHSTREAM_FUZZ_SECONDS:-5}" build/fuzz; } 2>&1 | tee "build/$p.log"
+    status[$p]=${PIPESTATUS[0]}
+    seconds[$p]=$((SECONDS - t0))
+    total[$p]=$(grep -c '^fuzz_[a-z0-9_]*: ' "build/$p.log")
+    failed[$p]=$(grep -c '^fuzz_[a-z0-9_]*: \(FAILED\|not built\)' "build/$p.log")
+    passed[$p]=$((total[$p] - failed[$p]))
+    flaky[$p]=""
+    continue
+  fi
   cmake --workflow --preset "$p" 2>&1 | tee "build/$p.log"
   status[$p]=${PIPESTATUS[0]}
   seconds[$p]=$((SECONDS - t0))
