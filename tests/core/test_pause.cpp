@@ -39,6 +39,14 @@ std::vector<WireSpan> two_moves(const Lsb (&start)[kAxes], std::size_t& first_mo
     return spans;
 }
 
+// Ticks the device until it rests at a pause (at most 5000 ticks).
+void tick_until_paused(Device& d) {
+    for (int i = 0; i < 5000 && !d.paused(); ++i) {
+        Lsb p[kAxes];
+        d.tick(p);
+    }
+}
+
 }  // namespace
 
 TEST_CASE("pause: the device holds at the marked span's end, pen up, until resumed", "[device][pause]") {
@@ -91,10 +99,7 @@ TEST_CASE("pause: a stop at a pause drops the rest and clears the pause", "[devi
     const std::vector<WireSpan> spans = two_moves(start, first);
     REQUIRE(send_all(d, spans) == Status::kOk);
     REQUIRE(d.command(Command::kStart) == Status::kOk);
-    for (int i = 0; i < 5000 && !d.paused(); ++i) {
-        Lsb p[kAxes];
-        d.tick(p);
-    }
+    tick_until_paused(d);
     REQUIRE(d.paused());
     REQUIRE(d.command(Command::kStop) == Status::kOk);
     Lsb p[kAxes];
@@ -135,10 +140,7 @@ TEST_CASE("pause: the paused flag on Modbus (register 35 bit 6) and CAN (status 
     REQUIRE(send_all(d, spans) == Status::kOk);
     REQUIRE(d.command(Command::kStart) == Status::kOk);
     CHECK(flags() == std::make_pair(0, 0));
-    for (int i = 0; i < 5000 && !d.paused(); ++i) {
-        Lsb p[kAxes];
-        d.tick(p);
-    }
+    tick_until_paused(d);
     REQUIRE(d.paused());
     CHECK(flags() == std::make_pair(int{modbus::flags::kPaused}, int{can::kFlagPaused}));
     REQUIRE(d.command(Command::kResume) == Status::kOk);

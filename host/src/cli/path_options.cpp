@@ -4,6 +4,7 @@
 #include <charconv>
 #include <cctype>
 #include <cmath>
+#include <fstream>
 #include <iostream>
 #include <sstream>
 #include <stdexcept>
@@ -125,12 +126,10 @@ GcodeOptions gcode_options(const PathOptions& o) {
     return g;
 }
 
-/// A G-code program from the file, or from `text` when given: its warnings printed, its pen
-/// mode noted in `gcode_pen`.
-Path read_gcode(const PathOptions& o, const std::string* text, std::string& gcode_pen) {
+/// A G-code program's path: its warnings printed, its pen mode noted in `gcode_pen`.
+Path read_gcode(const PathOptions& o, const std::string& text, std::string& gcode_pen) {
     GcodeReadInfo info;
-    Path path = text != nullptr ? parse_gcode_path(*text, path_display_name(o.file), gcode_options(o), &info)
-                                : load_gcode_path(o.file, gcode_options(o), &info);
+    Path path = parse_gcode_path(text, path_display_name(o.file), gcode_options(o), &info);
     for (const std::string& warning : info.warnings) std::cerr << "pathstream: warning: " << warning << '\n';
     gcode_pen = std::string(pen_control_name(info.pen)) + " (" + info.pen_reason + ")";
     return path;
@@ -190,33 +189,43 @@ std::string sniff_format(const std::string& text) {
     return "gcode";
 }
 
-// The path on standard input, named "<stdin>" in messages.
-Path read_stdin_path(const PathOptions& o, std::string& gcode_pen) {
+// The whole file, or standard input for "-".
+std::string read_input(const std::string& file) {
     std::ostringstream buffer;
-    buffer << std::cin.rdbuf();
-    const std::string text = buffer.str();
-    const std::string name = path_display_name("-");
-    const std::string format = o.format.empty() ? sniff_format(text) : o.format;
+    if (file == "-") {
+        buffer << std::cin.rdbuf();
+        return buffer.str();
+    }
+    std::ifstream in(file, std::ios::binary);
+    if (!in) throw InputError(file, {}, "cannot open file");
+    buffer << in.rdbuf();
+    if (in.bad()) throw InputError(file, {}, "cannot read file");
+    return buffer.str();
+}
+
+// A file's format: --format, else its extension (standard input: --format or "").
+std::string file_format(const PathOptions& o) {
+    if (!o.format.empty() || o.file == "-") return o.format;
+    const std::size_t dot = o.file.find_last_of('.');
+    std::string ext = o.file.substr(dot == std::string::npos ? o.file.size() : dot);
+    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+    if (ext == ".json" || ext == ".svg" || ext == ".csv") return ext.substr(1);
+    if (ext == ".gcode" || ext == ".ngc" || ext == ".nc" || ext == ".gc") return "gcode";
+    throw InputError(
+        o.file, {},
+        "unknown file type \"" + ext + "\" (expected .json, .csv, .svg, .gcode, .ngc, .nc or .gc)");
+}
+
+Path read_path(const PathOptions& o, std::string& gcode_pen) {
+    std::string format = file_format(o);  // an unknown extension is refused before reading
+    const std::string text = read_input(o.file);
+    const std::string name = path_display_name(o.file);
+    if (format.empty()) format = sniff_format(text);
     if (format.empty()) throw InputError(name, {}, "standard input is empty: no path to read");
     if (format == "json") return parse_json_path(text, name, o.tolerance);
     if (format == "svg") return parse_svg_path(text, name, o.tolerance);
     if (format == "csv") return parse_csv_path(text, name, basis_from_name(o.csv_basis), o.csv_closed);
-    return read_gcode(o, &text, gcode_pen);
-}
-
-Path read_path(const PathOptions& o, std::string& gcode_pen) {
-    if (o.file == "-") return read_stdin_path(o, gcode_pen);
-    std::string ext = !o.format.empty() ? "." + o.format
-                      : o.file.substr(o.file.find_last_of('.') == std::string::npos ? o.file.size()
-                                                                                   : o.file.find_last_of('.'));
-    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
-    if (ext == ".json") return load_json_path(o.file, o.tolerance);
-    if (ext == ".svg") return load_svg_path(o.file, o.tolerance);
-    if (ext == ".csv") return load_csv_path(o.file, basis_from_name(o.csv_basis), o.csv_closed);
-    if (ext == ".gcode" || ext == ".ngc" || ext == ".nc" || ext == ".gc") return read_gcode(o, nullptr, gcode_pen);
-    throw InputError(
-        o.file, {},
-        "unknown file type \"" + ext + "\" (expected .json, .csv, .svg, .gcode, .ngc, .nc or .gc)");
+    return read_gcode(o, text, gcode_pen);
 }
 }  // namespace
 
