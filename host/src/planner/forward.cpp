@@ -47,6 +47,13 @@ public:
         out.start = k;
         arrival_ = Arrival{};
         if (piece_.first == piece_.last || !(end_lambda_ - k.lambda > 1e-12)) return out;
+        // A piece no longer than the chord tolerance (a cusp's tip, a loop of a few LSB, points
+        // an LSB apart) is below what speed caps and spans of whole ticks can resolve: one span
+        // from rest to rest along its chord stays within the tolerance of it.
+        if (end_lambda_ - k.lambda <= delta_) {
+            if (const std::uint32_t m = creep_ticks(k.q); m > 0) out.spans.push_back({m, end_knot()});
+            return out;
+        }
         const auto advance = [&](const MotionSpan& s) {
             out.spans.push_back(s);
             arrival_ = Arrival{k, s.ticks};
@@ -93,6 +100,21 @@ public:
     }
 
 private:
+    /// Ticks of the rest-to-rest span from q to the end (zero tangents: peak acceleration
+    /// 6 d / tau^2 and peak velocity 1.5 d / tau per axis), the fewest within the limits and the
+    /// feed; 0 when q is the end already.
+    std::uint32_t creep_ticks(const Vec& q) const {
+        double tau = 0, d2 = 0;
+        for (std::size_t i = 0; i < axes_; ++i) {
+            const double d = std::fabs(end_q_[i] - q[i]);
+            d2 += d * d;
+            tau = std::max({tau, std::sqrt(6 * d / acc_[i]), 1.5 * d / vel_[i]});
+        }
+        if (!(d2 > 0)) return 0;
+        tau = std::max(tau, 1.5 * std::sqrt(d2) / feed_);
+        return static_cast<std::uint32_t>(std::clamp(std::ceil(tau / tick_ - 1e-9), 1.0, 65536.0));
+    }
+
     /// A point as a span carries it: on the LSB grid, rounded as the emitter rounds it.
     Vec grid_point(const Vec& q) const { return on_lsb_grid(q, lsb_, axes_); }
 
@@ -393,9 +415,14 @@ private:
             if (i + 1 <= piece_.last) kappa = std::max(kappa, norm(g_.curvature[i + 1]));
             corner = corner || norm(g_.corner_jump[i]) > 0;
         }
-        if (!corner && len * len * kappa / 8 < delta_ / 64) return 0;
         const Vec chord = sub(end.q, k.q);
         const double c2 = dot(chord, chord);
+        // A Hermite cubic stays between its ends only while its tangents are at most three
+        // chords long: a span from rest with a far faster end velocity (an end point pulled
+        // back by an axis with little acceleration) swings out behind its start.
+        const double tangent_reach = std::max(norm(v0), norm(end.v)) * tau;
+        const bool swings = tangent_reach * tangent_reach > 9 * c2;
+        if (!corner && !swings && len * len * kappa / 8 < delta_ / 64) return 0;
         double worst = 0;
         std::size_t h = hint_;
         for (int s = 1; s < 6; ++s) {
@@ -405,10 +432,15 @@ private:
             for (std::size_t i = 0; i < axes_; ++i) {
                 x[i] = h00 * k.q[i] + h10 * v0[i] * tau + h01 * end.q[i] + h11 * end.v[i] * tau;
             }
-            const double along = c2 > 0 ? std::clamp(dot(sub(x, k.q), chord) / c2, 0.0, 1.0) : w;
+            const double raw = c2 > 0 ? dot(sub(x, k.q), chord) / c2 : w;
+            const double along = std::clamp(raw, 0.0, 1.0);
             const PathAt p = path_at(pg_, piece_, k.lambda + along * len, h);
             const Vec off = sub(x, p.q);
-            worst = std::max(worst, norm(sub(off, scaled(p.t, dot(off, p.t)))));
+            // Beyond either end of the chord the cubic has left the span's stretch of path
+            // (backwards, or past its end): the whole distance counts, not only the part
+            // across the path.
+            const bool outside = raw < 0 || raw > 1;
+            worst = std::max(worst, outside ? norm(off) : norm(sub(off, scaled(p.t, dot(off, p.t)))));
         }
         return worst;
     }

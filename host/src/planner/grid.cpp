@@ -83,6 +83,15 @@ std::vector<double> segment_nodes(const Cubic& c, double length, const PlanOptio
         }
         out.push_back(b);
     }
+    // A cusp exactly on a node (q' vanishes there, as where a Bezier handle doubles back on a
+    // straight line) leaves both neighbouring intervals without a turn, because each end's
+    // tangent is taken on the interval's own side: compare the two sides at the node.
+    for (std::size_t i = 1; i + 1 < out.size(); ++i) {
+        if (norm(c.d1(out[i])) > 1e-9 * size) continue;
+        if (angle_between(unit_tangent(c, out[i], size, -1), unit_tangent(c, out[i], size, +1)) > 0.5 * kPi) {
+            cusps.push_back(out[i]);
+        }
+    }
     return out;
 }
 

@@ -1,0 +1,241 @@
+// Every path the readers accept must plan: seeded random curves of every basis built to be
+// hard — cusps, near-cusps (points one LSB apart or closer), repeated points, tiny loops,
+// hairpins and random walks that turn back on themselves — on the pen plotter's profile and
+// on random ones. None may fail, and every plan passes the exact per-tick check.
+//
+// Size: PATHSTREAM_HARD_PATH_CASES (default 60) cases from seed PATHSTREAM_HARD_PATH_SEED
+// (default 1); e.g. PATHSTREAM_HARD_PATH_CASES=5000 for a long run.
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <random>
+#include <string>
+
+#include "pathstream/host/geometry.hpp"
+#include "pathstream/host/planner.hpp"
+
+using namespace pathstream::host;
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+/// The pen plotter's profile (examples/machines/pen_plotter.json).
+MachineProfile pen_plotter() {
+    MachineProfile p;
+    p.axes.push_back({"x", 250, 3000});
+    p.axes.push_back({"y", 250, 3000});
+    p.feed = 80;
+    p.travel_feed = 200;
+    p.pen_down_delay = 0.08;
+    p.pen_up_delay = 0.06;
+    return p;
+}
+
+/// Draws the hard shapes: every generator returns points for `basis` (Bezier chains get
+/// 3k + 1 points) in a box of about `size` mm, with features down to `lsb`.
+class HardShapes {
+public:
+    HardShapes(std::uint64_t seed, double lsb) : rng_(seed), lsb_(lsb) {}
+
+    Subpath next(PathBasis basis) {
+        Subpath s;
+        s.basis = basis;
+        const int kind = static_cast<int>(rng_() % 5);
+        switch (kind) {
+            case 0: hairpins(s.points); break;
+            case 1: repeated(s.points); break;
+            case 2: tiny_loops(s.points); break;
+            case 3: turning_walk(s.points); break;
+            default: mixed(s.points); break;
+        }
+        if (basis == PathBasis::kBezier) {
+            while (s.points.size() % 3 != 1) s.points.push_back(s.points.back());
+        }
+        if (s.points.size() < 2) s.points.push_back(near(s.points.back(), 1));
+        kind_ = kind;
+        return s;
+    }
+    int last_kind() const { return kind_; }
+
+private:
+    double pick(double lo, double hi) { return std::uniform_real_distribution<double>(lo, hi)(rng_); }
+    /// A point `lsbs` LSB away from p in a random direction (0: p itself).
+    PathPoint near(const PathPoint& p, double lsbs) {
+        const double a = pick(0, 2 * kPi);
+        return {p[0] + lsbs * lsb_ * std::cos(a), p[1] + lsbs * lsb_ * std::sin(a)};
+    }
+    PathPoint random_point(double size) { return {pick(0, size), pick(0, size)}; }
+
+    /// Out and back: A, B, A' with A' within 0 to 2 LSB of A (the cusp), chained.
+    void hairpins(std::vector<PathPoint>& out) {
+        out.push_back(random_point(40));
+        const int n = 1 + static_cast<int>(rng_() % 4);
+        for (int i = 0; i < n; ++i) {
+            const PathPoint a = out.back();
+            const double len = std::exp(pick(std::log(0.005), std::log(5.0)));
+            const double dir = pick(0, 2 * kPi);
+            out.push_back({a[0] + len * std::cos(dir), a[1] + len * std::sin(dir)});
+            const double back = static_cast<double>(rng_() % 4) * 0.5;  // 0, 0.5, 1, 1.5 LSB
+            out.push_back(near(out[out.size() - 2], back));
+            if (rng_() % 2 == 0) out.push_back(random_point(40));
+        }
+    }
+    /// Points repeated two to four times among ordinary ones.
+    void repeated(std::vector<PathPoint>& out) {
+        const int n = 3 + static_cast<int>(rng_() % 6);
+        for (int i = 0; i < n; ++i) {
+            const PathPoint p = random_point(30);
+            const int copies = 1 + static_cast<int>(rng_() % 4);
+            for (int c = 0; c < copies; ++c) out.push_back(rng_() % 3 == 0 ? near(p, 0.5) : p);
+        }
+    }
+    /// Loops a few LSB to a few tenths of a millimetre across on a straight run.
+    void tiny_loops(std::vector<PathPoint>& out) {
+        PathPoint p = random_point(30);
+        out.push_back(p);
+        const int loops = 1 + static_cast<int>(rng_() % 3);
+        for (int l = 0; l < loops; ++l) {
+            p = {p[0] + pick(0.5, 5), p[1] + pick(-1, 1)};
+            out.push_back(p);
+            const double r = std::exp(pick(std::log(lsb_), std::log(0.3)));
+            const int k = 4 + static_cast<int>(rng_() % 5);
+            for (int i = 1; i <= k; ++i) {
+                const double a = 2 * kPi * i / k;
+                out.push_back({p[0] + r * std::sin(a), p[1] + r * (1 - std::cos(a))});
+            }
+        }
+        out.push_back({p[0] + pick(0.5, 5), p[1] + pick(-1, 1)});
+    }
+    /// A random walk whose every step turns back by 150 to 180 degrees.
+    void turning_walk(std::vector<PathPoint>& out) {
+        out.push_back(random_point(40));
+        double dir = pick(0, 2 * kPi);
+        const int n = 5 + static_cast<int>(rng_() % 20);
+        const double step = std::exp(pick(std::log(0.01), std::log(3.0)));
+        for (int i = 0; i < n; ++i) {
+            dir += kPi + pick(-0.5, 0.5);
+            const double len = step * pick(0.5, 1.5);
+            const PathPoint& a = out.back();
+            out.push_back({a[0] + len * std::cos(dir), a[1] + len * std::sin(dir)});
+        }
+    }
+    void mixed(std::vector<PathPoint>& out) {
+        hairpins(out);
+        repeated(out);
+        turning_walk(out);
+    }
+
+    std::mt19937_64 rng_;
+    double lsb_;
+    int kind_ = 0;
+};
+
+/// Writes a failing case as a path file and a profile (PATHSTREAM_HARD_PATH_DUMP set):
+/// hard_path_C.json and hard_profile_C.json in the working directory, for `pathstream plan`.
+void dump(const Path& path, const MachineProfile& p, int c) {
+    std::ofstream f("hard_path_" + std::to_string(c) + ".json");
+    f.precision(17);
+    const char* names[] = {"bspline", "catmull-rom", "bezier", "polyline"};
+    f << "{\"units\":\"mm\",\"subpaths\":[";
+    for (std::size_t s = 0; s < path.subpaths.size(); ++s) {
+        const Subpath& sp = path.subpaths[s];
+        f << (s ? "," : "") << "{\"basis\":\"" << names[static_cast<int>(sp.basis)] << "\",\"closed\":"
+          << (sp.closed ? "true" : "false") << ",\"points\":[";
+        for (std::size_t i = 0; i < sp.points.size(); ++i) {
+            f << (i ? "," : "") << "[" << sp.points[i][0] << "," << sp.points[i][1] << "]";
+        }
+        f << "]}";
+    }
+    f << "]}\n";
+    std::ofstream m("hard_profile_" + std::to_string(c) + ".json");
+    m.precision(17);
+    m << "{\"axes\":[";
+    for (std::size_t i = 0; i < p.axes.size(); ++i) {
+        m << (i ? "," : "") << "{\"name\":\"" << p.axes[i].name << "\",\"max_velocity\":" << p.axes[i].max_velocity
+          << ",\"max_acceleration\":" << p.axes[i].max_acceleration << "}";
+    }
+    m << "],\"tick_hz\":" << p.tick_hz << ",\"ticks_per_span\":" << p.ticks_per_span << ",\"mm_per_lsb\":"
+      << p.mm_per_lsb << ",\"chord_tolerance\":" << p.chord_tolerance << ",\"feed\":" << p.feed
+      << ",\"travel_feed\":" << p.travel_feed << ",\"pen_down_delay\":" << p.pen_down_delay
+      << ",\"pen_up_delay\":" << p.pen_up_delay << "}\n";
+}
+
+}  // namespace
+
+TEST_CASE("every accepted path plans: cusps, near-cusps, repeated points, tiny loops, hairpins",
+          "[planner][property]") {
+    const char* env_cases = std::getenv("PATHSTREAM_HARD_PATH_CASES");
+    const char* env_seed = std::getenv("PATHSTREAM_HARD_PATH_SEED");
+    const int cases = env_cases != nullptr ? std::atoi(env_cases) : 60;
+    const unsigned long seed = env_seed != nullptr ? std::strtoul(env_seed, nullptr, 10) : 1;
+    std::mt19937_64 rng(seed);
+    const auto log_pick = [&](double lo, double hi) {
+        return std::exp(std::uniform_real_distribution<double>(std::log(lo), std::log(hi))(rng));
+    };
+    int failures = 0;
+    for (int c = 0; c < cases; ++c) {
+        MachineProfile p = pen_plotter();
+        if (c % 3 == 2) {  // a random profile every third case
+            for (auto& a : p.axes) {
+                a.max_velocity = log_pick(20, 500);
+                a.max_acceleration = log_pick(200, 20000);
+            }
+            p.tick_hz = log_pick(250, 8000);
+            p.ticks_per_span = static_cast<std::uint32_t>(log_pick(1, 40));
+            p.mm_per_lsb = log_pick(1e-4, 5e-3);
+            p.chord_tolerance = std::max(log_pick(0.002, 0.05), p.mm_per_lsb);
+        }
+        HardShapes shapes(rng(), p.mm_per_lsb);
+        Path path;
+        path.axes = 2;
+        const int subpaths = 1 + static_cast<int>(rng() % 2);
+        std::string kinds;
+        for (int s = 0; s < subpaths; ++s) {
+            const auto basis = static_cast<PathBasis>(rng() % 4);
+            Subpath sp = shapes.next(basis);
+            sp.closed = basis != PathBasis::kBezier && rng() % 4 == 0 && sp.points.size() >= 3;
+            kinds += std::to_string(static_cast<int>(basis)) + "/" + std::to_string(shapes.last_kind()) + " ";
+            path.subpaths.push_back(std::move(sp));
+        }
+        INFO("case " << c << " seed " << seed << " (basis/shape: " << kinds << "): tick_hz " << p.tick_hz
+                     << ", ticks_per_span " << p.ticks_per_span << ", lsb " << p.mm_per_lsb);
+        try {
+            const auto segs = to_bezier_segments(path);
+            const Plan plan = plan_path(segs, p);
+            const PlanCheck check = check_plan(plan, segs, p);
+            CHECK(check.within_limits);
+            CHECK_FALSE(check.drawing_while_pen_moves);
+            CHECK(check.max_feed_fraction <= 1.0);
+            CHECK(check.max_deviation <= p.chord_tolerance + 1.5 * std::sqrt(2.0) * p.mm_per_lsb);
+            CHECK(check.ticks_checked == plan.total_ticks + 1);
+            if (!check.within_limits || check.max_deviation > p.chord_tolerance + 1.5 * std::sqrt(2.0) * p.mm_per_lsb) {
+                if (std::getenv("PATHSTREAM_HARD_PATH_DUMP") != nullptr) dump(path, p, c);
+            }
+        } catch (const PlanError& e) {
+            if (std::getenv("PATHSTREAM_HARD_PATH_DUMP") != nullptr) dump(path, p, c);
+            ++failures;
+            FAIL_CHECK("planning failed: " << e.what());
+        }
+    }
+    CHECK(failures == 0);
+}
+
+TEST_CASE("the cusp of a B-spline that turns back by one LSB plans", "[planner]") {
+    // Points two apart differ by one LSB: the curve stops at the turn and goes back.
+    Path path;
+    path.axes = 2;
+    Subpath s;
+    s.points = {{14.111, 196.545}, {12.675, 196.111}, {11.209, 195.794}, {9.752, 195.439},
+                {11.209, 195.795}, {12.637, 195.336}, {14.108, 195.044}};
+    path.subpaths.push_back(s);
+    const MachineProfile p = pen_plotter();
+    const auto segs = to_bezier_segments(path);
+    Plan plan;
+    REQUIRE_NOTHROW(plan = plan_path(segs, p));
+    const PlanCheck check = check_plan(plan, segs, p);
+    CHECK(check.within_limits);
+    CHECK(check.max_deviation <= p.chord_tolerance + 1.5 * std::sqrt(2.0) * p.mm_per_lsb);
+}
