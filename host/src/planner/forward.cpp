@@ -39,7 +39,7 @@ public:
         end_q_ = grid_point(g_.q[piece.last]);
     }
 
-    PieceMotion run(const Vec& start_q, const PieceMotion* resume, double resume_lambda, bool short_spans) {
+    PieceMotion run(const Vec& start_q, PieceMotion* resume, double resume_lambda, bool short_spans) {
         PieceMotion out;
         Knot k;
         k.lambda = g_.lambda[piece_.first];
@@ -59,10 +59,19 @@ public:
             arrival_ = Arrival{k, s.ticks};
             k = s.end;
         };
-        if (resume != nullptr) {  // keep the knots (and the spans ending there) before resume_lambda
-            for (const MotionSpan& s : resume->spans) {
-                if (!(s.end.lambda < resume_lambda) || s.end.lambda >= end_lambda_) break;
-                advance(s);
+        if (resume != nullptr) {
+            // Keep the knots (and the spans ending there) before resume_lambda: the attempt's
+            // spans are taken over and cut, not copied, so a retry costs what it replans.
+            std::vector<MotionSpan>& kept = resume->spans;
+            const auto cut = std::partition_point(kept.begin(), kept.end(), [&](const MotionSpan& s) {
+                return s.end.lambda < resume_lambda && s.end.lambda < end_lambda_;
+            });
+            kept.erase(cut, kept.end());
+            out.spans = std::move(kept);
+            if (!out.spans.empty()) {
+                const std::size_t n = out.spans.size();
+                arrival_ = Arrival{n >= 2 ? out.spans[n - 2].end : out.start, out.spans[n - 1].ticks};
+                k = out.spans[n - 1].end;
             }
         }
         const std::size_t limit = 50'000'000;
@@ -731,7 +740,7 @@ private:
 PieceMotion forward_pass(const PathGrid& g, const Piece& piece, const Limits& limits,
                          const std::vector<double>& caps, const std::vector<double>& beta,
                          const MachineProfile& profile, const PlanOptions& options, const Vec& start_q,
-                         const PieceMotion* resume, double resume_lambda, bool short_spans) {
+                         PieceMotion* resume, double resume_lambda, bool short_spans) {
     PieceTimer timer(g, piece, limits, caps, beta, profile, options);
     return timer.run(start_q, resume, resume_lambda, short_spans);
 }

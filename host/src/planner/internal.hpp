@@ -243,13 +243,14 @@ struct PieceMotion {
 /// Knots are on the LSB grid and their velocities rounded as the emitter rounds tangents, so
 /// that what is checked is exactly what the device runs; `start_q` is where the previous piece
 /// ended (on the grid).
-/// `resume` (optional): a previous attempt whose knots before `resume_lambda` are kept.
+/// `resume` (optional): a previous attempt whose knots before `resume_lambda` are kept (its
+/// spans are moved into the result and cut there).
 /// `short_spans`: allow spans shorter than ticks_per_span where a full one cannot be found
 /// (the last resort: their tangents are rounded on a different scale).
 PieceMotion forward_pass(const PathGrid& g, const Piece& piece, const Limits& limits,
                          const std::vector<double>& caps, const std::vector<double>& beta,
                          const MachineProfile& profile, const PlanOptions& options, const Vec& start_q,
-                         const PieceMotion* resume = nullptr, double resume_lambda = 0,
+                         PieceMotion* resume = nullptr, double resume_lambda = 0,
                          bool short_spans = false);
 
 /// A point on the LSB grid (mm), rounded as the emitter rounds span end points.
@@ -276,8 +277,27 @@ public:
     bool empty() const { return segs_.empty(); }
 
 private:
-    double segment_distance(std::size_t i, const Vec& p) const;
+    /// Distance from p to segment i when it is below `bound` (mm), else a value >= bound;
+    /// `at` (optional) gets the parameter of the nearest point when one below bound is found.
+    double segment_distance(std::size_t i, const Vec& p, double bound, double* at = nullptr) const;
     double box_distance(std::size_t i, const Vec& p) const;
+    /// Builds the bounding-box tree over segments order_[first, last) and returns its node.
+    std::size_t build_tree(std::size_t first, std::size_t last);
+    /// Every segment whose box is nearer than `best` goes to `consider` (which lowers best):
+    /// the tree's boxes are pruned against the best distance so far, O(log n) for a point near
+    /// the path instead of a scan of every segment.
+    template <typename Consider>
+    void search_tree(const Vec& p, double& best, Consider&& consider) const;
+
+    /// A node of the bounding-box tree: a leaf holds order_[first, last), an inner node its
+    /// two children.
+    struct TreeNode {
+        Vec lo{}, hi{};
+        std::size_t first = 0, last = 0;
+        std::size_t left = 0, right = 0;  ///< children (both 0 for a leaf)
+    };
+    std::vector<TreeNode> tree_;
+    std::vector<std::size_t> order_;
 
     std::vector<Cubic> segs_;
     std::vector<std::size_t> index_;
@@ -288,6 +308,7 @@ private:
     std::size_t cursor_ = 0;
     Vec last_p_{};
     double last_d_ = 0;
+    double last_u_ = 0;  ///< parameter of the last answer on segment cursor_
     bool started_ = false;
 };
 

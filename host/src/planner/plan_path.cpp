@@ -187,7 +187,7 @@ Plan plan_path(const std::vector<BezierSegment>& segments, const MachineProfile&
                     backward_pass(pg, piece, limits, factor, options.lookahead_margin, caps, span_time, dip, beta,
                                   to + 1, from);
                 const bool short_spans = retry >= 2 * options.max_local_retries / 3;
-                const PieceMotion previous = std::move(motion[p]);
+                PieceMotion previous = std::move(motion[p]);
                 // Knots in the interval ending at the first changed node interpolate its beta:
                 // resume before that interval.
                 const std::size_t keep = changed > piece.first ? changed - 1 : piece.first;

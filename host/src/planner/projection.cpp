@@ -21,6 +21,12 @@ PathProjector::PathProjector(std::vector<Cubic> segments, std::vector<std::size_
         lo_.push_back(lo);
         hi_.push_back(hi);
     }
+    order_.resize(segs_.size());
+    for (std::size_t i = 0; i < order_.size(); ++i) order_[i] = i;
+    if (!segs_.empty()) {
+        tree_.reserve(2 * segs_.size() / 4 + 2);
+        build_tree(0, segs_.size());
+    }
     // Runs of segments that join end to start; a closed run (ending where it starts) wraps
     // around in the search window.
     run_first_.resize(segs_.size());
@@ -33,6 +39,73 @@ PathProjector::PathProjector(std::vector<Cubic> segments, std::vector<std::size_
             run_last_[k] = e;
         }
         i = e + 1;
+    }
+}
+
+std::size_t PathProjector::build_tree(std::size_t first, std::size_t last) {
+    const std::size_t id = tree_.size();
+    tree_.push_back({});
+    Vec lo = lo_[order_[first]], hi = hi_[order_[first]];
+    for (std::size_t k = first; k < last; ++k) {
+        for (std::size_t a = 0; a < kAxesMax; ++a) {
+            lo[a] = std::min(lo[a], lo_[order_[k]][a]);
+            hi[a] = std::max(hi[a], hi_[order_[k]][a]);
+        }
+    }
+    tree_[id].lo = lo;
+    tree_[id].hi = hi;
+    tree_[id].first = first;
+    tree_[id].last = last;
+    if (last - first <= 4) return id;
+    // Median split along the widest axis of the box centres.
+    std::size_t axis = 0;
+    for (std::size_t a = 1; a < kAxesMax; ++a) {
+        if (hi[a] - lo[a] > hi[axis] - lo[axis]) axis = a;
+    }
+    const std::size_t mid = first + (last - first) / 2;
+    const auto centre = [&](std::size_t i) { return lo_[i][axis] + hi_[i][axis]; };
+    std::nth_element(order_.begin() + static_cast<std::ptrdiff_t>(first),
+                     order_.begin() + static_cast<std::ptrdiff_t>(mid),
+                     order_.begin() + static_cast<std::ptrdiff_t>(last),
+                     [&](std::size_t a, std::size_t b) { return centre(a) < centre(b); });
+    const std::size_t left = build_tree(first, mid);
+    const std::size_t right = build_tree(mid, last);
+    tree_[id].left = left;
+    tree_[id].right = right;
+    return id;
+}
+
+namespace {
+
+/// Distance from p to an axis-aligned box.
+double distance_to_box(const Vec& lo, const Vec& hi, const Vec& p) {
+    double s = 0;
+    for (std::size_t a = 0; a < kAxesMax; ++a) {
+        const double d = p[a] < lo[a] ? lo[a] - p[a] : (p[a] > hi[a] ? p[a] - hi[a] : 0.0);
+        s += d * d;
+    }
+    return std::sqrt(s);
+}
+
+}  // namespace
+
+template <typename Consider>
+void PathProjector::search_tree(const Vec& p, double& best, Consider&& consider) const {
+    if (tree_.empty()) return;
+    std::vector<std::size_t> stack{0};
+    while (!stack.empty()) {
+        const TreeNode& node = tree_[stack.back()];
+        stack.pop_back();
+        if (distance_to_box(node.lo, node.hi, p) >= best) continue;
+        if (node.left == 0 && node.right == 0) {
+            for (std::size_t k = node.first; k < node.last; ++k) consider(order_[k]);
+            continue;
+        }
+        // The nearer child is examined first (pushed last): it lowers `best` sooner.
+        const double dl = distance_to_box(tree_[node.left].lo, tree_[node.left].hi, p);
+        const double dr = distance_to_box(tree_[node.right].lo, tree_[node.right].hi, p);
+        stack.push_back(dl <= dr ? node.right : node.left);
+        stack.push_back(dl <= dr ? node.left : node.right);
     }
 }
 
@@ -95,7 +168,7 @@ double flatness(const Cubic& c) {
 
 }  // namespace
 
-double PathProjector::segment_distance(std::size_t i, const Vec& p) const {
+double PathProjector::segment_distance(std::size_t i, const Vec& p, double bound, double* at) const {
     // Branch and bound: a piece of the curve lies in the box of its control points, so a piece
     // whose box is farther than the best distance so far is dropped; nearly straight pieces
     // are projected on their chord and the parameter refined by Newton on the whole segment.
@@ -108,7 +181,7 @@ double PathProjector::segment_distance(std::size_t i, const Vec& p) const {
     Item stack[64];
     std::size_t n = 0;
     stack[n++] = {whole, 0.0, 1.0, 0};
-    double best = std::numeric_limits<double>::infinity();
+    double best = bound * bound;  // only a nearer point matters: prunes against the best so far
     while (n > 0) {
         const Item it = stack[--n];
         if (box_distance2(it.c, p) >= best) continue;
@@ -140,7 +213,10 @@ double PathProjector::segment_distance(std::size_t i, const Vec& p) const {
             }
             for (const double v : {u, it.u0, it.u1}) {
                 const Vec d = sub(whole.point(v), p);
-                best = std::min(best, dot(d, d));
+                if (dot(d, d) < best) {
+                    best = dot(d, d);
+                    if (at != nullptr) *at = v;
+                }
             }
             continue;
         }
@@ -167,14 +243,32 @@ double PathProjector::distance(const Vec& p, std::size_t& segment) {
     // Around the cursor, both ways, until `reach` mm of path (at least two segments each way).
     std::size_t from = cursor_;
     for (double behind = 0; from > 0 && (from + 2 > cursor_ || behind <= reach);) behind += length_[--from];
+    double best_u = 0;
     const auto consider = [&](std::size_t i) {
         if (box_distance(i, p) >= best) return;
-        const double d = segment_distance(i, p);
+        double u = 0;
+        const double d = segment_distance(i, p, best, &u);
         if (d < best) {
             best = d;
             best_i = i;
+            best_u = u;
         }
     };
+    if (started_ && cursor_ < n) {
+        // Any point of the path bounds the distance from above: the cursor segment's point
+        // nearest p by Newton from the last answer's parameter, so that the searches below
+        // prune nearly every box at once.
+        const Cubic& c = segs_[cursor_];
+        double u = last_u_;
+        for (int it = 0; it < 3; ++it) {
+            const Vec d = sub(c.point(u), p), d1 = c.d1(u), d2 = c.d2(u);
+            const double f = dot(d, d1), df = dot(d1, d1) + dot(d, d2);
+            if (!(df > 0)) break;
+            u = std::clamp(u - f / df, 0.0, 1.0);
+        }
+        best = norm(sub(c.point(u), p)) * (1 + 1e-12) + 1e-15;
+        best_u = u;
+    }
     if (n > 0) consider(std::min(cursor_, n - 1));  // the cursor's own segment wins ties
     double ahead = 0;
     for (std::size_t i = from; i < n && i < from + 10000; ++i) {
@@ -189,9 +283,10 @@ double PathProjector::distance(const Vec& p, std::size_t& segment) {
         }
     }
     if (!(best <= global_below_) || !started_) {  // not close around the cursor: every segment
-        for (std::size_t i = 0; i < n; ++i) consider(i);
+        search_tree(p, best, consider);
     }
     cursor_ = best_i;
+    last_u_ = best_u;
     last_p_ = p;
     last_d_ = best;
     started_ = true;
