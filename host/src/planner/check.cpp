@@ -60,13 +60,16 @@ SpanPeaks span_peaks(const CoreSpan& s, std::size_t axis) {
     return r;
 }
 
+}  // namespace
+
+namespace planner_detail {
+
 /// Feed requested for a span: its subpath's (pen-down) or travel's (pen-up), else the profile's.
 class FeedTable {
 public:
-    FeedTable(const std::vector<BezierSegment>& segments, const MachineProfile& profile) : profile_(profile) {
-        for (const auto& s : segments) {
-            if (s.feed > 0) (s.pen_down ? down_ : up_).emplace(s.subpath, s.feed);
-        }
+    explicit FeedTable(const MachineProfile& profile) : profile_(profile) {}
+    void add(const BezierSegment& s) {
+        if (s.feed > 0) (s.pen_down ? down_ : up_).emplace(s.subpath, s.feed);
     }
     double feed(const CoreSpan& s) const {
         const auto& m = s.pen_down ? down_ : up_;
@@ -80,262 +83,260 @@ private:
     std::map<std::size_t, double> down_, up_;
 };
 
-class Checker {
+/// The core's setpoint stream for any axis count (SetpointStream is a template on it).
+class CoreStepper {
 public:
-    Checker(const Plan& plan, const std::vector<BezierSegment>& segments, const MachineProfile& profile,
-            bool deviation)
-        : plan_(plan), profile_(profile), axes_(profile.axes.size()), feeds_(segments, profile),
-          do_deviation_(deviation) {
-        const double t = 1.0 / profile.tick_hz;
-        for (std::size_t i = 0; i < axes_; ++i) {
-            vlim_[i] = profile.axes[i].max_velocity * t / profile.mm_per_lsb;
-            alim_[i] = profile.axes[i].max_acceleration * t * t / profile.mm_per_lsb;
-        }
-        out_.axis_velocity_fraction.assign(axes_, 0);
-        out_.axis_acceleration_fraction.assign(axes_, 0);
-        out_.axis_velocity_fraction_exact.assign(axes_, 0);
-        out_.axis_acceleration_fraction_exact.assign(axes_, 0);
-        out_.axis_max_step.assign(axes_, 0);
-        out_.axis_max_second_difference.assign(axes_, 0);
-        out_.axis_velocity_limit_lsb.assign(vlim_.begin(),
-                                            vlim_.begin() + static_cast<std::ptrdiff_t>(axes_));
-        out_.axis_acceleration_limit_lsb.assign(alim_.begin(),
-                                                alim_.begin() + static_cast<std::ptrdiff_t>(axes_));
-        if (deviation) {
-            std::vector<Cubic> down;
-            std::vector<std::size_t> index;
-            for (std::size_t s = 0; s < segments.size(); ++s) {
-                if (!segments[s].pen_down) continue;
-                down.push_back(planner_detail::to_cubic(segments[s]));
-                index.push_back(s);
-            }
-            // Any distance over half the tolerance is confirmed against every segment.
-            projector_ = std::make_unique<PathProjector>(std::move(down), std::move(index),
-                                                         0.5 * profile.chord_tolerance);
-        }
-        // Pen windows: [tick, tick + delay) for every pen change, in tick order.
-        for (const PenEvent& e : plan.pen) {
-            const std::uint64_t d =
-                delay_ticks(e.down ? profile.pen_down_delay : profile.pen_up_delay, profile.tick_hz);
-            if (d > 0) windows_.emplace_back(e.tick, e.tick + d);
-        }
-        std::sort(windows_.begin(), windows_.end());
-    }
+    virtual ~CoreStepper() = default;
+    virtual Status push(const CoreSpan& cs, std::uint32_t tag) = 0;
+    virtual void tick(std::array<std::int64_t, kAxesMax>& out) = 0;
+};
 
-    PlanCheck run() {
-        if (plan_.spans.empty()) {
-            out_.within_limits = true;
-            return out_;
+template <unsigned Axes>
+class CoreStepperOf : public CoreStepper {
+public:
+    explicit CoreStepperOf(const CoreSpan& first) {
+        Lsb start[Axes];
+        for (unsigned a = 0; a < Axes; ++a) start[a] = core_value_at(first, a, 0);
+        stream_ = std::make_unique<SetpointStream<Axes, 4>>(start);
+    }
+    Status push(const CoreSpan& cs, std::uint32_t tag) override {
+        Span<Axes> span;
+        span.basis = cs.basis;
+        span.ticks = cs.ticks;
+        span.tag = tag;
+        span.outputs = cs.pen_down ? kOutputPenDown : 0;
+        for (unsigned a = 0; a < Axes; ++a) {
+            for (unsigned k = 0; k < 4; ++k) span.control[a][k] = cs.control[a][k];
         }
-        for (const CoreSpan& s : plan_.spans) {
-            if (s.control.size() != axes_ || s.cubic.size() != axes_) {
-                throw PlanError("plan check: a span has " + std::to_string(s.control.size()) +
-                                " axes but the machine has " + std::to_string(axes_));
-            }
-        }
-        switch (axes_) {
-            case 1: stream<1>(); break;
-            case 2: stream<2>(); break;
-            case 3: stream<3>(); break;
-            case 4: stream<4>(); break;
-            case 5: stream<5>(); break;
-            case 6: stream<6>(); break;
-            case 7: stream<7>(); break;
-            case 8: stream<8>(); break;
-            default: throw PlanError("plan check: 1 to 8 axes");
-        }
-        finish();
-        return out_;
+        return stream_->push(span);
+    }
+    void tick(std::array<std::int64_t, kAxesMax>& out) override {
+        Lsb v[Axes];
+        (void)stream_->tick(v);
+        for (unsigned a = 0; a < Axes; ++a) out[a] = v[a];
     }
 
 private:
-    template <unsigned Axes>
-    void stream() {
-        Lsb start[Axes];
-        for (unsigned a = 0; a < Axes; ++a) start[a] = core_value_at(plan_.spans.front(), a, 0);
-        auto s = std::make_unique<SetpointStream<Axes, 4>>(start);
-        Lsb out[Axes];
-        std::array<std::int64_t, kAxesMax> p{};
-        std::array<double, kAxesMax> e{};
-        for (std::size_t index = 0; index < plan_.spans.size(); ++index) {
-            const CoreSpan& cs = plan_.spans[index];
-            Span<Axes> span;
-            span.basis = cs.basis;
-            span.ticks = cs.ticks;
-            span.tag = static_cast<std::uint32_t>(index);
-            span.outputs = cs.pen_down ? kOutputPenDown : 0;
-            for (unsigned a = 0; a < Axes; ++a) {
-                for (unsigned k = 0; k < 4; ++k) span.control[a][k] = cs.control[a][k];
-            }
-            for (unsigned a = 0; a < Axes; ++a) {
-                const SpanPeaks peaks = span_peaks(cs, a);
-                const double fv = peaks.velocity / vlim_[a], fa = peaks.acceleration / alim_[a];
-                out_.max_span_velocity_fraction = std::max(out_.max_span_velocity_fraction, fv);
-                out_.max_span_acceleration_fraction = std::max(out_.max_span_acceleration_fraction, fa);
-                out_.axis_velocity_fraction_exact[a] = std::max(out_.axis_velocity_fraction_exact[a], fv);
-                out_.axis_acceleration_fraction_exact[a] = std::max(out_.axis_acceleration_fraction_exact[a], fa);
-            }
-            if (const Status st = s->push(span); st != Status::kOk) {
-                std::ostringstream m;
-                m << "plan check: span " << index << " (subpath " << cs.subpath << ") refused by the core: "
-                  << status_name(st);
-                throw PlanError(m.str());
-            }
-            for (std::uint32_t k = 0; k < cs.ticks; ++k) {
-                (void)s->tick(out);
-                for (unsigned a = 0; a < Axes; ++a) {
-                    p[a] = out[a];
-                    e[a] = exact_value(cs, a, k);
-                }
-                visit(p, e, &cs);
-            }
-        }
-        (void)s->tick(out);  // idle: the end point, held
-        const CoreSpan& last = plan_.spans.back();
-        for (unsigned a = 0; a < Axes; ++a) {
-            p[a] = out[a];
-            e[a] = exact_value(last, a, last.ticks);
-        }
-        visit(p, e, nullptr);
-    }
-
-    bool pen_down_at(std::uint64_t tick) {
-        while (pen_index_ < plan_.pen.size() && plan_.pen[pen_index_].tick <= tick) {
-            pen_down_ = plan_.pen[pen_index_].down;
-            ++pen_index_;
-        }
-        return pen_down_;
-    }
-
-    bool in_window(std::uint64_t tick) {
-        while (window_index_ < windows_.size() && windows_[window_index_].second <= tick) ++window_index_;
-        return window_index_ < windows_.size() && windows_[window_index_].first <= tick;
-    }
-
-    /// Tick k's setpoint p (and exact value e); `span` is the span supplying it (null: the end).
-    void visit(const std::array<std::int64_t, kAxesMax>& p, const std::array<double, kAxesMax>& e,
-               const CoreSpan* span) {
-        const std::uint64_t k = tick_;
-        if (k == 0) {  // at rest before the first tick
-            p1_ = p2_ = p;
-            e1_ = e2_ = e;
-        }
-        // First difference p[k] - p[k-1] (motion during tick k-1, inside span_prev_).
-        bool moved = false;
-        double speed2 = 0;
-        for (std::size_t a = 0; a < axes_; ++a) {
-            const std::int64_t step = p[a] - p1_[a];
-            const double d = static_cast<double>(step);
-            const double de = e[a] - e1_[a];
-            if (d != 0) moved = true;
-            speed2 += d * d;
-            out_.axis_max_step[a] = std::max(out_.axis_max_step[a], step < 0 ? -step : step);
-            velocity(a, std::fabs(d), std::fabs(de));
-        }
-        if (k > 0 && moved && in_window(k - 1)) out_.drawing_while_pen_moves = true;
-        if (k > 0 && moved && prev_span_ != nullptr) {
-            const double lsb_per_tick = profile_.mm_per_lsb * profile_.tick_hz;
-            // Allowance: each setpoint's rounding (< 1 LSB per axis in a difference) and the
-            // rounding of the spans' end points and tangents (about as much again).
-            const double speed =
-                std::max(0.0, std::sqrt(speed2) - 2 * std::sqrt(static_cast<double>(axes_))) * lsb_per_tick;
-            out_.max_feed_fraction = std::max(out_.max_feed_fraction, speed / feeds_.feed(*prev_span_));
-        }
-        // Second difference centred on k - 1.
-        if (k > 0) {
-            for (std::size_t a = 0; a < axes_; ++a) {
-                acceleration(a, p[a] - 2 * p1_[a] + p2_[a], std::fabs(e[a] - 2 * e1_[a] + e2_[a]));
-            }
-        }
-        // Deviation of a pen-down setpoint.
-        const bool down = pen_down_at(k);
-        if (!down) have_distance_ = false;
-        if (do_deviation_ && down && !projector_->empty()) {
-            if (k == 0 || moved || !have_distance_) {
-                Vec q{};
-                for (std::size_t a = 0; a < axes_; ++a) q[a] = static_cast<double>(p[a]) * profile_.mm_per_lsb;
-                std::size_t seg = 0;
-                distance_ = projector_->distance(q, seg);
-                have_distance_ = true;
-            }
-            if (distance_ > out_.max_deviation) {
-                out_.max_deviation = distance_;
-                out_.worst_deviation_tick = k;
-            }
-        }
-        p2_ = p1_;
-        p1_ = p;
-        e2_ = e1_;
-        e1_ = e;
-        prev_span_ = span;
-        ++tick_;
-    }
-
-    void velocity(std::size_t a, double d, double de) {
-        const double allowed = std::max(0.0, d - 1) / vlim_[a];
-        out_.axis_velocity_fraction[a] = std::max(out_.axis_velocity_fraction[a], allowed);
-        out_.max_velocity_fraction_raw = std::max(out_.max_velocity_fraction_raw, d / vlim_[a]);
-        out_.max_velocity_fraction_exact = std::max(out_.max_velocity_fraction_exact, de / vlim_[a]);
-        out_.axis_velocity_fraction_exact[a] = std::max(out_.axis_velocity_fraction_exact[a], de / vlim_[a]);
-    }
-
-    /// `second` is the integer setpoints' second difference, `de` the exact cubic's (magnitude).
-    void acceleration(std::size_t a, std::int64_t second, double de) {
-        const std::int64_t magnitude = second < 0 ? -second : second;
-        out_.axis_max_second_difference[a] =
-            std::max(out_.axis_max_second_difference[a], magnitude);
-        const double d = static_cast<double>(magnitude);
-        const double allowed = std::max(0.0, d - 2) / alim_[a];
-        out_.axis_acceleration_fraction[a] = std::max(out_.axis_acceleration_fraction[a], allowed);
-        out_.max_acceleration_fraction_raw = std::max(out_.max_acceleration_fraction_raw, d / alim_[a]);
-        out_.max_acceleration_fraction_exact = std::max(out_.max_acceleration_fraction_exact, de / alim_[a]);
-        out_.axis_acceleration_fraction_exact[a] = std::max(out_.axis_acceleration_fraction_exact[a], de / alim_[a]);
-    }
-
-    void finish() {
-        // The axes rest after the end: one more second difference, centred on the end point.
-        for (std::size_t a = 0; a < axes_; ++a) {
-            acceleration(a, p2_[a] - p1_[a], std::fabs(e2_[a] - e1_[a]));
-        }
-        for (std::size_t a = 0; a < axes_; ++a) {
-            out_.max_velocity_fraction = std::max(out_.max_velocity_fraction, out_.axis_velocity_fraction[a]);
-            out_.max_acceleration_fraction =
-                std::max(out_.max_acceleration_fraction, out_.axis_acceleration_fraction[a]);
-        }
-        // The exact cubic must be within the limits too (a device that validates spans refuses
-        // anything over), not only the rounded setpoints with their allowance.
-        out_.within_limits = out_.max_velocity_fraction <= 1 && out_.max_acceleration_fraction <= 1 &&
-                             out_.max_velocity_fraction_exact <= 1 && out_.max_acceleration_fraction_exact <= 1 &&
-                             out_.max_span_velocity_fraction <= 1 && out_.max_span_acceleration_fraction <= 1;
-        out_.ticks_checked = tick_;
-    }
-
-    const Plan& plan_;
-    const MachineProfile& profile_;
-    std::size_t axes_;
-    FeedTable feeds_;
-    bool do_deviation_;
-    PlanCheck out_;
-    std::array<double, kAxesMax> vlim_{}, alim_{};
-    std::unique_ptr<PathProjector> projector_;
-    std::vector<std::pair<std::uint64_t, std::uint64_t>> windows_;
-    std::size_t window_index_ = 0, pen_index_ = 0;
-    bool pen_down_ = false;
-    std::uint64_t tick_ = 0;
-    std::array<std::int64_t, kAxesMax> p1_{}, p2_{};
-    std::array<double, kAxesMax> e1_{}, e2_{};
-    const CoreSpan* prev_span_ = nullptr;
-    double distance_ = 0;
-    bool have_distance_ = false;
+    std::unique_ptr<SetpointStream<Axes, 4>> stream_;
 };
 
-}  // namespace
+static std::unique_ptr<CoreStepper> make_stepper(std::size_t axes, const CoreSpan& first) {
+    switch (axes) {
+        case 1: return std::make_unique<CoreStepperOf<1>>(first);
+        case 2: return std::make_unique<CoreStepperOf<2>>(first);
+        case 3: return std::make_unique<CoreStepperOf<3>>(first);
+        case 4: return std::make_unique<CoreStepperOf<4>>(first);
+        case 5: return std::make_unique<CoreStepperOf<5>>(first);
+        case 6: return std::make_unique<CoreStepperOf<6>>(first);
+        case 7: return std::make_unique<CoreStepperOf<7>>(first);
+        case 8: return std::make_unique<CoreStepperOf<8>>(first);
+        default: throw PlanError("plan check: 1 to 8 axes");
+    }
+}
 
-namespace planner_detail {
+TickChecker::TickChecker(const MachineProfile& profile, const std::vector<BezierSegment>* segments, bool deviation)
+    : profile_(profile), axes_(profile.axes.size()), feeds_(std::make_unique<FeedTable>(profile)),
+      do_deviation_(deviation && segments != nullptr) {
+    if (axes_ == 0 || axes_ > kAxesMax) throw PlanError("plan check: 1 to 8 axes");
+    const double t = 1.0 / profile.tick_hz;
+    for (std::size_t i = 0; i < axes_; ++i) {
+        vlim_[i] = profile.axes[i].max_velocity * t / profile.mm_per_lsb;
+        alim_[i] = profile.axes[i].max_acceleration * t * t / profile.mm_per_lsb;
+    }
+    out_.axis_velocity_fraction.assign(axes_, 0);
+    out_.axis_acceleration_fraction.assign(axes_, 0);
+    out_.axis_velocity_fraction_exact.assign(axes_, 0);
+    out_.axis_acceleration_fraction_exact.assign(axes_, 0);
+    out_.axis_max_step.assign(axes_, 0);
+    out_.axis_max_second_difference.assign(axes_, 0);
+    out_.axis_velocity_limit_lsb.assign(vlim_.begin(), vlim_.begin() + static_cast<std::ptrdiff_t>(axes_));
+    out_.axis_acceleration_limit_lsb.assign(alim_.begin(), alim_.begin() + static_cast<std::ptrdiff_t>(axes_));
+    if (segments != nullptr) {
+        for (const BezierSegment& seg : *segments) feeds_->add(seg);
+    }
+    if (do_deviation_) {
+        std::vector<Cubic> down;
+        std::vector<std::size_t> index;
+        for (std::size_t s = 0; s < segments->size(); ++s) {
+            if (!(*segments)[s].pen_down) continue;
+            down.push_back(to_cubic((*segments)[s]));
+            index.push_back(s);
+        }
+        // Any distance over half the tolerance is confirmed against every segment.
+        projector_ = std::make_unique<PathProjector>(std::move(down), std::move(index), 0.5 * profile.chord_tolerance);
+    }
+}
+
+TickChecker::~TickChecker() = default;
+
+void TickChecker::note_segment(const BezierSegment& segment) { feeds_->add(segment); }
+
+void TickChecker::pen(const PenEvent& e) {
+    const std::uint64_t d = delay_ticks(e.down ? profile_.pen_down_delay : profile_.pen_up_delay, profile_.tick_hz);
+    if (d > 0) windows_.emplace_back(e.tick, e.tick + d);
+    pens_.push_back(e);
+}
+
+void TickChecker::span(const CoreSpan& cs) {
+    if (cs.control.size() != axes_ || cs.cubic.size() != axes_) {
+        throw PlanError("plan check: a span has " + std::to_string(cs.control.size()) + " axes but the machine has " +
+                        std::to_string(axes_));
+    }
+    if (!stepper_) stepper_ = make_stepper(axes_, cs);
+    for (std::size_t a = 0; a < axes_; ++a) {
+        const SpanPeaks peaks = span_peaks(cs, a);
+        const double fv = peaks.velocity / vlim_[a], fa = peaks.acceleration / alim_[a];
+        out_.max_span_velocity_fraction = std::max(out_.max_span_velocity_fraction, fv);
+        out_.max_span_acceleration_fraction = std::max(out_.max_span_acceleration_fraction, fa);
+        out_.axis_velocity_fraction_exact[a] = std::max(out_.axis_velocity_fraction_exact[a], fv);
+        out_.axis_acceleration_fraction_exact[a] = std::max(out_.axis_acceleration_fraction_exact[a], fa);
+    }
+    if (const Status st = stepper_->push(cs, static_cast<std::uint32_t>(spans_)); st != Status::kOk) {
+        std::ostringstream m;
+        m << "plan check: span " << spans_ << " (subpath " << cs.subpath << ") refused by the core: " << status_name(st);
+        throw PlanError(m.str());
+    }
+    ++spans_;
+    std::array<std::int64_t, kAxesMax> p{};
+    std::array<double, kAxesMax> e{};
+    for (std::uint32_t k = 0; k < cs.ticks; ++k) {
+        stepper_->tick(p);
+        for (std::size_t a = 0; a < axes_; ++a) e[a] = exact_value(cs, a, k);
+        visit(p, e, cs);
+    }
+    last_ = cs;
+}
+
+bool TickChecker::over_limits() const {
+    for (std::size_t a = 0; a < axes_; ++a) {
+        if (out_.axis_velocity_fraction[a] > 1 || out_.axis_acceleration_fraction[a] > 1) return true;
+    }
+    return out_.max_velocity_fraction_exact > 1 || out_.max_acceleration_fraction_exact > 1 ||
+           out_.max_span_velocity_fraction > 1 || out_.max_span_acceleration_fraction > 1;
+}
+
+bool TickChecker::pen_down_at(std::uint64_t tick) {
+    while (pen_index_ < pens_.size() && pens_[pen_index_].tick <= tick) {
+        pen_down_ = pens_[pen_index_].down;
+        ++pen_index_;
+    }
+    return pen_down_;
+}
+
+bool TickChecker::in_window(std::uint64_t tick) {
+    while (window_index_ < windows_.size() && windows_[window_index_].second <= tick) ++window_index_;
+    return window_index_ < windows_.size() && windows_[window_index_].first <= tick;
+}
+
+void TickChecker::visit(const std::array<std::int64_t, kAxesMax>& p, const std::array<double, kAxesMax>& e,
+                        const CoreSpan& span) {
+    const std::uint64_t k = tick_;
+    if (k == 0) {  // at rest before the first tick
+        p1_ = p2_ = p;
+        e1_ = e2_ = e;
+    }
+    // First difference p[k] - p[k-1] (motion during tick k-1, inside the previous tick's span).
+    bool moved = false;
+    double speed2 = 0;
+    for (std::size_t a = 0; a < axes_; ++a) {
+        const std::int64_t step = p[a] - p1_[a];
+        const double d = static_cast<double>(step);
+        const double de = e[a] - e1_[a];
+        if (d != 0) moved = true;
+        speed2 += d * d;
+        out_.axis_max_step[a] = std::max(out_.axis_max_step[a], step < 0 ? -step : step);
+        velocity(a, std::fabs(d), std::fabs(de));
+    }
+    if (k > 0 && moved && in_window(k - 1)) out_.drawing_while_pen_moves = true;
+    if (k > 0 && moved && have_prev_span_) {
+        const double lsb_per_tick = profile_.mm_per_lsb * profile_.tick_hz;
+        // Allowance: each setpoint's rounding (< 1 LSB per axis in a difference) and the
+        // rounding of the spans' end points and tangents (about as much again).
+        const double speed = std::max(0.0, std::sqrt(speed2) - 2 * std::sqrt(static_cast<double>(axes_))) * lsb_per_tick;
+        out_.max_feed_fraction = std::max(out_.max_feed_fraction, speed / prev_feed_);
+    }
+    // Second difference centred on k - 1.
+    if (k > 0) {
+        for (std::size_t a = 0; a < axes_; ++a) {
+            acceleration(a, p[a] - 2 * p1_[a] + p2_[a], std::fabs(e[a] - 2 * e1_[a] + e2_[a]));
+        }
+    }
+    // Deviation of a pen-down setpoint.
+    const bool down = pen_down_at(k);
+    if (!down) have_distance_ = false;
+    if (do_deviation_ && down && !projector_->empty()) {
+        if (k == 0 || moved || !have_distance_) {
+            Vec q{};
+            for (std::size_t a = 0; a < axes_; ++a) q[a] = static_cast<double>(p[a]) * profile_.mm_per_lsb;
+            std::size_t seg = 0;
+            distance_ = projector_->distance(q, seg);
+            have_distance_ = true;
+        }
+        if (distance_ > out_.max_deviation) {
+            out_.max_deviation = distance_;
+            out_.worst_deviation_tick = k;
+        }
+    }
+    p2_ = p1_;
+    p1_ = p;
+    e2_ = e1_;
+    e1_ = e;
+    prev_feed_ = feeds_->feed(span);
+    have_prev_span_ = true;
+    ++tick_;
+}
+
+void TickChecker::velocity(std::size_t a, double d, double de) {
+    const double allowed = std::max(0.0, d - 1) / vlim_[a];
+    out_.axis_velocity_fraction[a] = std::max(out_.axis_velocity_fraction[a], allowed);
+    out_.max_velocity_fraction_raw = std::max(out_.max_velocity_fraction_raw, d / vlim_[a]);
+    out_.max_velocity_fraction_exact = std::max(out_.max_velocity_fraction_exact, de / vlim_[a]);
+    out_.axis_velocity_fraction_exact[a] = std::max(out_.axis_velocity_fraction_exact[a], de / vlim_[a]);
+}
+
+void TickChecker::acceleration(std::size_t a, std::int64_t second, double de) {
+    const std::int64_t magnitude = second < 0 ? -second : second;
+    out_.axis_max_second_difference[a] = std::max(out_.axis_max_second_difference[a], magnitude);
+    const double d = static_cast<double>(magnitude);
+    const double allowed = std::max(0.0, d - 2) / alim_[a];
+    out_.axis_acceleration_fraction[a] = std::max(out_.axis_acceleration_fraction[a], allowed);
+    out_.max_acceleration_fraction_raw = std::max(out_.max_acceleration_fraction_raw, d / alim_[a]);
+    out_.max_acceleration_fraction_exact = std::max(out_.max_acceleration_fraction_exact, de / alim_[a]);
+    out_.axis_acceleration_fraction_exact[a] = std::max(out_.axis_acceleration_fraction_exact[a], de / alim_[a]);
+}
+
+PlanCheck TickChecker::finish() {
+    if (spans_ == 0) {
+        out_.within_limits = true;
+        return out_;
+    }
+    // The end point, held: the idle tick after the last span.
+    std::array<std::int64_t, kAxesMax> p{};
+    std::array<double, kAxesMax> e{};
+    stepper_->tick(p);
+    for (std::size_t a = 0; a < axes_; ++a) e[a] = exact_value(last_, a, last_.ticks);
+    visit(p, e, last_);
+    // The axes rest after the end: one more second difference, centred on the end point.
+    for (std::size_t a = 0; a < axes_; ++a) acceleration(a, p2_[a] - p1_[a], std::fabs(e2_[a] - e1_[a]));
+    for (std::size_t a = 0; a < axes_; ++a) {
+        out_.max_velocity_fraction = std::max(out_.max_velocity_fraction, out_.axis_velocity_fraction[a]);
+        out_.max_acceleration_fraction = std::max(out_.max_acceleration_fraction, out_.axis_acceleration_fraction[a]);
+    }
+    // The exact cubic must be within the limits too (a device that validates spans refuses
+    // anything over), not only the rounded setpoints with their allowance.
+    out_.within_limits = out_.max_velocity_fraction <= 1 && out_.max_acceleration_fraction <= 1 &&
+                         out_.max_velocity_fraction_exact <= 1 && out_.max_acceleration_fraction_exact <= 1 &&
+                         out_.max_span_velocity_fraction <= 1 && out_.max_span_acceleration_fraction <= 1;
+    out_.ticks_checked = tick_;
+    return out_;
+}
+
 PlanCheck check_plan_impl(const Plan& plan, const std::vector<BezierSegment>& segments,
                           const MachineProfile& profile, bool deviation) {
-    if (profile.axes.empty() || profile.axes.size() > kAxesMax) throw PlanError("plan check: 1 to 8 axes");
-    return Checker(plan, segments, profile, deviation).run();
+    TickChecker checker(profile, &segments, deviation);
+    for (const PenEvent& e : plan.pen) checker.pen(e);
+    for (const CoreSpan& s : plan.spans) checker.span(s);
+    return checker.finish();
 }
 }  // namespace planner_detail
 

@@ -229,7 +229,7 @@ double arc_length(const Cubic& c, double u0, double u1) {
 }
 
 PathGrid build_grid(const std::vector<BezierSegment>& segments, const MachineProfile& profile,
-                    const PlanOptions& options) {
+                    const PlanOptions& options, std::size_t first_index) {
     const std::size_t axes = profile.axes.size();
     Builder b{segments, profile, options, {}, 0, 0};
     double a_min = 0;
@@ -244,12 +244,14 @@ PathGrid build_grid(const std::vector<BezierSegment>& segments, const MachinePro
         for (const auto& p : segments[s].p) {
             if (p.size() != axes) {
                 std::ostringstream m;
-                m << "segment " << s << " (subpath " << segments[s].subpath << ") has " << p.size()
+                m << "segment " << first_index + s << " (subpath " << segments[s].subpath << ") has " << p.size()
                   << " coordinates but the machine has " << axes << " axes";
                 throw PlanError(m.str());
             }
             for (double x : p) {
-                if (!std::isfinite(x)) throw PlanError("segment " + std::to_string(s) + " has a non-finite coordinate");
+                if (!std::isfinite(x)) {
+                    throw PlanError("segment " + std::to_string(first_index + s) + " has a non-finite coordinate");
+                }
             }
         }
         if (s == 0) b.out.cubics.reserve(segments.size());
@@ -258,8 +260,8 @@ PathGrid build_grid(const std::vector<BezierSegment>& segments, const MachinePro
             const double gap = norm(sub(b.out.cubics[s].p[0], b.out.cubics[s - 1].p[3]));
             if (gap > 1e-6) {
                 std::ostringstream m;
-                m << "segment " << s << " (subpath " << segments[s].subpath << ") starts " << gap
-                  << " mm away from where segment " << s - 1 << " ends: the path must be continuous";
+                m << "segment " << first_index + s << " (subpath " << segments[s].subpath << ") starts " << gap
+                  << " mm away from where segment " << first_index + s - 1 << " ends: the path must be continuous";
                 throw PlanError(m.str());
             }
         }

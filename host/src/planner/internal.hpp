@@ -5,6 +5,8 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <memory>
+#include <string>
 #include <vector>
 
 #include "pathstream/host/geometry.hpp"
@@ -165,8 +167,9 @@ struct PathGrid {
 
 /// Builds the grid, the stops (sharp corners, cusps, pen changes, ends) and the runs.
 /// `profile` gives the feeds. Throws PlanError on unusable input.
+/// `first_index`: the global index of segments[0], for messages (a window of a streamed job).
 PathGrid build_grid(const std::vector<BezierSegment>& segments, const MachineProfile& profile,
-                    const PlanOptions& options);
+                    const PlanOptions& options, std::size_t first_index = 0);
 
 /// Point and unit tangent at arc length `lambda` inside `piece`. `hint` is a node index to
 /// start searching from (updated), for the monotone walk of the forward pass.
@@ -253,6 +256,36 @@ PieceMotion forward_pass(const PathGrid& g, const Piece& piece, const Limits& li
                          PieceMotion* resume = nullptr, double resume_lambda = 0,
                          bool short_spans = false);
 
+/// The lookahead of one window's grid: speed caps, acceleration factors and the backward
+/// pass's beta per node, lowered locally by the retries of plan_piece.
+struct WindowLookahead {
+    WindowLookahead(const PathGrid& pg, const Limits& limits, const MachineProfile& profile,
+                    const PlanOptions& options);
+    void set_factor(std::size_t k);
+
+    const PathGrid& pg;
+    const Limits& limits;
+    const MachineProfile& profile;
+    const PlanOptions& options;
+    double span_time;
+    std::vector<double> base_caps, caps, local_factor, local_cap, corner_factor, factor, beta, dip;
+};
+
+/// Plans one piece: backward pass, forward pass from rest at start_q (or from the last knot
+/// of `carried`, whose spans were sent already and are kept first in the result), and the
+/// local retries. Throws PlanError naming the place when no whole-tick motion is found.
+/// `run_offset`: mm of the run before this window's grid, for that message.
+PieceMotion plan_piece(WindowLookahead& lookahead, const Piece& piece, const Vec& start_q, PieceMotion* carried,
+                       double run_offset, PlanStats& stats);
+
+/// "subpath N, X mm along it" for a place in a piece.
+std::string where(const PathGrid& pg, const Piece& piece, double lambda, double run_offset);
+
+/// The profile and options plan_path accepts (PlanError otherwise).
+void validate_plan_inputs(const MachineProfile& profile, const PlanOptions& options);
+/// Ticks of a regular span for `profile` (docs/planner.md §5, span length).
+std::uint32_t regular_span_ticks(const MachineProfile& profile);
+
 /// A point on the LSB grid (mm), rounded as the emitter rounds span end points.
 inline Vec on_lsb_grid(const Vec& q, double lsb, std::size_t axes) {
     Vec r{};
@@ -312,12 +345,120 @@ private:
     bool started_ = false;
 };
 
+class FeedTable;
+class CoreStepper;
+
+/// The per-tick check of check_plan, fed a plan in order (pen events before the spans at
+/// their ticks), so that a streamed plan is checked as it is made.
+class TickChecker {
+public:
+    /// `segments` (optional) give the feeds and, with `deviation`, the path to measure from.
+    TickChecker(const MachineProfile& profile, const std::vector<BezierSegment>* segments, bool deviation);
+    ~TickChecker();
+    TickChecker(const TickChecker&) = delete;
+    TickChecker& operator=(const TickChecker&) = delete;
+    /// A segment's requested feed (streamed plans give their segments as they are read).
+    void note_segment(const BezierSegment& segment);
+    void pen(const PenEvent& event);
+    /// Runs the span through the core tick by tick; throws PlanError if the core refuses it.
+    void span(const CoreSpan& span);
+    /// True when a tick or span so far is over a limit (exactly or after the allowance).
+    bool over_limits() const;
+    /// The held end point and the rest after it; the figures of the whole plan.
+    PlanCheck finish();
+
+private:
+    bool pen_down_at(std::uint64_t tick);
+    bool in_window(std::uint64_t tick);
+    void visit(const std::array<std::int64_t, kAxesMax>& p, const std::array<double, kAxesMax>& e,
+               const CoreSpan& span);
+    void velocity(std::size_t a, double d, double de);
+    void acceleration(std::size_t a, std::int64_t second, double de);
+
+    const MachineProfile& profile_;
+    std::size_t axes_;
+    std::unique_ptr<FeedTable> feeds_;
+    bool do_deviation_;
+    PlanCheck out_;
+    std::array<double, kAxesMax> vlim_{}, alim_{};
+    std::unique_ptr<PathProjector> projector_;
+    std::unique_ptr<CoreStepper> stepper_;
+    std::vector<std::pair<std::uint64_t, std::uint64_t>> windows_;
+    std::vector<PenEvent> pens_;
+    std::size_t window_index_ = 0, pen_index_ = 0, spans_ = 0;
+    bool pen_down_ = false;
+    std::uint64_t tick_ = 0;
+    std::array<std::int64_t, kAxesMax> p1_{}, p2_{};
+    std::array<double, kAxesMax> e1_{}, e2_{};
+    double prev_feed_ = 0;
+    bool have_prev_span_ = false;
+    double distance_ = 0;
+    bool have_distance_ = false;
+    CoreSpan last_;
+};
+
 /// check_plan, with the deviation part optional (the planner's own verification skips it).
 PlanCheck check_plan_impl(const Plan& plan, const std::vector<BezierSegment>& segments,
                           const MachineProfile& profile, bool deviation);
 
-/// Turns the motion of every piece plus the pen dwells into the plan's core spans.
-Plan emit_plan(const PathGrid& g, const std::vector<PieceMotion>& motion, const MachineProfile& profile,
-               PlanStats* stats);
+/// One event of a plan in the making, in plan order.
+struct PlanEvent {
+    enum class Kind { kSpan, kPen, kPause };
+    Kind kind = Kind::kSpan;
+    CoreSpan span;
+    PenEvent pen;
+    PlanPause pause;
+};
+
+/// Turns knots, runs and pen changes into the plan's core spans, pen events, dwells and
+/// pauses, in order (docs/planner.md §6). The last span is held back until the next event,
+/// because a pause marks the span it follows; finish() lets it go. Throws PlanError when a
+/// value is outside the core's range or the core refuses a span.
+class SpanEmitter {
+public:
+    SpanEmitter(const MachineProfile& profile, std::size_t axes, const Vec& start_mm);
+    /// The start of a run: its pause, pen change and rests, unless it continues the current
+    /// run (the same pen state and subpath: a run cut between two windows).
+    void begin_run(const Run& run);
+    /// A piece starts at `start_mm`: it must be where the last one ended (within 1 LSB).
+    void piece_start(const Vec& start_mm, std::size_t subpath);
+    /// The motion span from knot `from` to `span.end`.
+    void motion(const Knot& from, const MotionSpan& span, const Run& run);
+    /// The end of the job: the final lift and its dwell, and the held-back span.
+    void finish(std::size_t last_subpath);
+    /// The events made since the last call (moved out).
+    std::vector<PlanEvent> take();
+
+    std::uint64_t total_ticks() const { return total_ticks_; }
+    std::size_t motion_spans() const { return motion_spans_; }
+    std::uint64_t motion_ticks() const { return motion_ticks_; }
+    std::uint64_t dwell_ticks() const { return dwell_ticks_; }
+
+private:
+    using LsbVec = std::array<std::int64_t, kAxesMax>;
+    LsbVec quantise(const Vec& mm) const;
+    LsbVec tangent(const Vec& velocity, std::uint32_t ticks) const;
+    void span(const LsbVec& p1, const LsbVec& t0, const LsbVec& t1, std::uint32_t ticks, std::size_t subpath,
+              bool pen_down);
+    void dwell(std::uint64_t ticks, std::size_t subpath, bool pen_down);
+    void pen(bool down, std::size_t subpath, bool last);
+    void before_pen_down(const Run& run);
+    void release();
+    [[noreturn]] static void fail(std::size_t subpath, const std::string& what);
+
+    const MachineProfile& profile_;
+    std::size_t axes_;
+    std::vector<PlanEvent> events_;
+    bool held_ = false;  ///< events_.back() is a span held back
+    bool any_span_ = false, last_pen_down_ = false;
+    LsbVec pos_{};
+    bool pen_ = false;
+    bool in_run_ = false;
+    std::size_t run_subpath_ = 0;
+    bool run_pen_down_ = false;
+    std::uint64_t total_ticks_ = 0;
+    std::size_t motion_spans_ = 0;
+    std::uint64_t motion_ticks_ = 0, dwell_ticks_ = 0;
+};
 
 }  // namespace pathstream::host::planner_detail

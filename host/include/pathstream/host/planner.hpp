@@ -11,6 +11,7 @@
 
 #include "pathstream/host/geometry.hpp"
 #include "pathstream/host/machine.hpp"
+#include "pathstream/host/core_spans.hpp"
 #include "pathstream/host/plan.hpp"
 
 namespace pathstream::host {
@@ -44,6 +45,10 @@ struct PlanOptions {
     /// A joint turning by more than this (rad) is a corner where the motion stops exactly;
     /// smaller tangent jumps are crossed at the corner speed of docs/planner.md.
     double corner_stop_angle = 0.35;
+
+    /// Segments read per window of plan_stream (plan_path too): memory grows with this, not
+    /// with the job. A window is read further where its lookahead horizon needs it.
+    std::size_t window_segments = 2048;
 
     int max_replans = 8;          ///< whole-plan retries with lowered limits after a failed check
     int max_local_retries = 24;   ///< per piece: lookahead retries with a locally lowered margin
@@ -84,6 +89,76 @@ Plan plan_path(const std::vector<BezierSegment>& segments, const MachineProfile&
 Plan plan_path(const std::vector<BezierSegment>& segments, const MachineProfile& profile,
                const PlanOptions& options, PlanStats* stats = nullptr,
                const std::function<void(double fraction)>& progress = {});
+
+/// Receives a plan as it is made, in order: each pen event and pause before the spans that
+/// follow it (a pause comes right after the span it ends, which carries pause_after).
+/// Called from the planning thread only.
+class PlanSink {
+public:
+    virtual ~PlanSink() = default;
+    virtual void span(const CoreSpan& span) = 0;
+    virtual void pen(const PenEvent& event) = 0;
+    virtual void pause(const PlanPause& pause) = 0;
+    /// The plan so far is void: planning starts over with lowered limits (a per-tick check
+    /// failed, docs/planner.md §7). Return false when what was received cannot be taken back
+    /// (then planning fails with PlanError).
+    virtual bool restart() { return false; }
+};
+
+/// Gives the path's Bezier segments in order, one at a time, so that a job need not be held
+/// whole in memory. Called from the planning thread only.
+class SegmentSource {
+public:
+    virtual ~SegmentSource() = default;
+    /// The next segment into `out`; false at the end of the path.
+    virtual bool next(BezierSegment& out) = 0;
+    /// Back to the first segment (for a replan); false when the source cannot rewind.
+    virtual bool rewind() = 0;
+    /// Number of segments when known (for progress), else 0.
+    virtual std::size_t size_hint() const { return 0; }
+};
+
+/// A SegmentSource over segments held in memory (not copied: `segments` must outlive it).
+class VectorSegmentSource : public SegmentSource {
+public:
+    explicit VectorSegmentSource(const std::vector<BezierSegment>& segments) : segments_(segments) {}
+    bool next(BezierSegment& out) override {
+        if (next_ >= segments_.size()) return false;
+        out = segments_[next_++];
+        return true;
+    }
+    bool rewind() override {
+        next_ = 0;
+        return true;
+    }
+    std::size_t size_hint() const override { return segments_.size(); }
+
+private:
+    const std::vector<BezierSegment>& segments_;
+    std::size_t next_ = 0;
+};
+
+/// What a streamed plan came to (the Plan's totals, without its spans).
+struct PlanTotals {
+    std::size_t spans = 0;
+    std::size_t pen_changes = 0;
+    std::size_t pauses = 0;
+    std::uint64_t total_ticks = 0;
+    double duration = 0;        ///< s
+    double path_length = 0;     ///< mm, pen-down
+    double travel_length = 0;   ///< mm, pen-up
+};
+
+/// plan_path as a stream: plans the path in windows of segments with a bounded lookahead
+/// (docs/planner.md §8), handing each window's spans to `sink` once they passed the per-tick
+/// limit check, so that memory stays bounded whatever the job's length and the first spans
+/// come out before the last segments are read. The result is the same kind of plan as
+/// plan_path's (every span exact, checked on every tick); `stats`, when given, gets the
+/// run's figures except reference_motion_time (0 here). Throws PlanError as plan_path, and
+/// when a replan is needed but `sink` or `source` cannot start over.
+PlanTotals plan_stream(SegmentSource& source, const MachineProfile& profile, const PlanOptions& options,
+                       PlanSink& sink, PlanStats* stats = nullptr,
+                       const std::function<void(double fraction)>& progress = {});
 
 /// Checks every executed tick of `plan`: the integer setpoints as the core produces them
 /// (SetpointStream: continuity of every span is enforced) against the per-axis limits, with

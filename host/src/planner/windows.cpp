@@ -1,0 +1,432 @@
+// plan_stream: the path planned in windows of segments with a bounded lookahead, each window's
+// spans checked tick by tick and handed on, so that memory does not grow with the job
+// (docs/planner.md §8).
+//
+// A window is planned like a whole path whose end is a stop. Only the motion up to the commit
+// point, a horizon (more than the longest stopping distance) before the window's end, is
+// kept: there the lookahead already sees as far as it ever would. The next window starts at
+// the segment holding the last kept knot and continues from that knot (the retries never go
+// back before it).
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <optional>
+#include <utility>
+#include <sstream>
+
+#include "internal.hpp"
+
+namespace pathstream::host {
+namespace {
+
+using namespace planner_detail;
+
+constexpr std::size_t kMaxWindowSegments = std::size_t{1} << 26;
+
+/// Non-decreasing progress in [0, 1], each stage mapped into its share.
+class Progress {
+public:
+    explicit Progress(const std::function<void(double)>& f) : f_(f) {}
+    void operator()(double fraction) {
+        fraction = std::clamp(fraction, 0.0, 1.0);
+        if (!f_ || fraction < last_) return;
+        if (fraction < 1 && fraction - last_ < 0.002) return;  // no more than ~500 calls
+        last_ = fraction;
+        f_(fraction);
+    }
+
+private:
+    const std::function<void(double)>& f_;
+    double last_ = -1;
+};
+
+/// Where the kept motion ended: the knot it reached inside a segment (λ from that segment's
+/// start) and the knot the last span started from, or a piece start at rest.
+struct Carry {
+    bool started = false;      ///< anything planned yet
+    std::size_t segment = 0;   ///< global index of the segment holding the knot
+    double lambda_in_segment = 0;
+    bool moving = false;       ///< mid-piece: continue from `last` (else a piece starts at rest)
+    Knot prev, last;           ///< the last span ran from prev to last...
+    std::uint32_t ticks = 0;   ///< ...in this many ticks
+    Vec q{};                   ///< where the motion is (mm, on the LSB grid)
+    double run_offset = 0;     ///< mm of the current run before `segment`
+};
+
+/// One attempt at the whole job with fixed limits.
+class WindowPlanner {
+public:
+    WindowPlanner(SegmentSource& source, const MachineProfile& profile, const PlanOptions& options,
+                  const Limits& limits, PlanSink& sink, PlanStats& stats, Progress& report, double lo, double hi)
+        : source_(source), profile_(profile), options_(options), limits_(limits), sink_(sink), st_(stats),
+          report_(report), lo_(lo), hi_(hi), checker_(profile, nullptr, false) {
+        double a_min = std::numeric_limits<double>::infinity(), v_axes = 0;
+        for (std::size_t i = 0; i < profile.axes.size(); ++i) {
+            a_min = std::min(a_min, limits.acceleration[i]);
+            v_axes += limits.velocity[i] * limits.velocity[i];
+        }
+        a_min_ = a_min;
+        v_axes_ = std::sqrt(v_axes);
+        top_speed_ = std::min(v_axes_, std::max(profile.feed, profile.travel_feed));
+        total_ = source.size_hint();
+    }
+
+    /// Plans the job; false when the per-tick check found a tick over a limit (`check` says
+    /// which), true when every span went to the sink.
+    bool run(PlanCheck& check, PlanTotals& totals) {
+        std::size_t want = window_segments();
+        for (;;) {
+            read(want);
+            if (buffer_.empty()) break;  // nothing at all
+            const std::size_t window_first = window_start();
+            buffer_.erase(buffer_.begin(), buffer_.begin() + static_cast<std::ptrdiff_t>(window_first - base_));
+            base_ = window_first;
+            const PathGrid pg = build_grid(buffer_, profile_, options_, base_);
+            const double end = pg.grid.size() > 0 ? pg.grid.lambda.back() : 0.0;
+            const double carry_lambda = carry_in(pg);
+            double commit = std::numeric_limits<double>::infinity();
+            if (!exhausted_) {
+                commit = end - horizon();
+                // Room for at least a couple of spans past the carry, else read more.
+                const double room = 2 * v_axes_ * profile_.ticks_per_span / profile_.tick_hz + 1e-3;
+                if (!(commit > carry_lambda + room) && want < kMaxWindowSegments) {
+                    want *= 2;
+                    continue;
+                }
+                commit = std::max(commit, carry_lambda);
+            }
+            const auto before = std::pair{carry_.segment, carry_.lambda_in_segment};
+            plan_window(pg, carry_lambda, commit);
+            st_.grid_nodes += pg.grid.size();
+            if (exhausted_ && !cut_) {
+                emitter().finish(last_subpath_);
+                if (!deliver()) return fail(check);
+                break;
+            }
+            if (!deliver()) return fail(check);
+            if (std::pair{carry_.segment, carry_.lambda_in_segment} == before) {
+                // No span fitted before the commit point: a longer window moves it further.
+                if (want >= kMaxWindowSegments) throw PlanError("internal: the windowed planner made no progress");
+                want *= 2;
+            } else {
+                want = window_segments();
+            }
+            if (total_ > 0) report_(lo_ + (hi_ - lo_) * static_cast<double>(carry_.segment) / static_cast<double>(total_));
+        }
+        check = checker_.finish();
+        if (!check.within_limits) return false;
+        totals.spans = spans_;
+        totals.pen_changes = pens_;
+        totals.pauses = pauses_;
+        totals.total_ticks = emitter_ ? emitter_->total_ticks() : 0;
+        totals.duration = static_cast<double>(totals.total_ticks) / profile_.tick_hz;
+        totals.path_length = pen_down_length_;
+        totals.travel_length = travel_length_;
+        if (emitter_) {
+            st_.motion_spans = emitter_->motion_spans();
+            st_.motion_ticks = emitter_->motion_ticks();
+            st_.dwell_ticks = emitter_->dwell_ticks();
+        }
+        return true;
+    }
+
+    /// Whether any event went to the sink.
+    bool sent() const { return spans_ + pens_ + pauses_ > 0; }
+
+private:
+    SpanEmitter& emitter() { return *emitter_; }
+    std::size_t window_segments() const { return std::clamp<std::size_t>(options_.window_segments, 16, kMaxWindowSegments); }
+
+    bool fail(PlanCheck& check) {
+        check = checker_.finish();
+        return false;
+    }
+
+    /// Reads until `want` segments lie at or after the carry's segment, or the path ends.
+    void read(std::size_t want) {
+        while (!exhausted_ && buffer_.size() - (carry_.segment - base_) < want) {
+            BezierSegment s;
+            if (!source_.next(s)) {
+                exhausted_ = true;
+                break;
+            }
+            account(s);
+            checker_.note_segment(s);
+            top_speed_ = std::max(top_speed_, std::min(v_axes_, s.feed));
+            buffer_.push_back(std::move(s));
+        }
+    }
+
+    /// The pen-down and travel length of a new segment (degenerate ones count nothing).
+    void account(const BezierSegment& s) {
+        if (s.p[0].size() != profile_.axes.size()) return;  // build_grid reports it
+        const Cubic c = to_cubic(s);
+        if (c.size() < 1e-9) return;
+        const double length = arc_length(c, 0, 0.5) + arc_length(c, 0.5, 1);
+        if (!(length >= 1e-9)) return;
+        (s.pen_down ? pen_down_length_ : travel_length_) += length;
+        last_subpath_ = s.subpath;
+    }
+
+    /// Global index of the window's first segment: the carry's, or the one before it when
+    /// the motion continues across their joint (so the joint is planned as before).
+    std::size_t window_start() const {
+        std::size_t first = carry_.segment;
+        if (carry_.moving && first > base_) {
+            const BezierSegment& a = buffer_[first - 1 - base_];
+            const BezierSegment& b = buffer_[first - base_];
+            if (a.pen_down == b.pen_down && a.subpath == b.subpath) --first;
+        }
+        return first;
+    }
+
+    /// The carry's arc length in this window's grid.
+    double carry_in(const PathGrid& pg) const {
+        if (!carry_.started) return 0;
+        const Grid& g = pg.grid;
+        const std::size_t local = carry_.segment - base_;
+        for (std::size_t k = 0; k < g.size(); ++k) {
+            if (g.seg[k] >= local) return g.lambda[k] + (g.seg[k] == local ? carry_.lambda_in_segment : 0.0);
+        }
+        return g.size() > 0 ? g.lambda.back() : 0.0;
+    }
+
+    /// The longest stopping distance plus a margin: beyond it the lookahead sees as far as it
+    /// would on the whole path (the lookahead plans speed changes with part of the budget,
+    /// less near corners, hence twice the plain v^2 / 2a).
+    double horizon() const {
+        const double span = profile_.ticks_per_span / profile_.tick_hz;
+        return 1.1 * top_speed_ * top_speed_ / a_min_ + 4 * top_speed_ * span + 1.0;
+    }
+
+    void plan_window(const PathGrid& pg, double carry_lambda, double commit) {
+        const Grid& g = pg.grid;
+        WindowLookahead la(pg, limits_, profile_, options_);
+        cut_ = false;
+        if (!emitter_) {
+            emitter_.emplace(profile_, g.axes, pg.runs.front().start);
+            carry_.q = on_lsb_grid(pg.runs.front().start, profile_.mm_per_lsb, g.axes);
+            carry_.started = true;
+        }
+        bool carried_used = false;
+        for (std::size_t r = 0; r < pg.runs.size() && !cut_; ++r) {
+            const Run& run = pg.runs[r];
+            // Messages measure along the whole run: a run continued from the last window
+            // started before this grid.
+            const double run_start = g.lambda[pg.pieces[run.pieces.front()].first];
+            const double run_offset = r == 0 && carry_.moving ? carry_.run_offset - (segment_start(pg) - run_start) : 0.0;
+            for (const std::size_t index : run.pieces) {
+                const Piece& piece = pg.pieces[index];
+                const double first = g.lambda[piece.first], last = g.lambda[piece.last];
+                // Done already: wholly before the carry (a piece at rest at the carry's point
+                // starts there, and zero-length pieces before it were sent).
+                if (last < carry_lambda - 1e-9 || (last <= carry_lambda + 1e-12 && first < last)) continue;
+                if (first < carry_lambda - 1e-9 && !carry_.moving) continue;
+                emitter().begin_run(run);
+                PieceMotion carried;
+                const bool resume = carry_.moving && !carried_used && first <= carry_lambda + 1e-9 &&
+                                    carry_lambda < last;
+                if (resume) {
+                    carried.start.lambda = first;
+                    carried.start.q = carry_.q;
+                    MotionSpan a{0, carry_.prev}, b{carry_.ticks, carry_.last};
+                    a.end.lambda = std::min(carry_lambda, std::max(first, carry_lambda - 1e-9));
+                    b.end.lambda = carry_lambda;
+                    carried.spans = {a, b};
+                    carried_used = true;
+                } else {
+                    emitter().piece_start(carry_.q, run.subpath);
+                }
+                PieceMotion m = plan_piece(la, piece, carry_.q, resume ? &carried : nullptr, run_offset, st_);
+                ++st_.pieces;
+                const std::size_t skip = resume ? 2 : 0;
+                Knot from = skip > 0 ? m.spans[skip - 1].end : m.start;
+                Knot before = skip > 1 ? m.spans[skip - 2].end : m.start;
+                std::uint32_t ticks = skip > 0 ? m.spans[skip - 1].ticks : 0;
+                bool stopped_inside = false;
+                for (std::size_t i = skip; i < m.spans.size(); ++i) {
+                    const MotionSpan& s = m.spans[i];
+                    if (s.end.lambda > commit) {
+                        stopped_inside = true;
+                        break;
+                    }
+                    emitter().motion(from, s, run);
+                    before = from;
+                    from = s.end;
+                    ticks = s.ticks;
+                }
+                carry_.q = from.q;
+                if (stopped_inside) {
+                    cut_ = true;
+                    if (ticks == 0) {  // nothing of this piece sent: it starts the next window at rest
+                        set_carry(pg, run, run_offset, piece.first, first, false, Knot{}, Knot{}, 0);
+                    } else {
+                        set_carry(pg, run, run_offset, node_at(pg, piece, from.lambda), from.lambda, true, before,
+                                  from, ticks);
+                    }
+                    break;
+                }
+                carry_.moving = false;
+            }
+        }
+        if (!cut_ && !exhausted_) {
+            // Everything read was planned before the commit point (the last piece ended
+            // before it): the next window starts after the last segment, at rest.
+            carry_past_end();
+            cut_ = true;
+        }
+    }
+
+    /// Arc length in this grid where the carry's segment starts.
+    double segment_start(const PathGrid& pg) const {
+        const Grid& g = pg.grid;
+        const std::size_t local = carry_.segment - base_;
+        for (std::size_t k = 0; k < g.size(); ++k) {
+            if (g.seg[k] >= local) return g.lambda[k];
+        }
+        return g.size() > 0 ? g.lambda.back() : 0.0;
+    }
+
+    /// The next window continues at node `node` of this grid (moving: from knot `last`, which
+    /// the span of `ticks` ticks reached from `prev`; else a piece starts there at rest).
+    /// `run_offset`: mm of `run` before this grid.
+    void set_carry(const PathGrid& pg, const Run& run, double run_offset, std::size_t node, double lambda,
+                   bool moving, const Knot& prev, const Knot& last, std::uint32_t ticks) {
+        const Grid& g = pg.grid;
+        std::size_t seg_first = node;
+        while (seg_first > 0 && g.seg[seg_first - 1] == g.seg[node]) --seg_first;
+        const double run_start = g.lambda[pg.pieces[run.pieces.front()].first];
+        carry_.segment = base_ + g.seg[node];
+        carry_.lambda_in_segment = lambda - g.lambda[seg_first];
+        carry_.moving = moving;
+        carry_.prev = prev;
+        carry_.last = last;
+        carry_.ticks = ticks;
+        carry_.run_offset = run_offset + (g.lambda[seg_first] - run_start);
+    }
+
+    /// The next window starts after everything read, at rest.
+    void carry_past_end() {
+        carry_.segment = base_ + buffer_.size();
+        carry_.lambda_in_segment = 0;
+        carry_.moving = false;
+        carry_.run_offset = 0;
+    }
+
+    /// The grid node holding arc length `lambda` inside `piece` (the last node at or before it).
+    static std::size_t node_at(const PathGrid& pg, const Piece& piece, double lambda) {
+        const auto b = pg.grid.lambda.begin();
+        std::size_t k = static_cast<std::size_t>(
+            std::upper_bound(b + static_cast<std::ptrdiff_t>(piece.first), b + static_cast<std::ptrdiff_t>(piece.last) + 1,
+                             lambda) -
+            b);
+        k = k == 0 ? 0 : k - 1;
+        return std::clamp(k, piece.first, piece.last);
+    }
+
+    /// The window's events through the per-tick check, then to the sink; false when the check
+    /// found a tick over a limit (nothing of this window goes to the sink then).
+    bool deliver() {
+        std::vector<PlanEvent> events = emitter().take();
+        for (const PlanEvent& e : events) {
+            if (e.kind == PlanEvent::Kind::kSpan) checker_.span(e.span);
+            else if (e.kind == PlanEvent::Kind::kPen) checker_.pen(e.pen);
+        }
+        if (checker_.over_limits()) return false;
+        for (const PlanEvent& e : events) {
+            switch (e.kind) {
+                case PlanEvent::Kind::kSpan:
+                    sink_.span(e.span);
+                    ++spans_;
+                    break;
+                case PlanEvent::Kind::kPen:
+                    sink_.pen(e.pen);
+                    ++pens_;
+                    break;
+                case PlanEvent::Kind::kPause:
+                    sink_.pause(e.pause);
+                    ++pauses_;
+                    break;
+            }
+        }
+        return true;
+    }
+
+    SegmentSource& source_;
+    const MachineProfile& profile_;
+    const PlanOptions& options_;
+    const Limits& limits_;
+    PlanSink& sink_;
+    PlanStats& st_;
+    Progress& report_;
+    double lo_, hi_;
+    TickChecker checker_;
+    std::optional<SpanEmitter> emitter_;
+    std::vector<BezierSegment> buffer_;  ///< segments base_ .. base_ + size - 1
+    std::size_t base_ = 0;
+    bool exhausted_ = false;
+    bool cut_ = false;
+    Carry carry_;
+    double a_min_ = 0, v_axes_ = 0, top_speed_ = 0;
+    std::size_t total_ = 0;
+    std::size_t spans_ = 0, pens_ = 0, pauses_ = 0;
+    double pen_down_length_ = 0, travel_length_ = 0;
+    std::size_t last_subpath_ = 0;
+};
+
+}  // namespace
+
+PlanTotals plan_stream(SegmentSource& source, const MachineProfile& machine_profile, const PlanOptions& options,
+                       PlanSink& sink, PlanStats* stats, const std::function<void(double fraction)>& progress) {
+    validate_plan_inputs(machine_profile, options);
+    MachineProfile profile = machine_profile;  // what is planned with: spans of regular_span_ticks
+    profile.ticks_per_span = regular_span_ticks(machine_profile);
+    Progress report(progress);
+    PlanStats local;
+    PlanStats& st = stats != nullptr ? *stats : local;
+    st = PlanStats{};
+    st.segments = source.size_hint();
+    st.ticks_per_span = profile.ticks_per_span;
+    report(0);
+    Limits limits;
+    for (const auto& a : profile.axes) {
+        limits.velocity.push_back(a.max_velocity);
+        limits.acceleration.push_back(a.max_acceleration);
+    }
+    double lo = 0.0, hi = 0.95;
+    for (int attempt = 0;; ++attempt) {
+        PlanCheck check;
+        PlanTotals totals;
+        WindowPlanner planner(source, profile, options, limits, sink, st, report, lo, hi);
+        if (planner.run(check, totals)) {
+            report(1);
+            return totals;
+        }
+        if (attempt >= options.max_replans) {
+            std::ostringstream m;
+            m << "cannot meet the machine's limits on every tick after " << attempt << " replans (velocity at "
+              << 100 * check.max_velocity_fraction << " %, acceleration at " << 100 * check.max_acceleration_fraction
+              << " % of the limit after the rounding allowance; the exact cubic at "
+              << 100 * std::max(check.max_velocity_fraction_exact, check.max_span_velocity_fraction) << " % and "
+              << 100 * std::max(check.max_acceleration_fraction_exact, check.max_span_acceleration_fraction) << " %)";
+            throw PlanError(m.str());
+        }
+        if (!source.rewind() || (planner.sent() && !sink.restart())) {
+            throw PlanError("the plan needs lowered limits (a tick over a limit after rounding) but the spans "
+                            "already sent cannot be taken back");
+        }
+        for (std::size_t i = 0; i < profile.axes.size(); ++i) {
+            const double fv = std::max(check.axis_velocity_fraction[i], check.axis_velocity_fraction_exact[i]);
+            const double fa = std::max(check.axis_acceleration_fraction[i], check.axis_acceleration_fraction_exact[i]);
+            if (fv > 1) limits.velocity[i] *= 0.99 / fv;
+            if (fa > 1) limits.acceleration[i] *= 0.99 / fa;
+            st.velocity_scale = std::min(st.velocity_scale, limits.velocity[i] / profile.axes[i].max_velocity);
+            st.acceleration_scale = std::min(st.acceleration_scale, limits.acceleration[i] / profile.axes[i].max_acceleration);
+        }
+        ++st.replans;
+        lo = hi;
+        hi = lo + (0.99 - lo) * 0.8;
+    }
+}
+
+}  // namespace pathstream::host
