@@ -61,16 +61,21 @@ using Planner = PeerPlan (*)(std::vector<LineMove>, const MachineProfile&);
 PeerPlan grbl(std::vector<LineMove> m, const MachineProfile& p) { return plan_grbl_style(std::move(m), p); }
 PeerPlan klipper(std::vector<LineMove> m, const MachineProfile& p) { return plan_klipper_style(std::move(m), p); }
 
-void straight_lines(Checker& c, const char* name, Planner plan) {
+/// `cruise_ratio`: the share of a lone short move spent cruising (0 for grbl's triangle).
+void straight_lines(Checker& c, const char* name, Planner plan, double cruise_ratio) {
     const MachineProfile p = test_profile();
     const std::string n = name;
     // 100 mm along x at 80 mm/s, 3000 mm/s^2: trapezoid L/v + v/a.
     const PeerPlan line = plan(flatten_to_lines({straight({0, 0}, {100, 0})}, p), p);
     c.near(line.motion_time(), 100.0 / 80 + 80.0 / 3000, 1e-9, n + " 100 mm line time");
     c.expect(consistency_problem(line).empty(), n + " 100 mm line consistent: " + consistency_problem(line));
-    // 1 mm: a triangle, peak sqrt(a L) = 54.8 mm/s < feed; time 2 sqrt(L / a).
+    // 1 mm, too short to reach the feed: grbl accelerates over half of it and brakes over the
+    // other half (a triangle, peak sqrt(a L) = 54.8 mm/s, time 2 sqrt(L / a)); Klipper's
+    // minimum cruise ratio r keeps a share r cruising: peak v^2 = a L (1 - r), time
+    // 2 v / a + r L / v.
     const PeerPlan short_line = plan(flatten_to_lines({straight({0, 0}, {0, 1})}, p), p);
-    c.near(short_line.motion_time(), 2 * std::sqrt(1.0 / 3000), 1e-9, n + " 1 mm triangle time");
+    const double peak = std::sqrt(3000 * 1.0 * (1 - cruise_ratio));
+    c.near(short_line.motion_time(), 2 * peak / 3000 + cruise_ratio * 1.0 / peak, 1e-9, n + " 1 mm short move time");
     // Diagonal at 1000 mm/s requested: each axis at 250 mm/s and 3000 mm/s^2, so along the
     // move 250 sqrt 2 and 3000 sqrt 2.
     const double l = 100 * std::sqrt(2.0), v = 250 * std::sqrt(2.0), a = 3000 * std::sqrt(2.0);
@@ -168,8 +173,8 @@ void random_polylines(Checker& c) {
 
 int run_reference_self_test() {
     Checker c;
-    straight_lines(c, "grbl", grbl);
-    straight_lines(c, "Klipper", klipper);
+    straight_lines(c, "grbl", grbl, 0);
+    straight_lines(c, "Klipper", klipper, kKlipperMinimumCruiseRatio);
     corners(c);
     flattening(c);
     random_polylines(c);
