@@ -10,6 +10,8 @@
 #include <csignal>
 #include <cstdio>
 #include <cstring>
+#include <ctime>
+#include <limits>
 #include <fstream>
 #include <new>
 #include <sstream>
@@ -27,13 +29,23 @@ namespace {
 struct ChildReport {
     int phase = 0;  ///< 1 planned, 2 checked
     std::size_t segments = 0, spans = 0;
-    double plan_seconds = 0, check_seconds = 0;
+    double plan_seconds = 0, plan_cpu_seconds = 0, check_seconds = 0;
+    int runs = 0;
     double input_mb = 0, plan_peak_mb = 0, peak_mb = 0;
     bool check_passed = false;
     char message[240] = {};
 };
 
 constexpr int kExitPlanFailed = 3, kExitOutOfMemory = 4;
+constexpr int kMaxRuns = 5;            ///< plans per size at most...
+constexpr double kRunsSeconds = 1.0;   ///< ...while they have taken less than this in all
+
+/// CPU time of this process (the child: planning is single-threaded), s.
+double cpu_seconds() {
+    timespec t{};
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+    return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+}
 
 /// A field of /proc/self/status in MB ("VmRSS", "VmHWM"), 0 if absent.
 double status_mb(const char* field) {
@@ -84,9 +96,23 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
         std::vector<host::BezierSegment> segments = host::to_bezier_segments(wander_path(points));
         report.segments = segments.size();
         report.input_mb = status_mb("VmRSS");
-        const auto t0 = std::chrono::steady_clock::now();
-        const host::Plan plan = host::plan_path(segments, profile);
-        report.plan_seconds = seconds_since(t0);
+        // Small sizes are planned several times (best wall time kept): one run of a
+        // millisecond-scale plan on a shared machine says more about the scheduler than the planner.
+        host::Plan plan;
+        report.plan_seconds = std::numeric_limits<double>::infinity();
+        const auto started = std::chrono::steady_clock::now();
+        for (int run = 0; run < kMaxRuns && (run == 0 || seconds_since(started) < kRunsSeconds); ++run) {
+            plan = host::Plan{};
+            const double cpu0 = cpu_seconds();
+            const auto t0 = std::chrono::steady_clock::now();
+            plan = host::plan_path(segments, profile);
+            const double wall = seconds_since(t0);
+            if (wall < report.plan_seconds) {
+                report.plan_seconds = wall;
+                report.plan_cpu_seconds = cpu_seconds() - cpu0;
+            }
+            report.runs = run + 1;
+        }
         report.plan_peak_mb = status_mb("VmHWM");
         report.spans = plan.spans.size();
         report.phase = 1;
@@ -155,6 +181,8 @@ ScalingRow run_one(std::size_t points, const ScalingOptions& options, const host
     row.planned = last.phase >= 1;
     row.checked = last.phase >= 2;
     row.plan_seconds = last.plan_seconds;
+    row.plan_cpu_seconds = last.plan_cpu_seconds;
+    row.runs = last.runs;
     row.check_seconds = last.check_seconds;
     row.input_mb = last.input_mb;
     row.plan_peak_mb = last.plan_peak_mb;
@@ -204,22 +232,28 @@ void print_scaling(const std::vector<ScalingRow>& rows, const ScalingOptions& op
     std::printf("targets: 10k segments in <= 50 ms; us/segment within 1.5x of the 1k figure up to 1M; "
                 "peak RSS at 1M <= 64 MB and within 1.2x of 10k (printed, not judged)\n\n");
     if (markdown) {
-        std::printf("| points | segments | spans | plan s | us/segment | ratio to 1k | check s | input MB | plan peak MB | "
-                    "peak MB | load start | load end | status |\n");
-        std::printf("|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|\n");
+        std::printf("| points | segments | spans | plan s | plan CPU s | us/segment | ratio to 1k | CPU ratio to 1k | "
+                    "check s | input MB | plan peak MB | peak MB | load start | load end | status |\n");
+        std::printf("|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|\n");
     } else {
-        std::printf("%9s %9s %8s %9s %10s %8s %9s %8s %8s %8s %6s %6s  %s\n", "points", "segments", "spans", "plan s",
-                    "us/seg", "x 1k", "check s", "input MB", "plan MB", "peak MB", "load0", "load1", "status");
+        std::printf("%9s %9s %8s %9s %9s %8s %6s %6s %9s %8s %8s %8s %6s %6s  %s\n", "points", "segments", "spans",
+                    "plan s", "cpu s", "us/seg", "x 1k", "cpu x", "check s", "input MB", "plan MB", "peak MB", "load0",
+                    "load1", "status");
     }
-    double base = 0;  // us per segment of the first planned size
+    double base = 0, cpu_base = 0;  // us per segment of the first planned size, wall and CPU
     for (const ScalingRow& r : rows) {
-        const double per_segment = r.planned && r.segments > 0 ? 1e6 * r.plan_seconds / static_cast<double>(r.segments) : 0;
-        if (base == 0 && per_segment > 0) base = per_segment;
-        char plan[32] = "-", us[32] = "-", ratio[32] = "-", check[32] = "-", input[32] = "-", plan_mb[32] = "-";
+        const double n = static_cast<double>(r.segments);
+        const double per_segment = r.planned && r.segments > 0 ? 1e6 * r.plan_seconds / n : 0;
+        const double cpu_per_segment = r.planned && r.segments > 0 ? 1e6 * r.plan_cpu_seconds / n : 0;
+        if (base == 0 && per_segment > 0) base = per_segment, cpu_base = cpu_per_segment;
+        char plan[32] = "-", cpu[32] = "-", us[32] = "-", ratio[32] = "-", cpu_ratio[32] = "-", check[32] = "-",
+             input[32] = "-", plan_mb[32] = "-";
         if (r.planned) {
             std::snprintf(plan, sizeof plan, "%.3f", r.plan_seconds);
+            std::snprintf(cpu, sizeof cpu, "%.3f", r.plan_cpu_seconds);
             std::snprintf(us, sizeof us, "%.1f", per_segment);
             std::snprintf(ratio, sizeof ratio, "%.2f", per_segment / base);
+            std::snprintf(cpu_ratio, sizeof cpu_ratio, "%.2f", cpu_base > 0 ? cpu_per_segment / cpu_base : 0);
             std::snprintf(input, sizeof input, "%.1f", r.input_mb);
             std::snprintf(plan_mb, sizeof plan_mb, "%.1f", r.plan_peak_mb);
         }
@@ -227,15 +261,18 @@ void print_scaling(const std::vector<ScalingRow>& rows, const ScalingOptions& op
         const std::string segments = r.planned ? std::to_string(r.segments) : "-";
         const std::string spans = r.planned ? std::to_string(r.spans) : "-";
         if (markdown) {
-            std::printf("| %zu | %s | %s | %s | %s | %s | %s | %s | %s | %.1f | %.2f | %.2f | %s |\n", r.points,
-                        segments.c_str(), spans.c_str(), plan, us, ratio, check, input, plan_mb, r.peak_mb, r.load_start,
-                        r.load_end, r.status.c_str());
+            std::printf("| %zu | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %.1f | %.2f | %.2f | %s |\n", r.points,
+                        segments.c_str(), spans.c_str(), plan, cpu, us, ratio, cpu_ratio, check, input, plan_mb,
+                        r.peak_mb, r.load_start, r.load_end, r.status.c_str());
         } else {
-            std::printf("%9zu %9s %8s %9s %10s %8s %9s %8s %8s %8.1f %6.2f %6.2f  %s\n", r.points, segments.c_str(),
-                        spans.c_str(), plan, us, ratio, check, input, plan_mb, r.peak_mb, r.load_start, r.load_end,
-                        r.status.c_str());
+            std::printf("%9zu %9s %8s %9s %9s %8s %6s %6s %9s %8s %8s %8.1f %6.2f %6.2f  %s\n", r.points,
+                        segments.c_str(), spans.c_str(), plan, cpu, us, ratio, cpu_ratio, check, input, plan_mb,
+                        r.peak_mb, r.load_start, r.load_end, r.status.c_str());
         }
     }
+    std::printf("\nplan s: best of up to %d runs while under %g s in all (1 run for large sizes); cpu s: the "
+                "child's CPU time for that run\n",
+                kMaxRuns, kRunsSeconds);
 }
 
 }  // namespace pathstream::bench

@@ -18,7 +18,7 @@ struct ScalingOptions {
     std::size_t memory_limit_mb = 8192;    ///< the child's address space (RLIMIT_AS)
 };
 
-/// One size's figures. Times are wall seconds measured in the child; memory from the child's
+/// One size's figures. Times are measured in the child; memory from the child's
 /// /proc/self/status (VmRSS after the input was built, VmHWM after planning and at the end).
 struct ScalingRow {
     std::size_t points = 0, segments = 0, spans = 0;
@@ -26,7 +26,10 @@ struct ScalingRow {
     bool planned = false;          ///< plan figures below are valid
     bool checked = false;          ///< check figures below are valid
     bool check_passed = false;
-    double plan_seconds = 0, check_seconds = 0;
+    double plan_seconds = 0;       ///< best wall time of the runs (several for small sizes)
+    double plan_cpu_seconds = 0;   ///< the child's CPU time during that run
+    int runs = 0;                  ///< plans made (best kept)
+    double check_seconds = 0;
     double input_mb = 0;           ///< resident after building the path and its segments
     double plan_peak_mb = 0;       ///< peak resident after planning (input included)
     double peak_mb = 0;            ///< peak resident at the end (check included)
