@@ -11,8 +11,8 @@
 #include <cstdio>
 #include <cstring>
 #include <ctime>
-#include <limits>
 #include <fstream>
+#include <limits>
 #include <new>
 #include <sstream>
 #include <string>
@@ -37,8 +37,8 @@ struct ChildReport {
 };
 
 constexpr int kExitPlanFailed = 3, kExitOutOfMemory = 4;
-constexpr int kMaxRuns = 5;            ///< plans per size at most...
-constexpr double kRunsSeconds = 1.0;   ///< ...while they have taken less than this in all
+constexpr int kMaxRuns = 5;           ///< plans per size at most...
+constexpr double kRunsSeconds = 1.0;  ///< ...while they have taken less than this in all
 
 /// CPU time of this process (the child: planning is single-threaded), s.
 double cpu_seconds() {
@@ -86,7 +86,8 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
 }
 
 /// The child: plan `points`, report, check, report. Never returns.
-[[noreturn]] void child(std::size_t points, const ScalingOptions& options, const host::MachineProfile& profile, int fd) {
+[[noreturn]] void child(std::size_t points, const ScalingOptions& options,
+                        const host::MachineProfile& profile, int fd) {
     alarm(options.timeout_seconds);
     const rlim_t limit = static_cast<rlim_t>(options.memory_limit_mb) << 20;
     const rlimit address_space{limit, limit};
@@ -97,11 +98,13 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
         report.segments = segments.size();
         report.input_mb = status_mb("VmRSS");
         // Small sizes are planned several times (best wall time kept): one run of a
-        // millisecond-scale plan on a shared machine says more about the scheduler than the planner.
+        // millisecond-scale plan on a shared machine says more about the scheduler than the
+        // planner.
         host::Plan plan;
         report.plan_seconds = std::numeric_limits<double>::infinity();
         const auto started = std::chrono::steady_clock::now();
-        for (int run = 0; run < kMaxRuns && (run == 0 || seconds_since(started) < kRunsSeconds); ++run) {
+        for (int run = 0; run < kMaxRuns && (run == 0 || seconds_since(started) < kRunsSeconds);
+             ++run) {
             plan = host::Plan{};
             const double cpu0 = cpu_seconds();
             const auto t0 = std::chrono::steady_clock::now();
@@ -122,7 +125,8 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
         report.check_seconds = seconds_since(t1);
         report.peak_mb = status_mb("VmHWM");
         report.check_passed = check.within_limits && !check.drawing_while_pen_moves &&
-                              check.max_deviation <= profile.chord_tolerance + 1.5 * std::sqrt(2.0) * profile.mm_per_lsb;
+                              check.max_deviation <= profile.chord_tolerance +
+                                                         1.5 * std::sqrt(2.0) * profile.mm_per_lsb;
         report.phase = 2;
         send(fd, report);
         _exit(0);
@@ -135,7 +139,8 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
     }
 }
 
-ScalingRow run_one(std::size_t points, const ScalingOptions& options, const host::MachineProfile& profile) {
+ScalingRow run_one(std::size_t points, const ScalingOptions& options,
+                   const host::MachineProfile& profile) {
     ScalingRow row;
     row.points = points;
     row.load_start = load_average();
@@ -190,8 +195,9 @@ ScalingRow run_one(std::size_t points, const ScalingOptions& options, const host
     // The child's own peak (wait4 gives this child's rusage alone), whatever phase it reached.
     row.peak_mb = static_cast<double>(usage.ru_maxrss) / 1024;
     if (WIFSIGNALED(status)) {
-        row.status = WTERMSIG(status) == SIGALRM ? (row.planned ? "check timeout" : "timeout")
-                                                 : "killed by signal " + std::to_string(WTERMSIG(status));
+        row.status = WTERMSIG(status) == SIGALRM
+                         ? (row.planned ? "check timeout" : "timeout")
+                         : "killed by signal " + std::to_string(WTERMSIG(status));
     } else if (WEXITSTATUS(status) == kExitOutOfMemory) {
         row.status = "out of memory";
     } else if (WEXITSTATUS(status) == kExitPlanFailed) {
@@ -206,7 +212,8 @@ ScalingRow run_one(std::size_t points, const ScalingOptions& options, const host
 
 }  // namespace
 
-std::vector<ScalingRow> run_scaling(const ScalingOptions& options, const host::MachineProfile& profile) {
+std::vector<ScalingRow> run_scaling(const ScalingOptions& options,
+                                    const host::MachineProfile& profile) {
     std::vector<ScalingRow> rows;
     for (std::size_t points : {1'000ul, 10'000ul, 100'000ul, 1'000'000ul}) {
         if (points > options.max_segments) break;
@@ -225,35 +232,43 @@ bool scaling_passed(const std::vector<ScalingRow>& rows) {
     return true;
 }
 
-void print_scaling(const std::vector<ScalingRow>& rows, const ScalingOptions& options, bool markdown) {
-    std::printf("\nscaling: smooth random-walk B-spline of N points, each size planned in its own process "
-                "(limit %u s, %zu MB address space); wall times, machine load = 1-minute load average\n",
-                options.timeout_seconds, options.memory_limit_mb);
-    std::printf("targets: 10k segments in <= 50 ms; us/segment within 1.5x of the 1k figure up to 1M; "
-                "peak RSS at 1M <= 64 MB and within 1.2x of 10k (printed, not judged)\n\n");
+void print_scaling(const std::vector<ScalingRow>& rows, const ScalingOptions& options,
+                   bool markdown) {
+    std::printf(
+        "\nscaling: smooth random-walk B-spline of N points, each size planned in its own process "
+        "(limit %u s, %zu MB address space); wall times, machine load = 1-minute load average\n",
+        options.timeout_seconds, options.memory_limit_mb);
+    std::printf(
+        "targets: 10k segments in <= 50 ms; us/segment within 1.5x of the 1k figure up to 1M; "
+        "peak RSS at 1M <= 64 MB and within 1.2x of 10k (printed, not judged)\n\n");
     if (markdown) {
-        std::printf("| points | segments | spans | plan s | plan CPU s | us/segment | ratio to 1k | CPU ratio to 1k | "
-                    "check s | input MB | plan peak MB | peak MB | load start | load end | status |\n");
-        std::printf("|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|\n");
+        std::printf(
+            "| points | segments | spans | plan s | plan CPU s | us/segment | ratio to 1k | CPU "
+            "ratio to 1k | "
+            "check s | input MB | plan peak MB | peak MB | load start | load end | status |\n");
+        std::printf(
+            "|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|\n");
     } else {
-        std::printf("%9s %9s %8s %9s %9s %8s %6s %6s %9s %8s %8s %8s %6s %6s  %s\n", "points", "segments", "spans",
-                    "plan s", "cpu s", "us/seg", "x 1k", "cpu x", "check s", "input MB", "plan MB", "peak MB", "load0",
-                    "load1", "status");
+        std::printf("%9s %9s %8s %9s %9s %8s %6s %6s %9s %8s %8s %8s %6s %6s  %s\n", "points",
+                    "segments", "spans", "plan s", "cpu s", "us/seg", "x 1k", "cpu x", "check s",
+                    "input MB", "plan MB", "peak MB", "load0", "load1", "status");
     }
     double base = 0, cpu_base = 0;  // us per segment of the first planned size, wall and CPU
     for (const ScalingRow& r : rows) {
         const double n = static_cast<double>(r.segments);
         const double per_segment = r.planned && r.segments > 0 ? 1e6 * r.plan_seconds / n : 0;
-        const double cpu_per_segment = r.planned && r.segments > 0 ? 1e6 * r.plan_cpu_seconds / n : 0;
+        const double cpu_per_segment =
+            r.planned && r.segments > 0 ? 1e6 * r.plan_cpu_seconds / n : 0;
         if (base == 0 && per_segment > 0) base = per_segment, cpu_base = cpu_per_segment;
-        char plan[32] = "-", cpu[32] = "-", us[32] = "-", ratio[32] = "-", cpu_ratio[32] = "-", check[32] = "-",
-             input[32] = "-", plan_mb[32] = "-";
+        char plan[32] = "-", cpu[32] = "-", us[32] = "-", ratio[32] = "-", cpu_ratio[32] = "-",
+             check[32] = "-", input[32] = "-", plan_mb[32] = "-";
         if (r.planned) {
             std::snprintf(plan, sizeof plan, "%.3f", r.plan_seconds);
             std::snprintf(cpu, sizeof cpu, "%.3f", r.plan_cpu_seconds);
             std::snprintf(us, sizeof us, "%.1f", per_segment);
             std::snprintf(ratio, sizeof ratio, "%.2f", per_segment / base);
-            std::snprintf(cpu_ratio, sizeof cpu_ratio, "%.2f", cpu_base > 0 ? cpu_per_segment / cpu_base : 0);
+            std::snprintf(cpu_ratio, sizeof cpu_ratio, "%.2f",
+                          cpu_base > 0 ? cpu_per_segment / cpu_base : 0);
             std::snprintf(input, sizeof input, "%.1f", r.input_mb);
             std::snprintf(plan_mb, sizeof plan_mb, "%.1f", r.plan_peak_mb);
         }
@@ -261,18 +276,23 @@ void print_scaling(const std::vector<ScalingRow>& rows, const ScalingOptions& op
         const std::string segments = r.planned ? std::to_string(r.segments) : "-";
         const std::string spans = r.planned ? std::to_string(r.spans) : "-";
         if (markdown) {
-            std::printf("| %zu | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %.1f | %.2f | %.2f | %s |\n", r.points,
-                        segments.c_str(), spans.c_str(), plan, cpu, us, ratio, cpu_ratio, check, input, plan_mb,
-                        r.peak_mb, r.load_start, r.load_end, r.status.c_str());
+            std::printf(
+                "| %zu | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %.1f | %.2f | %.2f | %s "
+                "|\n",
+                r.points, segments.c_str(), spans.c_str(), plan, cpu, us, ratio, cpu_ratio, check,
+                input, plan_mb, r.peak_mb, r.load_start, r.load_end, r.status.c_str());
         } else {
-            std::printf("%9zu %9s %8s %9s %9s %8s %6s %6s %9s %8s %8s %8.1f %6.2f %6.2f  %s\n", r.points,
-                        segments.c_str(), spans.c_str(), plan, cpu, us, ratio, cpu_ratio, check, input, plan_mb,
-                        r.peak_mb, r.load_start, r.load_end, r.status.c_str());
+            std::printf("%9zu %9s %8s %9s %9s %8s %6s %6s %9s %8s %8s %8.1f %6.2f %6.2f  %s\n",
+                        r.points, segments.c_str(), spans.c_str(), plan, cpu, us, ratio, cpu_ratio,
+                        check, input, plan_mb, r.peak_mb, r.load_start, r.load_end,
+                        r.status.c_str());
         }
     }
-    std::printf("\nplan s: best of up to %d runs while under %g s in all (1 run for large sizes); cpu s: the "
-                "child's CPU time for that run\n",
-                kMaxRuns, kRunsSeconds);
+    std::printf(
+        "\nplan s: best of up to %d runs while under %g s in all (1 run for large sizes); cpu s: "
+        "the "
+        "child's CPU time for that run\n",
+        kMaxRuns, kRunsSeconds);
 }
 
 }  // namespace pathstream::bench

@@ -6,8 +6,8 @@
 
 namespace pathstream::bench {
 
-double grbl_junction_speed2(const host::PathPoint& from, const host::PathPoint& to, const host::MachineProfile& profile,
-                            double junction_deviation) {
+double grbl_junction_speed2(const host::PathPoint& from, const host::PathPoint& to,
+                            const host::MachineProfile& profile, double junction_deviation) {
     // cos_turn = -u1.u2 is the cosine of the angle the two lines make at the vertex: -1 going
     // straight on, +1 turning back.
     double cos_turn = 0;
@@ -16,8 +16,8 @@ double grbl_junction_speed2(const host::PathPoint& from, const host::PathPoint& 
         cos_turn -= from[i] * to[i];
         bend[i] = to[i] - from[i];
     }
-    if (cos_turn > 0.999999) return 0;                                           // a reversal
-    if (cos_turn < -0.999999) return std::numeric_limits<double>::infinity();    // straight on
+    if (cos_turn > 0.999999) return 0;                                         // a reversal
+    if (cos_turn < -0.999999) return std::numeric_limits<double>::infinity();  // straight on
     double bend_length = 0;
     for (double b : bend) bend_length += b * b;
     bend_length = std::sqrt(bend_length);
@@ -27,7 +27,8 @@ double grbl_junction_speed2(const host::PathPoint& from, const host::PathPoint& 
     return a_bend * junction_deviation * sin_half / (1 - sin_half);
 }
 
-PeerPlan plan_grbl_style(std::vector<LineMove> moves, const host::MachineProfile& profile, double junction_deviation) {
+PeerPlan plan_grbl_style(std::vector<LineMove> moves, const host::MachineProfile& profile,
+                         double junction_deviation) {
     const std::size_t n = moves.size();
     std::vector<double> nominal2(n), accel(n), max_entry2(n), entry2(n);
     for (std::size_t k = 0; k < n; ++k) {
@@ -37,7 +38,8 @@ PeerPlan plan_grbl_style(std::vector<LineMove> moves, const host::MachineProfile
         if (k == 0 || moves[k].stop_before) {
             max_entry2[k] = 0;
         } else {
-            const double junction2 = grbl_junction_speed2(moves[k - 1].unit, moves[k].unit, profile, junction_deviation);
+            const double junction2 =
+                grbl_junction_speed2(moves[k - 1].unit, moves[k].unit, profile, junction_deviation);
             max_entry2[k] = std::min({junction2, nominal2[k], nominal2[k - 1]});
         }
     }

@@ -31,8 +31,8 @@ constexpr double kGrblJunctionDeviation = 0.01;
 
 /// The junction speed squared (mm^2/s^2) between moves with unit directions `from` and `to`,
 /// before the nominal-speed caps. Cost: O(axes).
-double grbl_junction_speed2(const host::PathPoint& from, const host::PathPoint& to, const host::MachineProfile& profile,
-                            double junction_deviation);
+double grbl_junction_speed2(const host::PathPoint& from, const host::PathPoint& to,
+                            const host::MachineProfile& profile, double junction_deviation);
 
 /// Plans `moves` (flatten_to_lines) with the rules above. O(moves).
 PeerPlan plan_grbl_style(std::vector<LineMove> moves, const host::MachineProfile& profile,

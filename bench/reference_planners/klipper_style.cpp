@@ -19,9 +19,10 @@ struct QueuedMove {
 };
 
 /// The junction caps of `m` after `previous` (unit directions `from`, `to`).
-void cap_junction(QueuedMove& m, const QueuedMove& previous, const host::PathPoint& from, const host::PathPoint& to,
-                  double junction_deviation) {
-    double start2 = std::min({m.max_cruise2, previous.max_cruise2, previous.max_start2 + previous.delta2});
+void cap_junction(QueuedMove& m, const QueuedMove& previous, const host::PathPoint& from,
+                  const host::PathPoint& to, double junction_deviation) {
+    double start2 =
+        std::min({m.max_cruise2, previous.max_cruise2, previous.max_start2 + previous.delta2});
     double cos_turn = 0;  // -u1.u2: -1 straight on, +1 back
     for (std::size_t i = 0; i < to.size(); ++i) cos_turn -= from[i] * to[i];
     const double sin_half = std::sqrt(std::max(0.5 * (1 - cos_turn), 0.0));
@@ -29,8 +30,9 @@ void cap_junction(QueuedMove& m, const QueuedMove& previous, const host::PathPoi
     if (1 - sin_half > 0 && cos_half > 0) {
         const double r = sin_half / (1 - sin_half);
         const double tan_quarter = 0.25 * sin_half / cos_half;  // (L a tan/2) = delta2 tan / 4
-        start2 = std::min({start2, r * junction_deviation * m.accel, r * junction_deviation * previous.accel,
-                           m.delta2 * tan_quarter, previous.delta2 * tan_quarter});
+        start2 = std::min({start2, r * junction_deviation * m.accel,
+                           r * junction_deviation * previous.accel, m.delta2 * tan_quarter,
+                           previous.delta2 * tan_quarter});
     }
     m.max_start2 = start2;
     m.max_smoothed2 = std::min(start2, previous.max_smoothed2 + previous.smooth_delta2);
@@ -41,8 +43,10 @@ void cap_junction(QueuedMove& m, const QueuedMove& previous, const host::PathPoi
 PeerPlan plan_klipper_style(std::vector<LineMove> moves, const host::MachineProfile& profile,
                             double square_corner_velocity, double minimum_cruise_ratio) {
     double a_max = std::numeric_limits<double>::infinity();
-    for (const host::AxisLimits& axis : profile.axes) a_max = std::min(a_max, axis.max_acceleration);
-    const double junction_deviation = square_corner_velocity * square_corner_velocity * (std::sqrt(2.0) - 1) / a_max;
+    for (const host::AxisLimits& axis : profile.axes)
+        a_max = std::min(a_max, axis.max_acceleration);
+    const double junction_deviation =
+        square_corner_velocity * square_corner_velocity * (std::sqrt(2.0) - 1) / a_max;
 
     const std::size_t n = moves.size();
     std::vector<QueuedMove> q(n);
@@ -70,7 +74,8 @@ PeerPlan plan_klipper_style(std::vector<LineMove> moves, const host::MachineProf
     std::vector<Waiting> waiting;
     std::vector<TimedMove> timed(n);
     const auto set_profile = [&](std::size_t k, double start2, double cruise2, double end2) {
-        timed[k] = make_trapezoid(q[k].length, q[k].accel, std::min(start2, cruise2), cruise2, std::min(end2, cruise2));
+        timed[k] = make_trapezoid(q[k].length, q[k].accel, std::min(start2, cruise2), cruise2,
+                                  std::min(end2, cruise2));
     };
     double next_end2 = 0, next_smoothed2 = 0, peak_cruise2 = 0;
     for (std::size_t k = n; k-- > 0;) {
@@ -81,7 +86,8 @@ PeerPlan plan_klipper_style(std::vector<LineMove> moves, const host::MachineProf
         const double smoothed2 = std::min(m.max_smoothed2, reachable_smoothed2);
         if (smoothed2 < reachable_smoothed2) {
             // The smoothed profile accelerates in this move; where it can also decelerate (or
-            // moves wait behind it), its peak here caps the cruise of this move and the waiting ones.
+            // moves wait behind it), its peak here caps the cruise of this move and the waiting
+            // ones.
             if (smoothed2 + m.smooth_delta2 > next_smoothed2 || !waiting.empty()) {
                 peak_cruise2 = std::min(m.max_cruise2, 0.5 * (smoothed2 + reachable_smoothed2));
                 for (const Waiting& w : waiting) {
@@ -90,7 +96,8 @@ PeerPlan plan_klipper_style(std::vector<LineMove> moves, const host::MachineProf
                 }
                 waiting.clear();
             }
-            const double cruise2 = std::min({0.5 * (start2 + reachable_start2), m.max_cruise2, peak_cruise2});
+            const double cruise2 =
+                std::min({0.5 * (start2 + reachable_start2), m.max_cruise2, peak_cruise2});
             set_profile(k, start2, cruise2, next_end2);
         } else {
             waiting.push_back({k, start2, next_end2});
@@ -98,7 +105,8 @@ PeerPlan plan_klipper_style(std::vector<LineMove> moves, const host::MachineProf
         next_end2 = start2;
         next_smoothed2 = smoothed2;
     }
-    for (const Waiting& w : waiting) set_profile(w.move, w.start2, std::min(peak_cruise2, w.start2), w.end2);
+    for (const Waiting& w : waiting)
+        set_profile(w.move, w.start2, std::min(peak_cruise2, w.start2), w.end2);
 
     PeerPlan plan;
     plan.timed = std::move(timed);

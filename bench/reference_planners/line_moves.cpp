@@ -32,14 +32,16 @@ double second_difference(const PathPoint& a, const PathPoint& b, const PathPoint
 /// Equal parameter steps that keep every chord within `tolerance` of the cubic: the second
 /// derivative is linear in u, so its largest length is at an end, 6 max(|D0|, |D1|).
 std::size_t chord_count(const BezierSegment& s, double tolerance) {
-    const double bend = 6 * std::max(second_difference(s.p[0], s.p[1], s.p[2]), second_difference(s.p[1], s.p[2], s.p[3]));
+    const double bend = 6 * std::max(second_difference(s.p[0], s.p[1], s.p[2]),
+                                     second_difference(s.p[1], s.p[2], s.p[3]));
     const double n = std::ceil(std::sqrt(bend / (8 * tolerance)));
     return n < 1 ? 1 : static_cast<std::size_t>(std::min(n, 1e6));
 }
 
 }  // namespace
 
-std::vector<LineMove> flatten_to_lines(const std::vector<BezierSegment>& segments, const MachineProfile& profile) {
+std::vector<LineMove> flatten_to_lines(const std::vector<BezierSegment>& segments,
+                                       const MachineProfile& profile) {
     std::vector<LineMove> moves;
     bool stop_pending = true;  // the job starts at rest
     bool previous_pen = false;
@@ -52,7 +54,9 @@ std::vector<LineMove> flatten_to_lines(const std::vector<BezierSegment>& segment
         const std::size_t n = chord_count(s, profile.chord_tolerance);
         PathPoint from = s.p[0];
         for (std::size_t j = 1; j <= n; ++j) {
-            PathPoint to = j == n ? s.p[3] : host::bezier_point(s, static_cast<double>(j) / static_cast<double>(n));
+            PathPoint to =
+                j == n ? s.p[3]
+                       : host::bezier_point(s, static_cast<double>(j) / static_cast<double>(n));
             LineMove m;
             m.unit.resize(to.size());
             for (std::size_t i = 0; i < to.size(); ++i) m.unit[i] = to[i] - from[i];
@@ -87,7 +91,8 @@ double along_direction_acceleration(const PathPoint& unit, const MachineProfile&
     return a;
 }
 
-TimedMove make_trapezoid(double length, double accel, double v_entry2, double v_cruise2, double v_exit2) {
+TimedMove make_trapezoid(double length, double accel, double v_entry2, double v_cruise2,
+                         double v_exit2) {
     TimedMove t;
     t.accel = accel;
     double d_accel = (v_cruise2 - v_entry2) / (2 * accel);
@@ -125,22 +130,28 @@ std::string consistency_problem(const PeerPlan& plan) {
         const double slack = 1e-9 * std::max(1.0, t.v_cruise);
         const bool finite = std::isfinite(t.duration()) && std::isfinite(t.v_cruise);
         const double sum = t.d_accel + t.d_cruise + t.d_decel;
-        const bool ok = finite && t.t_accel >= 0 && t.t_cruise >= 0 && t.t_decel >= 0 && t.d_accel >= 0 &&
-                        t.d_cruise >= 0 && t.d_decel >= 0 && std::fabs(sum - m.length) <= 1e-9 * std::max(1.0, m.length) &&
-                        t.v_entry <= t.v_cruise + slack && t.v_exit <= t.v_cruise + slack && t.v_cruise > 0 &&
-                        t.accel > 0;
+        const bool ok = finite && t.t_accel >= 0 && t.t_cruise >= 0 && t.t_decel >= 0 &&
+                        t.d_accel >= 0 && t.d_cruise >= 0 && t.d_decel >= 0 &&
+                        std::fabs(sum - m.length) <= 1e-9 * std::max(1.0, m.length) &&
+                        t.v_entry <= t.v_cruise + slack && t.v_exit <= t.v_cruise + slack &&
+                        t.v_cruise > 0 && t.accel > 0;
         if (!ok) {
-            std::snprintf(text, sizeof text, "move %zu: inconsistent trapezoid (%.6g mm: %.6g/%.6g/%.6g mm, %.6g/%.6g/%.6g mm/s)", k,
-                          m.length, t.d_accel, t.d_cruise, t.d_decel, t.v_entry, t.v_cruise, t.v_exit);
+            std::snprintf(text, sizeof text,
+                          "move %zu: inconsistent trapezoid (%.6g mm: %.6g/%.6g/%.6g mm, "
+                          "%.6g/%.6g/%.6g mm/s)",
+                          k, m.length, t.d_accel, t.d_cruise, t.d_decel, t.v_entry, t.v_cruise,
+                          t.v_exit);
             return text;
         }
         const double previous_exit = k == 0 ? 0 : plan.timed[k - 1].v_exit;
         if (m.stop_before && (t.v_entry > slack || previous_exit > slack)) {
-            std::snprintf(text, sizeof text, "move %zu: not at rest at a stop (%.6g mm/s)", k, t.v_entry);
+            std::snprintf(text, sizeof text, "move %zu: not at rest at a stop (%.6g mm/s)", k,
+                          t.v_entry);
             return text;
         }
         if (std::fabs(t.v_entry - previous_exit) > slack) {
-            std::snprintf(text, sizeof text, "move %zu: entry %.9g mm/s after exit %.9g mm/s", k, t.v_entry, previous_exit);
+            std::snprintf(text, sizeof text, "move %zu: entry %.9g mm/s after exit %.9g mm/s", k,
+                          t.v_entry, previous_exit);
             return text;
         }
     }

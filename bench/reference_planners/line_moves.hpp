@@ -16,9 +16,9 @@ namespace pathstream::bench {
 /// One straight move, as a G1 line: from `start` to `end` (mm per axis) at up to `feed`.
 struct LineMove {
     host::PathPoint start, end;
-    host::PathPoint unit;      ///< (end - start) / length
-    double length = 0;         ///< mm, > 0 (zero-length pieces are dropped when flattening)
-    double feed = 0;           ///< requested speed, mm/s (the segment's, else the profile's)
+    host::PathPoint unit;  ///< (end - start) / length
+    double length = 0;     ///< mm, > 0 (zero-length pieces are dropped when flattening)
+    double feed = 0;       ///< requested speed, mm/s (the segment's, else the profile's)
     /// The machine is at rest before this move: the start of the job, a pen change, a pause or
     /// a dwell. Both peers stop there as pathstream does (grbl waits for its buffer to drain
     /// before a spindle/pen command; a pen lift is a separate move).
@@ -35,7 +35,8 @@ std::vector<LineMove> flatten_to_lines(const std::vector<host::BezierSegment>& s
 /// The largest speed and acceleration along direction `unit` that keep every axis within its
 /// own limit: min over axes of limit_i / |unit_i| (how grbl scales its per-axis settings).
 double along_direction_velocity(const host::PathPoint& unit, const host::MachineProfile& profile);
-double along_direction_acceleration(const host::PathPoint& unit, const host::MachineProfile& profile);
+double along_direction_acceleration(const host::PathPoint& unit,
+                                    const host::MachineProfile& profile);
 
 /// One move's planned speed profile: accelerate at `accel` from v_entry to v_cruise, cruise,
 /// decelerate at `accel` to v_exit (mm/s, mm/s^2; phases may be empty).
@@ -43,12 +44,14 @@ struct TimedMove {
     double v_entry = 0, v_cruise = 0, v_exit = 0, accel = 0;
     double t_accel = 0, t_cruise = 0, t_decel = 0;  ///< s
     double d_accel = 0, d_cruise = 0, d_decel = 0;  ///< mm, summing to the move's length
+    /// Seconds the move takes.
     double duration() const { return t_accel + t_cruise + t_decel; }
 };
 
 /// Builds the trapezoid of a move of `length` mm from squared speeds (v_cruise2 at least both
 /// ends'; the caller ensures the ends are reachable within the length at `accel`).
-TimedMove make_trapezoid(double length, double accel, double v_entry2, double v_cruise2, double v_exit2);
+TimedMove make_trapezoid(double length, double accel, double v_entry2, double v_cruise2,
+                         double v_exit2);
 
 /// A reference planner's whole result: the moves and their profiles, one each.
 struct PeerPlan {

@@ -49,7 +49,8 @@ TickFigures sample_at_ticks(const PeerPlan& plan, const host::MachineProfile& pr
             const double step = std::fabs(now[i] - before[i]);
             const double second = std::fabs(after[i] - 2 * now[i] + before[i]);
             const double a_limit = profile.axes[i].max_acceleration;
-            f.max_velocity_fraction = std::max(f.max_velocity_fraction, step / (profile.axes[i].max_velocity * tick));
+            f.max_velocity_fraction =
+                std::max(f.max_velocity_fraction, step / (profile.axes[i].max_velocity * tick));
             if (second / (a_limit * tick * tick) > f.max_acceleration_fraction) {
                 f.max_acceleration_fraction = second / (a_limit * tick * tick);
                 f.worst_time = static_cast<double>(k) * tick;

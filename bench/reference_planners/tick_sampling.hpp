@@ -12,7 +12,7 @@ namespace pathstream::bench {
 
 /// Largest per-tick figures of a sampled profile, over all axes and ticks.
 struct TickFigures {
-    std::uint64_t ticks = 0;       ///< samples taken after the start (the last one at rest)
+    std::uint64_t ticks = 0;  ///< samples taken after the start (the last one at rest)
     /// Largest change of an axis's per-tick velocity from one tick to the next, mm/s
     /// (|p[k+1] - 2 p[k] + p[k-1]| / T), and the limit's own per-tick step a_i T.
     double max_velocity_step = 0;
@@ -21,7 +21,7 @@ struct TickFigures {
     double max_acceleration_fraction = 0;
     /// Largest |first difference| / (v_i T): the per-tick velocity over the axis limit.
     double max_velocity_fraction = 0;
-    double worst_time = 0;          ///< s, where max_acceleration_fraction was found
+    double worst_time = 0;  ///< s, where max_acceleration_fraction was found
     /// Where the sampled motion ended (mm per axis) and how far it is from the last move's end.
     double end_error = 0;
 };
