@@ -1,111 +1,67 @@
-// bench_plan: how long does planning a 10,000-segment drawing take, and how close to the
-// time-optimal motion is the plan the device executes?
+// bench_plan: how long does planning a drawing take, how close to the time-optimal motion is the
+// plan the device executes, how does it compare with a grbl-style and a Klipper-style planner on
+// the same limits, and how do planning time and memory grow with the job?
 //
-// Paths (2 axes, millimetres), each --segments Bezier segments long (default 10,000):
-//   * rose     : closed uniform B-spline through N points of a 7-petal rose r = 60 cos(7 t);
-//   * wander   : open uniform B-spline through N - 1 points of a smooth random walk (seeded);
-//   * spiral   : polyline of N straight segments along an Archimedean spiral (every vertex a
-//                small corner, crossed at the corner speed).
 // Machine: examples/machines/pen_plotter.json's values (250 mm/s, 3000 mm/s^2 per axis, 1 kHz,
-// 8 ticks per span, 1 um LSB, feed 80 mm/s, chord tolerance 5 um).
+// 8 ticks per span, 1 um LSB, feed 80 mm/s, chord tolerance 5 um); the examples are planned on
+// that file itself, read as the CLI reads it.
 //
-// For each path, in the same run:
-//   * plan       : plan_path with the default options; wall time best of --runs (3) runs;
-//   * fine       : the same planner on a --density (16) times denser lookahead grid (grid step
-//                  and min nodes per segment x density, max turn / 4): the planner's own
-//                  converged figure;
-//   * optimum    : the continuous time-optimal profile (TOPP-RA forward pass, piecewise
-//                  constant path acceleration, full limits, no margins, no whole ticks) on that
-//                  dense grid: an independent lower bound of what any plan of this path can do.
-// "motion" is the executed motion time (span ticks / tick_hz, pen dwells excluded); "% above"
-// compares it with fine and with optimum. Every plan goes through check_plan (every tick, the
-// core's setpoints): within the limits, no motion during pen dwells, deviation within the chord
-// tolerance plus 1.5 sqrt(2) LSB; any failure prints why and exits with 1. Timings and the
-// motion times against fine and optimum are printed, never judged.
+// 1. Grid table: three 2-axis drawings of --segments Bezier segments (default 10,000) --
+//    rose (closed B-spline, 7 petals), wander (open B-spline random walk), spiral (polyline,
+//    every vertex a small corner; plan_paths.hpp):
+//    * plan       : plan_path with the default options; wall time best of --runs (3) runs;
+//    * fine       : the same planner on a --density (16) times denser lookahead grid (grid step
+//                   and min nodes per segment x density, max turn / 4): the planner's own
+//                   converged figure;
+//    * optimum    : the continuous time-optimal profile (TOPP-RA forward pass, piecewise
+//                   constant path acceleration, full limits, no margins, no whole ticks) on that
+//                   dense grid: an independent lower bound of what any plan of this path can do.
+//    "motion" is the executed motion time (span ticks / tick_hz, pen dwells excluded).
+// 2. Peer table (peer_comparison.hpp): the 1k and 10k spiral, random polylines with sharp
+//    (0.5-2.5 rad) and shallow (0.05-0.3 rad) corners, the random walk, the rose and every
+//    drawing in examples/, planned by pathstream and by the reference planners of
+//    bench/reference_planners/ (grbl-style junction deviation, Klipper-style square corner
+//    velocity); pathstream's motion time over theirs, its continuous optimum, and the peers'
+//    largest per-tick velocity step and acceleration sampled from their own profiles.
+// 3. --scaling (plan_scaling.hpp): 1k, 10k, 100k, 1M-point random walks, each planned in a
+//    forked child with a wall-time limit: time per segment, its ratio to 1k, peak RSS, load.
+// Every pathstream plan goes through check_plan (every tick, the core's setpoints): within the
+// limits, no motion during pen dwells, deviation within the chord tolerance plus 1.5 sqrt(2)
+// LSB. Timings, motion-time ratios and the targets' tallies are printed, never judged.
 //
-// Usage: bench_plan [--quick] [--segments N] [--density D] [--runs R] [--markdown] [--help]
-// Exit status (also printed by --help): 0 every plan passed its check, 1 a plan failed its check
-// or could not be made, 2 usage error.
+// Usage: bench_plan [--quick] [--segments N] [--density D] [--runs R] [--no-peers] [--markdown]
+//        bench_plan --scaling [--max-segments N] [--timeout S] [--markdown]
+//        bench_plan --self-test
+// Exit status (also printed by --help): 0 every plan passed its check (and the peers are
+// self-consistent); 1 a plan failed its check or could not be made, a peer's result is
+// inconsistent, or a self-test check failed; 2 usage error.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
-#include <random>
+#include <fstream>
 #include <string>
 #include <vector>
 
 #include "pathstream/host/geometry.hpp"
 #include "pathstream/host/planner.hpp"
+#include "peer_comparison.hpp"
+#include "plan_paths.hpp"
+#include "plan_scaling.hpp"
+#include "reference_planners/self_test.hpp"
 
 using namespace pathstream::host;
+using namespace pathstream::bench;
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-
-MachineProfile pen_plotter() {
-    MachineProfile p;
-    p.axes = {{"x", 250, 3000}, {"y", 250, 3000}};
-    p.mm_per_lsb = 0.001;
-    p.tick_hz = 1000;
-    p.ticks_per_span = 8;
-    p.feed = 80;
-    p.travel_feed = 200;
-    p.pen_down_delay = 0.08;
-    p.pen_up_delay = 0.06;
-    p.chord_tolerance = 0.005;
-    return p;
-}
-
-Path rose(std::size_t n) {
-    Subpath s;
-    s.basis = PathBasis::kBSpline;
-    s.closed = true;
-    for (std::size_t i = 0; i < n; ++i) {
-        const double t = 2 * kPi * static_cast<double>(i) / static_cast<double>(n);
-        const double r = 60 * std::cos(7 * t);
-        s.points.push_back({r * std::cos(t), r * std::sin(t)});
-    }
-    Path p;
-    p.subpaths = {s};
-    return p;
-}
-
-Path wander(std::size_t n) {
-    std::mt19937_64 rng(20261122);
-    std::normal_distribution<double> turn(0, 0.25);
-    Subpath s;
-    s.basis = PathBasis::kBSpline;
-    double x = 0, y = 0, heading = 0;
-    for (std::size_t i = 0; i + 1 < n; ++i) {  // an open B-spline of m points has m - 1 segments
-        s.points.push_back({x, y});
-        heading += turn(rng);
-        x += 1.5 * std::cos(heading);
-        y += 1.5 * std::sin(heading);
-        // stay within a 200 mm square: steer back towards the centre near the edges
-        if (std::fabs(x) > 100 || std::fabs(y) > 100) heading = std::atan2(-y, -x) + turn(rng);
-    }
-    s.points.push_back({x, y});
-    Path p;
-    p.subpaths = {s};
-    return p;
-}
-
-Path spiral(std::size_t n) {
-    Subpath s;
-    s.basis = PathBasis::kPolyline;
-    const double turns = 20, pitch = 3;  // mm between turns
-    for (std::size_t i = 0; i <= n; ++i) {
-        const double t = 2 * kPi * turns * static_cast<double>(i) / static_cast<double>(n);
-        const double r = 5 + pitch * t / (2 * kPi);
-        s.points.push_back({r * std::cos(t), r * std::sin(t)});
-    }
-    Path p;
-    p.subpaths = {s};
-    return p;
-}
+#ifdef PATHSTREAM_SOURCE_DIR
+const std::string kSource = PATHSTREAM_SOURCE_DIR;
+#else
+const std::string kSource = ".";
+#endif
 
 struct Row {
     std::string name;
@@ -120,62 +76,17 @@ double ms_since(std::chrono::steady_clock::time_point t0) {
     return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
 
-}  // namespace
 
-constexpr const char* kUsageText =
-    "usage: bench_plan [--quick] [--segments N] [--density D] [--runs R] [--markdown] [--help]\n"
-    "  Plans three 2-axis drawings (rose, wander, spiral) of N segments (default 10000) for the "
-    "pen\n"
-    "  plotter and prints planning time, motion time against the same planner on a D times denser\n"
-    "  grid (default 16) and the continuous optimum, and the check of every executed tick.\n"
-    "  --quick        1000 segments, one run (the ctest smoke run)\n"
-    "  --segments N   segments per path (>= 10)\n"
-    "  --density D    the denser grid's factor (>= 1)\n"
-    "  --runs R       planning runs per path, best time kept (default 3)\n"
-    "  --markdown     the table in Markdown\n"
-    "targets (independent of the machine's speed): every plan within the limits for its exact\n"
-    "cubic and every tick, no motion during a pen dwell, deviation within the chord tolerance "
-    "plus\n"
-    "1.5 sqrt(2) LSB. Times are printed, never judged.\n"
-    "exit status: 0 every plan passed; 1 a plan failed its check or could not be made; 2 usage\n"
-    "error.\n";
+/// The load averages, as /proc/loadavg has them ("0.54 1.22 1.70").
+std::string load_text() {
+    std::ifstream in("/proc/loadavg");
+    std::string one, five, fifteen;
+    in >> one >> five >> fifteen;
+    return one + " " + five + " " + fifteen;
+}
 
-int main(int argc, char** argv) {
-    std::size_t segments = 10000;
-    double density = 16;
-    int runs = 3;
-    bool markdown = false, quick = false;
-    for (int i = 1; i < argc; ++i) {
-        const std::string a = argv[i];
-        const bool has_value = i + 1 < argc;
-        if (a == "--quick") {
-            quick = true;
-        } else if (a == "--markdown") {
-            markdown = true;
-        } else if (a == "--segments" && has_value) {
-            segments = static_cast<std::size_t>(std::strtoul(argv[++i], nullptr, 10));
-        } else if (a == "--density" && has_value) {
-            density = std::strtod(argv[++i], nullptr);
-        } else if (a == "--runs" && has_value) {
-            runs = std::atoi(argv[++i]);
-        } else if (a == "--help" || a == "-h") {
-            std::fputs(kUsageText, stdout);
-            return 0;
-        } else {
-            std::fputs(kUsageText, stderr);
-            return 2;
-        }
-    }
-    if (quick) {
-        segments = std::min<std::size_t>(segments, 1000);
-        runs = 1;
-    }
-    if (segments < 10 || density < 1 || runs < 1) {
-        std::fprintf(stderr, "bench_plan: --segments >= 10, --density >= 1, --runs >= 1\n");
-        return 2;
-    }
-
-    const MachineProfile profile = pen_plotter();
+/// The grid table: plan, fine grid and optimum for three drawings. False if a plan failed.
+bool run_grid_table(std::size_t segments, double density, int runs, bool markdown, const MachineProfile& profile) {
     const PlanOptions options;
     PlanOptions fine = options;
     fine.grid_step /= density;
@@ -187,7 +98,7 @@ int main(int argc, char** argv) {
         const char* name;
         Path path;
     };
-    const Named paths[] = {{"rose", rose(segments)}, {"wander", wander(segments)}, {"spiral", spiral(segments)}};
+    const Named paths[] = {{"rose", rose_path(segments)}, {"wander", wander_path(segments)}, {"spiral", spiral_path(segments)}};
     std::vector<Row> rows;
     bool ok = true;
     for (const Named& np : paths) {
@@ -277,5 +188,147 @@ int main(int argc, char** argv) {
     std::printf("\ncheck (exact cubic and every tick within limits, no motion in pen dwells, deviation <= tolerance + "
                 "%.2f um): %s\n",
                 1000 * quantisation, ok ? "passed" : "FAILED");
+    return ok;
+}
+
+/// The peer table. False if a plan failed its check or a peer is inconsistent.
+bool run_peer_table(bool quick, bool markdown, const MachineProfile& profile) {
+    // Quick (the ctest smoke run): the same kinds of path, a tenth of the size.
+    const std::size_t scale = quick ? 10 : 1;
+    struct Named {
+        std::string name;
+        Path path;
+    };
+    const auto sized = [&](const char* kind, std::size_t n) { return std::string(kind) + " " + std::to_string(n / scale); };
+    std::vector<Named> paths = {
+        {sized("spiral", 1000), spiral_path(1000 / scale)},
+        {sized("spiral", 10000), spiral_path(10000 / scale)},
+        {sized("sharp", 1000), random_polyline(1000 / scale, 0.5, 2.5, 11)},
+        {sized("shallow", 1000), random_polyline(1000 / scale, 0.05, 0.3, 12)},
+        {sized("wander", 1000), wander_path(1000 / scale)},
+        {sized("rose", 1000), rose_path(1000 / scale)},
+    };
+    std::vector<PeerRow> rows;
+    for (const Named& n : paths) rows.push_back(compare_with_peers(n.name, n.path, profile));
+    // The examples on the profile file itself, read as `pathstream plan FILE -m ...` reads them.
+    MachineProfile plotter = profile;
+    try {
+        plotter = load_machine_profile(kSource + "/examples/machines/pen_plotter.json");
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "bench_plan: %s\n", e.what());
+        return false;
+    }
+    for (const char* file : {"landscape.svg", "rose.json", "leaf.ngc", "star.csv", "two_pens.svg", "wave.json"}) {
+        try {
+            rows.push_back(compare_with_peers(file, read_example(kSource + "/examples/" + file, plotter), plotter));
+        } catch (const std::exception& e) {
+            PeerRow failed;
+            failed.name = file;
+            failed.problem = e.what();
+            rows.push_back(failed);
+        }
+    }
+    print_peer_table(rows, profile, markdown);
+    bool ok = true;
+    for (const PeerRow& r : rows) {
+        if (!r.problem.empty()) {
+            std::fprintf(stderr, "bench_plan: %s: %s\n", r.name.c_str(), r.problem.c_str());
+            ok = false;
+        }
+    }
+    return ok;
+}
+
+}  // namespace
+
+constexpr const char* kUsageText =
+    "usage: bench_plan [--quick] [--segments N] [--density D] [--runs R] [--no-peers] [--markdown]\n"
+    "       bench_plan --scaling [--max-segments N] [--timeout S] [--markdown]\n"
+    "       bench_plan --self-test\n"
+    "  Plans three 2-axis drawings (rose, wander, spiral) of N segments (default 10000) for the pen\n"
+    "  plotter and prints planning time, motion time against the same planner on a D times denser\n"
+    "  grid (default 16) and the continuous optimum, and the check of every executed tick; then\n"
+    "  the peer table: pathstream's motion time against grbl-style and Klipper-style reference\n"
+    "  planners on spirals, random polylines, a random walk, a rose and the examples, with the\n"
+    "  peers' largest per-tick velocity step and acceleration.\n"
+    "  --quick          1000 segments, one run, peer paths a tenth the size (the ctest smoke run)\n"
+    "  --segments N     segments per path of the grid table (>= 10)\n"
+    "  --density D      the denser grid's factor (>= 1)\n"
+    "  --runs R         planning runs per path, best time kept (default 3)\n"
+    "  --no-peers       the grid table only\n"
+    "  --markdown       the tables in Markdown\n"
+    "  --scaling        planning time and peak memory of 1k, 10k, 100k and 1M-point random walks,\n"
+    "                   each in its own process (this table only)\n"
+    "  --max-segments N largest scaling size (default 1000000)\n"
+    "  --timeout S      wall seconds a scaling size may take (default 300)\n"
+    "  --self-test      the reference planners against closed-form answers\n"
+    "targets (independent of the machine's speed): every plan within the limits for its exact\n"
+    "cubic and every tick, no motion during a pen dwell, deviation within the chord tolerance plus\n"
+    "1.5 sqrt(2) LSB; the peers' results self-consistent. Times and ratios are printed, never judged.\n"
+    "exit status: 0 every plan passed; 1 a plan failed its check or could not be made, a peer's\n"
+    "result is inconsistent, a scaling size failed to plan, or a self-test check failed; 2 usage\n"
+    "error.\n";
+
+int main(int argc, char** argv) {
+    std::size_t segments = 10000;
+    double density = 16;
+    int runs = 3;
+    bool markdown = false, quick = false, peers = true, scaling = false, self_test = false;
+    ScalingOptions scaling_options;
+    for (int i = 1; i < argc; ++i) {
+        const std::string a = argv[i];
+        const bool has_value = i + 1 < argc;
+        if (a == "--quick") {
+            quick = true;
+        } else if (a == "--markdown") {
+            markdown = true;
+        } else if (a == "--no-peers") {
+            peers = false;
+        } else if (a == "--scaling") {
+            scaling = true;
+        } else if (a == "--self-test") {
+            self_test = true;
+        } else if (a == "--segments" && has_value) {
+            segments = static_cast<std::size_t>(std::strtoul(argv[++i], nullptr, 10));
+        } else if (a == "--max-segments" && has_value) {
+            scaling_options.max_segments = static_cast<std::size_t>(std::strtoul(argv[++i], nullptr, 10));
+        } else if (a == "--timeout" && has_value) {
+            scaling_options.timeout_seconds = static_cast<unsigned>(std::strtoul(argv[++i], nullptr, 10));
+        } else if (a == "--density" && has_value) {
+            density = std::strtod(argv[++i], nullptr);
+        } else if (a == "--runs" && has_value) {
+            runs = std::atoi(argv[++i]);
+        } else if (a == "--help" || a == "-h") {
+            std::fputs(kUsageText, stdout);
+            return 0;
+        } else {
+            std::fputs(kUsageText, stderr);
+            return 2;
+        }
+    }
+    if (quick) {
+        segments = std::min<std::size_t>(segments, 1000);
+        runs = 1;
+    }
+    if (segments < 10 || density < 1 || runs < 1 || scaling_options.max_segments < 1000 ||
+        scaling_options.timeout_seconds < 1) {
+        std::fprintf(stderr, "bench_plan: --segments >= 10, --density >= 1, --runs >= 1, --max-segments >= 1000, "
+                             "--timeout >= 1\n");
+        return 2;
+    }
+    if (self_test) return run_reference_self_test() == 0 ? 0 : 1;
+
+    const MachineProfile profile = bench_pen_plotter();
+    std::printf("bench_plan: machine load (1, 5, 15 min) at start: %s\n", load_text().c_str());
+    bool ok = true;
+    if (scaling) {
+        const std::vector<ScalingRow> rows = run_scaling(scaling_options, profile);
+        print_scaling(rows, scaling_options, markdown);
+        ok = scaling_passed(rows);
+    } else {
+        ok = run_grid_table(segments, density, runs, markdown, profile);
+        if (peers) ok = run_peer_table(quick, markdown, profile) && ok;
+    }
+    std::printf("\nbench_plan: machine load at end: %s; %s\n", load_text().c_str(), ok ? "passed" : "FAILED");
     return ok ? 0 : 1;
 }
