@@ -1,7 +1,8 @@
 // bench_plan --scaling: how planning time and memory grow with the job. For 1k, 10k, 100k and
-// 1M points (up to a cap), a smooth random-walk B-spline of that many points is planned in a
-// forked child process, so that each size's peak memory is its own and a size that takes too
-// long or too much memory is stopped without stopping the bench.
+// 1M points (up to a cap), a smooth random-walk B-spline of that many points is made segment
+// by segment and streamed through plan_stream (which checks every tick against the limits as
+// it goes) in a forked child process, so that each size's peak memory is its own and a size
+// that takes too long or too much memory is stopped without stopping the bench.
 #pragma once
 
 #include <cstddef>

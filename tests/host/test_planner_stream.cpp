@@ -14,6 +14,7 @@
 #include <random>
 #include <string>
 
+#include "pathstream/host/core_playback.hpp"
 #include "pathstream/host/geometry.hpp"
 #include "pathstream/host/planner.hpp"
 
@@ -206,4 +207,46 @@ TEST_CASE("a long job plans under a memory ceiling the whole-path planner needs 
     INFO("exit status 0: planned; 1: wrong plan; 2: out of memory; 3: setrlimit failed; 4: other error");
     CHECK(WEXITSTATUS(status) == 0);
 #endif
+}
+
+TEST_CASE("PlanChecker on a streamed plan gives check_plan's figures and the core's setpoints",
+          "[planner][stream]") {
+    Path path;
+    path.axes = 2;
+    for (int c = 0; c < 3; ++c) {
+        Subpath s;
+        s.basis = PathBasis::kCatmullRom;
+        for (int i = 0; i < 30; ++i) s.points.push_back({20.0 * c + 8 * std::cos(i * 0.7), 8 * std::sin(i * 0.9)});
+        path.subpaths.push_back(s);
+    }
+    const auto segments = to_bezier_segments(path);
+    const MachineProfile p = pen_plotter();
+    PlanOptions o;
+    o.window_segments = 20;
+    const Plan plan = plan_path(segments, p, o);
+    const PlanCheck whole = check_plan(plan, segments, p);
+
+    std::vector<std::array<std::int64_t, 3>> played;
+    play_through_core(plan.spans, 2, [&](const PlayedTick& t) {
+        played.push_back({t.setpoint[0], t.setpoint[1], t.pen_down ? 1 : 0});
+    });
+    VectorSegmentSource source(segments);
+    PlanChecker checker(segments, p);
+    std::vector<std::array<std::int64_t, 3>> streamed;
+    checker.on_tick([&](std::uint64_t tick, const std::int64_t* setpoint, bool pen_down) {
+        CHECK(tick == streamed.size());
+        streamed.push_back({setpoint[0], setpoint[1], pen_down ? 1 : 0});
+    });
+    const PlanTotals totals = plan_stream(source, p, o, checker);
+    const PlanCheck check = checker.finish();
+    CHECK(streamed == played);
+    CHECK(checker.spans() == plan.spans.size());
+    CHECK(checker.pen_changes() == plan.pen.size());
+    CHECK(totals.total_ticks == plan.total_ticks);
+    CHECK(check.within_limits == whole.within_limits);
+    CHECK(check.max_deviation == whole.max_deviation);
+    CHECK(check.worst_deviation_tick == whole.worst_deviation_tick);
+    CHECK(check.ticks_checked == whole.ticks_checked);
+    CHECK(check.max_acceleration_fraction_exact == whole.max_acceleration_fraction_exact);
+    CHECK(check.axis_max_step == whole.axis_max_step);
 }

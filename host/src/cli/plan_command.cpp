@@ -26,8 +26,12 @@ void add_plan_command(CLI::App& app, PlanCommandOptions& o) {
     cmd->add_flag("--json", o.json, "print the summary as one JSON document on standard output");
 }
 
-PlannedJob plan_job(const PathOptions& path_options, const std::string& machine_file,
-                    const std::vector<double>* lead_in_from) {
+namespace {
+
+/// Loads both files, checks they agree, and makes the segments (lead-in included): a job ready
+/// to plan.
+PlannedJob prepare_job(const PathOptions& path_options, const std::string& machine_file,
+                       const std::vector<double>* lead_in_from) {
     PlannedJob job;
     job.machine = load_machine_profile(machine_file);
     // The work area serves --fit area; the lead-in's origin is where the order starts from.
@@ -40,6 +44,14 @@ PlannedJob plan_job(const PathOptions& path_options, const std::string& machine_
     job.segments = to_bezier_segments(job.path);
     check_work_area(job.segments, job.path, job.machine, path_options.file);
     if (lead_in_from != nullptr) prepend_lead_in(job.segments, *lead_in_from);
+    return job;
+}
+
+}  // namespace
+
+PlannedJob plan_job(const PathOptions& path_options, const std::string& machine_file,
+                    const std::vector<double>* lead_in_from) {
+    PlannedJob job = prepare_job(path_options, machine_file, lead_in_from);
     const auto t0 = std::chrono::steady_clock::now();
     {
         ProgressBar bar("planning");
@@ -48,6 +60,9 @@ PlannedJob plan_job(const PathOptions& path_options, const std::string& machine_
     job.planning_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     job.check = check_plan(job.plan, job.segments, job.machine);
     check_plan_travel(job.plan, job.path, job.machine, path_options.file);
+    job.span_count = job.plan.spans.size();
+    job.pen_count = job.plan.pen.size();
+    job.pause_count = job.plan.pauses.size();
     return job;
 }
 
@@ -62,7 +77,7 @@ void print_plan_summary(const PlannedJob& job, std::ostream& out) {
     char line[256];
     std::snprintf(line, sizeof line, "  motion: %.3f s (%llu ticks at %g Hz), %zu spans, %zu pen changes\n",
                   job.plan.duration, static_cast<unsigned long long>(job.plan.total_ticks), job.machine.tick_hz,
-                  job.plan.spans.size(), job.plan.pen.size());
+                  job.span_count, job.pen_count);
     out << line;
     if (const std::string layers = layers_text(job.path); !layers.empty()) out << "  " << layers << '\n';
     std::snprintf(line, sizeof line, "  path: %.3f mm drawn, %.3f mm travel; planned in %.3f s\n", job.plan.path_length,
@@ -121,9 +136,9 @@ nlohmann::ordered_json plan_summary_json(const PlanCommandOptions& o, const Plan
     j["duration_s"] = job.plan.duration;
     j["ticks"] = job.plan.total_ticks;
     j["tick_hz"] = job.machine.tick_hz;
-    j["spans"] = job.plan.spans.size();
-    j["pen_changes"] = job.plan.pen.size();
-    j["pauses"] = job.plan.pauses.size();
+    j["spans"] = job.span_count;
+    j["pen_changes"] = job.pen_count;
+    j["pauses"] = job.pause_count;
     j["layers"] = layers_json(job.path);
     j["drawn_length_mm"] = job.plan.path_length;
     j["travel_length_mm"] = job.plan.travel_length;
@@ -138,25 +153,66 @@ nlohmann::ordered_json plan_summary_json(const PlanCommandOptions& o, const Plan
     return j;
 }
 
-/// Writes every executed tick as CSV to `csv`.
-void write_plan_rows(const PlannedJob& job, std::ostream& csv) {
+/// The CSV header: tick, time, one column per axis, pen.
+void write_plan_header(std::size_t axes, std::ostream& csv) {
     csv << "tick,t";
-    for (std::size_t a = 0; a < job.path.axes; ++a) csv << ',' << axis_column_name(a);
+    for (std::size_t a = 0; a < axes; ++a) csv << ',' << axis_column_name(a);
     csv << ",pen\n";
-    play_through_core(job.plan.spans, job.path.axes, [&](const PlayedTick& t) {
-        csv << t.tick << ',' << exact_decimal(static_cast<double>(t.tick) / job.machine.tick_hz);
-        for (std::size_t a = 0; a < job.path.axes; ++a) {
-            csv << ',' << lsb_to_mm_text(t.setpoint[a], job.machine.mm_per_lsb);
-        }
-        csv << ',' << (t.pen_down ? 1 : 0) << '\n';
-    });
 }
 
-/// Writes every executed tick as CSV: to a file atomically (a failed run leaves no file), or
-/// to standard output for "-".
-void write_plan_csv(const PlannedJob& job, const std::string& output) {
-    write_output(output, [&](std::ostream& csv) { write_plan_rows(job, csv); });
+/// One executed tick as a CSV row.
+void write_plan_row(const PlannedJob& job, std::uint64_t tick, const std::int64_t* setpoint, bool pen_down,
+                    std::ostream& csv) {
+    csv << tick << ',' << exact_decimal(static_cast<double>(tick) / job.machine.tick_hz);
+    for (std::size_t a = 0; a < job.path.axes; ++a) csv << ',' << lsb_to_mm_text(setpoint[a], job.machine.mm_per_lsb);
+    csv << ',' << (pen_down ? 1 : 0) << '\n';
 }
+
+/// The plan as it is made: into the per-tick check (whose ticks become CSV rows when `csv` is
+/// given) and through the device's travel check, span by span; nothing of it is kept.
+class StreamedPlan : public PlanSink {
+public:
+    StreamedPlan(PlannedJob& job, const std::string& file, std::ostream* csv)
+        : job_(job), file_(file), checker_(job.segments, job.machine) {
+        if (csv != nullptr) {
+            write_plan_header(job.path.axes, *csv);
+            checker_.on_tick([this, csv](std::uint64_t tick, const std::int64_t* setpoint, bool pen_down) {
+                write_plan_row(job_, tick, setpoint, pen_down, *csv);
+            });
+        }
+    }
+    void span(const CoreSpan& s) override {
+        check_span_travel(s, checker_.spans(), job_.path, job_.machine, file_);
+        checker_.span(s);
+    }
+    void pen(const PenEvent& e) override { checker_.pen(e); }
+    void pause(const PlanPause& p) override { checker_.pause(p); }
+
+    /// Plans the job through this sink; the check's figures and the counts go into the job.
+    void run() {
+        const auto t0 = std::chrono::steady_clock::now();
+        VectorSegmentSource source(job_.segments);
+        PlanTotals totals;
+        {
+            ProgressBar bar("planning");
+            totals = plan_stream(source, job_.machine, PlanOptions{}, *this, nullptr, [&](double f) { bar.update(f); });
+        }
+        job_.planning_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        job_.check = checker_.finish();
+        job_.plan.total_ticks = totals.total_ticks;
+        job_.plan.duration = totals.duration;
+        job_.plan.path_length = totals.path_length;
+        job_.plan.travel_length = totals.travel_length;
+        job_.span_count = totals.spans;
+        job_.pen_count = totals.pen_changes;
+        job_.pause_count = totals.pauses;
+    }
+
+private:
+    PlannedJob& job_;
+    const std::string& file_;
+    PlanChecker checker_;
+};
 
 }  // namespace
 
@@ -164,8 +220,14 @@ int run_plan(const PlanCommandOptions& o) {
     if (o.json && o.output == "-") {
         throw std::invalid_argument("--json and -o -: both would be written to standard output");
     }
-    const PlannedJob job = plan_job(o.path, o.machine);
-    if (!o.output.empty()) write_plan_csv(job, o.output);
+    // The plan is streamed: checked, and written as CSV rows when asked, as it is made (an
+    // output file appears whole or not at all).
+    PlannedJob job = prepare_job(o.path, o.machine, nullptr);
+    if (o.output.empty()) {
+        StreamedPlan(job, o.path.file, nullptr).run();
+    } else {
+        write_output(o.output, [&](std::ostream& csv) { StreamedPlan(job, o.path.file, &csv).run(); });
+    }
     const bool failed = !job.check.within_limits || job.check.drawing_while_pen_moves;
     // With --json, standard output holds the document or, on failure, nothing: the text
     // summary the error message points to then goes to standard error.

@@ -26,9 +26,10 @@ struct PlannedJob {
     Path path;
     MachineProfile machine;
     std::vector<BezierSegment> segments;
-    Plan plan;
+    Plan plan;  ///< empty when the plan was streamed (run_plan): the counts below hold
     PlanCheck check;
     double planning_seconds = 0;
+    std::size_t span_count = 0, pen_count = 0, pause_count = 0;
 };
 
 /// Loads both files, checks they agree (axis count), plans with a progress bar and checks

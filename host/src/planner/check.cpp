@@ -231,6 +231,7 @@ bool TickChecker::in_window(std::uint64_t tick) {
 void TickChecker::visit(const std::array<std::int64_t, kAxesMax>& p, const std::array<double, kAxesMax>& e,
                         const CoreSpan& span) {
     const std::uint64_t k = tick_;
+    if (observer_) observer_(k, p.data(), span.pen_down);
     if (k == 0) {  // at rest before the first tick
         p1_ = p2_ = p;
         e1_ = e2_ = e;
@@ -343,5 +344,31 @@ PlanCheck check_plan_impl(const Plan& plan, const std::vector<BezierSegment>& se
 PlanCheck check_plan(const Plan& plan, const std::vector<BezierSegment>& segments, const MachineProfile& profile) {
     return planner_detail::check_plan_impl(plan, segments, profile, true);
 }
+
+}  // namespace pathstream::host
+
+namespace pathstream::host {
+
+PlanChecker::PlanChecker(const std::vector<BezierSegment>& segments, const MachineProfile& profile)
+    : impl_(std::make_unique<planner_detail::TickChecker>(profile, &segments, true)) {}
+
+PlanChecker::~PlanChecker() = default;
+
+void PlanChecker::span(const CoreSpan& s) {
+    impl_->span(s);
+    ++spans_;
+    ticks_ += s.ticks;
+}
+
+void PlanChecker::pen(const PenEvent& e) {
+    impl_->pen(e);
+    ++pens_;
+}
+
+void PlanChecker::on_tick(std::function<void(std::uint64_t, const std::int64_t*, bool)> observer) {
+    impl_->observe(std::move(observer));
+}
+
+PlanCheck PlanChecker::finish() { return impl_->finish(); }
 
 }  // namespace pathstream::host

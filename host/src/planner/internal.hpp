@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -366,6 +367,10 @@ public:
     bool over_limits() const;
     /// The held end point and the rest after it; the figures of the whole plan.
     PlanCheck finish();
+    /// Called with every executed tick: its number, the core's setpoint (LSB per axis) and
+    /// the pen output of the span playing it (the held end point last).
+    using TickObserver = std::function<void(std::uint64_t tick, const std::int64_t* setpoint, bool pen_down)>;
+    void observe(TickObserver observer) { observer_ = std::move(observer); }
 
 private:
     bool pen_down_at(std::uint64_t tick);
@@ -395,6 +400,7 @@ private:
     double distance_ = 0;
     bool have_distance_ = false;
     CoreSpan last_;
+    TickObserver observer_;
 };
 
 /// check_plan, with the deviation part optional (the planner's own verification skips it).

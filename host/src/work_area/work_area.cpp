@@ -54,32 +54,34 @@ void check_work_area(const std::vector<BezierSegment>& segments, const Path& pat
     }
 }
 
-void check_plan_travel(const Plan& plan, const Path& path, const MachineProfile& profile,
+void check_span_travel(const CoreSpan& s, std::size_t index, const Path& path, const MachineProfile& profile,
                        const std::string& file) {
     const bool any = std::any_of(profile.axes.begin(), profile.axes.end(),
                                  [](const AxisLimits& l) { return l.has_travel; });
     if (!any) return;
     const DeviceLimitsLsb lsb = device_limits(profile);
-    for (std::size_t i = 0; i < plan.spans.size(); ++i) {
-        const CoreSpan& s = plan.spans[i];
-        for (std::size_t a = 0; a < profile.axes.size() && a < s.cubic.size(); ++a) {
-            if (!profile.axes[a].has_travel) continue;
-            device::AxisLimits l;
-            l.min_position = lsb.min_position[a];
-            l.max_position = lsb.max_position[a];
-            if (device::check_axis_travel(s.cubic[a], s.timing, l) == Status::kOk) continue;
-            const AxisLimits& axis = profile.axes[a];
-            const double from = s.control[a][0] * profile.mm_per_lsb;
-            throw InputError(
-                file, location_of(path, s.subpath),
-                "planned span " + std::to_string(i + 1) + " (subpath " + std::to_string(s.subpath + 1) +
-                    (s.pen_down ? "" : ", pen-up travel") + ", from " + axis.name + " = " + mm(from) +
-                    " mm) could leave the " + axis.name + " travel " + mm(axis.travel_min) + " .. " +
-                    mm(axis.travel_max) +
-                    " mm, and the device would refuse it: the path runs within the chord tolerance (" +
-                    mm(profile.chord_tolerance) + " mm) of the edge; move it inside by that much");
-        }
+    for (std::size_t a = 0; a < profile.axes.size() && a < s.cubic.size(); ++a) {
+        if (!profile.axes[a].has_travel) continue;
+        device::AxisLimits l;
+        l.min_position = lsb.min_position[a];
+        l.max_position = lsb.max_position[a];
+        if (device::check_axis_travel(s.cubic[a], s.timing, l) == Status::kOk) continue;
+        const AxisLimits& axis = profile.axes[a];
+        const double from = s.control[a][0] * profile.mm_per_lsb;
+        throw InputError(
+            file, location_of(path, s.subpath),
+            "planned span " + std::to_string(index + 1) + " (subpath " + std::to_string(s.subpath + 1) +
+                (s.pen_down ? "" : ", pen-up travel") + ", from " + axis.name + " = " + mm(from) +
+                " mm) could leave the " + axis.name + " travel " + mm(axis.travel_min) + " .. " +
+                mm(axis.travel_max) +
+                " mm, and the device would refuse it: the path runs within the chord tolerance (" +
+                mm(profile.chord_tolerance) + " mm) of the edge; move it inside by that much");
     }
+}
+
+void check_plan_travel(const Plan& plan, const Path& path, const MachineProfile& profile,
+                       const std::string& file) {
+    for (std::size_t i = 0; i < plan.spans.size(); ++i) check_span_travel(plan.spans[i], i, path, profile, file);
 }
 
 }  // namespace pathstream::host

@@ -5,6 +5,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -159,6 +160,36 @@ struct PlanTotals {
 PlanTotals plan_stream(SegmentSource& source, const MachineProfile& profile, const PlanOptions& options,
                        PlanSink& sink, PlanStats* stats = nullptr,
                        const std::function<void(double fraction)>& progress = {});
+
+namespace planner_detail {
+class TickChecker;
+}
+
+/// check_plan for a plan handed over in order, as a PlanSink (plan_stream's, or a chain):
+/// the same figures from finish(), without the plan held in memory. `segments` and `profile`
+/// must outlive it. Throws PlanError as check_plan when the core refuses a span.
+class PlanChecker : public PlanSink {
+public:
+    PlanChecker(const std::vector<BezierSegment>& segments, const MachineProfile& profile);
+    ~PlanChecker() override;
+    void span(const CoreSpan& span) override;
+    void pen(const PenEvent& event) override;
+    void pause(const PlanPause&) override { ++pauses_; }
+    /// Called with every executed tick as the core makes it: tick number, setpoint (LSB per
+    /// axis) and the pen output (the held end point comes last, from finish()).
+    void on_tick(std::function<void(std::uint64_t tick, const std::int64_t* setpoint, bool pen_down)> observer);
+    /// The held end point; the figures of the whole plan.
+    PlanCheck finish();
+    std::size_t spans() const { return spans_; }
+    std::size_t pen_changes() const { return pens_; }
+    std::size_t pauses() const { return pauses_; }
+    std::uint64_t ticks() const { return ticks_; }
+
+private:
+    std::unique_ptr<planner_detail::TickChecker> impl_;
+    std::size_t spans_ = 0, pens_ = 0, pauses_ = 0;
+    std::uint64_t ticks_ = 0;
+};
 
 /// Checks every executed tick of `plan`: the integer setpoints as the core produces them
 /// (SetpointStream: continuity of every span is enforced) against the per-axis limits, with

@@ -21,6 +21,11 @@ namespace pathstream::host {
 void check_work_area(const std::vector<BezierSegment>& segments, const Path& path,
                      const MachineProfile& profile, const std::string& file);
 
+/// check_plan_travel for one span (`index` counts from 0, for the message), as a streamed
+/// plan comes out.
+void check_span_travel(const CoreSpan& span, std::size_t index, const Path& path, const MachineProfile& profile,
+                       const std::string& file);
+
 /// Throws InputError naming the subpath when a planned span could leave an axis's travel by
 /// the device's proof (device::check_axis_travel on the span's exact cubic): the spans follow
 /// the path within the chord tolerance, so a path that runs along the very edge can be inside
