@@ -5,8 +5,10 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <deque>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -281,6 +283,28 @@ PieceMotion plan_piece(WindowLookahead& lookahead, const Piece& piece, const Vec
 
 /// "subpath N, X mm along it" for a place in a piece.
 std::string where(const PathGrid& pg, const Piece& piece, double lambda, double run_offset);
+
+/// Gives `inner`'s segments with every vertex between two straight segments of one run that
+/// turn by more than 1e-6 and at most `stop_angle` rad replaced by a blend: the segments are
+/// shortened by d each side and a quadratic Bezier (as a cubic) from V - d t1 over V to
+/// V + d t2 joins them, tangent to both, passing `deviation` mm from the vertex (d =
+/// 2 deviation / sin(turn / 2), at most half of each segment). Joints stay shared exactly.
+class CornerBlender : public SegmentSource {
+public:
+    CornerBlender(SegmentSource& inner, double deviation, double stop_angle);
+    bool next(BezierSegment& out) override;
+    bool rewind() override;
+    std::size_t size_hint() const override { return inner_.size_hint(); }
+
+private:
+    void blend(BezierSegment& b);
+
+    SegmentSource& inner_;
+    double deviation_, stop_angle_;
+    std::deque<BezierSegment> ready_;
+    std::optional<BezierSegment> held_;  ///< its end may still be shortened
+    double held_original_length_ = -1;
+};
 
 /// The profile and options plan_path accepts (PlanError otherwise).
 void validate_plan_inputs(const MachineProfile& profile, const PlanOptions& options);

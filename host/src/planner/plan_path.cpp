@@ -100,7 +100,13 @@ Plan plan_path(const std::vector<BezierSegment>& segments, const MachineProfile&
         // for this figure only).
         MachineProfile profile = machine_profile;
         profile.ticks_per_span = regular_span_ticks(machine_profile);
-        const PathGrid pg = build_grid(segments, profile, options);
+        // On the path as planned: corners blended as plan_stream blends them.
+        std::vector<BezierSegment> planned;
+        VectorSegmentSource again(segments);
+        CornerBlender blended(again, options.corner_blend * profile.chord_tolerance, options.corner_stop_angle);
+        SegmentSource& input = options.corner_blend > 0 ? static_cast<SegmentSource&>(blended) : again;
+        for (BezierSegment s; input.next(s);) planned.push_back(s);
+        const PathGrid pg = build_grid(planned, profile, options);
         PlanOptions full = options;
         full.velocity_margin = full.feed_margin = 1;
         Limits machine;

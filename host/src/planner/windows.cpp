@@ -394,10 +394,12 @@ PlanTotals plan_stream(SegmentSource& source, const MachineProfile& machine_prof
         limits.acceleration.push_back(a.max_acceleration);
     }
     double lo = 0.0, hi = 0.95;
+    CornerBlender blended(source, options.corner_blend * profile.chord_tolerance, options.corner_stop_angle);
+    SegmentSource& input = options.corner_blend > 0 ? static_cast<SegmentSource&>(blended) : source;
     for (int attempt = 0;; ++attempt) {
         PlanCheck check;
         PlanTotals totals;
-        WindowPlanner planner(source, profile, options, limits, sink, st, report, lo, hi);
+        WindowPlanner planner(input, profile, options, limits, sink, st, report, lo, hi);
         if (planner.run(check, totals)) {
             report(1);
             return totals;
@@ -411,7 +413,7 @@ PlanTotals plan_stream(SegmentSource& source, const MachineProfile& machine_prof
               << 100 * std::max(check.max_acceleration_fraction_exact, check.max_span_acceleration_fraction) << " %)";
             throw PlanError(m.str());
         }
-        if (!source.rewind() || (planner.sent() && !sink.restart())) {
+        if (!input.rewind() || (planner.sent() && !sink.restart())) {
             throw PlanError("the plan needs lowered limits (a tick over a limit after rounding) but the spans "
                             "already sent cannot be taken back");
         }

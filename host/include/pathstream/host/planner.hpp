@@ -46,6 +46,11 @@ struct PlanOptions {
     /// A joint turning by more than this (rad) is a corner where the motion stops exactly;
     /// smaller tangent jumps are crossed at the corner speed of docs/planner.md.
     double corner_stop_angle = 0.35;
+    /// Vertices between straight segments that turn by at most corner_stop_angle are replaced
+    /// by a curve passing this fraction of the chord tolerance from the vertex (0: crossed as
+    /// corners, with the corner speed of docs/planner.md §3). The planner follows the curve
+    /// within half the tolerance, so the motion stays within the tolerance of the vertex.
+    double corner_blend = 0.5;
 
     /// Segments read per window of plan_stream (plan_path too): memory grows with this, not
     /// with the job. A window is read further where its lookahead horizon needs it.
