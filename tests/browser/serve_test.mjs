@@ -1,0 +1,222 @@
+// `pathstream serve` in a real browser: Debian's Chromium, headless, driven by playwright-core
+// (no browser download), against `pathstream serve` and the simulated device on loopback.
+//
+//   node serve_test.mjs PATHSTREAM SOURCE_DIR OUT_DIR [--bench]
+//
+// Loads examples/landscape.svg and checks the preview's subpaths, time and travel against
+// `pathstream check --json` and `pathstream plan --json`; streams it, holds and resumes it mid
+// job, sees the progress reach 100 % and the device end idle; a malformed SVG shows its
+// file:line:col; a server beyond loopback refuses a request without its token. Screenshots
+// of the preview and of the running page go to OUT_DIR. Prints the server's CPU use while
+// streaming. --bench: also the preview's draw time for a 10^5-segment drawing against
+// landscape.svg's, measured in the same run.
+import { spawn, execFileSync } from 'node:child_process';
+import { mkdtempSync, writeFileSync, readFileSync, rmSync, mkdirSync } from 'node:fs';
+import { tmpdir } from 'node:os';
+import path from 'node:path';
+import { chromium } from 'playwright-core';
+
+const [bin, source, outDir] = process.argv.slice(2);
+const bench = process.argv.includes('--bench');
+if (!bin || !source || !outDir) {
+  console.error('usage: node serve_test.mjs PATHSTREAM SOURCE_DIR OUT_DIR [--bench]');
+  process.exit(2);
+}
+const machine = path.join(source, 'examples/machines/pen_plotter.json');
+const landscape = path.join(source, 'examples/landscape.svg');
+const work = mkdtempSync(path.join(tmpdir(), 'pathstream-browser-'));
+mkdirSync(outDir, { recursive: true });
+const children = [];
+let failures = 0;
+
+function check(ok, what) {
+  console.log(`${ok ? 'ok  ' : 'FAIL'} ${what}`);
+  if (!ok) failures++;
+}
+
+// Starts a command and resolves with the first match of `pattern` in its standard output.
+function startAndRead(args, pattern, name) {
+  const child = spawn(bin, args, { stdio: ['ignore', 'pipe', 'pipe'] });
+  children.push(child);
+  let text = '';
+  return new Promise((resolve, reject) => {
+    const timer = setTimeout(() => reject(new Error(`${name}: no ${pattern} in 10 s: ${text}`)), 10000);
+    const look = chunk => {
+      text += chunk;
+      const m = text.match(pattern);
+      if (m) { clearTimeout(timer); resolve({ child, match: m }); }
+    };
+    child.stdout.on('data', look);
+    child.stderr.on('data', chunk => { text += chunk; });
+    child.on('exit', code => reject(new Error(`${name} exited ${code}: ${text}`)));
+  });
+}
+
+// CPU seconds (user + system) of a process so far.
+function cpuSeconds(pid) {
+  const fields = readFileSync(`/proc/${pid}/stat`, 'utf8').split(') ')[1].split(' ');
+  return (Number(fields[11]) + Number(fields[12])) / 100;  // utime, stime in USER_HZ (100)
+}
+
+async function within(ms, what, condition) {
+  const end = Date.now() + ms;
+  while (Date.now() < end) {
+    if (await condition()) return true;
+    await new Promise(r => setTimeout(r, 50));
+  }
+  check(false, `${what} (within ${ms} ms)`);
+  return false;
+}
+
+const figure = async (page, id) => Number(await page.getAttribute(`#${id}`, 'data-value'));
+
+async function main() {
+  const reference = JSON.parse(execFileSync(bin, ['plan', landscape, '-m', machine, '--json'], { encoding: 'utf8' }));
+  const checked = JSON.parse(execFileSync(bin, ['check', landscape, '--json'], { encoding: 'utf8' }));
+
+  // The simulated plotter at three times real time (the 36 s drawing runs in 12 s).
+  const device = await startAndRead(['device', '--tcp', '127.0.0.1:0', '--time-scale', '3'],
+    /serving (modbus-tcp:\/\/\S+)/, 'device');
+  const target = device.match[1];
+  const server = await startAndRead(['serve', '-m', machine, '-t', target, '--listen', '127.0.0.1:0',
+    '--state-dir', path.join(work, 'state')], /(http:\/\/127\.0\.0\.1:\d+\/)/, 'serve');
+  const url = server.match[1];
+
+  const browser = await chromium.launch({
+    executablePath: '/usr/bin/chromium',
+    headless: true,
+    args: ['--headless', '--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run',
+      '--disable-background-networking', '--disable-component-update', '--disable-sync',
+      `--user-data-dir=${path.join(work, 'chromium')}`],
+  });
+  try {
+    const page = await browser.newPage({ viewport: { width: 1320, height: 900 } });
+    page.on('pageerror', e => check(false, `no script error on the page: ${e.message}`));
+    await page.goto(url);
+    await page.waitForSelector('body[data-ready="true"]');
+    await within(5000, 'the device shows idle', async () =>
+      (await page.getAttribute('#device-state', 'data-state')) === 'idle');
+
+    // Load and preview.
+    await page.setInputFiles('#file', landscape);
+    await page.waitForFunction(() => document.getElementById('fig-subpaths').dataset.value !== undefined);
+    const subpaths = await figure(page, 'fig-subpaths');
+    const time = await figure(page, 'fig-time');
+    const travel = await figure(page, 'fig-travel');
+    const drawn = await figure(page, 'fig-drawn');
+    check(subpaths === checked.subpaths.length, `preview subpaths ${subpaths} = check's ${checked.subpaths.length}`);
+    check(Math.abs(time - reference.duration_s) < 1e-9, `preview time ${time} s = plan's ${reference.duration_s} s`);
+    check(Math.abs(travel - reference.travel_length_mm) < 1e-6,
+      `preview travel ${travel} mm = plan's ${reference.travel_length_mm} mm`);
+    check(Math.abs(drawn - reference.drawn_length_mm) < 1e-6, `preview drawn ${drawn} mm = plan's ${reference.drawn_length_mm} mm`);
+    const landscapeDrawMs = await figure(page, 'fig-draw-ms');
+    await page.screenshot({ path: path.join(outDir, 'serve-preview.png') });
+
+    // Stream it; hold and resume mid-job; run to the end.
+    const cpu0 = cpuSeconds(server.child.pid), wall0 = Date.now();
+    await page.click('#start');
+    await within(15000, 'progress passes 30 %', async () => Number(await page.getAttribute('#progress', 'value')) > 0.3);
+    await page.screenshot({ path: path.join(outDir, 'serve-running.png') });
+    await page.click('#hold');
+    const held = await within(5000, 'the device holds', async () =>
+      (await page.getAttribute('#device-state', 'data-state')) === 'holding');
+    if (held) {
+      await new Promise(r => setTimeout(r, 600));
+      const a = Number(await page.getAttribute('#progress', 'value'));
+      await new Promise(r => setTimeout(r, 800));
+      const b = Number(await page.getAttribute('#progress', 'value'));
+      check(a === b && a < 1, `no progress while held (${a} then ${b})`);
+    }
+    await page.click('#resume');
+    await within(5000, 'the device runs again', async () =>
+      (await page.getAttribute('#device-state', 'data-state')) === 'running');
+    await within(30000, 'progress reaches 100 %', async () =>
+      (await page.textContent('#progress-text')).startsWith('100 %'));
+    check(Number(await page.getAttribute('#progress', 'value')) === 1, 'the progress bar is full');
+    await within(5000, 'the device ends idle', async () =>
+      (await page.getAttribute('#device-state', 'data-state')) === 'idle');
+    const cpu1 = cpuSeconds(server.child.pid), wall1 = Date.now();
+    const cpuShare = (cpu1 - cpu0) / ((wall1 - wall0) / 1000);
+    console.log(`figure: server CPU while streaming ${(100 * cpuShare).toFixed(2)} % of one core ` +
+      `(${(cpu1 - cpu0).toFixed(2)} s CPU in ${((wall1 - wall0) / 1000).toFixed(1)} s; the device's status ` +
+      `at 10 Hz and the job's progress at 10 Hz to one page; planning the run included)`);
+
+    // A malformed SVG: its place in the file, as the command line prints it.
+    const bad = path.join(work, 'broken.svg');
+    writeFileSync(bad, '<svg xmlns="http://www.w3.org/2000/svg" width="100mm" height="100mm" viewBox="0 0 100 100">\n' +
+      '  <path d="M 10 10 L 20 20"/>\n  <path d="M 10 10 L 20 q"/>\n</svg>\n');
+    await page.setInputFiles('#file', bad);
+    await page.waitForSelector('#error:not([hidden])');
+    const message = await page.textContent('#error');
+    check(/^broken\.svg:3:\d+: /.test(message), `the error names broken.svg:3:COL: "${message}"`);
+
+    if (bench) {
+      // 10^5 segments: a polyline spiral of 100,001 points.
+      const points = [];
+      for (let i = 0; i <= 100000; i++) {
+        const a = i * 0.02, r = 5 + 0.00055 * i;
+        points.push(`${(100 + r * Math.cos(a)).toFixed(3)},${(100 + r * Math.sin(a)).toFixed(3)}`);
+      }
+      const big = path.join(work, 'spiral100k.svg');
+      writeFileSync(big, `<svg xmlns="http://www.w3.org/2000/svg" width="200mm" height="200mm" viewBox="0 0 200 200">` +
+        `<polyline fill="none" stroke="black" points="${points.join(' ')}"/></svg>\n`);
+      await page.reload();
+      await page.waitForSelector('body[data-ready="true"]');
+      const t0 = Date.now();
+      await page.setInputFiles('#file', big);
+      await page.waitForFunction(() => document.getElementById('fig-spans').dataset.value !== undefined, null, { timeout: 300000 });
+      const planned = (Date.now() - t0) / 1000;
+      const first = await figure(page, 'fig-draw-ms');
+      // Redraws as the scrubber moves: the median of five.
+      const redraws = await page.evaluate(() => {
+        const scrub = document.getElementById('scrub');
+        const times = [];
+        for (let k = 0; k < 5; k++) {
+          scrub.value = String(Number(scrub.max) * (k + 1) / 6);
+          scrub.dispatchEvent(new Event('input'));
+          times.push(Number(document.getElementById('fig-draw-ms').dataset.value));
+        }
+        return times.sort((a, b) => a - b);
+      });
+      const spans = await figure(page, 'fig-spans');
+      const vertices = Number((await page.textContent('#fig-spans')).match(/\((\d+) vertices\)/)[1]);
+      console.log(`figure: preview of 100,000 segments (${spans} spans, ${vertices} vertices): first draw ` +
+        `${first.toFixed(1)} ms, redraw median ${redraws[2].toFixed(1)} ms; landscape.svg ${landscapeDrawMs.toFixed(1)} ms ` +
+        `(ratio ${(first / landscapeDrawMs).toFixed(1)}x); upload + plan + preview ${planned.toFixed(1)} s`);
+      await page.screenshot({ path: path.join(outDir, 'serve-100k.png') });
+    }
+  } finally {
+    await browser.close();
+  }
+
+  // Beyond loopback: no token, no answer; the token, an answer (over loopback all the same).
+  const open = await startAndRead(['serve', '-m', machine, '-t', target, '--listen', '0.0.0.0:0', '--token', 't0k3n-for-test',
+    '--state-dir', path.join(work, 'state2')], /http:\/\/0\.0\.0\.0:(\d+)\//, 'serve 0.0.0.0');
+  const base = `http://127.0.0.1:${open.match[1]}`;
+  const refused = await fetch(`${base}/api/state`);
+  check(refused.status === 403, `no token: ${refused.status} (want 403)`);
+  const wrong = await fetch(`${base}/`, { headers: { Authorization: 'Bearer wrong' } });
+  check(wrong.status === 403, `a wrong token: ${wrong.status} (want 403)`);
+  const allowed = await fetch(`${base}/api/state?token=t0k3n-for-test`);
+  check(allowed.status === 200, `the token: ${allowed.status} (want 200)`);
+  const crossSite = await fetch(`${base}/api/control`, {
+    method: 'POST', body: '{"verb":"stop"}',
+    headers: { Authorization: 'Bearer t0k3n-for-test', Origin: 'http://evil.example' },
+  });
+  check(crossSite.status === 403, `the token from another origin: ${crossSite.status} (want 403)`);
+}
+
+let status = 0;
+try {
+  await main();
+} catch (e) {
+  console.log(`FAIL ${e.stack || e}`);
+  failures++;
+} finally {
+  for (const c of children) c.kill('SIGTERM');
+  await new Promise(r => setTimeout(r, 300));
+  rmSync(work, { recursive: true, force: true });
+}
+status = failures === 0 ? 0 : 1;
+console.log(failures === 0 ? 'serve browser test: all passed' : `serve browser test: ${failures} failed`);
+process.exit(status);
