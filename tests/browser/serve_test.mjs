@@ -82,15 +82,16 @@ async function main() {
     '--state-dir', path.join(work, 'state')], /(http:\/\/127\.0\.0\.1:\d+\/)/, 'serve');
   const url = server.match[1];
 
-  const browser = await chromium.launch({
+  // A fresh profile directory each run; nothing but loopback is reached.
+  const browser = await chromium.launchPersistentContext(path.join(work, 'chromium'), {
     executablePath: '/usr/bin/chromium',
     headless: true,
     args: ['--headless', '--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run',
-      '--disable-background-networking', '--disable-component-update', '--disable-sync',
-      `--user-data-dir=${path.join(work, 'chromium')}`],
+      '--disable-background-networking', '--disable-component-update', '--disable-sync'],
+    viewport: { width: 1320, height: 900 },
   });
   try {
-    const page = await browser.newPage({ viewport: { width: 1320, height: 900 } });
+    const page = await browser.newPage();
     page.on('pageerror', e => check(false, `no script error on the page: ${e.message}`));
     await page.goto(url);
     await page.waitForSelector('body[data-ready="true"]');
@@ -99,7 +100,7 @@ async function main() {
 
     // Load and preview.
     await page.setInputFiles('#file', landscape);
-    await page.waitForFunction(() => document.getElementById('fig-subpaths').dataset.value !== undefined);
+    await page.waitForSelector('#fig-subpaths[data-value]');
     const subpaths = await figure(page, 'fig-subpaths');
     const time = await figure(page, 'fig-time');
     const travel = await figure(page, 'fig-travel');
@@ -164,7 +165,7 @@ async function main() {
       await page.waitForSelector('body[data-ready="true"]');
       const t0 = Date.now();
       await page.setInputFiles('#file', big);
-      await page.waitForFunction(() => document.getElementById('fig-spans').dataset.value !== undefined, null, { timeout: 300000 });
+      await page.waitForSelector('#fig-spans[data-value]', { timeout: 300000 });
       const planned = (Date.now() - t0) / 1000;
       const first = await figure(page, 'fig-draw-ms');
       // Redraws as the scrubber moves: the median of five.
