@@ -94,9 +94,17 @@ function showPreview(p) {
   $('simulate').disabled = false;
 }
 
+// At most one redraw per animation frame, however fast the updates come.
+let drawPending = false;
+function scheduleDraw() {
+  if (drawPending) return;
+  drawPending = true;
+  requestAnimationFrame(() => { drawPending = false; redraw(); });
+}
+
 function redraw() {
   const ms = view.draw();
-  setFigure('fig-draw-ms', ms, `${ms.toFixed(1)} ms`);
+  if (ms > 0) setFigure('fig-draw-ms', ms, `${ms.toFixed(1)} ms`);
   const p = page.preview;
   if (p) {
     const at = view.doneTick >= 0 ? view.doneTick : (view.limitTick === Infinity ? null : view.limitTick);
@@ -150,7 +158,7 @@ function wire() {
     const t = Number($('scrub').value);
     view.limitTick = t >= Number($('scrub').max) ? Infinity : t;
     $('scrub-text').textContent = page.preview ? `${(t / page.preview.summary.tick_hz).toFixed(2)} s` : '';
-    redraw();
+    scheduleDraw();
   });
   $('start').addEventListener('click', async () => {
     showError('');
@@ -202,7 +210,7 @@ function showDevice(d) {
   if (!page.jobRunning) {
     const axes = Object.values(d.position_mm);
     view.marker = axes.length >= 2 ? axes.slice(0, 2) : null;
-    if (page.preview) view.draw();
+    if (page.preview) scheduleDraw();
   }
 }
 
@@ -234,7 +242,7 @@ function onEvent(e) {
       const axes = Object.values(e.position_mm);
       view.marker = axes.slice(0, 2);
       view.doneTick = e.ticks - page.leadTicks;
-      redraw();
+      scheduleDraw();
       break;
     }
     case 'pause':
@@ -251,7 +259,7 @@ function onEvent(e) {
       } else {
         $('progress-text').textContent = `${e.outcome}${e.error ? `: ${e.error}` : ''} at ${(100 * e.ticks / e.plan_ticks).toFixed(1)} %`;
       }
-      redraw();
+      scheduleDraw();
       break;
     case 'command':
       if (!e.ok) $('command-text').textContent = `${e.verb}: ${e.error}`;

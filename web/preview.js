@@ -7,7 +7,12 @@ const INK = '#1d3557', DONE = '#e76f51', TRAVEL = '#9aa5b1', AREA = '#ced4da';
 export class PreviewView {
   constructor(canvas) {
     this.canvas = canvas;
-    this.ctx = canvas.getContext('2d', { willReadFrequently: false });
+    this.ctx = canvas.getContext('2d');
+    this.base = document.createElement('canvas');
+    this.base.width = canvas.width;
+    this.base.height = canvas.height;
+    this.baseCtx = this.base.getContext('2d');
+    this.built = null;           // what the path layer shows: { last, done } vertex indexes
     this.preview = null;
     this.limitTick = Infinity;   // the scrubber: draw only up to this tick
     this.doneTick = -1;          // the job's progress on this plan
@@ -30,6 +35,7 @@ export class PreviewView {
     this.rest = p.rest_mm && p.rest_mm.length >= 2 ? p.rest_mm : null;
     this.limitTick = Infinity;
     this.doneTick = -1;
+    this.built = null;
     this.fitView();
   }
 
@@ -58,13 +64,13 @@ export class PreviewView {
     return lo;
   }
 
-  // One stroke of every segment i (vertex i-1 to i) that `wanted(i)` accepts, as few
-  // subpaths as the runs allow.
-  strokeWhere(last, wanted, style, width, dash) {
-    const { ctx } = this, p = this.preview, { scale, ox, oy } = this.view;
+  // One stroke of every segment i (vertex i-1 to i, first <= i <= last) that `wanted(i)`
+  // accepts, as few subpaths as the runs allow.
+  strokeWhere(ctx, first, last, wanted, style, width, dash) {
+    const p = this.preview, { scale, ox, oy } = this.view;
     ctx.beginPath();
     let open = false;
-    for (let i = 1; i <= last; i++) {
+    for (let i = Math.max(first, 1); i <= last; i++) {
       if (!wanted(i)) { open = false; continue; }
       if (!open) ctx.moveTo(ox + p.x[i - 1] * scale, oy + p.y[i - 1] * scale);
       ctx.lineTo(ox + p.x[i] * scale, oy + p.y[i] * scale);
@@ -77,41 +83,60 @@ export class PreviewView {
     ctx.setLineDash([]);
   }
 
-  // Redraws everything; returns the milliseconds it took.
-  draw() {
+  // The path layer, drawn whole: the work area, the lead-in, travel, strokes, the done part.
+  // Kept on a canvas of its own so that a moving marker or a few more done segments cost
+  // nothing like a full redraw. Returns the milliseconds it took, rasterizing included.
+  rebuild(last, done) {
     const t0 = performance.now();
-    const { ctx, canvas } = this;
-    ctx.clearRect(0, 0, canvas.width, canvas.height);
-    const p = this.preview;
-    if (!p) return 0;
-    const { scale, ox, oy } = this.view;
+    const ctx = this.baseCtx, p = this.preview, { scale, ox, oy } = this.view;
+    ctx.clearRect(0, 0, this.base.width, this.base.height);
     if (p.area) {
       ctx.strokeStyle = AREA;
       ctx.lineWidth = 1;
       ctx.strokeRect(ox + p.area.x_min * scale, oy + p.area.y_min * scale,
                      (p.area.x_max - p.area.x_min) * scale, (p.area.y_max - p.area.y_min) * scale);
     }
-    const last = this.limitTick === Infinity ? p.n - 1 : this.vertexAt(this.limitTick);
-    const done = this.vertexAt(this.doneTick);
-    const pen = p.pen;
     if (this.rest && p.n > 0) {
       ctx.beginPath();
       ctx.moveTo(ox + this.rest[0] * scale, oy + this.rest[1] * scale);
       ctx.lineTo(ox + p.x[0] * scale, oy + p.y[0] * scale);
       ctx.setLineDash([2, 4]);
       ctx.strokeStyle = TRAVEL;
+      ctx.lineWidth = 0.8;
       ctx.stroke();
       ctx.setLineDash([]);
     }
-    this.strokeWhere(last, i => pen[i] === 0, TRAVEL, 0.8, [4, 3]);
-    this.strokeWhere(last, i => pen[i] === 1 && i > done, INK, 1.2, []);
-    if (done > 0) this.strokeWhere(Math.min(last, done), i => pen[i] === 1, DONE, 1.6, []);
-    if (last >= 0 && last < p.n - 1) this.dot(p.x[last], p.y[last], '#2a9d8f', 4);
-    if (this.marker) this.dot(this.marker[0], this.marker[1], '#d62828', 5);
+    const pen = p.pen;
+    this.strokeWhere(ctx, 1, last, i => pen[i] === 0, TRAVEL, 0.8, [4, 3]);
+    this.strokeWhere(ctx, 1, last, i => pen[i] === 1 && i > done, INK, 1.2, []);
+    this.strokeWhere(ctx, 1, Math.min(last, done), i => pen[i] === 1, DONE, 1.6, []);
     // Reading a pixel back makes the canvas finish rasterizing now, so the time measured is
     // the whole draw, not only the queuing of the path commands.
     ctx.getImageData(0, 0, 1, 1);
+    this.built = { last, done };
     return performance.now() - t0;
+  }
+
+  // Shows the current state; returns the milliseconds of a full redraw of the path, or 0 when
+  // the path layer could be kept (only the done part grew, or only the marker moved).
+  draw() {
+    const { ctx, canvas } = this;
+    ctx.clearRect(0, 0, canvas.width, canvas.height);
+    const p = this.preview;
+    if (!p) return 0;
+    const last = this.limitTick === Infinity ? p.n - 1 : this.vertexAt(this.limitTick);
+    const done = Math.min(this.vertexAt(this.doneTick), p.n - 1);
+    let ms = 0;
+    if (!this.built || this.built.last !== last || done < this.built.done) {
+      ms = this.rebuild(last, done);
+    } else if (done > this.built.done) {
+      this.strokeWhere(this.baseCtx, this.built.done + 1, Math.min(last, done), i => p.pen[i] === 1, DONE, 1.6, []);
+      this.built.done = done;
+    }
+    ctx.drawImage(this.base, 0, 0);
+    if (last >= 0 && last < p.n - 1) this.dot(p.x[last], p.y[last], '#2a9d8f', 4);
+    if (this.marker) this.dot(this.marker[0], this.marker[1], '#d62828', 5);
+    return ms;
   }
 
   dot(x, y, colour, r) {

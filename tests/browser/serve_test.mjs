@@ -93,6 +93,7 @@ async function main() {
   try {
     const page = await browser.newPage();
     page.on('pageerror', e => check(false, `no script error on the page: ${e.message}`));
+    page.on('console', m => { if (m.type() === 'error' && !/favicon|404/.test(m.text())) console.log(`page console: ${m.text()}`); });
     await page.goto(url);
     await page.waitForSelector('body[data-ready="true"]');
     await within(5000, 'the device shows idle', async () =>
@@ -163,18 +164,25 @@ async function main() {
         `<polyline fill="none" stroke="black" points="${points.join(' ')}"/></svg>\n`);
       await page.reload();
       await page.waitForSelector('body[data-ready="true"]');
+      page.on('response', r => { if (r.url().includes('/api/drawing')) console.log(`upload answered ${r.status()}`); });
+      page.on('requestfailed', r => console.log(`request failed: ${r.url()} ${r.failure()?.errorText}`));
       const t0 = Date.now();
       await page.setInputFiles('#file', big);
-      await page.waitForSelector('#fig-spans[data-value]', { timeout: 300000 });
+      await page.waitForSelector('#fig-spans[data-value], #error:not([hidden])', { timeout: 300000 });
+      const uploadError = await page.textContent('#error');
+      if (uploadError) throw new Error(`the 10^5-segment drawing: ${uploadError}`);
       const planned = (Date.now() - t0) / 1000;
       const first = await figure(page, 'fig-draw-ms');
       // Redraws as the scrubber moves: the median of five.
-      const redraws = await page.evaluate(() => {
+      const redraws = await page.evaluate(async () => {
         const scrub = document.getElementById('scrub');
+        const frame = () => new Promise(r => requestAnimationFrame(() => r()));
         const times = [];
         for (let k = 0; k < 5; k++) {
-          scrub.value = String(Number(scrub.max) * (k + 1) / 6);
+          scrub.value = String(Math.round(Number(scrub.max) * (k + 1) / 6));
           scrub.dispatchEvent(new Event('input'));
+          await frame();
+          await frame();
           times.push(Number(document.getElementById('fig-draw-ms').dataset.value));
         }
         return times.sort((a, b) => a - b);

@@ -62,7 +62,11 @@ private:
     std::vector<Vertex> kept_, run_;
 };
 
-double rounded(double v, double unit) { return std::round(v / unit) * unit; }
+// v to `digits` decimals, as the nearest double to that decimal (it prints as written).
+double rounded(double v, int digits) {
+    const double scale = std::pow(10.0, digits);
+    return std::round(v * scale) / scale;
+}
 
 }  // namespace
 
@@ -119,16 +123,16 @@ nlohmann::ordered_json preview_json(const Plan& plan, const Path& path, const Ma
     ticks.reserve(vertices.size());
     pens.reserve(vertices.size());
     for (const Vertex& v : vertices) {
-        xs.push_back(rounded(v.x, 1e-4));
-        ys.push_back(rounded(v.y, 1e-4));
+        xs.push_back(rounded(v.x, 4));
+        ys.push_back(rounded(v.y, 4));
         ticks.push_back(v.tick);
         pens.push_back(v.pen ? 1 : 0);
     }
     out["path"] = {{"x", xs}, {"y", ys}, {"tick", ticks}, {"pen", pens}};
     std::vector<double> t, v;
     for (std::size_t b = 0; b < bins; ++b) {
-        t.push_back(rounded(plan.duration * (static_cast<double>(b) + 0.5) / static_cast<double>(bins), 1e-4));
-        v.push_back(rounded(bin_speed[b], 1e-3));
+        t.push_back(rounded(plan.duration * (static_cast<double>(b) + 0.5) / static_cast<double>(bins), 4));
+        v.push_back(rounded(bin_speed[b], 3));
     }
     out["speed"] = {{"t", t}, {"v", v}};
     std::vector<std::uint64_t> pauses;
