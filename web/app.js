@@ -223,6 +223,9 @@ function onEvent(e) {
       $('resume-job').disabled = e.running;
       if (e.running) {
         $('job-text').textContent = `${e.kind}: started`;
+        $('progress').value = 0;
+        $('progress-text').textContent = 'starting';
+        view.doneTick = -1;
       } else {
         $('job-text').textContent = e.exit === 0 ? `${e.kind}: ended` : `${e.kind}: ${e.error || `exit ${e.exit}`}`;
         $('resume-job').disabled = false;

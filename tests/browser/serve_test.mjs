@@ -117,7 +117,9 @@ async function main() {
     // Stream it; hold and resume mid-job; run to the end.
     const cpu0 = cpuSeconds(server.child.pid), wall0 = Date.now();
     await page.click('#start');
-    await within(15000, 'progress passes 30 %', async () => Number(await page.getAttribute('#progress', 'value')) > 0.3);
+    await within(15000, 'progress passes 30 %', async () =>
+      /^\d+\.\d %  ETA/.test(await page.textContent('#progress-text')) &&
+      Number(await page.getAttribute('#progress', 'value')) > 0.3);
     await page.screenshot({ path: path.join(outDir, 'serve-running.png') });
     await page.click('#hold');
     const held = await within(5000, 'the device holds', async () =>
@@ -142,6 +144,50 @@ async function main() {
     console.log(`figure: server CPU while streaming ${(100 * cpuShare).toFixed(2)} % of one core ` +
       `(${(cpu1 - cpu0).toFixed(2)} s CPU in ${((wall1 - wall0) / 1000).toFixed(1)} s; the device's status ` +
       `at 10 Hz and the job's progress at 10 Hz to one page; planning the run included)`);
+
+    // At rest: the pen down and up, a jog of 10 mm.
+    await page.click('#pen-down');
+    await within(5000, 'the pen goes down', async () => (await page.getAttribute('#pen-state', 'data-down')) === 'true');
+    await page.click('#pen-up');
+    await within(5000, 'the pen goes up', async () => (await page.getAttribute('#pen-state', 'data-down')) === 'false');
+    const xOf = async () => Number((await page.textContent('#position')).match(/x (-?[\d.]+)/)[1]);
+    const x0 = await xOf();
+    await page.selectOption('#step', '10');
+    await page.click('[data-jog="x"][data-sign="1"]');
+    const jogged = await within(8000, 'a jog of x +10 mm', async () => Math.abs(await xOf() - (x0 + 10)) < 1e-6);
+    if (!jogged) console.log(`  the page says: ${await page.textContent('#command-text')}`);
+
+    // One layer: the preview plans it alone. Then the whole drawing again: streamed, stopped,
+    // resumed from its journal.
+    const layers = await page.$$eval('#layers label', ls => ls.map(l => l.textContent.trim()));
+    const house = layers.findIndex(l => l.startsWith('House'));
+    check(house >= 0, `the layers are listed: ${layers.join(', ')}`);
+    const houseSubpaths = Number(layers[house].match(/\((\d+)\)$/)[1]);
+    for (let i = 0; i < layers.length; i++) {
+      if (i !== house) await page.uncheck(`#layers label:nth-child(${i + 1}) input`);
+    }
+    await within(10000, `the preview of layer House alone has its ${houseSubpaths} subpaths`,
+      async () => (await figure(page, 'fig-subpaths')) === houseSubpaths);
+    for (let i = 0; i < layers.length; i++) {
+      if (i !== house) await page.check(`#layers label:nth-child(${i + 1}) input`);
+    }
+    await within(10000, 'every layer again: 42 subpaths', async () => (await figure(page, 'fig-subpaths')) === 42);
+    await page.click('#start');
+    await within(15000, 'the second job passes 20 %', async () =>
+      /^\d+\.\d %  ETA/.test(await page.textContent('#progress-text')) &&
+      Number(await page.getAttribute('#progress', 'value')) > 0.2);
+    await page.click('#stop');
+    const stopped = await within(10000, 'the job ends stopped', async () => (await page.textContent('#progress-text')).startsWith('stopped'));
+    if (!stopped) {
+      console.log(`  progress: ${await page.textContent('#progress-text')}; job: ${await page.textContent('#job-text')}; ` +
+        `command: ${await page.textContent('#command-text')}; device: ${await page.textContent('#device-state')}`);
+    }
+    await within(5000, 'the device is idle after the stop', async () =>
+      (await page.getAttribute('#device-state', 'data-state')) === 'idle');
+    await within(5000, 'Resume job is offered', async () => !(await page.isDisabled('#resume-job')));
+    await page.click('#resume-job');
+    await within(30000, 'the resumed job reaches 100 %', async () =>
+      (await page.textContent('#progress-text')).startsWith('100 %'));
 
     // A malformed SVG: its place in the file, as the command line prints it.
     const bad = path.join(work, 'broken.svg');

@@ -184,6 +184,7 @@ bool Server::start_child(const std::string& kind, std::vector<std::string> argv)
     if (job_thread_.joinable()) job_thread_.join();
     job_ = std::make_unique<ChildProcess>(argv, (fs::path(config_.state_dir) / "drawing").string());
     job_kind_ = kind;
+    stop_requested_.store(false);
     job_running_.store(true);
     for (const char* k : {"job_start", "progress", "job_end", "pause"}) hub_.forget(k);
     hub_.publish(Json{{"event", "process"}, {"kind", kind}, {"running", true}, {"drawing", drawing_file()}}.dump(),
@@ -197,6 +198,11 @@ bool Server::start_child(const std::string& kind, std::vector<std::string> argv)
                     if (line.find(std::string("\"event\":\"") + k + "\"") != std::string::npos) sticky = k;
                 }
                 hub_.publish(line, sticky);
+                // The stream holds at the first signal and says so; the second stops it.
+                if (sticky.empty() && stop_requested_.load() &&
+                    line.find("\"event\":\"hold\"") != std::string::npos) {
+                    child->signal(SIGTERM);
+                }
             },
             errors);
         Json end{{"event", "process"}, {"kind", kind}, {"running", false}, {"exit", exit_code}};
@@ -254,10 +260,10 @@ Server::Reply Server::control(const nlohmann::json& request) {
     const std::string verb = request["verb"].get<std::string>();
     if (verb == "stop" && job_running()) {
         // The job's own stream stops the device (a hold, then a stop that drops the queue)
-        // and records it in the journal.
+        // and records it in the journal: the first signal now, the second once it holds.
         const std::lock_guard<std::mutex> lock(job_mutex_);
         if (job_) {
-            job_->signal(SIGTERM);
+            stop_requested_.store(true);
             job_->signal(SIGTERM);
         }
         return {200, Json{{"ok", true}, {"message", "stopping the job"}}};
@@ -281,12 +287,12 @@ Server::Reply Server::control(const nlohmann::json& request) {
         if (!d.is_number() || !std::isfinite(d.get<double>()) || d.get<double>() == 0 || std::fabs(d.get<double>()) > 10000) {
             throw std::invalid_argument("jog: want distance_mm, not 0, at most 10000 either way");
         }
-        argv.push_back("--");
+        // A negative number stays a positional argument for ctl's parser (as `jog y -3`).
         argv.push_back(number_text(d.get<double>()));
         if (request.contains("feed")) {
             const nlohmann::json f = request["feed"];
             if (!f.is_number() || !(f.get<double>() > 0) || f.get<double>() > 1e6) throw std::invalid_argument("jog: feed in mm/s, > 0");
-            argv.insert(argv.end() - 2, "--feed=" + number_text(f.get<double>()));
+            argv.push_back("--feed=" + number_text(f.get<double>()));
         }
     } else {
         return {400, error_body("unknown verb '" + verb + "'")};

@@ -100,6 +100,9 @@ private:
     std::thread job_thread_;
     std::string job_kind_;
     std::atomic<bool> job_running_{false};
+    /// Stop asked for: the job's hold event brings the second signal (two sent at once
+    /// would merge into one, a hold).
+    std::atomic<bool> stop_requested_{false};
 };
 
 }  // namespace pathstream::host::serve
