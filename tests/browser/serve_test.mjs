@@ -115,8 +115,11 @@ async function main() {
     await page.screenshot({ path: path.join(outDir, 'serve-preview.png') });
 
     // Stream it; hold and resume mid-job; run to the end.
-    const cpu0 = cpuSeconds(server.child.pid), wall0 = Date.now();
     await page.click('#start');
+    // The server's CPU from the job's first progress to its end: the live updates (device
+    // status and job progress, each at 10 Hz, to one page), without the planning of the run.
+    await within(15000, 'the job reports progress', async () => /^\d+\.\d %  ETA/.test(await page.textContent('#progress-text')));
+    const cpu0 = cpuSeconds(server.child.pid), wall0 = Date.now();
     await within(15000, 'progress passes 30 %', async () =>
       /^\d+\.\d %  ETA/.test(await page.textContent('#progress-text')) &&
       Number(await page.getAttribute('#progress', 'value')) > 0.3);
@@ -143,7 +146,7 @@ async function main() {
     const cpuShare = (cpu1 - cpu0) / ((wall1 - wall0) / 1000);
     console.log(`figure: server CPU while streaming ${(100 * cpuShare).toFixed(2)} % of one core ` +
       `(${(cpu1 - cpu0).toFixed(2)} s CPU in ${((wall1 - wall0) / 1000).toFixed(1)} s; the device's status ` +
-      `at 10 Hz and the job's progress at 10 Hz to one page; planning the run included)`);
+      `at 10 Hz and the job's progress at 10 Hz to one page, a hold included)`);
 
     // At rest: the pen down and up, a jog of 10 mm.
     await page.click('#pen-down');
