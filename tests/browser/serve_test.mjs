@@ -61,7 +61,10 @@ function cpuSeconds(pid) {
 async function within(ms, what, condition) {
   const end = Date.now() + ms;
   while (Date.now() < end) {
-    if (await condition()) return true;
+    if (await condition()) {
+      console.log(`ok   ${what}`);
+      return true;
+    }
     await new Promise(r => setTimeout(r, 50));
   }
   check(false, `${what} (within ${ms} ms)`);
@@ -113,6 +116,25 @@ async function main() {
     check(Math.abs(drawn - reference.drawn_length_mm) < 1e-6, `preview drawn ${drawn} mm = plan's ${reference.drawn_length_mm} mm`);
     const landscapeDrawMs = await figure(page, 'fig-draw-ms');
     await page.screenshot({ path: path.join(outDir, 'serve-preview.png') });
+
+    // Simulate: `pathstream sim`'s report on the page.
+    await page.click('#simulate');
+    await within(20000, 'the simulation report is shown', async () =>
+      (await page.textContent('#sim-report')).includes('pathstream run on the simulated device'));
+
+    // Fit to A4 with a margin: the drawn length of `plan --fit a4 --margin 10` (the order's
+    // start point changes the travel, not what is drawn).
+    const fitted = JSON.parse(execFileSync(bin, ['plan', landscape, '-m', machine, '--fit', 'a4', '--margin', '10', '--json'],
+      { encoding: 'utf8' }));
+    await page.selectOption('#fit', 'a4');
+    await page.fill('#margin', '10');
+    await page.dispatchEvent('#margin', 'change');
+    await within(10000, `fit A4, margin 10: drawn ${fitted.drawn_length_mm.toFixed(3)} mm as plan's`, async () =>
+      Math.abs(await figure(page, 'fig-drawn') - fitted.drawn_length_mm) < 1e-6);
+    await page.selectOption('#fit', '');
+    await page.fill('#margin', '0');
+    await page.dispatchEvent('#margin', 'change');
+    await within(10000, 'as drawn again: the plan\'s time', async () => Math.abs(await figure(page, 'fig-time') - reference.duration_s) < 1e-9);
 
     // Stream it; hold and resume mid-job; run to the end.
     await page.click('#start');

@@ -95,7 +95,7 @@ int run_serve(const ServeCommandOptions& o) {
     c.listen_host = listen.host;
     c.port = listen.port;
     c.access.token = read_token(o);
-    c.access.loopback = serve::is_loopback_host(listen.host) && listen.host != "localhost";
+    c.access.loopback = serve::is_loopback_host(listen.host);
     if (!c.access.loopback && c.access.token.empty()) {
         throw std::invalid_argument("serve: --listen " + o.listen +
                                     " reaches beyond this machine: give --token or --token-file");

@@ -7,6 +7,7 @@
 
 namespace pathstream::host {
 
+/// The command line of `serve`, as parsed.
 struct ServeCommandOptions {
     std::string machine;                 ///< --machine: the profile every job is planned for
     std::string target;                  ///< --target: the device's URL
@@ -18,8 +19,12 @@ struct ServeCommandOptions {
     double events_rate = 10;             ///< progress updates per second to the page
 };
 
+/// Adds the `serve` subcommand and its options, parsed into `options` (which must outlive
+/// the parse).
 void add_serve_command(CLI::App& app, ServeCommandOptions& options);
-/// Serves until SIGINT or SIGTERM; returns the exit status.
+/// Serves until SIGINT or SIGTERM (a job still streaming is held first); returns the exit
+/// status. Throws std::invalid_argument for bad options (a listen address beyond loopback
+/// without a token), InputError for a bad profile, std::runtime_error when it cannot listen.
 int run_serve(const ServeCommandOptions& options);
 
 }  // namespace pathstream::host

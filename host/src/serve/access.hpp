@@ -35,12 +35,14 @@ bool is_loopback_host(const std::string& host);
 /// thread.
 std::optional<std::string> refusal(const AccessPolicy& policy, const RequestFacts& request);
 
-/// Whether `listen` ("HOST:PORT", "[::1]:PORT") may serve without a token; splits it.
-/// Throws std::invalid_argument for a malformed address or port.
+/// Where to listen, from --listen.
 struct ListenAddress {
-    std::string host;
-    unsigned port = 0;
+    std::string host;   ///< as given, without the brackets of an IPv6 address
+    unsigned port = 0;  ///< 0: any free port
 };
+
+/// Splits `listen` ("HOST:PORT", "[::1]:PORT"). Throws std::invalid_argument for a malformed
+/// address or port. Pure; any thread.
 ListenAddress parse_listen_address(const std::string& listen);
 
 }  // namespace pathstream::host::serve
