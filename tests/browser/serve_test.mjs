@@ -269,6 +269,14 @@ async function main() {
     await browser.close();
   }
 
+  // Beyond loopback without a token: refused at the command line.
+  try {
+    execFileSync(bin, ['serve', '-m', machine, '-t', target, '--listen', '0.0.0.0:0'], { stdio: 'pipe', timeout: 10000 });
+    check(false, 'serve --listen 0.0.0.0:0 without a token is refused');
+  } catch (e) {
+    check(e.status === 2 && /give --token/.test(String(e.stderr)),
+      `serve --listen 0.0.0.0:0 without a token exits 2: ${String(e.stderr).trim()}`);
+  }
   // Beyond loopback: no token, no answer; the token, an answer (over loopback all the same).
   const open = await startAndRead(['serve', '-m', machine, '-t', target, '--listen', '0.0.0.0:0', '--token', 't0k3n-for-test',
     '--state-dir', path.join(work, 'state2')], /http:\/\/0\.0\.0\.0:(\d+)\//, 'serve 0.0.0.0');
