@@ -266,6 +266,10 @@ function onEvent(e) {
       break;
     case 'command':
       if (!e.ok) $('command-text').textContent = `${e.verb}: ${e.error}`;
+      // A job held on the way to a stop: the server's stop dropped the rest of its queue.
+      if (e.ok && e.verb === 'stop' && $('progress-text').textContent.startsWith('held')) {
+        $('progress-text').textContent = $('progress-text').textContent.replace(/^held/, 'stopped');
+      }
       break;
     default: break;
   }

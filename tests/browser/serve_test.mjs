@@ -115,7 +115,7 @@ async function main() {
       `preview travel ${travel} mm = plan's ${reference.travel_length_mm} mm`);
     check(Math.abs(drawn - reference.drawn_length_mm) < 1e-6, `preview drawn ${drawn} mm = plan's ${reference.drawn_length_mm} mm`);
     const landscapeDrawMs = await figure(page, 'fig-draw-ms');
-    await page.screenshot({ path: path.join(outDir, 'serve-preview.png') });
+    await page.screenshot({ path: path.join(outDir, 'serve-preview.png'), fullPage: true });
 
     // Simulate: `pathstream sim`'s report on the page.
     await page.click('#simulate');
@@ -145,7 +145,7 @@ async function main() {
     await within(15000, 'progress passes 30 %', async () =>
       /^\d+\.\d %  ETA/.test(await page.textContent('#progress-text')) &&
       Number(await page.getAttribute('#progress', 'value')) > 0.3);
-    await page.screenshot({ path: path.join(outDir, 'serve-running.png') });
+    await page.screenshot({ path: path.join(outDir, 'serve-running.png'), fullPage: true });
     await page.click('#hold');
     const held = await within(5000, 'the device holds', async () =>
       (await page.getAttribute('#device-state', 'data-state')) === 'holding');

@@ -190,21 +190,34 @@ bool Server::start_child(const std::string& kind, std::vector<std::string> argv)
     hub_.publish(Json{{"event", "process"}, {"kind", kind}, {"running", true}, {"drawing", drawing_file()}}.dump(),
                  "process");
     job_thread_ = std::thread([this, kind, child = job_.get()] {
-        std::string errors;
+        std::string errors, outcome;
         const int exit_code = child->wait(
             [&](const std::string& line) {
                 std::string sticky;
                 for (const char* k : {"job_start", "progress", "job_end", "pause", "state"}) {
                     if (line.find(std::string("\"event\":\"") + k + "\"") != std::string::npos) sticky = k;
                 }
+                if (sticky == "job_end") {
+                    for (const char* o : {"finished", "held", "stopped", "failed"}) {
+                        if (line.find(std::string("\"outcome\":\"") + o + "\"") != std::string::npos) outcome = o;
+                    }
+                }
                 hub_.publish(line, sticky);
-                // The stream holds at the first signal and says so; the second stops it.
+                // The stream holds at the first signal and says so; a second one stops it.
                 if (sticky.empty() && stop_requested_.load() &&
                     line.find("\"event\":\"hold\"") != std::string::npos) {
                     child->signal(SIGTERM);
                 }
             },
             errors);
+        // A hold that came to rest before the second signal was seen: the stop drops the
+        // queue as `ctl stop` does (the journal resumes from where the device rests).
+        if (stop_requested_.load() && outcome == "held") {
+            const ChildOutput r = run_child({config_.executable, "ctl", config_.target, "stop", "--wait=10"}, config_.state_dir);
+            hub_.publish(Json{{"event", "command"}, {"verb", "stop"}, {"ok", r.exit_code == 0},
+                              {"error", r.exit_code == 0 ? "" : last_lines(r.err, 1)}}
+                             .dump());
+        }
         Json end{{"event", "process"}, {"kind", kind}, {"running", false}, {"exit", exit_code}};
         end["report"] = clean_message(last_lines(errors, 12));
         if (exit_code != 0) end["error"] = clean_message(last_lines(errors, 1));
