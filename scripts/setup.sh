@@ -23,7 +23,11 @@ packages=(
   can-utils libgpiod-dev gpiod
   # real-kernel test VM (SocketCAN vcan, gpio-sim): emulator, initramfs tools
   qemu-system-x86 busybox-static cpio
+  # pathstream serve: the HTTP server library; its page's tests drive Debian's Chromium
+  libcpp-httplib-dev chromium
 )
+# Node.js and npm for the browser tests, from Debian unless a node is installed already.
+command -v node > /dev/null && command -v npm > /dev/null || packages+=(nodejs npm)
 
 missing=()
 for p in "${packages[@]}"; do
@@ -38,6 +42,16 @@ else
   export DEBIAN_FRONTEND=noninteractive
   $sudo apt-get update -q
   $sudo apt-get install -y -q --no-install-recommends "${missing[@]}"
+fi
+
+# The browser tests' one npm package (playwright-core: it drives the system's Chromium and
+# never downloads a browser) at the version package-lock.json pins; installed again only when
+# the lock file is newer than the last install.
+browser_dir="$(cd "$(dirname "$0")/.." && pwd)/tests/browser"
+if [ ! -f "$browser_dir/node_modules/.package-lock.json" ] ||
+   [ "$browser_dir/package-lock.json" -nt "$browser_dir/node_modules/.package-lock.json" ]; then
+  echo "setup: npm ci in tests/browser (playwright-core)"
+  PLAYWRIGHT_SKIP_BROWSER_DOWNLOAD=1 npm ci --prefix "$browser_dir" --no-audit --no-fund --loglevel=error
 fi
 
 # The real-kernel test VM (Debian's kernel, its modules and out-of-tree gpio-sim) has its own

@@ -16,6 +16,7 @@
 #include "cli/drive_command.hpp"
 #include "cli/eval_command.hpp"
 #include "cli/plan_command.hpp"
+#include "cli/serve_command.hpp"
 #include "cli/setpoints_command.hpp"
 #include "cli/sim_command.hpp"
 #include "cli/stream_command.hpp"
@@ -53,6 +54,8 @@ int main(int argc, char** argv) {
     pathstream::host::add_drive_command(app, drive);
     pathstream::host::CtlCommandOptions ctl;
     pathstream::host::add_ctl_command(app, ctl);
+    pathstream::host::ServeCommandOptions serve;
+    pathstream::host::add_serve_command(app, serve);
 
     try {
         app.parse(argc, argv);
@@ -75,6 +78,7 @@ int main(int argc, char** argv) {
         if (app.got_subcommand("device")) return pathstream::host::run_device(device);
         if (app.got_subcommand("drive")) return pathstream::host::run_drive(drive);
         if (app.got_subcommand("ctl")) return pathstream::host::run_ctl(ctl);
+        if (app.got_subcommand("serve")) return pathstream::host::run_serve(serve);
     } catch (const pathstream::host::InputError& e) {
         std::cerr << e.what() << '\n';
         return kExitInput;

@@ -1,0 +1,151 @@
+#include "serve_command.hpp"
+
+#include <signal.h>
+
+#include <atomic>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <stdexcept>
+#include <thread>
+
+#include "path_options.hpp"
+#include "pathstream/host/planner.hpp"
+#include "plan_command.hpp"
+#include "serve/access.hpp"
+#include "serve/child_process.hpp"
+#include "serve/preview.hpp"
+#include "serve/server.hpp"
+
+namespace pathstream::host {
+
+namespace fs = std::filesystem;
+
+void add_serve_command(CLI::App& app, ServeCommandOptions& o) {
+    CLI::App* cmd = app.add_subcommand(
+        "serve", "Serve a web page that loads, places, previews, simulates and streams drawings to a device and "
+                 "steers it (docs/serve.md)");
+    cmd->add_option("--machine,-m", o.machine, "machine profile (JSON, docs/formats.md)")
+        ->required()
+        ->check(CLI::ExistingFile);
+    cmd->add_option("--target,-t", o.target,
+                    "device: modbus-tcp://HOST:PORT?unit=N, modbus-rtu:///dev/ttyX?... or can://IFACE?node=N")
+        ->required();
+    cmd->add_option("--listen", o.listen,
+                    "HOST:PORT to serve on; an address other than loopback needs --token or --token-file")
+        ->capture_default_str();
+    cmd->add_option("--token", o.token, "a secret every request must carry (?token= once, then a cookie)");
+    cmd->add_option("--token-file", o.token_file, "read the token from the first line of this file")
+        ->check(CLI::ExistingFile);
+    cmd->add_option("--state-dir", o.state_dir,
+                    "directory for the uploaded drawing and the job journal (default: a new temporary one)");
+    cmd->add_option("--max-upload-mb", o.max_upload_mb, "largest drawing accepted, MB")
+        ->capture_default_str()
+        ->check(CLI::Range(0.001, 1024.0));
+    cmd->add_option("--events-rate", o.events_rate, "progress updates per second sent to the page")
+        ->capture_default_str()
+        ->check(CLI::Range(1.0, 50.0));
+}
+
+namespace {
+
+std::atomic<bool> g_stop{false};
+extern "C" void on_serve_signal(int) { g_stop.store(true); }
+
+std::string read_token(const ServeCommandOptions& o) {
+    if (!o.token.empty() && !o.token_file.empty()) throw std::invalid_argument("serve: --token or --token-file, not both");
+    if (o.token_file.empty()) return o.token;
+    std::ifstream in(o.token_file);
+    std::string line;
+    std::getline(in, line);
+    while (!line.empty() && (line.back() == '\r' || line.back() == ' ')) line.pop_back();
+    if (line.empty()) throw std::invalid_argument("serve: --token-file " + o.token_file + ": the first line is empty");
+    return line;
+}
+
+// The preview of `file` under path options `arguments`: parsed by the same option parser as
+// every path command, planned by plan_job (what `plan` prints).
+nlohmann::ordered_json plan_for_page(const std::string& file, const std::vector<std::string>& arguments,
+                                     const std::string& machine) {
+    CLI::App parser{"preview"};
+    PathOptions options;
+    add_path_options(parser, options);
+    std::vector<std::string> args = {file};
+    args.insert(args.end(), arguments.begin(), arguments.end());
+    std::vector<std::string> reversed(args.rbegin(), args.rend());  // CLI11 takes them last first
+    try {
+        parser.parse(reversed);
+    } catch (const CLI::ParseError& e) {
+        throw std::invalid_argument(std::string("options: ") + e.what());
+    }
+    const PlannedJob job = plan_job(options, machine);
+    if (!job.check.within_limits || job.check.drawing_while_pen_moves) {
+        throw PlanError("the plan failed its per-tick check (a planner bug)");
+    }
+    return serve::preview_json(job.plan, job.path, job.machine);
+}
+
+}  // namespace
+
+int run_serve(const ServeCommandOptions& o) {
+    serve::ServerConfig c;
+    const serve::ListenAddress listen = serve::parse_listen_address(o.listen);
+    c.listen_host = listen.host;
+    c.port = listen.port;
+    c.access.token = read_token(o);
+    c.access.loopback = serve::is_loopback_host(listen.host);
+    if (!c.access.loopback && c.access.token.empty()) {
+        throw std::invalid_argument("serve: --listen " + o.listen +
+                                    " reaches beyond this machine: give --token or --token-file");
+    }
+    c.machine_file = fs::absolute(o.machine).string();
+    c.target = o.target;
+    c.executable = serve::self_executable();
+    c.events_rate = o.events_rate;
+    c.max_upload_bytes = static_cast<std::size_t>(o.max_upload_mb * 1024 * 1024);
+    bool temporary = false;
+    if (o.state_dir.empty()) {
+        std::string pattern = (fs::temp_directory_path() / "pathstream-serve-XXXXXX").string();
+        if (::mkdtemp(pattern.data()) == nullptr) throw std::runtime_error("serve: cannot create a temporary directory");
+        c.state_dir = pattern;
+        temporary = true;
+    } else {
+        fs::create_directories(o.state_dir);
+        c.state_dir = fs::absolute(o.state_dir).string();
+    }
+    MachineProfile machine = load_machine_profile(o.machine);
+    const std::string machine_file = c.machine_file;
+    int status = 0;
+    {
+        serve::Server server(c, machine, [machine_file](const std::string& file, const std::vector<std::string>& args) {
+            return plan_for_page(file, args, machine_file);
+        });
+        server.bind();
+        std::printf("pathstream serve: http://%s:%u/%s for %s (machine %s)\n",
+                    listen.host.find(':') != std::string::npos ? ("[" + listen.host + "]").c_str() : listen.host.c_str(),
+                    server.bound_port(), c.access.token.empty() ? "" : "?token=...", o.target.c_str(),
+                    o.machine.c_str());
+        std::printf("state         %s\n", c.state_dir.c_str());
+        std::fflush(stdout);
+        ::signal(SIGINT, on_serve_signal);
+        ::signal(SIGTERM, on_serve_signal);
+        ::signal(SIGPIPE, SIG_IGN);
+        std::thread watcher([&] {
+            while (!g_stop.load()) std::this_thread::sleep_for(std::chrono::milliseconds(100));
+            server.stop();
+        });
+        server.run();
+        g_stop.store(true);
+        watcher.join();
+        std::printf("pathstream serve: stopped\n");
+    }
+    if (temporary) {
+        std::error_code ignored;
+        fs::remove_all(c.state_dir, ignored);
+    }
+    return status;
+}
+
+}  // namespace pathstream::host

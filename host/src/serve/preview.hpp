@@ -1,0 +1,34 @@
+// What the page draws before a run: the planned path to scale, its timing and its figures.
+#pragma once
+
+#include <nlohmann/json.hpp>
+
+#include "pathstream/host/machine.hpp"
+#include "pathstream/host/path.hpp"
+#include "pathstream/host/plan.hpp"
+
+namespace pathstream::host::serve {
+
+/// How finely the preview follows the plan.
+struct PreviewOptions {
+    /// mm: consecutive span end points within this of the chord between two kept vertices are
+    /// merged into one straight piece (a straight line planned as 200 spans is one piece).
+    double tolerance_mm = 0.01;
+    std::size_t speed_samples = 1200;  ///< at most this many points on the speed plot
+};
+
+/// The plan as the page shows it, one JSON document:
+///  summary: the same figures and keys as `pathstream plan --json` (duration_s, ticks,
+///    tick_hz, spans, pen_changes, pauses, layers, drawn_length_mm, travel_length_mm) and
+///    subpaths (the pen-down subpaths planned);
+///  work_area: the machine's x-y travel box in mm, or null;
+///  path: parallel arrays x, y (mm), tick (the plan's tick at that vertex) and pen (1 when
+///    the piece ending at the vertex draws), from the first span's start point through every
+///    span's end point, merged as `options` says;
+///  speed: t (s) and v (mm/s), the fastest span speed in each of up to speed_samples bins;
+///  pauses: the ticks of the programmed pauses.
+/// Cost: one pass over the spans (a few vertices' work per span). Any thread.
+nlohmann::ordered_json preview_json(const Plan& plan, const Path& path, const MachineProfile& machine,
+                                    const PreviewOptions& options = {});
+
+}  // namespace pathstream::host::serve

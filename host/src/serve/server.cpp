@@ -1,0 +1,502 @@
+#include "server.hpp"
+
+#include <httplib.h>
+#include <signal.h>
+
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <stdexcept>
+
+#include "drawing_request.hpp"
+#include "pathstream/host/device_link.hpp"
+#include "pathstream/host/device_setup.hpp"
+#include "serve/web_assets.hpp"
+
+namespace pathstream::host::serve {
+
+namespace fs = std::filesystem;
+using Json = nlohmann::ordered_json;
+
+/// A handler's answer: an HTTP status and a JSON body.
+struct Server::Reply {
+    int status = 200;
+    Json body;
+};
+
+namespace {
+
+constexpr const char* kCookie = "pathstream_token";
+
+Json error_body(const std::string& message) { return Json{{"ok", false}, {"error", message}}; }
+
+std::string cookie_value(const std::string& cookies, const std::string& name) {
+    std::size_t at = 0;
+    while (at < cookies.size()) {
+        const std::size_t end = std::min(cookies.find(';', at), cookies.size());
+        std::string item = cookies.substr(at, end - at);
+        while (!item.empty() && item.front() == ' ') item.erase(0, 1);
+        if (item.rfind(name + "=", 0) == 0) return item.substr(name.size() + 1);
+        at = end + 1;
+    }
+    return "";
+}
+
+std::string number_text(double v) {
+    char text[64];
+    std::snprintf(text, sizeof text, "%.6f", v);
+    return text;
+}
+
+// The last lines of a command's standard error that say something (its error message).
+std::string last_lines(const std::string& text, std::size_t count) {
+    std::vector<std::string> lines;
+    std::size_t at = 0;
+    while (at < text.size()) {
+        const std::size_t end = std::min(text.find('\n', at), text.size());
+        std::string line = text.substr(at, end - at);
+        // A progress bar redraws with carriage returns: its last state is what was seen.
+        if (const std::size_t cr = line.rfind('\r'); cr != std::string::npos) line = line.substr(cr + 1);
+        if (!line.empty()) lines.push_back(line);
+        at = end + 1;
+    }
+    std::string out;
+    for (std::size_t i = lines.size() > count ? lines.size() - count : 0; i < lines.size(); ++i) {
+        out += (out.empty() ? "" : "\n") + lines[i];
+    }
+    return out;
+}
+
+}  // namespace
+
+Server::Server(ServerConfig config, MachineProfile machine, PreviewFunction preview)
+    : config_(std::move(config)), machine_(std::move(machine)), preview_(std::move(preview)),
+      http_(std::make_unique<httplib::Server>()) {
+    fs::create_directories(fs::path(config_.state_dir) / "drawing");
+    routes();
+}
+
+Server::~Server() {
+    stop();
+    if (poller_.joinable()) poller_.join();
+    if (job_thread_.joinable()) job_thread_.join();
+}
+
+void Server::bind() {
+    if (config_.port == 0) {
+        const int port = http_->bind_to_any_port(config_.listen_host);
+        if (port <= 0) throw std::runtime_error("serve: cannot listen on " + config_.listen_host);
+        bound_port_ = static_cast<unsigned>(port);
+    } else {
+        if (!http_->bind_to_port(config_.listen_host, static_cast<int>(config_.port))) {
+            throw std::runtime_error("serve: cannot listen on " + config_.listen_host + ":" +
+                                     std::to_string(config_.port) + " (in use?)");
+        }
+        bound_port_ = config_.port;
+    }
+    config_.access.port = bound_port_;
+}
+
+void Server::run() {
+    poller_ = std::thread([this] { poll_device(); });
+    http_->listen_after_bind();
+}
+
+void Server::stop() {
+    if (stopping_.exchange(true)) return;
+    {
+        // A job that streams is asked to hold at the next span boundary: the machine stops
+        // drawing with the rest of the job kept, and the journal resumes it.
+        const std::lock_guard<std::mutex> lock(job_mutex_);
+        if (job_ && job_running_.load() && job_kind_ == "stream") job_->signal(SIGTERM);
+    }
+    hub_.close();
+    http_->stop();
+}
+
+std::string Server::drawing_file() const {
+    const std::lock_guard<std::mutex> lock(drawing_mutex_);
+    return drawing_name_;
+}
+
+// Messages name the drawing as the page knows it, never the server's directory.
+std::string Server::clean_message(std::string message) const {
+    const std::string dir = (fs::path(config_.state_dir) / "drawing").string() + "/";
+    for (std::size_t at = message.find(dir); at != std::string::npos; at = message.find(dir)) message.erase(at, dir.size());
+    return message;
+}
+
+std::vector<std::string> Server::arguments(const nlohmann::json& options) const {
+    std::vector<std::string> args = path_arguments(options);
+    // The order starts where the pen is, as `stream` orders it: the preview and the run then
+    // plan the same drawing.
+    const std::lock_guard<std::mutex> lock(device_mutex_);
+    if (!rest_mm_.empty()) {
+        std::string start = "--order-start=";
+        for (std::size_t a = 0; a < rest_mm_.size(); ++a) start += (a ? "," : "") + number_text(rest_mm_[a]);
+        args.push_back(start);
+    }
+    return args;
+}
+
+Json Server::plan_preview(const std::vector<std::string>& args) const {
+    const std::string name = drawing_file();
+    if (name.empty()) throw std::invalid_argument("no drawing loaded");
+    const std::lock_guard<std::mutex> lock(plan_mutex_);
+    Json p = preview_((fs::path(config_.state_dir) / "drawing" / name).string(), args);
+    p["drawing"] = name;
+    std::vector<double> start;
+    {
+        const std::lock_guard<std::mutex> device_lock(device_mutex_);
+        start = rest_mm_;
+    }
+    p["rest_mm"] = start;
+    return p;
+}
+
+Server::Reply Server::upload(const std::string& given_name, const std::string& body) {
+    const std::string name = upload_file_name(given_name);
+    const fs::path dir = fs::path(config_.state_dir) / "drawing";
+    if (job_running()) return {409, error_body("a job is running: wait for it to end, or stop it")};
+    {
+        const std::lock_guard<std::mutex> lock(drawing_mutex_);
+        for (const auto& entry : fs::directory_iterator(dir)) fs::remove_all(entry.path());
+        std::ofstream out(dir / name, std::ios::binary);
+        out.write(body.data(), static_cast<std::streamsize>(body.size()));
+        if (!out.flush()) return {500, error_body("cannot store the drawing")};
+        drawing_name_ = name;
+    }
+    return preview(Json::object());
+}
+
+Server::Reply Server::preview(const nlohmann::json& options) {
+    Json p = plan_preview(arguments(options));
+    p["ok"] = true;
+    return {200, p};
+}
+
+bool Server::job_running() const { return job_running_.load(); }
+
+bool Server::start_child(const std::string& kind, std::vector<std::string> argv) {
+    const std::lock_guard<std::mutex> lock(job_mutex_);
+    if (job_running_.load() || stopping_.load()) return false;
+    if (job_thread_.joinable()) job_thread_.join();
+    job_ = std::make_unique<ChildProcess>(argv, (fs::path(config_.state_dir) / "drawing").string());
+    job_kind_ = kind;
+    stop_requested_.store(false);
+    job_running_.store(true);
+    for (const char* k : {"job_start", "progress", "job_end", "pause"}) hub_.forget(k);
+    hub_.publish(Json{{"event", "process"}, {"kind", kind}, {"running", true}, {"drawing", drawing_file()}}.dump(),
+                 "process");
+    job_thread_ = std::thread([this, kind, child = job_.get()] {
+        std::string errors, outcome;
+        const int exit_code = child->wait(
+            [&](const std::string& line) {
+                std::string sticky;
+                for (const char* k : {"job_start", "progress", "job_end", "pause", "state"}) {
+                    if (line.find(std::string("\"event\":\"") + k + "\"") != std::string::npos) sticky = k;
+                }
+                if (sticky == "job_end") {
+                    for (const char* o : {"finished", "held", "stopped", "failed"}) {
+                        if (line.find(std::string("\"outcome\":\"") + o + "\"") != std::string::npos) outcome = o;
+                    }
+                }
+                hub_.publish(line, sticky);
+                // The stream holds at the first signal and says so; a second one stops it.
+                if (sticky.empty() && stop_requested_.load() &&
+                    line.find("\"event\":\"hold\"") != std::string::npos) {
+                    child->signal(SIGTERM);
+                }
+            },
+            errors);
+        // A hold that came to rest before the second signal was seen: the stop drops the
+        // queue as `ctl stop` does (the journal resumes from where the device rests).
+        if (stop_requested_.load() && outcome == "held") {
+            const ChildOutput r = run_child({config_.executable, "ctl", config_.target, "stop", "--wait=10"}, config_.state_dir);
+            hub_.publish(Json{{"event", "command"}, {"verb", "stop"}, {"ok", r.exit_code == 0},
+                              {"error", r.exit_code == 0 ? "" : last_lines(r.err, 1)}}
+                             .dump());
+        }
+        Json end{{"event", "process"}, {"kind", kind}, {"running", false}, {"exit", exit_code}};
+        end["report"] = clean_message(last_lines(errors, 12));
+        if (exit_code != 0) end["error"] = clean_message(last_lines(errors, 1));
+        hub_.publish(end.dump(), "process");
+        job_running_.store(false);
+    });
+    return true;
+}
+
+Server::Reply Server::run_job(const nlohmann::json& options) {
+    if (job_running()) return {409, error_body("a job is running already")};
+    const std::vector<std::string> args = arguments(options);
+    Json p = plan_preview(args);  // throws for a drawing that cannot be planned: nothing starts
+    std::vector<std::string> argv = {config_.executable, "stream", drawing_file()};
+    argv.insert(argv.end(), args.begin(), args.end());
+    for (const std::string& a : {std::string("--machine=") + config_.machine_file, "--target=" + config_.target,
+                                 std::string("--lead-in"), std::string("--events=-"),
+                                 "--events-rate=" + number_text(config_.events_rate),
+                                 "--journal=" + (fs::path(config_.state_dir) / "job.journal.json").string()}) {
+        argv.push_back(a);
+    }
+    if (!start_child("stream", argv)) return {409, error_body("a job is running already")};
+    p["ok"] = true;
+    return {200, p};
+}
+
+Server::Reply Server::resume() {
+    const fs::path journal = fs::path(config_.state_dir) / "job.journal.json";
+    if (!fs::exists(journal)) return {409, error_body("no job journal: nothing was streamed from this page yet")};
+    const std::vector<std::string> argv = {config_.executable, "stream", "--resume=" + journal.string(),
+                                           "--events=-", "--events-rate=" + number_text(config_.events_rate)};
+    if (!start_child("resume", argv)) return {409, error_body("a job is running already")};
+    return {200, Json{{"ok", true}}};
+}
+
+Server::Reply Server::simulate(const nlohmann::json& options) {
+    const std::string name = drawing_file();
+    if (name.empty()) return {409, error_body("no drawing loaded")};
+    std::vector<std::string> argv = {config_.executable, "sim", name};
+    const std::vector<std::string> args = arguments(options);
+    argv.insert(argv.end(), args.begin(), args.end());
+    argv.push_back("--machine=" + config_.machine_file);
+    const ChildOutput r = run_child(argv, (fs::path(config_.state_dir) / "drawing").string());
+    Json body{{"ok", r.exit_code == 0}, {"exit", r.exit_code}, {"report", clean_message(r.out)}};
+    if (r.exit_code != 0) body["error"] = clean_message(last_lines(r.err, 3));
+    return {r.exit_code == 0 ? 200 : 422, body};
+}
+
+Server::Reply Server::control(const nlohmann::json& request) {
+    if (!request.is_object() || !request.contains("verb") || !request["verb"].is_string()) {
+        return {400, error_body("want {\"verb\": ...}")};
+    }
+    const std::string verb = request["verb"].get<std::string>();
+    if (verb == "stop" && job_running()) {
+        // The job's own stream stops the device (a hold, then a stop that drops the queue)
+        // and records it in the journal: the first signal now, the second once it holds.
+        const std::lock_guard<std::mutex> lock(job_mutex_);
+        if (job_) {
+            stop_requested_.store(true);
+            job_->signal(SIGTERM);
+        }
+        return {200, Json{{"ok", true}, {"message", "stopping the job"}}};
+    }
+    std::vector<std::string> argv = {config_.executable, "ctl", config_.target, verb};
+    const auto axis_name = [&](const nlohmann::json& v) {
+        if (!v.is_string()) throw std::invalid_argument("axis: want an axis name");
+        for (const AxisLimits& a : machine_.axes) {
+            if (a.name == v.get<std::string>()) return a.name;
+        }
+        throw std::invalid_argument("axis: the machine has no axis '" + v.get<std::string>() + "'");
+    };
+    if (verb == "hold" || verb == "resume" || verb == "stop" || verb == "reset") {
+    } else if (verb == "home") {
+    } else if (verb == "pen") {
+        if (!request.contains("down") || !request["down"].is_boolean()) throw std::invalid_argument("pen: want down true or false");
+        argv.push_back(request["down"].get<bool>() ? "down" : "up");
+    } else if (verb == "jog") {
+        argv.push_back(axis_name(request.value("axis", nlohmann::json())));
+        const nlohmann::json d = request.value("distance_mm", nlohmann::json());
+        if (!d.is_number() || !std::isfinite(d.get<double>()) || d.get<double>() == 0 || std::fabs(d.get<double>()) > 10000) {
+            throw std::invalid_argument("jog: want distance_mm, not 0, at most 10000 either way");
+        }
+        // A negative number stays a positional argument for ctl's parser (as `jog y -3`).
+        argv.push_back(number_text(d.get<double>()));
+        if (request.contains("feed")) {
+            const nlohmann::json f = request["feed"];
+            if (!f.is_number() || !(f.get<double>() > 0) || f.get<double>() > 1e6) throw std::invalid_argument("jog: feed in mm/s, > 0");
+            argv.push_back("--feed=" + number_text(f.get<double>()));
+        }
+    } else {
+        return {400, error_body("unknown verb '" + verb + "'")};
+    }
+    argv.insert(argv.begin() + 4, {"--machine=" + config_.machine_file, "--json", "--wait=60"});
+    const ChildOutput r = run_child(argv, config_.state_dir);
+    Json body{{"ok", r.exit_code == 0}, {"verb", verb}};
+    if (!r.out.empty()) {
+        try {
+            body["result"] = Json::parse(r.out);
+        } catch (const std::exception&) {
+            body["result"] = r.out;
+        }
+    }
+    if (r.exit_code != 0) body["error"] = last_lines(r.err, 1);
+    hub_.publish(Json{{"event", "command"}, {"verb", verb}, {"ok", r.exit_code == 0},
+                      {"error", r.exit_code == 0 ? "" : last_lines(r.err, 1)}}
+                     .dump());
+    return {r.exit_code == 0 ? 200 : 422, body};
+}
+
+Json Server::state() const {
+    Json axes = Json::array();
+    for (const AxisLimits& a : machine_.axes) {
+        axes.push_back({{"name", a.name}, {"travel_min", a.travel_min}, {"travel_max", a.travel_max},
+                        {"max_velocity", a.max_velocity}});
+    }
+    const fs::path journal = fs::path(config_.state_dir) / "job.journal.json";
+    Json s{{"ok", true},
+           {"machine", {{"file", fs::path(config_.machine_file).filename().string()}, {"axes", axes},
+                        {"tick_hz", machine_.tick_hz}}},
+           {"target", config_.target},
+           {"drawing", drawing_file()},
+           {"job_running", job_running()},
+           {"journal", fs::exists(journal)},
+           {"max_upload_bytes", config_.max_upload_bytes}};
+    return s;
+}
+
+void Server::poll_device() {
+    LinkOptions options;
+    options.link_timeout_seconds = 2;
+    options.response_timeout_ms = 300;
+    const auto period = std::chrono::duration<double>(1.0 / config_.status_hz);
+    std::unique_ptr<DeviceLink> link;
+    std::string last_error;
+    while (!stopping_.load()) {
+        const auto next = std::chrono::steady_clock::now() + period;
+        try {
+            if (!link) link = open_device_link(config_.target, options);
+            const DeviceSnapshot s = link->status();
+            Json position = Json::object(), homing = Json::object();
+            std::vector<double> rest;
+            for (unsigned a = 0; a < s.axes && a < kMaxAxes && a < machine_.axes.size(); ++a) {
+                const double mm = s.position[a] * machine_.mm_per_lsb;
+                position[machine_.axes[a].name] = mm;
+                homing[machine_.axes[a].name] = axis_homing_name(s.homing[a].state);
+                rest.push_back(mm);
+            }
+            {
+                const std::lock_guard<std::mutex> lock(device_mutex_);
+                rest_mm_ = rest;
+            }
+            Json e{{"event", "device"},
+                   {"state", device_state_name(s.state)},
+                   {"code", s.state},
+                   {"fault", s.fault_code == 0 ? "" : fault_text(s.fault_code)},
+                   {"pen_down", s.pen_down()},
+                   {"paused", s.paused()},
+                   {"held_by_underrun", s.held_by_underrun()},
+                   {"homing", s.homing_runs()},
+                   {"queued_spans", s.queued},
+                   {"ticks_executed", s.ticks_executed},
+                   {"position_mm", position},
+                   {"homed", homing}};
+            hub_.publish(e.dump(), "device");
+            last_error.clear();
+        } catch (const std::exception& e) {
+            link.reset();
+            const std::string message = e.what();
+            if (message != last_error) hub_.publish(Json{{"event", "device"}, {"error", message}}.dump(), "device");
+            last_error = message;
+            std::this_thread::sleep_for(std::chrono::milliseconds(500));
+        }
+        std::this_thread::sleep_until(next);
+    }
+}
+
+void Server::routes() {
+    httplib::Server& h = *http_;
+    h.new_task_queue = [] { return new httplib::ThreadPool(16); };
+    h.set_payload_max_length(config_.max_upload_bytes);
+    h.set_pre_routing_handler([this](const httplib::Request& req, httplib::Response& res) {
+        RequestFacts facts;
+        facts.method = req.method;
+        facts.host = req.get_header_value("Host");
+        facts.origin = req.get_header_value("Origin");
+        facts.authorization = req.get_header_value("Authorization");
+        facts.query_token = req.get_param_value("token");
+        facts.cookie_token = cookie_value(req.get_header_value("Cookie"), kCookie);
+        if (const auto why = refusal(config_.access, facts)) {
+            res.status = 403;
+            res.set_content(error_body("refused: " + *why).dump(), "application/json");
+            return httplib::Server::HandlerResponse::Handled;
+        }
+        res.set_header("Cache-Control", "no-store");
+        res.set_header("X-Content-Type-Options", "nosniff");
+        res.set_header("X-Frame-Options", "DENY");
+        res.set_header("Referrer-Policy", "no-referrer");
+        // The page keeps the token as a cookie that only this origin's requests carry.
+        if (!config_.access.token.empty() && !facts.query_token.empty()) {
+            res.set_header("Set-Cookie", std::string(kCookie) + "=" + facts.query_token +
+                                             "; Path=/; HttpOnly; SameSite=Strict");
+        }
+        return httplib::Server::HandlerResponse::Unhandled;
+    });
+    const auto json_handler = [this](auto&& body) {
+        return [this, body](const httplib::Request& req, httplib::Response& res) {
+            Reply reply;
+            try {
+                nlohmann::json request = req.body.empty() ? nlohmann::json::object() : nlohmann::json::parse(req.body);
+                reply = body(req, request);
+            } catch (const nlohmann::json::parse_error&) {
+                reply = {400, error_body("the request body is not JSON")};
+            } catch (const std::invalid_argument& e) {
+                reply = {422, error_body(clean_message(e.what()))};
+            } catch (const std::exception& e) {
+                // Input errors (file:line:col), planning failures: what the CLI would print.
+                reply = {422, error_body(clean_message(e.what()))};
+            }
+            res.status = reply.status;
+            res.set_content(reply.body.dump(), "application/json");
+        };
+    };
+    h.Get("/api/state", json_handler([this](const httplib::Request&, const nlohmann::json&) { return Reply{200, state()}; }));
+    h.Post("/api/drawing", [this](const httplib::Request& req, httplib::Response& res) {
+        Reply reply;
+        try {
+            reply = upload(req.get_param_value("name"), req.body);
+        } catch (const std::exception& e) {
+            reply = {422, error_body(clean_message(e.what()))};
+        }
+        res.status = reply.status;
+        res.set_content(reply.body.dump(), "application/json");
+    });
+    h.Post("/api/preview", json_handler([this](const httplib::Request&, const nlohmann::json& j) {
+        return preview(j.value("options", nlohmann::json::object()));
+    }));
+    h.Post("/api/run", json_handler([this](const httplib::Request&, const nlohmann::json& j) {
+        return run_job(j.value("options", nlohmann::json::object()));
+    }));
+    h.Post("/api/simulate", json_handler([this](const httplib::Request&, const nlohmann::json& j) {
+        return simulate(j.value("options", nlohmann::json::object()));
+    }));
+    h.Post("/api/resume", json_handler([this](const httplib::Request&, const nlohmann::json&) { return resume(); }));
+    h.Post("/api/control", json_handler([this](const httplib::Request&, const nlohmann::json& j) { return control(j); }));
+    h.Get("/api/events", [this](const httplib::Request&, httplib::Response& res) {
+        auto cursor = std::make_shared<std::uint64_t>(0);
+        auto first = std::make_shared<bool>(true);
+        res.set_chunked_content_provider("text/event-stream", [this, cursor, first](std::size_t, httplib::DataSink& sink) {
+            std::string out;
+            if (*first) {
+                *first = false;
+                out = "retry: 1000\n\n";
+                for (const HubEvent& e : hub_.sticky(*cursor)) out += "data: " + e.json + "\n\n";
+            } else {
+                const std::vector<HubEvent> events = hub_.wait_after(*cursor, std::chrono::milliseconds(2000));
+                if (stopping_.load()) {
+                    sink.done();
+                    return false;
+                }
+                if (events.empty()) out = ": idle\n\n";
+                for (const HubEvent& e : events) {
+                    out += "data: " + e.json + "\n\n";
+                    *cursor = e.sequence;
+                }
+            }
+            return sink.write(out.data(), out.size());
+        });
+    });
+    h.Get(R"(/[A-Za-z0-9_.\-]*)", [](const httplib::Request& req, httplib::Response& res) {
+        const WebAsset* asset = find_web_asset(req.path);
+        if (!asset) {
+            res.status = 404;
+            return;
+        }
+        res.set_header("Content-Security-Policy",
+                       "default-src 'self'; img-src 'self' data: blob:; style-src 'self'; script-src 'self'; "
+                       "connect-src 'self'; frame-ancestors 'none'");
+        res.set_content(reinterpret_cast<const char*>(asset->data), asset->size, asset->content_type);
+    });
+}
+
+}  // namespace pathstream::host::serve

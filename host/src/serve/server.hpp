@@ -1,0 +1,108 @@
+// `pathstream serve`: one page and a small HTTP API that load, place, preview, simulate and
+// stream a drawing and steer the machine, with live updates as server-sent events
+// (docs/serve.md).
+#pragma once
+
+#include <atomic>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "access.hpp"
+#include "child_process.hpp"
+#include "event_hub.hpp"
+#include "pathstream/host/machine.hpp"
+
+namespace httplib {
+class Server;
+}
+
+namespace pathstream::host::serve {
+
+/// Everything the server is started with; read-only once it runs.
+struct ServerConfig {
+    std::string listen_host = "127.0.0.1";
+    unsigned port = 8080;             ///< 0: any free port (bound_port() says which)
+    AccessPolicy access;
+    std::string machine_file;         ///< absolute path of the machine profile
+    std::string target;               ///< the device's URL, for stream and ctl
+    std::string state_dir;            ///< absolute; the uploaded drawing and the job journal live here
+    std::string executable;           ///< this program, whose stream, sim and ctl commands run the jobs
+    double events_rate = 10;          ///< stream --events-rate: progress updates per second
+    double status_hz = 10;            ///< device status reads per second
+    std::size_t max_upload_bytes = 16u << 20;
+};
+
+/// Plans the drawing `file` with path options `arguments` (as a path command's command line
+/// after FILE) and returns preview_json's document. Throws what plan_job throws.
+using PreviewFunction =
+    std::function<nlohmann::ordered_json(const std::string& file, const std::vector<std::string>& arguments)>;
+
+/// The HTTP server and what runs behind it: a device status poller thread, at most one job
+/// (a `stream` or `sim` child) with its reader thread, and the event hub the pages listen to.
+class Server {
+public:
+    Server(ServerConfig config, MachineProfile machine, PreviewFunction preview);
+    ~Server();
+    Server(const Server&) = delete;
+    Server& operator=(const Server&) = delete;
+
+    /// Binds the listening socket. Throws std::runtime_error when the address cannot be bound.
+    void bind();
+    /// The port bound (after bind()).
+    unsigned bound_port() const { return bound_port_; }
+    /// Serves until stop(); starts the status poller. Blocks; call once.
+    void run();
+    /// Ends run(): a job still streaming is asked to hold (its journal can resume it), the
+    /// pages' event streams end. Any thread, not a signal handler.
+    void stop();
+
+private:
+    struct Reply;
+    void routes();
+    Reply upload(const std::string& name, const std::string& body);
+    Reply preview(const nlohmann::json& options);
+    Reply run_job(const nlohmann::json& options);
+    Reply simulate(const nlohmann::json& options);
+    Reply resume();
+    Reply control(const nlohmann::json& request);
+    nlohmann::ordered_json state() const;
+    std::vector<std::string> arguments(const nlohmann::json& options) const;
+    nlohmann::ordered_json plan_preview(const std::vector<std::string>& args) const;
+    bool start_child(const std::string& kind, std::vector<std::string> argv);
+    bool job_running() const;
+    void poll_device();
+    std::string drawing_file() const;
+    std::string clean_message(std::string message) const;
+
+    ServerConfig config_;
+    MachineProfile machine_;
+    PreviewFunction preview_;
+    std::unique_ptr<httplib::Server> http_;
+    unsigned bound_port_ = 0;
+    EventHub hub_;
+    std::atomic<bool> stopping_{false};
+    std::thread poller_;
+
+    mutable std::mutex device_mutex_;  ///< the poller writes, the handlers read
+    std::vector<double> rest_mm_;      ///< the device's last position read; empty: none yet
+
+    mutable std::mutex drawing_mutex_;
+    std::string drawing_name_;         ///< the stored drawing's file name; empty: none
+    mutable std::mutex plan_mutex_;    ///< one plan at a time (they are CPU-bound)
+
+    mutable std::mutex job_mutex_;
+    std::unique_ptr<ChildProcess> job_;
+    std::thread job_thread_;
+    std::string job_kind_;
+    std::atomic<bool> job_running_{false};
+    /// Stop asked for: the job's hold event brings the second signal (two sent at once
+    /// would merge into one, a hold).
+    std::atomic<bool> stop_requested_{false};
+};
+
+}  // namespace pathstream::host::serve
