@@ -315,7 +315,11 @@ private:
                 stamp.job = chain.job;
                 stamp.job_end = job_end;
                 stamp.pause_after = pause;
-                for (unsigned a = 0; a < Axes; ++a) stamp.end_tangent[a] = w.end_tangent[a];
+                for (unsigned a = 0; a < Axes; ++a) {
+                    stamp.end_tangent[a] = w.end_tangent[a];
+                    stamp.start_tangent[a] = w.start_tangent[a];
+                    stamp.chord[a] = w.end[a] - chain.start[a];  // both within +-2^27
+                }
                 between();
                 if (Status st = channel_.queue.push(span, stamp); st != Status::kOk) return st;
             }
