@@ -2,6 +2,7 @@
 #include "pathstream/host/geometry.hpp"
 
 #include <cmath>
+#include <functional>
 #include <stdexcept>
 #include <string>
 
@@ -70,53 +71,89 @@ std::array<PathPoint, 4> straight(const PathPoint& a, const PathPoint& b) {
     return {a, combine(a, 2.0 / 3, b, 1.0 / 3), combine(a, 1.0 / 3, b, 2.0 / 3), b};
 }
 
-std::vector<std::array<PathPoint, 4>> subpath_segments(const Subpath& sp, std::size_t index) {
+using Controls = std::array<PathPoint, 4>;
+
+/// Hands a subpath's cubics to `emit` one at a time, with the joints shared exactly (not
+/// merely to rounding: each segment's P0 is a copy of the previous P3) and a closed subpath
+/// ending where it starts. One segment is held back until the next is known, so the whole
+/// subpath is never held at once.
+class JointSharer {
+public:
+    JointSharer(bool closed, const std::function<void(Controls&)>& emit) : closed_(closed), emit_(emit) {}
+
+    void add(Controls&& c) {
+        if (held_) {
+            c[0] = pending_[3];
+            emit_(pending_);
+        } else {
+            first_ = c[0];
+        }
+        pending_ = std::move(c);
+        held_ = true;
+    }
+    /// The last segment (`last_end`: its end point, for open B-spline and Catmull-Rom ends).
+    void finish(const PathPoint* last_end) {
+        if (!held_) return;
+        if (last_end != nullptr) pending_[3] = *last_end;
+        if (closed_) pending_[3] = first_;
+        emit_(pending_);
+        held_ = false;
+    }
+
+private:
+    bool closed_;
+    const std::function<void(Controls&)>& emit_;
+    Controls pending_;
+    PathPoint first_;
+    bool held_ = false;
+};
+
+void subpath_segments(const Subpath& sp, std::size_t index, const std::function<void(Controls&)>& emit) {
     const auto& pts = sp.points;
     const std::size_t m = pts.size();
-    std::vector<std::array<PathPoint, 4>> out;
     const auto too_few = [&](const char* need) {
         throw std::invalid_argument("subpath " + std::to_string(index) + ": " + basis_name(sp.basis) +
                                     " needs " + need + " points, got " + std::to_string(m));
     };
+    JointSharer out(sp.closed, emit);
     switch (sp.basis) {
         case PathBasis::kBSpline:
         case PathBasis::kCatmullRom: {
             if (m < (sp.closed ? 3u : 2u)) too_few(sp.closed ? "at least 3" : "at least 2");
             std::vector<PathPoint> storage;
+            bool first = true;
             for (const Window& w : windows(pts, sp.closed, storage)) {
-                out.push_back(sp.basis == PathBasis::kBSpline ? bspline_to_bezier(w) : catmull_rom_to_bezier(w));
+                Controls c = sp.basis == PathBasis::kBSpline ? bspline_to_bezier(w) : catmull_rom_to_bezier(w);
+                if (first && !sp.closed) c[0] = pts.front();  // the clamped start is exactly the first point
+                first = false;
+                out.add(std::move(c));
             }
-            if (!sp.closed) {  // the clamped ends are exactly the first and last points
-                out.front()[0] = pts.front();
-                out.back()[3] = pts.back();
-            }
-            break;
+            out.finish(sp.closed ? nullptr : &pts.back());  // and the clamped end the last
+            return;
         }
         case PathBasis::kBezier: {
             if (sp.closed ? (m < 3 || m % 3 != 0) : (m < 4 || m % 3 != 1)) too_few(sp.closed ? "3k" : "3k + 1");
             const std::size_t count = sp.closed ? m / 3 : (m - 1) / 3;
             for (std::size_t i = 0; i < count; ++i) {
-                out.push_back({pts[3 * i], pts[3 * i + 1], pts[3 * i + 2], pts[(3 * i + 3) % m]});
+                out.add({pts[3 * i], pts[3 * i + 1], pts[3 * i + 2], pts[(3 * i + 3) % m]});
             }
             break;
         }
         case PathBasis::kPolyline: {
             if (m < (sp.closed ? 3u : 2u)) too_few(sp.closed ? "at least 3" : "at least 2");
             const std::size_t count = sp.closed ? m : m - 1;
-            for (std::size_t i = 0; i < count; ++i) out.push_back(straight(pts[i], pts[(i + 1) % m]));
+            for (std::size_t i = 0; i < count; ++i) out.add(straight(pts[i], pts[(i + 1) % m]));
             break;
         }
     }
-    // Joints are shared exactly (not merely to rounding), and a closed subpath ends where it starts.
-    for (std::size_t i = 1; i < out.size(); ++i) out[i][0] = out[i - 1][3];
-    if (sp.closed && !out.empty()) out.back()[3] = out.front()[0];
-    return out;
+    out.finish(nullptr);
 }
 
 }  // namespace
 
-std::vector<BezierSegment> to_bezier_segments(const Path& path) {
-    std::vector<BezierSegment> out;
+void for_each_bezier_segment(const Path& path, const std::function<void(const BezierSegment&)>& visit) {
+    bool any = false;
+    PathPoint last_end;
     for (std::size_t s = 0; s < path.subpaths.size(); ++s) {
         const Subpath& sp = path.subpaths[s];
         for (const auto& p : sp.points) {
@@ -126,28 +163,34 @@ std::vector<BezierSegment> to_bezier_segments(const Path& path) {
                                             std::to_string(path.axes));
             }
         }
-        auto segments = subpath_segments(sp, s);
-        if (segments.empty()) continue;
-        if (!out.empty()) {  // straight pen-up travel from the last end point to this start
-            BezierSegment travel;
-            travel.p = straight(out.back().p[3], segments.front()[0]);
-            travel.pen_down = false;
-            travel.subpath = s;
-            out.push_back(std::move(travel));
-        }
-        const std::size_t first = out.size();
-        for (auto& p : segments) {
-            BezierSegment seg;
-            seg.p = std::move(p);
-            seg.pen_down = true;
-            seg.subpath = s;
-            seg.feed = sp.feed;
-            out.push_back(std::move(seg));
-        }
-        out[first].pause_before = sp.pause_before;
-        out[first].dwell_before = sp.dwell_before;
-        out[first].dwell_pen_down = sp.dwell_pen_down;
+        bool first = true;
+        BezierSegment seg;
+        seg.pen_down = true;
+        seg.subpath = s;
+        seg.feed = sp.feed;
+        subpath_segments(sp, s, [&](Controls& c) {
+            if (first && any) {  // straight pen-up travel from the last end point to this start
+                BezierSegment travel;
+                travel.p = straight(last_end, c[0]);
+                travel.pen_down = false;
+                travel.subpath = s;
+                visit(travel);
+            }
+            seg.p = std::move(c);
+            seg.pause_before = first && sp.pause_before;
+            seg.dwell_before = first ? sp.dwell_before : 0;
+            seg.dwell_pen_down = first && sp.dwell_pen_down;
+            first = false;
+            any = true;
+            visit(seg);
+            last_end = seg.p[3];
+        });
     }
+}
+
+std::vector<BezierSegment> to_bezier_segments(const Path& path) {
+    std::vector<BezierSegment> out;
+    for_each_bezier_segment(path, [&](const BezierSegment& s) { out.push_back(s); });
     return out;
 }
 

@@ -1,5 +1,6 @@
 #include "pathstream/host/machine.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -108,6 +109,7 @@ public:
               << " mm): integer setpoints cannot meet it";
             fail(root.contains("chord_tolerance") ? "/chord_tolerance" : "/mm_per_lsb", m.str());
         }
+        check_plannable(root, p);
         if (root.contains("gpio")) p.gpio = gpio(root["gpio"], p);
         if (root.contains("layer_feeds")) {
             const json& f = root["layer_feeds"];
@@ -115,12 +117,80 @@ public:
             for (const auto& [name, value] : f.items()) {
                 const std::string ptr = "/layer_feeds/" + json_pointer_token(name);
                 p.layer_feeds.emplace_back(name, number(value, ptr, "layer feed", 0, 1e5, true, "mm/s"));
+                if (p.layer_feeds.back().second < min_velocity(p)) {
+                    fail(ptr, "layer feed " + format(p.layer_feeds.back().second) +
+                                  " mm/s is below 1 LSB per span: planning would crawl (allowed: >= " +
+                                  format(min_velocity(p)) + " mm/s)");
+                }
             }
         }
         return p;
     }
 
 private:
+    // Values the planner cannot work with although each is within its own range: speeds and
+    // accelerations too small for the position and time grid (a span moves whole LSB at its
+    // ends), spans so long that one at full speed crosses the whole work area. Each is
+    // refused at the value that decides it, with the range it must lie in.
+    void check_plannable(const json& root, const MachineProfile& p) const {
+        const double n = p.ticks_per_span;
+        const double v_min = min_velocity(p);
+        const double a_min = min_acceleration(p);
+        const std::string grid = "(" + format(p.mm_per_lsb) + " mm/LSB, " + format(p.tick_hz) + " Hz, " +
+                                 format(n) + " ticks per span)";
+        for (std::size_t i = 0; i < p.axes.size(); ++i) {
+            const AxisLimits& a = p.axes[i];
+            const std::string ptr = "/axes/" + std::to_string(i);
+            if (a.max_velocity < v_min) {
+                fail(ptr + "/max_velocity",
+                     "max_velocity " + format(a.max_velocity) + " mm/s is below 1 LSB per span " + grid +
+                         ": planning would crawl (allowed: >= " + format(v_min) +
+                         " mm/s; or raise ticks_per_span, or lower tick_hz)");
+            }
+            if (a.max_acceleration < a_min) {
+                fail(ptr + "/max_acceleration",
+                     "max_acceleration " + format(a.max_acceleration) +
+                         " mm/s^2 cannot gain 1 LSB per span of speed within one span " + grid +
+                         " (allowed: >= " + format(a_min) + " mm/s^2; or raise ticks_per_span, or lower tick_hz)");
+            }
+            // One span at the axis's top speed must stay within its travel, or within the
+            // device's position range when it has none.
+            const double extent = a.has_travel ? a.travel_max - a.travel_min
+                                               : 2.0 * static_cast<double>(kMaxPositionLsb) * p.mm_per_lsb;
+            const double span_mm = a.max_velocity * n / p.tick_hz;
+            if (span_mm > extent) {
+                const double longest = std::max(1.0, std::floor(extent * p.tick_hz / a.max_velocity));
+                const std::string where = a.has_travel ? "its travel" : "the device's position range";
+                const std::string what = "a span of " + format(n) + " ticks at axis " + a.name + "'s max_velocity " +
+                                         format(a.max_velocity) + " mm/s crosses " + format(span_mm) +
+                                         " mm, more than " + where + " (" + format(extent) + " mm)";
+                if (root.contains("ticks_per_span")) {
+                    fail("/ticks_per_span", "ticks_per_span " + format(n) + " is too long: " + what +
+                                                " (allowed: 1 .. " + format(longest) + " ticks)");
+                }
+                fail(ptr + "/max_velocity", "max_velocity " + format(a.max_velocity) + " mm/s is too fast for " +
+                                                "spans of " + format(n) + " ticks: " + what + " (allowed: <= " +
+                                                format(extent * p.tick_hz / n) + " mm/s)");
+            }
+        }
+        const auto check_feed = [&](const char* key, double feed) {
+            if (feed >= v_min) return;
+            const bool given = root.contains(key);
+            fail(given ? std::string("/") + key : std::string(),
+                 std::string(key) + (given ? " " : " (default) ") + format(feed) + " mm/s is below 1 LSB per span " +
+                     grid + ": planning would crawl (allowed: >= " + format(v_min) + " mm/s)");
+        };
+        check_feed("feed", p.feed);
+        check_feed("travel_feed", p.travel_feed);
+    }
+
+    // Shortest decimal that reads back as `x` (up to 6 significant digits).
+    static std::string format(double x) {
+        std::ostringstream m;
+        m << x;
+        return m.str();
+    }
+
     GpioLineConfig line(const json& v, const std::string& ptr, const char* what) const {
         if (!v.is_object()) fail(ptr, std::string(what) + " must be an object like {\"line\": 3}");
         only_keys(v, ptr, {"line", "active_low", "bias"});
@@ -222,6 +292,13 @@ private:
 };
 
 }  // namespace
+
+double min_velocity(const MachineProfile& p) { return p.mm_per_lsb * p.tick_hz / p.ticks_per_span; }
+
+double min_acceleration(const MachineProfile& p) {
+    const double span_seconds = p.ticks_per_span / p.tick_hz;
+    return min_velocity(p) / span_seconds;
+}
 
 MachineProfile parse_machine_profile(const std::string& text, const std::string& file) {
     MachineProfile profile = ProfileReader(text, file).read(parse_json_document(text, file));

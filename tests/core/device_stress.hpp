@@ -78,6 +78,13 @@ public:
                     fail(s, "second difference beyond the acceleration limit");
             }
         }
+        if (s.paused()) {
+            ++paused_ticks_;
+            if (st != device::DeviceState::kHolding) fail(s, "paused flag outside holding");
+        } else if (paused1_ && st == device::DeviceState::kRunning) {
+            ++pauses_resumed_;
+        }
+        paused1_ = s.paused();
         if (s.path_tick()) {
             ++path_ticks_;
             if (s.span_epoch != s.epoch) fail(s, "a span of an older epoch was executed");
@@ -106,6 +113,10 @@ public:
     const std::string& failure() const { return failure_; }
     std::uint64_t ticks() const { return n_; }
     std::uint64_t path_ticks() const { return path_ticks_; }
+    /// Ticks holding at a programmed pause (the status's paused flag).
+    std::uint64_t paused_ticks() const { return paused_ticks_; }
+    /// Programmed pauses left by a resume (paused, then running).
+    std::uint64_t pauses_resumed() const { return pauses_resumed_; }
     std::uint64_t epochs() const { return epochs_; }
     std::uint64_t jobs_finished() const { return jobs_finished_; }
     std::uint64_t state_changes() const { return state_changes_; }
@@ -131,7 +142,9 @@ private:
     std::size_t keep_;
     std::string failure_;
     std::vector<Lsb> positions_;
-    std::uint64_t n_ = 0, path_ticks_ = 0, epochs_ = 0, jobs_finished_ = 0, state_changes_ = 0;
+    std::uint64_t n_ = 0, path_ticks_ = 0, paused_ticks_ = 0, pauses_resumed_ = 0, epochs_ = 0,
+                  jobs_finished_ = 0, state_changes_ = 0;
+    bool paused1_ = false;
     std::uint64_t in_state_[6] = {};
     std::int64_t p1_[kAxes] = {}, p2_[kAxes] = {};
     device::DeviceState state1_ = device::DeviceState::kIdle, state2_ = device::DeviceState::kIdle;
@@ -143,6 +156,7 @@ struct DriverCounts {
     std::uint64_t actions = 0, batches_ok = 0, batches_refused = 0, spans_ok = 0,
                   invalid_refused = 0;
     std::uint64_t commands = 0, faults = 0, estops = 0, job_ends_sent = 0, status_reads = 0;
+    std::uint64_t pauses_sent = 0;  ///< accepted batches ending in a programmed pause
 };
 
 /// The task side: one random action per step(). `between` is passed to accept_batch (the
@@ -301,13 +315,20 @@ private:
         if (!ending_ && pick(0, 19) == 0) ending_ = true;
         const int count = pick(1, 12);
         std::vector<device::WireSpan> spans;
-        bool job_end = false;
+        bool job_end = false, pause = false;
         for (int i = 0; i < count && !job_end; ++i) {
             spans.push_back(next_span(at, v, n));
             if (ending_ && v[0] == 0 && v[1] == 0) {
-                if (pick(0, 9) < 7) {
+                // At rest: a job end, or a programmed pause (the device holds there until a
+                // resume, then the job goes on from rest), or neither.
+                const int what = pick(0, 9);
+                if (what < 5) {
                     spans.back().flags =
                         static_cast<std::uint8_t>(spans.back().flags | device::kWireJobEnd);
+                } else if (what < 8) {
+                    spans.back().flags =
+                        static_cast<std::uint8_t>(spans.back().flags | device::kWirePause);
+                    pause = true;
                 }
                 job_end = true;
             }
@@ -318,6 +339,7 @@ private:
             ++counts_.batches_ok;
             counts_.spans_ok += spans.size();
             if (job_end && (spans.back().flags & device::kWireJobEnd) != 0) ++counts_.job_ends_sent;
+            if (pause) ++counts_.pauses_sent;
             for (unsigned a = 0; a < kAxes; ++a) {
                 at_[a] = at[a];
                 v_[a] = v[a];
@@ -355,7 +377,7 @@ private:
         int bad_flag = -1;
         device::WireSpan& w = spans[static_cast<std::size_t>(index)];
         const std::int32_t n = static_cast<std::int32_t>(w.ticks);
-        switch (pick(0, 4)) {
+        switch (pick(0, 5)) {
             case 0:  // a gap in the sequence numbers
                 first += 3;
                 break;
@@ -376,6 +398,17 @@ private:
                 j.end[0] = static_cast<std::int32_t>(at_[0] + static_cast<std::int64_t>(v0 + v1) *
                                                                   j.ticks / 2);
                 j.flags = device::kWireJobEnd;  // T0 sent: v0 over this span's length
+                break;
+            }
+            case 4: {  // a pause while moving (as the job end above)
+                spans.resize(1);
+                device::WireSpan& p = spans[0];
+                const std::int32_t v0 = v_[0];
+                const std::int32_t v1 = v0 >= 0 ? v0 + 2 : v0 - 2;
+                p.end_tangent[0] = v1 * static_cast<std::int32_t>(p.ticks);
+                p.end[0] = static_cast<std::int32_t>(at_[0] + static_cast<std::int64_t>(v0 + v1) *
+                                                                  p.ticks / 2);
+                p.flags = device::kWirePause;
                 break;
             }
             default:  // an unknown flag

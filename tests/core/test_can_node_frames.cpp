@@ -103,8 +103,9 @@ TEST_CASE("CAN node refuses a resend with other bytes under the same sequence", 
     const auto p = two_spans();
     auto other = p;
     other[7] ^= 1;  // the first span's end moves by one LSB
-    const auto send = [&](const std::vector<std::uint8_t>& payload) {
-        n.feed(pc::encode_span_start(5, {1, 2, static_cast<std::uint16_t>(payload.size())}));
+    const auto send = [&](const std::vector<std::uint8_t>& payload, std::uint32_t first = 1,
+                          std::uint8_t count = 2) {
+        n.feed(pc::encode_span_start(5, {first, count, static_cast<std::uint16_t>(payload.size())}));
         for (std::size_t i = 0; i < pc::data_frames(payload.size()); ++i) {
             n.feed(pc::encode_span_data(5, static_cast<std::uint8_t>(i), payload.data(),
                                         payload.size()));
@@ -115,6 +116,12 @@ TEST_CASE("CAN node refuses a resend with other bytes under the same sequence", 
     CHECK(send(other).result == static_cast<std::uint8_t>(Status::kBadSequence));
     CHECK(n.dev.duplicates() == 0);
     CHECK(send(p).result == 0);
+    CHECK(n.dev.duplicates() == 1);
+    CHECK(n.dev.queued_spans() == 2);
+    // The last span alone under its number is no resend of the batch, even with its bytes: a
+    // part of a batch cannot be compared with the batch's CRC.
+    const std::vector<std::uint8_t> tail(p.begin() + 28, p.end());
+    CHECK(send(tail, 2, 1).result == static_cast<std::uint8_t>(Status::kBadSequence));
     CHECK(n.dev.duplicates() == 1);
     CHECK(n.dev.queued_spans() == 2);
 }

@@ -1,5 +1,6 @@
-// The device under stress: a task side sending random valid and invalid batches, commands,
-// faults, e-stops and resets at random moments, and a tick side checked on every tick (steps
+// The device under stress: a task side sending random valid and invalid batches (some ending
+// in a programmed pause, kWirePause, that a later resume leaves; some pausing while moving,
+// refused), commands, faults, e-stops and resets at random moments, and a tick side checked on every tick (steps
 // and second differences within the limits, generated moves included; no motion in idle,
 // fault or e-stop; no span of an older epoch executed; the pen up on every tick that is not a
 // path tick; the status never torn). Two ways:
@@ -37,6 +38,9 @@ void check_coverage(const TickChecker& c, const DriverCounts& n, std::uint64_t t
     CHECK(c.jobs_finished() > 0);
     CHECK(n.batches_ok > 100);
     CHECK(n.invalid_refused > 10);
+    CHECK(n.pauses_sent > 0);
+    CHECK(c.paused_ticks() > 0);
+    CHECK(c.pauses_resumed() > 0);
 }
 
 void print_summary(const char* name, std::uint64_t seed, const TickChecker& c,
@@ -46,7 +50,7 @@ void print_summary(const char* name, std::uint64_t seed, const TickChecker& c,
         "%u underruns, "
         "%llu batches accepted (%llu spans), %llu refused, %llu invalid refused, %llu commands, "
         "%llu faults, "
-        "%llu e-stops\n",
+        "%llu e-stops, %llu pauses sent (%llu ticks paused, %llu resumed)\n",
         name, static_cast<unsigned long long>(seed), static_cast<unsigned long long>(c.ticks()),
         static_cast<unsigned long long>(c.path_ticks()), static_cast<unsigned long long>(generated),
         static_cast<unsigned long long>(c.epochs()),
@@ -55,7 +59,9 @@ void print_summary(const char* name, std::uint64_t seed, const TickChecker& c,
         static_cast<unsigned long long>(n.batches_refused),
         static_cast<unsigned long long>(n.invalid_refused),
         static_cast<unsigned long long>(n.commands), static_cast<unsigned long long>(n.faults),
-        static_cast<unsigned long long>(n.estops));
+        static_cast<unsigned long long>(n.estops), static_cast<unsigned long long>(n.pauses_sent),
+        static_cast<unsigned long long>(c.paused_ticks()),
+        static_cast<unsigned long long>(c.pauses_resumed()));
     std::printf(
         "  ticks per state: idle %llu, running %llu, holding %llu, stopping %llu, fault %llu, "
         "e-stop %llu\n",

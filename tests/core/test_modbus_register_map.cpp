@@ -175,6 +175,13 @@ TEST_CASE("a resend with other bytes under the same sequence is refused", "[devi
           Ex::kNone);
     CHECK(status(m)[modbus::status::kDuplicates] == 1);
     CHECK(d.queued_spans() == 6);
+    // The tail of the last batch under its numbers, with other bytes: not a resend either.
+    const auto tail = window(4, test::trapezoid_move<kAxes>(start, 10000, 8), 3, 3);
+    CHECK(m.write_holding_registers(modbus::kSpanWindow, static_cast<std::uint16_t>(tail.size()), tail.data()) ==
+          Ex::kIllegalDataValue);
+    CHECK(status(m)[modbus::status::kLastRefusal] == static_cast<std::uint16_t>(Status::kBadSequence));
+    CHECK(status(m)[modbus::status::kDuplicates] == 1);
+    CHECK(d.queued_spans() == 6);
 }
 
 TEST_CASE("tick rates below the profile's range are refused", "[device][modbus]") {

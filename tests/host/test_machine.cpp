@@ -58,3 +58,50 @@ TEST_CASE("impossible profiles are refused with the place and the reason", "[hos
                               {"name": "x", "max_velocity": 1, "max_acceleration": 1}]})") ==
           "m.json:2:40: axis name \"x\" is used twice");
 }
+
+TEST_CASE("profiles the planner cannot work with are refused at the value, with the range", "[host][machine]") {
+    // Speeds below 1 LSB per span (0.125 mm/s at 0.001 mm, 1000 Hz, 8 ticks per span).
+    CHECK(error_of(R"({"axes": [{"name": "x", "max_velocity": 1e-300, "max_acceleration": 1000}]})") ==
+          "m.json:1:41: max_velocity 1e-300 mm/s is below 1 LSB per span (0.001 mm/LSB, 1000 Hz, 8 ticks per span): "
+          "planning would crawl (allowed: >= 0.125 mm/s; or raise ticks_per_span, or lower tick_hz)");
+    CHECK(error_of(R"({"axes": [{"name": "x", "max_velocity": 0.1, "max_acceleration": 1000}]})") != "no error");
+    CHECK(error_of(R"({"axes": [{"name": "x", "max_velocity": 0.125, "max_acceleration": 1000}]})") == "no error");
+    // Accelerations that cannot gain that speed within a span (15.625 mm/s^2 here).
+    CHECK(error_of(R"({"axes": [{"name": "x", "max_velocity": 100, "max_acceleration": 1e-300}]})") ==
+          "m.json:1:66: max_acceleration 1e-300 mm/s^2 cannot gain 1 LSB per span of speed within one span "
+          "(0.001 mm/LSB, 1000 Hz, 8 ticks per span) (allowed: >= 15.625 mm/s^2; or raise ticks_per_span, or "
+          "lower tick_hz)");
+    CHECK(error_of(R"({"axes": [{"name": "x", "max_velocity": 100, "max_acceleration": 15.625}]})") == "no error");
+    // The same acceleration is fine with longer spans.
+    CHECK(error_of(R"({"axes": [{"name": "x", "max_velocity": 100, "max_acceleration": 1}], "ticks_per_span": 32})") ==
+          "no error");
+    // Feeds too.
+    CHECK(error_of(std::string("{") + kAxes + ", \"feed\": 0.01}") ==
+          "m.json:1:82: feed 0.01 mm/s is below 1 LSB per span (0.001 mm/LSB, 1000 Hz, 8 ticks per span): planning "
+          "would crawl (allowed: >= 0.125 mm/s)");
+    CHECK(error_of(std::string("{") + kAxes + ", \"travel_feed\": 1e-9}").find("m.json:1:89: travel_feed 1e-09 mm/s") ==
+          0);
+    CHECK(error_of(std::string("{") + kAxes + ", \"layer_feeds\": {\"red\": 1e-9}}").find("m.json:1:97: layer feed 1e-09 mm/s is below 1 LSB per span") == 0);
+}
+
+TEST_CASE("spans longer than the work area at full speed are refused", "[host][machine]") {
+    // examples/machines/a3_plotter.json with the documented maximum ticks_per_span: one span at
+    // 250 mm/s crosses 16,384 mm of a 430 mm travel.
+    const char* a3 = R"({"axes": [{"name": "x", "max_velocity": 250, "max_acceleration": 3000, "travel": [0, 430]},
+                                  {"name": "y", "max_velocity": 250, "max_acceleration": 3000, "travel": [0, 297]}],
+                         "ticks_per_span": 65536})";
+    CHECK(error_of(a3) ==
+          "m.json:3:44: ticks_per_span 65536 is too long: a span of 65536 ticks at axis x's max_velocity 250 mm/s "
+          "crosses 16384 mm, more than its travel (430 mm) (allowed: 1 .. 1720 ticks)");
+    // Without travel, the bound is the device's position range (2^28 LSB: 268 m at 1 um).
+    CHECK(error_of(R"({"axes": [{"name": "x", "max_velocity": 1000, "max_acceleration": 3000}], "ticks_per_span": 65536})") ==
+          "no error");
+    CHECK(error_of(R"({"axes": [{"name": "x", "max_velocity": 1000, "max_acceleration": 3000}], "mm_per_lsb": 0.00001,
+                       "ticks_per_span": 65536})")
+              .find("m.json:2:42: ticks_per_span 65536 is too long: a span of 65536 ticks at axis x's max_velocity 1000 "
+                    "mm/s crosses 65536 mm, more than the device's position range (2684.35 mm)") == 0);
+    // The default span length: reported at the velocity that is too fast for it.
+    CHECK(error_of(R"({"axes": [{"name": "x", "max_velocity": 99999, "max_acceleration": 3000, "travel": [0, 100]}]})") ==
+          "m.json:1:41: max_velocity 99999 mm/s is too fast for spans of 8 ticks: a span of 8 ticks at axis x's "
+          "max_velocity 99999 mm/s crosses 799.992 mm, more than its travel (100 mm) (allowed: <= 12500 mm/s)");
+}

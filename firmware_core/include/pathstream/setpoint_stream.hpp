@@ -144,6 +144,19 @@ public:
     /// holds). A device decides stops here, where the last span's end velocity is known.
     /// Consumer context.
     bool between_spans() const { return active_ == nullptr; }
+    /// The span in progress (its stamp included), or nullptr between spans. Consumer context.
+    const PreparedSpan<Axes>* span_in_progress() const { return active_; }
+    /// Ticks the span in progress has supplied (1 .. its ticks - 1; 0 between spans): the
+    /// next tick() supplies its tick k = ticks_into_span(). Consumer context.
+    std::uint32_t ticks_into_span() const {
+        return active_ != nullptr ? active_->ticks - active_->countdown : 0u;
+    }
+    /// The setpoint the next tick() supplies for `axis` from the span in progress (the exact
+    /// curve at its tick k, rounded once), without supplying it. Precondition: a span is in
+    /// progress. O(1). Consumer context.
+    Lsb next_setpoint(unsigned axis) const {
+        return active_->wide ? active_->wide_state[axis].position() : active_->narrow[axis].position();
+    }
     /// Where the axes rest between spans (the last span's end point, or the start). Consumer.
     Lsb resting_position(unsigned axis) const { return hold_[axis]; }
     /// End point of the last pushed span (or the start): where the next push must begin.

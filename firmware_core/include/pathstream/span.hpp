@@ -31,13 +31,16 @@ inline constexpr std::uint8_t kOutputPenDown = 1u << 0;
 
 /// What a queue entry carries besides the motion, for whoever consumes the queue; the stream
 /// itself never reads it. A device stamps each span with the queue epoch it was accepted in,
-/// its job, the end marker and the end tangent it needs to plan a stop at the span's end
-/// (device/motion_device.hpp); written by the producer before the entry is published.
+/// its job, the end marker, and the Hermite chord and tangents it needs to plan a stop at the
+/// span's end or inside it (device/motion_device.hpp); written by the producer before the
+/// entry is published.
 template <unsigned Axes>
 struct SpanStamp {
     std::uint32_t epoch = 0;
     std::uint32_t job = 0;
-    std::int32_t end_tangent[Axes] = {};  ///< Hermite T1 per axis (LSB per span)
+    std::int32_t end_tangent[Axes] = {};    ///< Hermite T1 per axis (LSB per span)
+    std::int32_t start_tangent[Axes] = {};  ///< Hermite T0 per axis (LSB per span)
+    std::int32_t chord[Axes] = {};          ///< P1 - P0 per axis (LSB, |.| <= 2^28)
     bool job_end = false;
     bool pause_after = false;  ///< the device holds at this span's end (it ends at rest)
 };

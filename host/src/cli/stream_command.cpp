@@ -93,7 +93,7 @@ std::atomic<int> g_interrupts{0};
 extern "C" void on_stream_signal(int) {
     const int n = g_interrupts.fetch_add(1) + 1;
     static const char hold[] =
-        "\npathstream: interrupt: holding at the next span boundary (Ctrl-C again: stop and drop the queue)\n";
+        "\npathstream: interrupt: holding from the current tick (Ctrl-C again: stop and drop the queue)\n";
     static const char stop[] = "\npathstream: interrupt: stopping\n";
     if (n == 1) {
         (void)!write(2, hold, sizeof hold - 1);

@@ -1,15 +1,14 @@
 // The device end of the native CAN protocol (can_protocol.hpp): assembles span batches from
 // span-start and span-data frames and feeds MotionDevice::accept_batch (all or nothing,
-// duplicates acknowledged, a resend with other bytes refused), applies commands and the
-// configuration, answers with acks and status frames. Freestanding: no heap, storage inline
-// (the batch being received and the last one queued: 2 x 1792 bytes).
+// duplicates acknowledged, a resend with other bytes refused by the core), applies commands
+// and the configuration, answers with acks and status frames. Freestanding: no heap, storage
+// inline (the batch being received: 1792 bytes).
 #pragma once
 
 #include <cstddef>
 #include <cstdint>
 
 #include "pathstream/device/can_protocol.hpp"
-#include "pathstream/device/last_batch.hpp"
 #include "pathstream/device/operator_commands.hpp"
 #include "pathstream/device/motion_device.hpp"
 #include "pathstream/status.hpp"
@@ -242,18 +241,7 @@ private:
         ++next_index_;
         if (received_ < transfer_.length) return;
         active_ = false;
-        // A resend of the last batch must carry its bytes: the core compares sequence numbers only.
-        if (last_batch_.conflicts(transfer_.first_sequence, transfer_.count, buffer_, received_,
-                                  device_.last_accepted_sequence())) {
-            ++refused_;
-            const auto result = static_cast<std::uint8_t>(Status::kBadSequence);
-            return ack(kAckSpans, result, transfer_.first_sequence, send);
-        }
-        const std::uint32_t duplicates = device_.duplicates();
         const Status st = device_.accept_batch(transfer_.first_sequence, transfer_.count, buffer_, received_);
-        if (st == Status::kOk && device_.duplicates() == duplicates) {
-            last_batch_.remember(transfer_.first_sequence, transfer_.count, buffer_, received_);
-        }
         if (st != Status::kOk) ++refused_;
         ack(kAckSpans, static_cast<std::uint8_t>(st), transfer_.first_sequence, send);
     }
@@ -271,7 +259,6 @@ private:
     std::uint32_t refused_ = 0;
     bool bus_problem_ = false;
     std::uint8_t buffer_[kMaxTransferBytes] = {};
-    LastBatch<kMaxTransferBytes> last_batch_;  // the last batch queued, to compare resends with
 };
 
 }  // namespace pathstream::device::can

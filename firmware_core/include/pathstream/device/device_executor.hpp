@@ -1,6 +1,7 @@
 // The device's tick side: consumes the span queue one tick at a time, applies the task side's
 // requests from the mailbox, owns the one motion-stop path (hold, stop, underrun, job end,
-// fault, e-stop) and the re-entry, drives the discrete outputs, and publishes the status.
+// fault, e-stop; a hold or stop from the tick that takes it, inside a span too) and the
+// re-entry, drives the discrete outputs, and publishes the status.
 // Runs in the tick interrupt only. Shares nothing with the task side but the DeviceChannel.
 #pragma once
 
@@ -35,8 +36,9 @@ public:
     /// and publishes the status. Only a span stamped with the current epoch is ever played:
     /// older ones are dropped unplayed whenever the queue is between spans. Steady state
     /// costs SetpointStream::tick plus the request loads and the status publication; a
-    /// controlled stop or re-entry is planned in this call at a span boundary (a one-off of a
-    /// few thousand instructions per axis). Tick interrupt context.
+    /// controlled stop or re-entry is planned in this call, at a span boundary or in the tick
+    /// that takes a hold or stop (a one-off of a few thousand instructions per axis). Tick
+    /// interrupt context.
     void tick(Lsb (&out)[Axes]) {
         SetpointStream<Axes, Capacity>& queue = channel_.queue;
         // In the middle of a span, with no request taken, a tick changes only the status's hot
@@ -194,7 +196,9 @@ private:
                 }
                 break;
             case Command::kHold:
-                if (s == DeviceState::kRunning) hold_requested_ = true;
+                // Inside a span: the stop starts in this tick. Between spans (and during a
+                // re-entry, until it reaches the path): at the boundary.
+                if (s == DeviceState::kRunning && !stop_within_span(false)) hold_requested_ = true;
                 break;
             case Command::kResume:
                 if (s == DeviceState::kHolding) {
@@ -208,7 +212,7 @@ private:
             case Command::kStop:
                 manual_pen_ = 0;
                 if (s == DeviceState::kRunning) {
-                    stop_requested_ = true;
+                    if (!stop_within_span(true)) stop_requested_ = true;
                 } else if (s == DeviceState::kHolding) {
                     if (motion_ == Motion::kRest) {
                         drop_queue();
@@ -370,6 +374,48 @@ private:
         return false;
     }
 
+    // A hold (`stopping` false) or stop taken inside a span: a controlled stop planned like
+    // one at a boundary (plan_stop), from the setpoint the span would supply in this tick and
+    // the span's velocity there (velocity_within_span); that setpoint becomes the boundary a
+    // resume re-enters at, and the rest of the span plays after the re-entry. False, and
+    // nothing done, between spans and during the device's own moves.
+    bool stop_within_span(bool stopping) {
+        SetpointStream<Axes, Capacity>& queue = channel_.queue;
+        const PreparedSpan<Axes>* span = queue.span_in_progress();
+        if (motion_ != Motion::kStream || span == nullptr) return false;
+        for (unsigned a = 0; a < Axes; ++a) boundary_[a] = rest_[a] = queue.next_setpoint(a);
+        hold_requested_ = stop_requested_ = false;
+        set_held_by_underrun(false);
+        Span<Axes> stop;
+        if (velocity_within_span(span->stamp.chord, span->stamp.start_tangent,
+                                 span->stamp.end_tangent, span->ticks, queue.ticks_into_span(),
+                                 limits(), boundary_tangent_, boundary_ticks_) != Status::kOk) {
+            fault(FaultCode::kStopFailed);
+            return true;
+        }
+        bool moving = false;
+        for (unsigned a = 0; a < Axes; ++a) moving = moving || boundary_tangent_[a] != 0;
+        if (!moving) {
+            set_motion(Motion::kRest);
+            if (stopping) {
+                drop_queue();
+                set_state(DeviceState::kIdle);
+            } else {
+                set_state(DeviceState::kHolding);
+            }
+            return true;
+        }
+        if (plan_stop(boundary_, boundary_tangent_, boundary_ticks_, limits(), stop) !=
+                Status::kOk ||
+            !start_generated(stop)) {
+            fault(FaultCode::kStopFailed);
+            return true;
+        }
+        generated_kind_ = stopping ? Generated::kStopStop : Generated::kHoldStop;
+        set_state(stopping ? DeviceState::kStopping : DeviceState::kHolding);
+        return true;
+    }
+
     void begin_reentry() {
         bool at_boundary = true;
         bool moving = false;
@@ -395,7 +441,9 @@ private:
         }
         generated_kind_ = Generated::kReentry;
         drop_stale();
-        const PreparedSpan<Axes>* next = channel_.queue.next_span();
+        // The span the re-entry leads into: the one a stop inside a span left, else the next.
+        const PreparedSpan<Axes>* next = channel_.queue.span_in_progress();
+        if (next == nullptr) next = channel_.queue.next_span();
         pen_lead_outputs_ = next != nullptr
                                 ? static_cast<std::uint8_t>(next->outputs & kOutputPenDown)
                                 : std::uint8_t{0};
@@ -420,9 +468,10 @@ private:
         for (unsigned a = 0; a < Axes; ++a) rest_[a] = generated_.resting_position(a);
         set_motion(Motion::kRest);
         if (kind == Generated::kReentry) {
-            // The stream resumes at the boundary it left; a stop or hold requested meanwhile
-            // is taken at the next boundary.
+            // The stream resumes where it left the path; a stop or hold requested meanwhile
+            // is taken there: at once inside a span, else at the boundary (at_boundary).
             set_motion(Motion::kStream);
+            if (stop_requested_ || hold_requested_) (void)stop_within_span(stop_requested_);
             return;
         }
         if (kind == Generated::kStopStop || stop_requested_) {

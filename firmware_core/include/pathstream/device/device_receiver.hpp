@@ -8,6 +8,7 @@
 #include <cstddef>
 #include <cstdint>
 
+#include "pathstream/device/batch_crc.hpp"
 #include "pathstream/device/device_channel.hpp"
 #include "pathstream/device/device_state.hpp"
 #include "pathstream/device/motion_limits.hpp"
@@ -62,17 +63,21 @@ public:
     /// (the first span of a job, and the first after a queue drop, start from rest) and for a
     /// job end at rest, before any is queued; on an error nothing changes. Each queued span is
     /// stamped with the current epoch, its job (the sequence number of the job's first span)
-    /// and its end tangent. A batch that was already accepted entirely (a retry after a lost
-    /// reply) is acknowledged with kOk and not queued again (duplicates() counts it).
+    /// and its end tangent. A resend of the last accepted batch (a retry after a lost reply:
+    /// the same first sequence, count, length and CRC-32 of the payload) is acknowledged with
+    /// kOk and not queued again (duplicates() counts it); other bytes under those numbers are
+    /// a master out of step: kBadSequence, whatever the transport.
     /// Errors: kNotConfigured; kWrongState (fault, e-stop, stopping, or a queue drop by the
     /// tick while the batch was being queued: its spans are then never executed);
-    /// kBadSequence (a gap or a partial overlap); kBadBatch (count 0 or > kMaxBatchSpans,
+    /// kBadSequence (a gap, a partial overlap, an older batch, or the last batch's numbers
+    /// with other bytes); kBadBatch (count 0 or > kMaxBatchSpans,
     /// length mismatch, bad flags); a span's own Status (its validation, kVelocityLimit,
     /// kAccelerationLimit, kVelocityStep, kJobEndMoving); and only for a batch that is
     /// otherwise acceptable, kQueueFull (not enough free slots: retry later).
     /// `between` is called before each span is queued: a test hook that runs the tick there
     /// (the interrupt could); the default does nothing. Cost: two decodes and one validation
-    /// per span, and the push's own validation (~5,000 instructions per axis on M4).
+    /// per span, the push's own validation (~5,000 instructions per axis on M4), and one
+    /// CRC-32 of the payload (~8 steps per byte) for an accepted batch or a resend.
     template <typename Between = NoInterleave>
     [[nodiscard]] Status accept_batch(std::uint32_t first_sequence, std::uint16_t count,
                                       const std::uint8_t* payload, std::size_t length,
@@ -86,9 +91,11 @@ public:
         }
         if (count == 0 || count > kMaxBatchSpans) return Status::kBadBatch;
         sync_epoch(s);
-        const std::uint32_t last = first_sequence + count - 1u;
-        if (first_sequence == next_sequence_ - count && last == next_sequence_ - 1u &&
-            count <= accepted_spans_) {
+        if (last_batch_.count != 0 && first_sequence == last_batch_.first &&
+            count == last_batch_.count && first_sequence + count == next_sequence_) {
+            // The core compares the bytes itself: every transport gets the same answer.
+            if (length != last_batch_.length || batch_crc32(payload, length) != last_batch_.crc)
+                return Status::kBadSequence;
             ++duplicates_;
             return Status::kOk;
         }
@@ -110,7 +117,7 @@ public:
         if (status().epoch != producer_epoch_) return Status::kWrongState;
         chain_ = chain;
         next_sequence_ += count;
-        accepted_spans_ += count;
+        last_batch_ = {first_sequence, count, length, batch_crc32(payload, length)};
         return Status::kOk;
     }
 
@@ -258,6 +265,14 @@ private:
         std::uint32_t job = 1;
     };
 
+    // The last batch queued, as much of it as a resend is compared with (count 0: none yet).
+    struct LastBatch {
+        std::uint32_t first = 0;
+        std::uint16_t count = 0;
+        std::size_t length = 0;
+        std::uint32_t crc = 0;
+    };
+
     // A new epoch (the tick dropped the queue): the next span starts at rest at its origin,
     // and begins a new job.
     void sync_epoch(const DeviceStatus<Axes>& s) {
@@ -300,7 +315,11 @@ private:
                 stamp.job = chain.job;
                 stamp.job_end = job_end;
                 stamp.pause_after = pause;
-                for (unsigned a = 0; a < Axes; ++a) stamp.end_tangent[a] = w.end_tangent[a];
+                for (unsigned a = 0; a < Axes; ++a) {
+                    stamp.end_tangent[a] = w.end_tangent[a];
+                    stamp.start_tangent[a] = w.start_tangent[a];
+                    stamp.chord[a] = w.end[a] - chain.start[a];  // both within +-2^27
+                }
                 between();
                 if (Status st = channel_.queue.push(span, stamp); st != Status::kOk) return st;
             }
@@ -353,7 +372,7 @@ private:
     bool configured_ = false;
     bool enforce_travel_ = true;
     std::uint32_t next_sequence_ = 1;
-    std::uint32_t accepted_spans_ = 0;
+    LastBatch last_batch_;
     std::uint32_t duplicates_ = 0;
     std::uint32_t producer_epoch_ = 0;
     std::uint32_t request_number_ = 0;

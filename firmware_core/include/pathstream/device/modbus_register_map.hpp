@@ -5,7 +5,6 @@
 
 #include <cstdint>
 
-#include "pathstream/device/last_batch.hpp"
 #include "pathstream/device/operator_commands.hpp"
 #include "pathstream/device/modbus_map.hpp"
 #include "pathstream/device/motion_device.hpp"
@@ -238,22 +237,12 @@ private:
             e = Exception::kIllegalDataValue;
             return Status::kBadBatch;
         }
-        // The core acknowledges a resend of its last batch by sequence numbers alone; a
-        // different payload under those numbers is a master out of step, not a retry.
-        const std::uint32_t last = device_.last_accepted_sequence();
-        if (last_batch_.conflicts(first, spans, payload_, bytes, last)) return Status::kBadSequence;
-        const std::uint32_t duplicates = device_.duplicates();
-        const Status st = device_.accept_batch(first, spans, payload_, bytes);
-        if (st == Status::kOk && device_.duplicates() == duplicates) {
-            last_batch_.remember(first, spans, payload_, bytes);
-        }
-        return st;
+        return device_.accept_batch(first, spans, payload_, bytes);
     }
 
     MotionDevice<Axes, Capacity>& device_;
     OperatorCommands<Axes, Capacity> operator_;
     std::uint8_t payload_[2 * 123] = {};
-    LastBatch<sizeof payload_> last_batch_;
     std::uint16_t last_command_ = 0;
     std::uint16_t last_refusal_ = 0;
     std::uint16_t refusals_ = 0;

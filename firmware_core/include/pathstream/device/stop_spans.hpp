@@ -1,5 +1,5 @@
-// The device's own spans: a controlled stop from a span boundary, and the move back onto the
-// path when motion resumes. Both are Hermite spans checked like any other (core validation,
+// The device's own spans: a controlled stop from a span boundary or from inside a span, and
+// the move back onto the path when motion resumes. Both are Hermite spans checked like any other (core validation,
 // exact limit check), so a generated span never exceeds what a host span may do.
 #pragma once
 
@@ -8,6 +8,7 @@
 #include "pathstream/device/motion_limits.hpp"
 #include "pathstream/span.hpp"
 #include "pathstream/status.hpp"
+#include "pathstream/wide_int.hpp"
 
 namespace pathstream::device {
 
@@ -80,6 +81,73 @@ template <unsigned Axes>
         if (s != Status::kAccelerationLimit && s != Status::kVelocityLimit) return s;
     }
     return Status::kStopTooLong;
+}
+
+/// Shortest base of a stop from inside a span longer than this: a stop from a long span's
+/// interior takes at least this many ticks (64 ms at 1 kHz) unless its velocity needs more,
+/// so the rounding of its start tangent stays within 1/128 LSB per tick.
+inline constexpr std::uint32_t kMinInSpanStopBase = 64;
+
+/// Where a controlled stop from tick `k` (1 .. n-1) of a Hermite span of `n` ticks starts:
+/// the span's velocity there, per axis, as the tangent `tangent` of a span of `base` ticks
+/// (velocity tangent/base LSB per tick), for plan_stop. The exact velocity is M/n^3 LSB per
+/// tick with M = 6k(n-k)C + (n-k)(n-3k)T0 + k(3k-2n)T1 (C the chord P1 - P0, T0 and T1 the
+/// span's tangents: the stamp's); `tangent` is base*M/n^3 rounded to the nearest integer
+/// (halves away from zero), within 1/(2 base) LSB per tick of it: the rounding the join
+/// check allows a span of `base` ticks. base = n when the span is no longer than the stop
+/// needs or than kMinInSpanStopBase, so the stop is planned on the span's own length like a
+/// stop at its end (at k = n this is exactly T1 on n ticks); otherwise base = max(m0,
+/// kMinInSpanStopBase), m0 the fewest ticks in which every axis can shed its velocity at its
+/// max_acceleration, so a long span's stop is not stretched to the span's length.
+/// Exact: |M| < 2^63 for every admitted chord, tangent and tick count (proven below); the
+/// products and quotients after it are two-word. Errors: kStopTooLong when a tangent leaves
+/// +-kMaxTangentLsb. Cost: per axis three 64-bit products, two 128-bit products and two
+/// 128-bit divisions (a one-off, like plan_stop). Tick interrupt context.
+template <unsigned Axes>
+[[nodiscard]] Status velocity_within_span(const std::int32_t (&chord)[Axes],
+                                          const std::int32_t (&start_tangent)[Axes],
+                                          const std::int32_t (&end_tangent)[Axes], std::uint32_t n,
+                                          std::uint32_t k, const MotionLimits<Axes>& limits,
+                                          std::int32_t (&tangent)[Axes], std::uint32_t& base) {
+    using stop_detail::magnitude64;
+    // |6k(n-k)C| <= 1.5 n^2 2^28 and |(n-k)(n-3k)T0|, |k(3k-2n)T1| <= n^2 2^29 with n <= 2^16,
+    // |C| <= 2^28, |T| <= 2^29: |M| <= 5.5 * 2^60 < 2^63.
+    static_assert(kMaxSpanTicks <= (1u << 16) && kMaxTangentLsb <= (std::int64_t{1} << 29) &&
+                  2 * kMaxPositionLsb <= (std::int64_t{1} << 28));
+    const std::int64_t nn = n, kk = k;
+    const std::uint64_t cube = static_cast<std::uint64_t>(n) * n * n;  // < 2^49
+    const std::uint64_t hz2 = static_cast<std::uint64_t>(limits.tick_hz) * limits.tick_hz;
+    std::int64_t m[Axes];
+    std::uint64_t need = 1;  // m0: ticks the stop needs at the axes' max_acceleration
+    for (unsigned a = 0; a < Axes; ++a) {
+        m[a] = 6 * kk * (nn - kk) * chord[a] + (nn - kk) * (nn - 3 * kk) * start_tangent[a] +
+               kk * (3 * kk - 2 * nn) * end_tangent[a];
+        // ceil(|M| hz^2 / (n^3 a_max)): the deceleration |v| hz^2 / ticks within a_max.
+        const FloorDivision per_cube = floor_divide(multiply_unsigned(magnitude64(m[a]), hz2), cube);
+        if (per_cube.quotient.hi != 0) {
+            need = kMaxSpanTicks + 1u;
+            continue;
+        }
+        const std::uint64_t q = per_cube.quotient.lo + (per_cube.remainder != 0 ? 1u : 0u);
+        const std::uint64_t amax = limits.axis[a].max_acceleration;
+        const std::uint64_t ticks = q / amax + (q % amax != 0 ? 1u : 0u);
+        if (ticks > need) need = ticks;
+    }
+    base = n;
+    if (n > kMinInSpanStopBase && need < n) {
+        base = need > kMinInSpanStopBase ? static_cast<std::uint32_t>(need) : kMinInSpanStopBase;
+    }
+    for (unsigned a = 0; a < Axes; ++a) {
+        // round(base M / n^3) = floor((2 base |M| + n^3) / (2 n^3)), signed like M.
+        const Int128 twice = multiply_unsigned(magnitude64(m[a]), 2u * static_cast<std::uint64_t>(base));
+        const FloorDivision r = floor_divide(twice + Int128::from(static_cast<std::int64_t>(cube)), 2 * cube);
+        if (r.quotient.hi != 0 || r.quotient.lo > static_cast<std::uint64_t>(kMaxTangentLsb)) {
+            return Status::kStopTooLong;
+        }
+        const std::int64_t t = static_cast<std::int64_t>(r.quotient.lo);
+        tangent[a] = static_cast<std::int32_t>(m[a] < 0 ? -t : t);
+    }
+    return Status::kOk;
 }
 
 /// Plans the move from rest at `from` back to `to`, arriving with the velocity of a span of

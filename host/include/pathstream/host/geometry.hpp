@@ -4,6 +4,7 @@
 
 #include <array>
 #include <cstddef>
+#include <functional>
 #include <vector>
 
 #include "pathstream/host/path.hpp"
@@ -29,6 +30,12 @@ struct BezierSegment {
 /// straight pen-up travel segment between consecutive subpaths. Consecutive segments share
 /// end points exactly.
 std::vector<BezierSegment> to_bezier_segments(const Path& path);
+
+/// The segments to_bezier_segments returns, in the same order and equal, handed to `visit` one
+/// at a time instead of stored: memory O(one subpath's B-spline windows), not O(segments).
+/// For readers of the whole path that keep nothing per segment (check's figures). Throws as
+/// to_bezier_segments.
+void for_each_bezier_segment(const Path& path, const std::function<void(const BezierSegment&)>& visit);
 
 /// Puts a straight pen-up move from `from` (mm per axis: where the machine rests, e.g. after
 /// homing) to the first segment's start in front of `segments` (control points at thirds,

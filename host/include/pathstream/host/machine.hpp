@@ -73,9 +73,21 @@ struct MachineProfile {
     double tick_seconds() const { return 1.0 / tick_hz; }
 };
 
+/// Slowest speed a profile may ask for, mm/s: 1 LSB per span (mm_per_lsb * tick_hz /
+/// ticks_per_span). Below it the spans' whole-LSB ends advance by less than one LSB per
+/// span and planning crawls through ever more ticks. O(1).
+double min_velocity(const MachineProfile& profile);
+
+/// Lowest max_acceleration a profile may give an axis, mm/s^2: the one that gains
+/// min_velocity() within one span (mm_per_lsb * tick_hz^2 / ticks_per_span^2). O(1).
+double min_acceleration(const MachineProfile& profile);
+
 /// Parses a machine profile JSON document. Throws InputError ("file:line:col: ...") on
 /// malformed JSON, unknown keys, wrong types, non-finite or impossible values (zero or
-/// negative limits, tick rate outside 10 Hz..100 kHz, ...).
+/// negative limits, tick rate outside 10 Hz..100 kHz, ...), and on values the planner cannot
+/// work with: a max_velocity, feed, travel_feed or layer feed below min_velocity(), a
+/// max_acceleration below min_acceleration(), or spans so long that one at an axis's
+/// max_velocity crosses more than its travel (or the device's position range without one).
 MachineProfile parse_machine_profile(const std::string& text, const std::string& file);
 
 /// Reads and parses a machine profile file. Throws InputError.
