@@ -12,6 +12,15 @@ const char* basis_name(PathBasis basis) {
     return "?";
 }
 
+Path without_subpaths(const Path& path) {
+    Path out;
+    out.axes = path.axes;
+    out.layers = path.layers;
+    out.units = path.units;
+    out.mm_per_unit = path.mm_per_unit;
+    return out;
+}
+
 std::string point_count_problem(const Subpath& sp) {
     const std::size_t n = sp.points.size();
     const std::string kind = sp.closed ? "closed " : "open ";

@@ -109,5 +109,12 @@ expect setpoints-svg 0 'every setpoint' -- "$bin" setpoints "$src/examples/two_p
 expect eval-stdout 0 'span,u,x,y' -- "$bin" eval "$src/examples/rose.json" -o -
 [ ! -e "$src/-" ] && [ ! -e ./- ] && passed=$((passed + 1)) || { echo "FAIL: a file named - was written"; failures=$((failures + 1)); }
 
+# A 10^6-point CSV is checked within 300 MB of address space (RLIMIT_AS): it once needed
+# 574 MB resident (every Bezier segment and several copies of the path held at once).
+awk 'BEGIN { for (i = 0; i < 1000000; i++) printf "%.4f,%.4f\n", 100 + 80 * cos(i * 0.001), 100 + 80 * sin(i * 0.001) }' \
+  > "$work/million.csv"
+expect million-points-csv 0 '1000000 points' -- bash -c "ulimit -v 300000 && \"$bin\" check \"$work/million.csv\" --keep-order"
+rm -f "$work/million.csv"
+
 echo "cli: $passed passed, $failures failed"
 [ "$failures" -eq 0 ]

@@ -147,8 +147,10 @@ LoadedPath load_path_report(const PathOptions& o, const MachineProfile* machine,
     }
     loaded.placed = placement.active();
     const std::optional<Box2> area = machine != nullptr ? work_area(*machine) : std::nullopt;
-    path = place_path(path, placement, area, &loaded.placement);
-    path = group_by_layer(select_layers(path, o.layers));
+    // Each step on the path only when it has something to do: a 10^6-point path is ~60 MB a copy.
+    if (loaded.placed) path = place_path(path, placement, area, &loaded.placement);
+    if (!o.layers.empty()) path = select_layers(path, o.layers);
+    path = group_by_layer(std::move(path));
     pause_between_layers(path, o.pause == "layer"  ? LayerPause::kEveryLayer
                                : o.pause == "none" ? LayerPause::kNone
                                                    : LayerPause::kPenChange);
@@ -165,7 +167,7 @@ LoadedPath load_path_report(const PathOptions& o, const MachineProfile* machine,
         } else if (start != nullptr && start->size() == path.axes) {
             order.start = *start;
         }
-        path = order_sections(path, order, &loaded.order);
+        path = order_sections(std::move(path), order, &loaded.order);
         loaded.ordered = true;
     }
     loaded.path = std::move(path);

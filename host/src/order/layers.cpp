@@ -63,20 +63,18 @@ Path select_layers(const Path& path, const std::vector<std::string>& chosen) {
     if (chosen.empty()) return path;
     std::vector<bool> keep(std::max<std::size_t>(path.layers.size(), 1), false);
     for (const std::string& c : chosen) keep[find_layer(path, c)] = true;
-    Path out = path;
-    out.subpaths.clear();
+    Path out = without_subpaths(path);
     for (const Subpath& s : path.subpaths)
         if (keep.at(s.layer)) out.subpaths.push_back(s);
     if (out.subpaths.empty()) throw std::invalid_argument("--layer: the chosen layers have nothing to draw");
     return out;
 }
 
-Path group_by_layer(const Path& path) {
+Path group_by_layer(Path path) {
     if (path.layers.empty()) return path;
-    Path out = path;
-    std::stable_sort(out.subpaths.begin(), out.subpaths.end(),
+    std::stable_sort(path.subpaths.begin(), path.subpaths.end(),
                      [](const Subpath& a, const Subpath& b) { return a.layer < b.layer; });
-    return out;
+    return path;
 }
 
 void pause_between_layers(Path& path, LayerPause when) {
@@ -104,9 +102,8 @@ void apply_layer_feeds(Path& path, const MachineProfile& machine) {
     }
 }
 
-Path order_sections(const Path& path, const OrderOptions& options, OrderReport* report) {
-    Path out = path;
-    out.subpaths.clear();
+Path order_sections(Path path, const OrderOptions& options, OrderReport* report) {
+    Path out = without_subpaths(path);
     OrderReport total;
     total.subpaths_before = path.subpaths.size();
     total.travel_before = pen_up_travel(path, options.start);
@@ -114,15 +111,17 @@ Path order_sections(const Path& path, const OrderOptions& options, OrderReport* 
     for (std::size_t first = 0; first < path.subpaths.size();) {
         std::size_t end = first + 1;
         while (end < path.subpaths.size() && !starts_section(path, end)) ++end;
-        Path section = path;
-        section.subpaths.assign(path.subpaths.begin() + static_cast<std::ptrdiff_t>(first),
-                                path.subpaths.begin() + static_cast<std::ptrdiff_t>(end));
-        const Subpath head = section.subpaths.front();
-        if (head.dwell_before > 0) {
+        Path section = without_subpaths(path);
+        // Moved, not copied: each subpath goes into exactly one section.
+        section.subpaths.assign(std::make_move_iterator(path.subpaths.begin() + static_cast<std::ptrdiff_t>(first)),
+                                std::make_move_iterator(path.subpaths.begin() + static_cast<std::ptrdiff_t>(end)));
+        const bool head_pauses = section.subpaths.front().pause_before;
+        const bool head_rests = section.subpaths.front().dwell_before > 0;
+        if (head_rests) {
             // A rest belongs to the place it was programmed at: that subpath stays first, as is.
-            out.subpaths.push_back(head);
+            from = curve_end(section.subpaths.front());
+            out.subpaths.push_back(std::move(section.subpaths.front()));
             section.subpaths.erase(section.subpaths.begin());
-            from = curve_end(head);
         }
         if (!section.subpaths.empty()) {
             OrderOptions o = options;
@@ -133,7 +132,7 @@ Path order_sections(const Path& path, const OrderOptions& options, OrderReport* 
             total.work += r.work;
             for (std::size_t i = 0; i < ordered.subpaths.size(); ++i) {
                 Subpath& sp = ordered.subpaths[i];
-                sp.pause_before = i == 0 && head.pause_before && head.dwell_before == 0;
+                sp.pause_before = i == 0 && head_pauses && !head_rests;
                 out.subpaths.push_back(std::move(sp));
             }
         }

@@ -400,8 +400,7 @@ void improve(Tour& tour) {
 
 /// The subpaths of `path` in the order of `visits`, reversed or rotated as chosen.
 Path build(const Path& path, const std::vector<Item>& items, const std::vector<Visit>& visits) {
-    Path out = path;
-    out.subpaths.clear();
+    Path out = without_subpaths(path);
     for (const Visit& v : visits) {
         const Item& it = items[v.item];
         const Subpath& s = path.subpaths[it.subpath];
@@ -486,12 +485,11 @@ Subpath rotated_subpath(const Subpath& s, std::size_t shift) {
 
 Path merge_touching(const Path& path, double tolerance, std::size_t* merged) {
     std::size_t joins = 0;
-    Path out = path;
     if (tolerance < 0) {
         if (merged != nullptr) *merged = 0;
-        return out;
+        return path;
     }
-    out.subpaths.clear();
+    Path out = without_subpaths(path);
     const auto& in = path.subpaths;
     const auto joinable = [&](const Subpath& s) {
         return !s.closed && joinable_basis(s.basis) && s.points.size() >= 2 && point_count_problem(s).empty();

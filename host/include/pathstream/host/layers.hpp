@@ -18,8 +18,9 @@ namespace pathstream::host {
 Path select_layers(const Path& path, const std::vector<std::string>& chosen);
 
 /// The subpaths grouped by layer, layers in their order, each layer's subpaths in the order
-/// they had (stable). A path without layers is returned as it is.
-Path group_by_layer(const Path& path);
+/// they had (stable). A path without layers is returned as it is. Takes the path by value:
+/// pass it moved to sort it in place.
+Path group_by_layer(Path path);
 
 /// When a job pauses between layers for a pen change.
 enum class LayerPause {
@@ -41,7 +42,7 @@ void apply_layer_feeds(Path& path, const MachineProfile& machine);
 /// (Subpath::pause_before, dwell_before), which keep their place at a section's start; each
 /// section starts where the previous one ended. Layers drawn with one pen (no pause between
 /// them) are ordered together. `report` covers the whole path.
-Path order_sections(const Path& path, const OrderOptions& options, OrderReport* report = nullptr);
+Path order_sections(Path path, const OrderOptions& options, OrderReport* report = nullptr);
 
 /// Per layer: its name, subpath count and pen-down length (mm), for reports.
 struct LayerSummary {

@@ -62,6 +62,10 @@ struct Path {
     double mm_per_unit = 1.0;  ///< coordinates above are already in mm; this converts back
 };
 
+/// A path with everything of `path` (axes, layers, units) but its subpaths: what the
+/// reordering steps start from, without copying every point first. O(layers).
+Path without_subpaths(const Path& path);
+
 /// Name used in files and messages ("bspline", "catmull-rom", "bezier", "polyline").
 const char* basis_name(PathBasis basis);
 
