@@ -117,7 +117,7 @@ std::vector<BezierSegment> collect(SegmentSource& source) {
 }
 
 /// VmSize of this process in bytes (the address space RLIMIT_AS limits).
-std::size_t address_space() {
+[[maybe_unused]] std::size_t address_space() {
     std::ifstream f("/proc/self/status");
     std::string key;
     while (f >> key) {
