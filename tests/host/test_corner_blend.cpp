@@ -7,19 +7,12 @@
 
 #include "pathstream/host/geometry.hpp"
 #include "pathstream/host/planner.hpp"
+#include "pen_plotter_profile.hpp"
 
 using namespace pathstream::host;
+using pathstream::host::test::pen_plotter;
 
 namespace {
-
-MachineProfile pen_plotter() {
-    MachineProfile p;
-    p.axes.push_back({"x", 250, 3000});
-    p.axes.push_back({"y", 250, 3000});
-    p.feed = 80;
-    p.travel_feed = 200;
-    return p;
-}
 
 /// A polygon of `n` vertices on a circle of radius r: every vertex turns by 2 pi / n.
 Path polygon(int n, double r) {

@@ -15,24 +15,14 @@
 
 #include "pathstream/host/geometry.hpp"
 #include "pathstream/host/planner.hpp"
+#include "pen_plotter_profile.hpp"
 
 using namespace pathstream::host;
+using pathstream::host::test::pen_plotter;
 
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
-
-/// The pen plotter's profile (examples/machines/pen_plotter.json).
-MachineProfile pen_plotter() {
-    MachineProfile p;
-    p.axes.push_back({"x", 250, 3000});
-    p.axes.push_back({"y", 250, 3000});
-    p.feed = 80;
-    p.travel_feed = 200;
-    p.pen_down_delay = 0.08;
-    p.pen_up_delay = 0.06;
-    return p;
-}
 
 /// Draws the hard shapes: every generator returns points for `basis` (Bezier chains get
 /// 3k + 1 points) in a box of about `size` mm, with features down to `lsb`.

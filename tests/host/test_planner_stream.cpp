@@ -17,21 +17,12 @@
 #include "pathstream/host/core_playback.hpp"
 #include "pathstream/host/geometry.hpp"
 #include "pathstream/host/planner.hpp"
+#include "pen_plotter_profile.hpp"
 
 using namespace pathstream::host;
+using pathstream::host::test::pen_plotter;
 
 namespace {
-
-MachineProfile pen_plotter() {
-    MachineProfile p;
-    p.axes.push_back({"x", 250, 3000});
-    p.axes.push_back({"y", 250, 3000});
-    p.feed = 80;
-    p.travel_feed = 200;
-    p.pen_down_delay = 0.08;
-    p.pen_up_delay = 0.06;
-    return p;
-}
 
 /// A smooth random walk as an open uniform B-spline, given segment by segment (Bezier form of
 /// each window of four control points): nothing of the job is held in memory.

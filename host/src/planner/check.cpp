@@ -199,12 +199,16 @@ void TickChecker::span(const CoreSpan& cs) {
     ++spans_;
     std::array<std::int64_t, kAxesMax> p{};
     std::array<double, kAxesMax> e{};
+    const double feed = feeds_->feed(cs);  // once per span, not per tick
     for (std::uint32_t k = 0; k < cs.ticks; ++k) {
         stepper_->tick(p);
         for (std::size_t a = 0; a < axes_; ++a) e[a] = exact_value(cs, a, k);
-        visit(p, e, cs);
+        visit(p, e, cs.pen_down, feed);
     }
-    last_ = cs;
+    // What the held end point after the last span needs (finish), without copying the span.
+    for (std::size_t a = 0; a < axes_; ++a) last_end_[a] = exact_value(cs, a, cs.ticks);
+    last_pen_down_ = cs.pen_down;
+    last_feed_ = feed;
 }
 
 bool TickChecker::over_limits() const {
@@ -229,9 +233,9 @@ bool TickChecker::in_window(std::uint64_t tick) {
 }
 
 void TickChecker::visit(const std::array<std::int64_t, kAxesMax>& p, const std::array<double, kAxesMax>& e,
-                        const CoreSpan& span) {
+                        bool pen_output, double feed) {
     const std::uint64_t k = tick_;
-    if (observer_) observer_(k, p.data(), span.pen_down);
+    if (observer_) observer_(k, p.data(), pen_output);
     if (k == 0) {  // at rest before the first tick
         p1_ = p2_ = p;
         e1_ = e2_ = e;
@@ -282,7 +286,7 @@ void TickChecker::visit(const std::array<std::int64_t, kAxesMax>& p, const std::
     p1_ = p;
     e2_ = e1_;
     e1_ = e;
-    prev_feed_ = feeds_->feed(span);
+    prev_feed_ = feed;
     have_prev_span_ = true;
     ++tick_;
 }
@@ -315,8 +319,8 @@ PlanCheck TickChecker::finish() {
     std::array<std::int64_t, kAxesMax> p{};
     std::array<double, kAxesMax> e{};
     stepper_->tick(p);
-    for (std::size_t a = 0; a < axes_; ++a) e[a] = exact_value(last_, a, last_.ticks);
-    visit(p, e, last_);
+    for (std::size_t a = 0; a < axes_; ++a) e[a] = last_end_[a];
+    visit(p, e, last_pen_down_, last_feed_);
     // The axes rest after the end: one more second difference, centred on the end point.
     for (std::size_t a = 0; a < axes_; ++a) acceleration(a, p2_[a] - p1_[a], std::fabs(e2_[a] - e1_[a]));
     for (std::size_t a = 0; a < axes_; ++a) {

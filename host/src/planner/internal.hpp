@@ -399,8 +399,10 @@ public:
 private:
     bool pen_down_at(std::uint64_t tick);
     bool in_window(std::uint64_t tick);
+    /// Tick k's setpoint p and exact value e, from a span with pen output `pen_output` and
+    /// requested feed `feed`.
     void visit(const std::array<std::int64_t, kAxesMax>& p, const std::array<double, kAxesMax>& e,
-               const CoreSpan& span);
+               bool pen_output, double feed);
     void velocity(std::size_t a, double d, double de);
     void acceleration(std::size_t a, std::int64_t second, double de);
 
@@ -423,7 +425,9 @@ private:
     bool have_prev_span_ = false;
     double distance_ = 0;
     bool have_distance_ = false;
-    CoreSpan last_;
+    std::array<double, kAxesMax> last_end_{};  ///< the last span's exact end point (LSB)
+    bool last_pen_down_ = false;
+    double last_feed_ = 0;
     TickObserver observer_;
 };
 

@@ -183,12 +183,19 @@ private:
     /// The carry's arc length in this window's grid.
     double carry_in(const PathGrid& pg) const {
         if (!carry_.started) return 0;
+        const std::size_t k = carry_node(pg);
+        const bool inside = k < pg.grid.size() && pg.grid.seg[k] == carry_.segment - base_;
+        return segment_start(pg) + (inside ? carry_.lambda_in_segment : 0.0);
+    }
+
+    /// The first node of the carry's segment in this grid (or of the first segment after it;
+    /// the grid's size when there is none).
+    std::size_t carry_node(const PathGrid& pg) const {
         const Grid& g = pg.grid;
         const std::size_t local = carry_.segment - base_;
-        for (std::size_t k = 0; k < g.size(); ++k) {
-            if (g.seg[k] >= local) return g.lambda[k] + (g.seg[k] == local ? carry_.lambda_in_segment : 0.0);
-        }
-        return g.size() > 0 ? g.lambda.back() : 0.0;
+        std::size_t k = 0;
+        while (k < g.size() && g.seg[k] < local) ++k;
+        return k;
     }
 
     /// The longest stopping distance plus a margin: beyond it the lookahead sees as far as it
@@ -279,12 +286,8 @@ private:
 
     /// Arc length in this grid where the carry's segment starts.
     double segment_start(const PathGrid& pg) const {
-        const Grid& g = pg.grid;
-        const std::size_t local = carry_.segment - base_;
-        for (std::size_t k = 0; k < g.size(); ++k) {
-            if (g.seg[k] >= local) return g.lambda[k];
-        }
-        return g.size() > 0 ? g.lambda.back() : 0.0;
+        const std::size_t k = carry_node(pg);
+        return k < pg.grid.size() ? pg.grid.lambda[k] : (pg.grid.size() > 0 ? pg.grid.lambda.back() : 0.0);
     }
 
     /// The next window continues at node `node` of this grid (moving: from knot `last`, which

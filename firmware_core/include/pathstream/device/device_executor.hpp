@@ -352,6 +352,13 @@ private:
         set_held_by_underrun(underrun);
         if (underrun) status_.underruns = status_.underruns + 1u;
         hold_requested_ = stop_requested_ = false;
+        begin_stop(stopping, moving);
+        return false;
+    }
+
+    // From boundary_ with boundary_tangent_ over boundary_ticks_: at rest, hold or end the
+    // job (a stop drops the queue); moving, the controlled stop of plan_stop.
+    void begin_stop(bool stopping, bool moving) {
         if (!moving) {
             set_motion(Motion::kRest);
             if (stopping) {
@@ -360,18 +367,17 @@ private:
             } else {
                 set_state(DeviceState::kHolding);
             }
-            return false;
+            return;
         }
         Span<Axes> stop;
         if (plan_stop(boundary_, boundary_tangent_, boundary_ticks_, limits(), stop) !=
                 Status::kOk ||
             !start_generated(stop)) {
             fault(FaultCode::kStopFailed);
-            return false;
+            return;
         }
         generated_kind_ = stopping ? Generated::kStopStop : Generated::kHoldStop;
         set_state(stopping ? DeviceState::kStopping : DeviceState::kHolding);
-        return false;
     }
 
     // A hold (`stopping` false) or stop taken inside a span: a controlled stop planned like
@@ -386,7 +392,6 @@ private:
         for (unsigned a = 0; a < Axes; ++a) boundary_[a] = rest_[a] = queue.next_setpoint(a);
         hold_requested_ = stop_requested_ = false;
         set_held_by_underrun(false);
-        Span<Axes> stop;
         if (velocity_within_span(span->stamp.chord, span->stamp.start_tangent,
                                  span->stamp.end_tangent, span->ticks, queue.ticks_into_span(),
                                  limits(), boundary_tangent_, boundary_ticks_) != Status::kOk) {
@@ -395,24 +400,7 @@ private:
         }
         bool moving = false;
         for (unsigned a = 0; a < Axes; ++a) moving = moving || boundary_tangent_[a] != 0;
-        if (!moving) {
-            set_motion(Motion::kRest);
-            if (stopping) {
-                drop_queue();
-                set_state(DeviceState::kIdle);
-            } else {
-                set_state(DeviceState::kHolding);
-            }
-            return true;
-        }
-        if (plan_stop(boundary_, boundary_tangent_, boundary_ticks_, limits(), stop) !=
-                Status::kOk ||
-            !start_generated(stop)) {
-            fault(FaultCode::kStopFailed);
-            return true;
-        }
-        generated_kind_ = stopping ? Generated::kStopStop : Generated::kHoldStop;
-        set_state(stopping ? DeviceState::kStopping : DeviceState::kHolding);
+        begin_stop(stopping, moving);
         return true;
     }
 
