@@ -148,8 +148,9 @@ void SpanEmitter::finish(std::size_t last_subpath) {
     release();
 }
 
-std::vector<PlanEvent> SpanEmitter::take() {
-    std::vector<PlanEvent> out;
+void SpanEmitter::take(std::vector<PlanEvent>& out) {
+    // The two buffers trade places, so both keep their capacity from window to window.
+    out.clear();
     if (held_) {  // keep the held-back span for the next call
         PlanEvent last = std::move(events_.back());
         events_.pop_back();
@@ -158,7 +159,6 @@ std::vector<PlanEvent> SpanEmitter::take() {
     } else {
         out.swap(events_);
     }
-    return out;
 }
 
 void SpanEmitter::fail(std::size_t subpath, const std::string& what) {

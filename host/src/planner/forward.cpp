@@ -54,6 +54,10 @@ public:
             if (const std::uint32_t m = creep_ticks(k.q); m > 0) out.spans.push_back({m, end_knot()});
             return out;
         }
+        // Spans never go faster than the feed: the piece needs at least length / (feed tau) of
+        // them; reserving a quarter more spares most of the vector's regrowth and copies.
+        const double at_feed = (end_lambda_ - k.lambda) / (feed_ * n_ * tick_);
+        if (at_feed > 0 && at_feed < 1e6) out.spans.reserve(static_cast<std::size_t>(1.25 * at_feed) + 8);
         const auto advance = [&](const MotionSpan& s) {
             out.spans.push_back(s);
             arrival_ = Arrival{k, s.ticks};

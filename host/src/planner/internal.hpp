@@ -460,8 +460,9 @@ public:
     void motion(const Knot& from, const MotionSpan& span, const Run& run);
     /// The end of the job: the final lift and its dwell, and the held-back span.
     void finish(std::size_t last_subpath);
-    /// The events made since the last call (moved out).
-    std::vector<PlanEvent> take();
+    /// The events made since the last call, moved into `out` (cleared first; its storage is
+    /// reused for the next events, so a caller that passes the same vector allocates once).
+    void take(std::vector<PlanEvent>& out);
 
     std::uint64_t total_ticks() const { return total_ticks_; }
     std::size_t motion_spans() const { return motion_spans_; }

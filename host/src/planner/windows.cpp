@@ -330,7 +330,8 @@ private:
     /// The window's events through the per-tick check, then to the sink; false when the check
     /// found a tick over a limit (nothing of this window goes to the sink then).
     bool deliver() {
-        std::vector<PlanEvent> events = emitter().take();
+        std::vector<PlanEvent>& events = delivered_;
+        emitter().take(events);
         for (const PlanEvent& e : events) {
             if (e.kind == PlanEvent::Kind::kSpan) checker_.span(e.span);
             else if (e.kind == PlanEvent::Kind::kPen) checker_.pen(e.pen);
@@ -355,6 +356,7 @@ private:
         return true;
     }
 
+    std::vector<PlanEvent> delivered_;  ///< the events deliver() hands on (storage reused)
     SegmentSource& source_;
     const MachineProfile& profile_;
     const PlanOptions& options_;
