@@ -7,6 +7,7 @@
 #include <limits>
 #include <map>
 #include <stdexcept>
+#include <type_traits>
 #include <string>
 #include <utility>
 #include <vector>
@@ -398,13 +399,18 @@ void improve(Tour& tour) {
     }
 }
 
-/// The subpaths of `path` in the order of `visits`, reversed or rotated as chosen.
-Path build(const Path& path, const std::vector<Item>& items, const std::vector<Visit>& visits) {
+/// The subpaths of `path` in the order of `visits`, reversed or rotated as chosen; those kept
+/// as they are move out of a non-const `path` (each subpath is visited once).
+template <class P>
+Path build(P& path, const std::vector<Item>& items, const std::vector<Visit>& visits) {
+    constexpr bool consume = !std::is_const_v<P>;
     Path out = without_subpaths(path);
     for (const Visit& v : visits) {
         const Item& it = items[v.item];
-        const Subpath& s = path.subpaths[it.subpath];
-        if (!it.cyclic) {
+        auto& s = path.subpaths[it.subpath];
+        if (!it.cyclic && v.choice == 0 && consume) {
+            out.subpaths.push_back(std::move(s));
+        } else if (!it.cyclic) {
             out.subpaths.push_back(v.choice == 0 ? s : reversed_subpath(s));
         } else if (s.closed) {
             out.subpaths.push_back(rotated_subpath(s, it.shifts[v.choice]));
@@ -415,9 +421,10 @@ Path build(const Path& path, const std::vector<Item>& items, const std::vector<V
     return out;
 }
 
-/// Orders `path` (already joined) from `start`: greedy then improvement.
-Path order_items(const Path& path, const PathPoint& start, const OrderOptions& o, bool greedy,
-                 std::size_t& work) {
+/// Orders `path` (already joined) from `start`: greedy then improvement. A non-const `path`
+/// is not needed afterwards: its subpaths may move into the result.
+template <class P>
+Path order_items(P& path, const PathPoint& start, const OrderOptions& o, bool greedy, std::size_t& work) {
     const std::vector<Item> items = make_items(path, o.merge_tolerance);
     Tour tour(items, start, o.work_limit);
     if (greedy) {
@@ -482,6 +489,45 @@ Subpath rotated_subpath(const Subpath& s, std::size_t shift) {
                 r.points.end());
     return r;
 }
+
+namespace {
+/// Whether merge_touching would join anything: two joinable subpaths of one basis and feed
+/// with ends within `tolerance` (a superset of its joins: false means it joins none).
+bool any_touching(const Path& path, double tolerance) {
+    if (tolerance < 0) return false;
+    const auto& in = path.subpaths;
+    const auto joinable = [&](const Subpath& s) {
+        return !s.closed && joinable_basis(s.basis) && s.points.size() >= 2 && point_count_problem(s).empty();
+    };
+    const double cell = std::max(tolerance, 1e-9);
+    using Key = std::pair<long long, long long>;
+    const auto key = [&](const PathPoint& p) {
+        const auto [x, y] = plane(p);
+        return Key{static_cast<long long>(std::floor(x / cell)), static_cast<long long>(std::floor(y / cell))};
+    };
+    std::map<Key, std::vector<std::pair<std::size_t, const PathPoint*>>> ends;
+    for (std::size_t i = 0; i < in.size(); ++i) {
+        if (!joinable(in[i])) continue;
+        for (const PathPoint* p : {&in[i].points.front(), &in[i].points.back()}) ends[key(*p)].push_back({i, p});
+    }
+    for (const auto& [k, list] : ends) {
+        for (const auto& [i, p] : list) {
+            for (long long dx = -1; dx <= 1; ++dx) {
+                for (long long dy = -1; dy <= 1; ++dy) {
+                    const auto found = ends.find({k.first + dx, k.second + dy});
+                    if (found == ends.end()) continue;
+                    for (const auto& [j, q] : found->second) {
+                        const Subpath &a = in[i], &b = in[j];
+                        if (j == i || a.basis != b.basis || a.feed != b.feed || p->size() != q->size()) continue;
+                        if (distance(*p, *q) <= tolerance) return true;
+                    }
+                }
+            }
+        }
+    }
+    return false;
+}
+}  // namespace
 
 Path merge_touching(const Path& path, double tolerance, std::size_t* merged) {
     std::size_t joins = 0;
@@ -566,13 +612,20 @@ Path order_path(const Path& path, const OrderOptions& o, OrderReport* report) {
     OrderReport r;
     r.subpaths_before = path.subpaths.size();
     r.travel_before = pen_up_travel(path, start);
-    Path joined = merge_touching(path, o.merge_tolerance, &r.merged);
-    Path best = order_items(joined, start, o, true, r.work);
+    // Joined into a copy only when some ends touch: a 10^6-point path is ~60 MB a copy.
+    Path best;
+    if (any_touching(path, o.merge_tolerance)) {
+        Path joined = merge_touching(path, o.merge_tolerance, &r.merged);
+        best = order_items(joined, start, o, true, r.work);
+    } else {
+        best = order_items(path, start, o, true, r.work);
+    }
     double best_travel = pen_up_travel(best, start);
     // Greedy may lose to a good document order: improve that instead (never worse than it).
     if (best_travel > r.travel_before) {
         OrderOptions plain = o;
         plain.merge_tolerance = -1;
+        best = Path{};  // not held while the next is built
         best = order_items(path, start, plain, false, r.work);
         best_travel = pen_up_travel(best, start);
         r.merged = 0;
