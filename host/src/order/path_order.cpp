@@ -46,6 +46,35 @@ Subpath rotated_open_loop(const Subpath& s, std::size_t shift) {
     return r;
 }
 
+/// rotated_open_loop in place: the same points, none copied but Q[shift] once.
+void rotate_open_loop(Subpath& s, std::size_t shift) {
+    if (shift == 0) return;
+    s.points.erase(s.points.begin());  // Q[1..m-1]
+    std::rotate(s.points.begin(), s.points.begin() + static_cast<std::ptrdiff_t>(shift - 1), s.points.end());
+    s.points.push_back(s.points.front());  // Q[shift..m-1], Q[1..shift]
+}
+
+/// reversed_subpath in place.
+void reverse_points(Subpath& r) {
+    if (r.closed && !r.points.empty()) {
+        std::reverse(r.points.begin() + 1, r.points.end());
+    } else {
+        std::reverse(r.points.begin(), r.points.end());
+    }
+}
+
+/// rotated_subpath in place (its checks and messages).
+void rotate_points(Subpath& r, std::size_t shift) {
+    if (!r.closed) throw std::invalid_argument("rotated_subpath: the subpath is open");
+    if (r.points.empty()) return;
+    if (r.basis == PathBasis::kBezier && shift % 3 != 0) {
+        throw std::invalid_argument("rotated_subpath: a Bezier chain starts only at on-curve points (shift " +
+                                    std::to_string(shift) + " is not a multiple of 3)");
+    }
+    std::rotate(r.points.begin(), r.points.begin() + static_cast<std::ptrdiff_t>(shift % r.points.size()),
+                r.points.end());
+}
+
 /// 2-D cell of a point for the grids: the first two axes (one-axis paths: y = 0).
 std::pair<double, double> plane(const PathPoint& p) {
     return {p.empty() ? 0.0 : p[0], p.size() > 1 ? p[1] : 0.0};
@@ -408,8 +437,16 @@ Path build(P& path, const std::vector<Item>& items, const std::vector<Visit>& vi
     for (const Visit& v : visits) {
         const Item& it = items[v.item];
         auto& s = path.subpaths[it.subpath];
-        if (!it.cyclic && v.choice == 0 && consume) {
-            out.subpaths.push_back(std::move(s));
+        if constexpr (consume) {  // moved, then reversed or rotated in place
+            Subpath r = std::move(s);
+            if (!it.cyclic) {
+                if (v.choice != 0) reverse_points(r);
+            } else if (r.closed) {
+                rotate_points(r, it.shifts[v.choice]);
+            } else {
+                rotate_open_loop(r, it.shifts[v.choice]);
+            }
+            out.subpaths.push_back(std::move(r));
         } else if (!it.cyclic) {
             out.subpaths.push_back(v.choice == 0 ? s : reversed_subpath(s));
         } else if (s.closed) {
@@ -469,24 +506,14 @@ double pen_up_travel(const Path& path, const PathPoint& start) {
 
 Subpath reversed_subpath(const Subpath& s) {
     Subpath r = s;
-    if (s.closed && !r.points.empty()) {
-        std::reverse(r.points.begin() + 1, r.points.end());
-    } else {
-        std::reverse(r.points.begin(), r.points.end());
-    }
+    reverse_points(r);
     return r;
 }
 
 Subpath rotated_subpath(const Subpath& s, std::size_t shift) {
     if (!s.closed) throw std::invalid_argument("rotated_subpath: the subpath is open");
-    if (s.points.empty()) return s;
-    if (s.basis == PathBasis::kBezier && shift % 3 != 0) {
-        throw std::invalid_argument("rotated_subpath: a Bezier chain starts only at on-curve points (shift " +
-                                    std::to_string(shift) + " is not a multiple of 3)");
-    }
     Subpath r = s;
-    std::rotate(r.points.begin(), r.points.begin() + static_cast<std::ptrdiff_t>(shift % s.points.size()),
-                r.points.end());
+    rotate_points(r, shift);
     return r;
 }
 
