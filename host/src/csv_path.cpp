@@ -144,6 +144,8 @@ public:
         std::size_t axes = 0;
         bool first_content = true;
         if (text.substr(0, 3) == "\xEF\xBB\xBF") text.remove_prefix(3);  // UTF-8 byte order mark
+        // At most one point a line: reserved at once, the list never grows by copying.
+        sp.points.reserve(static_cast<std::size_t>(std::count(text.begin(), text.end(), '\n')) + 1);
         for (std::size_t line = 1; !text.empty(); ++line) {
             const std::size_t end = text.find('\n');
             const std::string_view current = text.substr(0, end);
@@ -170,6 +172,7 @@ public:
                          std::to_string(axes));
             }
             PathPoint point;
+            point.reserve(fields.size());
             for (const Field& f : fields) point.push_back(coordinate(f, line));
             if (sp.points.empty()) sp.location = SourceLocation{line, fields.front().column};
             sp.points.push_back(std::move(point));

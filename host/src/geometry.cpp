@@ -23,25 +23,20 @@ PathPoint reflect(const PathPoint& end, const PathPoint& next) {  // phantom poi
 
 /// Four-point windows of a uniform B-spline or Catmull-Rom subpath, as core_spans.cpp makes
 /// them: open ends get phantom points 2 P0 - P1 and 2 Pm - Pm-1; closed subpaths are periodic.
-std::vector<Window> windows(const std::vector<PathPoint>& pts, bool closed,
-                            std::vector<PathPoint>& storage) {
+/// Hands them to `visit` one at a time: a window list of a 10^6-point subpath is ~40 MB.
+template <typename Visit>
+void for_each_window(const std::vector<PathPoint>& pts, bool closed, Visit&& visit) {
     const std::size_t m = pts.size();
-    std::vector<Window> out;
     if (closed) {
         for (std::size_t i = 0; i < m; ++i) {
-            out.push_back({&pts[(i + m - 1) % m], &pts[i], &pts[(i + 1) % m], &pts[(i + 2) % m]});
+            visit(Window{&pts[(i + m - 1) % m], &pts[i], &pts[(i + 1) % m], &pts[(i + 2) % m]});
         }
-        return out;
+        return;
     }
-    storage.clear();
-    storage.push_back(reflect(pts[0], pts[1]));
-    storage.push_back(reflect(pts[m - 1], pts[m - 2]));
-    std::vector<const PathPoint*> ext;
-    ext.push_back(&storage[0]);
-    for (const auto& p : pts) ext.push_back(&p);
-    ext.push_back(&storage[1]);
-    for (std::size_t i = 0; i + 3 < ext.size(); ++i) out.push_back({ext[i], ext[i + 1], ext[i + 2], ext[i + 3]});
-    return out;
+    const PathPoint before = reflect(pts[0], pts[1]), after = reflect(pts[m - 1], pts[m - 2]);
+    // The extended list: before, pts[0], ..., pts[m - 1], after (m + 2 points).
+    const auto ext = [&](std::size_t i) { return i == 0 ? &before : i == m + 1 ? &after : &pts[i - 1]; };
+    for (std::size_t i = 0; i + 3 < m + 2; ++i) visit(Window{ext(i), ext(i + 1), ext(i + 2), ext(i + 3)});
 }
 
 /// Weighted sum w0 Q0 + w1 Q1 + w2 Q2 + w3 Q3 of a window.
@@ -120,14 +115,13 @@ void subpath_segments(const Subpath& sp, std::size_t index, const std::function<
         case PathBasis::kBSpline:
         case PathBasis::kCatmullRom: {
             if (m < (sp.closed ? 3u : 2u)) too_few(sp.closed ? "at least 3" : "at least 2");
-            std::vector<PathPoint> storage;
             bool first = true;
-            for (const Window& w : windows(pts, sp.closed, storage)) {
+            for_each_window(pts, sp.closed, [&](const Window& w) {
                 Controls c = sp.basis == PathBasis::kBSpline ? bspline_to_bezier(w) : catmull_rom_to_bezier(w);
                 if (first && !sp.closed) c[0] = pts.front();  // the clamped start is exactly the first point
                 first = false;
                 out.add(std::move(c));
-            }
+            });
             out.finish(sp.closed ? nullptr : &pts.back());  // and the clamped end the last
             return;
         }

@@ -24,7 +24,8 @@ std::size_t json_bytes_scanned() {
 // nested document cannot exhaust the stack.
 class JsonIndexBuilder {
 public:
-    JsonIndexBuilder(std::string_view text, JsonIndex& index) : text_(text), index_(index) {}
+    JsonIndexBuilder(std::string_view text, JsonIndex& index, std::size_t max_depth)
+        : text_(text), index_(index), max_depth_(max_depth) {}
 
     void build() {
         index_lines();
@@ -78,8 +79,10 @@ private:
         return decoded.is_string() ? decoded.get<std::string>() : std::string(raw);
     }
 
-    // Records a value starting at pos_ as the next child of the innermost open container.
+    // Records a value starting at pos_ as the next child of the innermost open container
+    // (kNone: nested too deep to be recorded).
     std::size_t add_node() {
+        if (open_.size() > max_depth_) return kNone;
         const std::size_t id = index_.nodes_.size();
         index_.nodes_.push_back({pos_, false, {}, {}});
         if (!open_.empty()) index_.nodes_[open_.back().node].children.push_back(id);
@@ -94,7 +97,7 @@ private:
         if (!open_.back().keys.insert(k).second && !index_.duplicate_key_) {
             index_.duplicate_key_ = key_at;
         }
-        index_.nodes_[open_.back().node].keys.push_back(std::move(k));
+        if (open_.back().node != kNone) index_.nodes_[open_.back().node].keys.push_back(std::move(k));
         skip_space();
         if (!at(':')) return false;
         ++pos_;
@@ -107,7 +110,7 @@ private:
             const std::size_t id = add_node();
             const char c = text_[pos_];
             if (c == '{' || c == '[') {
-                index_.nodes_[id].object = c == '{';
+                if (id != kNone) index_.nodes_[id].object = c == '{';
                 open_.push_back({id, c == '{', {}});
                 ++pos_;
                 skip_space();
@@ -161,15 +164,18 @@ private:
         }
     }
 
+    static constexpr std::size_t kNone = static_cast<std::size_t>(-1);
+
     std::string_view text_;
     JsonIndex& index_;
+    std::size_t max_depth_;
     std::size_t pos_ = 0;
     bool done_ = false;
     std::vector<Open> open_;
 };
 
-JsonIndex::JsonIndex(std::string_view text) {
-    JsonIndexBuilder(text, *this).build();
+JsonIndex::JsonIndex(std::string_view text, std::size_t max_depth) {
+    JsonIndexBuilder(text, *this, max_depth).build();
 }
 
 std::optional<std::size_t> JsonIndex::offset_of(const std::string& pointer) const {

@@ -22,8 +22,9 @@ constexpr double kMaxCoordinateMm = 1e6;  // 1 km: beyond any plotter; catches u
 
 class Reader : public JsonChecker {
 public:
-    Reader(const std::string& text, const std::string& file, double nurbs_tolerance_mm)
-        : JsonChecker(text, file), nurbs_tolerance_mm_(nurbs_tolerance_mm) {}
+    Reader(const std::string& text, const std::string& file, double nurbs_tolerance_mm,
+           FlatNumberArrays& flat)
+        : JsonChecker(text, file), nurbs_tolerance_mm_(nurbs_tolerance_mm), flat_(flat) {}
 
     PathBasis basis(const json& v, const std::string& pointer) const {
         if (!v.is_string()) fail(pointer, "basis must be a string");
@@ -45,14 +46,19 @@ public:
 
     double coordinate(const json& v, const std::string& pointer, double scale) const {
         if (!v.is_number()) fail(pointer, "coordinate must be a number");
-        const double x = v.get<double>();
-        if (!std::isfinite(x)) fail(pointer, "coordinate is not finite");
+        return coordinate_mm(v.get<double>(), [&] { return pointer; }, scale);
+    }
+
+    /// A number's coordinate in mm; `pointer()` gives its place, only for an error.
+    template <class Pointer>
+    double coordinate_mm(double x, const Pointer& pointer, double scale) const {
+        if (!std::isfinite(x)) fail(pointer(), "coordinate is not finite");
         const double mm = x * scale;
         if (std::fabs(mm) > kMaxCoordinateMm) {
             std::ostringstream m;
             m << "coordinate " << x << " is out of range (|value| <= " << kMaxCoordinateMm
               << " mm)";
-            fail(pointer, m.str());
+            fail(pointer(), m.str());
         }
         return mm;
     }
@@ -77,6 +83,11 @@ public:
     std::vector<PathPoint> points(const json& v, const std::string& pointer, double scale,
                                   std::size_t& axes) const {
         if (!v.is_array()) fail(pointer, "points must be an array of [x, y, ...] arrays");
+        if (const auto flat = flat_.found.find(pointer); flat != flat_.found.end()) {
+            FlatNumberArrays::Rows rows = std::move(flat->second);
+            flat_.found.erase(flat);  // freed once the points are made
+            return flat_points(rows, pointer, scale, axes);
+        }
         std::vector<PathPoint> out;
         for (std::size_t i = 0; i < v.size(); ++i) {
             const std::string p = pointer + "/" + std::to_string(i);
@@ -94,6 +105,33 @@ public:
             PathPoint point;
             for (std::size_t a = 0; a < pt.size(); ++a) {
                 point.push_back(coordinate(pt[a], p + "/" + std::to_string(a), scale));
+            }
+            out.push_back(std::move(point));
+        }
+        return out;
+    }
+
+    /// points() of an array read flat: the same checks in the same order, the same messages.
+    std::vector<PathPoint> flat_points(const FlatNumberArrays::Rows& rows, const std::string& pointer,
+                                       double scale, std::size_t& axes) const {
+        std::vector<PathPoint> out;
+        out.reserve(rows.widths.size());
+        const double* value = rows.values.data();
+        for (std::size_t i = 0; i < rows.widths.size(); ++i) {
+            const std::size_t width = rows.widths[i];
+            const auto p = [&] { return pointer + "/" + std::to_string(i); };
+            if (axes == 0) {
+                if (width < 1 || width > kMaxAxes) {
+                    fail(p(), "point has " + std::to_string(width) + " coordinates (1 to 8 axes)");
+                }
+                axes = width;
+            } else if (width != axes) {
+                fail(p(), "point has " + std::to_string(width) + " coordinates, expected " +
+                              std::to_string(axes));
+            }
+            PathPoint point(width);
+            for (std::size_t a = 0; a < width; ++a) {
+                point[a] = coordinate_mm(*value++, [&] { return p() + "/" + std::to_string(a); }, scale);
             }
             out.push_back(std::move(point));
         }
@@ -179,6 +217,8 @@ public:
         if (has_points == has_subpaths) {
             fail("", "give either \"points\" (one subpath) or \"subpaths\", not both or neither");
         }
+        // Located from here on without an error: "/points" or "/subpaths/N", not the points.
+        locate_shallow(has_points ? 1 : 2);
         if (has_points) {
             Subpath sp;
             sp.basis = default_basis;
@@ -205,6 +245,7 @@ public:
 
 private:
     double nurbs_tolerance_mm_;
+    FlatNumberArrays& flat_;
 };
 
 }  // namespace
@@ -213,7 +254,11 @@ Path parse_json_path(const std::string& text, const std::string& file, double nu
     if (!(nurbs_tolerance_mm > 0) || !std::isfinite(nurbs_tolerance_mm)) {
         throw std::invalid_argument("parse_json_path: the NURBS tolerance must be positive and finite");
     }
-    return Reader(text, file, nurbs_tolerance_mm).path(parse_json_document(text, file));
+    // The points arrays are read flat: a document tree of 10^6 points is ~100 MB.
+    FlatNumberArrays flat;
+    flat.where = {"/points", "/subpaths/*/points"};
+    const nlohmann::json document = parse_json_document(text, file, &flat);
+    return Reader(text, file, nurbs_tolerance_mm, flat).path(document);
 }
 
 Path load_json_path(const std::string& file, double nurbs_tolerance_mm) {

@@ -173,6 +173,27 @@ private:
                                                 format(extent * p.tick_hz / n) + " mm/s)");
             }
         }
+        // Without a travel, the position range bounds a span only at hundreds of metres: a span
+        // may then last no longer than each such axis's stop from its max_velocity at its
+        // max_acceleration (v / a), or the default span, or the shortest span the floors above
+        // allow for it, whichever is longest. Longer spans make every stop of the path cost a
+        // whole span (65,536 ticks: 65.5 s at 1 kHz) and plan for minutes.
+        for (std::size_t i = 0; i < p.axes.size(); ++i) {
+            const AxisLimits& a = p.axes[i];
+            if (a.has_travel) continue;
+            const double stop_ticks = a.max_velocity * p.tick_hz / a.max_acceleration;
+            const double floor_ticks = std::max(p.mm_per_lsb * p.tick_hz / a.max_velocity,
+                                                p.tick_hz * std::sqrt(p.mm_per_lsb / a.max_acceleration));
+            const double longest = std::max({std::floor(stop_ticks), static_cast<double>(MachineProfile{}.ticks_per_span),
+                                             std::ceil(floor_ticks)});
+            if (n <= longest) continue;
+            fail(root.contains("ticks_per_span") ? "/ticks_per_span" : "",
+                 "ticks_per_span " + format(n) + " is too long: a span of " + format(n) + " ticks (" +
+                     format(n / p.tick_hz) + " s) outlasts axis " + a.name + "'s stop from its max_velocity " +
+                     format(a.max_velocity) + " mm/s at its max_acceleration " + format(a.max_acceleration) +
+                     " mm/s^2 (" + format(stop_ticks / p.tick_hz) + " s), and the axis has no travel to bound it " +
+                     "(allowed: 1 .. " + format(longest) + " ticks)");
+        }
         const auto check_feed = [&](const char* key, double feed) {
             if (feed >= v_min) return;
             const bool given = root.contains(key);

@@ -270,3 +270,68 @@ TEST_CASE("a hold at any tick of a span leaves the path in the tick that takes i
         r.check_limits(limits);
     }
 }
+
+TEST_CASE("an underrun after a long moving span stops within the stopping distance, not the span",
+          "[device][stop]") {
+    // 8,192 ticks from rest at 0.004 LSB/tick^2 to ~33 LSB/tick, then (sent late) 8,192 ticks
+    // back to rest. With nothing queued at the first span's end, the device stops there by
+    // itself: planned like a stop inside a span, it takes the ~164 ticks 0.2 LSB/tick^2 needs,
+    // not the span's 8,192 (a stop on the span's own length once ran on for ~134,000 LSB).
+    constexpr std::uint32_t kTicks = 8192;
+    constexpr std::int32_t kDistance = 134217;
+    const Lsb start[kAxes] = {1000, -1000};
+    const auto limits = gentle_limits();
+    std::vector<WireSpan> spans(2);
+    for (unsigned a = 0; a < kAxes; ++a) {
+        const std::int32_t d = kDistance / static_cast<std::int32_t>(a + 1);
+        spans[0].end[a] = start[a] + d;
+        spans[0].end_tangent[a] = 2 * d;
+        spans[1].start_tangent[a] = 2 * d;
+        spans[1].end[a] = start[a] + 2 * d;
+    }
+    spans[0].ticks = spans[1].ticks = kTicks;
+    spans[0].outputs = spans[1].outputs = kOutputPenDown;
+    spans[1].flags = kWireJobEnd;
+    Device twin(start), d(start);
+    for (Device* x : {&twin, &d}) REQUIRE(x->configure(limits) == Status::kOk);
+    REQUIRE(send(twin, spans, 0, 2) == Status::kOk);
+    REQUIRE(twin.command(Command::kStart) == Status::kOk);
+    Run whole, r;
+    whole.run_until(twin, [&] { return twin.state() == DeviceState::kIdle; }, 4 * kTicks);
+    REQUIRE(twin.finished_job() == 1);
+    REQUIRE(twin.underruns() == 0);
+
+    REQUIRE(send(d, spans, 0, 1) == Status::kOk);
+    REQUIRE(d.command(Command::kStart) == Status::kOk);
+    r.run(d, kTicks);
+    REQUIRE(d.ticks_executed() == kTicks);
+    const std::size_t to_rest = r.run_until(d, [&] { return !own_move(d) && d.state() == DeviceState::kHolding; },
+                                            4 * kTicks);
+    CHECK(d.underruns() == 1);
+    CHECK(d.held_by_underrun());
+    const double v = static_cast<double>(whole.ticks[kTicks][0] - whole.ticks[kTicks - 1][0]);
+    const double fewest = v / (limits.axis[0].max_acceleration / 1e6);
+    CHECK(to_rest + 1 >= static_cast<std::size_t>(fewest));
+    CHECK(to_rest <= 2 * static_cast<std::size_t>(fewest + 1));
+    // The stop starts at the boundary point and its first step continues the span's velocity
+    // (within the rounding).
+    CHECK(r.ticks[kTicks] == whole.ticks[kTicks]);
+    for (unsigned a = 0; a < kAxes; ++a) {
+        const std::int64_t path_step = std::int64_t{whole.ticks[kTicks + 1][a]} - whole.ticks[kTicks][a];
+        const std::int64_t stop_step = std::int64_t{r.ticks[kTicks + 1][a]} - r.ticks[kTicks][a];
+        CHECK(std::llabs(stop_step - path_step) <= 1);
+    }
+    r.run(d, 100);
+    CHECK(r.ticks.back() == r.ticks[r.ticks.size() - 101]);  // holding still
+
+    // The next span arrives: resume re-enters at the boundary and the rest plays as queued.
+    REQUIRE(send(d, spans, 1, 1) == Status::kOk);
+    REQUIRE(d.command(Command::kResume) == Status::kOk);
+    r.run_until(d, [&] { return d.state() == DeviceState::kIdle; }, 4 * kTicks);
+    REQUIRE(d.state() == DeviceState::kIdle);
+    CHECK(d.finished_job() == 1);
+    CHECK(d.ticks_executed() == 2 * kTicks);
+    CHECK(r.path_ticks() == whole.path_ticks());
+    CHECK(r.ticks.back() == whole.ticks.back());
+    r.check_limits(limits);
+}

@@ -93,9 +93,30 @@ TEST_CASE("spans longer than the work area at full speed are refused", "[host][m
     CHECK(error_of(a3) ==
           "m.json:3:44: ticks_per_span 65536 is too long: a span of 65536 ticks at axis x's max_velocity 250 mm/s "
           "crosses 16384 mm, more than its travel (430 mm) (allowed: 1 .. 1720 ticks)");
-    // Without travel, the bound is the device's position range (2^28 LSB: 268 m at 1 um).
+    // Without travel, the device's position range (2^28 LSB: 268 m at 1 um) bounds a span only
+    // at hundreds of metres: there a span lasts no longer than the axis's stop from full speed
+    // (1000 mm/s at 3000 mm/s^2: 0.333 s, 333 ticks at 1 kHz).
     CHECK(error_of(R"({"axes": [{"name": "x", "max_velocity": 1000, "max_acceleration": 3000}], "ticks_per_span": 65536})") ==
+          "m.json:1:93: ticks_per_span 65536 is too long: a span of 65536 ticks (65.536 s) outlasts axis x's stop from "
+          "its max_velocity 1000 mm/s at its max_acceleration 3000 mm/s^2 (0.333333 s), and the axis has no travel to "
+          "bound it (allowed: 1 .. 333 ticks)");
+    CHECK(error_of(R"({"axes": [{"name": "x", "max_velocity": 1000, "max_acceleration": 3000}], "ticks_per_span": 333})") ==
           "no error");
+    CHECK(error_of(R"({"axes": [{"name": "x", "max_velocity": 1000, "max_acceleration": 3000}], "ticks_per_span": 334})") !=
+          "no error");
+    // Never below the default span (a fast stop: 10 mm/s at 3000 mm/s^2 takes 3.3 ticks) ...
+    CHECK(error_of(R"({"axes": [{"name": "x", "max_velocity": 10, "max_acceleration": 3000}], "ticks_per_span": 8})") ==
+          "no error");
+    CHECK(error_of(R"({"axes": [{"name": "x", "max_velocity": 10, "max_acceleration": 3000}], "ticks_per_span": 9})")
+              .find("(allowed: 1 .. 8 ticks)") != std::string::npos);
+    // ... nor below the shortest span the floors allow (0.01 mm/s moves 1 LSB in 100 ticks).
+    CHECK(error_of(R"({"axes": [{"name": "x", "max_velocity": 0.01, "max_acceleration": 1000}], "ticks_per_span": 100})") ==
+          "no error");
+    CHECK(error_of(R"({"axes": [{"name": "x", "max_velocity": 0.01, "max_acceleration": 1000}], "ticks_per_span": 101})")
+              .find("(allowed: 1 .. 100 ticks)") != std::string::npos);
+    // An axis with travel is bounded by its travel only (the a3 plotter above allows 1720).
+    CHECK(error_of(R"({"axes": [{"name": "x", "max_velocity": 250, "max_acceleration": 3000, "travel": [0, 430]}],
+                       "ticks_per_span": 1720})") == "no error");
     CHECK(error_of(R"({"axes": [{"name": "x", "max_velocity": 1000, "max_acceleration": 3000}], "mm_per_lsb": 0.00001,
                        "ticks_per_span": 65536})")
               .find("m.json:2:42: ticks_per_span 65536 is too long: a span of 65536 ticks at axis x's max_velocity 1000 "

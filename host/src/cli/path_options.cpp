@@ -4,6 +4,8 @@
 #include <charconv>
 #include <cctype>
 #include <cmath>
+#include <filesystem>
+#include <system_error>
 #include <fstream>
 #include <iostream>
 #include <sstream>
@@ -191,18 +193,26 @@ std::string sniff_format(const std::string& text) {
     return "gcode";
 }
 
+// Everything `in` holds, appended in blocks to a string reserved for `size_hint` bytes: no
+// second copy of the text (a string stream's buffer and then its str() held two or three).
+std::string read_all(std::istream& in, std::size_t size_hint) {
+    std::string text;
+    text.reserve(size_hint);
+    char block[1 << 16];
+    while (in.read(block, sizeof block) || in.gcount() > 0) text.append(block, static_cast<std::size_t>(in.gcount()));
+    return text;
+}
+
 // The whole file, or standard input for "-".
 std::string read_input(const std::string& file) {
-    std::ostringstream buffer;
-    if (file == "-") {
-        buffer << std::cin.rdbuf();
-        return buffer.str();
-    }
+    if (file == "-") return read_all(std::cin, 0);
     std::ifstream in(file, std::ios::binary);
     if (!in) throw InputError(file, {}, "cannot open file");
-    buffer << in.rdbuf();
+    std::error_code error;
+    const std::uintmax_t size = std::filesystem::file_size(file, error);
+    std::string text = read_all(in, !error && size < (std::uintmax_t{1} << 40) ? static_cast<std::size_t>(size) : 0);
     if (in.bad()) throw InputError(file, {}, "cannot read file");
-    return buffer.str();
+    return text;
 }
 
 // A file's format: --format, else its extension (standard input: --format or "").

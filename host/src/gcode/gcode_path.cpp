@@ -1,6 +1,7 @@
 // parse_gcode_path / load_gcode_path: lines -> program run -> path; the pen mode choice.
 #include "pathstream/host/gcode_path.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <set>
@@ -21,6 +22,7 @@ std::vector<std::string_view> split_lines(const std::string& text) {
     std::vector<std::string_view> lines;
     std::string_view rest(text);
     if (rest.substr(0, 3) == "\xEF\xBB\xBF") rest.remove_prefix(3);  // UTF-8 byte order mark
+    lines.reserve(static_cast<std::size_t>(std::count(rest.begin(), rest.end(), '\n')) + 1);
     while (!rest.empty()) {
         const std::size_t end = rest.find('\n');
         std::string_view current = rest.substr(0, end);
@@ -110,6 +112,7 @@ Path parse_gcode_path(const std::string& text, const std::string& file, const Gc
         chosen.pen = choose_pen(evidence, options.z_down_max, out.pen_reason);
         if (chosen.pen != PenControl::kZ || path.subpaths.empty()) {
             std::vector<std::string> again;  // the warnings of the first run stand
+            path = Path{};  // not held through the second run
             path = run(lines, file, chosen, ignored, false, nullptr, again);
         }
     } else {

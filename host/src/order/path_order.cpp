@@ -7,6 +7,7 @@
 #include <limits>
 #include <map>
 #include <stdexcept>
+#include <type_traits>
 #include <string>
 #include <utility>
 #include <vector>
@@ -43,6 +44,35 @@ Subpath rotated_open_loop(const Subpath& s, std::size_t shift) {
     r.points.insert(r.points.end(), s.points.begin() + 1,
                     s.points.begin() + static_cast<std::ptrdiff_t>(shift) + 1);
     return r;
+}
+
+/// rotated_open_loop in place: the same points, none copied but Q[shift] once.
+void rotate_open_loop(Subpath& s, std::size_t shift) {
+    if (shift == 0) return;
+    s.points.erase(s.points.begin());  // Q[1..m-1]
+    std::rotate(s.points.begin(), s.points.begin() + static_cast<std::ptrdiff_t>(shift - 1), s.points.end());
+    s.points.push_back(s.points.front());  // Q[shift..m-1], Q[1..shift]
+}
+
+/// reversed_subpath in place.
+void reverse_points(Subpath& r) {
+    if (r.closed && !r.points.empty()) {
+        std::reverse(r.points.begin() + 1, r.points.end());
+    } else {
+        std::reverse(r.points.begin(), r.points.end());
+    }
+}
+
+/// rotated_subpath in place (its checks and messages).
+void rotate_points(Subpath& r, std::size_t shift) {
+    if (!r.closed) throw std::invalid_argument("rotated_subpath: the subpath is open");
+    if (r.points.empty()) return;
+    if (r.basis == PathBasis::kBezier && shift % 3 != 0) {
+        throw std::invalid_argument("rotated_subpath: a Bezier chain starts only at on-curve points (shift " +
+                                    std::to_string(shift) + " is not a multiple of 3)");
+    }
+    std::rotate(r.points.begin(), r.points.begin() + static_cast<std::ptrdiff_t>(shift % r.points.size()),
+                r.points.end());
 }
 
 /// 2-D cell of a point for the grids: the first two axes (one-axis paths: y = 0).
@@ -398,13 +428,26 @@ void improve(Tour& tour) {
     }
 }
 
-/// The subpaths of `path` in the order of `visits`, reversed or rotated as chosen.
-Path build(const Path& path, const std::vector<Item>& items, const std::vector<Visit>& visits) {
+/// The subpaths of `path` in the order of `visits`, reversed or rotated as chosen; those kept
+/// as they are move out of a non-const `path` (each subpath is visited once).
+template <class P>
+Path build(P& path, const std::vector<Item>& items, const std::vector<Visit>& visits) {
+    constexpr bool consume = !std::is_const_v<P>;
     Path out = without_subpaths(path);
     for (const Visit& v : visits) {
         const Item& it = items[v.item];
-        const Subpath& s = path.subpaths[it.subpath];
-        if (!it.cyclic) {
+        auto& s = path.subpaths[it.subpath];
+        if constexpr (consume) {  // moved, then reversed or rotated in place
+            Subpath r = std::move(s);
+            if (!it.cyclic) {
+                if (v.choice != 0) reverse_points(r);
+            } else if (r.closed) {
+                rotate_points(r, it.shifts[v.choice]);
+            } else {
+                rotate_open_loop(r, it.shifts[v.choice]);
+            }
+            out.subpaths.push_back(std::move(r));
+        } else if (!it.cyclic) {
             out.subpaths.push_back(v.choice == 0 ? s : reversed_subpath(s));
         } else if (s.closed) {
             out.subpaths.push_back(rotated_subpath(s, it.shifts[v.choice]));
@@ -415,9 +458,10 @@ Path build(const Path& path, const std::vector<Item>& items, const std::vector<V
     return out;
 }
 
-/// Orders `path` (already joined) from `start`: greedy then improvement.
-Path order_items(const Path& path, const PathPoint& start, const OrderOptions& o, bool greedy,
-                 std::size_t& work) {
+/// Orders `path` (already joined) from `start`: greedy then improvement. A non-const `path`
+/// is not needed afterwards: its subpaths may move into the result.
+template <class P>
+Path order_items(P& path, const PathPoint& start, const OrderOptions& o, bool greedy, std::size_t& work) {
     const std::vector<Item> items = make_items(path, o.merge_tolerance);
     Tour tour(items, start, o.work_limit);
     if (greedy) {
@@ -462,26 +506,55 @@ double pen_up_travel(const Path& path, const PathPoint& start) {
 
 Subpath reversed_subpath(const Subpath& s) {
     Subpath r = s;
-    if (s.closed && !r.points.empty()) {
-        std::reverse(r.points.begin() + 1, r.points.end());
-    } else {
-        std::reverse(r.points.begin(), r.points.end());
-    }
+    reverse_points(r);
     return r;
 }
 
 Subpath rotated_subpath(const Subpath& s, std::size_t shift) {
     if (!s.closed) throw std::invalid_argument("rotated_subpath: the subpath is open");
-    if (s.points.empty()) return s;
-    if (s.basis == PathBasis::kBezier && shift % 3 != 0) {
-        throw std::invalid_argument("rotated_subpath: a Bezier chain starts only at on-curve points (shift " +
-                                    std::to_string(shift) + " is not a multiple of 3)");
-    }
     Subpath r = s;
-    std::rotate(r.points.begin(), r.points.begin() + static_cast<std::ptrdiff_t>(shift % s.points.size()),
-                r.points.end());
+    rotate_points(r, shift);
     return r;
 }
+
+namespace {
+/// Whether merge_touching would join anything: two joinable subpaths of one basis and feed
+/// with ends within `tolerance` (a superset of its joins: false means it joins none).
+bool any_touching(const Path& path, double tolerance) {
+    if (tolerance < 0) return false;
+    const auto& in = path.subpaths;
+    const auto joinable = [&](const Subpath& s) {
+        return !s.closed && joinable_basis(s.basis) && s.points.size() >= 2 && point_count_problem(s).empty();
+    };
+    const double cell = std::max(tolerance, 1e-9);
+    using Key = std::pair<long long, long long>;
+    const auto key = [&](const PathPoint& p) {
+        const auto [x, y] = plane(p);
+        return Key{static_cast<long long>(std::floor(x / cell)), static_cast<long long>(std::floor(y / cell))};
+    };
+    std::map<Key, std::vector<std::pair<std::size_t, const PathPoint*>>> ends;
+    for (std::size_t i = 0; i < in.size(); ++i) {
+        if (!joinable(in[i])) continue;
+        for (const PathPoint* p : {&in[i].points.front(), &in[i].points.back()}) ends[key(*p)].push_back({i, p});
+    }
+    for (const auto& [k, list] : ends) {
+        for (const auto& [i, p] : list) {
+            for (long long dx = -1; dx <= 1; ++dx) {
+                for (long long dy = -1; dy <= 1; ++dy) {
+                    const auto found = ends.find({k.first + dx, k.second + dy});
+                    if (found == ends.end()) continue;
+                    for (const auto& [j, q] : found->second) {
+                        const Subpath &a = in[i], &b = in[j];
+                        if (j == i || a.basis != b.basis || a.feed != b.feed || p->size() != q->size()) continue;
+                        if (distance(*p, *q) <= tolerance) return true;
+                    }
+                }
+            }
+        }
+    }
+    return false;
+}
+}  // namespace
 
 Path merge_touching(const Path& path, double tolerance, std::size_t* merged) {
     std::size_t joins = 0;
@@ -566,13 +639,20 @@ Path order_path(const Path& path, const OrderOptions& o, OrderReport* report) {
     OrderReport r;
     r.subpaths_before = path.subpaths.size();
     r.travel_before = pen_up_travel(path, start);
-    Path joined = merge_touching(path, o.merge_tolerance, &r.merged);
-    Path best = order_items(joined, start, o, true, r.work);
+    // Joined into a copy only when some ends touch: a 10^6-point path is ~60 MB a copy.
+    Path best;
+    if (any_touching(path, o.merge_tolerance)) {
+        Path joined = merge_touching(path, o.merge_tolerance, &r.merged);
+        best = order_items(joined, start, o, true, r.work);
+    } else {
+        best = order_items(path, start, o, true, r.work);
+    }
     double best_travel = pen_up_travel(best, start);
     // Greedy may lose to a good document order: improve that instead (never worse than it).
     if (best_travel > r.travel_before) {
         OrderOptions plain = o;
         plain.merge_tolerance = -1;
+        best = Path{};  // not held while the next is built
         best = order_items(path, start, plain, false, r.work);
         best_travel = pen_up_travel(best, start);
         r.merged = 0;

@@ -700,6 +700,7 @@ private:
             sp.basis = PathBasis::kBezier;
             sp.closed = false;
             sp.location = at;
+            sp.points.reserve(3 * pieces.size() + 1);  // at most: no growth by doubling
             for (const svg::Cubic& c : pieces) {
                 Point mm[4];
                 bool degenerate = true;

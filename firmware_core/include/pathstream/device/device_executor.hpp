@@ -352,6 +352,19 @@ private:
         set_held_by_underrun(underrun);
         if (underrun) status_.underruns = status_.underruns + 1u;
         hold_requested_ = stop_requested_ = false;
+        // The stop is planned on the base an in-span stop at the span's last tick would get
+        // (velocity_within_span at k = n, where the chord and T0 drop out: the velocity is
+        // T1/n): the span's own length n, exactly T1, for spans of up to kMinInSpanStopBase
+        // ticks or when the stop needs n ticks or more; else the ticks the stop needs, so a
+        // long span's stop (an underrun after it) is not stretched to the span's length.
+        if (moving) {
+            const std::int32_t none[Axes] = {};
+            if (velocity_within_span(none, none, current_.tangent, current_.ticks, current_.ticks, limits(),
+                                     boundary_tangent_, boundary_ticks_) != Status::kOk) {
+                fault(FaultCode::kStopFailed);
+                return false;
+            }
+        }
         begin_stop(stopping, moving);
         return false;
     }

@@ -19,8 +19,9 @@ namespace pathstream::host {
 class JsonIndex {
 public:
     /// Scans `text`, which nlohmann::json has already accepted as a prefix (it stops at a NUL
-    /// byte). Duplicate keys and bytes after the root value are recorded, not thrown.
-    explicit JsonIndex(std::string_view text);
+    /// byte). Duplicate keys and bytes after the root value are recorded, not thrown. Values
+    /// nested deeper than `max_depth` (the root: 0) are not indexed: offset_of finds none.
+    explicit JsonIndex(std::string_view text, std::size_t max_depth = static_cast<std::size_t>(-1));
 
     /// Offset of the value at JSON Pointer `pointer` (RFC 6901, "" for the root), if any.
     std::optional<std::size_t> offset_of(const std::string& pointer) const;
