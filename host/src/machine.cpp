@@ -48,7 +48,7 @@ public:
     MachineProfile read(const json& root) const {
         if (!root.is_object()) fail("", "a machine profile must be a JSON object");
         only_keys(root, "", {"axes", "mm_per_lsb", "tick_hz", "ticks_per_span", "feed", "travel_feed",
-                             "pen_down_delay", "pen_up_delay", "chord_tolerance", "gpio", "layer_feeds"});
+                             "pen_down_delay", "pen_up_delay", "chord_tolerance", "corner_stop_angle", "gpio", "layer_feeds"});
         MachineProfile p;
         if (!root.contains("axes")) fail("", "machine profile has no \"axes\"");
         const json& axes = root["axes"];
@@ -100,6 +100,13 @@ public:
         if (root.contains("pen_up_delay")) p.pen_up_delay = number(root["pen_up_delay"], "/pen_up_delay", "pen_up_delay", 0, 60, false, "s");
         if (root.contains("chord_tolerance")) {
             p.chord_tolerance = number(root["chord_tolerance"], "/chord_tolerance", "chord_tolerance", 0, 10, true, "mm");
+        }
+        if (root.contains("corner_stop_angle")) {
+            // Degrees, as CAM tools give angles. Not below 1: joints of smooth curves turn by
+            // rounding noise, and each would become a stop.
+            const double degrees = number(root["corner_stop_angle"], "/corner_stop_angle", "corner_stop_angle", 1,
+                                          180, false, "degrees");
+            p.corner_stop_angle = degrees * 3.14159265358979323846 / 180;
         }
         // One LSB cannot be resolved more finely than the tolerance asks for: a tolerance below
         // half an LSB could never be met by integer setpoints.

@@ -67,3 +67,18 @@ TEST_CASE("sharp vertices still stop; a blend never crosses a pen change", "[pla
     }
     CHECK(stops >= 4);
 }
+
+TEST_CASE("a profile's corner_stop_angle turns shallow vertices into stops", "[planner][blend]") {
+    MachineProfile p = pen_plotter();
+    const Path path = polygon(12, 20);  // 0.524 rad (30 degrees) at every vertex
+    const auto segments = to_bezier_segments(path);
+    PlanStats crossed_stats, stopped_stats;
+    p.corner_stop_angle = 40 * 3.14159265358979 / 180;  // above the vertices' turn: blended
+    const Plan crossed = plan_path(segments, p, PlanOptions{}, &crossed_stats);
+    p.corner_stop_angle = 10 * 3.14159265358979 / 180;  // below it: every vertex stops
+    const Plan stopped = plan_path(segments, p, PlanOptions{}, &stopped_stats);
+    CHECK(check_plan(crossed, segments, p).within_limits);
+    CHECK(check_plan(stopped, segments, p).within_limits);
+    CHECK(crossed_stats.pieces < stopped_stats.pieces);
+    CHECK(stopped_stats.pieces >= 12);  // one piece per side at least
+}

@@ -1,6 +1,8 @@
 // Machine profile reader: defaults, every field, and each impossible value's own message.
 #include <catch2/catch.hpp>
 
+#include <cmath>
+
 #include "pathstream/host/input_error.hpp"
 #include "pathstream/host/machine.hpp"
 
@@ -29,6 +31,17 @@ TEST_CASE("a minimal profile takes the documented defaults", "[host][machine]") 
     CHECK(p.tick_hz == 1000);
     CHECK(p.ticks_per_span == 8);
     CHECK(p.source == "m.json");
+    CHECK(p.corner_stop_angle < 0);  // the planner's own angle
+}
+
+TEST_CASE("corner_stop_angle is read in degrees, 1 to 180", "[host][machine]") {
+    const MachineProfile p =
+        parse_machine_profile(std::string("{") + kAxes + ", \"corner_stop_angle\": 45}", "m.json");
+    CHECK(p.corner_stop_angle == Approx(std::atan(1.0)).epsilon(1e-12));  // 45 degrees: pi / 4
+    CHECK(error_of(std::string("{") + kAxes + ", \"corner_stop_angle\": 0.5}") ==
+          "m.json:1:95: corner_stop_angle 0.5 degrees is impossible (allowed: >= 1 and <= 180 degrees)");
+    CHECK(error_of(std::string("{") + kAxes + ", \"corner_stop_angle\": 181}") ==
+          "m.json:1:95: corner_stop_angle 181 degrees is impossible (allowed: >= 1 and <= 180 degrees)");
 }
 
 TEST_CASE("the example profile loads", "[host][machine]") {
@@ -52,7 +65,8 @@ TEST_CASE("impossible profiles are refused with the place and the reason", "[hos
     CHECK(error_of(std::string("{") + kAxes + ", \"chord_tolerance\": 0.0001}") ==
           "m.json:1:93: chord_tolerance 0.0001 mm is below half an LSB (0.0005 mm): integer setpoints cannot meet it");
     CHECK(error_of(std::string("{") + kAxes + ", \"speed\": 3}") ==
-          "m.json:1:83: unknown key \"speed\" (expected one of: axes, chord_tolerance, feed, gpio, layer_feeds, mm_per_lsb, "
+          "m.json:1:83: unknown key \"speed\" (expected one of: axes, chord_tolerance, corner_stop_angle, feed, gpio, "
+          "layer_feeds, mm_per_lsb, "
           "pen_down_delay, pen_up_delay, tick_hz, ticks_per_span, travel_feed)");
     CHECK(error_of(R"({"axes": [{"name": "x", "max_velocity": 1, "max_acceleration": 1},
                               {"name": "x", "max_velocity": 1, "max_acceleration": 1}]})") ==

@@ -306,6 +306,8 @@ private:
     double held_original_length_ = -1;
 };
 
+/// `options` with what the machine profile sets itself (its corner_stop_angle, when given).
+PlanOptions profile_options(const PlanOptions& options, const MachineProfile& profile);
 /// The profile and options plan_path accepts (PlanError otherwise).
 void validate_plan_inputs(const MachineProfile& profile, const PlanOptions& options);
 /// Ticks of a regular span for `profile` (docs/planner.md §5, span length).

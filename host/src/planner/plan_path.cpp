@@ -19,6 +19,12 @@ void require(bool ok, const std::string& what) {
 
 namespace planner_detail {
 
+PlanOptions profile_options(const PlanOptions& options, const MachineProfile& profile) {
+    PlanOptions out = options;
+    if (profile.corner_stop_angle >= 0) out.corner_stop_angle = profile.corner_stop_angle;
+    return out;
+}
+
 void validate_plan_inputs(const MachineProfile& p, const PlanOptions& o) {
     require(!p.axes.empty() && p.axes.size() <= kAxesMax, "1 to 8 axes");
     for (const auto& a : p.axes) {
@@ -103,10 +109,12 @@ Plan plan_path(const std::vector<BezierSegment>& segments, const MachineProfile&
         // On the path as planned: corners blended as plan_stream blends them.
         std::vector<BezierSegment> planned;
         VectorSegmentSource again(segments);
-        CornerBlender blended(again, options.corner_blend * profile.chord_tolerance, options.corner_stop_angle);
+        const PlanOptions planned_options = profile_options(options, profile);
+        CornerBlender blended(again, options.corner_blend * profile.chord_tolerance,
+                              planned_options.corner_stop_angle);
         SegmentSource& input = options.corner_blend > 0 ? static_cast<SegmentSource&>(blended) : again;
         for (BezierSegment s; input.next(s);) planned.push_back(s);
-        const PathGrid pg = build_grid(planned, profile, options);
+        const PathGrid pg = build_grid(planned, profile, planned_options);
         PlanOptions full = options;
         full.velocity_margin = full.feed_margin = 1;
         Limits machine;

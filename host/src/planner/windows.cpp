@@ -381,8 +381,9 @@ private:
 
 }  // namespace
 
-PlanTotals plan_stream(SegmentSource& source, const MachineProfile& machine_profile, const PlanOptions& options,
+PlanTotals plan_stream(SegmentSource& source, const MachineProfile& machine_profile, const PlanOptions& requested,
                        PlanSink& sink, PlanStats* stats, const std::function<void(double fraction)>& progress) {
+    const PlanOptions options = profile_options(requested, machine_profile);
     validate_plan_inputs(machine_profile, options);
     MachineProfile profile = machine_profile;  // what is planned with: spans of regular_span_ticks
     profile.ticks_per_span = regular_span_ticks(machine_profile);

@@ -64,6 +64,9 @@ struct MachineProfile {
     double pen_down_delay = 0.05;      ///< s the pen needs to settle after going down
     double pen_up_delay = 0.05;        ///< s the pen needs to lift
     double chord_tolerance = 0.005;    ///< mm: max distance of executed ticks from the path
+    /// Optional "corner_stop_angle" (1..180 degrees in the file, radians here): a joint turning
+    /// by more stops exactly; absent (< 0): the planner's PlanOptions::corner_stop_angle.
+    double corner_stop_angle = -1;
     GpioConfig gpio;                   ///< optional "gpio" object
     /// Optional "layer_feeds": pen-down speed (mm/s) per layer name (an Inkscape layer's label,
     /// a stroke colour such as "#ff0000"), for subpaths that set no feed of their own.

@@ -44,7 +44,8 @@ struct PlanOptions {
     double lookahead_bend_margin = 0.995;
 
     /// A joint turning by more than this (rad) is a corner where the motion stops exactly;
-    /// smaller tangent jumps are crossed at the corner speed of docs/planner.md.
+    /// smaller tangent jumps are crossed at the corner speed of docs/planner.md. A machine
+    /// profile's corner_stop_angle, when it has one, replaces it.
     double corner_stop_angle = 0.35;
     /// Vertices between straight segments that turn by at most corner_stop_angle are replaced
     /// by a curve passing this fraction of the chord tolerance from the vertex (0: crossed as
