@@ -204,7 +204,10 @@ TEST_CASE("PlanningThread: an error on the planning thread reaches the consumer;
     SECTION("cancel") {
         RandomWalkSource walk(3000, 3);
         PlanningThread planning(walk, machine, PlanOptions{}, {});
-        while (planning.queued() < PlanningThread::kCapacity) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+        while (planning.queued() < PlanningThread::kCapacity && !planning.finished()) {
+            std::this_thread::sleep_for(std::chrono::milliseconds(1));
+        }
+        REQUIRE(planning.queued() == PlanningThread::kCapacity);
         planning.cancel();  // the planner waits on the full queue: it ends at its next look
         while (!planning.finished()) std::this_thread::sleep_for(std::chrono::milliseconds(1));
         CHECK_FALSE(planning.totals().has_value());

@@ -111,6 +111,11 @@ public:
             // The plan failed while the job ran: the device holds at rest (or never started);
             // drop the rest of its queue, then report the plan's error.
             command(static_cast<std::uint8_t>(device::Command::kStop), true);
+            const auto deadline = Clock::now() + std::chrono::duration<double>(options_.interrupt.hold_timeout_seconds);
+            while (s.state != static_cast<std::uint8_t>(device::DeviceState::kIdle) && Clock::now() < deadline) {
+                std::this_thread::sleep_for(std::chrono::milliseconds(options_.poll_interval_ms));
+                s = link_.request_status();
+            }
             std::rethrow_exception(supply_error_);
         }
         report_.final_status = snapshot_of(s);

@@ -125,6 +125,11 @@ public:
             // The plan failed while the job ran: the device holds at rest (or never started);
             // drop the rest of its queue, then report the plan's error.
             command(device::Command::kStop, true);
+            const auto deadline = Clock::now() + std::chrono::duration<double>(options_.interrupt.hold_timeout_seconds);
+            while (s.state != static_cast<std::uint16_t>(device::DeviceState::kIdle) && Clock::now() < deadline) {
+                std::this_thread::sleep_for(std::chrono::milliseconds(options_.poll_interval_ms));
+                s = read_status();
+            }
             std::rethrow_exception(supply_error_);
         }
         report_.final_status = s;
