@@ -131,12 +131,12 @@ TEST_CASE("PlanningThread: the spans cross the queue as plan_stream makes them, 
     const MachineProfile machine = pen_plotter();
     // Longer than the queue: the planning thread waits on it, and cannot be finished
     // before the consumer took most of the job.
-    RandomWalkSource reference_walk(3000, 7);
+    RandomWalkSource reference_walk(4500, 7);
     DigestSink reference;
     const PlanTotals expected = plan_stream(reference_walk, machine, PlanOptions{}, reference);
     REQUIRE(expected.spans > 2 * PlanningThread::kCapacity);
 
-    RandomWalkSource walk(3000, 7);
+    RandomWalkSource walk(4500, 7);
     DigestSink tapped;
     PlanningThread planning(walk, machine, PlanOptions{}, {&tapped, {}});
     Digest taken;
