@@ -64,7 +64,8 @@ def run(binary, machine, csv, position, work, plan_first):
     device.terminate()
     device.wait()
     if done.returncode != 0:
-        return {"error": f"exit {done.returncode}: {done.stderr.strip().splitlines()[-1:]}"}
+        message = [line for line in done.stderr.splitlines() if line.startswith("pathstream:")]
+        return {"error": f"exit {done.returncode} after {wall:.1f} s: {message[-1:]}"}
     rss_kb = int(re.search(r"Maximum resident set size \(kbytes\): (\d+)", done.stderr).group(1))
     first = None
     with open(events) as f:
