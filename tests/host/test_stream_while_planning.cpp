@@ -57,6 +57,8 @@ std::vector<host::BezierSegment> collect(host::SegmentSource& source) {
 
 }  // namespace
 
+// Not [threads]: under ThreadSanitizer the reference plan alone would take minutes; the
+// planning thread's sharing is what the [threads] cases here and in test_spsc_ring.cpp run.
 TEST_CASE("a long job streams while it is planned: first batch before planning ends, ticks as plan_path's",
           "[stream][modbus]") {
     const host::MachineProfile machine = pen_plotter();
@@ -87,7 +89,8 @@ TEST_CASE("a long job streams while it is planned: first batch before planning e
     CHECK(device.device->recorded_setpoints().size() == reference.total_ticks * 2);
 }
 
-TEST_CASE("a planning error while the device runs: a controlled stop, then the planning error", "[stream][modbus]") {
+TEST_CASE("a planning error while the device runs: a controlled stop, then the planning error",
+          "[stream][modbus][threads]") {
     const host::MachineProfile machine = pen_plotter();
     RandomWalkSource walk(3000, 5);
     const host::Plan reference = host::plan_path(collect(walk), machine);
