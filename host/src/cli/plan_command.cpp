@@ -26,10 +26,6 @@ void add_plan_command(CLI::App& app, PlanCommandOptions& o) {
     cmd->add_flag("--json", o.json, "print the summary as one JSON document on standard output");
 }
 
-namespace {
-
-/// Loads both files, checks they agree, and makes the segments (lead-in included): a job ready
-/// to plan.
 PlannedJob prepare_job(const PathOptions& path_options, const std::string& machine_file,
                        const std::vector<double>* lead_in_from) {
     PlannedJob job;
@@ -46,8 +42,6 @@ PlannedJob prepare_job(const PathOptions& path_options, const std::string& machi
     if (lead_in_from != nullptr) prepend_lead_in(job.segments, *lead_in_from);
     return job;
 }
-
-}  // namespace
 
 PlannedJob plan_job(const PathOptions& path_options, const std::string& machine_file,
                     const std::vector<double>* lead_in_from) {

@@ -32,6 +32,11 @@ struct PlannedJob {
     std::size_t span_count = 0, pen_count = 0, pause_count = 0;
 };
 
+/// Loads both files, checks they agree (axis count) and makes the segments, the lead-in's
+/// included: a job ready to plan (its plan empty). Throws InputError for bad files.
+PlannedJob prepare_job(const PathOptions& path, const std::string& machine_file,
+                       const std::vector<double>* lead_in_from = nullptr);
+
 /// Loads both files, checks they agree (axis count), plans with a progress bar and checks
 /// every tick. Throws InputError for bad files, PlanError when planning fails.
 /// `lead_in_from` (mm per axis, optional): the machine's position; when it is not the path's

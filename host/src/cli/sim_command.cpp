@@ -180,8 +180,8 @@ std::size_t count_subpaths(const Plan& plan) {
 }
 
 /// One simulated tick as the events see it: the device always runs, in simulated time.
-JobSample sim_sample(const sim::TickProbe& p, const PlannedJob& job, const JobEvents& events) {
-    const std::vector<std::uint64_t>& prefix = events.prefix_ticks();
+/// `prefix`: ticks before each span of the plan (size spans + 1).
+JobSample sim_sample(const sim::TickProbe& p, const PlannedJob& job, const std::vector<std::uint64_t>& prefix) {
     const std::size_t spans = job.plan.spans.size();
     JobSample s;
     s.sim_seconds = static_cast<double>(p.tick + 1) / job.machine.tick_hz;
@@ -205,9 +205,13 @@ sim::SimulationResult simulate_job(const SimCommandOptions& o, const PlannedJob&
     options.servo.bandwidth_hz = o.bandwidth_hz;
     options.servo.damping = o.damping;
     options.realtime = o.realtime;
+    std::vector<std::uint64_t> prefix;
     if (!o.events.empty()) {
+        prefix.reserve(job.plan.spans.size() + 1);
+        prefix.push_back(0);
+        for (const CoreSpan& s : job.plan.spans) prefix.push_back(prefix.back() + s.ticks);
         options.tick_observer = [&](const sim::TickProbe& p) {
-            events.sample(sim_sample(p, job, events));
+            events.sample(sim_sample(p, job, prefix));
         };
     }
     ProgressBar bar(o.realtime ? "running (real time)" : "simulating");

@@ -5,6 +5,8 @@
 
 #include <algorithm>
 #include <cstring>
+#include <deque>
+#include <optional>
 #include <atomic>
 #include <chrono>
 #include <thread>
@@ -21,10 +23,14 @@
 #include "pathstream/host/cia402_master.hpp"
 #include "pathstream/host/device_link.hpp"
 #include "pathstream/host/device_setup.hpp"
+#include "pathstream/host/input_error.hpp"
 #include "pathstream/host/events.hpp"
 #include "pathstream/host/job_journal.hpp"
+#include "pathstream/host/planning_thread.hpp"
 #include "pathstream/host/progress.hpp"
+#include "pathstream/host/span_supply.hpp"
 #include "plan_command.hpp"
+#include "stream_plan_tap.hpp"
 
 namespace pathstream::host {
 
@@ -51,6 +57,9 @@ void add_stream_command(CLI::App& app, StreamCommandOptions& o) {
                     "job journal, written as the stream goes, for --resume (default: DRAWING.journal.json in the "
                     "current directory, DRAWING the file's name without its extension)");
     cmd->add_flag("--no-journal", o.no_journal, "write no job journal");
+    cmd->add_flag("--plan-first", o.plan_first,
+                  "plan the whole job before sending anything (the events' totals are known from job_start; "
+                  "memory grows with the job) instead of streaming while the planner works");
     cmd->add_option("--resume", o.resume,
                     "continue the drawing of this job journal after a Ctrl-C, a stop, a fault reset, a device "
                     "restart or a host crash (FILE, --machine and --target default to the journal's)")
@@ -135,6 +144,12 @@ public:
     }
 
     const std::string& path() const { return path_; }
+    const JobJournal& journal() const { return journal_; }
+
+    /// What comes after the drawing's next programmed pause (in order, as planning finds them).
+    void add_pause(std::string next) { journal_.pauses.push_back(std::move(next)); }
+    /// The job's spans file is complete: recorded with its hash at the next write.
+    void set_plan_hash(std::string hash) { journal_.plan_hash = std::move(hash); }
 
 private:
     std::string path_;
@@ -149,17 +164,116 @@ struct StreamEnd {
     std::uint32_t job = 0;
 };
 
-// The progress bar's detail: the queue level, then where the job is and the device's state.
-std::string bar_detail(double queued, const JobEvents& events) {
-    char queue[32];
-    std::snprintf(queue, sizeof queue, "queue %.2f s", queued);
-    const std::string status = events.status_text();
-    return status.empty() ? std::string(queue) : std::string(queue) + ", " + status;
+// What comes after a programmed pause that subpath `subpath` follows: the next layer's name
+// where the layer changes, else the subpath and where it is in the file.
+std::string pause_description(const Path& path, std::size_t subpath) {
+    const Subpath& s = path.subpaths.at(subpath);
+    const bool new_layer = !path.layers.empty() && (subpath == 0 || path.subpaths[subpath - 1].layer != s.layer);
+    if (new_layer) return "layer \"" + path.layers.at(s.layer).name + "\"";
+    return "subpath " + std::to_string(subpath + 1) +
+           (s.location.line > 0 ? " (line " + std::to_string(s.location.line) + ")" : "");
 }
 
-StreamEnd stream_over_can(const Plan& plan, const MachineProfile& machine,
-                          const StreamCommandOptions& o, const StreamObserver& observer,
-                          const HeldJob* held, const JobEvents& events) {
+// Where a span sits in the drawing: for the report of where an interrupted job stopped.
+struct SpanPlace {
+    std::int64_t origin = 0;        // index in the drawing's plan; -1: a re-entry span
+    std::size_t subpath = 0;
+    std::uint64_t drawing_tick = 0;  // the drawing's tick at its start
+};
+
+// The whole drawing's counts, known once planning ended.
+struct DrawingTotals {
+    std::size_t spans = 0;
+    std::size_t subpaths = 0;
+    std::uint64_t ticks = 0;
+};
+
+// The job as the streamer takes it, span by span: the events learn each span, the journal
+// each pause's description (a job planned as it streams), and the spans not yet executed are
+// kept for the report of where an interrupt stopped. Streaming thread only.
+class TrackedSupply : public SpanSupply {
+public:
+    // `job`: the job held in memory (a resume; its places from there), null for a first job
+    // planned as it streams (span i is the drawing's span i). `path`: describes the pauses of
+    // a first job; null when the journal has them already.
+    TrackedSupply(SpanSupply& inner, const JobSpans* job, JobEvents& events, JournalWriter& writer,
+                  const Path* path)
+        : inner_(inner), job_(job), events_(events), writer_(writer), path_(path) {}
+
+    Take take(CoreSpan& out) override {
+        const Take t = inner_.take(out);
+        if (t == Take::kEnd && pause_pending_ && path_ != nullptr) {
+            writer_.add_pause(pause_description(*path_, last_subpath_));
+            pause_pending_ = false;
+        }
+        if (t != Take::kSpan) return t;
+        SpanPlace place{static_cast<std::int64_t>(taken_), out.subpath, ticks_};
+        if (job_ != nullptr) place = {job_->origin.at(taken_), out.subpath, job_->drawing_tick.at(taken_)};
+        places_.push_back(place);
+        events_.add_span(out);
+        if (pause_pending_ && path_ != nullptr) writer_.add_pause(pause_description(*path_, out.subpath));
+        pause_pending_ = out.pause_after;
+        last_subpath_ = out.subpath;
+        ticks_ += out.ticks;
+        ++taken_;
+        return t;
+    }
+    std::optional<std::uint64_t> total_ticks() const override { return inner_.total_ticks(); }
+
+    // The job's spans before `index` were executed: their places are not needed again.
+    void executed_before(std::size_t index) {
+        while (places_base_ < index && !places_.empty()) {
+            places_.pop_front();
+            ++places_base_;
+        }
+    }
+    // Where span `index` of the job sits, when it was taken and not forgotten.
+    std::optional<SpanPlace> place(std::size_t index) const {
+        if (index < places_base_ || index - places_base_ >= places_.size()) return std::nullopt;
+        return places_[index - places_base_];
+    }
+
+private:
+    SpanSupply& inner_;
+    const JobSpans* job_;
+    JobEvents& events_;
+    JournalWriter& writer_;
+    const Path* path_;
+    std::deque<SpanPlace> places_;
+    std::size_t places_base_ = 0;
+    std::size_t taken_ = 0;
+    std::uint64_t ticks_ = 0;
+    bool pause_pending_ = false;
+    std::size_t last_subpath_ = 0;
+};
+
+// The progress bar's fraction and detail: the queue level, then where the job is and the
+// device's state; while planning goes on the job's length is not known: the motion done and
+// how far planning got instead.
+struct BarView {
+    double fraction = 0;
+    std::string detail;
+};
+BarView bar_view(std::uint64_t ticks, std::optional<std::uint64_t> total, double queued, const JobEvents& events,
+                 const PlanningThread* planning, double tick_hz) {
+    char text[96];
+    BarView v;
+    if (total) {
+        v.fraction = *total > 0 ? static_cast<double>(ticks) / static_cast<double>(*total) : 1.0;
+        std::snprintf(text, sizeof text, "queue %.2f s", queued);
+    } else {
+        std::snprintf(text, sizeof text, "%.1f s done, planning %.0f %%, queue %.2f s",
+                      static_cast<double>(ticks) / tick_hz, planning != nullptr ? 100 * planning->fraction() : 0.0,
+                      queued);
+    }
+    const std::string status = events.status_text();
+    v.detail = status.empty() ? std::string(text) : std::string(text) + ", " + status;
+    return v;
+}
+
+StreamEnd stream_over_can(SpanSupply& supply, const MachineProfile& machine, const StreamCommandOptions& o,
+                          const StreamObserver& observer, const HeldJob* held, const JobEvents& events,
+                          const PlanningThread* planning) {
     const CanTarget t = parse_can_target(o.stream.target);
     hal::SocketCanBus bus(t.interface_name);
     CanStreamOptions c;
@@ -174,8 +288,9 @@ StreamEnd stream_over_can(const Plan& plan, const MachineProfile& machine,
     CanStreamReport r;
     {
         ProgressBar bar("streaming");
-        r = stream_can(plan, machine, bus, c, [&](double fraction, double queued) {
-            bar.update(fraction, bar_detail(queued, events));
+        r = stream_can(supply, machine, bus, c, [&](std::uint64_t ticks, std::optional<std::uint64_t> total, double queued) {
+            const BarView v = bar_view(ticks, total, queued, events, planning, machine.tick_hz);
+            bar.update(v.fraction, v.detail);
         });
     }
     if (r.interrupted != 0) return {r.interrupted, r.final_status, r.job};
@@ -197,18 +312,20 @@ StreamEnd stream_over_can(const Plan& plan, const MachineProfile& machine,
     return {0, r.final_status, r.job};
 }
 
-StreamEnd stream_over_modbus(const Plan& plan, const MachineProfile& machine,
-                             const StreamCommandOptions& o, const StreamObserver& observer,
-                             const HeldJob* held, const JobEvents& events) {
+StreamEnd stream_over_modbus(SpanSupply& supply, const MachineProfile& machine, const StreamCommandOptions& o,
+                             const StreamObserver& observer, const HeldJob* held, const JobEvents& events,
+                             const PlanningThread* planning) {
     StreamOptions options = o.stream;
     options.observer = observer;
     options.held = held;
     StreamReport r;
     {
         ProgressBar bar("streaming");
-        r = stream_modbus(plan, machine, options, [&](double fraction, double queued) {
-            bar.update(fraction, bar_detail(queued, events));
-        });
+        r = stream_modbus(supply, machine, options,
+                          [&](std::uint64_t ticks, std::optional<std::uint64_t> total, double queued) {
+                              const BarView v = bar_view(ticks, total, queued, events, planning, machine.tick_hz);
+                              bar.update(v.fraction, v.detail);
+                          });
     }
     if (r.interrupted != 0) return {r.interrupted, r.final_status, r.job};
     std::printf("streamed      %s\n", o.stream.target.c_str());
@@ -231,9 +348,11 @@ StreamEnd stream_over_modbus(const Plan& plan, const MachineProfile& machine,
     return {0, r.final_status, r.job};
 }
 
-// Where an interrupted job stopped, in the drawing's terms, and how to go on.
-void print_interrupted(const StreamEnd& end, const JobSpans& job, std::uint32_t job_id, const MachineProfile& machine,
-                       const std::string& journal) {
+// Where an interrupted job stopped, in the drawing's terms, and how to go on. `next`: the
+// first span of the job not executed to its end (its place, when known); `totals`: the
+// drawing's, when planning got to its end; `resumable`: the journal can resume it.
+void print_interrupted(const StreamEnd& end, std::optional<SpanPlace> next, std::optional<DrawingTotals> totals,
+                       const MachineProfile& machine, const std::string& journal, bool resumable) {
     const DeviceSnapshot& s = end.status;
     std::printf("interrupted   the device %s at",
                 end.interrupted == 1 && s.state == 2 ? "holds at rest (the rest of the job queued)"
@@ -243,21 +362,22 @@ void print_interrupted(const StreamEnd& end, const JobSpans& job, std::uint32_t 
         std::printf(" %s %.4f mm", machine.axes[a].name.c_str(), s.position[a] * machine.mm_per_lsb);
     }
     std::printf(", pen up\n");
-    // The next span of the job that was not executed to its end.
-    std::size_t next = 0;
-    if (job_id != 0 && s.last_completed + 1 >= job_id) next = s.last_completed + 1 - job_id;
-    while (next < job.origin.size() && job.origin[next] < 0) ++next;
-    if (next < job.plan.spans.size()) {
+    if (next && totals) {
         std::printf("              stopped before drawing span %lld of %zu (subpath %zu of %zu, tick %llu of %llu)\n",
-                    static_cast<long long>(job.origin[next]) + 1, job.drawing_spans,
-                    static_cast<std::size_t>(job.plan.spans[next].subpath) + 1, job.subpaths,
-                    static_cast<unsigned long long>(job.drawing_tick[next]),
-                    static_cast<unsigned long long>(job.drawing_ticks));
+                    static_cast<long long>(next->origin) + 1, totals->spans, next->subpath + 1, totals->subpaths,
+                    static_cast<unsigned long long>(next->drawing_tick),
+                    static_cast<unsigned long long>(totals->ticks));
+    } else if (next) {
+        std::printf("              stopped before drawing span %lld (subpath %zu, tick %llu; planning did not finish)\n",
+                    static_cast<long long>(next->origin) + 1, next->subpath + 1,
+                    static_cast<unsigned long long>(next->drawing_tick));
     }
-    if (!journal.empty()) {
-        std::printf("resume with   pathstream stream --resume %s\n", journal.c_str());
-    } else {
+    if (journal.empty()) {
         std::printf("resume        not possible: --no-journal\n");
+    } else if (!resumable) {
+        std::printf("resume        not possible: planning did not finish, the journal has no plan to go on from\n");
+    } else {
+        std::printf("resume with   pathstream stream --resume %s\n", journal.c_str());
     }
 }
 
@@ -276,11 +396,13 @@ bool enter_pressed() {
 }
 
 // The operator's side of programmed pauses: a message (and an event) at each, and Enter at
-// the terminal resumes when standard input is one that no path is read from.
-void handle_pauses(InterruptOptions& interrupt, const JobJournal& journal, JobEvents& events,
+// the terminal resumes when standard input is one that no path is read from. The pauses'
+// descriptions are the journal's (a job planned as it streams adds them as they come).
+void handle_pauses(InterruptOptions& interrupt, const JournalWriter& writer, JobEvents& events,
                    const std::string& target, bool terminal) {
-    interrupt.on_pause = [&journal, &events, target, terminal](std::size_t index) {
-        const std::string next = index < journal.pauses.size() ? journal.pauses[index] : "the rest of the job";
+    interrupt.on_pause = [&writer, &events, target, terminal](std::size_t index) {
+        const std::vector<std::string>& pauses = writer.journal().pauses;
+        const std::string next = index < pauses.size() ? pauses[index] : "the rest of the job";
         std::fprintf(stderr, "\npathstream: paused for a pen change, %s next: %s `pathstream ctl %s resume`\n",
                      next.c_str(), terminal ? "press Enter to go on, or" : "go on with", target.c_str());
         events.pause(index, next);
@@ -288,16 +410,41 @@ void handle_pauses(InterruptOptions& interrupt, const JobJournal& journal, JobEv
     if (terminal) interrupt.resume_requested = enter_pressed;
 }
 
-// Streams `job` (its spans as the plan), keeping the journal and writing the events; returns
-// the exit status.
-int stream_job(const JobSpans& job, const MachineProfile& machine, StreamCommandOptions o,
+// What stream_job streams: the spans and what is known of the whole job.
+struct JobToStream {
+    SpanSupply& supply;
+    // The job held in memory (a resume, --plan-first): its spans file is written before the
+    // stream, its totals known. Null: a first job planned as it streams.
+    const JobSpans* spans = nullptr;
+    // The planner feeding `supply` and its tap (the spans file), for a job planned as it
+    // streams; `path` describes its pauses.
+    PlanningThread* planning = nullptr;
+    const StreamPlanTap* tap = nullptr;
+    const Path* path = nullptr;
+    std::size_t subpaths = 0;  // of the whole drawing
+};
+
+// After a stream that ended early (an interrupt, a device error) while planning still runs:
+// planning goes on to its end, for the journal's spans file that --resume needs, unless the
+// operator interrupts again.
+void finish_planning(PlanningThread& planning, bool journal) {
+    if (planning.finished() || !journal) return;
+    std::printf("planning      the rest of the job, for --resume (Ctrl-C: skip it; no resume then)\n");
+    std::fflush(stdout);
+    const int interrupts = g_interrupts.load();
+    planning.drain([interrupts] { return g_interrupts.load() == interrupts; });
+}
+
+// Streams `job`, keeping the journal and writing the events; returns the exit status.
+int stream_job(const JobToStream& job, const MachineProfile& machine, StreamCommandOptions o,
                JobJournal journal, const std::string& journal_path, const HeldJob* held,
                const EventChannel& channel) {
     const bool can = o.stream.target.rfind("can://", 0) == 0;
     if (!journal_path.empty()) {
         const std::string plan_file = std::filesystem::absolute(journal_path + ".plan").string();
         journal.plan_file = plan_file;
-        journal.plan_hash = write_job_spans(job, plan_file);
+        // A job planned as it streams has its spans file once planning ends (set_plan_hash).
+        journal.plan_hash = job.spans != nullptr ? write_job_spans(*job.spans, plan_file) : "";
         std::printf("journal       %s\n", journal_path.c_str());
     }
     JournalWriter writer(journal_path, journal);
@@ -305,33 +452,63 @@ int stream_job(const JobSpans& job, const MachineProfile& machine, StreamCommand
     o.stream.interrupt.hold_timeout_seconds = o.hold_timeout_seconds;
     std::signal(SIGINT, on_stream_signal);
     std::signal(SIGTERM, on_stream_signal);
-    JobEvents events(channel, job.plan, machine,
-                     {"stream", journal.drawing, o.stream.target, job.subpaths});
-    handle_pauses(o.stream.interrupt, journal, events, o.stream.target,
+    JobEvents events(channel, machine, {"stream", journal.drawing, o.stream.target, job.subpaths});
+    if (job.spans != nullptr) {
+        events.set_totals(job.spans->plan.total_ticks, job.spans->plan.spans.size(), job.spans->plan.pauses.size());
+    }
+    TrackedSupply supply(job.supply, job.spans, events, writer, job.spans == nullptr ? job.path : nullptr);
+    handle_pauses(o.stream.interrupt, writer, events, o.stream.target,
                   o.path.file != "-" && ::isatty(STDIN_FILENO) == 1);
+    // Once planning has ended: its totals go to the events, its spans file to the journal.
+    bool plan_recorded = job.planning == nullptr;
+    std::optional<DrawingTotals> totals;
+    if (job.spans != nullptr) totals = DrawingTotals{job.spans->drawing_spans, job.spans->subpaths, job.spans->drawing_ticks};
+    const auto record_plan = [&] {
+        if (plan_recorded || !job.planning->finished()) return;
+        plan_recorded = true;
+        if (const std::optional<PlanTotals> t = job.planning->totals()) {
+            events.set_totals(t->total_ticks, t->spans, t->pauses);
+            totals = DrawingTotals{t->spans, job.subpaths, t->total_ticks};
+            if (!journal_path.empty()) writer.set_plan_hash(job.tap->spans_hash());
+        }
+    };
     // Every status read goes to both records: the journal and the events.
     const StreamObserver observer = [&](const StreamTrace& t) {
+        record_plan();
+        if (t.job != 0 && t.status.last_completed + 1 >= t.job) supply.executed_before(t.status.last_completed + 1 - t.job);
         writer.trace(t);
         events.trace(t);
     };
     StreamEnd end;
     try {
-        end = can ? stream_over_can(job.plan, machine, o, observer, held, events)
-                  : stream_over_modbus(job.plan, machine, o, observer, held, events);
+        end = can ? stream_over_can(supply, machine, o, observer, held, events, job.planning)
+                  : stream_over_modbus(supply, machine, o, observer, held, events, job.planning);
     } catch (const std::exception& e) {
+        if (job.planning != nullptr) finish_planning(*job.planning, !journal_path.empty());
+        record_plan();
         writer.finish("failed", e.what());
         events.end("failed", e.what());
         throw;
     }
     // The handler stays: a late second Ctrl-C must not cut the report of where it stopped.
     if (end.interrupted == 0) {
+        record_plan();
         writer.finish("finished");
-        events.end("finished", "", job.plan.total_ticks);
+        events.end("finished", "", events.total_ticks());
         return 0;
     }
+    if (job.planning != nullptr) finish_planning(*job.planning, !journal_path.empty());
+    record_plan();
     writer.finish(end.interrupted == 1 ? "held" : "stopped");
     events.end(end.interrupted == 1 ? "held" : "stopped");
-    print_interrupted(end, job, end.job, machine, writer.path());
+    // The next span of the job that was not executed to its end (re-entry spans skipped).
+    std::optional<SpanPlace> next;
+    const DeviceSnapshot& s = end.status;
+    std::size_t index = 0;
+    if (end.job != 0 && s.last_completed + 1 >= end.job) index = s.last_completed + 1 - end.job;
+    for (next = supply.place(index); next && next->origin < 0; next = supply.place(++index)) {
+    }
+    print_interrupted(end, next, totals, machine, writer.path(), !writer.journal().plan_hash.empty());
     return kExitInterrupted;
 }
 
@@ -342,6 +519,11 @@ int run_resume(StreamCommandOptions o, const EventChannel& channel) {
     if (o.machine.empty()) o.machine = journal.machine;
     if (o.stream.target.empty()) o.stream.target = journal.target;
     const MachineProfile machine = load_machine_profile(o.machine);
+    if (journal.plan_hash.empty()) {
+        throw InputError(o.resume, {},
+                         "the job's plan was never complete: its stream ended before planning did, so there is "
+                         "nothing to go on from; stream the drawing again");
+    }
     const JobSpans job = read_job_spans(journal.plan_file, journal.plan_hash);
     if (journal.outcome == "finished") {
         std::printf("resume        %s: the job already ran to its end; nothing to do\n", o.resume.c_str());
@@ -400,7 +582,9 @@ int run_resume(StreamCommandOptions o, const EventChannel& channel) {
         std::printf("resume        the device holds job %u at span %u of %zu: streaming the rest, then resume\n",
                     journal.job, s.last_completed + 1 - journal.job, spans);
         const HeldJob held{journal.job, s.last_accepted};
-        return stream_job(job, machine, o, journal, o.resume, &held, channel);
+        PlanSupply supply(job.plan);
+        return stream_job({supply, &job, nullptr, nullptr, nullptr, job.subpaths}, machine, o, journal, o.resume,
+                          &held, channel);
     }
     if (s.state != static_cast<unsigned>(device::DeviceState::kIdle)) {
         throw StreamError(o.stream.target + ": device is " + device_state_name(s.state) +
@@ -427,23 +611,15 @@ int run_resume(StreamCommandOptions o, const EventChannel& channel) {
     next.job = 0;
     next.outcome = "streaming";
     next.error.clear();
-    return stream_job(resumed, machine, o, next, o.resume, nullptr, channel);
+    PlanSupply supply(resumed.plan);
+    return stream_job({supply, &resumed, nullptr, nullptr, nullptr, resumed.subpaths}, machine, o, next, o.resume,
+                      nullptr, channel);
 }
 
-// What comes after each programmed pause: the next layer's name where the layer changes,
-// else the subpath and where it is in the file.
+// What comes after each programmed pause of a plan in memory (pause_description of each).
 std::vector<std::string> pause_descriptions(const Path& path, const Plan& plan) {
     std::vector<std::string> out;
-    for (const PlanPause& p : plan.pauses) {
-        const Subpath& s = path.subpaths.at(p.subpath);
-        const bool new_layer = !path.layers.empty() && (p.subpath == 0 || path.subpaths[p.subpath - 1].layer != s.layer);
-        if (new_layer) {
-            out.push_back("layer \"" + path.layers.at(s.layer).name + "\"");
-        } else {
-            out.push_back("subpath " + std::to_string(p.subpath + 1) +
-                          (s.location.line > 0 ? " (line " + std::to_string(s.location.line) + ")" : ""));
-        }
-    }
+    for (const PlanPause& p : plan.pauses) out.push_back(pause_description(path, p.subpath));
     return out;
 }
 
@@ -469,6 +645,39 @@ int stream_cia402(const PlannedJob& planned, const std::string& url, const Event
         events.end("failed", e.what());
         throw;
     }
+}
+
+// Plans `job` on the planning thread and streams its spans as they come (docs/cli.md,
+// "Planning while streaming"): the first batch goes out once the first window is planned.
+int stream_while_planning(const PlannedJob& job, const StreamCommandOptions& o, const JobJournal& journal,
+                          const std::string& journal_path, const EventChannel& channel) {
+    const std::string spans_file =
+        journal_path.empty() ? "" : std::filesystem::absolute(journal_path + ".plan").string();
+    StreamPlanTap tap(job, o.path.file, spans_file);
+    VectorSegmentSource source(job.segments);
+    PlanningThread planning(source, job.machine, PlanOptions{},
+                            {&tap, [&tap](const PlanTotals& totals) { tap.finish(totals); }});
+    {
+        // Until the first window is planned; a Ctrl-C meanwhile ends the command, nothing sent.
+        ProgressBar bar("planning the first window");
+        while (planning.queued() == 0 && !planning.finished()) {
+            if (g_interrupts.load() > 0) {
+                planning.cancel();
+                bar.finish();
+                std::printf("interrupted   while planning: nothing was sent to the device\n");
+                return kExitInterrupted;
+            }
+            bar.update(planning.fraction());
+            std::this_thread::sleep_for(std::chrono::milliseconds(2));
+        }
+    }
+    if (planning.finished() && !planning.totals()) {
+        // Planning failed before a span was ready: its error, and nothing written or sent.
+        CoreSpan none;
+        (void)planning.take(none);
+    }
+    return stream_job({planning, nullptr, &planning, &tap, &job.path, job.path.subpaths.size()}, job.machine, o,
+                      journal, journal_path, nullptr, channel);
 }
 
 // The events' file, opened before anything is planned or sent (so a bad path costs nothing).
@@ -535,25 +744,31 @@ int run_stream(const StreamCommandOptions& o) {
             }
         }
     }
-    const PlannedJob planned = plan_job(path, o.machine, o.lead_in ? &rest_mm : nullptr);
-    if (g_interrupts.load() > 0) {
-        std::printf("interrupted   while planning: nothing was sent to the device\n");
-        return kExitInterrupted;
-    }
-    if (url.rfind("can://", 0) == 0 && url.find("protocol=cia402") != std::string::npos) {
-        std::signal(SIGINT, SIG_DFL);  // CiA 402 streams have no hold: Ctrl-C ends the process
-        std::signal(SIGTERM, SIG_DFL);
-        // CiA 402 drives take one setpoint per cycle from the host: no device queue to hold.
-        return stream_cia402(planned, url, channel, path_display_name(o.path.file));
-    }
     JobJournal journal;
-    journal.pauses = pause_descriptions(planned.path, planned.plan);
     journal.target = url;
     journal.machine = std::filesystem::absolute(o.machine).string();
     journal.drawing = path_display_name(o.path.file);
     const std::string journal_path = o.no_journal ? "" : (o.journal.empty() ? default_journal_path(o.path.file) : o.journal);
-    return stream_job(job_from_plan(planned.plan), planned.machine, o, journal, journal_path,
-                      nullptr, channel);
+    if (cia402 || o.plan_first) {
+        const PlannedJob planned = plan_job(path, o.machine, o.lead_in ? &rest_mm : nullptr);
+        if (g_interrupts.load() > 0) {
+            std::printf("interrupted   while planning: nothing was sent to the device\n");
+            return kExitInterrupted;
+        }
+        if (cia402) {
+            std::signal(SIGINT, SIG_DFL);  // CiA 402 streams have no hold: Ctrl-C ends the process
+            std::signal(SIGTERM, SIG_DFL);
+            // CiA 402 drives take one setpoint per cycle from the host: no device queue to hold.
+            return stream_cia402(planned, url, channel, path_display_name(o.path.file));
+        }
+        journal.pauses = pause_descriptions(planned.path, planned.plan);
+        const JobSpans job = job_from_plan(planned.plan);
+        PlanSupply supply(job.plan);
+        return stream_job({supply, &job, nullptr, nullptr, nullptr, job.subpaths}, planned.machine, o, journal,
+                          journal_path, nullptr, channel);
+    }
+    return stream_while_planning(prepare_job(path, o.machine, o.lead_in ? &rest_mm : nullptr), o, journal,
+                                 journal_path, channel);
 }
 
 }  // namespace pathstream::host

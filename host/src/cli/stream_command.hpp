@@ -20,6 +20,9 @@ struct StreamCommandOptions {
     double hold_timeout_seconds = 10;  ///< Ctrl-C: a hold not at rest by then becomes a stop
     std::string events;                ///< --events: NDJSON events to this file ("-": stdout)
     double events_rate = 5;            ///< --events-rate: progress events per second, at most
+    /// --plan-first: plan the whole job before anything is sent (the events' totals known
+    /// from job_start; memory grows with the job), instead of streaming while planning.
+    bool plan_first = false;
 };
 
 /// Exit status of a stream interrupted by Ctrl-C or SIGTERM: the device holds at rest or

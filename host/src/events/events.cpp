@@ -80,12 +80,37 @@ void NdjsonWriter::write(const EventJson& object) {
     std::fflush(file_);
 }
 
+JobEvents::JobEvents(const EventChannel& channel, const MachineProfile& machine, JobInfo info)
+    : channel_(channel), machine_(machine), info_(std::move(info)) {}
+
 JobEvents::JobEvents(const EventChannel& channel, const Plan& plan, const MachineProfile& machine,
                      JobInfo info)
-    : channel_(channel), plan_(plan), machine_(machine), info_(std::move(info)) {
-    prefix_.reserve(plan.spans.size() + 1);
-    prefix_.push_back(0);
-    for (const CoreSpan& s : plan.spans) prefix_.push_back(prefix_.back() + s.ticks);
+    : JobEvents(channel, machine, std::move(info)) {
+    for (const CoreSpan& s : plan.spans) add_span(s);
+    set_totals(plan.total_ticks, plan.spans.size(), plan.pauses.size());
+}
+
+void JobEvents::add_span(const CoreSpan& span) {
+    marks_.push_back({ticks_added_, span.subpath, span.pen_down});
+    ++spans_added_;
+    ticks_added_ += span.ticks;
+}
+
+void JobEvents::set_totals(std::uint64_t ticks, std::size_t spans, std::size_t pauses) {
+    total_ticks_ = ticks;
+    total_spans_ = spans;
+    total_pauses_ = pauses;
+}
+
+// Ticks of the spans before `span` (clamped to the spans added; never below the spans
+// already dropped, which the samples have passed).
+std::uint64_t JobEvents::ticks_before(std::size_t span) const {
+    if (span >= spans_added_) return ticks_added_;
+    return marks_.at(span - std::min(span, marks_base_)).ticks_before;
+}
+
+EventJson JobEvents::total_json(const std::optional<std::uint64_t>& value) const {
+    return value ? EventJson(*value) : EventJson(nullptr);
 }
 
 // Seconds since the command started, to the microsecond.
@@ -118,9 +143,10 @@ void JobEvents::start(std::optional<std::uint32_t> job) {
     e["drawing"] = info_.drawing;
     e["target"] = info_.target;
     e["job"] = job ? EventJson(*job) : EventJson(nullptr);
-    e["plan_ticks"] = plan_.total_ticks;
-    e["duration_s"] = static_cast<double>(plan_.total_ticks) / machine_.tick_hz;
-    e["spans"] = plan_.spans.size();
+    e["plan_ticks"] = total_json(total_ticks_);
+    e["duration_s"] = total_ticks_ ? EventJson(static_cast<double>(*total_ticks_) / machine_.tick_hz)
+                                   : EventJson(nullptr);
+    e["spans"] = total_json(total_spans_);
     e["subpaths"] = info_.subpaths;
     e["tick_hz"] = machine_.tick_hz;
     e["mm_per_lsb"] = machine_.mm_per_lsb;
@@ -201,10 +227,10 @@ void JobEvents::on_underruns(const JobSample& s) {
 // subpath and pen events for every span the device entered since the last sample, in order:
 // a sample may come after several short spans, and none of their changes may be lost.
 void JobEvents::enter_spans(const JobSample& s) {
-    if (plan_.spans.empty()) return;
-    const long long last = static_cast<long long>(std::min(s.next_span, plan_.spans.size() - 1));
+    if (spans_added_ == 0) return;
+    const long long last = static_cast<long long>(std::min(s.next_span, spans_added_ - 1));
     for (long long k = entered_ + 1; k <= last; ++k) {
-        const CoreSpan& span = plan_.spans[static_cast<std::size_t>(k)];
+        const SpanMark& span = marks_.at(static_cast<std::size_t>(k) - marks_base_);
         if (!subpath_ || *subpath_ != span.subpath) {
             subpath_ = span.subpath;
             EventJson e = event("subpath");
@@ -222,6 +248,11 @@ void JobEvents::enter_spans(const JobSample& s) {
         }
     }
     entered_ = std::max(entered_, last);
+    // The samples only go forward: spans before the last entered one are not looked at again.
+    while (entered_ > 0 && marks_base_ < static_cast<std::size_t>(entered_) && !marks_.empty()) {
+        marks_.pop_front();
+        ++marks_base_;
+    }
 }
 
 // A progress event at most progress_hz times a second (simulated seconds for sim).
@@ -230,12 +261,20 @@ void JobEvents::on_progress(const JobSample& s) {
     const double clock = s.sim_seconds ? e["sim_t"].get<double>() : e["t"].get<double>();
     if (last_progress_ && clock - *last_progress_ < 1.0 / channel_.progress_hz) return;
     last_progress_ = clock;
-    const double total = static_cast<double>(plan_.total_ticks);
-    const std::uint64_t left = plan_.total_ticks - std::min(s.ticks, plan_.total_ticks);
-    e["fraction"] = total > 0 ? rounded(static_cast<double>(s.ticks) / total, 1e6) : 1.0;
-    e["ticks"] = s.ticks;
-    e["plan_ticks"] = plan_.total_ticks;
-    e["eta_s"] = rounded(static_cast<double>(left) / machine_.tick_hz, 1e6);
+    if (total_ticks_) {
+        const double total = static_cast<double>(*total_ticks_);
+        const std::uint64_t left = *total_ticks_ - std::min(s.ticks, *total_ticks_);
+        e["fraction"] = total > 0 ? rounded(static_cast<double>(s.ticks) / total, 1e6) : 1.0;
+        e["ticks"] = s.ticks;
+        e["plan_ticks"] = *total_ticks_;
+        e["eta_s"] = rounded(static_cast<double>(left) / machine_.tick_hz, 1e6);
+    } else {
+        // Still planning: how far the job goes is not known yet.
+        e["fraction"] = nullptr;
+        e["ticks"] = s.ticks;
+        e["plan_ticks"] = nullptr;
+        e["eta_s"] = nullptr;
+    }
     e["queue_s"] = rounded(static_cast<double>(s.queued_ticks) / machine_.tick_hz, 1e6);
     e["queue_spans"] = s.queued_spans ? EventJson(*s.queued_spans) : EventJson(nullptr);
     e["position_mm"] = position_json(s.position);
@@ -253,7 +292,7 @@ EventJson JobEvents::position_json(const Lsb* position) const {
 void JobEvents::trace(const StreamTrace& t) {
     start(t.job);
     const DeviceSnapshot& d = t.status;
-    const std::size_t spans = plan_.spans.size();
+    const std::size_t spans = spans_added_;
     // Sequence numbers: span i of the job is sequence job + i.
     const auto index_after = [&](std::uint32_t sequence) -> std::size_t {
         if (t.job == 0 || sequence + 1 < t.job) return 0;
@@ -265,15 +304,15 @@ void JobEvents::trace(const StreamTrace& t) {
     s.next_span = index_after(d.last_completed);
     if (!have_base_) {
         // The device counts path ticks of every job: the job's tick 0 is where it stood then.
-        tick_base_ = d.ticks_executed - static_cast<std::uint32_t>(prefix_[s.next_span]);
-        first_ticks_ = prefix_[s.next_span];
+        tick_base_ = d.ticks_executed - static_cast<std::uint32_t>(ticks_before(s.next_span));
+        first_ticks_ = ticks_before(s.next_span);
         have_base_ = true;
     }
-    s.ticks = std::min<std::uint64_t>(static_cast<std::uint32_t>(d.ticks_executed - tick_base_),
-                                      plan_.total_ticks);
+    s.ticks = static_cast<std::uint32_t>(d.ticks_executed - tick_base_);
+    if (total_ticks_) s.ticks = std::min(s.ticks, *total_ticks_);
     // Running, or it ran between two reads (a short job, or an underrun's hold in between).
     s.started = d.state == kRunning || s.ticks > first_ticks_;
-    const std::uint64_t sent = prefix_[index_after(t.acknowledged)];
+    const std::uint64_t sent = ticks_before(index_after(t.acknowledged));
     s.queued_ticks = sent > s.ticks ? sent - s.ticks : 0;
     s.queued_spans = d.queued;
     s.underruns = d.underruns;
@@ -287,7 +326,7 @@ void JobEvents::pause(std::size_t index, const std::string& next) {
     start(job_);
     EventJson e = event("pause");
     e["pause"] = index + 1;
-    e["pauses"] = plan_.pauses.size();
+    e["pauses"] = total_json(total_pauses_);
     e["ticks"] = ticks_;
     e["next"] = next;
     emit(e);
@@ -302,7 +341,7 @@ void JobEvents::end(const std::string& outcome, const std::string& error,
     e["outcome"] = outcome;
     e["job"] = job_ ? EventJson(*job_) : EventJson(nullptr);
     e["ticks"] = ticks.value_or(ticks_);
-    e["plan_ticks"] = plan_.total_ticks;
+    e["plan_ticks"] = total_json(total_ticks_);
     e["wall_s"] = rounded(e["t"].get<double>() - start_t_, 1e6);
     if (!error.empty()) e["error"] = error;
     emit(e);

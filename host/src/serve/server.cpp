@@ -233,8 +233,10 @@ Server::Reply Server::run_job(const nlohmann::json& options) {
     Json p = plan_preview(args);  // throws for a drawing that cannot be planned: nothing starts
     std::vector<std::string> argv = {config_.executable, "stream", drawing_file()};
     argv.insert(argv.end(), args.begin(), args.end());
+    // --plan-first: the page shows the job's length from job_start on (web/app.js reads it
+    // there), which a stream planned as it goes only knows at its end.
     for (const std::string& a : {std::string("--machine=") + config_.machine_file, "--target=" + config_.target,
-                                 std::string("--lead-in"), std::string("--events=-"),
+                                 std::string("--lead-in"), std::string("--plan-first"), std::string("--events=-"),
                                  "--events-rate=" + number_text(config_.events_rate),
                                  "--journal=" + (fs::path(config_.state_dir) / "job.journal.json").string()}) {
         argv.push_back(a);

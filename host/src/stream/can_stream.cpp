@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <exception>
 #include <sstream>
 #include <stdexcept>
 #include <thread>
@@ -19,6 +20,7 @@
 #include "pathstream/device/wire_span.hpp"
 #include "pathstream/host/device_setup.hpp"
 #include "pathstream/host/wire_plan.hpp"
+#include "wire_feed.hpp"
 #include "pathstream/status.hpp"
 
 namespace pathstream::host {
@@ -29,8 +31,8 @@ using Clock = std::chrono::steady_clock;
 
 class CanStreamer {
 public:
-    CanStreamer(const Plan& plan, const MachineProfile& profile, hal::CanBus& bus, const CanStreamOptions& options)
-        : plan_(plan), profile_(profile), options_(options), node_(options.node), link_(bus, options, report_) {}
+    CanStreamer(SpanSupply& supply, const MachineProfile& profile, hal::CanBus& bus, const CanStreamOptions& options)
+        : feed_(supply), profile_(profile), options_(options), node_(options.node), link_(bus, options, report_) {}
 
     /// Identity and state checked, the device's rest position (LSB per axis, status E).
     std::vector<Lsb> rest_position() {
@@ -41,7 +43,7 @@ public:
         return std::vector<Lsb>(s.position, s.position + axes_);
     }
 
-    CanStreamReport run(const StreamProgress& progress) {
+    CanStreamReport run(const SupplyProgress& progress) {
         const auto wall_start = Clock::now();
         link_.mark_alive();
         encode_plan();
@@ -62,13 +64,14 @@ public:
             static_cast<std::uint64_t>(std::ceil(options_.lead_seconds * profile_.tick_hz));
         bool started = false;
         StreamInterrupt interrupt(options_.interrupt);
-        PauseWatch pauses(options_.interrupt, plan_.pauses);
+        PauseWatch pauses(options_.interrupt, feed_.pauses());
         while (true) {
+            if (supply_error_) interrupt.force_hold();
             const StreamInterrupt::Action action = interrupt.next_action(started);
             if (action == StreamInterrupt::Action::kHold) command(static_cast<std::uint8_t>(device::Command::kHold), true);
             if (action == StreamInterrupt::Action::kStop) command(static_cast<std::uint8_t>(device::Command::kStop), true);
             const std::uint64_t lead = queued_ticks(s, next);
-            if (!interrupt.active() && next < spans_.size() && free_slots_ > 0 && (lead < lead_target || !started)) {
+            if (!interrupt.active() && free_slots_ > 0 && (lead < lead_target || !started) && can_send(next)) {
                 send_batch(next);
                 // Flow control: never more than the device's free slots, as last reported.
                 s.last_accepted = acknowledged_;
@@ -79,7 +82,7 @@ public:
                 observe(s, interrupt);
                 check_running(s, started && !interrupt.stop_sent());
             }
-            if (!started && !interrupt.active() && (queued_ticks(s, next) >= lead_target || next == spans_.size())) {
+            if (!started && !interrupt.active() && (queued_ticks(s, next) >= lead_target || all_sent(next))) {
                 command(static_cast<std::uint8_t>(go), false);
                 started = true;
                 started_at_ = Clock::now();
@@ -92,9 +95,10 @@ public:
                 command(static_cast<std::uint8_t>(device::Command::kResume), true);
             }
             if (progress) {
-                progress(static_cast<double>(s.ticks_executed - start_ticks_) / static_cast<double>(plan_.total_ticks),
+                progress(static_cast<std::uint32_t>(s.ticks_executed - start_ticks_), feed_.total_ticks(),
                          static_cast<double>(queued_ticks(s, next)) / profile_.tick_hz);
             }
+            feed_.release_before(std::min(next, completed_count(s)));  // executed: never needed again
             // The plan is one job (its last span marks the end): done when the device reports
             // it finished, idle at its end point.
             if (job_finished(s)) break;
@@ -103,13 +107,24 @@ public:
                 break;
             }
         }
+        if (supply_error_) {
+            // The plan failed while the job ran: the device holds at rest (or never started);
+            // drop the rest of its queue, then report the plan's error.
+            command(static_cast<std::uint8_t>(device::Command::kStop), true);
+            const auto deadline = Clock::now() + std::chrono::duration<double>(options_.interrupt.hold_timeout_seconds);
+            while (s.state != static_cast<std::uint8_t>(device::DeviceState::kIdle) && Clock::now() < deadline) {
+                std::this_thread::sleep_for(std::chrono::milliseconds(options_.poll_interval_ms));
+                s = link_.request_status();
+            }
+            std::rethrow_exception(supply_error_);
+        }
         report_.final_status = snapshot_of(s);
         report_.ticks_executed = s.finished_job_ticks;
         report_.job = report_.interrupted != 0 ? base_ : s.finished_job;
         report_.last_completed = s.last_completed - base_ + 1;
         report_.duplicates = s.duplicates;
         report_.underruns = s.underruns;
-        for (unsigned a = 0; a < axes_; ++a) report_.final_position[a] = plan_.spans.back().control[a][1];
+        for (unsigned a = 0; a < axes_; ++a) report_.final_position[a] = feed_.end()[a];
         report_.wall_seconds = std::chrono::duration<double>(Clock::now() - wall_start).count();
         return report_;
     }
@@ -133,16 +148,16 @@ private:
         if ((s.flags & pc::kFlagConfigured) == 0) {
             fail("device lost its configuration: it restarted; resume from its rest instead");
         }
-        if (s.last_accepted < h.job || s.last_accepted - h.job >= spans_.size() || s.last_completed + 1 < h.job) {
+        if (s.last_accepted < h.job || !feed_.available(s.last_accepted - h.job) || s.last_completed + 1 < h.job) {
             std::ostringstream m;
-            m << "device holds spans up to " << s.last_accepted << ", not job " << h.job << " of " << spans_.size()
+            m << "device holds spans up to " << s.last_accepted << ", not job " << h.job << " of " << feed_.count()
               << " spans";
             fail(m.str());
         }
         base_ = h.job;
         acknowledged_ = s.last_accepted;
         const std::size_t completed = s.last_completed + 1 - h.job;
-        start_ticks_ = s.ticks_executed - static_cast<std::uint32_t>(prefix_ticks_[completed]);
+        start_ticks_ = s.ticks_executed - static_cast<std::uint32_t>(feed_.ticks_before(completed));
         return s.last_accepted + 1 - h.job;
     }
 
@@ -225,12 +240,13 @@ private:
     }
 
     void send_batch(std::size_t& next) {
-        const std::size_t max_spans =
-            std::min<std::size_t>({device::kMaxBatchSpans, free_slots_, spans_.size() - next});
+        const std::size_t max_spans = std::min<std::size_t>(device::kMaxBatchSpans, free_slots_);
         std::vector<std::uint8_t> payload;
         std::size_t count = 0;
-        while (count < max_spans && payload.size() + spans_[next + count].size() <= pc::kMaxTransferBytes) {
-            payload.insert(payload.end(), spans_[next + count].begin(), spans_[next + count].end());
+        while (count < max_spans && can_send(next + count) &&
+               payload.size() + feed_.bytes(next + count).size() <= pc::kMaxTransferBytes) {
+            const std::vector<std::uint8_t>& span = feed_.bytes(next + count);
+            payload.insert(payload.end(), span.begin(), span.end());
             ++count;
         }
         const std::uint32_t first = base_ + static_cast<std::uint32_t>(next);
@@ -272,17 +288,36 @@ private:
 
     // ---- plan and bookkeeping ------------------------------------------------------------
 
+    // The job's first span (planning may still run): where the device must rest.
     void encode_plan() {
-        WirePlan w = encode_wire_plan(plan_);
-        axes_ = w.axes;
-        for (unsigned a = 0; a < axes_; ++a) plan_start_[a] = w.start[a];
-        spans_ = std::move(w.spans);
-        prefix_ticks_ = std::move(w.prefix_ticks);
+        feed_.wait_first();
+        axes_ = feed_.axes();
+        for (unsigned a = 0; a < axes_; ++a) plan_start_[a] = feed_.start()[a];
+    }
+
+    // Span `next` can be sent now. An error of the supply (planning failed) ends the stream
+    // with a controlled stop: the error is kept for the end, the interrupt handling holds.
+    bool can_send(std::size_t next) {
+        if (supply_error_) return false;
+        try {
+            return feed_.available(next);
+        } catch (...) {
+            supply_error_ = std::current_exception();
+            return false;
+        }
+    }
+
+    // Every span of the job is sent (the supply ended and the last one is encoded).
+    bool all_sent(std::size_t next) const { return feed_.complete() && next == feed_.count(); }
+
+    // Spans of the job the device executed to their end.
+    std::size_t completed_count(const pc::Status3& s) const {
+        return s.last_completed >= base_ ? s.last_completed - base_ + 1 : 0;
     }
 
     std::uint64_t queued_ticks(const pc::Status3& s, std::size_t sent) const {
-        const std::size_t done = s.last_completed >= base_ ? s.last_completed - base_ + 1 : 0;
-        return done >= sent ? 0 : prefix_ticks_[sent] - prefix_ticks_[done];
+        const std::size_t done = completed_count(s);
+        return done >= sent ? 0 : feed_.ticks_before(sent) - feed_.ticks_before(done);
     }
 
     // A device whose sequence or tick count went backwards, or that lost its configuration,
@@ -321,15 +356,14 @@ private:
                s.finished_job == base_;
     }
 
-    const Plan& plan_;
+    WireFeed feed_;
+    std::exception_ptr supply_error_;  // the plan's error, rethrown once the device is stopped
     const MachineProfile& profile_;
     const CanStreamOptions& options_;
     std::uint8_t node_;
     CanStreamReport report_;
     CanLink link_;
     unsigned axes_ = 0;
-    std::vector<std::vector<std::uint8_t>> spans_;
-    std::vector<std::uint64_t> prefix_ticks_;
     std::uint32_t base_ = 1;
     std::uint32_t acknowledged_ = 0;
     std::uint32_t start_ticks_ = 0;
@@ -386,13 +420,21 @@ CanTarget parse_can_target(const std::string& url) {
 std::vector<Lsb> can_rest_position(const MachineProfile& profile, hal::CanBus& bus,
                                    const CanStreamOptions& options) {
     const Plan none;
-    CanStreamer s(none, profile, bus, options);
+    PlanSupply supply(none);
+    CanStreamer s(supply, profile, bus, options);
     return s.rest_position();
 }
 
 CanStreamReport stream_can(const Plan& plan, const MachineProfile& profile, hal::CanBus& bus,
                            const CanStreamOptions& options, const StreamProgress& progress) {
-    CanStreamer s(plan, profile, bus, options);
+    PlanSupply supply(plan);
+    CanStreamer s(supply, profile, bus, options);
+    return s.run(plan_progress(progress));
+}
+
+CanStreamReport stream_can(SpanSupply& supply, const MachineProfile& profile, hal::CanBus& bus,
+                           const CanStreamOptions& options, const SupplyProgress& progress) {
+    CanStreamer s(supply, profile, bus, options);
     return s.run(progress);
 }
 

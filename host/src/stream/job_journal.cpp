@@ -18,15 +18,26 @@ namespace {
 
 constexpr const char* kSpansHeader = "pathstream job spans 1";
 
-std::string fnv1a_hex(const std::string& text) {
+// FNV-1a 64 over bytes given in pieces.
+struct Fnv1a {
     std::uint64_t h = 1469598103934665603ull;
-    for (const unsigned char c : text) {
-        h ^= c;
-        h *= 1099511628211ull;
+    void add(const char* data, std::size_t size) {
+        for (std::size_t i = 0; i < size; ++i) {
+            h ^= static_cast<unsigned char>(data[i]);
+            h *= 1099511628211ull;
+        }
     }
-    char out[17];
-    std::snprintf(out, sizeof out, "%016llx", static_cast<unsigned long long>(h));
-    return out;
+    std::string hex() const {
+        char out[17];
+        std::snprintf(out, sizeof out, "%016llx", static_cast<unsigned long long>(h));
+        return out;
+    }
+};
+
+std::string fnv1a_hex(const std::string& text) {
+    Fnv1a f;
+    f.add(text.data(), text.size());
+    return f.hex();
 }
 
 // The core's plan_reentry for a run-time axis count.
@@ -189,26 +200,52 @@ JobSpans resume_from(const JobSpans& job, std::size_t first, const std::vector<L
     return out;
 }
 
-std::string write_job_spans(const JobSpans& job, const std::string& path) {
-    std::ostringstream text;
-    const std::size_t axes = job.plan.spans.empty() ? 0 : job.plan.spans.front().control.size();
-    text << kSpansHeader << '\n';
-    text << "axes " << axes << " spans " << job.plan.spans.size() << " drawing_spans "
-         << job.drawing_spans << " drawing_ticks " << job.drawing_ticks << " subpaths "
-         << job.subpaths << '\n';
-    for (std::size_t i = 0; i < job.plan.spans.size(); ++i) {
-        const CoreSpan& s = job.plan.spans[i];
-        text << job.origin[i] << ' ' << job.drawing_tick[i] << ' ' << s.subpath << ' '
-             << ((s.pen_down ? 1 : 0) | (s.pause_after ? 2 : 0)) << ' ' << s.ticks;
-        for (const auto& c : s.control)
-            text << ' ' << c[0] << ' ' << c[1] << ' ' << c[2] << ' ' << c[3];
-        text << '\n';
+JobSpansWriter::JobSpansWriter(std::string path) : path_(std::move(path)), body_(std::tmpfile()) {
+    if (body_ == nullptr) throw std::runtime_error(path_ + ": cannot make a temporary file for the job's spans");
+}
+
+JobSpansWriter::~JobSpansWriter() {
+    if (body_ != nullptr) std::fclose(body_);
+}
+
+void JobSpansWriter::add(const CoreSpan& s, std::int64_t origin, std::uint64_t drawing_tick) {
+    if (spans_ == 0) axes_ = s.control.size();
+    std::fprintf(body_, "%lld %llu %zu %d %u", static_cast<long long>(origin),
+                 static_cast<unsigned long long>(drawing_tick), s.subpath,
+                 (s.pen_down ? 1 : 0) | (s.pause_after ? 2 : 0), static_cast<unsigned>(s.ticks));
+    for (const auto& c : s.control) std::fprintf(body_, " %d %d %d %d", c[0], c[1], c[2], c[3]);
+    std::fputc('\n', body_);
+    ++spans_;
+}
+
+std::string JobSpansWriter::finish(std::size_t drawing_spans, std::uint64_t drawing_ticks, std::size_t subpaths) {
+    std::ostringstream header;
+    header << kSpansHeader << '\n';
+    header << "axes " << axes_ << " spans " << spans_ << " drawing_spans " << drawing_spans << " drawing_ticks "
+           << drawing_ticks << " subpaths " << subpaths << '\n';
+    const std::string head = header.str();
+    Fnv1a hash;
+    hash.add(head.data(), head.size());
+    AtomicFile f(path_);
+    f.stream() << head;
+    if (std::fflush(body_) != 0 || std::fseek(body_, 0, SEEK_SET) != 0) {
+        throw std::runtime_error(path_ + ": the job's spans could not be written back");
     }
-    const std::string contents = text.str();
-    AtomicFile f(path);
-    f.stream() << contents;
+    char buffer[1 << 16];
+    std::size_t n = 0;
+    while ((n = std::fread(buffer, 1, sizeof buffer, body_)) > 0) {
+        hash.add(buffer, n);
+        f.stream().write(buffer, static_cast<std::streamsize>(n));
+    }
+    if (std::ferror(body_)) throw std::runtime_error(path_ + ": the job's spans could not be read back");
     f.commit();
-    return fnv1a_hex(contents);
+    return hash.hex();
+}
+
+std::string write_job_spans(const JobSpans& job, const std::string& path) {
+    JobSpansWriter w(path);
+    for (std::size_t i = 0; i < job.plan.spans.size(); ++i) w.add(job.plan.spans[i], job.origin[i], job.drawing_tick[i]);
+    return w.finish(job.drawing_spans, job.drawing_ticks, job.subpaths);
 }
 
 JobSpans read_job_spans(const std::string& path, const std::string& expected_hash) {

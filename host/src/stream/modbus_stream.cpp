@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <exception>
 #include <sstream>
 #include <thread>
 #include <vector>
@@ -14,6 +15,7 @@
 #include "pathstream/device/wire_span.hpp"
 #include "pathstream/host/device_setup.hpp"
 #include "pathstream/host/wire_plan.hpp"
+#include "wire_feed.hpp"
 #include "modbus_link.hpp"
 #include "stream_interrupt.hpp"
 #include "pathstream/hal/modbus_client.hpp"
@@ -31,8 +33,8 @@ using DeviceStatus = DeviceSnapshot;
 
 class Streamer {
 public:
-    Streamer(const Plan& plan, const MachineProfile& profile, const StreamOptions& options)
-        : plan_(plan), profile_(profile), options_(options), link_(options) {}
+    Streamer(SpanSupply& supply, const MachineProfile& profile, const StreamOptions& options)
+        : feed_(supply), profile_(profile), options_(options), link_(options) {}
 
     /// Identity and state checked, the device's rest position (LSB per axis).
     std::vector<Lsb> rest_position() {
@@ -44,7 +46,7 @@ public:
         return std::vector<Lsb>(s.position, s.position + axes_);
     }
 
-    StreamReport run(const StreamProgress& progress) {
+    StreamReport run(const SupplyProgress& progress) {
         const auto wall_start = Clock::now();
         link_.mark_alive();
         last_batch_ok_ = Clock::now();
@@ -65,8 +67,9 @@ public:
         const std::uint64_t lead_target = static_cast<std::uint64_t>(std::ceil(options_.lead_seconds * profile_.tick_hz));
         bool started = false;
         StreamInterrupt interrupt(options_.interrupt);
-        PauseWatch pauses(options_.interrupt, plan_.pauses);
+        PauseWatch pauses(options_.interrupt, feed_.pauses());
         while (true) {
+            if (supply_error_) interrupt.force_hold();
             const StreamInterrupt::Action action = interrupt.next_action(started);
             if (action == StreamInterrupt::Action::kHold) command(device::Command::kHold, true);
             if (action == StreamInterrupt::Action::kStop) command(device::Command::kStop, true);
@@ -74,7 +77,7 @@ public:
             if (interrupt.active()) {
                 std::this_thread::sleep_for(std::chrono::milliseconds(options_.poll_interval_ms));
                 s = read_status();
-            } else if (next < spans_.size() && s.free_slots > 0 && (lead < lead_target || !started)) {
+            } else if (s.free_slots > 0 && (lead < lead_target || !started) && can_send(next)) {
                 s = send_batch(next, s.free_slots);
             } else {
                 bool predicted = false;
@@ -82,7 +85,7 @@ public:
                 // Woken when the lead should have drained to the target: send the next batch
                 // at once (its FC23 answer is the status) instead of polling first. The free
                 // slots known are a lower bound (slots only free up), so the batch fits.
-                if (predicted && next < spans_.size() && s.free_slots > 0) {
+                if (predicted && s.free_slots > 0 && can_send(next)) {
                     s = send_batch(next, s.free_slots);
                 } else {
                     s = read_status();
@@ -94,7 +97,7 @@ public:
             // Start once the lead is queued, or everything is, or the device's queue is full
             // (a lead longer than the queue holds would otherwise never start).
             if (!started && !interrupt.active() &&
-                (queued_ticks(s, next) >= lead_target || next == spans_.size() || s.free_slots == 0)) {
+                (queued_ticks(s, next) >= lead_target || all_sent(next) || s.free_slots == 0)) {
                 command(go, false);
                 started = true;
                 started_at_ = Clock::now();
@@ -107,7 +110,7 @@ public:
                 command(device::Command::kResume, true);
             }
             if (progress) {
-                progress(static_cast<double>(s.ticks_executed - start_ticks_) / static_cast<double>(plan_.total_ticks),
+                progress(static_cast<std::uint32_t>(s.ticks_executed - start_ticks_), feed_.total_ticks(),
                          static_cast<double>(queued_ticks(s, next)) / profile_.tick_hz);
             }
             // The plan is one job (its last span marks the end): done when the device reports
@@ -117,6 +120,17 @@ public:
                 report_.interrupted = interrupt.outcome();
                 break;
             }
+        }
+        if (supply_error_) {
+            // The plan failed while the job ran: the device holds at rest (or never started);
+            // drop the rest of its queue, then report the plan's error.
+            command(device::Command::kStop, true);
+            const auto deadline = Clock::now() + std::chrono::duration<double>(options_.interrupt.hold_timeout_seconds);
+            while (s.state != static_cast<std::uint16_t>(device::DeviceState::kIdle) && Clock::now() < deadline) {
+                std::this_thread::sleep_for(std::chrono::milliseconds(options_.poll_interval_ms));
+                s = read_status();
+            }
+            std::rethrow_exception(supply_error_);
         }
         report_.final_status = s;
         report_.ticks_executed = s.finished_job_ticks;
@@ -144,9 +158,9 @@ private:
         check_identity(s, false, device::DeviceState::kHolding);
         const HeldJob& h = *options_.held;
         if ((s.flags & 1u) == 0) fail("device lost its configuration: it restarted; resume from its rest instead");
-        if (s.last_accepted < h.job || s.last_accepted - h.job >= spans_.size() || s.last_completed + 1 < h.job) {
+        if (s.last_accepted < h.job || !feed_.available(s.last_accepted - h.job) || s.last_completed + 1 < h.job) {
             std::ostringstream m;
-            m << "device holds spans up to " << s.last_accepted << ", not job " << h.job << " of " << spans_.size()
+            m << "device holds spans up to " << s.last_accepted << ", not job " << h.job << " of " << feed_.count()
               << " spans";
             fail(m.str());
         }
@@ -154,7 +168,7 @@ private:
         acknowledged_ = s.last_accepted;
         configured_ = true;
         const std::size_t completed = s.last_completed + 1 - h.job;
-        start_ticks_ = s.ticks_executed - static_cast<std::uint32_t>(prefix_ticks_[completed]);
+        start_ticks_ = s.ticks_executed - static_cast<std::uint32_t>(feed_.ticks_before(completed));
         return s.last_accepted + 1 - h.job;
     }
 
@@ -271,28 +285,44 @@ private:
         }
     }
 
+    // The job's first span (planning may still run): where the device must rest.
     void encode_plan() {
-        WirePlan w = encode_wire_plan(plan_);
-        axes_ = w.axes;
-        for (unsigned a = 0; a < 8; ++a) start_[a] = w.start[a];
-        spans_ = std::move(w.spans);
-        prefix_ticks_ = std::move(w.prefix_ticks);
+        feed_.wait_first();
+        axes_ = feed_.axes();
+        for (unsigned a = 0; a < axes_; ++a) start_[a] = feed_.start()[a];
     }
+
+    // Span `next` can be sent now. An error of the supply (planning failed) ends the stream
+    // with a controlled stop: the error is kept for the end, the interrupt handling holds.
+    bool can_send(std::size_t next) {
+        if (supply_error_) return false;
+        try {
+            return feed_.available(next);
+        } catch (...) {
+            supply_error_ = std::current_exception();
+            return false;
+        }
+    }
+
+    // Every span of the job is sent (the supply ended and the last one is encoded).
+    bool all_sent(std::size_t next) const { return feed_.complete() && next == feed_.count(); }
 
     // Ticks of motion sent but not yet executed, exact: the device counts path ticks.
     std::uint64_t queued_ticks(const DeviceStatus& s, std::size_t sent) const {
         const std::uint64_t done = static_cast<std::uint32_t>(s.ticks_executed - start_ticks_);
-        return done >= prefix_ticks_[sent] ? 0 : prefix_ticks_[sent] - done;
+        const std::uint64_t sent_ticks = feed_.ticks_before(sent);
+        return done >= sent_ticks ? 0 : sent_ticks - done;
     }
 
     DeviceStatus send_batch(std::size_t& next, std::uint16_t free_slots) {
         const std::size_t max_bytes = 2u * mb::kMaxPayloadRegistersFc23;
-        const std::size_t max_spans =
-            std::min<std::size_t>({batch_limit_, free_slots, spans_.size() - next});
+        const std::size_t max_spans = std::min<std::size_t>(batch_limit_, free_slots);
         std::vector<std::uint8_t> payload;
         std::size_t count = 0;
-        while (count < max_spans && payload.size() + spans_[next + count].size() <= max_bytes) {
-            payload.insert(payload.end(), spans_[next + count].begin(), spans_[next + count].end());
+        while (count < max_spans && can_send(next + count) &&
+               payload.size() + feed_.bytes(next + count).size() <= max_bytes) {
+            const std::vector<std::uint8_t>& span = feed_.bytes(next + count);
+            payload.insert(payload.end(), span.begin(), span.end());
             ++count;
         }
         const std::uint32_t first = base_ + static_cast<std::uint32_t>(next);
@@ -351,6 +381,7 @@ private:
 
     void batch_done(std::size_t& next, std::size_t count, std::uint32_t last) {
         next += count;
+        feed_.release_before(next);  // acknowledged: never sent again
         ++report_.batches;
         report_.spans_sent += count;
         acknowledged_ = last;
@@ -442,14 +473,13 @@ private:
                s.finished_job == base_;
     }
 
-    const Plan& plan_;
+    WireFeed feed_;
+    std::exception_ptr supply_error_;  // the plan's error, rethrown once the device is stopped
     const MachineProfile& profile_;
     const StreamOptions& options_;
     ModbusLink link_;
     unsigned axes_ = 0;
     std::int32_t start_[8] = {};
-    std::vector<std::vector<std::uint8_t>> spans_;
-    std::vector<std::uint64_t> prefix_ticks_;
     std::uint32_t base_ = 1;
     std::uint32_t acknowledged_ = 0;
     std::uint32_t start_ticks_ = 0;
@@ -472,13 +502,21 @@ private:
 
 std::vector<Lsb> modbus_rest_position(const MachineProfile& profile, const StreamOptions& options) {
     const Plan none;
-    Streamer s(none, profile, options);
+    PlanSupply supply(none);
+    Streamer s(supply, profile, options);
     return s.rest_position();
 }
 
 StreamReport stream_modbus(const Plan& plan, const MachineProfile& profile, const StreamOptions& options,
                            const StreamProgress& progress) {
-    Streamer s(plan, profile, options);
+    PlanSupply supply(plan);
+    Streamer s(supply, profile, options);
+    return s.run(plan_progress(progress));
+}
+
+StreamReport stream_modbus(SpanSupply& supply, const MachineProfile& profile, const StreamOptions& options,
+                           const SupplyProgress& progress) {
+    Streamer s(supply, profile, options);
     return s.run(progress);
 }
 

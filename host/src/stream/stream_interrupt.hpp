@@ -23,7 +23,7 @@ public:
     /// instead when the device was never started: it drops what is queued and nothing moved),
     /// a stop at the second request or when the hold has not come to rest in time.
     Action next_action(bool started) {
-        const int request = options_.request != nullptr ? options_.request->load() : 0;
+        const int request = std::max(options_.request != nullptr ? options_.request->load() : 0, forced_);
         if (request >= 1 && !hold_sent_ && !stop_sent_) {
             if (!started) {
                 stop_sent_ = true;
@@ -41,6 +41,10 @@ public:
         }
         return Action::kNone;
     }
+
+    /// The stream cannot go on (its plan failed): from now on as if the operator asked for a
+    /// hold, which becomes a stop when the device never started or the hold times out.
+    void force_hold() { forced_ = std::max(forced_, 1); }
 
     /// An interrupt is under way: send no more spans, start and resume nothing.
     bool active() const { return hold_sent_ || stop_sent_; }
@@ -64,6 +68,7 @@ public:
 private:
     using Clock = std::chrono::steady_clock;
     const InterruptOptions& options_;
+    int forced_ = 0;
     bool hold_sent_ = false;
     bool stop_sent_ = false;
     Clock::time_point hold_at_;

@@ -76,4 +76,11 @@ std::vector<Lsb> can_rest_position(const MachineProfile& profile, hal::CanBus& b
 CanStreamReport stream_can(const Plan& plan, const MachineProfile& profile, hal::CanBus& bus,
                            const CanStreamOptions& options, const StreamProgress& progress = {});
 
+/// stream_can for spans that are still being planned, as stream_modbus's SpanSupply form:
+/// spans sent as the supply has them, the job's end marked once it ends, a supply error
+/// while the device runs brought to a controlled stop (hold, then stop) and rethrown.
+/// Memory: the spans the device has not executed, not the job.
+CanStreamReport stream_can(SpanSupply& supply, const MachineProfile& profile, hal::CanBus& bus,
+                           const CanStreamOptions& options, const SupplyProgress& progress = {});
+
 }  // namespace pathstream::host

@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cstdint>
 #include <cstdio>
+#include <deque>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -79,12 +80,23 @@ struct JobSample {
 };
 
 /// Turns samples of one job into events (docs/events.md) and keeps what the stream's progress
-/// bar shows. Written from one thread.
+/// bar shows. Written from one thread. Learns the job's spans as they are planned (add_span)
+/// and its totals once planning ends (set_totals); keeps only the spans not yet entered.
 class JobEvents {
 public:
-    /// `plan`: the job's spans; both must outlive this object.
+    /// A job whose spans come later (add_span); `channel` and `machine` must outlive this.
+    JobEvents(const EventChannel& channel, const MachineProfile& machine, JobInfo info);
+    /// A planned job: every span of `plan` added and its totals set.
     JobEvents(const EventChannel& channel, const Plan& plan, const MachineProfile& machine,
               JobInfo info);
+
+    /// The job's next span, in order (before the samples that show it executing). O(1).
+    void add_span(const CoreSpan& span);
+    /// The job's totals, once known: its ticks, spans and programmed pauses. Until then the
+    /// events carry null for them (and for a progress event's fraction and ETA).
+    void set_totals(std::uint64_t ticks, std::size_t spans, std::size_t pauses);
+    /// The job's ticks, when known.
+    std::optional<std::uint64_t> total_ticks() const { return total_ticks_; }
 
     /// job_start, once (later calls do nothing); `job`: the device's job id when known.
     void start(std::optional<std::uint32_t> job);
@@ -103,8 +115,6 @@ public:
 
     /// "subpath 2/5, pen down, running": the progress bar's detail (empty parts left out).
     std::string status_text() const;
-    /// Ticks before span i (prefix sums; size spans + 1).
-    const std::vector<std::uint64_t>& prefix_ticks() const { return prefix_; }
 
 private:
     double now() const;
@@ -116,12 +126,24 @@ private:
     void enter_spans(const JobSample& s);
     void on_progress(const JobSample& s);
     EventJson position_json(const Lsb* position) const;
+    std::uint64_t ticks_before(std::size_t span) const;
+    EventJson total_json(const std::optional<std::uint64_t>& value) const;
 
+    // What events need of a span not yet entered.
+    struct SpanMark {
+        std::uint64_t ticks_before = 0;
+        std::size_t subpath = 0;
+        bool pen_down = false;
+    };
     const EventChannel& channel_;
-    const Plan& plan_;
     const MachineProfile& machine_;
     JobInfo info_;
-    std::vector<std::uint64_t> prefix_;
+    std::deque<SpanMark> marks_;  ///< spans marks_base_ .. spans_added_ - 1
+    std::size_t marks_base_ = 0;
+    std::size_t spans_added_ = 0;
+    std::uint64_t ticks_added_ = 0;
+    std::optional<std::uint64_t> total_ticks_;
+    std::optional<std::uint64_t> total_spans_, total_pauses_;
     std::optional<double> sim_seconds_;  ///< of the last sample (sim events carry it)
     bool started_event_ = false, ended_ = false;
     double start_t_ = 0;

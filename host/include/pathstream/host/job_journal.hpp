@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <cstdio>
 #include <string>
 #include <vector>
 
@@ -38,7 +39,32 @@ JobSpans job_from_plan(const Plan& plan);
 JobSpans resume_from(const JobSpans& job, std::size_t first, const std::vector<Lsb>& rest,
                      const DeviceLimitsLsb& limits);
 
-/// Writes `job` to `path` atomically (one line per span); returns its FNV-1a 64 hash, hex.
+/// Writes a job's spans file as the spans come, holding none of them: the span lines go to an
+/// anonymous temporary file, and finish() writes `path` atomically (the header, which needs
+/// the totals, first). Nothing appears at `path` before finish(). One thread.
+class JobSpansWriter {
+public:
+    /// Throws std::runtime_error when no temporary file can be made.
+    explicit JobSpansWriter(std::string path);
+    ~JobSpansWriter();
+    JobSpansWriter(const JobSpansWriter&) = delete;
+    JobSpansWriter& operator=(const JobSpansWriter&) = delete;
+    /// The job's next span: its index in the drawing's plan (-1: a re-entry span) and the
+    /// drawing's tick at its start. O(axes).
+    void add(const CoreSpan& span, std::int64_t origin, std::uint64_t drawing_tick);
+    /// Writes the file (the whole drawing's spans, ticks and subpaths in the header); returns
+    /// its FNV-1a 64 hash, hex. Throws std::runtime_error when the file cannot be written.
+    std::string finish(std::size_t drawing_spans, std::uint64_t drawing_ticks, std::size_t subpaths);
+
+private:
+    std::string path_;
+    std::FILE* body_ = nullptr;
+    std::size_t spans_ = 0;
+    std::size_t axes_ = 0;
+};
+
+/// Writes `job` to `path` atomically (one line per span, with JobSpansWriter); returns its
+/// FNV-1a 64 hash, hex.
 std::string write_job_spans(const JobSpans& job, const std::string& path);
 /// Reads what write_job_spans wrote. Throws InputError (`path:line:col: what`) for anything
 /// else, and when the contents do not hash to `expected_hash` (unless it is empty).

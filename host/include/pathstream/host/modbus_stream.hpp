@@ -4,12 +4,14 @@
 #include <atomic>
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <stdexcept>
 #include <string>
 
 #include "pathstream/host/device_link.hpp"
 #include "pathstream/host/machine.hpp"
 #include "pathstream/host/plan.hpp"
+#include "pathstream/host/span_supply.hpp"
 
 namespace pathstream::host {
 
@@ -91,6 +93,19 @@ struct StreamReport {
 
 /// Progress: fraction of the plan's ticks executed, and the device queue's lead in seconds.
 using StreamProgress = std::function<void(double fraction, double queued_seconds)>;
+/// Progress of a stream whose plan may still be made: the job's path ticks executed, its
+/// ticks once known (nullopt while planning goes on), the device queue's lead in seconds.
+using SupplyProgress =
+    std::function<void(std::uint64_t ticks, std::optional<std::uint64_t> total_ticks, double queued_seconds)>;
+
+/// A StreamProgress fed from a SupplyProgress's figures (the total is known for a plan).
+/// Cheap to copy; calls `progress` from the streaming thread.
+inline SupplyProgress plan_progress(const StreamProgress& progress) {
+    if (!progress) return {};
+    return [progress](std::uint64_t ticks, std::optional<std::uint64_t> total, double queued) {
+        progress(total && *total > 0 ? static_cast<double>(ticks) / static_cast<double>(*total) : 0.0, queued);
+    };
+}
 
 /// Streams `plan` (Hermite spans, as plan_path makes them) to the device at options.target:
 /// checks its identity (magic, protocol version, axis count) and that it rests at the plan's
@@ -107,5 +122,14 @@ std::vector<Lsb> modbus_rest_position(const MachineProfile& profile, const Strea
 
 StreamReport stream_modbus(const Plan& plan, const MachineProfile& profile, const StreamOptions& options,
                            const StreamProgress& progress = {});
+
+/// stream_modbus for spans that are still being planned: sends what `supply` has as the
+/// device's queue drains, waits (polling the device) while it has nothing yet, and marks the
+/// job's end on the last span once the supply ends. The device starts once the lead is queued
+/// or the whole job is. An exception from the supply (the planning error) while the device
+/// runs brings it to a controlled stop first (a hold, at rest, then a stop that drops the
+/// queue), then is rethrown. Memory: the spans the device has not acknowledged, not the job.
+StreamReport stream_modbus(SpanSupply& supply, const MachineProfile& profile, const StreamOptions& options,
+                           const SupplyProgress& progress = {});
 
 }  // namespace pathstream::host
