@@ -313,7 +313,12 @@ TEST_CASE("home and pen over native CAN: status E reports each axis, status A th
     const std::unique_ptr<host::DeviceLink> link = host::open_can_link(host_bus, c);
     CHECK(link->command_with_arguments(device::kCommandHome, 2, 0, 0) == Status::kNoHoming);  // y: no switch
     REQUIRE(link->command_with_arguments(device::kCommandHome, 0, 0, 0) == Status::kOk);
-    host::DeviceSnapshot s = poll_until(*link, [](const host::DeviceSnapshot& x) { return !x.homing_runs(); });
+    // Until x's homing has ended: a status read before the device took the command shows no
+    // homing running either (a loaded machine saw that).
+    host::DeviceSnapshot s = poll_until(*link, [](const host::DeviceSnapshot& x) {
+        return !x.homing_runs() &&
+               (x.homing[0].state == AxisHoming::kHomed || x.homing[0].state == AxisHoming::kFailed);
+    });
     CHECK((s.homing[0].state == AxisHoming::kHomed && s.homing[1].state == AxisHoming::kNotHomed));
     CHECK((s.position[0] >= 950 && s.position[0] <= 1000 && s.position[1] == 15000));
     REQUIRE(link->command_with_arguments(device::kCommandPen, 0, 1, 0) == Status::kOk);
