@@ -66,12 +66,12 @@ public:
         StreamInterrupt interrupt(options_.interrupt);
         PauseWatch pauses(options_.interrupt, feed_.pauses());
         while (true) {
-            if (supply_error_) interrupt.force_hold();
+            if (feed_.error()) interrupt.force_hold();
             const StreamInterrupt::Action action = interrupt.next_action(started);
             if (action == StreamInterrupt::Action::kHold) command(static_cast<std::uint8_t>(device::Command::kHold), true);
             if (action == StreamInterrupt::Action::kStop) command(static_cast<std::uint8_t>(device::Command::kStop), true);
             const std::uint64_t lead = queued_ticks(s, next);
-            if (!interrupt.active() && free_slots_ > 0 && (lead < lead_target || !started) && can_send(next)) {
+            if (!interrupt.active() && free_slots_ > 0 && (lead < lead_target || !started) && feed_.sendable(next)) {
                 send_batch(next);
                 // Flow control: never more than the device's free slots, as last reported.
                 s.last_accepted = acknowledged_;
@@ -107,7 +107,7 @@ public:
                 break;
             }
         }
-        if (supply_error_) {
+        if (feed_.error()) {
             // The plan failed while the job ran: the device holds at rest (or never started);
             // drop the rest of its queue, then report the plan's error.
             command(static_cast<std::uint8_t>(device::Command::kStop), true);
@@ -116,7 +116,7 @@ public:
                 std::this_thread::sleep_for(std::chrono::milliseconds(options_.poll_interval_ms));
                 s = link_.request_status();
             }
-            std::rethrow_exception(supply_error_);
+            std::rethrow_exception(feed_.error());
         }
         report_.final_status = snapshot_of(s);
         report_.ticks_executed = s.finished_job_ticks;
@@ -243,7 +243,7 @@ private:
         const std::size_t max_spans = std::min<std::size_t>(device::kMaxBatchSpans, free_slots_);
         std::vector<std::uint8_t> payload;
         std::size_t count = 0;
-        while (count < max_spans && can_send(next + count) &&
+        while (count < max_spans && feed_.sendable(next + count) &&
                payload.size() + feed_.bytes(next + count).size() <= pc::kMaxTransferBytes) {
             const std::vector<std::uint8_t>& span = feed_.bytes(next + count);
             payload.insert(payload.end(), span.begin(), span.end());
@@ -293,18 +293,6 @@ private:
         feed_.wait_first();
         axes_ = feed_.axes();
         for (unsigned a = 0; a < axes_; ++a) plan_start_[a] = feed_.start()[a];
-    }
-
-    // Span `next` can be sent now. An error of the supply (planning failed) ends the stream
-    // with a controlled stop: the error is kept for the end, the interrupt handling holds.
-    bool can_send(std::size_t next) {
-        if (supply_error_) return false;
-        try {
-            return feed_.available(next);
-        } catch (...) {
-            supply_error_ = std::current_exception();
-            return false;
-        }
     }
 
     // Every span of the job is sent (the supply ended and the last one is encoded).
@@ -357,7 +345,6 @@ private:
     }
 
     WireFeed feed_;
-    std::exception_ptr supply_error_;  // the plan's error, rethrown once the device is stopped
     const MachineProfile& profile_;
     const CanStreamOptions& options_;
     std::uint8_t node_;

@@ -69,7 +69,7 @@ public:
         StreamInterrupt interrupt(options_.interrupt);
         PauseWatch pauses(options_.interrupt, feed_.pauses());
         while (true) {
-            if (supply_error_) interrupt.force_hold();
+            if (feed_.error()) interrupt.force_hold();
             const StreamInterrupt::Action action = interrupt.next_action(started);
             if (action == StreamInterrupt::Action::kHold) command(device::Command::kHold, true);
             if (action == StreamInterrupt::Action::kStop) command(device::Command::kStop, true);
@@ -77,7 +77,7 @@ public:
             if (interrupt.active()) {
                 std::this_thread::sleep_for(std::chrono::milliseconds(options_.poll_interval_ms));
                 s = read_status();
-            } else if (s.free_slots > 0 && (lead < lead_target || !started) && can_send(next)) {
+            } else if (s.free_slots > 0 && (lead < lead_target || !started) && feed_.sendable(next)) {
                 s = send_batch(next, s.free_slots);
             } else {
                 bool predicted = false;
@@ -85,7 +85,7 @@ public:
                 // Woken when the lead should have drained to the target: send the next batch
                 // at once (its FC23 answer is the status) instead of polling first. The free
                 // slots known are a lower bound (slots only free up), so the batch fits.
-                if (predicted && s.free_slots > 0 && can_send(next)) {
+                if (predicted && s.free_slots > 0 && feed_.sendable(next)) {
                     s = send_batch(next, s.free_slots);
                 } else {
                     s = read_status();
@@ -121,7 +121,7 @@ public:
                 break;
             }
         }
-        if (supply_error_) {
+        if (feed_.error()) {
             // The plan failed while the job ran: the device holds at rest (or never started);
             // drop the rest of its queue, then report the plan's error.
             command(device::Command::kStop, true);
@@ -130,7 +130,7 @@ public:
                 std::this_thread::sleep_for(std::chrono::milliseconds(options_.poll_interval_ms));
                 s = read_status();
             }
-            std::rethrow_exception(supply_error_);
+            std::rethrow_exception(feed_.error());
         }
         report_.final_status = s;
         report_.ticks_executed = s.finished_job_ticks;
@@ -292,18 +292,6 @@ private:
         for (unsigned a = 0; a < axes_; ++a) start_[a] = feed_.start()[a];
     }
 
-    // Span `next` can be sent now. An error of the supply (planning failed) ends the stream
-    // with a controlled stop: the error is kept for the end, the interrupt handling holds.
-    bool can_send(std::size_t next) {
-        if (supply_error_) return false;
-        try {
-            return feed_.available(next);
-        } catch (...) {
-            supply_error_ = std::current_exception();
-            return false;
-        }
-    }
-
     // Every span of the job is sent (the supply ended and the last one is encoded).
     bool all_sent(std::size_t next) const { return feed_.complete() && next == feed_.count(); }
 
@@ -319,7 +307,7 @@ private:
         const std::size_t max_spans = std::min<std::size_t>(batch_limit_, free_slots);
         std::vector<std::uint8_t> payload;
         std::size_t count = 0;
-        while (count < max_spans && can_send(next + count) &&
+        while (count < max_spans && feed_.sendable(next + count) &&
                payload.size() + feed_.bytes(next + count).size() <= max_bytes) {
             const std::vector<std::uint8_t>& span = feed_.bytes(next + count);
             payload.insert(payload.end(), span.begin(), span.end());
@@ -474,7 +462,6 @@ private:
     }
 
     WireFeed feed_;
-    std::exception_ptr supply_error_;  // the plan's error, rethrown once the device is stopped
     const MachineProfile& profile_;
     const StreamOptions& options_;
     ModbusLink link_;

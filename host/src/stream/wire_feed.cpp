@@ -26,6 +26,16 @@ void WireFeed::wait_first() {
     for (unsigned a = 0; a < axes_; ++a) start_[a] = pending_.control[a][0];
 }
 
+bool WireFeed::sendable(std::size_t index) {
+    if (error_) return false;
+    try {
+        return available(index);
+    } catch (...) {
+        error_ = std::current_exception();
+        return false;
+    }
+}
+
 bool WireFeed::available(std::size_t index) {
     while (index >= count() && !complete_) {
         if (!have_pending_) {

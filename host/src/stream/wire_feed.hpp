@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <deque>
+#include <exception>
 #include <optional>
 #include <vector>
 
@@ -31,6 +32,12 @@ public:
     /// Takes from the supply, without waiting, until span `index` is encoded; true when it
     /// is. Throws the supply's error and WireEncoder's.
     bool available(std::size_t index);
+    /// available(), except that an error of the supply or the encoder (planning failed) is
+    /// kept, not thrown: false from then on, and error() holds it, for a streamer that brings
+    /// the device to a stop before it reports the error.
+    bool sendable(std::size_t index);
+    /// The error sendable() kept, or null.
+    std::exception_ptr error() const { return error_; }
     /// Every span of the job was taken and encoded: count() is the job's span count.
     bool complete() const { return complete_; }
     /// Spans encoded so far.
@@ -69,6 +76,7 @@ private:
     std::size_t base_ = 0;  // index of entries_.front()
     std::uint64_t ticks_ = 0;
     std::vector<PlanPause> pauses_;
+    std::exception_ptr error_;
 };
 
 }  // namespace pathstream::host
