@@ -518,20 +518,27 @@ Subpath rotated_subpath(const Subpath& s, std::size_t shift) {
 }
 
 namespace {
+/// A subpath merge_touching may join at its ends: open, of a joinable basis, points valid.
+bool joinable(const Subpath& s) {
+    return !s.closed && joinable_basis(s.basis) && s.points.size() >= 2 && point_count_problem(s).empty();
+}
+
+/// The grid cell (side `cell`, mm) of an end point in the plane: ends within `cell` of each
+/// other lie in the same or neighbouring cells.
+using EndCell = std::pair<long long, long long>;
+EndCell end_cell(const PathPoint& p, double cell) {
+    const auto [x, y] = plane(p);
+    return EndCell{static_cast<long long>(std::floor(x / cell)), static_cast<long long>(std::floor(y / cell))};
+}
+
 /// Whether merge_touching would join anything: two joinable subpaths of one basis and feed
 /// with ends within `tolerance` (a superset of its joins: false means it joins none).
 bool any_touching(const Path& path, double tolerance) {
     if (tolerance < 0) return false;
     const auto& in = path.subpaths;
-    const auto joinable = [&](const Subpath& s) {
-        return !s.closed && joinable_basis(s.basis) && s.points.size() >= 2 && point_count_problem(s).empty();
-    };
     const double cell = std::max(tolerance, 1e-9);
-    using Key = std::pair<long long, long long>;
-    const auto key = [&](const PathPoint& p) {
-        const auto [x, y] = plane(p);
-        return Key{static_cast<long long>(std::floor(x / cell)), static_cast<long long>(std::floor(y / cell))};
-    };
+    using Key = EndCell;
+    const auto key = [&](const PathPoint& p) { return end_cell(p, cell); };
     std::map<Key, std::vector<std::pair<std::size_t, const PathPoint*>>> ends;
     for (std::size_t i = 0; i < in.size(); ++i) {
         if (!joinable(in[i])) continue;
@@ -564,16 +571,10 @@ Path merge_touching(const Path& path, double tolerance, std::size_t* merged) {
     }
     Path out = without_subpaths(path);
     const auto& in = path.subpaths;
-    const auto joinable = [&](const Subpath& s) {
-        return !s.closed && joinable_basis(s.basis) && s.points.size() >= 2 && point_count_problem(s).empty();
-    };
     // End points of joinable subpaths by grid cell (cell size: the tolerance).
     const double cell = std::max(tolerance, 1e-9);
-    using Key = std::pair<long long, long long>;
-    const auto key = [&](const PathPoint& p) {
-        const auto [x, y] = plane(p);
-        return Key{static_cast<long long>(std::floor(x / cell)), static_cast<long long>(std::floor(y / cell))};
-    };
+    using Key = EndCell;
+    const auto key = [&](const PathPoint& p) { return end_cell(p, cell); };
     std::map<Key, std::vector<std::pair<std::size_t, int>>> ends;  // subpath, 0 first / 1 last
     for (std::size_t i = 0; i < in.size(); ++i) {
         if (!joinable(in[i])) continue;
