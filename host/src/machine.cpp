@@ -57,7 +57,7 @@ public:
             const std::string ptr = "/axes/" + std::to_string(i);
             const json& a = axes[i];
             if (!a.is_object()) fail(ptr, "axis must be an object with name, max_velocity, max_acceleration");
-            only_keys(a, ptr, {"name", "max_velocity", "max_acceleration", "travel"});
+            only_keys(a, ptr, {"name", "max_velocity", "max_acceleration", "max_jerk", "travel"});
             for (const char* key : {"name", "max_velocity", "max_acceleration"}) {
                 if (!a.contains(key)) fail(ptr, std::string("axis has no \"") + key + "\"");
             }
@@ -70,6 +70,9 @@ public:
             limits.max_velocity = number(a["max_velocity"], ptr + "/max_velocity", "max_velocity", 0, 1e5, true, "mm/s");
             limits.max_acceleration =
                 number(a["max_acceleration"], ptr + "/max_acceleration", "max_acceleration", 0, 1e7, true, "mm/s^2");
+            if (a.contains("max_jerk")) {
+                limits.max_jerk = number(a["max_jerk"], ptr + "/max_jerk", "max_jerk", 0, 1e10, true, "mm/s^3");
+            }
             if (a.contains("travel")) {
                 const json& t = a["travel"];
                 if (!t.is_array() || t.size() != 2) fail(ptr + "/travel", "travel must be [min, max] in mm");
