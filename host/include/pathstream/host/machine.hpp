@@ -13,13 +13,13 @@ struct AxisLimits {
     std::string name;                  ///< "x", "y", ...
     double max_velocity = 0;           ///< mm/s, > 0
     double max_acceleration = 0;       ///< mm/s^2, > 0
-    /// mm/s^3, > 0 when the profile sets "max_jerk"; 0: no jerk limit (acceleration may step
-    /// at span joins as before).
-    double max_jerk = 0;
     /// The work area along this axis ("travel": [min, max] in mm, min < max): a job whose path
     /// leaves it is refused, and the device checks every span against it. Absent: no limit.
     bool has_travel = false;
     double travel_min = 0, travel_max = 0;
+    /// mm/s^3, > 0 when the profile sets "max_jerk"; 0: no jerk limit (acceleration may step
+    /// at span joins as before).
+    double max_jerk = 0;
 };
 
 /// One GPIO line of the profile's "gpio" object (docs/formats.md, docs/gpio.md).
