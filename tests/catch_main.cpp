@@ -1,3 +1,3 @@
-// Catch2 entry point for the host tests.
+// Catch2 entry point of the host, serve and hal test programs: compiled once, linked by each.
 #define CATCH_CONFIG_MAIN
 #include <catch2/catch.hpp>
