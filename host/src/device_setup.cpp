@@ -32,6 +32,9 @@ DeviceLimitsLsb device_limits(const MachineProfile& profile) {
         l.max_velocity.push_back(fit_u32(std::ceil(a.max_velocity / profile.mm_per_lsb), "axis " + a.name + " max_velocity"));
         l.max_acceleration.push_back(
             fit_u32(std::ceil(a.max_acceleration / profile.mm_per_lsb), "axis " + a.name + " max_acceleration"));
+        l.max_jerk.push_back(a.max_jerk > 0 ? fit_u32(std::ceil(a.max_jerk / profile.mm_per_lsb / device::kJerkUnitLsb),
+                                                      "axis " + a.name + " max_jerk (in 100 LSB/s^3)")
+                                            : 0);
         const double range = static_cast<double>(kMaxPositionLsb);
         double low = -range, high = range;
         if (a.has_travel) {

@@ -97,6 +97,7 @@ std::string config_values() {
     for (int a = 0; a < 2; ++a) v << ' ' << (250000 >> 16) << ' ' << (250000 & 0xFFFF) << ' ' << (3000000 >> 16) << ' '
                                   << (3000000 & 0xFFFF);
     v << " 0 0 0 0 0 0 0 0";  // travel of both axes: 0, 0 = no soft limits
+    v << " 0 0 0 0";          // max jerk of both axes: 0 = no jerk limit
     return v.str();
 }
 
@@ -149,7 +150,7 @@ void check_device(const std::string& program, const std::string& link) {
     const std::string written =
         mbpoll(program, link + " -r " + std::to_string(mb::kConfig + 1) + " -t 4 -1 " + config_values());
     INFO("mbpoll output:\n" << written);
-    CHECK_THAT(written, Contains("Written 26 references"));
+    CHECK_THAT(written, Contains("Written 30 references"));
     const auto hz = values(mbpoll(program, link + " -r " + std::to_string(mb::kConfig + 1) + " -c 2 -t 4:int -B -1"));
     CHECK(hz.at(mb::kConfig + 1) == 1000);
     const auto flags = values(mbpoll(program, link + " -r " + std::to_string(st::kFlags + 1) + " -c 1 -t 3 -1"));

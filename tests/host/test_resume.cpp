@@ -413,7 +413,7 @@ TEST_CASE("ctl's link: status and every command over Modbus TCP, refusals by nam
     ModbusDeviceThread dt(start_of(job.plan), 1.0, &limits);
     const std::unique_ptr<host::DeviceLink> link = host::open_device_link(dt.target(), {});
     host::DeviceSnapshot s = link->status();
-    CHECK((s.magic == 0x5053 && s.version == 4 && s.axes == 2 && s.state == 0));
+    CHECK((s.magic == 0x5053 && s.version == 5 && s.axes == 2 && s.state == 0));
     CHECK((s.position[0] == start_of(job.plan)[0] && s.position[1] == start_of(job.plan)[1]));
     CHECK(link->command(Command::kHold) == Status::kWrongState);  // idle: nothing to hold
     CHECK(link->command(Command::kResume) == Status::kWrongState);

@@ -32,6 +32,8 @@ enum class [[nodiscard]] Status : std::uint8_t{
     kNoHoming = 21,               ///< home: no homing switch for a requested axis
     kOutsideTravel = 22,          ///< the span could leave an axis's travel (its soft limits)
     kPauseMoving = 23,            ///< a span with a pause after it must end at rest
+    kJerkLimit = 24,              ///< the span's exact cubic has more jerk than an axis may
+    kAccelerationStep = 25,       ///< acceleration steps at a join by more than one tick of jerk
 };
 
 /// Short stable name of a status, for logs and host messages. Never null.
@@ -68,6 +70,10 @@ constexpr const char* status_name(Status s) {
             return "span leaves an axis's travel (soft limits)";
         case Status::kPauseMoving:
             return "a span followed by a pause must end at rest";
+        case Status::kJerkLimit:
+            return "span exceeds an axis jerk limit";
+        case Status::kAccelerationStep:
+            return "acceleration steps at a join by more than one tick of jerk";
     }
     return "unknown status";
 }

@@ -96,4 +96,56 @@ Status check_join(std::int32_t start_tangent, std::uint32_t ticks,
     return lhs <= rhs ? Status::kOk : Status::kVelocityStep;
 }
 
+TickAcceleration start_acceleration(const TickCubic& cubic, const SpanTiming& timing) {
+    // p''(0) = 2b / s per u^2, over n^2 per tick^2; s n^2 = D / n.
+    return TickAcceleration{2 * cubic.b, timing.denominator / timing.ticks};
+}
+
+TickAcceleration end_acceleration(const TickCubic& cubic, const SpanTiming& timing) {
+    return TickAcceleration{6 * cubic.a + 2 * cubic.b, timing.denominator / timing.ticks};
+}
+
+TickAcceleration hermite_end_acceleration(std::int32_t chord, std::int32_t start_tangent,
+                                          std::int32_t end_tangent, std::uint32_t n) {
+    // |6C| <= 1.5 2^30, |2 T0 + 4 T1| <= 6 2^29: the numerator < 2^33.
+    const std::int64_t nn = n;
+    return TickAcceleration{-6 * std::int64_t{chord} + 2 * std::int64_t{start_tangent} +
+                                4 * std::int64_t{end_tangent},
+                            static_cast<std::uint64_t>(nn * nn)};
+}
+
+Status check_axis_jerk(const TickCubic& cubic, const SpanTiming& timing, const AxisLimits& limits,
+                       std::uint32_t tick_hz) {
+    if (limits.max_jerk == 0) return Status::kOk;
+    // Jerk 6a / D LSB/tick^3, times hz^3 per s^3: |6a| hz^3 (< 2^36 2^50) against J D
+    // (< 2^39 2^51).
+    const std::uint64_t hz = tick_hz;
+    const Int128 lhs = multiply_unsigned(magnitude64(6 * cubic.a), hz * hz * hz);
+    const Int128 rhs = multiply_unsigned(static_cast<std::uint64_t>(limits.max_jerk) * kJerkUnitLsb,
+                                         timing.denominator);
+    return lhs <= rhs ? Status::kOk : Status::kJerkLimit;
+}
+
+Status check_acceleration_step(const TickAcceleration& start, const TickAcceleration& previous_end,
+                               const AxisLimits& limits, std::uint32_t tick_hz) {
+    if (limits.max_jerk == 0) return Status::kOk;
+    // |N/Q - N'/Q'| <= J / hz^3, multiplied out: |N Q' - N' Q| hz^3 <= J Q Q'. |N| < 2^36 and
+    // Q < 2^35 (docs/exact-math.md): the difference < 2^72, times hz^3 (< 2^50) < 2^122; the
+    // bound J Q Q' < 2^39 2^70.
+    const Int128 difference =
+        Int128::from(start.numerator) * static_cast<std::int64_t>(previous_end.denominator) -
+        Int128::from(previous_end.numerator) * static_cast<std::int64_t>(start.denominator);
+    const std::int64_t hz = tick_hz;
+    const Int128 lhs = magnitude(difference) * (hz * hz * hz);
+    const Int128 rhs = multiply_unsigned(static_cast<std::uint64_t>(limits.max_jerk) * kJerkUnitLsb,
+                                         start.denominator) *
+                       static_cast<std::int64_t>(previous_end.denominator);
+    return lhs <= rhs ? Status::kOk : Status::kAccelerationStep;
+}
+
+Status check_end_at_rest(const TickAcceleration& end, const AxisLimits& limits,
+                         std::uint32_t tick_hz) {
+    return check_acceleration_step(TickAcceleration{}, end, limits, tick_hz);
+}
+
 }  // namespace pathstream::device

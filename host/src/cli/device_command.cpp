@@ -234,6 +234,9 @@ Machine prepare_machine(sim::SimulatedMotionDevice& device, const DeviceCommandO
     for (std::size_t a = 0; a < profile->axes.size(); ++a) {
         text += ", " + profile->axes[a].name + " " + std::to_string(limits.max_velocity[a]) +
                 " LSB/s " + std::to_string(limits.max_acceleration[a]) + " LSB/s^2";
+        if (limits.max_jerk[a] != 0) {
+            text += " " + std::to_string(std::uint64_t{limits.max_jerk[a]} * device::kJerkUnitLsb) + " LSB/s^3";
+        }
     }
     log("configured", text, {{"tick_hz", limits.tick_hz}});
     if (profile->gpio.present && !o.no_gpio) {

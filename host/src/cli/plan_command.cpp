@@ -94,6 +94,22 @@ void print_plan_summary(const PlannedJob& job, std::ostream& out) {
             static_cast<long long>(c.axis_max_second_difference.at(a)),
             c.axis_acceleration_limit_lsb.at(a));
         out << line;
+        // Jerk: the spans' constant jerk and the largest acceleration step at a join, against
+        // J and one tick of J when the profile sets max_jerk.
+        if (c.axis_jerk_limit_lsb.at(a) > 0) {
+            std::snprintf(line, sizeof line,
+                          "  axis %s: exact cubic jerk %.2f %% of max jerk (%.4g mm/s^3), join acceleration step "
+                          "%.2f %% of one tick of it\n",
+                          job.machine.axes[a].name.c_str(), 100 * c.axis_jerk_fraction_exact.at(a), c.axis_jerk.at(a),
+                          100 * c.axis_join_acceleration_step_fraction.at(a));
+        } else {
+            std::snprintf(line, sizeof line,
+                          "  axis %s: exact cubic jerk %.4g mm/s^3 (%.4g LSB/tick^3), join acceleration step "
+                          "%.4g mm/s^2 (no max_jerk)\n",
+                          job.machine.axes[a].name.c_str(), c.axis_jerk.at(a), c.axis_jerk_lsb.at(a),
+                          c.axis_join_acceleration_step.at(a));
+        }
+        out << line;
     }
     std::snprintf(line, sizeof line, "  every tick checked (%llu): %s%s\n", static_cast<unsigned long long>(c.ticks_checked),
                   c.within_limits ? "within limits" : "LIMITS EXCEEDED",
@@ -114,7 +130,18 @@ nlohmann::ordered_json plan_axes_json(const PlannedJob& job) {
             {"max_step_lsb_per_tick", c.axis_max_step.at(a)},
             {"velocity_limit_lsb_per_tick", c.axis_velocity_limit_lsb.at(a)},
             {"max_second_difference_lsb_per_tick2", c.axis_max_second_difference.at(a)},
-            {"acceleration_limit_lsb_per_tick2", c.axis_acceleration_limit_lsb.at(a)}};
+            {"acceleration_limit_lsb_per_tick2", c.axis_acceleration_limit_lsb.at(a)},
+            {"jerk_lsb_per_tick3", c.axis_jerk_lsb.at(a)},
+            {"jerk_mm_per_s3", c.axis_jerk.at(a)},
+            {"join_acceleration_step_lsb_per_tick2", c.axis_join_acceleration_step_lsb.at(a)},
+            {"join_acceleration_step_mm_per_s2", c.axis_join_acceleration_step.at(a)}};
+        // Only with a max_jerk: the limit and the fractions of it.
+        if (c.axis_jerk_limit_lsb.at(a) > 0) {
+            auto& x = axes[job.machine.axes[a].name];
+            x["jerk_limit_lsb_per_tick3"] = c.axis_jerk_limit_lsb.at(a);
+            x["jerk_fraction_cubic"] = c.axis_jerk_fraction_exact.at(a);
+            x["join_acceleration_step_fraction"] = c.axis_join_acceleration_step_fraction.at(a);
+        }
     }
     return axes;
 }
@@ -232,6 +259,12 @@ int run_plan(const PlanCommandOptions& o) {
         print_plan_summary(job, text);
     }
     if (failed) {
+        // The planner does not plan within a jerk limit yet: say so rather than "a bug".
+        const PlanCheck& c = job.check;
+        if (c.jerk_limited && (c.max_jerk_fraction_exact > 1 || c.max_join_acceleration_step_fraction > 1)) {
+            throw PlanError("the plan exceeds the machine's max_jerk (the planner does not plan within a jerk "
+                            "limit yet): see the summary above");
+        }
         throw PlanError("the plan failed its per-tick check (a planner bug): see the summary above");
     }
     if (o.json) std::cout << plan_summary_json(o, job).dump(2) << '\n';

@@ -130,6 +130,18 @@ void limits_json(const PlannedJob& job, const plot::ReportFigures& f, Json& j) {
     j["acceleration_fraction_cubic"] = f.acceleration_fraction_cubic;
     j["velocity_fraction_setpoints"] = c.max_velocity_fraction;
     j["acceleration_fraction_setpoints"] = c.max_acceleration_fraction;
+    // Jerk figures (docs/planner.md, section 7): fractions only with a max_jerk, else null.
+    j["jerk_limited"] = c.jerk_limited;
+    j["jerk_fraction_cubic"] = c.jerk_limited ? Json(c.max_jerk_fraction_exact) : Json(nullptr);
+    j["join_acceleration_step_fraction"] =
+        c.jerk_limited ? Json(c.max_join_acceleration_step_fraction) : Json(nullptr);
+    Json jerk = Json::object();
+    for (std::size_t a = 0; a < job.machine.axes.size() && a < c.axis_jerk.size(); ++a) {
+        jerk[job.machine.axes[a].name] = {{"jerk_mm_per_s3", c.axis_jerk[a]},
+                                          {"jerk_lsb_per_tick3", c.axis_jerk_lsb[a]},
+                                          {"join_acceleration_step_mm_per_s2", c.axis_join_acceleration_step[a]}};
+    }
+    j["jerk_axes"] = jerk;
     j["executed_window_ticks"] = f.executed_half_window;
     j["executed_acceleration_noise_mm_per_s2"] = f.executed_acceleration_noise;
     Json axes = Json::object();
@@ -282,6 +294,12 @@ int run_sim(const SimCommandOptions& o) {
         return 4;
     }
     if (failed) {
+        // The planner does not plan within a jerk limit yet: say so rather than "a bug".
+        const PlanCheck& c = job.check;
+        if (c.jerk_limited && (c.max_jerk_fraction_exact > 1 || c.max_join_acceleration_step_fraction > 1)) {
+            throw PlanError("the plan exceeds the machine's max_jerk (the planner does not plan within a jerk "
+                            "limit yet): see the report above");
+        }
         throw PlanError("the plan failed its per-tick check (a planner bug): see the report above");
     }
     if (o.json) std::cout << document.dump(2) << '\n';

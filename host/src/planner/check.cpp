@@ -17,6 +17,7 @@
 #include <sstream>
 
 #include "internal.hpp"
+#include "jerk_meter.hpp"
 #include "pathstream/setpoint_stream.hpp"
 #include "pathstream/span.hpp"
 
@@ -339,9 +340,15 @@ PlanCheck TickChecker::finish() {
 PlanCheck check_plan_impl(const Plan& plan, const std::vector<BezierSegment>& segments,
                           const MachineProfile& profile, bool deviation) {
     TickChecker checker(profile, &segments, deviation);
+    JerkMeter jerk(profile);
     for (const PenEvent& e : plan.pen) checker.pen(e);
-    for (const CoreSpan& s : plan.spans) checker.span(s);
-    return checker.finish();
+    for (const CoreSpan& s : plan.spans) {
+        checker.span(s);
+        jerk.span(s);
+    }
+    PlanCheck out = checker.finish();
+    jerk.finish(out);
+    return out;
 }
 }  // namespace planner_detail
 
@@ -354,12 +361,14 @@ PlanCheck check_plan(const Plan& plan, const std::vector<BezierSegment>& segment
 namespace pathstream::host {
 
 PlanChecker::PlanChecker(const std::vector<BezierSegment>& segments, const MachineProfile& profile)
-    : impl_(std::make_unique<planner_detail::TickChecker>(profile, &segments, true)) {}
+    : impl_(std::make_unique<planner_detail::TickChecker>(profile, &segments, true)),
+      jerk_(std::make_unique<planner_detail::JerkMeter>(profile)) {}
 
 PlanChecker::~PlanChecker() = default;
 
 void PlanChecker::span(const CoreSpan& s) {
     impl_->span(s);
+    jerk_->span(s);
     ++spans_;
     ticks_ += s.ticks;
 }
@@ -373,6 +382,10 @@ void PlanChecker::on_tick(std::function<void(std::uint64_t, const std::int64_t*,
     impl_->observe(std::move(observer));
 }
 
-PlanCheck PlanChecker::finish() { return impl_->finish(); }
+PlanCheck PlanChecker::finish() {
+    PlanCheck out = impl_->finish();
+    jerk_->finish(out);
+    return out;
+}
 
 }  // namespace pathstream::host

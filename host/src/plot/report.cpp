@@ -171,6 +171,17 @@ std::string text_report(const Plan& plan, const PlanCheck* check, const MachineP
           << (check->within_limits ? "within the axis limits" : "LIMITS EXCEEDED")
           << " (exact cubic peak: v " << percent2(f.velocity_fraction_cubic) << " %, a "
           << percent2(f.acceleration_fraction_cubic) << " %)\n";
+        // Jerk next to it: against max_jerk when the profile sets one, else in mm/s^3.
+        if (check->jerk_limited) {
+            o << "  jerk       cubic " << percent2(check->max_jerk_fraction_exact) << " % of max jerk, join step "
+              << percent2(check->max_join_acceleration_step_fraction) << " % of one tick of it\n";
+        } else if (!check->axis_jerk.empty()) {
+            o << "  jerk       cubic peak " << fmt("%.4g", *std::max_element(check->axis_jerk.begin(), check->axis_jerk.end()))
+              << " mm/s^3, join step "
+              << fmt("%.4g", *std::max_element(check->axis_join_acceleration_step.begin(),
+                                               check->axis_join_acceleration_step.end()))
+              << " mm/s^2 (no max_jerk)\n";
+        }
         if (check->max_velocity_fraction > 1 || check->max_acceleration_fraction > 1) {
             o << "             setpoint differences over limit + rounding (v "
               << percent(check->max_velocity_fraction) << " %, a "

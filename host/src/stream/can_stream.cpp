@@ -218,6 +218,8 @@ private:
                                                static_cast<std::uint32_t>(l.min_position[a])));
             frames.push_back(pc::encode_config(node_, pc::config_item_max_position(a), static_cast<std::uint8_t>(axes_),
                                                static_cast<std::uint32_t>(l.max_position[a])));
+            frames.push_back(pc::encode_config(node_, pc::config_item_jerk(a), static_cast<std::uint8_t>(axes_),
+                                               l.max_jerk[a]));
         }
         frames.push_back(pc::encode_config(node_, pc::kConfigItemPenDown,
                                            static_cast<std::uint8_t>(axes_), l.pen_down_ticks));

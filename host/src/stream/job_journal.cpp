@@ -53,6 +53,7 @@ Status reentry_for(const std::vector<Lsb>& from, const std::vector<std::int32_t>
     for (unsigned a = 0; a < Axes; ++a) {
         limits.axis[a].max_velocity = l.max_velocity[a];
         limits.axis[a].max_acceleration = l.max_acceleration[a];
+        if (l.max_jerk.size() == Axes) limits.axis[a].max_jerk = l.max_jerk[a];
         f[a] = from[a];
         t[a] = to[a];
         g[a] = tangent[a];

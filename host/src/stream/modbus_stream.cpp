@@ -255,6 +255,9 @@ private:
             r[t + 1] = static_cast<std::uint16_t>(lo & 0xFFFFu);
             r[t + 2] = static_cast<std::uint16_t>(hi >> 16);
             r[t + 3] = static_cast<std::uint16_t>(hi & 0xFFFFu);
+            const std::uint16_t j = mb::config_jerk_register(axes_, a);
+            r[j] = static_cast<std::uint16_t>(l.max_jerk[a] >> 16);
+            r[j + 1] = static_cast<std::uint16_t>(l.max_jerk[a] & 0xFFFFu);
         }
         try {
             link_.transact([&] { link_.client().write_registers(mb::kConfig, r); });

@@ -176,15 +176,18 @@ private:
         const std::uint32_t value = get(f, kConfigSignals[2]);
         if (axes != Axes) return ack(kAckConfig, static_cast<std::uint8_t>(Status::kBadLimits), item, send);
         const bool travel_item = item >= config_item_min_position(0) && item < config_item_min_position(Axes);
-        if (item > 2 * Axes && item != kConfigItemPenDown && !travel_item) {
+        const bool jerk_item = item >= config_item_jerk(0) && item < config_item_jerk(Axes);
+        if (item > 2 * Axes && item != kConfigItemPenDown && !travel_item && !jerk_item) {
             return ack(kAckConfig, kResultBadFrame, item, send);
         }
         if (item == 0) {
             config_seen_ = 0;
-            pending_ = MotionLimits<Axes>{};  // travel items are optional: the whole range
+            pending_ = MotionLimits<Axes>{};  // travel and jerk items are optional: none
             pending_.tick_hz = value;
         } else if (item == kConfigItemPenDown) {
             pending_.pen_down_ticks = value;
+        } else if (jerk_item) {
+            pending_.axis[item - config_item_jerk(0)].max_jerk = value;
         } else if (travel_item) {
             const unsigned axis = (item - config_item_min_position(0)) / 2u;
             if ((item - config_item_min_position(0)) % 2u == 0) {

@@ -92,6 +92,9 @@ constexpr std::uint8_t config_item_velocity(unsigned axis) { return static_cast<
 constexpr std::uint8_t config_item_acceleration(unsigned axis) { return static_cast<std::uint8_t>(2 + 2 * axis); }
 constexpr std::uint8_t config_item_min_position(unsigned axis) { return static_cast<std::uint8_t>(18 + 2 * axis); }
 constexpr std::uint8_t config_item_max_position(unsigned axis) { return static_cast<std::uint8_t>(19 + 2 * axis); }
+/// Item 34 + a: axis a's max jerk (units of 100 LSB/s^3; optional: without it, or 0, no jerk
+/// limit).
+constexpr std::uint8_t config_item_jerk(unsigned axis) { return static_cast<std::uint8_t>(34 + axis); }
 
 /// A frame as the protocol sees it (the HAL's CanFrame without the flags it never uses).
 struct Frame {
@@ -127,7 +130,8 @@ inline constexpr const char* kResultValues =
     "8 \"discontinuous span\" 9 \"velocity limit\" 10 \"acceleration limit\" 11 \"bad limits\" "
     "12 \"not configured\" 13 \"bad sequence\" 14 \"bad batch\" 15 \"wrong state\" 16 \"stop too long\" "
     "17 \"nothing to resume\" 18 \"velocity step\" 19 \"job end moving\" 20 \"unknown command\" "
-    "21 \"no homing switch\" "
+    "21 \"no homing switch\" 22 \"outside travel\" 23 \"pause moving\" 24 \"jerk limit\" "
+    "25 \"acceleration step\" "
     "128 \"incomplete transfer\" 129 \"bad frame\" 130 \"too long\"";
 inline constexpr const char* kFaultValues =
     "0 \"none\" 1 \"external\" 2 \"stop failed\" 3 \"re-entry failed\" "
@@ -204,7 +208,7 @@ inline constexpr Signal kStatusESignals[] = {
 inline constexpr Signal kConfigSignals[] = {
     {"Item", 0, 1, false, "",
      "0 tick rate, 1+2a axis a max velocity, 2+2a axis a max acceleration, 18+2a / 19+2a axis a travel min / max, "
-     "17 pen-down delay (last)",
+     "34+a axis a max jerk, 17 pen-down delay (last)",
      -2},
     {"Axes", 1, 1, false, "", "axis count (must match the device)"},
     {"TickRate", 2, 4, false, "Hz", "device tick rate", 0},
@@ -242,6 +246,14 @@ inline constexpr Signal kConfigSignals[] = {
     {"MaxPosition6", 2, 4, true, "LSB", "axis 6 travel max", 31},
     {"MinPosition7", 2, 4, true, "LSB", "axis 7 travel min", 32},
     {"MaxPosition7", 2, 4, true, "LSB", "axis 7 travel max", 33},
+    {"MaxJerk0", 2, 4, false, "100 LSB/s^3", "axis 0 max jerk (0: none)", 34},
+    {"MaxJerk1", 2, 4, false, "100 LSB/s^3", "axis 1 max jerk (0: none)", 35},
+    {"MaxJerk2", 2, 4, false, "100 LSB/s^3", "axis 2 max jerk (0: none)", 36},
+    {"MaxJerk3", 2, 4, false, "100 LSB/s^3", "axis 3 max jerk (0: none)", 37},
+    {"MaxJerk4", 2, 4, false, "100 LSB/s^3", "axis 4 max jerk (0: none)", 38},
+    {"MaxJerk5", 2, 4, false, "100 LSB/s^3", "axis 5 max jerk (0: none)", 39},
+    {"MaxJerk6", 2, 4, false, "100 LSB/s^3", "axis 6 max jerk (0: none)", 40},
+    {"MaxJerk7", 2, 4, false, "100 LSB/s^3", "axis 7 max jerk (0: none)", 41},
 };
 inline constexpr Signal kCommandArgsSignals[] = {
     {"Command", 0, 1, false, "", "6 jog, 7 set position, 8 home, 9 pen", -1, kCommandArgsValues},
@@ -272,7 +284,7 @@ inline constexpr Message kMessages[] = {
     {"StatusC", kStatusCBase, 8, true, "device -> host: progress and identity", kStatusCSignals, 4},
     {"Config", kConfigBase, 6, false,
      "host -> device: tick rate, per-axis limits and travel, and pen-down delay, one item per frame",
-     kConfigSignals, 36},
+     kConfigSignals, 44},
     {"SpanStart", kSpanStartBase, 8, false, "host -> device: starts a span batch transfer",
      kSpanStartSignals, 4},
     {"SpanData", kSpanDataBase, 8, false, "host -> device: 7 bytes of the batch's wire spans",

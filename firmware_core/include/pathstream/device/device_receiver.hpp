@@ -72,7 +72,10 @@ public:
     /// kBadSequence (a gap, a partial overlap, an older batch, or the last batch's numbers
     /// with other bytes); kBadBatch (count 0 or > kMaxBatchSpans,
     /// length mismatch, bad flags); a span's own Status (its validation, kVelocityLimit,
-    /// kAccelerationLimit, kVelocityStep, kJobEndMoving); and only for a batch that is
+    /// kAccelerationLimit, kOutsideTravel, kVelocityStep, kJobEndMoving, kPauseMoving, and
+    /// under a jerk limit kJerkLimit and kAccelerationStep: the acceleration at every join,
+    /// a job's first span, after a pause and at a job end or pause too, where the other side
+    /// is rest); and only for a batch that is
     /// otherwise acceptable, kQueueFull (not enough free slots: retry later).
     /// `between` is called before each span is queued: a test hook that runs the tick there
     /// (the interrupt could); the default does nothing. Cost: two decodes and one validation
@@ -119,6 +122,17 @@ public:
         next_sequence_ += count;
         last_batch_ = {first_sequence, count, length, batch_crc32(payload, length)};
         return Status::kOk;
+    }
+
+    /// accept_batch for the device's own jobs (jog, homing): their constant-acceleration
+    /// spans are checked like a host's but for the jerk limit, which they do not follow (their
+    /// acceleration steps at their joins; docs/device.md, "Jerk limit"). Task context.
+    [[nodiscard]] Status accept_own_batch(std::uint32_t first_sequence, std::uint16_t count,
+                                          const std::uint8_t* payload, std::size_t length) {
+        check_jerk_ = false;
+        const Status s = accept_batch(first_sequence, count, payload, length);
+        check_jerk_ = true;
+        return s;
     }
 
     /// Requests a command; the next tick applies it (a second request before that tick
@@ -256,11 +270,13 @@ public:
     std::uint32_t queued_spans() const { return channel_.queue.queued_spans(); }
 
 private:
-    // Where the next span must start: position, end tangent and length of the last span
-    // accepted (tangent 0: at rest), and the job the next span belongs to.
+    // Where the next span must start: position, end tangent, end acceleration and length of
+    // the last span accepted (tangent and acceleration 0: at rest, as after a job end or a
+    // pause), and the job the next span belongs to.
     struct Chain {
         Lsb start[Axes] = {};
         std::int32_t tangent[Axes] = {};
+        TickAcceleration acceleration[Axes] = {};
         std::uint32_t ticks = 1;
         std::uint32_t job = 1;
     };
@@ -324,6 +340,12 @@ private:
                 if (Status st = channel_.queue.push(span, stamp); st != Status::kOk) return st;
             }
             for (unsigned a = 0; a < Axes; ++a) {
+                // A job end or a pause is followed by rest: the next span starts from there.
+                chain.acceleration[a] =
+                    job_end || pause
+                        ? TickAcceleration{}
+                        : hermite_end_acceleration(w.end[a] - chain.start[a], w.start_tangent[a],
+                                                   w.end_tangent[a], w.ticks);
                 chain.start[a] = w.end[a];
                 chain.tangent[a] = w.end_tangent[a];
             }
@@ -333,8 +355,9 @@ private:
         return offset == length ? Status::kOk : Status::kBadBatch;
     }
 
-    // The core's validation, the exact limit check, the join with the previous span, and a
-    // job end or a pause at rest.
+    // The core's validation, the exact limit checks (velocity, acceleration, jerk, travel), the
+    // join with the previous span (velocity, and acceleration under a jerk limit), and a job
+    // end or a pause at rest (velocity, and acceleration under a jerk limit).
     Status check_span(const Span<Axes>& span, const WireSpan& w, const Chain& chain,
                       bool job_end, bool pause) const {
         ValidatedSpan<Axes> v;
@@ -351,10 +374,22 @@ private:
                     return st;
                 }
             }
+            if (!check_jerk_) continue;
+            if (Status st = check_axis_jerk(v.cubic[a], v.timing, limits_.axis[a], limits_.tick_hz);
+                st != Status::kOk) {
+                return st;
+            }
         }
         for (unsigned a = 0; a < Axes; ++a) {
             if (Status st = check_join(w.start_tangent[a], w.ticks, chain.tangent[a], chain.ticks,
                                        limits_.axis[a], limits_.tick_hz);
+                st != Status::kOk) {
+                return st;
+            }
+            if (!check_jerk_) continue;
+            if (Status st = check_acceleration_step(start_acceleration(v.cubic[a], v.timing),
+                                                    chain.acceleration[a], limits_.axis[a],
+                                                    limits_.tick_hz);
                 st != Status::kOk) {
                 return st;
             }
@@ -364,6 +399,15 @@ private:
             if (job_end) return Status::kJobEndMoving;
             if (pause) return Status::kPauseMoving;
         }
+        if (check_jerk_ && (job_end || pause)) {
+            for (unsigned a = 0; a < Axes; ++a) {
+                if (Status st = check_end_at_rest(end_acceleration(v.cubic[a], v.timing),
+                                                  limits_.axis[a], limits_.tick_hz);
+                    st != Status::kOk) {
+                    return st;
+                }
+            }
+        }
         return Status::kOk;
     }
 
@@ -371,6 +415,7 @@ private:
     MotionLimits<Axes> limits_;
     bool configured_ = false;
     bool enforce_travel_ = true;
+    bool check_jerk_ = true;  // off only inside accept_own_batch
     std::uint32_t next_sequence_ = 1;
     LastBatch last_batch_;
     std::uint32_t duplicates_ = 0;

@@ -410,7 +410,7 @@ private:
                 length += encode_wire_span(w, Axes, bytes + length, sizeof bytes - length);
                 ++count;
             }
-            const Status s = device_.accept_batch(device_.last_accepted_sequence() + 1u, count, bytes, length);
+            const Status s = device_.accept_own_batch(device_.last_accepted_sequence() + 1u, count, bytes, length);
             if (s != Status::kOk) {
                 (void)finish_error(HomingError::kDeviceRefused, s);
                 return false;

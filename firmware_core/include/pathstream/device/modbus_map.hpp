@@ -13,7 +13,8 @@ inline constexpr std::uint16_t kMagic = 0x5053;  ///< "PS"
 /// 3: operator commands with arguments (jog, set position, home, pen), the homing flag and
 /// per-axis homing registers (42-49).
 /// 4: programmed pauses (wire flag kWirePause) and the paused flag (bit 6).
-inline constexpr std::uint16_t kProtocolVersion = 4;
+/// 5: per-axis jerk limits at the end of the configuration block (config_jerk_register).
+inline constexpr std::uint16_t kProtocolVersion = 5;
 
 /// Status block: input registers (FC4) from 0, mirrored read-only in holding registers
 /// (FC3/FC23) at the same addresses so one FC23 can write spans and read the status.
@@ -76,17 +77,23 @@ inline constexpr std::uint16_t kCommandWithArguments = 5;
 ///   the re-entry's pen lead), +4..9 reserved (0),
 ///   +10 + 4a .. : axis a max velocity (LSB/s, u32), max acceleration (LSB/s^2, u32),
 ///   +10 + 4 axes + 4a .. : axis a travel (soft limits): min position, max position (LSB, i32;
-///   0 and 0: no limits, the whole position range).
+///   0 and 0: no limits, the whole position range),
+///   +10 + 8 axes + 2a .. : axis a max jerk (units of 100 LSB/s^3, u32; 0: no jerk limit).
+/// Eight axes end at register 199, just below the span window.
 /// Accepted only idle with nothing queued; read back with FC3.
 inline constexpr std::uint16_t kConfig = 110;
 inline constexpr std::uint16_t kConfigPenDownTicks = 3;
 inline constexpr std::uint16_t kConfigAxisBase = 10;
 constexpr std::uint16_t config_registers(unsigned axes) {
-    return static_cast<std::uint16_t>(kConfigAxisBase + 8 * axes);
+    return static_cast<std::uint16_t>(kConfigAxisBase + 10 * axes);
 }
 /// First register of axis `axis`'s travel (min, then max) in a device of `axes` axes.
 constexpr std::uint16_t config_travel_register(unsigned axes, unsigned axis) {
     return static_cast<std::uint16_t>(kConfigAxisBase + 4 * axes + 4 * axis);
+}
+/// First register (high word) of axis `axis`'s max jerk in a device of `axes` axes.
+constexpr std::uint16_t config_jerk_register(unsigned axes, unsigned axis) {
+    return static_cast<std::uint16_t>(kConfigAxisBase + 8 * axes + 2 * axis);
 }
 
 /// Span window (holding): one FC16 (or the write half of an FC23) at kSpanWindow carries
@@ -94,6 +101,7 @@ constexpr std::uint16_t config_travel_register(unsigned axes, unsigned axis) {
 ///   the payload, +5.. payload (wire spans, two bytes per register, big-endian, the last
 ///   register padded with a zero byte).
 inline constexpr std::uint16_t kSpanWindow = 200;
+static_assert(kConfig + config_registers(8) <= kSpanWindow, "the configuration block ends below the span window");
 inline constexpr std::uint16_t kSpanHeaderRegisters = 5;
 /// Largest FC16 write (123 registers) minus the header: payload registers per batch.
 inline constexpr std::uint16_t kMaxPayloadRegistersFc16 = 123 - kSpanHeaderRegisters;

@@ -172,6 +172,7 @@ private:
             const std::uint16_t t = modbus::config_travel_register(Axes, a);
             put_u32(&b[t], static_cast<std::uint32_t>(l.axis[a].min_position));
             put_u32(&b[t + 2], static_cast<std::uint32_t>(l.axis[a].max_position));
+            put_u32(&b[modbus::config_jerk_register(Axes, a)], l.axis[a].max_jerk);
         }
     }
 
@@ -209,6 +210,7 @@ private:
                 l.axis[a].min_position = static_cast<std::int32_t>(u32(&v[t]));
                 l.axis[a].max_position = static_cast<std::int32_t>(u32(&v[t + 2]));
             }
+            l.axis[a].max_jerk = u32(&v[modbus::config_jerk_register(Axes, a)]);
         }
         return device_.configure(l);
     }

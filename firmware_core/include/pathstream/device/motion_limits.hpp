@@ -1,8 +1,10 @@
-// Per-axis velocity and acceleration limits, and the exact check of a span against them.
+// Per-axis velocity, acceleration and jerk limits, and the exact checks of a span against them.
 //
 // The device refuses any span whose exact cubic (before the core's one rounding) would move an
-// axis faster or accelerate it harder than its limit anywhere inside the span. The check is
-// exact integer arithmetic: no tolerance, no sampling (docs/device.md).
+// axis faster, accelerate it harder or change its acceleration faster than its limit anywhere
+// inside the span, and any join where the velocity or (with a jerk limit) the acceleration
+// steps by more than one tick's worth. The checks are exact integer arithmetic: no tolerance,
+// no sampling (docs/device.md).
 #pragma once
 
 #include <cstdint>
@@ -19,13 +21,23 @@ inline constexpr std::uint32_t kMaxTickHz = 100000;
 /// never runs a rate no profile can describe.
 inline constexpr std::uint32_t kMinTickHz = 10;
 
-/// Limits of one axis in LSB per second and LSB per second squared (both >= 1), and its
-/// travel (the work area's soft limits, LSB; the default is the whole position range).
+/// The unit of AxisLimits::max_jerk: 100 LSB/s^3. A 32-bit count of it spans 100 ..
+/// 4.3e11 LSB/s^3, i.e. 1e3 mm/s^3 at 10 um per LSB (1e5 LSB/s^3, 1,000 units: 0.1 %
+/// steps) up to 1e7 mm/s^3 at 0.1 um per LSB (1e11 LSB/s^3), and fits the two registers and
+/// one CAN item every other limit takes.
+inline constexpr std::uint32_t kJerkUnitLsb = 100;
+
+/// Limits of one axis in LSB per second and LSB per second squared (both >= 1), its jerk
+/// limit (0: none), and its travel (the work area's soft limits, LSB; the default is the whole
+/// position range).
 struct AxisLimits {
     std::uint32_t max_velocity = 0;      ///< LSB/s
     std::uint32_t max_acceleration = 0;  ///< LSB/s^2
     std::int32_t min_position = -static_cast<std::int32_t>(kMaxPositionLsb);
     std::int32_t max_position = static_cast<std::int32_t>(kMaxPositionLsb);
+    /// In kJerkUnitLsb (100 LSB/s^3); 0: no jerk limit (no jerk check inside a span, and the
+    /// acceleration may step at a join, as without the field).
+    std::uint32_t max_jerk = 0;
 };
 
 /// The device's motion configuration: tick rate, each axis's limits, and the pen-down delay
@@ -43,8 +55,10 @@ struct MotionLimits {
 /// Longest pen-down delay, in ticks: what one 16-bit Modbus register holds.
 inline constexpr std::uint32_t kMaxPenDownTicks = 65535;
 
-/// kOk when tick_hz is kMinTickHz..kMaxTickHz, every limit is >= 1 and pen_down_ticks is at most
-/// kMaxPenDownTicks; kBadLimits otherwise. Cost: a loop over the axes. Any context.
+/// kOk when tick_hz is kMinTickHz..kMaxTickHz, every velocity and acceleration limit is >= 1,
+/// pen_down_ticks is at most kMaxPenDownTicks and the travel is a range within the position
+/// range; kBadLimits otherwise. Every max_jerk is valid (0: none; the jerk arithmetic is
+/// proven for the whole 32-bit range). Cost: a loop over the axes. Any context.
 template <unsigned Axes>
 [[nodiscard]] Status check_limits(const MotionLimits<Axes>& limits) {
     if (limits.tick_hz < kMinTickHz || limits.tick_hz > kMaxTickHz) return Status::kBadLimits;
@@ -89,5 +103,53 @@ template <unsigned Axes>
 [[nodiscard]] Status check_join(std::int32_t start_tangent, std::uint32_t ticks,
                                 std::int32_t previous_end_tangent, std::uint32_t previous_ticks,
                                 const AxisLimits& limits, std::uint32_t tick_hz);
+
+/// One axis's acceleration at a span's start or end in LSB/tick^2, as an exact fraction
+/// numerator / denominator (denominator = scale * n^2 >= 1). Rest is {0, 1}. Plain value.
+struct TickAcceleration {
+    std::int64_t numerator = 0;     ///< |.| < 2^36 for any cubic make_tick_cubic accepts
+    std::uint64_t denominator = 1;  ///< < 2^35
+};
+
+/// The acceleration of an axis's exact cubic (from make_tick_cubic) at u = 0: 2b / (s n^2).
+/// For a Hermite span, (6(P1 - P0) - 4 T0 - 2 T1) / n^2. Cost: a few multiplies. Any context.
+TickAcceleration start_acceleration(const TickCubic& cubic, const SpanTiming& timing);
+
+/// The acceleration at u = 1: (6a + 2b) / (s n^2); for a Hermite span,
+/// (-6(P1 - P0) + 2 T0 + 4 T1) / n^2. Cost: a few multiplies. Any context.
+TickAcceleration end_acceleration(const TickCubic& cubic, const SpanTiming& timing);
+
+/// The acceleration at the end of a Hermite span of n ticks with chord C = P1 - P0 and
+/// tangents T0, T1 on one axis: (-6C + 2T0 + 4T1) / n^2 LSB/tick^2, the same fraction as
+/// end_acceleration of the span's cubic. |C| <= 2^28, |T| <= kMaxTangentLsb, n 1..kMaxSpanTicks.
+/// Cost: a few multiplies. Any context.
+TickAcceleration hermite_end_acceleration(std::int32_t chord, std::int32_t start_tangent,
+                                          std::int32_t end_tangent, std::uint32_t n);
+
+/// Checks one axis's exact cubic against its jerk limit J = max_jerk * kJerkUnitLsb / hz^3
+/// LSB/tick^3: the cubic's third derivative is the constant 6a / (s n^3) LSB/tick^3 (for a
+/// Hermite span 6(2 P0 - 2 P1 + T0 + T1) / n^3), and |6a| hz^3 <= J' D with J' the limit in
+/// LSB/s^3 is checked exactly. kOk without a jerk limit (max_jerk 0), else kOk or kJerkLimit.
+/// `tick_hz` 1..kMaxTickHz. Cost: two 128-bit products. Task context.
+[[nodiscard]] Status check_axis_jerk(const TickCubic& cubic, const SpanTiming& timing,
+                                     const AxisLimits& limits, std::uint32_t tick_hz);
+
+/// Checks one axis at a join: the acceleration at the next span's start (`start`) may differ
+/// from the previous span's end (`previous_end`; {0, 1} for rest: a job's first span, after a
+/// pause, a job end or a queue drop) by at most one tick of jerk, J * 1 tick =
+/// max_jerk * kJerkUnitLsb / hz^3 LSB/tick^2:
+///   |N Q' - N' Q| hz^3 <= max_jerk * kJerkUnitLsb * Q Q'
+/// (N/Q and N'/Q' the two fractions; spans of different lengths compare exactly). kOk without
+/// a jerk limit, else kOk or kAccelerationStep. Exact (two-word integers: every product stays
+/// below 2^123). `tick_hz` 1..kMaxTickHz. Cost: a few 128-bit products. Task context.
+[[nodiscard]] Status check_acceleration_step(const TickAcceleration& start,
+                                             const TickAcceleration& previous_end,
+                                             const AxisLimits& limits, std::uint32_t tick_hz);
+
+/// Checks that a span may end at rest (a job end, a pause): its end acceleration is within
+/// one tick of jerk of 0 (check_acceleration_step against rest). kOk without a jerk limit,
+/// else kOk or kAccelerationStep. Cost and context as check_acceleration_step.
+[[nodiscard]] Status check_end_at_rest(const TickAcceleration& end, const AxisLimits& limits,
+                                       std::uint32_t tick_hz);
 
 }  // namespace pathstream::device

@@ -25,13 +25,16 @@ struct DeviceLimitsLsb {
     /// the whole position range (+-2^27) without one.
     std::vector<std::int32_t> min_position;
     std::vector<std::int32_t> max_position;
+    /// Per axis, the jerk limit in units of 100 LSB/s^3 (device::kJerkUnitLsb), 0: none.
+    std::vector<std::uint32_t> max_jerk;
 };
 
 /// The profile's limits rounded up to whole LSB (the planner works to the profile's limits
-/// exactly, so the device must allow them), its pen_down_delay in ticks as the planner
-/// counts it (delay_ticks), and each axis's travel rounded inward to whole LSB. Throws
-/// std::range_error naming the axis when a limit does not fit 32 bits, a travel leaves the
-/// position range (+-2^27 LSB), or the pen-down delay exceeds 65535 ticks.
+/// exactly, so the device must allow them), its max_jerk rounded up to whole units of
+/// 100 LSB/s^3 (0 without one), its pen_down_delay in ticks as the planner counts it
+/// (delay_ticks), and each axis's travel rounded inward to whole LSB. Throws std::range_error
+/// naming the axis when a limit does not fit 32 bits, a travel leaves the position range
+/// (+-2^27 LSB), or the pen-down delay exceeds 65535 ticks.
 DeviceLimitsLsb device_limits(const MachineProfile& profile);
 
 /// Index of the axis called `name` in the profile. Throws std::invalid_argument if none.

@@ -169,6 +169,7 @@ PlanTotals plan_stream(SegmentSource& source, const MachineProfile& profile, con
 
 namespace planner_detail {
 class TickChecker;
+class JerkMeter;
 }
 
 /// check_plan for a plan handed over in order, as a PlanSink (plan_stream's, or a chain):
@@ -193,6 +194,7 @@ public:
 
 private:
     std::unique_ptr<planner_detail::TickChecker> impl_;
+    std::unique_ptr<planner_detail::JerkMeter> jerk_;
     std::size_t spans_ = 0, pens_ = 0, pauses_ = 0;
     std::uint64_t ticks_ = 0;
 };

@@ -113,6 +113,7 @@ public:
                 m.axis[a].min_position = l.min_position[a];
                 m.axis[a].max_position = l.max_position[a];
             }
+            if (l.max_jerk.size() == Axes) m.axis[a].max_jerk = l.max_jerk[a];
         }
         m.pen_down_ticks = l.pen_down_ticks;
         return device_.configure(m);
