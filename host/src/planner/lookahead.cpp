@@ -93,6 +93,51 @@ std::vector<double> speed_caps(const PathGrid& pg, const Limits& limits, const M
     return caps;
 }
 
+void jerk_caps(const PathGrid& pg, const Limits& limits, const MachineProfile& profile, std::uint32_t filter_ticks,
+               std::vector<double>& caps) {
+    const Grid& g = pg.grid;
+    const double span = profile.ticks_per_span / profile.tick_hz;
+    const double share = limits.jerk_share;
+    const auto cap = [&](std::size_t k, double s) { caps[k] = std::min(caps[k], s * s); };
+    // Stops (pieces' ends) are passed at rest: no curvature rule there, and the filter never
+    // averages across them.
+    std::vector<char> stop(g.size(), 0);
+    for (const Piece& piece : pg.pieces) stop[piece.first] = stop[piece.last] = 1;
+    for (std::size_t k = 0; k < g.size(); ++k) {
+        for (std::size_t i = 0; i < g.axes; ++i) {
+            const double j = i < limits.jerk.size() ? limits.jerk[i] : 0.0;
+            if (!(j > 0)) continue;
+            // A tangent jump J crossed at speed s: the spans around it turn the velocity by
+            // s |J_i| within about one span, up and down again.
+            const double jump = std::fabs(g.corner_jump[k][i]);
+            if (jump > 0) cap(k, share * j * span * span / (2 * jump));
+            if (k + 1 >= g.size() || stop[k] || stop[k + 1]) continue;
+            const double dk = std::fabs(g.curvature[k + 1][i] - g.curvature[k][i]);
+            if (!(dk > 0)) continue;
+            // A change of curvature by dk over dl at speed s: kappa' s^3 = dk s^3 / dl; where
+            // that takes less than a span, a step of dk s^2 in the acceleration, which the spans
+            // around it spread over about a span.
+            const double dl = g.lambda[k + 1] - g.lambda[k];
+            const double step = std::sqrt(share * j * span / (2 * dk));
+            const double s = dl > 0 ? std::max(std::cbrt(share * j * dl / dk), step) : step;
+            cap(k, s);
+            cap(k + 1, s);
+        }
+    }
+    // The filter raises the speed at a dip to the mean over M ticks: every cap must hold over
+    // the distance the window covers around it.
+    const double reach_time = (filter_ticks + profile.ticks_per_span) / profile.tick_hz;
+    const std::vector<double> before = caps;
+    for (const Piece& piece : pg.pieces) {
+        for (std::size_t k = piece.first; k <= piece.last; ++k) {
+            const double d = reach_time * std::sqrt(std::min(before[k], kNoCap));
+            for (std::size_t i = k; i-- > piece.first && g.lambda[k] - g.lambda[i] <= d;) caps[k] = std::min(caps[k], before[i]);
+            for (std::size_t i = k + 1; i <= piece.last && g.lambda[i] - g.lambda[k] <= d; ++i)
+                caps[k] = std::min(caps[k], before[i]);
+        }
+    }
+}
+
 void reserve_for_corners(const PathGrid& pg, const Limits& limits, const std::vector<double>& caps,
                          double span_time, std::vector<double>& factor) {
     const Grid& g = pg.grid;
