@@ -280,10 +280,11 @@ bool run_jerk_table(std::size_t segments, bool markdown, const MachineProfile& p
         paths.push_back({f, read_example(kSource + "/examples/" + f, profile)});
     }
     const double jerks[] = {1e5, 1e6};
-    std::printf("\n%s", markdown ? "| path | segments | motion s | plan ms | motion s, j 1e5 | % | plan ms | j % | "
-                                   "motion s, j 1e6 | % | plan ms | j % |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n"
-                                 : "path               segments  motion s   plan ms  | j=1e5: motion s        %   plan ms     j %  "
-                                   "| j=1e6: motion s        %   plan ms     j %\n");
+    std::printf("\n%s", markdown ? "| path | segments | motion s | plan ms | motion s, j 1e5 | % | plan ms | j % | replans | "
+                                   "motion s, j 1e6 | % | plan ms | j % | replans |\n"
+                                   "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n"
+                                 : "path               segments  motion s   plan ms  | j=1e5: motion s        %   plan ms     j %  r "
+                                   "| j=1e6: motion s        %   plan ms     j %  r\n");
     bool ok = true;
     for (const Named& np : paths) {
         const std::vector<BezierSegment> segs = to_bezier_segments(np.path);
@@ -308,13 +309,20 @@ bool run_jerk_table(std::size_t segments, bool markdown, const MachineProfile& p
                                   np.name.c_str(), segs.size(), motion, ms);
                 } else {
                     const double jf = jerk_fraction(plan, p);
-                    std::snprintf(cell, sizeof cell, markdown ? "| %.3f | %+.2f | %.1f | %.1f " : "| %15.3f %+8.2f %9.1f %7.1f ",
-                                  motion, 100 * (motion / base - 1), ms, 100 * jf);
+                    std::snprintf(cell, sizeof cell, markdown ? "| %.3f | %+.2f | %.1f | %.1f | %d " : "| %15.3f %+8.2f %9.1f %7.1f %2d ",
+                                  motion, 100 * (motion / base - 1), ms, 100 * jf, st.replans);
                     if (jf > 1) ok = false;
                 }
                 if (!passed) ok = false;
                 line += cell;
-                if (!passed) line += markdown ? "(check FAILED) " : "(check FAILED) ";
+                if (!passed) {
+                    char why[160];
+                    std::snprintf(why, sizeof why, "(check FAILED: v %.3f a %.3f dev %.4f mm) ",
+                                  std::max(check.max_velocity_fraction_exact, check.max_span_velocity_fraction),
+                                  std::max(check.max_acceleration_fraction_exact, check.max_span_acceleration_fraction),
+                                  check.max_deviation);
+                    line += why;
+                }
             } catch (const std::exception& e) {
                 line += std::string("| ") + e.what() + " ";
                 ok = false;

@@ -553,6 +553,9 @@ JerkSetup jerk_setup(const MachineProfile& profile, const Limits& limits);
 struct JerkFailure {
     bool failed = false;
     bool velocity = false;  ///< a velocity limit (else jerk or acceleration)
+    /// The rule that refused most candidates: 0 join, 1 jerk inside a span, 2 the end at
+    /// rest, 3 acceleration, 4 velocity.
+    int rule = 0;
     std::size_t axis = 0;
     std::string where;
 };
@@ -603,6 +606,12 @@ private:
     bool choose_and_emit(bool end, const PathGrid& pg, const Piece& piece, double run_offset, SpanEmitter& emitter);
     bool choose_axis(std::size_t axis, std::size_t from, std::size_t to, bool end);
     bool valid(std::size_t axis, std::size_t k, std::int64_t t_next, bool end) const;
+    /// Counts a refusal by `rule` (for the failure's message); false.
+    bool reject(int rule) const {
+        ++rejected_[static_cast<std::size_t>(rule)];
+        return false;
+    }
+    mutable std::array<std::size_t, 5> rejected_{};
     JKnot& knot(std::size_t k) { return knots_[k - knot_base_]; }
     const JKnot& knot(std::size_t k) const { return knots_[k - knot_base_]; }
     std::int64_t p_at(std::size_t axis, std::int64_t k) const;

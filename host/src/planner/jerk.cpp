@@ -46,12 +46,12 @@ JerkSetup jerk_setup(const MachineProfile& p, const Limits& limits) {
     JerkSetup s;
     s.span_ticks = p.ticks_per_span;
     s.jerk_lsb.fill(kInf);
-    double ratio = 0;  // largest a / j, s
+    double ratio = 0;  // largest a / j, s (the machine's a: replans lower the acceleration, not M)
     for (std::size_t i = 0; i < p.axes.size(); ++i) {
         s.jerk_lsb[i] = jerk_lsb(p.axes[i], p);
         if (p.axes[i].max_jerk > 0) {
             s.active = true;
-            ratio = std::max(ratio, limits.acceleration[i] / p.axes[i].max_jerk);
+            ratio = std::max(ratio, p.axes[i].max_acceleration / p.axes[i].max_jerk);
         }
     }
     if (!s.active) return s;
@@ -210,21 +210,21 @@ bool JerkStage::valid(std::size_t a, std::size_t k, std::int64_t, bool end) cons
         if (i == 0) {
             const long double m2 = static_cast<long double>(prev_n_) * prev_n_;
             const long double step = std::fabs(static_cast<long double>(a0) * m2 - static_cast<long double>(prev_a_[a]) * n2);
-            if (step > static_cast<long double>(j) * n2 * m2) return false;
+            if (step > static_cast<long double>(j) * n2 * m2) return reject(0);
         } else {
             const std::int64_t pm = p_at(a, static_cast<std::int64_t>(i) - 1);
             const std::int64_t tm = knot(i - 1).t[a];
             const double r = static_cast<double>(6 * (p1 - pm) - 2 * (tm + 4 * t0 + t1));
-            if (std::fabs(r) > j * n2) return false;
+            if (std::fabs(r) > j * n2) return reject(0);
         }
-        if (std::fabs(static_cast<double>(6 * (-2 * dp + t0 + t1))) > j * n2 * n) return false;
-        if (end && std::fabs(a1) > 0.5 * j * n2) return false;
+        if (std::fabs(static_cast<double>(6 * (-2 * dp + t0 + t1))) > j * n2 * n) return reject(1);
+        if (end && std::fabs(a1) > 0.5 * j * n2) return reject(2);
     }
-    if (std::fabs(a0) > alim_[a] * n2 || std::fabs(a1) > alim_[a] * n2) return false;
+    if (std::fabs(a0) > alim_[a] * n2 || std::fabs(a1) > alim_[a] * n2) return reject(3);
     const auto v = [&](double u) { return std::fabs(t0 + a0 * u + (a1 - a0) * u * u / 2); };
     double peak = std::max(std::fabs(static_cast<double>(t0)), std::fabs(static_cast<double>(t1)));
     if (a0 * a1 < 0) peak = std::max(peak, v(a0 / (a0 - a1)));
-    return peak <= vlim_[a] * n;
+    return peak <= vlim_[a] * n || reject(4);
 }
 
 // Tangents of knots from..to on one axis: each the nearest integer to its target that keeps
@@ -280,10 +280,13 @@ bool JerkStage::choose_and_emit(bool end, const PathGrid& pg, const Piece& piece
     const std::size_t to = targets_ - 1;
     if (to <= final_) return true;
     for (std::size_t a = 0; a < axes_; ++a) {
+        rejected_.fill(0);
         if (!choose_axis(a, final_ + 1, to, end)) {
             failure_.failed = true;
             failure_.axis = a;
-            failure_.velocity = false;
+            const auto most = std::max_element(rejected_.begin(), rejected_.end()) - rejected_.begin();
+            failure_.velocity = most == 4;
+            failure_.rule = static_cast<int>(most);
             failure_.where = where(pg, piece, knot(final_).lambda, run_offset);
             return false;
         }

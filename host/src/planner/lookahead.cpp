@@ -103,6 +103,16 @@ void jerk_caps(const PathGrid& pg, const Limits& limits, const MachineProfile& p
     // averages across them.
     std::vector<char> stop(g.size(), 0);
     for (const Piece& piece : pg.pieces) stop[piece.first] = stop[piece.last] = 1;
+    for (std::size_t k = 0; k + 1 < g.size(); ++k) {
+        // The spline through knots on both sides of a curvature step dk (a joint) leaves the
+        // path by about 0.07 dk h^2 (h the span's length, measured): within 0.4 delta.
+        const double dk = norm(sub(g.curvature[k + 1], g.curvature[k]));
+        if (dk > 0 && !stop[k] && !stop[k + 1] && g.lambda[k + 1] <= g.lambda[k]) {
+            const double s = std::sqrt(0.4 * profile.chord_tolerance / (0.07 * dk)) / span;
+            cap(k, s);
+            cap(k + 1, s);
+        }
+    }
     for (std::size_t k = 0; k < g.size(); ++k) {
         for (std::size_t i = 0; i < g.axes; ++i) {
             const double j = i < limits.jerk.size() ? limits.jerk[i] : 0.0;
@@ -111,6 +121,10 @@ void jerk_caps(const PathGrid& pg, const Limits& limits, const MachineProfile& p
             // s |J_i| within about one span, up and down again.
             const double jump = std::fabs(g.corner_jump[k][i]);
             if (jump > 0) cap(k, share * j * span * span / (2 * jump));
+            // Turning the velocity at curvature kappa: its derivative along the tangent, kappa^2
+            // s^3 (within the quarter of the limit the filter leaves).
+            const double kappa = norm(g.curvature[k]);
+            if (kappa > 0 && !stop[k]) cap(k, std::cbrt((1 - share) * j / (kappa * kappa * std::fabs(g.tangent[k][i]) + 1e-300)));
             if (k + 1 >= g.size() || stop[k] || stop[k + 1]) continue;
             const double dk = std::fabs(g.curvature[k + 1][i] - g.curvature[k][i]);
             if (!(dk > 0)) continue;

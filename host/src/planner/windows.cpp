@@ -441,6 +441,14 @@ PlanTotals plan_stream(SegmentSource& source, const MachineProfile& machine_prof
         limits.acceleration.push_back(a.max_acceleration);
         limits.jerk.push_back(a.max_jerk);
     }
+    // The jerk stage's spline through knots rounded to the LSB moves the accelerations by a
+    // few hundredths of an LSB/tick^2, and overshoots a little where the filter is as short as
+    // a span: the second-order stage leaves it 3 % to 10 %.
+    if (limits.has_jerk()) {
+        const JerkSetup js = jerk_setup(profile, limits);
+        const double headroom = 0.97 - 0.07 * std::min(1.0, double(profile.ticks_per_span) / js.filter_ticks);
+        for (double& a : limits.acceleration) a *= headroom;
+    }
     double lo = 0.0, hi = 0.95;
     CornerBlender blended(source, options.corner_blend * profile.chord_tolerance, options.corner_stop_angle);
     SegmentSource& input = options.corner_blend > 0 ? static_cast<SegmentSource&>(blended) : source;
@@ -474,12 +482,11 @@ PlanTotals plan_stream(SegmentSource& source, const MachineProfile& machine_prof
                             "already sent cannot be taken back");
         }
         for (std::size_t i = 0; i < profile.axes.size() && jerk.failed; ++i) {
-            // The jerk stage failed: less acceleration (a shorter filter, smaller curvature
-            // terms) and a smaller share of the jerk for the filter (docs/planner.md §12).
+            // The jerk stage failed: less acceleration, with the same filter (the filter's jerk
+            // and the curvature terms 3 kappa s s'' both fall with it; docs/planner.md §12).
             limits.acceleration[i] *= 0.85;
             st.acceleration_scale = std::min(st.acceleration_scale, limits.acceleration[i] / profile.axes[i].max_acceleration);
         }
-        if (jerk.failed) limits.jerk_share *= 0.85;
         for (std::size_t i = 0; i < profile.axes.size() && !jerk.failed; ++i) {
             const double fv = std::max(check.axis_velocity_fraction[i], check.axis_velocity_fraction_exact[i]);
             const double fa = std::max(check.axis_acceleration_fraction[i], check.axis_acceleration_fraction_exact[i]);
