@@ -262,3 +262,39 @@ TEST_CASE("jerk: a limit too low for the profile is refused with its axis", "[pl
         CHECK(m.find("max_jerk 100") != std::string::npos);
     }
 }
+
+TEST_CASE("jerk: windows of 16 segments carry the filter across their joints", "[planner][jerk]") {
+    // A smooth random walk of 200 B-spline segments is one piece: planned in windows of 16,
+    // the jerk stage's filter and knots continue across every window's cut.
+    const MachineProfile p = pen_plotter(1e6);
+    Path path;
+    path.axes = 2;
+    Subpath s;
+    std::mt19937_64 rng(5);
+    std::normal_distribution<double> turn(0, 0.25);
+    double x = 0, y = 0, heading = 0;
+    for (int i = 0; i < 201; ++i) {
+        s.points.push_back({x, y});
+        heading += turn(rng);
+        x += 1.5 * std::cos(heading);
+        y += 1.5 * std::sin(heading);
+    }
+    path.subpaths = {s};
+    const auto segs = to_bezier_segments(path);
+    PlanOptions small;
+    small.window_segments = 16;
+    PlanStats st;
+    const Plan windowed = plan_path(segs, p, small, &st);
+    const JerkFigures f = jerk_figures(windowed, p);
+    CHECK(f.inside <= 1.0);
+    CHECK(f.join <= 1.0);
+    CHECK(f.velocity <= 1.0);
+    CHECK(f.acceleration <= 1.0);
+    const PlanCheck c = check_plan(windowed, segs, p);
+    CHECK(c.within_limits);
+    CHECK(c.max_deviation <= p.chord_tolerance + 1.5 * std::sqrt(2.0) * p.mm_per_lsb);
+    // Close to the plan of one window.
+    PlanStats whole;
+    plan_path(segs, p, PlanOptions{}, &whole);
+    CHECK(static_cast<double>(st.motion_ticks) <= 1.01 * static_cast<double>(whole.motion_ticks));
+}
