@@ -141,7 +141,14 @@ void jerk_caps(const PathGrid& pg, const Limits& limits, const MachineProfile& p
     // The filter raises the speed at a dip to the mean over M ticks: every cap must hold over
     // the distance the window covers around it.
     const double reach_time = (filter_ticks + profile.ticks_per_span) / profile.tick_hz;
-    const std::vector<double> before = caps;
+    // Dips below the speed one tick of acceleration gives (a T: the neighbourhood of a stop,
+    // a cusp) erode their surroundings no lower than that: the motion comes to rest there
+    // anyway, and the jerk stage's exact check guards what is left.
+    double a_min = 1e300;
+    for (const double a : limits.acceleration) a_min = std::min(a_min, a);
+    const double slowest = a_min / profile.tick_hz * a_min / profile.tick_hz;
+    std::vector<double> before = caps;
+    for (std::size_t k = 0; k < g.size(); ++k) before[k] = std::max(caps[k], slowest);
     for (const Piece& piece : pg.pieces) {
         for (std::size_t k = piece.first; k <= piece.last; ++k) {
             const double d = reach_time * std::sqrt(std::min(before[k], kNoCap));
