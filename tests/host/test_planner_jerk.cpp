@@ -7,7 +7,6 @@
 //
 // Random cases: PATHSTREAM_JERK_CASES (default 3) paths, seed PATHSTREAM_PLAN_SEED (default 1).
 #include <catch2/catch.hpp>
-
 #include <cmath>
 #include <cstdlib>
 #include <random>
@@ -37,8 +36,8 @@ std::string source_dir() {
 
 /// The worst figures of a plan against the jerk rules, as fractions of J (LSB/tick^3).
 struct JerkFigures {
-    double inside = 0;  ///< |6 (2 P0 - 2 P1 + T0 + T1)| / n^3 over J
-    double join = 0;    ///< |a_start(next) - a_end(previous)| over J
+    double inside = 0;                      ///< |6 (2 P0 - 2 P1 + T0 + T1)| / n^3 over J
+    double join = 0;                        ///< |a_start(next) - a_end(previous)| over J
     double velocity = 0, acceleration = 0;  ///< exact span peaks over the limits
 };
 
@@ -62,10 +61,14 @@ JerkFigures jerk_figures(const Plan& plan, const MachineProfile& p) {
             a_end[i] = end;
             const double a_lim = p.axes[i].max_acceleration * t * t / p.mm_per_lsb;
             const double v_lim = p.axes[i].max_velocity * t / p.mm_per_lsb;
-            f.acceleration = std::max(f.acceleration, static_cast<double>(std::max(std::fabs(start), std::fabs(end))) / a_lim);
-            const double a0 = static_cast<double>(start * n * n), a1 = static_cast<double>(end * n * n);
+            f.acceleration =
+                std::max(f.acceleration,
+                         static_cast<double>(std::max(std::fabs(start), std::fabs(end))) / a_lim);
+            const double a0 = static_cast<double>(start * n * n),
+                         a1 = static_cast<double>(end * n * n);
             const auto v = [&](double u) {
-                return std::fabs(static_cast<double>(t0) + a0 * u + (a1 - a0) * u * u / 2) / static_cast<double>(n) / v_lim;
+                return std::fabs(static_cast<double>(t0) + a0 * u + (a1 - a0) * u * u / 2) /
+                       static_cast<double>(n) / v_lim;
             };
             for (int k = 0; k <= 16; ++k) f.velocity = std::max(f.velocity, v(k / 16.0));
             if (a0 * a1 < 0) f.velocity = std::max(f.velocity, v(a0 / (a0 - a1)));
@@ -92,7 +95,8 @@ Plan plan_with_jerk(const Path& path, const MachineProfile& p, PlanStats* stats 
     CHECK(c.within_limits);
     CHECK_FALSE(c.drawing_while_pen_moves);
     CHECK(c.max_feed_fraction <= 1.0);
-    CHECK(c.max_deviation <= p.chord_tolerance + 1.5 * std::sqrt(static_cast<double>(p.axes.size())) * p.mm_per_lsb);
+    CHECK(c.max_deviation <=
+          p.chord_tolerance + 1.5 * std::sqrt(static_cast<double>(p.axes.size())) * p.mm_per_lsb);
     return plan;
 }
 
@@ -131,7 +135,9 @@ Path line(std::vector<PathPoint> points, std::size_t axes) {
 double s_curve_time(double d, double v, double a, double j) {
     // Accelerating to speed w takes w/a + a/j when a is reached (w >= a^2/j), else 2 sqrt(w/j);
     // the distance covered meanwhile is w times half of that. Bisect the top speed.
-    const auto ramp_time = [&](double w) { return w >= a * a / j ? w / a + a / j : 2 * std::sqrt(w / j); };
+    const auto ramp_time = [&](double w) {
+        return w >= a * a / j ? w / a + a / j : 2 * std::sqrt(w / j);
+    };
     double lo = 0, hi = v;
     if (ramp_time(v) * v > d) {
         for (int it = 0; it < 200; ++it) {
@@ -175,18 +181,31 @@ TEST_CASE("jerk: a circle and the examples on the pen plotter", "[planner][jerk]
         path.subpaths = {s};
         plan_with_jerk(path, p);
     }
-    SECTION("rose.json") { plan_with_jerk(load_json_path(ex + "rose.json"), p); }
-    SECTION("wave.json") { plan_with_jerk(load_json_path(ex + "wave.json"), p); }
-    SECTION("landscape.svg") { plan_with_jerk(load_svg_path(ex + "landscape.svg"), p); }
-    SECTION("two_pens.svg") { plan_with_jerk(load_svg_path(ex + "two_pens.svg"), p); }
-    SECTION("leaf.ngc") { plan_with_jerk(load_gcode_path(ex + "leaf.ngc"), p); }
+    SECTION("rose.json") {
+        plan_with_jerk(load_json_path(ex + "rose.json"), p);
+    }
+    SECTION("wave.json") {
+        plan_with_jerk(load_json_path(ex + "wave.json"), p);
+    }
+    SECTION("landscape.svg") {
+        plan_with_jerk(load_svg_path(ex + "landscape.svg"), p);
+    }
+    SECTION("two_pens.svg") {
+        plan_with_jerk(load_svg_path(ex + "two_pens.svg"), p);
+    }
+    SECTION("leaf.ngc") {
+        plan_with_jerk(load_gcode_path(ex + "leaf.ngc"), p);
+    }
     SECTION("star.csv, a closed polyline with blended corners") {
-        plan_with_jerk(load_csv_path(ex + "star.csv", PathBasis::kPolyline, true), pen_plotter(1e6));
+        plan_with_jerk(load_csv_path(ex + "star.csv", PathBasis::kPolyline, true),
+                       pen_plotter(1e6));
     }
 }
 
 TEST_CASE("jerk: from rest to rest on one axis and on three", "[planner][jerk]") {
-    SECTION("one axis") { plan_with_jerk(line({{0}, {30}, {10}, {10.5}}, 1), profile(100, 2000, 5e4, 1)); }
+    SECTION("one axis") {
+        plan_with_jerk(line({{0}, {30}, {10}, {10.5}}, 1), profile(100, 2000, 5e4, 1));
+    }
     SECTION("three axes") {
         Path path;
         path.axes = 3;

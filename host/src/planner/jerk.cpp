@@ -13,16 +13,24 @@ namespace pathstream::host::planner_detail {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
-constexpr std::size_t kSplineReach = 14;    // knots each side the spline tangent looks at
-constexpr std::size_t kBacktrack = 8;       // knots whose tangents stay open to backtracking
-constexpr std::int64_t kTangentReach = 3;   // candidates: the rounded target +- this
-constexpr int kStepBudget = 200000;         // backtracking steps per choice
+constexpr std::size_t kSplineReach = 14;   // knots each side the spline tangent looks at
+constexpr std::size_t kBacktrack = 8;      // knots whose tangents stay open to backtracking
+constexpr std::int64_t kTangentReach = 3;  // candidates: the rounded target +- this
+constexpr int kStepBudget = 200000;        // backtracking steps per choice
 
 // Hermite basis integrated from 0 to u (for the box filter's integral of lambda).
-double i00(double u) { return u * u * u * u / 2 - u * u * u + u; }
-double i10(double u) { return u * u * u * u / 4 - 2 * u * u * u / 3 + u * u / 2; }
-double i01(double u) { return -u * u * u * u / 2 + u * u * u; }
-double i11(double u) { return u * u * u * u / 4 - u * u * u / 3; }
+double i00(double u) {
+    return u * u * u * u / 2 - u * u * u + u;
+}
+double i10(double u) {
+    return u * u * u * u / 4 - 2 * u * u * u / 3 + u * u / 2;
+}
+double i01(double u) {
+    return -u * u * u * u / 2 + u * u * u;
+}
+double i11(double u) {
+    return u * u * u * u / 4 - u * u * u / 3;
+}
 
 // Jerk limit in LSB/tick^3 (infinity without one).
 double jerk_lsb(const AxisLimits& a, const MachineProfile& p) {
@@ -61,7 +69,8 @@ JerkSetup jerk_setup(const MachineProfile& p, const Limits& limits) {
     return s;
 }
 
-JerkStage::JerkStage(const MachineProfile& profile, const Limits&, const JerkSetup& setup, std::size_t axes)
+JerkStage::JerkStage(const MachineProfile& profile, const Limits&, const JerkSetup& setup,
+                     std::size_t axes)
     : profile_(profile), setup_(setup), axes_(axes) {
     const double t = 1 / profile.tick_hz;
     for (std::size_t i = 0; i < axes; ++i) {
@@ -70,7 +79,8 @@ JerkStage::JerkStage(const MachineProfile& profile, const Limits&, const JerkSet
     }
 }
 
-void JerkStage::piece_begin(double lambda, std::size_t subpath, bool pen_down, const SpanEmitter& emitter) {
+void JerkStage::piece_begin(double lambda, std::size_t subpath, bool pen_down,
+                            const SpanEmitter& emitter) {
     in_piece_ = true;
     subpath_ = subpath;
     pen_down_ = pen_down;
@@ -127,13 +137,17 @@ double JerkStage::filtered(std::int64_t t) const {
     const double lo = static_cast<double>(t) - m, hi = static_cast<double>(t);
     const double ref = raw_lambda(hi);
     double sum = 0;
-    const double start = raw_.empty() ? static_cast<double>(raw_end_) : static_cast<double>(raw_.front().t0);
+    const double start =
+        raw_.empty() ? static_cast<double>(raw_end_) : static_cast<double>(raw_.front().t0);
     if (lo < start) sum += (std::min(hi, start) - lo) * (l_start_ - ref);
-    if (hi > static_cast<double>(raw_end_)) sum += (hi - std::max(lo, static_cast<double>(raw_end_))) * (l_end_ - ref);
+    if (hi > static_cast<double>(raw_end_))
+        sum += (hi - std::max(lo, static_cast<double>(raw_end_))) * (l_end_ - ref);
     for (const RawSpan& r : raw_) {
-        const double a = std::max(lo, static_cast<double>(r.t0)), b = std::min(hi, static_cast<double>(r.t0 + r.m));
+        const double a = std::max(lo, static_cast<double>(r.t0)),
+                     b = std::min(hi, static_cast<double>(r.t0 + r.m));
         if (!(b > a)) continue;
-        const double ua = (a - static_cast<double>(r.t0)) / r.m, ub = (b - static_cast<double>(r.t0)) / r.m;
+        const double ua = (a - static_cast<double>(r.t0)) / r.m,
+                     ub = (b - static_cast<double>(r.t0)) / r.m;
         sum += r.m * ((r.l0 - ref) * (i00(ub) - i00(ua)) + r.d0 * (i10(ub) - i10(ua)) +
                       (r.l1 - ref) * (i01(ub) - i01(ua)) + r.d1 * (i11(ub) - i11(ua)));
     }
@@ -142,11 +156,11 @@ double JerkStage::filtered(std::int64_t t) const {
 
 std::int64_t JerkStage::p_at(std::size_t axis, std::int64_t k) const {
     if (k <= 0) return p0_[axis];
-    const std::size_t i = std::max(static_cast<std::size_t>(k), knot_base_);  // pruned: weight < 1e-8
+    const std::size_t i =
+        std::max(static_cast<std::size_t>(k), knot_base_);  // pruned: weight < 1e-8
     if (ended_ && i >= last_knot_) return knot(last_knot_).p[axis];
     return knot(i).p[axis];
 }
-
 
 void JerkStage::add_knots(const PathGrid& pg, const Piece& piece) {
     const std::int64_t n = setup_.span_ticks;
@@ -161,13 +175,15 @@ void JerkStage::add_knots(const PathGrid& pg, const Piece& piece) {
             for (std::size_t a = 0; a < axes_; ++a) kn.p[a] = end_p_[a];
         } else {
             const PathAt at = path_at(pg, piece, kn.lambda, hint_);
-            for (std::size_t a = 0; a < axes_; ++a) kn.p[a] = std::llround(at.q[a] / profile_.mm_per_lsb);
+            for (std::size_t a = 0; a < axes_; ++a)
+                kn.p[a] = std::llround(at.q[a] / profile_.mm_per_lsb);
         }
         knots_.push_back(kn);
     }
     // Raw spans the filter no longer reaches.
     const std::int64_t next = static_cast<std::int64_t>(knot_base_ + knots_.size()) * n;
-    while (raw_.size() > 1 && raw_.front().t0 + raw_.front().m + setup_.filter_ticks + 1 < next) raw_.pop_front();
+    while (raw_.size() > 1 && raw_.front().t0 + raw_.front().m + setup_.filter_ticks + 1 < next)
+        raw_.pop_front();
 }
 
 // Target tangents: those of the interpolating C2 cubic spline through the knots (the piece at
@@ -182,8 +198,8 @@ void JerkStage::add_targets() {
         JKnot& kn = knot(k);
         for (std::size_t a = 0; a < axes_; ++a) {
             double sum = 0;
-            for (std::int64_t j = -static_cast<std::int64_t>(kSplineReach); j <= static_cast<std::int64_t>(kSplineReach);
-                 ++j) {
+            for (std::int64_t j = -static_cast<std::int64_t>(kSplineReach);
+                 j <= static_cast<std::int64_t>(kSplineReach); ++j) {
                 const std::int64_t i = static_cast<std::int64_t>(k) + j;
                 const double wj = c0 * std::pow(rho, static_cast<double>(std::llabs(j)));
                 sum += wj * 3 * static_cast<double>(p_at(a, i + 1) - p_at(a, i - 1));
@@ -202,14 +218,17 @@ bool JerkStage::valid(std::size_t a, std::size_t k, std::int64_t, bool end) cons
     const double n = setup_.span_ticks, n2 = n * n;
     const double j = setup_.jerk_lsb[a];
     const std::size_t i = k - 1;
-    const std::int64_t p0 = p_at(a, static_cast<std::int64_t>(i)), p1 = p_at(a, static_cast<std::int64_t>(k));
+    const std::int64_t p0 = p_at(a, static_cast<std::int64_t>(i)),
+                       p1 = p_at(a, static_cast<std::int64_t>(k));
     const std::int64_t t0 = knot(i).t[a], t1 = knot(k).t[a];
     const std::int64_t dp = p1 - p0;
-    const double a0 = static_cast<double>(6 * dp - 4 * t0 - 2 * t1), a1 = static_cast<double>(-6 * dp + 2 * t0 + 4 * t1);
+    const double a0 = static_cast<double>(6 * dp - 4 * t0 - 2 * t1),
+                 a1 = static_cast<double>(-6 * dp + 2 * t0 + 4 * t1);
     if (std::isfinite(j)) {
         if (i == 0) {
             const long double m2 = static_cast<long double>(prev_n_) * prev_n_;
-            const long double step = std::fabs(static_cast<long double>(a0) * m2 - static_cast<long double>(prev_a_[a]) * n2);
+            const long double step = std::fabs(static_cast<long double>(a0) * m2 -
+                                               static_cast<long double>(prev_a_[a]) * n2);
             if (step > static_cast<long double>(j) * n2 * m2) return reject(0);
         } else {
             const std::int64_t pm = p_at(a, static_cast<std::int64_t>(i) - 1);
@@ -284,7 +303,8 @@ bool JerkStage::choose_and_emit(bool end, const PathGrid& pg, const Piece& piece
         if (!choose_axis(a, final_ + 1, to, end)) {
             failure_.failed = true;
             failure_.axis = a;
-            const auto most = std::max_element(rejected_.begin(), rejected_.end()) - rejected_.begin();
+            const auto most =
+                std::max_element(rejected_.begin(), rejected_.end()) - rejected_.begin();
             failure_.velocity = most == 4;
             failure_.rule = static_cast<int>(most);
             failure_.where = where(pg, piece, knot(final_).lambda, run_offset);
@@ -293,11 +313,13 @@ bool JerkStage::choose_and_emit(bool end, const PathGrid& pg, const Piece& piece
     }
     const std::size_t commit = end ? to : (to > kBacktrack ? to - kBacktrack : 0);
     for (std::size_t k = final_ + 1; k <= commit; ++k) {
-        emitter.motion_lsb(knot(k).p, knot(k - 1).t, knot(k).t, setup_.span_ticks, subpath_, pen_down_);
+        emitter.motion_lsb(knot(k).p, knot(k - 1).t, knot(k).t, setup_.span_ticks, subpath_,
+                           pen_down_);
         final_ = k;
     }
     // Knots neither the targets nor the backtracking reach again.
-    const std::size_t keep = std::min(final_ > 0 ? final_ - 1 : 0, targets_ > kSplineReach + 1 ? targets_ - kSplineReach - 1 : 0);
+    const std::size_t keep = std::min(
+        final_ > 0 ? final_ - 1 : 0, targets_ > kSplineReach + 1 ? targets_ - kSplineReach - 1 : 0);
     while (knot_base_ < keep && knots_.size() > 1) {
         knots_.pop_front();
         ++knot_base_;
@@ -305,8 +327,8 @@ bool JerkStage::choose_and_emit(bool end, const PathGrid& pg, const Piece& piece
     return true;
 }
 
-bool JerkStage::raw_span(const Knot& from, const MotionSpan& span, const PathGrid& pg, const Piece& piece,
-                         double run_offset, SpanEmitter& emitter) {
+bool JerkStage::raw_span(const Knot& from, const MotionSpan& span, const PathGrid& pg,
+                         const Piece& piece, double run_offset, SpanEmitter& emitter) {
     RawSpan r;
     r.t0 = raw_end_;
     r.m = span.ticks;
@@ -325,11 +347,12 @@ bool JerkStage::raw_span(const Knot& from, const MotionSpan& span, const PathGri
     return choose_and_emit(false, pg, piece, run_offset, emitter);
 }
 
-bool JerkStage::piece_end(const Vec& end_q, const PathGrid& pg, const Piece& piece, double run_offset,
-                          SpanEmitter& emitter) {
+bool JerkStage::piece_end(const Vec& end_q, const PathGrid& pg, const Piece& piece,
+                          double run_offset, SpanEmitter& emitter) {
     in_piece_ = false;
     if (raw_.empty()) return true;  // no motion
-    for (std::size_t a = 0; a < axes_; ++a) end_p_[a] = std::llround(end_q[a] / profile_.mm_per_lsb);
+    for (std::size_t a = 0; a < axes_; ++a)
+        end_p_[a] = std::llround(end_q[a] / profile_.mm_per_lsb);
     ended_ = true;
     const std::int64_t n = setup_.span_ticks;
     last_knot_ = static_cast<std::size_t>((raw_end_ + setup_.filter_ticks + n - 1) / n);
@@ -347,7 +370,8 @@ bool JerkStage::piece_end(const Vec& end_q, const PathGrid& pg, const Piece& pie
         ++last_knot_;
         targets_ = std::max(std::min(targets_, last_knot_ - 3), final_ + 1);
     }
-    added_ticks_ += static_cast<std::uint64_t>(static_cast<std::int64_t>(last_knot_) * n - raw_end_);
+    added_ticks_ +=
+        static_cast<std::uint64_t>(static_cast<std::int64_t>(last_knot_) * n - raw_end_);
     return true;
 }
 
