@@ -596,7 +596,16 @@ private:
         std::array<double, kAxesMax> target{};  ///< the C2 spline's tangent through the points
         LsbVec t{};
         double lambda = 0;
+        std::array<Vec, 3> between{};    ///< the path at the quarters of the span ending here (mm)
+        std::array<Vec, 3> between_t{};  ///< and its unit tangent there
     };
+    static constexpr std::size_t kQuarters = 3;
+    /// The whole tick nearest quarter i + 1 of a span (at least 1 tick apart from its ends).
+    std::int64_t quarter_tick(std::size_t i) const {
+        const std::int64_t n = setup_.span_ticks;
+        return std::clamp<std::int64_t>((static_cast<std::int64_t>(i + 1) * n + 2) / 4, std::min<std::int64_t>(1, n - 1), n - 1);
+    }
+    void check_deviation(std::size_t k, const PathGrid& pg, const Piece& piece, double run_offset) const;
     double filtered(std::int64_t t) const;
     double raw_lambda(double t) const;
     /// Positions of the knots up to raw time `until` (or all, once the piece ended).
@@ -633,6 +642,7 @@ private:
     std::size_t targets_ = 0;    ///< knots with a target tangent
     std::size_t final_ = 0;      ///< knots whose tangent is final (spans up to it emitted)
     LsbVec p0_{}, end_p_{};      ///< the piece's start and end point (LSB)
+    Vec end_q_{};                ///< the piece's end point (mm)
     LsbVec prev_a_{};            ///< the previous span's end acceleration (numerator)...
     std::uint32_t prev_n_ = 1;   ///< ...over this many ticks squared
     std::size_t hint_ = 0;

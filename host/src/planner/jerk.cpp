@@ -169,20 +169,34 @@ void JerkStage::add_knots(const PathGrid& pg, const Piece& piece) {
         const std::int64_t t = static_cast<std::int64_t>(k) * n;
         if (ended_ ? k > last_knot_ : t > raw_end_) break;
         JKnot kn;
-        kn.lambda = filtered(t);
-        if (ended_ && t >= raw_end_ + setup_.filter_ticks) {
-            kn.lambda = l_end_;
-            for (std::size_t a = 0; a < axes_; ++a) kn.p[a] = end_p_[a];
-        } else {
-            const PathAt at = path_at(pg, piece, kn.lambda, hint_);
-            for (std::size_t a = 0; a < axes_; ++a)
-                kn.p[a] = std::llround(at.q[a] / profile_.mm_per_lsb);
+        const auto point = [&](std::int64_t tick, double& lambda) {
+            if (ended_ && tick >= raw_end_ + setup_.filter_ticks) {
+                lambda = l_end_;
+                PathAt at;
+                at.q = end_q_;
+                return at;
+            }
+            lambda = filtered(tick);
+            return path_at(pg, piece, lambda, hint_);
+        };
+        // The path where the span ending here should be at its quarters (for the deviation).
+        for (std::size_t i = 0; i < kQuarters && k > 0; ++i) {
+            double unused = 0;
+            const PathAt at = point(t - n + quarter_tick(i), unused);
+            kn.between[i] = at.q;
+            kn.between_t[i] = at.t;
+        }
+        const Vec q = point(t, kn.lambda).q;
+        for (std::size_t a = 0; a < axes_; ++a) {
+            kn.p[a] = ended_ && t >= raw_end_ + setup_.filter_ticks
+                          ? end_p_[a]
+                          : std::llround(q[a] / profile_.mm_per_lsb);
         }
         knots_.push_back(kn);
     }
     // Raw spans the filter no longer reaches.
     const std::int64_t next = static_cast<std::int64_t>(knot_base_ + knots_.size()) * n;
-    while (raw_.size() > 1 && raw_.front().t0 + raw_.front().m + setup_.filter_ticks + 1 < next)
+    while (raw_.size() > 1 && raw_.front().t0 + raw_.front().m + setup_.filter_ticks + n + 1 < next)
         raw_.pop_front();
 }
 
@@ -313,6 +327,7 @@ bool JerkStage::choose_and_emit(bool end, const PathGrid& pg, const Piece& piece
     }
     const std::size_t commit = end ? to : (to > kBacktrack ? to - kBacktrack : 0);
     for (std::size_t k = final_ + 1; k <= commit; ++k) {
+        check_deviation(k, pg, piece, run_offset);
         emitter.motion_lsb(knot(k).p, knot(k - 1).t, knot(k).t, setup_.span_ticks, subpath_,
                            pen_down_);
         final_ = k;
@@ -325,6 +340,46 @@ bool JerkStage::choose_and_emit(bool end, const PathGrid& pg, const Piece& piece
         ++knot_base_;
     }
     return true;
+}
+
+// The span ending at knot k against the path where the filtered motion is at its quarters,
+// across the path's tangent: within the chord tolerance (plus sqrt(axes) LSB) of the
+// path as planned, else PlanError. check_plan measures every tick against the path as given.
+void JerkStage::check_deviation(std::size_t k, const PathGrid& pg, const Piece& piece,
+                                double run_offset) const {
+    const JKnot& a = knot(k - 1);
+    const JKnot& b = knot(k);
+    const double lsb = profile_.mm_per_lsb;
+    // check_plan's bound, delta + 1.5 sqrt(axes) LSB, less the setpoints' rounding.
+    const double allowed = profile_.chord_tolerance + std::sqrt(static_cast<double>(axes_)) * lsb;
+    for (std::size_t i = 0; i < kQuarters; ++i) {
+        const std::int64_t n = setup_.span_ticks;
+        const double u = static_cast<double>(quarter_tick(i)) / static_cast<double>(n);
+        const double h00 = 2 * u * u * u - 3 * u * u + 1, h10 = u * u * u - 2 * u * u + u;
+        const double h01 = -2 * u * u * u + 3 * u * u, h11 = u * u * u - u * u;
+        // Across the path's tangent there (the timing may differ along it by micrometres).
+        Vec d{};
+        for (std::size_t x = 0; x < axes_; ++x) {
+            const double p =
+                (h00 * static_cast<double>(a.p[x]) + h10 * static_cast<double>(a.t[x]) +
+                 h01 * static_cast<double>(b.p[x]) + h11 * static_cast<double>(b.t[x])) *
+                lsb;
+            d[x] = p - b.between[i][x];
+        }
+        // Where the timing differs by more than 20 um the tangent's line is no longer the path
+        // (0.2 um off at a 1 mm radius): that quarter is left to check_plan.
+        const double along = dot(d, b.between_t[i]);
+        if (std::fabs(along) > 0.02) continue;
+        const double d2 = std::max(0.0, dot(d, d) - along * along);
+        if (std::sqrt(d2) > allowed) {
+            std::ostringstream m;
+            m << "cannot plan " << where(pg, piece, b.lambda, run_offset)
+              << " within the jerk limit: a span leaves the path by " << std::sqrt(d2)
+              << " mm, over the chord tolerance (a curvature step too sharp for the spans; "
+                 "a larger max_jerk or chord_tolerance)";
+            throw PlanError(m.str());
+        }
+    }
 }
 
 bool JerkStage::raw_span(const Knot& from, const MotionSpan& span, const PathGrid& pg,
@@ -353,6 +408,7 @@ bool JerkStage::piece_end(const Vec& end_q, const PathGrid& pg, const Piece& pie
     if (raw_.empty()) return true;  // no motion
     for (std::size_t a = 0; a < axes_; ++a)
         end_p_[a] = std::llround(end_q[a] / profile_.mm_per_lsb);
+    end_q_ = end_q;
     ended_ = true;
     const std::int64_t n = setup_.span_ticks;
     last_knot_ = static_cast<std::size_t>((raw_end_ + setup_.filter_ticks + n - 1) / n);
@@ -366,6 +422,8 @@ bool JerkStage::piece_end(const Vec& end_q, const PathGrid& pg, const Piece& pie
         JKnot kn;
         kn.lambda = l_end_;
         for (std::size_t a = 0; a < axes_; ++a) kn.p[a] = end_p_[a];
+        kn.between.fill(end_q_);
+        kn.between_t.fill(Vec{});
         knots_.push_back(kn);
         ++last_knot_;
         targets_ = std::max(std::min(targets_, last_knot_ - 3), final_ + 1);
