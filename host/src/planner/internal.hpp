@@ -568,7 +568,7 @@ struct JerkFailure {
 /// continues in the next one (rebase()).
 class JerkStage {
 public:
-    JerkStage(const MachineProfile& profile, const Limits& limits, const JerkSetup& setup, std::size_t axes);
+    JerkStage(const MachineProfile& profile, const JerkSetup& setup, std::size_t axes);
     /// A piece starts at rest at the emitter's position, at arc length `lambda`.
     void piece_begin(double lambda, std::size_t subpath, bool pen_down, const SpanEmitter& emitter);
     /// The second-order span from `from` to `span.end`; `pg`, `piece`: the current window's.
@@ -614,7 +614,8 @@ private:
     /// Chooses the tangents of knots chosen_from.. (backtracking), emits the final spans.
     bool choose_and_emit(bool end, const PathGrid& pg, const Piece& piece, double run_offset, SpanEmitter& emitter);
     bool choose_axis(std::size_t axis, std::size_t from, std::size_t to, bool end);
-    bool valid(std::size_t axis, std::size_t k, std::int64_t t_next, bool end) const;
+    /// Whether knot k's tangent keeps the rules with the knots before it (see jerk.cpp).
+    bool valid(std::size_t axis, std::size_t k, bool end) const;
     /// Counts a refusal by `rule` (for the failure's message); false.
     bool reject(int rule) const {
         ++rejected_[static_cast<std::size_t>(rule)];

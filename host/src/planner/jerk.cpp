@@ -69,8 +69,7 @@ JerkSetup jerk_setup(const MachineProfile& p, const Limits& limits) {
     return s;
 }
 
-JerkStage::JerkStage(const MachineProfile& profile, const Limits&, const JerkSetup& setup,
-                     std::size_t axes)
+JerkStage::JerkStage(const MachineProfile& profile, const JerkSetup& setup, std::size_t axes)
     : profile_(profile), setup_(setup), axes_(axes) {
     const double t = 1 / profile.tick_hz;
     for (std::size_t i = 0; i < axes; ++i) {
@@ -228,7 +227,7 @@ void JerkStage::add_targets() {
 // the span from k - 1 to k (jerk, acceleration at both ends, peak velocity), and at the
 // piece's last knot its end at rest (|a| within half the limit, so that the next piece's start
 // has room).
-bool JerkStage::valid(std::size_t a, std::size_t k, std::int64_t, bool end) const {
+bool JerkStage::valid(std::size_t a, std::size_t k, bool end) const {
     const double n = setup_.span_ticks, n2 = n * n;
     const double j = setup_.jerk_lsb[a];
     const std::size_t i = k - 1;
@@ -254,7 +253,9 @@ bool JerkStage::valid(std::size_t a, std::size_t k, std::int64_t, bool end) cons
         if (end && std::fabs(a1) > 0.5 * j * n2) return reject(2);
     }
     if (std::fabs(a0) > alim_[a] * n2 || std::fabs(a1) > alim_[a] * n2) return reject(3);
-    const auto v = [&](double u) { return std::fabs(t0 + a0 * u + (a1 - a0) * u * u / 2); };
+    const auto v = [&](double u) {
+        return std::fabs(static_cast<double>(t0) + a0 * u + (a1 - a0) * u * u / 2);
+    };
     double peak = std::max(std::fabs(static_cast<double>(t0)), std::fabs(static_cast<double>(t1)));
     if (a0 * a1 < 0) peak = std::max(peak, v(a0 / (a0 - a1)));
     return peak <= vlim_[a] * n || reject(4);
@@ -290,7 +291,7 @@ bool JerkStage::choose_axis(std::size_t a, std::size_t from, std::size_t to, boo
         while (f.tried < limit) {
             knot(k).t[a] = last ? 0 : candidate(k, f.tried);
             ++f.tried;
-            if (valid(a, k, 0, last)) {
+            if (valid(a, k, last)) {
                 ok = true;
                 break;
             }

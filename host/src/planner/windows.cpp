@@ -235,7 +235,7 @@ private:
             emitter_.emplace(profile_, g.axes, pg.runs.front().start);
             if (jerk_setup_.active) {
                 emitter_->set_jerk_limits(jerk_setup_.jerk_lsb);
-                jerk_.emplace(profile_, limits_, jerk_setup_, g.axes);
+                jerk_.emplace(profile_, jerk_setup_, g.axes);
             }
             carry_.q = on_lsb_grid(pg.runs.front().start, profile_.mm_per_lsb, g.axes);
             carry_.started = true;
