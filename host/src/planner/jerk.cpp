@@ -65,7 +65,9 @@ JerkSetup jerk_setup(const MachineProfile& p, const Limits& limits) {
     if (!s.active) return s;
     // A box filter of M ticks turns path accelerations within +-A into path jerk within 2 A / M.
     const double m = std::ceil(2 * ratio * p.tick_hz / limits.jerk_share - 1e-9);
-    s.filter_ticks = static_cast<std::uint32_t>(std::clamp(m, 1.0, 1e9));
+    // At least two spans: a filter shorter than the knots' spacing leaves stops that the
+    // spline through the knots cannot follow without overshooting them.
+    s.filter_ticks = static_cast<std::uint32_t>(std::clamp(m, 2.0 * p.ticks_per_span, 1e9));
     return s;
 }
 

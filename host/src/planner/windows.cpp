@@ -463,10 +463,13 @@ PlanTotals plan_stream(SegmentSource& source, const MachineProfile& machine_prof
         }
         const JerkFailure jerk = planner.jerk_failure();
         if (jerk.failed && attempt >= options.max_replans) {
+            static const char* const rules[] = {"the acceleration step at a join", "the jerk inside a span",
+                                                "the end at rest", "the acceleration limit", "the velocity limit"};
             throw PlanError("cannot meet the jerk limit of axis " + profile.axes[jerk.axis].name + " at " + jerk.where +
                             " after " + std::to_string(attempt) +
-                            " replans with lowered acceleration (no integer tangents keep every span and join "
-                            "within it and the velocity and acceleration limits)");
+                            " replans with lowered limits (no integer tangents keep every span and join "
+                            "within it and the velocity and acceleration limits; most often refused: " +
+                            rules[std::clamp(jerk.rule, 0, 4)] + ")");
         }
         if (attempt >= options.max_replans) {
             std::ostringstream m;
@@ -481,7 +484,13 @@ PlanTotals plan_stream(SegmentSource& source, const MachineProfile& machine_prof
             throw PlanError("the plan needs lowered limits (a tick over a limit after rounding) but the spans "
                             "already sent cannot be taken back");
         }
-        for (std::size_t i = 0; i < profile.axes.size() && jerk.failed; ++i) {
+        if (jerk.failed && jerk.velocity) {
+            // The spline through the knots overshoots a velocity limit the second-order stage
+            // reached: that axis's velocity a little lower.
+            limits.velocity[jerk.axis] *= 0.97;
+            st.velocity_scale = std::min(st.velocity_scale, limits.velocity[jerk.axis] / profile.axes[jerk.axis].max_velocity);
+        }
+        for (std::size_t i = 0; i < profile.axes.size() && jerk.failed && !jerk.velocity; ++i) {
             // The jerk stage failed: less acceleration, with the same filter (the filter's jerk
             // and the curvature terms 3 kappa s s'' both fall with it; docs/planner.md §12).
             limits.acceleration[i] *= 0.85;
