@@ -162,6 +162,9 @@ TEST_CASE("jerk: a straight line is near the analytic S-curve time", "[planner][
         CHECK(time >= best * 0.999);
         CHECK(time <= best * 1.06);
         CHECK(st.jerk_filter_ticks > 0);
+        // One piece: the filter's length plus the rest up to a whole span.
+        CHECK(st.jerk_added_ticks >= st.jerk_filter_ticks);
+        CHECK(st.jerk_added_ticks < st.jerk_filter_ticks + 4 * st.ticks_per_span);
     }
 }
 

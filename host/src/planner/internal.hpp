@@ -579,7 +579,6 @@ public:
     bool piece_end(const Vec& end_q, const PathGrid& pg, const Piece& piece, double run_offset, SpanEmitter& emitter);
     /// A new window: arc length of the last raw knot there is `lambda` (the grids differ).
     void rebase(double lambda);
-    bool in_piece() const { return in_piece_; }
     const JerkFailure& failure() const { return failure_; }
     /// The extra ticks the filter and the rest at piece ends added (for the figures).
     std::uint64_t added_ticks() const { return added_ticks_; }

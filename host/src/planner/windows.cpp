@@ -75,6 +75,7 @@ public:
     /// Where the jerk stage could not meet the limits (failed: a replan with less acceleration).
     const JerkFailure& jerk_failure() const { return jerk_failure_; }
     std::uint32_t jerk_filter_ticks() const { return jerk_setup_.filter_ticks; }
+    std::uint64_t jerk_added_ticks() const { return jerk_ ? jerk_->added_ticks() : 0; }
 
     /// Plans the job; false when the per-tick check found a tick over a limit (`check` says
     /// which), true when every span went to the sink.
@@ -458,6 +459,7 @@ PlanTotals plan_stream(SegmentSource& source, const MachineProfile& machine_prof
         WindowPlanner planner(input, profile, options, limits, sink, st, report, lo, hi);
         if (planner.run(check, totals)) {
             st.jerk_filter_ticks = planner.jerk_filter_ticks();
+            st.jerk_added_ticks = planner.jerk_added_ticks();
             report(1);
             return totals;
         }
