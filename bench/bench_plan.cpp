@@ -31,6 +31,7 @@
 //
 // Usage: bench_plan [--quick] [--segments N] [--density D] [--runs R] [--no-peers] [--markdown]
 //        bench_plan --scaling [--max-segments N] [--timeout S] [--markdown]
+//        bench_plan --jerk [--segments N] [--markdown]
 //        bench_plan --self-test
 // Exit status (also printed by --help): 0 every plan passed its check (and the peers are
 // self-consistent); 1 a plan failed its check or could not be made, a peer's result is
@@ -239,11 +240,104 @@ bool run_peer_table(bool quick, bool markdown, const MachineProfile& profile) {
     return ok;
 }
 
+
+/// Worst jerk figures of a plan from its integer control values (docs/planner.md §12), as
+/// fractions of the limit: inside the spans and at the joins (rest at both ends).
+double jerk_fraction(const Plan& plan, const MachineProfile& p) {
+    const double t = 1 / p.tick_hz;
+    double worst = 0;
+    std::vector<long double> a_end(p.axes.size(), 0.0L);
+    for (const CoreSpan& s : plan.spans) {
+        const long double n = s.ticks;
+        for (std::size_t i = 0; i < p.axes.size(); ++i) {
+            const auto& c = s.control[i];
+            const long double j = p.axes[i].max_jerk * t * t * t / p.mm_per_lsb;
+            const long double dp = static_cast<long double>(c[1]) - c[0];
+            const long double third = 6 * (-2 * dp + c[2] + c[3]) / (n * n * n);
+            const long double start = (6 * dp - 4 * c[2] - 2 * c[3]) / (n * n);
+            worst = std::max(worst, static_cast<double>(std::max(std::fabs(third), std::fabs(start - a_end[i])) / j));
+            a_end[i] = (-6 * dp + 2 * c[2] + 4 * c[3]) / (n * n);
+        }
+    }
+    for (std::size_t i = 0; i < p.axes.size(); ++i) {
+        const long double j = p.axes[i].max_jerk * t * t * t / p.mm_per_lsb;
+        worst = std::max(worst, static_cast<double>(std::fabs(a_end[i]) / j));
+    }
+    return worst;
+}
+
+/// The jerk table: motion and planning time with max_jerk 1e5 and 1e6 mm/s^3 on every axis
+/// against the plan without a jerk limit, on the grid table's drawings and the examples.
+bool run_jerk_table(std::size_t segments, bool markdown, const MachineProfile& profile) {
+    struct Named {
+        std::string name;
+        Path path;
+    };
+    std::vector<Named> paths = {{"rose " + std::to_string(segments), rose_path(segments)},
+                                {"wander " + std::to_string(segments), wander_path(segments)},
+                                {"spiral " + std::to_string(segments), spiral_path(segments)}};
+    for (const char* f : {"rose.json", "wave.json", "landscape.svg", "leaf.ngc", "star.csv", "two_pens.svg"}) {
+        paths.push_back({f, read_example(kSource + "/examples/" + f, profile)});
+    }
+    const double jerks[] = {1e5, 1e6};
+    std::printf("\n%s", markdown ? "| path | segments | motion s | plan ms | motion s, j 1e5 | % | plan ms | j % | replans | "
+                                   "motion s, j 1e6 | % | plan ms | j % | replans |\n"
+                                   "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n"
+                                 : "path               segments  motion s   plan ms  | j=1e5: motion s        %   plan ms     j %  r "
+                                   "| j=1e6: motion s        %   plan ms     j %  r\n");
+    bool ok = true;
+    for (const Named& np : paths) {
+        const std::vector<BezierSegment> segs = to_bezier_segments(np.path);
+        double base = 0;
+        std::string line;
+        char cell[200];
+        for (int k = -1; k < 2; ++k) {
+            MachineProfile p = profile;
+            for (auto& a : p.axes) a.max_jerk = k < 0 ? 0 : jerks[k];
+            try {
+                PlanStats st;
+                const auto t0 = std::chrono::steady_clock::now();
+                const Plan plan = plan_path(segs, p, PlanOptions{}, &st);
+                const double ms = ms_since(t0);
+                const double motion = static_cast<double>(st.motion_ticks) / p.tick_hz;
+                const PlanCheck check = check_plan(plan, segs, p);
+                const bool passed = check.within_limits && !check.drawing_while_pen_moves &&
+                                    check.max_deviation <= p.chord_tolerance + 1.5 * std::sqrt(2.0) * p.mm_per_lsb;
+                if (k < 0) {
+                    base = motion;
+                    std::snprintf(cell, sizeof cell, markdown ? "| %s | %zu | %.3f | %.1f " : "%-18s %8zu %9.3f %9.1f ",
+                                  np.name.c_str(), segs.size(), motion, ms);
+                } else {
+                    const double jf = jerk_fraction(plan, p);
+                    std::snprintf(cell, sizeof cell, markdown ? "| %.3f | %+.2f | %.1f | %.1f | %d " : "| %15.3f %+8.2f %9.1f %7.1f %2d ",
+                                  motion, 100 * (motion / base - 1), ms, 100 * jf, st.replans);
+                    if (jf > 1) ok = false;
+                }
+                if (!passed) ok = false;
+                line += cell;
+                if (!passed) {
+                    char why[160];
+                    std::snprintf(why, sizeof why, "(check FAILED: v %.3f a %.3f dev %.4f mm) ",
+                                  std::max(check.max_velocity_fraction_exact, check.max_span_velocity_fraction),
+                                  std::max(check.max_acceleration_fraction_exact, check.max_span_acceleration_fraction),
+                                  check.max_deviation);
+                    line += why;
+                }
+            } catch (const std::exception& e) {
+                line += std::string("| ") + e.what() + " ";
+                ok = false;
+            }
+        }
+        std::printf("%s%s\n", line.c_str(), markdown ? "|" : "");
+    }
+    return ok;
+}
 }  // namespace
 
 constexpr const char* kUsageText =
     "usage: bench_plan [--quick] [--segments N] [--density D] [--runs R] [--no-peers] [--markdown]\n"
     "       bench_plan --scaling [--max-segments N] [--timeout S] [--markdown]\n"
+    "       bench_plan --jerk [--segments N] [--markdown]\n"
     "       bench_plan --self-test\n"
     "  Plans three 2-axis drawings (rose, wander, spiral) of N segments (default 10000) for the pen\n"
     "  plotter and prints planning time, motion time against the same planner on a D times denser\n"
@@ -261,6 +355,9 @@ constexpr const char* kUsageText =
     "                   each in its own process (this table only)\n"
     "  --max-segments N largest scaling size (default 1000000)\n"
     "  --timeout S      wall seconds a scaling size may take (default 300)\n"
+    "  --jerk           the cost of a jerk limit: motion and planning time with max_jerk 1e5 and\n"
+    "                   1e6 mm/s^3 against none, on the grid table's drawings (N segments, default\n"
+    "                   1000 here) and the examples, each plan checked (this table only)\n"
     "  --self-test      the reference planners against closed-form answers\n"
     "targets (independent of the machine's speed): every plan within the limits for its exact\n"
     "cubic and every tick, no motion during a pen dwell, deviation within the chord tolerance plus\n"
@@ -273,7 +370,8 @@ int main(int argc, char** argv) {
     std::size_t segments = 10000;
     double density = 16;
     int runs = 3;
-    bool markdown = false, quick = false, peers = true, scaling = false, self_test = false;
+    bool markdown = false, quick = false, peers = true, scaling = false, self_test = false, jerk = false;
+    bool segments_given = false;
     ScalingOptions scaling_options;
     for (int i = 1; i < argc; ++i) {
         const std::string a = argv[i];
@@ -288,8 +386,11 @@ int main(int argc, char** argv) {
             scaling = true;
         } else if (a == "--self-test") {
             self_test = true;
+        } else if (a == "--jerk") {
+            jerk = true;
         } else if (a == "--segments" && has_value) {
             segments = static_cast<std::size_t>(std::strtoul(argv[++i], nullptr, 10));
+            segments_given = true;
         } else if (a == "--max-segments" && has_value) {
             scaling_options.max_segments = static_cast<std::size_t>(std::strtoul(argv[++i], nullptr, 10));
         } else if (a == "--timeout" && has_value) {
@@ -321,7 +422,9 @@ int main(int argc, char** argv) {
     const MachineProfile profile = bench_pen_plotter();
     std::printf("bench_plan: machine load (1, 5, 15 min) at start: %s\n", load_text().c_str());
     bool ok = true;
-    if (scaling) {
+    if (jerk) {
+        ok = run_jerk_table(segments_given ? segments : 1000, markdown, profile);
+    } else if (scaling) {
         const std::vector<ScalingRow> rows = run_scaling(scaling_options, profile);
         print_scaling(rows, scaling_options, markdown);
         ok = scaling_passed(rows);

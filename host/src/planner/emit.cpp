@@ -45,6 +45,7 @@ void SpanEmitter::span(const LsbVec& p1, const LsbVec& t0, const LsbVec& t1, std
     s.subpath = subpath;
     s.pen_down = pen_down;
     if (make_span_timing(s.basis, ticks, s.timing) != Status::kOk) fail(subpath, "span ticks out of range");
+    if (check_jerk_) verify_jerk(p1, t0, t1, ticks, subpath);
     const LsbVec* values[4] = {&pos_, &p1, &t0, &t1};
     s.control.reserve(axes_);
     s.cubic.reserve(axes_);
@@ -70,6 +71,8 @@ void SpanEmitter::span(const LsbVec& p1, const LsbVec& t0, const LsbVec& t1, std
         s.control.push_back(c);
         s.cubic.push_back(cubic);
     }
+    for (std::size_t a = 0; a < axes_; ++a) a_end_[a] = -6 * (p1[a] - pos_[a]) + 2 * t0[a] + 4 * t1[a];
+    last_ticks_ = ticks;
     release();
     events_.push_back(std::move(ev));
     held_ = true;
@@ -143,8 +146,46 @@ void SpanEmitter::motion(const Knot& from, const MotionSpan& s, const Run& run) 
     motion_ticks_ += s.ticks;
 }
 
+void SpanEmitter::motion_lsb(const LsbVec& p1, const LsbVec& t0, const LsbVec& t1, std::uint32_t ticks,
+                             std::size_t subpath, bool pen_down) {
+    span(p1, t0, t1, ticks, subpath, pen_down);
+    ++motion_spans_;
+    motion_ticks_ += ticks;
+}
+
+// The jerk rules of docs/planner.md §12 on the exact integer span, before it is made: its
+// third derivative 6 (2 P0 - 2 P1 + T0 + T1) / n^3 and the step from the last span's end
+// acceleration to its start acceleration (6 (P1 - P0) - 4 T0 - 2 T1) / n^2, both within J.
+void SpanEmitter::verify_jerk(const LsbVec& p1, const LsbVec& t0, const LsbVec& t1, std::uint32_t ticks,
+                              std::size_t subpath) {
+    const long double n = ticks, m = last_ticks_;
+    for (std::size_t a = 0; a < axes_; ++a) {
+        const long double j = jerk_lsb_[a];
+        if (!std::isfinite(static_cast<double>(j))) continue;
+        const std::int64_t dp = p1[a] - pos_[a];
+        const long double third = std::fabs(static_cast<long double>(6 * (-2 * dp + t0[a] + t1[a])));
+        const long double start = static_cast<long double>(6 * dp - 4 * t0[a] - 2 * t1[a]);
+        const long double step = std::fabs(start * m * m - static_cast<long double>(a_end_[a]) * n * n);
+        if (third > j * n * n * n || step > j * n * n * m * m) {
+            std::ostringstream msg;
+            msg << "axis " << a << ": a span at tick " << total_ticks_ << " exceeds the jerk limit of " << j
+                << " LSB/tick^3 (" << (third > j * n * n * n ? "inside the span" : "at its join with the last one")
+                << ")";
+            fail(subpath, msg.str());
+        }
+    }
+}
+
 void SpanEmitter::finish(std::size_t last_subpath) {
     if (pen_) pen(false, last_subpath, true);
+    if (check_jerk_) {  // the job ends at rest
+        const long double n = last_ticks_;
+        for (std::size_t a = 0; a < axes_; ++a) {
+            if (std::fabs(static_cast<long double>(a_end_[a])) > jerk_lsb_[a] * n * n) {
+                fail(last_subpath, "axis " + std::to_string(a) + ": the last span does not end within the jerk limit");
+            }
+        }
+    }
     release();
 }
 

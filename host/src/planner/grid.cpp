@@ -236,6 +236,15 @@ PathGrid build_grid(const std::vector<BezierSegment>& segments, const MachinePro
     for (const auto& a : profile.axes) a_min = a_min == 0 ? a.max_acceleration : std::min(a_min, a.max_acceleration);
     const double tick = 1 / profile.tick_hz;
     b.kappa_stop_ = a_min > 0 ? 1 / (a_min * tick * tick) : std::numeric_limits<double>::infinity();
+    // With a jerk limit (docs/planner.md §12) also where the jerk cap kappa^2 s^3 <= j / 4 is below
+    // that speed, a T: kappa > sqrt(j / 4 / (a T)^3), smallest limits.
+    double j_min = 0;
+    for (const auto& a : profile.axes) {
+        if (a.max_jerk > 0) j_min = j_min == 0 ? a.max_jerk : std::min(j_min, a.max_jerk);
+    }
+    if (j_min > 0 && a_min > 0) {
+        b.kappa_stop_ = std::min(b.kappa_stop_, std::sqrt(0.25 * j_min / std::pow(a_min * tick, 3)));
+    }
     b.out.grid.axes = axes;
     for (VecArray* v : {&b.out.grid.q, &b.out.grid.tangent, &b.out.grid.curvature, &b.out.grid.corner_jump}) {
         v->set_axes(axes);

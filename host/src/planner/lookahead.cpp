@@ -93,6 +93,72 @@ std::vector<double> speed_caps(const PathGrid& pg, const Limits& limits, const M
     return caps;
 }
 
+void jerk_caps(const PathGrid& pg, const Limits& limits, const MachineProfile& profile, std::uint32_t filter_ticks,
+               std::vector<double>& caps) {
+    const Grid& g = pg.grid;
+    const double span = profile.ticks_per_span / profile.tick_hz;
+    const double share = limits.jerk_share;
+    const auto cap = [&](std::size_t k, double s) { caps[k] = std::min(caps[k], s * s); };
+    // Stops (pieces' ends) are passed at rest: no curvature rule there, and the filter never
+    // averages across them.
+    std::vector<char> stop(g.size(), 0);
+    for (const Piece& piece : pg.pieces) stop[piece.first] = stop[piece.last] = 1;
+    for (std::size_t k = 0; k + 1 < g.size(); ++k) {
+        // The spline through knots on both sides of a curvature step dk (a joint) leaves the
+        // path by about 0.07 dk h^2 (h the span's length, measured): within 0.4 delta.
+        const double dk = norm(sub(g.curvature[k + 1], g.curvature[k]));
+        if (dk > 0 && !stop[k] && !stop[k + 1] && g.lambda[k + 1] <= g.lambda[k]) {
+            const double s = std::sqrt(0.4 * profile.chord_tolerance / (0.07 * dk)) / span;
+            cap(k, s);
+            cap(k + 1, s);
+        }
+    }
+    for (std::size_t k = 0; k < g.size(); ++k) {
+        for (std::size_t i = 0; i < g.axes; ++i) {
+            const double j = i < limits.jerk.size() ? limits.jerk[i] : 0.0;
+            if (!(j > 0)) continue;
+            // A tangent jump J crossed at speed s: the spans around it turn the velocity by
+            // s |J_i| within about one span, up and down again.
+            const double jump = std::fabs(g.corner_jump[k][i]);
+            if (jump > 0) cap(k, share * j * span * span / (2 * jump));
+            // Turning the velocity at curvature kappa: its derivative along the tangent, kappa^2
+            // s^3 (within the quarter of the limit the filter leaves).
+            const double kappa = norm(g.curvature[k]);
+            if (kappa > 0 && !stop[k]) cap(k, std::cbrt((1 - share) * j / (kappa * kappa * std::fabs(g.tangent[k][i]) + 1e-300)));
+            if (k + 1 >= g.size() || stop[k] || stop[k + 1]) continue;
+            const double dk = std::fabs(g.curvature[k + 1][i] - g.curvature[k][i]);
+            if (!(dk > 0)) continue;
+            // A change of curvature by dk over dl at speed s: kappa' s^3 = dk s^3 / dl; where
+            // that takes less than a span, a step of dk s^2 in the acceleration, which the spans
+            // around it spread over about a span.
+            const double dl = g.lambda[k + 1] - g.lambda[k];
+            const double step = std::sqrt(share * j * span / (2 * dk));
+            const double s = dl > 0 ? std::max(std::cbrt(share * j * dl / dk), step) : step;
+            cap(k, s);
+            cap(k + 1, s);
+        }
+    }
+    // The filter raises the speed at a dip to the mean over M ticks: every cap must hold over
+    // the distance the window covers around it.
+    const double reach_time = (filter_ticks + profile.ticks_per_span) / profile.tick_hz;
+    // Dips below the speed one tick of acceleration gives (a T: the neighbourhood of a stop,
+    // a cusp) erode their surroundings no lower than that: the motion comes to rest there
+    // anyway, and the jerk stage's exact check guards what is left.
+    double a_min = 1e300;
+    for (const double a : limits.acceleration) a_min = std::min(a_min, a);
+    const double slowest = a_min / profile.tick_hz * a_min / profile.tick_hz;
+    std::vector<double> before = caps;
+    for (std::size_t k = 0; k < g.size(); ++k) before[k] = std::max(caps[k], slowest);
+    for (const Piece& piece : pg.pieces) {
+        for (std::size_t k = piece.first; k <= piece.last; ++k) {
+            const double d = reach_time * std::sqrt(std::min(before[k], kNoCap));
+            for (std::size_t i = k; i-- > piece.first && g.lambda[k] - g.lambda[i] <= d;) caps[k] = std::min(caps[k], before[i]);
+            for (std::size_t i = k + 1; i <= piece.last && g.lambda[i] - g.lambda[k] <= d; ++i)
+                caps[k] = std::min(caps[k], before[i]);
+        }
+    }
+}
+
 void reserve_for_corners(const PathGrid& pg, const Limits& limits, const std::vector<double>& caps,
                          double span_time, std::vector<double>& factor) {
     const Grid& g = pg.grid;

@@ -13,6 +13,7 @@ WindowLookahead::WindowLookahead(const PathGrid& grid, const Limits& lim, const 
     : pg(grid), limits(lim), profile(prof), options(opt), span_time(prof.ticks_per_span / prof.tick_hz) {
     const std::size_t n = pg.grid.size();
     base_caps = speed_caps(pg, limits, profile, options);
+    if (limits.has_jerk()) jerk_caps(pg, limits, profile, jerk_setup(profile, limits).filter_ticks, base_caps);
     caps = base_caps;
     local_factor.assign(n, 1.0);
     local_cap.assign(n, 1.0);

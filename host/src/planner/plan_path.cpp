@@ -40,6 +40,22 @@ void validate_plan_inputs(const MachineProfile& p, const PlanOptions& o) {
     require(std::isfinite(p.chord_tolerance) && p.chord_tolerance > 0, "chord_tolerance must be > 0");
     require(std::isfinite(p.pen_down_delay) && p.pen_down_delay >= 0, "pen_down_delay must be >= 0");
     require(std::isfinite(p.pen_up_delay) && p.pen_up_delay >= 0, "pen_up_delay must be >= 0");
+    // A jerk limit needs spans of n ticks with J n^2 >= 8 and J n^3 >= 120 (J in LSB/tick^3,
+    // docs/planner.md §12); spans beyond 8 times the regular length are refused.
+    const double tick = 1 / p.tick_hz;
+    const double n_max = std::min<double>(8.0 * regular_span_ticks(p), kMaxSpanTicks);
+    const double j_min = std::max(8 / (n_max * n_max), 120 / (n_max * n_max * n_max)) * p.mm_per_lsb / (tick * tick * tick);
+    for (const auto& a : p.axes) {
+        require(std::isfinite(a.max_jerk) && a.max_jerk >= 0, "axis " + a.name + ": max_jerk must be >= 0");
+        if (a.max_jerk > 0 && a.max_jerk < j_min) {
+            std::ostringstream m;
+            m << (p.source.empty() ? "" : p.source + ": ") << "axis " << a.name << ": max_jerk " << a.max_jerk
+              << " mm/s^3 is below the planner's minimum of " << j_min
+              << " mm/s^3 for this profile (spans of at most " << n_max
+              << " ticks must meet it exactly on the LSB grid; use a larger max_jerk or mm_per_lsb)";
+            throw PlanError("machine profile: " + m.str());
+        }
+    }
     if (!(o.velocity_margin > 0 && o.velocity_margin <= 1 && o.feed_margin > 0 && o.feed_margin <= 1 &&
           o.acceleration_margin > 0 && o.acceleration_margin <= 1 && o.lookahead_margin > 0 &&
           o.lookahead_margin <= 1 && o.lookahead_bend_margin > 0 && o.lookahead_bend_margin <= 1 && o.max_turn > 0 && o.min_nodes_per_segment >= 1)) {

@@ -69,7 +69,13 @@ public:
         v_axes_ = std::sqrt(v_axes);
         top_speed_ = std::min(v_axes_, std::max(profile.feed, profile.travel_feed));
         total_ = source.size_hint();
+        jerk_setup_ = jerk_setup(profile, limits);
     }
+
+    /// Where the jerk stage could not meet the limits (failed: a replan with less acceleration).
+    const JerkFailure& jerk_failure() const { return jerk_failure_; }
+    std::uint32_t jerk_filter_ticks() const { return jerk_setup_.filter_ticks; }
+    std::uint64_t jerk_added_ticks() const { return jerk_ ? jerk_->added_ticks() : 0; }
 
     /// Plans the job; false when the per-tick check found a tick over a limit (`check` says
     /// which), true when every span went to the sink.
@@ -97,6 +103,7 @@ public:
             }
             const auto before = std::pair{carry_.segment, carry_.lambda_in_segment};
             plan_window(pg, carry_lambda, commit);
+            if (jerk_failure_.failed) return fail(check);
             st_.grid_nodes += pg.grid.size();
             if (exhausted_ && !cut_) {
                 emitter().finish(last_subpath_);
@@ -177,6 +184,21 @@ private:
             const BezierSegment& b = buffer_[first - base_];
             if (a.pen_down == b.pen_down && a.subpath == b.subpath) --first;
         }
+        if (carry_.moving && jerk_setup_.active) {
+            // The jerk stage's filtered position lags the motion by up to M ticks of travel:
+            // the path there must be in this window too.
+            const double lag = (jerk_setup_.filter_ticks + 2.0 * profile_.ticks_per_span) / profile_.tick_hz *
+                                   top_speed_ + 1.0 + carry_.lambda_in_segment;
+            double back = 0;
+            while (first > base_ && back < lag) {
+                const BezierSegment& a = buffer_[first - 1 - base_];
+                const BezierSegment& b = buffer_[first - base_];
+                if (a.pen_down != b.pen_down || a.subpath != b.subpath) break;
+                const Cubic c = to_cubic(a);
+                back += arc_length(c, 0, 0.5) + arc_length(c, 0.5, 1);
+                --first;
+            }
+        }
         return first;
     }
 
@@ -212,6 +234,10 @@ private:
         cut_ = false;
         if (!emitter_) {
             emitter_.emplace(profile_, g.axes, pg.runs.front().start);
+            if (jerk_setup_.active) {
+                emitter_->set_jerk_limits(jerk_setup_.jerk_lsb);
+                jerk_.emplace(profile_, jerk_setup_, g.axes);
+            }
             carry_.q = on_lsb_grid(pg.runs.front().start, profile_.mm_per_lsb, g.axes);
             carry_.started = true;
         }
@@ -244,6 +270,10 @@ private:
                 } else {
                     emitter().piece_start(carry_.q, run.subpath);
                 }
+                if (jerk_) {
+                    if (resume) jerk_->rebase(carry_lambda);
+                    else jerk_->piece_begin(first, run.subpath, run.pen_down, emitter());
+                }
                 PieceMotion m = plan_piece(la, piece, carry_.q, resume ? &carried : nullptr, run_offset, st_);
                 ++st_.pieces;
                 const std::size_t skip = resume ? 2 : 0;
@@ -257,7 +287,12 @@ private:
                         stopped_inside = true;
                         break;
                     }
-                    emitter().motion(from, s, run);
+                    if (!jerk_) {
+                        emitter().motion(from, s, run);
+                    } else if (!jerk_->raw_span(from, s, pg, piece, run_offset, emitter())) {
+                        jerk_failure_ = jerk_->failure();
+                        return;
+                    }
                     before = from;
                     from = s.end;
                     ticks = s.ticks;
@@ -274,6 +309,10 @@ private:
                     break;
                 }
                 carry_.moving = false;
+                if (jerk_ && !jerk_->piece_end(from.q, pg, piece, run_offset, emitter())) {
+                    jerk_failure_ = jerk_->failure();
+                    return;
+                }
             }
         }
         if (!cut_ && !exhausted_) {
@@ -367,6 +406,9 @@ private:
     double lo_, hi_;
     TickChecker checker_;
     std::optional<SpanEmitter> emitter_;
+    JerkSetup jerk_setup_;
+    std::optional<JerkStage> jerk_;
+    JerkFailure jerk_failure_;
     std::vector<BezierSegment> buffer_;  ///< segments base_ .. base_ + size - 1
     std::size_t base_ = 0;
     bool exhausted_ = false;
@@ -386,7 +428,7 @@ PlanTotals plan_stream(SegmentSource& source, const MachineProfile& machine_prof
     const PlanOptions options = profile_options(requested, machine_profile);
     validate_plan_inputs(machine_profile, options);
     MachineProfile profile = machine_profile;  // what is planned with: spans of regular_span_ticks
-    profile.ticks_per_span = regular_span_ticks(machine_profile);
+    profile.ticks_per_span = jerk_span_ticks(machine_profile, regular_span_ticks(machine_profile));
     Progress report(progress);
     PlanStats local;
     PlanStats& st = stats != nullptr ? *stats : local;
@@ -398,6 +440,15 @@ PlanTotals plan_stream(SegmentSource& source, const MachineProfile& machine_prof
     for (const auto& a : profile.axes) {
         limits.velocity.push_back(a.max_velocity);
         limits.acceleration.push_back(a.max_acceleration);
+        limits.jerk.push_back(a.max_jerk);
+    }
+    // The jerk stage's spline through knots rounded to the LSB moves the accelerations by a
+    // few hundredths of an LSB/tick^2, and overshoots a little where the filter is as short as
+    // a span: the second-order stage leaves it 3 % to 10 %.
+    if (limits.has_jerk()) {
+        const JerkSetup js = jerk_setup(profile, limits);
+        const double headroom = 0.97 - 0.07 * std::min(1.0, double(profile.ticks_per_span) / js.filter_ticks);
+        for (double& a : limits.acceleration) a *= headroom;
     }
     double lo = 0.0, hi = 0.95;
     CornerBlender blended(source, options.corner_blend * profile.chord_tolerance, options.corner_stop_angle);
@@ -407,8 +458,20 @@ PlanTotals plan_stream(SegmentSource& source, const MachineProfile& machine_prof
         PlanTotals totals;
         WindowPlanner planner(input, profile, options, limits, sink, st, report, lo, hi);
         if (planner.run(check, totals)) {
+            st.jerk_filter_ticks = planner.jerk_filter_ticks();
+            st.jerk_added_ticks = planner.jerk_added_ticks();
             report(1);
             return totals;
+        }
+        const JerkFailure jerk = planner.jerk_failure();
+        if (jerk.failed && attempt >= options.max_replans) {
+            static const char* const rules[] = {"the acceleration step at a join", "the jerk inside a span",
+                                                "the end at rest", "the acceleration limit", "the velocity limit"};
+            throw PlanError("cannot meet the jerk limit of axis " + profile.axes[jerk.axis].name + " at " + jerk.where +
+                            " after " + std::to_string(attempt) +
+                            " replans with lowered limits (no integer tangents keep every span and join "
+                            "within it and the velocity and acceleration limits; most often refused: " +
+                            rules[std::clamp(jerk.rule, 0, 4)] + ")");
         }
         if (attempt >= options.max_replans) {
             std::ostringstream m;
@@ -423,7 +486,19 @@ PlanTotals plan_stream(SegmentSource& source, const MachineProfile& machine_prof
             throw PlanError("the plan needs lowered limits (a tick over a limit after rounding) but the spans "
                             "already sent cannot be taken back");
         }
-        for (std::size_t i = 0; i < profile.axes.size(); ++i) {
+        if (jerk.failed && jerk.velocity) {
+            // The spline through the knots overshoots a velocity limit the second-order stage
+            // reached: that axis's velocity a little lower.
+            limits.velocity[jerk.axis] *= 0.97;
+            st.velocity_scale = std::min(st.velocity_scale, limits.velocity[jerk.axis] / profile.axes[jerk.axis].max_velocity);
+        }
+        for (std::size_t i = 0; i < profile.axes.size() && jerk.failed && !jerk.velocity; ++i) {
+            // The jerk stage failed: less acceleration, with the same filter (the filter's jerk
+            // and the curvature terms 3 kappa s s'' both fall with it; docs/planner.md §12).
+            limits.acceleration[i] *= 0.85;
+            st.acceleration_scale = std::min(st.acceleration_scale, limits.acceleration[i] / profile.axes[i].max_acceleration);
+        }
+        for (std::size_t i = 0; i < profile.axes.size() && !jerk.failed; ++i) {
             const double fv = std::max(check.axis_velocity_fraction[i], check.axis_velocity_fraction_exact[i]);
             const double fa = std::max(check.axis_acceleration_fraction[i], check.axis_acceleration_fraction_exact[i]);
             if (fv > 1) limits.velocity[i] *= 0.99 / fv;

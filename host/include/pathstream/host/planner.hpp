@@ -79,6 +79,11 @@ struct PlanStats {
     /// Motion time (s) of the continuous TOPP-RA optimum on the same grid with the machine's
     /// full limits: the time-optimal reference the executed motion is compared with.
     double reference_motion_time = 0;
+    /// With a jerk limit: ticks of the jerk stage's box filter (docs/planner.md §12), else 0.
+    std::uint32_t jerk_filter_ticks = 0;
+    /// With a jerk limit: motion ticks the jerk stage added to the second-order plan (the
+    /// filter's length and the rest at the end of every piece), else 0.
+    std::uint64_t jerk_added_ticks = 0;
 };
 
 /// Plans `segments` (consecutive, continuous; to_bezier_segments makes them) for `profile`:
