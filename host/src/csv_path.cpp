@@ -146,7 +146,8 @@ public:
         if (text.substr(0, 3) == "\xEF\xBB\xBF") text.remove_prefix(3);  // UTF-8 byte order mark
         // At most one point a line: reserved at once (with the first point, which sets the axes),
         // the list never grows by copying.
-        const std::size_t lines = static_cast<std::size_t>(std::count(text.begin(), text.end(), '\n')) + 1;
+        const std::size_t lines =
+            static_cast<std::size_t>(std::count(text.begin(), text.end(), '\n')) + 1;
         for (std::size_t line = 1; !text.empty(); ++line) {
             const std::size_t end = text.find('\n');
             const std::string_view current = text.substr(0, end);

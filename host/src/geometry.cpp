@@ -35,7 +35,9 @@ void for_each_window(const PointList& pts, bool closed, Visit&& visit) {
     }
     const PathPoint before = reflect(pts[0], pts[1]), after = reflect(pts[m - 1], pts[m - 2]);
     // The extended list: before, pts[0], ..., pts[m - 1], after (m + 2 points).
-    const auto ext = [&](std::size_t i) { return i == 0 ? PointRef(before) : i == m + 1 ? PointRef(after) : pts[i - 1]; };
+    const auto ext = [&](std::size_t i) {
+        return i == 0 ? PointRef(before) : i == m + 1 ? PointRef(after) : pts[i - 1];
+    };
     for (std::size_t i = 0; i + 3 < m + 2; ++i) visit(Window{ext(i), ext(i + 1), ext(i + 2), ext(i + 3)});
 }
 
@@ -153,8 +155,8 @@ void for_each_bezier_segment(const Path& path, const std::function<void(const Be
         const Subpath& sp = path.subpaths[s];
         if (!sp.points.empty() && sp.points.axes() != path.axes) {  // a list's points have one size
             throw std::invalid_argument("subpath " + std::to_string(s) + ": a point has " +
-                                        std::to_string(sp.points.axes()) + " coordinates, expected " +
-                                        std::to_string(path.axes));
+                                        std::to_string(sp.points.axes()) +
+                                        " coordinates, expected " + std::to_string(path.axes));
         }
         bool first = true;
         BezierSegment seg;

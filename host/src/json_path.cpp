@@ -80,7 +80,8 @@ public:
         return sp;
     }
 
-    PointList points(const json& v, const std::string& pointer, double scale, std::size_t& axes) const {
+    PointList points(const json& v, const std::string& pointer, double scale,
+                     std::size_t& axes) const {
         if (!v.is_array()) fail(pointer, "points must be an array of [x, y, ...] arrays");
         if (const auto flat = flat_.found.find(pointer); flat != flat_.found.end()) {
             FlatNumberArrays::Rows rows = std::move(flat->second);
@@ -111,8 +112,8 @@ public:
     }
 
     /// points() of an array read flat: the same checks in the same order, the same messages.
-    PointList flat_points(const FlatNumberArrays::Rows& rows, const std::string& pointer, double scale,
-                          std::size_t& axes) const {
+    PointList flat_points(const FlatNumberArrays::Rows& rows, const std::string& pointer,
+                          double scale, std::size_t& axes) const {
         PointList out;
         const double* value = rows.values.data();
         for (std::size_t i = 0; i < rows.widths.size(); ++i) {

@@ -2,6 +2,7 @@
 #include "pathstream/host/point_list.hpp"
 
 #include <algorithm>
+#include <functional>
 #include <stdexcept>
 #include <string>
 
@@ -32,9 +33,9 @@ void PointList::push_back(PointRef p) {
         throw std::invalid_argument("a point has " + std::to_string(p.size()) +
                                     " coordinates, expected " + std::to_string(axes_));
     }
-    // p may view this list: an insert from a range of our own storage would read freed memory.
-    if (coords_.size() + axes_ > coords_.capacity() && p.data() >= coords_.data() &&
-        p.data() < coords_.data() + coords_.size()) {
+    // p may view this list: inserting from our own storage is not allowed (it may move).
+    const std::less<const double*> before;
+    if (!before(p.data(), coords_.data()) && before(p.data(), coords_.data() + coords_.size())) {
         const PathPoint copy = p.vector();
         coords_.insert(coords_.end(), copy.begin(), copy.end());
         return;

@@ -144,8 +144,10 @@ const double kQuarter = 4.0 / 3.0 * std::tan(kPi / 8);  // a quarter circle's ta
 
 // ---- syntax and modal state ---------------------------------------------------------------
 
-TEST_CASE("G-code: a run of lines is a polyline; with a curve, a Bezier chain with control points at thirds",
-          "[host][gcode]") {
+TEST_CASE(
+    "G-code: a run of lines is a polyline; with a curve, a Bezier chain with control points at "
+    "thirds",
+    "[host][gcode]") {
     const Path p = gcode("G21 G90 G17\nG0 X0 Y0\nG1 Z-1 F600\nG1 X30 Y0\nX30 Y30\nG0 Z5\nM2\n");
     REQUIRE(p.axes == 2);
     REQUIRE(p.subpaths.size() == 1);
@@ -158,7 +160,8 @@ TEST_CASE("G-code: a run of lines is a polyline; with a curve, a Bezier chain wi
     CHECK(m.subpaths[0].basis == PathBasis::kBezier);
     REQUIRE(m.subpaths[0].points.size() == 3 * 4 + 1);
     const std::vector<P2> lines = line_chain({{0, 0}, {30, 0}, {30, 30}});
-    for (std::size_t i = 0; i < lines.size(); ++i) CHECK(near(m.subpaths[0].points[i], lines[i].x, lines[i].y));
+    for (std::size_t i = 0; i < lines.size(); ++i)
+        CHECK(near(m.subpaths[0].points[i], lines[i].x, lines[i].y));
     CHECK(near(m.subpaths[0].points[12], 50, 40));
     CHECK(near(m.subpaths[0].points[10], 40 + 10.0 / 3, 40));
     CHECK_FALSE(sp.closed);

@@ -92,8 +92,7 @@ std::vector<std::vector<double>> dense_curve(const Curve& c, std::size_t samples
     return out;
 }
 
-std::vector<std::vector<double>> dense_chain(const PointList& q,
-                                             std::size_t per_piece) {
+std::vector<std::vector<double>> dense_chain(const PointList& q, std::size_t per_piece) {
     std::vector<std::vector<double>> out;
     const std::size_t pieces = (q.size() - 1) / 3;
     for (std::size_t k = 0; k < pieces; ++k) {

@@ -119,7 +119,8 @@ TEST_CASE("rotating a closed subpath keeps its curve", "[order]") {
 TEST_CASE("touching polyline and Bezier ends are joined, splines are not", "[order]") {
     Path p;
     Subpath a{PathBasis::kPolyline, false, {{0, 20}, {10, 20}}, 0, {}};
-    Subpath b{PathBasis::kPolyline, false, {{20, 25}, {10.004, 20}}, 0, {}};  // touches a's end, reversed
+    // touches a's end, reversed
+    Subpath b{PathBasis::kPolyline, false, {{20, 25}, {10.004, 20}}, 0, {}};
     Subpath c{PathBasis::kBezier, false, {{0, 0}, {1, 1}, {2, 1}, {3, 0}}, 0, {}};
     Subpath d{PathBasis::kBezier, false, {{3, 0}, {4, -1}, {5, -1}, {6, 0}}, 0, {}};
     Subpath e{PathBasis::kBSpline, false, {{6, 0}, {7, 3}, {8, 0}}, 0, {}};
@@ -140,7 +141,8 @@ TEST_CASE("touching polyline and Bezier ends are joined, splines are not", "[ord
     CHECK(none == 1);
 }
 
-TEST_CASE("a polyline touching a Bezier chain joins it as a Bezier chain of the same curve", "[order]") {
+TEST_CASE("a polyline touching a Bezier chain joins it as a Bezier chain of the same curve",
+          "[order]") {
     Path p;
     const Subpath line{PathBasis::kPolyline, false, {{0, 0}, {3, 0}, {3, 3}}, 0, {}};
     const Subpath curve{PathBasis::kBezier, false, {{3, 3}, {4, 4}, {5, 4}, {6, 3}}, 0, {}};
@@ -158,7 +160,8 @@ TEST_CASE("a polyline touching a Bezier chain joins it as a Bezier chain of the 
     for (const BezierSegment& b : segments_of(curve)) expected.push_back(b);
     const std::vector<BezierSegment> got = segments_of(joined);
     REQUIRE(got.size() == expected.size());
-    for (std::size_t i = 0; i < got.size(); ++i) CHECK(segment_gap(got[i], expected[i], false) == 0);
+    for (std::size_t i = 0; i < got.size(); ++i)
+        CHECK(segment_gap(got[i], expected[i], false) == 0);
 }
 
 TEST_CASE("order: never more travel than document order (seeded)", "[order]") {

@@ -76,8 +76,8 @@ void check_points(const Subpath& s, const std::vector<Point>& expected) {
     const std::vector<Point> chain = chain_of(s);
     REQUIRE(chain.size() == expected.size());
     for (std::size_t i = 0; i < expected.size(); ++i) {
-        INFO("point " << i << ": (" << chain[i].x << ", " << chain[i].y << ") expected (" << expected[i].x << ", "
-                      << expected[i].y << ")");
+        INFO("point " << i << ": (" << chain[i].x << ", " << chain[i].y << ") expected ("
+                      << expected[i].x << ", " << expected[i].y << ")");
         CHECK(std::fabs(chain[i].x - expected[i].x) <= kEps);
         CHECK(std::fabs(chain[i].y - expected[i].y) <= kEps);
     }
@@ -194,8 +194,9 @@ TEST_CASE("svg: M and L, absolute and relative, with implicit linetos", "[svg]")
 }
 
 TEST_CASE("svg: a subpath of straight pieces only is a polyline of their ends", "[svg]") {
-    const Path p = parse(R"(<path d="M 0 0 L 10 0 L 10 10 Z M 20 0 L 30 0 Q 40 0 40 10"/>)"
-                         R"(<polyline points="0,20 10,20 10,30"/><rect x="50" y="0" width="10" height="5"/>)");
+    const Path p =
+        parse(R"(<path d="M 0 0 L 10 0 L 10 10 Z M 20 0 L 30 0 Q 40 0 40 10"/>)"
+              R"(<polyline points="0,20 10,20 10,30"/><rect x="50" y="0" width="10" height="5"/>)");
     REQUIRE(p.subpaths.size() == 4);
     CHECK(p.subpaths[0].basis == PathBasis::kPolyline);
     CHECK(p.subpaths[0].points == PointList{{0, 0}, {10, 0}, {10, 10}, {0, 0}});

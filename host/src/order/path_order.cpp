@@ -103,7 +103,8 @@ std::vector<Item> make_items(const Path& path, double tolerance) {
             for (std::size_t r = 0; r + step <= m; r += step) {
                 if (s.basis == PathBasis::kBSpline) {
                     PathPoint p(s.points[r].size());
-                    const PointRef a = s.points[(r + m - 1) % m], b = s.points[r], c = s.points[(r + 1) % m];
+                    const PointRef a = s.points[(r + m - 1) % m], b = s.points[r],
+                                   c = s.points[(r + 1) % m];
                     for (std::size_t k = 0; k < p.size(); ++k) p[k] = (a[k] + 4 * b[k] + c[k]) / 6;
                     it.starts.push_back(p);
                 } else {
@@ -144,7 +145,9 @@ public:
         return it.cyclic ? it.starts[v.choice] : PointRef(v.choice == 0 ? it.last : it.first);
     }
     /// Where the pen is before position k.
-    PointRef before(std::size_t k) const { return k == 0 ? PointRef(start_) : end_of(visits[k - 1]); }
+    PointRef before(std::size_t k) const {
+        return k == 0 ? PointRef(start_) : end_of(visits[k - 1]);
+    }
 
     double travel() const {
         double t = 0;
@@ -566,7 +569,8 @@ bool any_touching(const Path& path, double tolerance) {
     std::map<Key, std::vector<std::pair<std::size_t, PointRef>>> ends;
     for (std::size_t i = 0; i < in.size(); ++i) {
         if (!joinable(in[i])) continue;
-        for (const PointRef p : {in[i].points.front(), in[i].points.back()}) ends[key(p)].push_back({i, p});
+        for (const PointRef p : {in[i].points.front(), in[i].points.back()})
+            ends[key(p)].push_back({i, p});
     }
     for (const auto& [k, list] : ends) {
         for (const auto& [i, p] : list) {

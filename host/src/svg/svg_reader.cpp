@@ -699,9 +699,9 @@ private:
             // Only straight pieces (lines, polylines, rectangles without corners): a polyline
             // of their ends, 1 point a piece instead of 3; the planner makes the same straight
             // cubics of it (docs/formats-svg.md).
-            const bool straight = std::all_of(pieces.begin(), pieces.end(), [](const svg::Cubic& c) {
-                return c == svg::line_cubic(c[0], c[3]);
-            });
+            const bool straight =
+                std::all_of(pieces.begin(), pieces.end(),
+                            [](const svg::Cubic& c) { return c == svg::line_cubic(c[0], c[3]); });
             Subpath sp;
             sp.basis = straight ? PathBasis::kPolyline : PathBasis::kBezier;
             sp.closed = false;
