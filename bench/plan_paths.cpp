@@ -63,7 +63,7 @@ Path wander_path(std::size_t n) {
     std::normal_distribution<double> turn(0, 0.25);
     Subpath s;
     s.basis = PathBasis::kBSpline;
-    s.points.reserve(n);
+    s.points.reserve(n, 2);
     double x = 0, y = 0, heading = 0;
     for (std::size_t i = 0; i + 1 < n; ++i) {
         s.points.push_back({x, y});

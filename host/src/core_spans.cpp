@@ -13,7 +13,7 @@ namespace {
 
 using LsbPoint = std::vector<std::int64_t>;
 
-LsbPoint quantise(const PathPoint& p, double mm_per_lsb) {
+LsbPoint quantise(PointRef p, double mm_per_lsb) {
     LsbPoint q;
     for (double mm : p) q.push_back(std::llround(mm / mm_per_lsb));
     return q;

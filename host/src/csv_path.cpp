@@ -144,8 +144,10 @@ public:
         std::size_t axes = 0;
         bool first_content = true;
         if (text.substr(0, 3) == "\xEF\xBB\xBF") text.remove_prefix(3);  // UTF-8 byte order mark
-        // At most one point a line: reserved at once, the list never grows by copying.
-        sp.points.reserve(static_cast<std::size_t>(std::count(text.begin(), text.end(), '\n')) + 1);
+        // At most one point a line: reserved at once (with the first point, which sets the axes),
+        // the list never grows by copying.
+        const std::size_t lines =
+            static_cast<std::size_t>(std::count(text.begin(), text.end(), '\n')) + 1;
         for (std::size_t line = 1; !text.empty(); ++line) {
             const std::size_t end = text.find('\n');
             const std::string_view current = text.substr(0, end);
@@ -171,11 +173,13 @@ public:
                      "point has " + std::to_string(fields.size()) + " coordinates, expected " +
                          std::to_string(axes));
             }
-            PathPoint point;
-            point.reserve(fields.size());
-            for (const Field& f : fields) point.push_back(coordinate(f, line));
-            if (sp.points.empty()) sp.location = SourceLocation{line, fields.front().column};
-            sp.points.push_back(std::move(point));
+            double point[kMaxAxes];
+            for (std::size_t a = 0; a < axes; ++a) point[a] = coordinate(fields[a], line);
+            if (sp.points.empty()) {
+                sp.location = SourceLocation{line, fields.front().column};
+                sp.points.reserve(lines, axes);
+            }
+            sp.points.push_back(PointRef(point, axes));
         }
         check_count(sp);
         Path p;

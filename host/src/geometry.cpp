@@ -9,15 +9,15 @@
 namespace pathstream::host {
 namespace {
 
-using Window = std::array<const PathPoint*, 4>;
+using Window = std::array<PointRef, 4>;
 
-PathPoint combine(const PathPoint& a, double wa, const PathPoint& b, double wb) {
+PathPoint combine(PointRef a, double wa, PointRef b, double wb) {
     PathPoint r(a.size());
     for (std::size_t i = 0; i < a.size(); ++i) r[i] = wa * a[i] + wb * b[i];
     return r;
 }
 
-PathPoint reflect(const PathPoint& end, const PathPoint& next) {  // phantom point 2 end - next
+PathPoint reflect(PointRef end, PointRef next) {  // phantom point 2 end - next
     return combine(end, 2.0, next, -1.0);
 }
 
@@ -25,25 +25,27 @@ PathPoint reflect(const PathPoint& end, const PathPoint& next) {  // phantom poi
 /// them: open ends get phantom points 2 P0 - P1 and 2 Pm - Pm-1; closed subpaths are periodic.
 /// Hands them to `visit` one at a time: a window list of a 10^6-point subpath is ~40 MB.
 template <typename Visit>
-void for_each_window(const std::vector<PathPoint>& pts, bool closed, Visit&& visit) {
+void for_each_window(const PointList& pts, bool closed, Visit&& visit) {
     const std::size_t m = pts.size();
     if (closed) {
         for (std::size_t i = 0; i < m; ++i) {
-            visit(Window{&pts[(i + m - 1) % m], &pts[i], &pts[(i + 1) % m], &pts[(i + 2) % m]});
+            visit(Window{pts[(i + m - 1) % m], pts[i], pts[(i + 1) % m], pts[(i + 2) % m]});
         }
         return;
     }
     const PathPoint before = reflect(pts[0], pts[1]), after = reflect(pts[m - 1], pts[m - 2]);
     // The extended list: before, pts[0], ..., pts[m - 1], after (m + 2 points).
-    const auto ext = [&](std::size_t i) { return i == 0 ? &before : i == m + 1 ? &after : &pts[i - 1]; };
+    const auto ext = [&](std::size_t i) {
+        return i == 0 ? PointRef(before) : i == m + 1 ? PointRef(after) : pts[i - 1];
+    };
     for (std::size_t i = 0; i + 3 < m + 2; ++i) visit(Window{ext(i), ext(i + 1), ext(i + 2), ext(i + 3)});
 }
 
 /// Weighted sum w0 Q0 + w1 Q1 + w2 Q2 + w3 Q3 of a window.
 PathPoint weigh(const Window& q, double w0, double w1, double w2, double w3) {
-    PathPoint r(q[0]->size());
+    PathPoint r(q[0].size());
     for (std::size_t i = 0; i < r.size(); ++i) {
-        r[i] = w0 * (*q[0])[i] + w1 * (*q[1])[i] + w2 * (*q[2])[i] + w3 * (*q[3])[i];
+        r[i] = w0 * q[0][i] + w1 * q[1][i] + w2 * q[2][i] + w3 * q[3][i];
     }
     return r;
 }
@@ -58,11 +60,11 @@ std::array<PathPoint, 4> bspline_to_bezier(const Window& q) {
 /// Bezier control points of a uniform Catmull-Rom window (P0..P3, curve from P1 to P2):
 /// (P1, P1 + (P2 - P0)/6, P2 - (P3 - P1)/6, P2).
 std::array<PathPoint, 4> catmull_rom_to_bezier(const Window& q) {
-    return {*q[1], weigh(q, -1.0 / 6, 1, 1.0 / 6, 0), weigh(q, 0, 1.0 / 6, 1, -1.0 / 6), *q[2]};
+    return {q[1], weigh(q, -1.0 / 6, 1, 1.0 / 6, 0), weigh(q, 0, 1.0 / 6, 1, -1.0 / 6), q[2]};
 }
 
 /// A straight cubic from a to b with its handles at the thirds (uniform speed in u).
-std::array<PathPoint, 4> straight(const PathPoint& a, const PathPoint& b) {
+std::array<PathPoint, 4> straight(PointRef a, PointRef b) {
     return {a, combine(a, 2.0 / 3, b, 1.0 / 3), combine(a, 1.0 / 3, b, 2.0 / 3), b};
 }
 
@@ -87,9 +89,9 @@ public:
         held_ = true;
     }
     /// The last segment (`last_end`: its end point, for open B-spline and Catmull-Rom ends).
-    void finish(const PathPoint* last_end) {
+    void finish(const PointRef* last_end) {
         if (!held_) return;
-        if (last_end != nullptr) pending_[3] = *last_end;
+        if (last_end != nullptr) pending_[3] = last_end->vector();
         if (closed_) pending_[3] = first_;
         emit_(pending_);
         held_ = false;
@@ -122,7 +124,8 @@ void subpath_segments(const Subpath& sp, std::size_t index, const std::function<
                 first = false;
                 out.add(std::move(c));
             });
-            out.finish(sp.closed ? nullptr : &pts.back());  // and the clamped end the last
+            const PointRef last = pts.back();
+            out.finish(sp.closed ? nullptr : &last);  // and the clamped end the last
             return;
         }
         case PathBasis::kBezier: {
@@ -150,12 +153,10 @@ void for_each_bezier_segment(const Path& path, const std::function<void(const Be
     PathPoint last_end;
     for (std::size_t s = 0; s < path.subpaths.size(); ++s) {
         const Subpath& sp = path.subpaths[s];
-        for (const auto& p : sp.points) {
-            if (p.size() != path.axes) {
-                throw std::invalid_argument("subpath " + std::to_string(s) + ": a point has " +
-                                            std::to_string(p.size()) + " coordinates, expected " +
-                                            std::to_string(path.axes));
-            }
+        if (!sp.points.empty() && sp.points.axes() != path.axes) {  // a list's points have one size
+            throw std::invalid_argument("subpath " + std::to_string(s) + ": a point has " +
+                                        std::to_string(sp.points.axes()) +
+                                        " coordinates, expected " + std::to_string(path.axes));
         }
         bool first = true;
         BezierSegment seg;

@@ -80,15 +80,15 @@ public:
         return sp;
     }
 
-    std::vector<PathPoint> points(const json& v, const std::string& pointer, double scale,
-                                  std::size_t& axes) const {
+    PointList points(const json& v, const std::string& pointer, double scale,
+                     std::size_t& axes) const {
         if (!v.is_array()) fail(pointer, "points must be an array of [x, y, ...] arrays");
         if (const auto flat = flat_.found.find(pointer); flat != flat_.found.end()) {
             FlatNumberArrays::Rows rows = std::move(flat->second);
             flat_.found.erase(flat);  // freed once the points are made
             return flat_points(rows, pointer, scale, axes);
         }
-        std::vector<PathPoint> out;
+        PointList out;
         for (std::size_t i = 0; i < v.size(); ++i) {
             const std::string p = pointer + "/" + std::to_string(i);
             const json& pt = v[i];
@@ -112,10 +112,9 @@ public:
     }
 
     /// points() of an array read flat: the same checks in the same order, the same messages.
-    std::vector<PathPoint> flat_points(const FlatNumberArrays::Rows& rows, const std::string& pointer,
-                                       double scale, std::size_t& axes) const {
-        std::vector<PathPoint> out;
-        out.reserve(rows.widths.size());
+    PointList flat_points(const FlatNumberArrays::Rows& rows, const std::string& pointer,
+                          double scale, std::size_t& axes) const {
+        PointList out;
         const double* value = rows.values.data();
         for (std::size_t i = 0; i < rows.widths.size(); ++i) {
             const std::size_t width = rows.widths[i];
@@ -129,11 +128,12 @@ public:
                 fail(p(), "point has " + std::to_string(width) + " coordinates, expected " +
                               std::to_string(axes));
             }
-            PathPoint point(width);
+            if (out.empty()) out.reserve(rows.widths.size(), width);
+            double point[kMaxAxes];
             for (std::size_t a = 0; a < width; ++a) {
                 point[a] = coordinate_mm(*value++, [&] { return p() + "/" + std::to_string(a); }, scale);
             }
-            out.push_back(std::move(point));
+            out.push_back(PointRef(point, width));
         }
         return out;
     }
@@ -168,7 +168,7 @@ public:
             }
             curve.degree = static_cast<int>(d.get<long>());
         }
-        curve.points = points(v["points"], pointer + "/points", scale, axes);
+        curve.points = points(v["points"], pointer + "/points", scale, axes).vectors();
         if (curve.points.size() < static_cast<std::size_t>(curve.degree) + 1) {
             fail(pointer + "/points", "degree " + std::to_string(curve.degree) + " needs at least " +
                                           std::to_string(curve.degree + 1) + " control points, got " +

@@ -42,7 +42,17 @@ Figures measure(const Path& path) {
                                  0.1012285362903763};
     Figures f;
     for (const Subpath& sp : path.subpaths) {
-        const auto& q = sp.points;
+        // A run of lines is a polyline: its Bezier chain has the control points at the thirds.
+        std::vector<PathPoint> q;
+        for (std::size_t i = 0; i < sp.points.size(); ++i) {
+            const PathPoint p = sp.points[i];
+            if (sp.basis == PathBasis::kPolyline && i > 0) {
+                const PathPoint a = q.back();
+                q.push_back({a[0] + (p[0] - a[0]) / 3, a[1] + (p[1] - a[1]) / 3});
+                q.push_back({a[0] + 2 * (p[0] - a[0]) / 3, a[1] + 2 * (p[1] - a[1]) / 3});
+            }
+            q.push_back(p);
+        }
         for (std::size_t k = 0; k + 3 < q.size(); k += 3) {
             auto at = [&](double t, int axis) {
                 const double s = 1 - t;

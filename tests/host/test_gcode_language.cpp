@@ -156,9 +156,9 @@ TEST_CASE("G-code: G92 offsets and G53", "[gcode]") {
     const Path p = run("G0 X10 Y5 Z-1\nG92 X0 Y0\nG1 X5 Y5\nG53 G1 X1 Y1\nG92.1\nG1 X2 Y2\n");
     REQUIRE(p.subpaths.size() == 1);
     const auto& pts = p.subpaths[0].points;
-    CHECK(pts[3] == PathPoint{15, 10});
-    CHECK(pts[6] == PathPoint{1, 1});
-    CHECK(pts[9] == PathPoint{2, 2});
+    CHECK(pts[1] == PathPoint{15, 10});  // lines only: a polyline of their ends
+    CHECK(pts[2] == PathPoint{1, 1});
+    CHECK(pts[3] == PathPoint{2, 2});
     CHECK(error_of("G92\n") == "t.ngc:1:1: G92 needs at least one of X, Y, Z");
     CHECK(error_of("G92 G1 X1\n") ==
           "t.ngc:1:5: G28, G30 and G92 use the block's axis words: no motion code with them");
@@ -268,8 +268,8 @@ TEST_CASE("G-code: a setting's own line reads the old value", "[gcode]") {
 TEST_CASE("G-code: G92.2 and G92.3, G28.1 and G30.1", "[gcode]") {
     // G92.2 drops the offset but keeps #5211..; G92.3 takes it back from them.
     const Path p = run("G0 X10 Z-1\nG92 X0\nG92.2\nG1 X1\nG92.3\nG1 X1\n");
-    CHECK(p.subpaths[0].points[3] == PathPoint{1, 0});
-    CHECK(p.subpaths[0].points[6] == PathPoint{11, 0});
+    CHECK(p.subpaths[0].points[1] == PathPoint{1, 0});
+    CHECK(p.subpaths[0].points[2] == PathPoint{11, 0});
     // G28.1 stores where the machine is (mm, also under G20); G28 goes back there.
     const Path q = run("G20 G0 X1 Y2 Z-1\nG28.1\nG0 X0 Y0\nG28\nG1 X[#5161/25.4 + 1]\n");
     CHECK(q.subpaths[0].points.front() == PathPoint{25.4, 50.8});
@@ -286,7 +286,7 @@ TEST_CASE("G-code: call arguments zero the rest; repeat rounds", "[gcode]") {
     // #2 is 7 before the call; the call gives only #1, so #2 reads 0 inside and 7 after.
     const Path p = run("o1 sub\nG1 X#1 Y#2\no1 endsub\n#2=7\nG1 Z-1\no1 call [3]\nG1 Y#2\n");
     REQUIRE(p.subpaths.size() == 1);
-    CHECK(p.subpaths[0].points[3] == PathPoint{3, 0});
+    CHECK(p.subpaths[0].points[1] == PathPoint{3, 0});
     CHECK(last_point(p) == std::make_pair(3.0, 7.0));
     // repeat [2.6] runs 3 times, [2.5] twice (halves to even), [0.4] never.
     auto passes = [](const std::string& count) {

@@ -43,12 +43,29 @@ bool near(const PathPoint& p, double x, double y, double eps = kExact) {
     return p.size() == 2 && std::fabs(p[0] - x) <= eps && std::fabs(p[1] - y) <= eps;
 }
 
-/// The chain's points must be exactly these (within 1e-9).
+/// A subpath's Bezier chain: its points, or for a polyline (a run of lines only) its pieces
+/// with their control points at the thirds.
+std::vector<PathPoint> chain_of(const Subpath& sp) {
+    std::vector<PathPoint> out;
+    for (std::size_t i = 0; i < sp.points.size(); ++i) {
+        const PathPoint p = sp.points[i];
+        if (sp.basis == PathBasis::kPolyline && i > 0) {
+            const PathPoint a = out.back();
+            out.push_back({a[0] + (p[0] - a[0]) / 3, a[1] + (p[1] - a[1]) / 3});
+            out.push_back({a[0] + 2 * (p[0] - a[0]) / 3, a[1] + 2 * (p[1] - a[1]) / 3});
+        }
+        out.push_back(p);
+    }
+    return out;
+}
+
+/// The subpath's Bezier chain must be exactly these points (within 1e-9).
 void check_points(const Subpath& sp, const std::vector<P2>& expected) {
-    REQUIRE(sp.points.size() == expected.size());
+    const std::vector<PathPoint> chain = chain_of(sp);
+    REQUIRE(chain.size() == expected.size());
     for (std::size_t i = 0; i < expected.size(); ++i) {
-        INFO("point " << i << ": " << sp.points[i][0] << ", " << sp.points[i][1]);
-        CHECK(near(sp.points[i], expected[i].x, expected[i].y));
+        INFO("point " << i << ": " << chain[i][0] << ", " << chain[i][1]);
+        CHECK(near(chain[i], expected[i].x, expected[i].y));
     }
 }
 
@@ -127,12 +144,26 @@ const double kQuarter = 4.0 / 3.0 * std::tan(kPi / 8);  // a quarter circle's ta
 
 // ---- syntax and modal state ---------------------------------------------------------------
 
-TEST_CASE("G-code: lines become Bezier chains with control points at thirds", "[host][gcode]") {
+TEST_CASE(
+    "G-code: a run of lines is a polyline; with a curve, a Bezier chain with control points at "
+    "thirds",
+    "[host][gcode]") {
     const Path p = gcode("G21 G90 G17\nG0 X0 Y0\nG1 Z-1 F600\nG1 X30 Y0\nX30 Y30\nG0 Z5\nM2\n");
     REQUIRE(p.axes == 2);
     REQUIRE(p.subpaths.size() == 1);
     const Subpath& sp = p.subpaths[0];
-    CHECK(sp.basis == PathBasis::kBezier);
+    CHECK(sp.basis == PathBasis::kPolyline);
+    CHECK(sp.points == PointList{{0, 0}, {30, 0}, {30, 30}});
+    // An arc after lines: the whole run becomes one Bezier chain, the lines at thirds.
+    const Path m = gcode("G0 X0 Y0\nG1 Z-1\nG1 X30\nX30 Y30\nG2 X40 Y40 I10 J0\nG1 X50\n");
+    REQUIRE(m.subpaths.size() == 1);
+    CHECK(m.subpaths[0].basis == PathBasis::kBezier);
+    REQUIRE(m.subpaths[0].points.size() == 3 * 4 + 1);
+    const std::vector<P2> lines = line_chain({{0, 0}, {30, 0}, {30, 30}});
+    for (std::size_t i = 0; i < lines.size(); ++i)
+        CHECK(near(m.subpaths[0].points[i], lines[i].x, lines[i].y));
+    CHECK(near(m.subpaths[0].points[12], 50, 40));
+    CHECK(near(m.subpaths[0].points[10], 40 + 10.0 / 3, 40));
     CHECK_FALSE(sp.closed);
     CHECK(sp.feed == 10.0);  // 600 mm/min
     CHECK(sp.location.line == 4);

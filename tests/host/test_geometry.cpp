@@ -85,7 +85,7 @@ TEST_CASE("B-spline and Catmull-Rom segments agree with the basis evaluated dire
                     sp.points = random_points(rng, 3 + static_cast<std::size_t>(trial) * 2, axes);
                     path.subpaths.push_back(sp);
                     const auto segs = to_bezier_segments(path);
-                    const auto w = windows(sp.points, closed);
+                    const auto w = windows(sp.points.vectors(), closed);
                     REQUIRE(segs.size() == w.size());
                     const auto core = basis == PathBasis::kBSpline ? pathstream::Basis::kUniformBSpline
                                                                    : pathstream::Basis::kCatmullRom;

@@ -43,7 +43,7 @@ std::vector<double> de_boor(const Curve& c, double u) {
     return {d[p][0] / d[p][2], d[p][1] / d[p][2]};
 }
 
-std::vector<double> bezier_at(const std::vector<PathPoint>& q, std::size_t piece, double t) {
+std::vector<double> bezier_at(const PointList& q, std::size_t piece, double t) {
     const std::size_t k = 3 * piece;
     const double s = 1 - t;
     const double b[4] = {s * s * s, 3 * s * s * t, 3 * s * t * t, t * t * t};
@@ -92,8 +92,7 @@ std::vector<std::vector<double>> dense_curve(const Curve& c, std::size_t samples
     return out;
 }
 
-std::vector<std::vector<double>> dense_chain(const std::vector<PathPoint>& q,
-                                             std::size_t per_piece) {
+std::vector<std::vector<double>> dense_chain(const PointList& q, std::size_t per_piece) {
     std::vector<std::vector<double>> out;
     const std::size_t pieces = (q.size() - 1) / 3;
     for (std::size_t k = 0; k < pieces; ++k) {
@@ -126,7 +125,7 @@ Path read_json(const Curve& c, double tolerance) {
 }
 
 /// The exact case: piece j of the chain is knot span j, linearly reparameterised.
-double exact_error(const Curve& c, const std::vector<PathPoint>& chain) {
+double exact_error(const Curve& c, const PointList& chain) {
     std::vector<double> breaks;
     for (std::size_t i = static_cast<std::size_t>(c.degree); i <= c.points.size(); ++i) {
         if (breaks.empty() || breaks.back() != c.knots[i]) breaks.push_back(c.knots[i]);
@@ -234,8 +233,8 @@ TEST_CASE("NURBS: G5.2 with weights and order", "[gcode][nurbs]") {
                   {{0, 0}, {10, 20}, {20, -20}, {30, 0}, {40, 10}},
                   {1, 1, 2, 1, 1},
                   {0, 0, 0, 0, 1, 2, 2, 2, 2}};
-    std::vector<PathPoint> chain = p.subpaths[0].points;
-    chain.resize(chain.size() - 3);  // the G1 after the curve
+    PointList chain = p.subpaths[0].points;
+    for (int k = 0; k < 3; ++k) chain.pop_back();  // the G1 after the curve
     CHECK(hausdorff(dense_curve(c, 3000), dense_chain(chain, 200)) <= 0.01);
     CHECK(chain.back() == PathPoint{40, 10});
     // Equal weights, order 4: exact, one span per knot interval.

@@ -118,19 +118,20 @@ TEST_CASE("rotating a closed subpath keeps its curve", "[order]") {
 
 TEST_CASE("touching polyline and Bezier ends are joined, splines are not", "[order]") {
     Path p;
-    Subpath a{PathBasis::kPolyline, false, {{0, 0}, {10, 0}}, 0, {}};
-    Subpath b{PathBasis::kPolyline, false, {{20, 5}, {10.004, 0}}, 0, {}};  // touches a's end, reversed
+    Subpath a{PathBasis::kPolyline, false, {{0, 20}, {10, 20}}, 0, {}};
+    // touches a's end, reversed
+    Subpath b{PathBasis::kPolyline, false, {{20, 25}, {10.004, 20}}, 0, {}};
     Subpath c{PathBasis::kBezier, false, {{0, 0}, {1, 1}, {2, 1}, {3, 0}}, 0, {}};
     Subpath d{PathBasis::kBezier, false, {{3, 0}, {4, -1}, {5, -1}, {6, 0}}, 0, {}};
     Subpath e{PathBasis::kBSpline, false, {{6, 0}, {7, 3}, {8, 0}}, 0, {}};
     Subpath f{PathBasis::kBSpline, false, {{8, 0}, {9, 3}, {10, 0}}, 0, {}};
-    Subpath g{PathBasis::kPolyline, false, {{20, 5}, {30, 5}}, 25, {}};  // another feed
+    Subpath g{PathBasis::kPolyline, false, {{20, 25}, {30, 25}}, 25, {}};  // another feed
     p.subpaths = {a, b, c, d, e, f, g};
     std::size_t merged = 0;
     const Path m = merge_touching(p, 0.01, &merged);
     CHECK(merged == 2);
     REQUIRE(m.subpaths.size() == 5);
-    CHECK(m.subpaths[0].points == std::vector<PathPoint>{{0, 0}, {10, 0}, {20, 5}});
+    CHECK(m.subpaths[0].points == std::vector<PathPoint>{{0, 20}, {10, 20}, {20, 25}});
     CHECK(m.subpaths[1].points.size() == 7);
     CHECK(point_count_problem(m.subpaths[1]).empty());
     CHECK(m.subpaths[2].basis == PathBasis::kBSpline);
@@ -138,6 +139,29 @@ TEST_CASE("touching polyline and Bezier ends are joined, splines are not", "[ord
     std::size_t none = 0;
     CHECK(merge_touching(p, 0.001, &none).subpaths.size() == 6);
     CHECK(none == 1);
+}
+
+TEST_CASE("a polyline touching a Bezier chain joins it as a Bezier chain of the same curve",
+          "[order]") {
+    Path p;
+    const Subpath line{PathBasis::kPolyline, false, {{0, 0}, {3, 0}, {3, 3}}, 0, {}};
+    const Subpath curve{PathBasis::kBezier, false, {{3, 3}, {4, 4}, {5, 4}, {6, 3}}, 0, {}};
+    p.subpaths = {curve, line};
+    std::size_t merged = 0;
+    const Path m = merge_touching(p, 0.01, &merged);
+    CHECK(merged == 1);
+    REQUIRE(m.subpaths.size() == 1);
+    const Subpath& joined = m.subpaths[0];
+    CHECK(joined.basis == PathBasis::kBezier);
+    REQUIRE(point_count_problem(joined).empty());
+    // The line's segments first (the chain grew backwards from the curve's start), then the curve:
+    // segment by segment what the two subpaths draw, control points exactly.
+    std::vector<BezierSegment> expected = segments_of(line);
+    for (const BezierSegment& b : segments_of(curve)) expected.push_back(b);
+    const std::vector<BezierSegment> got = segments_of(joined);
+    REQUIRE(got.size() == expected.size());
+    for (std::size_t i = 0; i < got.size(); ++i)
+        CHECK(segment_gap(got[i], expected[i], false) == 0);
 }
 
 TEST_CASE("order: never more travel than document order (seeded)", "[order]") {

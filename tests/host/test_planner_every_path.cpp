@@ -60,7 +60,7 @@ private:
     PathPoint random_point(double size) { return {pick(0, size), pick(0, size)}; }
 
     /// Out and back: A, B, A' with A' within 0 to 2 LSB of A (the cusp), chained.
-    void hairpins(std::vector<PathPoint>& out) {
+    void hairpins(PointList& out) {
         out.push_back(random_point(40));
         const int n = 1 + static_cast<int>(rng_() % 4);
         for (int i = 0; i < n; ++i) {
@@ -74,7 +74,7 @@ private:
         }
     }
     /// Points repeated two to four times among ordinary ones.
-    void repeated(std::vector<PathPoint>& out) {
+    void repeated(PointList& out) {
         const int n = 3 + static_cast<int>(rng_() % 6);
         for (int i = 0; i < n; ++i) {
             const PathPoint p = random_point(30);
@@ -83,7 +83,7 @@ private:
         }
     }
     /// Loops a few LSB to a few tenths of a millimetre across on a straight run.
-    void tiny_loops(std::vector<PathPoint>& out) {
+    void tiny_loops(PointList& out) {
         PathPoint p = random_point(30);
         out.push_back(p);
         const int loops = 1 + static_cast<int>(rng_() % 3);
@@ -100,7 +100,7 @@ private:
         out.push_back({p[0] + pick(0.5, 5), p[1] + pick(-1, 1)});
     }
     /// A random walk whose every step turns back by 150 to 180 degrees.
-    void turning_walk(std::vector<PathPoint>& out) {
+    void turning_walk(PointList& out) {
         out.push_back(random_point(40));
         double dir = pick(0, 2 * kPi);
         const int n = 5 + static_cast<int>(rng_() % 20);
@@ -112,7 +112,7 @@ private:
             out.push_back({a[0] + len * std::cos(dir), a[1] + len * std::sin(dir)});
         }
     }
-    void mixed(std::vector<PathPoint>& out) {
+    void mixed(PointList& out) {
         hairpins(out);
         repeated(out);
         turning_walk(out);

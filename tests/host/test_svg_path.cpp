@@ -48,21 +48,39 @@ std::string body_error(const std::string& body) {
     return error_of(doc(body));
 }
 
-void check_points(const Subpath& s, const std::vector<Point>& expected) {
-    CHECK(s.basis == PathBasis::kBezier);
-    CHECK_FALSE(s.closed);
-    REQUIRE(s.points.size() == expected.size());
-    for (std::size_t i = 0; i < expected.size(); ++i) {
-        INFO("point " << i << ": (" << s.points[i][0] << ", " << s.points[i][1] << ") expected ("
-                      << expected[i].x << ", " << expected[i].y << ")");
-        REQUIRE(s.points[i].size() == 2);
-        CHECK(std::fabs(s.points[i][0] - expected[i].x) <= kEps);
-        CHECK(std::fabs(s.points[i][1] - expected[i].y) <= kEps);
-    }
-}
-
 Point third(Point a, Point b, double t) {
     return {a.x + (b.x - a.x) * t, a.y + (b.y - a.y) * t};
+}
+
+// A subpath's Bezier chain: its points, or for a polyline its pieces with their control
+// points at the thirds (the curve the planner draws of it).
+std::vector<Point> chain_of(const Subpath& s) {
+    std::vector<Point> out;
+    for (std::size_t i = 0; i < s.points.size(); ++i) {
+        const Point p{s.points[i][0], s.points[i][1]};
+        if (s.basis == PathBasis::kPolyline && i > 0) {
+            out.push_back(third(out.back(), p, 1.0 / 3));
+            out.push_back(third(out[out.size() - 2], p, 2.0 / 3));
+        }
+        out.push_back(p);
+    }
+    return out;
+}
+
+// The subpath draws the Bezier chain `expected`: as that chain, or as a polyline when every
+// piece of it is straight.
+void check_points(const Subpath& s, const std::vector<Point>& expected) {
+    CHECK((s.basis == PathBasis::kBezier || s.basis == PathBasis::kPolyline));
+    CHECK_FALSE(s.closed);
+    REQUIRE(s.points.axes() == 2);
+    const std::vector<Point> chain = chain_of(s);
+    REQUIRE(chain.size() == expected.size());
+    for (std::size_t i = 0; i < expected.size(); ++i) {
+        INFO("point " << i << ": (" << chain[i].x << ", " << chain[i].y << ") expected ("
+                      << expected[i].x << ", " << expected[i].y << ")");
+        CHECK(std::fabs(chain[i].x - expected[i].x) <= kEps);
+        CHECK(std::fabs(chain[i].y - expected[i].y) <= kEps);
+    }
 }
 
 // The chain of straight pieces through `corners`, as the reader must produce it.
@@ -173,6 +191,21 @@ TEST_CASE("svg: M and L, absolute and relative, with implicit linetos", "[svg]")
     REQUIRE(p.subpaths.size() == 3);
     check_points(p.subpaths[1], lines({{12, 2}, {13, 2}}));  // m relative to the current point
     check_points(p.subpaths[2], lines({{50, 50}, {60, 60}}));
+}
+
+TEST_CASE("svg: a subpath of straight pieces only is a polyline of their ends", "[svg]") {
+    const Path p =
+        parse(R"(<path d="M 0 0 L 10 0 L 10 10 Z M 20 0 L 30 0 Q 40 0 40 10"/>)"
+              R"(<polyline points="0,20 10,20 10,30"/><rect x="50" y="0" width="10" height="5"/>)");
+    REQUIRE(p.subpaths.size() == 4);
+    CHECK(p.subpaths[0].basis == PathBasis::kPolyline);
+    CHECK(p.subpaths[0].points == PointList{{0, 0}, {10, 0}, {10, 10}, {0, 0}});
+    CHECK(p.subpaths[1].basis == PathBasis::kBezier);  // a curve in it: every piece a cubic
+    CHECK(p.subpaths[1].points.size() == 7);
+    CHECK(p.subpaths[2].basis == PathBasis::kPolyline);
+    CHECK(p.subpaths[2].points.size() == 3);
+    CHECK(p.subpaths[3].basis == PathBasis::kPolyline);
+    CHECK(p.subpaths[3].points.size() == 5);
 }
 
 TEST_CASE("svg: H and V, absolute and relative", "[svg]") {
@@ -603,7 +636,8 @@ TEST_CASE("svg: rect, sharp and rounded", "[svg]") {
         parse(R"(<rect x="10" y="20" width="30" height="40" rx="5"/>)").subpaths.at(0);
     REQUIRE(r.points.size() == 8 * 3 + 1);  // four sides, four quarter arcs
     Subpath top = r;
-    top.points.resize(4);
+    top.points.clear();
+    top.points.append(r.points, 0, 4);
     check_points(top, lines({{15, 20}, {35, 20}}));
     CHECK(near_point({r.points[6][0], r.points[6][1]}, {40, 25}));  // end of the first corner
     CHECK(near_point({r.points[12][0], r.points[12][1]}, {35, 60}));
@@ -911,9 +945,9 @@ TEST_CASE("svg: size, unit and viewBox errors", "[svg]") {
 }
 
 TEST_CASE("svg: coordinates beyond 1e6 mm and bad tolerances", "[svg]") {
-    // the first point out of range is the second control point, 2/3 of the way
+    // a line is a polyline of its ends: the end point is the first out of range
     CHECK(body_error(R"(<path d="M 0 0 L 3000000 0"/>)") ==
-          "t.svg:1:98: coordinate 2000000 mm is out of range (|value| <= 1e+06 mm after units and "
+          "t.svg:1:98: coordinate 3000000 mm is out of range (|value| <= 1e+06 mm after units and "
           "transforms)");
     CHECK(
         body_error(
@@ -941,10 +975,9 @@ TEST_CASE("svg: examples/landscape.svg", "[svg]") {
     CHECK(p.axes == 2);
     CHECK(p.subpaths.size() == 42);
     for (const Subpath& s : p.subpaths) {
-        CHECK(s.basis == PathBasis::kBezier);
+        CHECK((s.basis == PathBasis::kBezier || s.basis == PathBasis::kPolyline));
         CHECK_FALSE(s.closed);
-        REQUIRE(s.points.size() % 3 == 1);
-        REQUIRE(s.points.size() >= 4);
+        REQUIRE(point_count_problem(s).empty());
         for (const PathPoint& q : s.points) {  // inside the 160 x 120 mm page
             CHECK(q[0] >= 0);
             CHECK(q[0] <= 160);

@@ -336,9 +336,7 @@ void Interpreter::follow(const std::vector<Cubic>& pieces, bool down, Vec2 to, S
 
 void Interpreter::line(Vec2 to, double z_to, SourceLocation at) {
     const Vec2 from = position_;
-    const Cubic piece{
-        {from, from + (1.0 / 3.0) * (to - from), from + (2.0 / 3.0) * (to - from), to}};
-    follow({piece}, pen_down(z_, z_to), to, at);
+    follow({line_piece(from, to)}, pen_down(z_, z_to), to, at);
 }
 
 Path Interpreter::finish(bool allow_empty) {

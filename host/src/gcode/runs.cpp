@@ -12,6 +12,23 @@ namespace {
 PathPoint point(Vec2 v) {
     return PathPoint{v.x, v.y};
 }
+
+Vec2 vec(PointRef p) {
+    return {p[0], p[1]};
+}
+
+/// A polyline run as the Bezier chain of its line pieces (a curve is joining it).
+void to_bezier_chain(Subpath& run) {
+    PointList chain(2);
+    chain.reserve(3 * run.points.size(), 2);
+    chain.push_back(run.points.front());
+    for (std::size_t i = 1; i < run.points.size(); ++i) {
+        const Cubic line = line_piece(vec(run.points[i - 1]), vec(run.points[i]));
+        for (std::size_t k = 1; k < line.p.size(); ++k) chain.push_back({line.p[k].x, line.p[k].y});
+    }
+    run.points = std::move(chain);
+    run.basis = PathBasis::kBezier;
+}
 }  // namespace
 
 void RunBuilder::draw(const Cubic& piece, double feed_mm_s, SourceLocation at,
@@ -26,7 +43,7 @@ void RunBuilder::draw(const Cubic& piece, double feed_mm_s, SourceLocation at,
     if (open_ && done_.back().feed != feed_mm_s) open_ = false;  // one feed per subpath
     if (!open_) {
         Subpath sp;
-        sp.basis = PathBasis::kBezier;
+        sp.basis = is_line_piece(piece) ? PathBasis::kPolyline : PathBasis::kBezier;
         sp.closed = false;
         sp.feed = feed_mm_s;
         sp.location = at;
@@ -42,8 +59,13 @@ void RunBuilder::draw(const Cubic& piece, double feed_mm_s, SourceLocation at,
     } else if (done_.back().points.back() != point(p0)) {
         throw std::logic_error("RunBuilder::draw: piece does not start where the run ends");
     }
-    for (std::size_t k = 1; k < piece.p.size(); ++k)
-        done_.back().points.push_back(point(piece.p[k]));
+    Subpath& run = done_.back();
+    if (run.basis == PathBasis::kPolyline && is_line_piece(piece)) {
+        run.points.push_back(point(piece.p[3]));  // the planner makes the same cubic of it
+        return;
+    }
+    if (run.basis == PathBasis::kPolyline) to_bezier_chain(run);
+    for (std::size_t k = 1; k < piece.p.size(); ++k) run.points.push_back(point(piece.p[k]));
 }
 
 void RunBuilder::lift() {

@@ -1,5 +1,6 @@
-// Collects the pieces of pen-down moves into subpaths: one open Bezier chain per maximal run
-// of pen-down moves with one feed.
+// Collects the pieces of pen-down moves into subpaths: one open subpath per maximal run of
+// pen-down moves with one feed, a polyline while the run has only line pieces, else a Bezier
+// chain.
 #pragma once
 
 #include <string>
@@ -34,7 +35,8 @@ public:
     /// Pieces drawn so far.
     std::size_t pieces() const { return pieces_; }
 
-    /// The subpaths drawn so far (kBezier, open, 3k + 1 points, 2 axes); ends the open run.
+    /// The subpaths drawn so far (open, 2 axes; kPolyline of the piece ends where every piece
+    /// is line_piece of its ends, else kBezier with 3k + 1 points); ends the open run.
     std::vector<Subpath> finish();
 
 private:

@@ -16,7 +16,7 @@ namespace pathstream::host {
 namespace {
 
 /// Euclidean distance over every axis.
-double distance(const PathPoint& a, const PathPoint& b) {
+double distance(PointRef a, PointRef b) {
     double s = 0;
     for (std::size_t i = 0; i < a.size() && i < b.size(); ++i) s += (a[i] - b[i]) * (a[i] - b[i]);
     return std::sqrt(s);
@@ -40,27 +40,23 @@ bool is_open_loop(const Subpath& s, double tolerance) {
 Subpath rotated_open_loop(const Subpath& s, std::size_t shift) {
     if (shift == 0) return s;
     Subpath r = s;
-    r.points.assign(s.points.begin() + static_cast<std::ptrdiff_t>(shift), s.points.end());
-    r.points.insert(r.points.end(), s.points.begin() + 1,
-                    s.points.begin() + static_cast<std::ptrdiff_t>(shift) + 1);
+    r.points.clear();
+    r.points.append(s.points, shift, s.points.size());
+    r.points.append(s.points, 1, shift + 1);
     return r;
 }
 
 /// rotated_open_loop in place: the same points, none copied but Q[shift] once.
 void rotate_open_loop(Subpath& s, std::size_t shift) {
     if (shift == 0) return;
-    s.points.erase(s.points.begin());  // Q[1..m-1]
-    std::rotate(s.points.begin(), s.points.begin() + static_cast<std::ptrdiff_t>(shift - 1), s.points.end());
+    s.points.erase_front(1);  // Q[1..m-1]
+    s.points.rotate(shift - 1);
     s.points.push_back(s.points.front());  // Q[shift..m-1], Q[1..shift]
 }
 
 /// reversed_subpath in place.
 void reverse_points(Subpath& r) {
-    if (r.closed && !r.points.empty()) {
-        std::reverse(r.points.begin() + 1, r.points.end());
-    } else {
-        std::reverse(r.points.begin(), r.points.end());
-    }
+    r.points.reverse(r.closed ? 1 : 0);
 }
 
 /// rotated_subpath in place (its checks and messages).
@@ -71,12 +67,11 @@ void rotate_points(Subpath& r, std::size_t shift) {
         throw std::invalid_argument("rotated_subpath: a Bezier chain starts only at on-curve points (shift " +
                                     std::to_string(shift) + " is not a multiple of 3)");
     }
-    std::rotate(r.points.begin(), r.points.begin() + static_cast<std::ptrdiff_t>(shift % r.points.size()),
-                r.points.end());
+    r.points.rotate(shift);
 }
 
 /// 2-D cell of a point for the grids: the first two axes (one-axis paths: y = 0).
-std::pair<double, double> plane(const PathPoint& p) {
+std::pair<double, double> plane(PointRef p) {
     return {p.empty() ? 0.0 : p[0], p.size() > 1 ? p[1] : 0.0};
 }
 
@@ -84,7 +79,7 @@ std::pair<double, double> plane(const PathPoint& p) {
 struct Item {
     std::size_t subpath = 0;
     bool cyclic = false;                ///< closed, or an open loop
-    std::vector<PathPoint> starts;      ///< cyclic: curve point at each allowed start
+    PointList starts;                   ///< cyclic: curve point at each allowed start
     std::vector<std::size_t> shifts;    ///< cyclic: rotation giving that start
     PathPoint first, last;              ///< open: curve ends
 };
@@ -108,9 +103,10 @@ std::vector<Item> make_items(const Path& path, double tolerance) {
             for (std::size_t r = 0; r + step <= m; r += step) {
                 if (s.basis == PathBasis::kBSpline) {
                     PathPoint p(s.points[r].size());
-                    const PathPoint &a = s.points[(r + m - 1) % m], &b = s.points[r], &c = s.points[(r + 1) % m];
+                    const PointRef a = s.points[(r + m - 1) % m], b = s.points[r],
+                                   c = s.points[(r + 1) % m];
                     for (std::size_t k = 0; k < p.size(); ++k) p[k] = (a[k] + 4 * b[k] + c[k]) / 6;
-                    it.starts.push_back(std::move(p));
+                    it.starts.push_back(p);
                 } else {
                     it.starts.push_back(s.points[r]);
                 }
@@ -140,16 +136,18 @@ public:
 
     std::vector<Visit> visits;
 
-    const PathPoint& start_of(const Visit& v) const {
+    PointRef start_of(const Visit& v) const {
         const Item& it = items_[v.item];
-        return it.cyclic ? it.starts[v.choice] : (v.choice == 0 ? it.first : it.last);
+        return it.cyclic ? it.starts[v.choice] : PointRef(v.choice == 0 ? it.first : it.last);
     }
-    const PathPoint& end_of(const Visit& v) const {
+    PointRef end_of(const Visit& v) const {
         const Item& it = items_[v.item];
-        return it.cyclic ? it.starts[v.choice] : (v.choice == 0 ? it.last : it.first);
+        return it.cyclic ? it.starts[v.choice] : PointRef(v.choice == 0 ? it.last : it.first);
     }
     /// Where the pen is before position k.
-    const PathPoint& before(std::size_t k) const { return k == 0 ? start_ : end_of(visits[k - 1]); }
+    PointRef before(std::size_t k) const {
+        return k == 0 ? PointRef(start_) : end_of(visits[k - 1]);
+    }
 
     double travel() const {
         double t = 0;
@@ -166,11 +164,11 @@ public:
         for (std::size_t i = 0; i < n && !spent(); ++i) {
             for (std::size_t j = i; j < n && j <= i + window; ++j) {
                 ++work_;
-                const PathPoint& a = before(i);
+                const PointRef a = before(i);
                 double old_cost = distance(a, start_of(visits[i]));
                 double new_cost = distance(a, end_of(visits[j]));
                 if (j + 1 < n) {
-                    const PathPoint& b = start_of(visits[j + 1]);
+                    const PointRef b = start_of(visits[j + 1]);
                     old_cost += distance(end_of(visits[j]), b);
                     new_cost += distance(start_of(visits[i]), b);
                 }
@@ -204,10 +202,11 @@ public:
         for (std::size_t k = 0; k < visits.size() && !spent(); ++k) {
             const Item& it = items_[visits[k].item];
             if (!it.cyclic) continue;
-            const PathPoint& a = before(k);
-            const PathPoint* b = k + 1 < visits.size() ? &start_of(visits[k + 1]) : nullptr;
+            const PointRef a = before(k);
+            const bool has_b = k + 1 < visits.size();
+            const PointRef b = has_b ? start_of(visits[k + 1]) : a;
             const auto cost = [&](std::size_t c) {
-                return distance(a, it.starts[c]) + (b != nullptr ? distance(it.starts[c], *b) : 0.0);
+                return distance(a, it.starts[c]) + (has_b ? distance(it.starts[c], b) : 0.0);
             };
             std::size_t best = visits[k].choice;
             double best_cost = cost(best);
@@ -227,21 +226,23 @@ private:
     bool try_move_block(std::size_t i, std::size_t len, std::size_t window) {
         const std::size_t n = visits.size();
         const std::size_t j = i + len - 1;
-        const PathPoint& a = before(i);
-        const PathPoint* b = j + 1 < n ? &start_of(visits[j + 1]) : nullptr;
-        const PathPoint& s = start_of(visits[i]);
-        const PathPoint& e = end_of(visits[j]);
+        const PointRef a = before(i);
+        const bool has_b = j + 1 < n;
+        const PointRef b = has_b ? start_of(visits[j + 1]) : a;
+        const PointRef s = start_of(visits[i]);
+        const PointRef e = end_of(visits[j]);
         // Taking the block out saves this much (a then straight to b).
-        const double removed = distance(a, s) + (b != nullptr ? distance(e, *b) - distance(a, *b) : 0.0);
+        const double removed = distance(a, s) + (has_b ? distance(e, b) - distance(a, b) : 0.0);
         const std::size_t lo = i > window ? i - window : 0, hi = std::min(n, j + 1 + window);
         for (std::size_t p = lo; p <= hi; ++p) {  // gap before position p (p == n: the end)
             if (p >= i && p <= j + 1) continue;
             ++work_;
-            const PathPoint& c = before(p);
-            const PathPoint* d = p < n ? &start_of(visits[p]) : nullptr;
-            const double base = d != nullptr ? distance(c, *d) : 0.0;
-            const double forward = distance(c, s) + (d != nullptr ? distance(e, *d) : 0.0) - base;
-            const double backward = distance(c, e) + (d != nullptr ? distance(s, *d) : 0.0) - base;
+            const PointRef c = before(p);
+            const bool has_d = p < n;
+            const PointRef d = has_d ? start_of(visits[p]) : c;
+            const double base = has_d ? distance(c, d) : 0.0;
+            const double forward = distance(c, s) + (has_d ? distance(e, d) : 0.0) - base;
+            const double backward = distance(c, e) + (has_d ? distance(s, d) : 0.0) - base;
             const bool flip = backward < forward;
             if (std::min(forward, backward) < removed - kGain) {
                 std::vector<Visit> block(visits.begin() + static_cast<std::ptrdiff_t>(i),
@@ -273,7 +274,7 @@ private:
 class StartGrid {
 public:
     struct Entry {
-        PathPoint point;
+        PointRef point;  ///< into the items the grid is built from
         std::size_t item, choice;
     };
 
@@ -296,7 +297,7 @@ public:
     }
 
     /// The live entry nearest to p (ties: the lowest id); entries_.size() when none is left.
-    std::size_t nearest(const PathPoint& p) const {
+    std::size_t nearest(PointRef p) const {
         if (live_ == 0) return entries_.size();
         const auto [x, y] = plane(p);
         // Distances to the projection of p onto the grid bound those to p from below.
@@ -395,7 +396,7 @@ std::vector<Visit> greedy_order(const std::vector<Item>& items, const PathPoint&
     std::vector<Visit> order;
     std::vector<bool> placed(items.size(), false);
     StartGrid grid(std::move(entries));
-    PathPoint here = start;
+    PointRef here = start;
     for (;;) {
         const std::size_t id = grid.nearest(here);
         if (id == grid.size()) break;
@@ -403,7 +404,7 @@ std::vector<Visit> greedy_order(const std::vector<Item>& items, const PathPoint&
         const Item& it = items[e.item];
         order.push_back({e.item, e.choice});
         placed[e.item] = true;
-        here = it.cyclic ? it.starts[e.choice] : (e.choice == 0 ? it.last : it.first);
+        here = it.cyclic ? it.starts[e.choice] : PointRef(e.choice == 0 ? it.last : it.first);
         grid.remove_item(ids[e.item]);
     }
     // Items without a start (no points) keep their document place at the end.
@@ -480,7 +481,7 @@ PathPoint curve_start(const Subpath& s) {
     const std::size_t m = s.points.size();
     if (m == 0) return {};
     if (s.closed && s.basis == PathBasis::kBSpline && m >= 3) {
-        PathPoint p(s.points[0].size());
+        PathPoint p(s.points.axes());
         for (std::size_t k = 0; k < p.size(); ++k) {
             p[k] = (s.points[m - 1][k] + 4 * s.points[0][k] + s.points[1][k]) / 6;
         }
@@ -490,7 +491,7 @@ PathPoint curve_start(const Subpath& s) {
 }
 
 PathPoint curve_end(const Subpath& s) {
-    return s.closed ? curve_start(s) : (s.points.empty() ? PathPoint{} : s.points.back());
+    return s.closed ? curve_start(s) : (s.points.empty() ? PathPoint{} : s.points.back().vector());
 }
 
 double pen_up_travel(const Path& path, const PathPoint& start) {
@@ -526,23 +527,50 @@ bool joinable(const Subpath& s) {
 /// The grid cell (side `cell`, mm) of an end point in the plane: ends within `cell` of each
 /// other lie in the same or neighbouring cells.
 using EndCell = std::pair<long long, long long>;
-EndCell end_cell(const PathPoint& p, double cell) {
+EndCell end_cell(PointRef p, double cell) {
     const auto [x, y] = plane(p);
     return EndCell{static_cast<long long>(std::floor(x / cell)), static_cast<long long>(std::floor(y / cell))};
 }
 
-/// Whether merge_touching would join anything: two joinable subpaths of one basis and feed
+/// A polyline as the Bezier chain the planner draws of it: control points at the thirds, as
+/// geometry.cpp's straight segments.
+void to_bezier_chain(Subpath& s) {
+    PointList chain;
+    chain.reserve(3 * s.points.size(), s.points.axes());
+    chain.push_back(s.points.front());
+    PathPoint c(s.points.axes());
+    for (std::size_t i = 1; i < s.points.size(); ++i) {
+        const PointRef a = s.points[i - 1], b = s.points[i];
+        for (const auto& [wa, wb] : {std::pair{2.0 / 3, 1.0 / 3}, std::pair{1.0 / 3, 2.0 / 3}}) {
+            for (std::size_t k = 0; k < c.size(); ++k) c[k] = wa * a[k] + wb * b[k];
+            chain.push_back(c);
+        }
+        chain.push_back(b);
+    }
+    s.points = std::move(chain);
+    s.basis = PathBasis::kBezier;
+}
+
+/// Two joinable subpaths made one basis for joining: a polyline meeting a Bezier chain (an SVG
+/// path of lines only and one with curves) becomes a Bezier chain too.
+void same_basis(Subpath& a, Subpath& b) {
+    if (a.basis == b.basis) return;
+    to_bezier_chain(a.basis == PathBasis::kPolyline ? a : b);
+}
+
+/// Whether merge_touching would join anything: two joinable subpaths of one feed
 /// with ends within `tolerance` (a superset of its joins: false means it joins none).
 bool any_touching(const Path& path, double tolerance) {
     if (tolerance < 0) return false;
     const auto& in = path.subpaths;
     const double cell = std::max(tolerance, 1e-9);
     using Key = EndCell;
-    const auto key = [&](const PathPoint& p) { return end_cell(p, cell); };
-    std::map<Key, std::vector<std::pair<std::size_t, const PathPoint*>>> ends;
+    const auto key = [&](PointRef p) { return end_cell(p, cell); };
+    std::map<Key, std::vector<std::pair<std::size_t, PointRef>>> ends;
     for (std::size_t i = 0; i < in.size(); ++i) {
         if (!joinable(in[i])) continue;
-        for (const PathPoint* p : {&in[i].points.front(), &in[i].points.back()}) ends[key(*p)].push_back({i, p});
+        for (const PointRef p : {in[i].points.front(), in[i].points.back()})
+            ends[key(p)].push_back({i, p});
     }
     for (const auto& [k, list] : ends) {
         for (const auto& [i, p] : list) {
@@ -552,8 +580,8 @@ bool any_touching(const Path& path, double tolerance) {
                     if (found == ends.end()) continue;
                     for (const auto& [j, q] : found->second) {
                         const Subpath &a = in[i], &b = in[j];
-                        if (j == i || a.basis != b.basis || a.feed != b.feed || p->size() != q->size()) continue;
-                        if (distance(*p, *q) <= tolerance) return true;
+                        if (j == i || a.feed != b.feed || p.size() != q.size()) continue;
+                        if (distance(p, q) <= tolerance) return true;
                     }
                 }
             }
@@ -574,7 +602,7 @@ Path merge_touching(const Path& path, double tolerance, std::size_t* merged) {
     // End points of joinable subpaths by grid cell (cell size: the tolerance).
     const double cell = std::max(tolerance, 1e-9);
     using Key = EndCell;
-    const auto key = [&](const PathPoint& p) { return end_cell(p, cell); };
+    const auto key = [&](PointRef p) { return end_cell(p, cell); };
     std::map<Key, std::vector<std::pair<std::size_t, int>>> ends;  // subpath, 0 first / 1 last
     for (std::size_t i = 0; i < in.size(); ++i) {
         if (!joinable(in[i])) continue;
@@ -583,7 +611,7 @@ Path merge_touching(const Path& path, double tolerance, std::size_t* merged) {
     }
     std::vector<bool> used(in.size(), false);
     // The lowest-index unused compatible subpath with an end within the tolerance of p.
-    const auto find = [&](const Subpath& with, const PathPoint& p) {
+    const auto find = [&](const Subpath& with, PointRef p) {
         std::pair<std::size_t, int> best{in.size(), 0};
         const Key k = key(p);
         for (long long dx = -1; dx <= 1; ++dx) {
@@ -595,8 +623,8 @@ Path merge_touching(const Path& path, double tolerance, std::size_t* merged) {
                            list.end());
                 for (const auto& [i, side] : list) {
                     const Subpath& s = in[i];
-                    if (s.basis != with.basis || s.feed != with.feed || s.points[0].size() != p.size()) continue;
-                    const PathPoint& q = side == 0 ? s.points.front() : s.points.back();
+                    if (s.feed != with.feed || s.points[0].size() != p.size()) continue;
+                    const PointRef q = side == 0 ? s.points.front() : s.points.back();
                     if (distance(p, q) > tolerance) continue;
                     if (i < best.first || (i == best.first && side < best.second)) best = {i, side};
                 }
@@ -615,16 +643,18 @@ Path merge_touching(const Path& path, double tolerance, std::size_t* merged) {
             if (b == in.size()) break;
             used[b] = true;
             ++joins;
-            const Subpath next = side == 0 ? in[b] : reversed_subpath(in[b]);
-            chain.points.insert(chain.points.end(), next.points.begin() + 1, next.points.end());
+            Subpath next = side == 0 ? in[b] : reversed_subpath(in[b]);
+            same_basis(chain, next);
+            chain.points.append(next.points, 1, next.points.size());
         }
         for (;;) {  // backward from the chain's first point
             const auto [b, side] = find(chain, chain.points.front());
             if (b == in.size()) break;
             used[b] = true;
             ++joins;
-            const Subpath prev = side == 1 ? in[b] : reversed_subpath(in[b]);
-            chain.points.insert(chain.points.begin(), prev.points.begin(), prev.points.end() - 1);
+            Subpath prev = side == 1 ? in[b] : reversed_subpath(in[b]);
+            same_basis(chain, prev);
+            chain.points.prepend(prev.points, 0, prev.points.size() - 1);
         }
     }
     if (merged != nullptr) *merged = joins;

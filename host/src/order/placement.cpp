@@ -172,7 +172,7 @@ Path place_path(const Path& path, const PlacementOptions& o, const std::optional
 
     Path out = path;
     for (Subpath& s : out.subpaths) {
-        for (PathPoint& p : s.points) m.apply(p[0], p[1]);
+        for (PointMutRef p : s.points) m.apply(p[0], p[1]);
     }
     r.scale = scale;
     r.after = r.before ? std::optional<Box2>(m.apply(*r.before)) : std::nullopt;

@@ -696,11 +696,18 @@ private:
                                      " curve pieces (the reader's limit for a file of " +
                                      std::to_string(text_.size()) + " bytes; <use> copies count)");
             }
+            // Only straight pieces (lines, polylines, rectangles without corners): a polyline
+            // of their ends, 1 point a piece instead of 3; the planner makes the same straight
+            // cubics of it (docs/formats-svg.md).
+            const bool straight =
+                std::all_of(pieces.begin(), pieces.end(),
+                            [](const svg::Cubic& c) { return c == svg::line_cubic(c[0], c[3]); });
             Subpath sp;
-            sp.basis = PathBasis::kBezier;
+            sp.basis = straight ? PathBasis::kPolyline : PathBasis::kBezier;
             sp.closed = false;
             sp.location = at;
-            sp.points.reserve(3 * pieces.size() + 1);  // at most: no growth by doubling
+            // At most this many points: no growth by doubling.
+            sp.points.reserve((straight ? 1 : 3) * pieces.size() + 1, 2);
             for (const svg::Cubic& c : pieces) {
                 Point mm[4];
                 bool degenerate = true;
@@ -711,6 +718,7 @@ private:
                 }
                 if (degenerate) continue;
                 for (int k = sp.points.empty() ? 0 : 1; k < 4; ++k) {
+                    if (straight && (k == 1 || k == 2)) continue;  // a polyline keeps the ends
                     check(mm[k].x, at);
                     check(mm[k].y, at);
                     sp.points.push_back({mm[k].x, mm[k].y});

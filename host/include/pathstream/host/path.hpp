@@ -6,6 +6,8 @@
 #include <string>
 #include <vector>
 
+#include "pathstream/host/point_list.hpp"
+
 namespace pathstream::host {
 
 /// How a subpath's points define the curve.
@@ -22,14 +24,11 @@ struct SourceLocation {
     std::size_t column = 0;
 };
 
-/// One point: one coordinate per axis, in millimetres.
-using PathPoint = std::vector<double>;
-
 /// A connected piece of the path, drawn pen-down.
 struct Subpath {
     PathBasis basis = PathBasis::kBSpline;
     bool closed = false;
-    std::vector<PathPoint> points;
+    PointList points;         ///< flat: every point has Path::axes coordinates
     double feed = 0;          ///< requested speed along it, mm/s; 0: the machine profile's feed
     SourceLocation location;  ///< where the subpath starts in the file
     std::size_t layer = 0;    ///< index into Path::layers (0 when the file has no layers)

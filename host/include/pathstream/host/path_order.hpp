@@ -50,11 +50,12 @@ Subpath reversed_subpath(const Subpath& subpath);
 /// Throws std::invalid_argument for an open subpath or a shift not allowed for the basis.
 Subpath rotated_subpath(const Subpath& subpath, std::size_t shift);
 
-/// Joins open polyline and Bezier subpaths of the same basis and feed whose ends lie within
-/// `tolerance` mm (reversing one where that makes them meet); the joint keeps the first one's
-/// point. B-spline and Catmull-Rom subpaths are never joined: their curve near an end depends
-/// on the clamping, so concatenating the point lists would change the curve at the joint.
-/// Deterministic: the first subpath in document order absorbs the lowest-index match.
+/// Joins open polyline and Bezier subpaths of the same feed whose ends lie within `tolerance`
+/// mm (reversing one where that makes them meet); the joint keeps the first one's point. A
+/// polyline joined to a Bezier chain becomes a Bezier chain first (straight pieces, control
+/// points at the thirds). B-spline and Catmull-Rom subpaths are never joined: their curve near an
+/// end depends on the clamping, so concatenating the point lists would change the curve at the
+/// joint. Deterministic: the first subpath in document order absorbs the lowest-index match.
 Path merge_touching(const Path& path, double tolerance, std::size_t* merged = nullptr);
 
 /// The path with its subpaths reordered, reversed, rotated (closed ones) and joined to cut
