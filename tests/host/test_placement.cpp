@@ -97,7 +97,7 @@ TEST_CASE("placement: fit area uses the work area; align without fit", "[placeme
     CHECK(c.x_max == Approx(0));
     CHECK(c.y_min == Approx(0));
     MachineProfile m;
-    m.axes = {{"x", 1, 1, 0, true, -5, 5}, {"y", 1, 1, 0, true, 0, 3}};
+    m.axes = {{"x", 1, 1, true, -5, 5}, {"y", 1, 1, true, 0, 3}};
     CHECK(work_area(m)->x_min == -5);
     m.axes[1].has_travel = false;
     CHECK_FALSE(work_area(m).has_value());
