@@ -7,7 +7,8 @@
 #   SECONDS_PER_TARGET  default 10
 #   BUILD_DIR           the tree configured with the preset fuzz (default build/fuzz)
 # Environment: FUZZ_TARGETS="json_path csv_path" runs only those; FUZZ_WORK=DIR keeps the
-# scratch corpora and reproducers there (default: a temporary directory, kept on failure).
+# scratch corpora and reproducers there (default: a temporary directory, kept on failure);
+# FUZZ_RUNS=N also stops each target after N executions (whichever comes first).
 set -u
 here=$(cd "$(dirname "$0")" && pwd)
 seconds=${1:-10}
@@ -27,7 +28,9 @@ for t in $targets; do
     dict=""
     [ -f "$here/dict/$t.dict" ] && dict="-dict=$here/dict/$t.dict"
     # -rss_limit_mb: a reader is allowed what a big drawing needs, not unbounded memory.
-    "$exe" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 -max_len=8192 \
+    runs_cap=""
+    [ -n "${FUZZ_RUNS:-}" ] && runs_cap="-runs=$FUZZ_RUNS"
+    "$exe" -max_total_time="$seconds" $runs_cap -timeout=10 -rss_limit_mb=2048 -max_len=8192 \
         -artifact_prefix="$work/$t-" $dict "$work/$t" "$here/corpus/$t" >"$log" 2>&1
     status=$?
     runs=$(sed -n 's/^Done \([0-9]*\) runs in \([0-9]*\) second.*/\1 executions in \2 s/p' "$log")

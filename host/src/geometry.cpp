@@ -163,6 +163,12 @@ void for_each_bezier_segment(const Path& path, const std::function<void(const Be
         seg.pen_down = true;
         seg.subpath = s;
         seg.feed = sp.feed;
+        seg.blend_tolerance = sp.corner_mode != CornerMode::kBlend ? 0.0
+                              : sp.blend_tolerance > 0             ? sp.blend_tolerance
+                                                                   : -1.0;
+        std::size_t joint = 0;  // index of the segment about to be visited
+        auto next_stop = sp.stops.begin();
+        const bool stops = sp.corner_mode == CornerMode::kExactStop;
         subpath_segments(sp, s, [&](Controls& c) {
             if (first && any) {  // straight pen-up travel from the last end point to this start
                 BezierSegment travel;
@@ -175,6 +181,9 @@ void for_each_bezier_segment(const Path& path, const std::function<void(const Be
             seg.pause_before = first && sp.pause_before;
             seg.dwell_before = first ? sp.dwell_before : 0;
             seg.dwell_pen_down = first && sp.dwell_pen_down;
+            while (stops && next_stop != sp.stops.end() && *next_stop < joint) ++next_stop;
+            seg.stop_before = stops && !first && next_stop != sp.stops.end() && *next_stop == joint;
+            ++joint;
             first = false;
             any = true;
             visit(seg);

@@ -150,6 +150,60 @@ TEST_CASE("jog and set position refusals leave the device as it was", "[device][
     CHECK(write(jog_registers(0, 10, 0, kCommandSetPosition)) == Ex::kServerDeviceFailure);
 }
 
+TEST_CASE("a jog whose last short span fits no length is refused before any span is queued",
+          "[device][jog][modbus]") {
+    // Found by fuzz_modbus_map: a slow tick-rate-heavy axis (117 LSB/s^2 at 63,744 Hz) jogged
+    // 256 LSB. The ramps fit, the remainder at rest fits no span length up to kMaxSpanTicks;
+    // the jog used to find that out after queuing its first eight spans.
+    const Lsb start[kAxes] = {0, 0};
+    Device d(start);
+    Map m(d);
+    MotionLimits<kAxes> l;
+    l.tick_hz = 63744;
+    l.axis[0] = {2281701465u, 117};
+    l.axis[1] = {3860742, 4218880};
+    l.pen_down_ticks = 29952;
+    REQUIRE(d.configure(l) == Status::kOk);
+    const std::vector<std::uint16_t> r = jog_registers(0, 256, 0);
+    CHECK(m.write_holding_registers(modbus::kCommand, 5, r.data()) == Ex::kIllegalDataValue);
+    std::vector<std::uint16_t> s(modbus::status::kCount);
+    REQUIRE(m.read_input_registers(0, modbus::status::kCount, s.data()) == Ex::kNone);
+    CHECK(static_cast<Status>(s[modbus::status::kLastRefusal]) == Status::kBadLimits);
+    CHECK(d.queued_spans() == 0);
+    CHECK(d.last_accepted_sequence() == 0);
+    CHECK(d.free_slots() == kCapacity);
+    // On these limits a move is refused at plan() or every one of its spans passes the
+    // device's check and the last ends on the target; some are taken.
+    int taken = 0;
+    for (std::int64_t distance = -300; distance <= 300; ++distance) {
+        if (distance == 0) continue;
+        AxisMove<kAxes> move;
+        const Lsb from[kAxes] = {1000, -7};
+        if (move.plan(from, 0, distance, l.axis[0].max_velocity, l) != Status::kOk) continue;
+        ++taken;
+        Lsb at[kAxes] = {from[0], from[1]};
+        WireSpan w;
+        while (move.pending()) {
+            REQUIRE(move.next(w));
+            Span<kAxes> span;
+            span.basis = Basis::kHermite;
+            span.ticks = w.ticks;
+            for (unsigned a = 0; a < kAxes; ++a) {
+                span.control[a][0] = at[a];
+                span.control[a][1] = w.end[a];
+                span.control[a][2] = w.start_tangent[a];
+                span.control[a][3] = w.end_tangent[a];
+                at[a] = w.end[a];
+            }
+            REQUIRE(stop_detail::check_span(span, l) == Status::kOk);
+        }
+        CHECK(!move.next(w));
+        CHECK(at[0] == from[0] + distance);
+        CHECK(at[1] == from[1]);
+    }
+    CHECK(taken > 0);
+}
+
 TEST_CASE(
     "a stop in the middle of a jog: the device stops within its limits and the jog is fed no more",
     "[device][jog]") {

@@ -284,7 +284,7 @@ TEST_CASE("G-code: zero-length pieces are dropped and empty runs skipped", "[hos
     CHECK(p.subpaths[0].location.line == 9);
 }
 
-TEST_CASE("G-code: accepted and ignored codes; M2 and M30 end the program", "[host][gcode]") {
+TEST_CASE("G-code: accepted codes change no geometry; M2 and M30 end the program", "[host][gcode]") {
     const Path p = gcode(
         "G17 G21 G40 G49 G54 G61 G80 G90 G94 G91.1 T1 S500\nG4 P0.5\nG64 P0.01 Q0.01\nG61.1\n"
         "M3 S100\nM5\nG0 Z-1\nG1 X10\nM30\nthis is @ not G-code\n");

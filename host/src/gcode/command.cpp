@@ -219,11 +219,12 @@ private:
                 break;
             case 610:
             case 611:
-                claim(kPathControl, w, name);
-                break;
             case 640:
                 claim(kPathControl, w, name);
-                c.path_control = true;
+                c.path_control = tenths == 610   ? CornerMode::kExactPath
+                                 : tenths == 611 ? CornerMode::kExactStop
+                                                 : CornerMode::kBlend;
+                c.path_control_at = w.at;
                 break;
             case 900:
                 claim(kDistance, w, name);

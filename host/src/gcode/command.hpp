@@ -38,8 +38,8 @@ struct IgnoredCode {
     SourceLocation at;
 };
 
-/// One block, decoded. Codes the reader accepts and ignores (G17, G40, G49, G54, G61, G61.1,
-/// G64, G94, S, T) leave no trace here apart from `path_control` (G64 may carry P and Q).
+/// One block, decoded. Codes the reader accepts and ignores (G17, G40, G49, G54, G94, S, T)
+/// leave no trace here.
 struct Command {
     SourceLocation start;                  ///< the block's first word
     std::optional<Motion> motion;          ///< G0 G1 G2 G3 G5 G5.1 G80
@@ -50,7 +50,8 @@ struct Command {
     NonModal non_modal = NonModal::kNone;  ///< G4, G28, G30, G53, G92...
     SourceLocation non_modal_at;           ///< where that G word is
     bool nurbs_end = false;                ///< G5.3
-    bool path_control = false;             ///< G64 (may take P and Q)
+    std::optional<CornerMode> path_control;  ///< G61 (exact path), G61.1 (exact stop), G64 (P, Q)
+    SourceLocation path_control_at;         ///< where that G word is
     std::optional<bool> spindle_on;        ///< M3, M4 (true) / M5 (false)
     bool end_program = false;              ///< M2, M30
     bool pause = false;                    ///< M0, M1

@@ -95,6 +95,7 @@ bool Interpreter::execute(const Command& c) {
         }
         feed_ = mm_per_min / 60.0;
     }
+    if (c.path_control) path_control(c);
     if (c.spindle_on) {
         spindle_ = *c.spindle_on;
         if (spindle_) evidence_.spindle = true;
@@ -159,11 +160,28 @@ bool Interpreter::execute(const Command& c) {
     return true;
 }
 
+void Interpreter::path_control(const Command& c) {
+    double tolerance = 0;
+    if (c.path_control == CornerMode::kBlend) {
+        // G64 P: the most a rounded corner may depart from the programmed vertex; G64 Q (naive
+        // CAM: merging nearly collinear moves) has no counterpart, the planner keeps every move.
+        if (const Word* p = c.value('P')) {
+            if (!(p->value >= 0)) fail(p->at, "G64 blend tolerance P must not be negative");
+            tolerance = length(*p);
+        }
+        if (const Word* q = c.value('Q'); q && !(q->value >= 0)) {
+            fail(q->at, "G64 naive CAM tolerance Q must not be negative");
+        }
+    }
+    runs_.set_corners(*c.path_control, tolerance);
+}
+
 void Interpreter::check_words_used(const Command& c, Motion move, bool moving) const {
     const bool arc = moving && (move == Motion::kArcCw || move == Motion::kArcCcw);
     const bool spline = moving && (move == Motion::kCubic || move == Motion::kQuadratic);
     const bool cubic = moving && move == Motion::kCubic;
     const bool nurbs = moving && move == Motion::kNurbs;
+    const bool blending = c.path_control == CornerMode::kBlend;
     const struct {
         char letter;
         bool used;
@@ -171,10 +189,14 @@ void Interpreter::check_words_used(const Command& c, Motion move, bool moving) c
         {'I', arc || spline},
         {'J', arc || spline},
         {'R', arc},
-        {'P', arc || cubic || nurbs || c.non_modal == NonModal::kDwell || c.path_control},
-        {'Q', cubic || c.path_control},
+        {'P', arc || cubic || nurbs || c.non_modal == NonModal::kDwell || blending},
+        {'Q', cubic || blending},
         {'L', nurbs},
     };
+    if (const Word* p = c.value('P');
+        p && blending && (arc || cubic || nurbs || c.non_modal == NonModal::kDwell)) {
+        fail(p->at, "word P would be used by G64 and by the block's other command: give G64 a block of its own");
+    }
     for (const auto& u : uses) {
         if (const Word* w = c.value(u.letter); w && !u.used) {
             fail(w->at,
@@ -327,6 +349,7 @@ void Interpreter::follow(const std::vector<Cubic>& pieces, bool down, Vec2 to, S
     }
     if (down) {
         for (const Cubic& piece : pieces) runs_.draw(piece, feed_, at, file_);
+        runs_.end_block();
     } else {
         runs_.lift();
     }

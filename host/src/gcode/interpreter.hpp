@@ -52,6 +52,8 @@ private:
     /// Whether the pen is down where the machine stands now (for G4).
     bool pen_down_now() const;
 
+    /// G61, G61.1, G64 [P] [Q]: the corner rule for the moves that follow.
+    void path_control(const Command& c);
     void check_words_used(const Command& c, Motion move, bool moving) const;
     /// G92, G92.1, G92.2, G92.3, G28.1, G30.1; G28 and G30 travel.
     void non_modal(const Command& c);

@@ -1,6 +1,7 @@
 // Pen-down runs -> Bezier-chain subpaths.
 #include "runs.hpp"
 
+#include <cstdint>
 #include <stdexcept>
 #include <string>
 
@@ -15,6 +16,13 @@ PathPoint point(Vec2 v) {
 
 Vec2 vec(PointRef p) {
     return {p[0], p[1]};
+}
+
+/// Curve segments in a run so far.
+std::size_t segments(const Subpath& run) {
+    const std::size_t m = run.points.size();
+    if (m == 0) return 0;
+    return run.basis == PathBasis::kPolyline ? m - 1 : (m - 1) / 3;
 }
 
 /// A polyline run as the Bezier chain of its line pieces (a curve is joining it).
@@ -40,7 +48,10 @@ void RunBuilder::draw(const Cubic& piece, double feed_mm_s, SourceLocation at,
             file, at,
             "more than " + std::to_string(kMaxPieces) + " curve pieces drawn (the reader's limit)");
     }
-    if (open_ && done_.back().feed != feed_mm_s) open_ = false;  // one feed per subpath
+    if (open_ && (done_.back().feed != feed_mm_s || done_.back().corner_mode != corner_mode_ ||
+                  done_.back().blend_tolerance != blend_tolerance_)) {
+        close_run();  // one feed and one path control mode per subpath
+    }
     if (!open_) {
         Subpath sp;
         sp.basis = is_line_piece(piece) ? PathBasis::kPolyline : PathBasis::kBezier;
@@ -50,6 +61,8 @@ void RunBuilder::draw(const Cubic& piece, double feed_mm_s, SourceLocation at,
         sp.pause_before = pause_next_;
         sp.dwell_before = dwell_next_;
         sp.dwell_pen_down = dwell_pen_down_;
+        sp.corner_mode = corner_mode_;
+        sp.blend_tolerance = blend_tolerance_;
         pause_next_ = false;
         dwell_next_ = 0;
         dwell_pen_down_ = false;
@@ -68,12 +81,26 @@ void RunBuilder::draw(const Cubic& piece, double feed_mm_s, SourceLocation at,
     for (std::size_t k = 1; k < piece.p.size(); ++k) run.points.push_back(point(piece.p[k]));
 }
 
-void RunBuilder::lift() {
+void RunBuilder::end_block() {
+    if (!open_ || corner_mode_ != CornerMode::kExactStop) return;
+    Subpath& run = done_.back();
+    const auto joint = static_cast<std::uint32_t>(segments(run));
+    if (joint > 0 && (run.stops.empty() || run.stops.back() != joint)) run.stops.push_back(joint);
+}
+
+void RunBuilder::close_run() {
+    if (open_ && !done_.back().stops.empty() && done_.back().stops.back() >= segments(done_.back())) {
+        done_.back().stops.pop_back();
+    }
     open_ = false;
 }
 
+void RunBuilder::lift() {
+    close_run();
+}
+
 std::vector<Subpath> RunBuilder::finish() {
-    open_ = false;
+    close_run();
     return std::move(done_);
 }
 

@@ -1,5 +1,5 @@
 // Collects the pieces of pen-down moves into subpaths: one open subpath per maximal run of
-// pen-down moves with one feed, a polyline while the run has only line pieces, else a Bezier
+// pen-down moves with one feed and one path control mode, a polyline while the run has only line pieces, else a Bezier
 // chain.
 #pragma once
 
@@ -25,6 +25,16 @@ public:
     /// Ends the open run, if any (pen up).
     void lift();
 
+    /// The path control mode for pieces drawn from now on (G61, G61.1, G64 [P]): a run has one,
+    /// so a change within a run starts a new subpath where it ends, as a feed change does.
+    /// `blend_tolerance_mm`: G64 P in mm (0: none given).
+    void set_corners(CornerMode mode, double blend_tolerance_mm) {
+        corner_mode_ = mode;
+        blend_tolerance_ = mode == CornerMode::kBlend ? blend_tolerance_mm : 0;
+    }
+    /// A block's pieces are drawn: in exact stop mode (G61.1) the motion rests where it ended.
+    void end_block();
+
     /// The next subpath started gets Subpath::pause_before (M0, M1).
     void pause_next() { pause_next_ = true; }
     /// The next subpath started rests `seconds` more at its start (G4), pen down or up.
@@ -46,6 +56,11 @@ private:
     double dwell_next_ = 0;
     bool dwell_pen_down_ = false;
     std::size_t pieces_ = 0;
+    CornerMode corner_mode_ = CornerMode::kBlend;
+    double blend_tolerance_ = 0;
+
+    /// Ends the open run: a rest recorded at its very end is no joint.
+    void close_run();
 };
 
 }  // namespace pathstream::host::gcode

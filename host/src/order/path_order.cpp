@@ -27,9 +27,10 @@ bool joinable_basis(PathBasis basis) {
     return basis == PathBasis::kPolyline || basis == PathBasis::kBezier;
 }
 
-/// An open polyline or Bezier chain whose ends meet: it may start at any on-curve vertex.
+/// An open polyline or Bezier chain whose ends meet: it may start at any on-curve vertex
+/// (unless it rests at some of its vertices: those would move).
 bool is_open_loop(const Subpath& s, double tolerance) {
-    if (s.closed || !joinable_basis(s.basis) || tolerance < 0) return false;
+    if (s.closed || !joinable_basis(s.basis) || tolerance < 0 || s.corner_mode == CornerMode::kExactStop) return false;
     const std::size_t m = s.points.size();
     if (s.basis == PathBasis::kBezier ? m < 7 || (m - 1) % 3 != 0 : m < 3) return false;
     return distance(s.points.front(), s.points.back()) <= tolerance;
@@ -54,9 +55,32 @@ void rotate_open_loop(Subpath& s, std::size_t shift) {
     s.points.push_back(s.points.front());  // Q[shift..m-1], Q[1..shift]
 }
 
+/// Curve segments of a polyline or Bezier chain (Subpath::stops counts joints between them).
+std::size_t segment_count(const Subpath& s) {
+    const std::size_t m = s.points.size();
+    if (s.basis == PathBasis::kBezier) return s.closed ? m / 3 : (m > 0 ? (m - 1) / 3 : 0);
+    return s.closed ? m : (m > 0 ? m - 1 : 0);
+}
+
+/// Subpath::stops after the segments were renumbered: joint k becomes (k * sign + shift) mod n,
+/// kept ascending; a joint landing on the ends (0) is dropped (the motion rests there anyway).
+void renumber_stops(Subpath& r, long long sign, long long shift) {
+    if (r.stops.empty()) return;
+    const long long n = static_cast<long long>(segment_count(r));
+    std::vector<std::uint32_t> out;
+    out.reserve(r.stops.size());
+    for (const std::uint32_t k : r.stops) {
+        const long long j = n > 0 ? ((sign * static_cast<long long>(k) + shift) % n + n) % n : 0;
+        if (j > 0) out.push_back(static_cast<std::uint32_t>(j));
+    }
+    std::sort(out.begin(), out.end());
+    r.stops = std::move(out);
+}
+
 /// reversed_subpath in place.
 void reverse_points(Subpath& r) {
     r.points.reverse(r.closed ? 1 : 0);
+    renumber_stops(r, -1, static_cast<long long>(segment_count(r)));
 }
 
 /// rotated_subpath in place (its checks and messages).
@@ -68,6 +92,7 @@ void rotate_points(Subpath& r, std::size_t shift) {
                                     std::to_string(shift) + " is not a multiple of 3)");
     }
     r.points.rotate(shift);
+    renumber_stops(r, 1, -static_cast<long long>(r.basis == PathBasis::kBezier ? shift / 3 : shift));
 }
 
 /// 2-D cell of a point for the grids: the first two axes (one-axis paths: y = 0).
@@ -519,9 +544,16 @@ Subpath rotated_subpath(const Subpath& s, std::size_t shift) {
 }
 
 namespace {
-/// A subpath merge_touching may join at its ends: open, of a joinable basis, points valid.
+/// A subpath merge_touching may join at its ends: open, of a joinable basis, points valid, not
+/// resting at its joints (the join would lose the rest at its own ends).
 bool joinable(const Subpath& s) {
-    return !s.closed && joinable_basis(s.basis) && s.points.size() >= 2 && point_count_problem(s).empty();
+    return !s.closed && joinable_basis(s.basis) && s.points.size() >= 2 && point_count_problem(s).empty() &&
+           s.corner_mode != CornerMode::kExactStop;
+}
+
+/// Whether two subpaths may become one: the same feed and the same corner rule.
+bool same_motion(const Subpath& a, const Subpath& b) {
+    return a.feed == b.feed && a.corner_mode == b.corner_mode && a.blend_tolerance == b.blend_tolerance;
 }
 
 /// The grid cell (side `cell`, mm) of an end point in the plane: ends within `cell` of each
@@ -580,7 +612,7 @@ bool any_touching(const Path& path, double tolerance) {
                     if (found == ends.end()) continue;
                     for (const auto& [j, q] : found->second) {
                         const Subpath &a = in[i], &b = in[j];
-                        if (j == i || a.feed != b.feed || p.size() != q.size()) continue;
+                        if (j == i || !same_motion(a, b) || p.size() != q.size()) continue;
                         if (distance(p, q) <= tolerance) return true;
                     }
                 }
@@ -623,7 +655,7 @@ Path merge_touching(const Path& path, double tolerance, std::size_t* merged) {
                            list.end());
                 for (const auto& [i, side] : list) {
                     const Subpath& s = in[i];
-                    if (s.feed != with.feed || s.points[0].size() != p.size()) continue;
+                    if (!same_motion(s, with) || s.points[0].size() != p.size()) continue;
                     const PointRef q = side == 0 ? s.points.front() : s.points.back();
                     if (distance(p, q) > tolerance) continue;
                     if (i < best.first || (i == best.first && side < best.second)) best = {i, side};

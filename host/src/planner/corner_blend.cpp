@@ -1,6 +1,6 @@
 // Corner blending: the vertex between two straight segments of one run that turn by less than
 // the stop angle becomes a short curve that stays within a fraction of the chord tolerance of
-// it, so that the motion crosses the corner at the curvature's speed instead of the speed at
+// it (or within the subpath's own smaller blend tolerance, G64 P; never in G61 or G61.1), so that the motion crosses the corner at the curvature's speed instead of the speed at
 // which every axis can jump its velocity within one tick (docs/planner.md §3, §8).
 #include <algorithm>
 #include <cmath>
@@ -87,7 +87,9 @@ void CornerBlender::blend(BezierSegment& b) {
     BezierSegment& a = *held_;
     Vec ta{}, tb{};
     double la = 0, lb = 0;
-    const bool same_run = a.pen_down == b.pen_down && a.subpath == b.subpath && !b.pause_before && b.dwell_before == 0;
+    // A subpath in exact path or exact stop mode (G61, G61.1) keeps its vertices.
+    const bool same_run = a.pen_down == b.pen_down && a.subpath == b.subpath && !b.pause_before &&
+                          b.dwell_before == 0 && !b.stop_before && b.blend_tolerance != 0;
     if (same_run && a.p[0].size() == b.p[0].size() && a.p[0].size() <= kAxesMax && straight(a, ta, la) &&
         straight(b, tb, lb)) {
         if (held_original_length_ < 0) held_original_length_ = la;
@@ -97,7 +99,8 @@ void CornerBlender::blend(BezierSegment& b) {
             // d sin(turn / 2) / 2 from the vertex V; each leg takes at most half a segment
             // (the first one what its earlier blend left of it).
             const double half = std::sin(0.5 * turn);
-            double d = 2 * deviation_ / half;
+            const double deviation = b.blend_tolerance > 0 ? std::min(deviation_, b.blend_tolerance) : deviation_;
+            double d = 2 * deviation / half;
             d = std::min({d, 0.5 * held_original_length_, la, 0.5 * lb});
             if (d > 1e-6) {
                 const std::size_t axes = a.p[0].size();
@@ -107,6 +110,7 @@ void CornerBlender::blend(BezierSegment& b) {
                 BezierSegment corner = a;
                 corner.pause_before = false;
                 corner.dwell_before = 0;
+                corner.stop_before = false;
                 corner.p[0] = start;
                 // The quadratic's middle control point V raised to a cubic: P + 2/3 (V - P).
                 corner.p[1] = to_point(add(scaled(to_vec(start), 1.0 / 3), scaled(v, 2.0 / 3)), axes);

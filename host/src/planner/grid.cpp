@@ -165,7 +165,7 @@ struct Builder {
                 const std::size_t a = seg_first - 1, b = seg_first;
                 const double turn = angle_between(g.tangent[a], g.tangent[b]);
                 const bool sharp = norm(g.curvature[a]) > kappa_stop_ || norm(g.curvature[b]) > kappa_stop_;
-                if (turn > options.corner_stop_angle || sharp) {
+                if (turn > options.corner_stop_angle || sharp || segments[s].stop_before) {
                     close_piece(run, piece_first, a, feed);
                     piece_first = b;
                 } else if (turn > 1e-9) {

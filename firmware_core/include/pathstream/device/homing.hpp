@@ -79,7 +79,10 @@ public:
     AxisMove() = default;
 
     /// Plans `distance` LSB (signed) on `axis` from `start` at up to `velocity` LSB/s within
-    /// `limits`. kBadLimits when no span length gives a usable acceleration step.
+    /// `limits`. kBadLimits when no span length gives a usable acceleration step or the creep
+    /// span fits the limits at no length: every span is settled here, so next() cannot fail
+    /// half-way through a move (a jog refused after some of its spans were queued would leave
+    /// the device changed by a refused command).
     [[nodiscard]] Status plan(const Lsb (&start)[Axes], unsigned axis, std::int64_t distance, std::uint32_t velocity,
                               const MotionLimits<Axes>& limits) {
         for (unsigned a = 0; a < Axes; ++a) at_[a] = start[a];
@@ -120,14 +123,21 @@ public:
         const std::int64_t middle = remaining_ - 2 * ramp_distance_;
         cruise_spans_ = ramp_spans_ == 0 ? 0 : middle / cruise_;
         creep_ = ramp_spans_ == 0 ? middle : middle % cruise_;
+        creep_ticks_ = 0;
+        if (creep_ != 0) {
+            const std::int64_t creep_from = start[axis] + sign_ * (remaining_ - creep_);
+            if (creep_from > kMaxPositionLsb || creep_from < -kMaxPositionLsb) return Status::kBadLimits;
+            creep_ticks_ = creep_length(static_cast<Lsb>(creep_from));
+            if (creep_ticks_ == 0) return Status::kBadLimits;
+        }
         return Status::kOk;
     }
 
     /// True while spans remain.
     bool pending() const { return index_ < total_spans(); }
 
-    /// Writes the next span (absolute end point, explicit tangents, pen up). False when the
-    /// move is complete or the creep span cannot be made to fit the limits.
+    /// Writes the next span (absolute end point, explicit tangents, pen up). False only when
+    /// the move is complete.
     bool next(WireSpan& w) {
         if (!pending()) return false;
         w = WireSpan{};
@@ -145,7 +155,9 @@ public:
             t0 = ramp_tangent(static_cast<std::uint32_t>(k));
             t1 = ramp_tangent(static_cast<std::uint32_t>(k - 1));
         } else {
-            if (!creep_span(w)) return false;
+            at_[axis_] = static_cast<Lsb>(at_[axis_] + sign_ * creep_);
+            w.ticks = creep_ticks_;
+            fill(w, 0, 0);
             ++index_;
             return true;
         }
@@ -176,26 +188,21 @@ private:
         w.end_tangent[axis_] = t1;
     }
 
-    // The remainder at rest: P1 = P0 + creep, T0 = T1 = 0, lengthened until it passes.
-    bool creep_span(WireSpan& w) {
+    // Ticks of the remainder at rest from `from` (P1 = P0 + creep, T0 = T1 = 0): the first
+    // of n, 2n, 4n .. that passes the limits; 0 when none up to kMaxSpanTicks does.
+    std::uint32_t creep_length(Lsb from) const {
         Span<Axes> s;
         s.basis = Basis::kHermite;
+        for (unsigned a = 0; a < Axes; ++a) {
+            s.control[a][0] = s.control[a][1] = a == axis_ ? from : at_[a];
+            s.control[a][2] = s.control[a][3] = 0;
+        }
+        s.control[axis_][1] = static_cast<Lsb>(from + sign_ * creep_);
         for (std::uint32_t ticks = n_; ticks <= kMaxSpanTicks; ticks *= 2) {
             s.ticks = ticks;
-            for (unsigned a = 0; a < Axes; ++a) {
-                s.control[a][0] = at_[a];
-                s.control[a][1] = at_[a];
-                s.control[a][2] = s.control[a][3] = 0;
-            }
-            s.control[axis_][1] = static_cast<std::int32_t>(at_[axis_] + sign_ * creep_);
-            if (stop_detail::check_span(s, limits_) == Status::kOk) {
-                at_[axis_] = s.control[axis_][1];
-                w.ticks = ticks;
-                fill(w, 0, 0);
-                return true;
-            }
+            if (stop_detail::check_span(s, limits_) == Status::kOk) return ticks;
         }
-        return false;
+        return 0;
     }
 
     Lsb at_[Axes] = {};
@@ -210,6 +217,7 @@ private:
     std::int64_t ramp_distance_ = 0;
     std::int64_t cruise_spans_ = 0;
     std::int64_t creep_ = 0;
+    std::uint32_t creep_ticks_ = 0;  // length of the creep span, settled by plan()
     std::int64_t index_ = 0;
 };
 

@@ -40,7 +40,8 @@ struct GcodeReadInfo {
 };
 
 /// Parses a G-code program into a 2-axis path (X, Y in mm): one subpath (basis kBezier, open,
-/// points P0 C C P1 C C ... of 3k + 1) per maximal run of pen-down moves with one feed; G0 and
+/// points P0 C C P1 C C ... of 3k + 1) per maximal run of pen-down moves with one feed and one
+/// path control mode (G61, G61.1, G64 [P]: Subpath::corner_mode, blend_tolerance, stops); G0 and
 /// pen-up moves are travel between subpaths. Subpath::feed is the F word in mm/s (0 until the
 /// program gives F). `file` names the source in error messages.
 /// Throws InputError ("file:line:col: what is wrong") at the offending word for syntax errors,

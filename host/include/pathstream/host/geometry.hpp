@@ -23,6 +23,12 @@ struct BezierSegment {
     bool pause_before = false;
     double dwell_before = 0;
     bool dwell_pen_down = false;
+    /// The vertex at this segment's start, inside its subpath: < 0 may be rounded within the
+    /// planner's own bound, > 0 within the smaller of that and this many mm (G64 P), 0 not at
+    /// all (G61, G61.1). From Subpath::corner_mode and blend_tolerance.
+    double blend_tolerance = -1;
+    /// The motion comes to rest at this segment's start (a joint in Subpath::stops: G61.1).
+    bool stop_before = false;
 };
 
 /// Converts every subpath to Bezier segments (B-spline and Catmull-Rom spans exactly, with the

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -16,6 +17,13 @@ enum class PathBasis {
     kCatmullRom,  ///< uniform Catmull-Rom through every point
     kBezier,      ///< cubic Bezier chain: P0 C C P1 C C P2 ... (3k + 1 points open, 3k closed)
     kPolyline,    ///< straight segments between points
+};
+
+/// What the planner may do at the vertices inside a subpath (G-code's path control modes).
+enum class CornerMode {
+    kBlend,      ///< round vertices within Subpath::blend_tolerance (G64, the default)
+    kExactPath,  ///< go through every vertex exactly, slowing as the turn needs (G61)
+    kExactStop,  ///< also come to rest at the joints in Subpath::stops (G61.1: each block's end)
 };
 
 /// Where a value came from in its input file (1-based), for error messages.
@@ -40,6 +48,15 @@ struct Subpath {
     /// the pen down (after the pen-down delay) or up (before the pen goes down).
     double dwell_before = 0;
     bool dwell_pen_down = false;
+    CornerMode corner_mode = CornerMode::kBlend;
+    /// kBlend: a rounded vertex stays within this many mm of it (G64 P), on top of the planner's
+    /// own bound (PlanOptions::corner_blend of the chord tolerance), which it can only tighten;
+    /// 0: the planner's bound alone.
+    double blend_tolerance = 0;
+    /// kExactStop: the joints where the motion rests, ascending; joint k (1 <= k < segments) is
+    /// where the subpath's curve segment k starts (a polyline's point k, a Bezier chain's
+    /// point 3k). Other bases and modes: empty.
+    std::vector<std::uint32_t> stops{};
 };
 
 /// A named group of subpaths plotted with one pen (an Inkscape layer, a stroke colour).
