@@ -204,6 +204,47 @@ TEST_CASE("a jog whose last short span fits no length is refused before any span
     CHECK(taken > 0);
 }
 
+TEST_CASE("a jog under a jerk limit passes the device's jerk rules and ends on its target",
+          "[device][jog][jerk]") {
+    // The device checks its own moves like a host's spans: a constant-acceleration move at the
+    // axis's full acceleration is refused under these limits, the jog's own plan is taken.
+    for (const std::uint32_t max_jerk : {100000u, 1000000u, 30000000u, 4000000000u}) {
+        MotionLimits<kAxes> l = plotter_limits();
+        for (auto& a : l.axis) a.max_jerk = max_jerk;  // units of 100 LSB/s^3
+        for (const std::int32_t distance : {1, -3, 7, 100, -5001, 40000, -123457}) {
+            INFO("max_jerk " << max_jerk << " distance " << distance);
+            const Lsb start[kAxes] = {2000, -1000};
+            Device d(start);
+            REQUIRE(d.configure(l) == Status::kOk);
+            Jog<kAxes, kCapacity> jog(d);
+            REQUIRE(jog.start(1, distance, 0) == Status::kOk);
+            run_to_idle(
+                d, [&] { jog.service(); }, l, 2000000);
+            CHECK_FALSE(jog.feeding());
+            CHECK(d.position(1) == start[1] + distance);
+            CHECK(d.position(0) == start[0]);
+            CHECK(d.finished_job() == 1);
+            CHECK(d.status().underruns == 0);
+        }
+        // The same move planned without the jerk limit: refused where its acceleration steps.
+        MotionLimits<kAxes> no_jerk = l;
+        for (auto& a : no_jerk.axis) a.max_jerk = 0;
+        if (static_cast<std::uint64_t>(max_jerk) * kJerkUnitLsb / l.tick_hz >= l.axis[1].max_acceleration) {
+            continue;  // one tick of jerk reaches the full acceleration: nothing to refuse
+        }
+        const Lsb start[kAxes] = {0, 0};
+        Device d(start);
+        REQUIRE(d.configure(l) == Status::kOk);
+        AxisMove<kAxes> move;
+        REQUIRE(move.plan(start, 1, 40000, l.axis[1].max_velocity, no_jerk) == Status::kOk);
+        WireSpan w;
+        REQUIRE(move.next(w));
+        std::uint8_t bytes[64];
+        const std::size_t length = encode_wire_span(w, kAxes, bytes, sizeof bytes);
+        CHECK(d.accept_batch(1, 1, bytes, length) == Status::kAccelerationStep);
+    }
+}
+
 TEST_CASE(
     "a stop in the middle of a jog: the device stops within its limits and the jog is fed no more",
     "[device][jog]") {

@@ -124,17 +124,6 @@ public:
         return Status::kOk;
     }
 
-    /// accept_batch for the device's own jobs (jog, homing): their constant-acceleration
-    /// spans are checked like a host's but for the jerk limit, which they do not follow (their
-    /// acceleration steps at their joins; docs/device.md, "Jerk limit"). Task context.
-    [[nodiscard]] Status accept_own_batch(std::uint32_t first_sequence, std::uint16_t count,
-                                          const std::uint8_t* payload, std::size_t length) {
-        check_jerk_ = false;
-        const Status s = accept_batch(first_sequence, count, payload, length);
-        check_jerk_ = true;
-        return s;
-    }
-
     /// Requests a command; the next tick applies it (a second request before that tick
     /// replaces the first). Every value is checked here: kUnknownCommand for a value that is
     /// no Command; kWrongState when the state does not allow it (start: idle; hold: running;
@@ -374,7 +363,6 @@ private:
                     return st;
                 }
             }
-            if (!check_jerk_) continue;
             if (Status st = check_axis_jerk(v.cubic[a], v.timing, limits_.axis[a], limits_.tick_hz);
                 st != Status::kOk) {
                 return st;
@@ -386,7 +374,6 @@ private:
                 st != Status::kOk) {
                 return st;
             }
-            if (!check_jerk_) continue;
             if (Status st = check_acceleration_step(start_acceleration(v.cubic[a], v.timing),
                                                     chain.acceleration[a], limits_.axis[a],
                                                     limits_.tick_hz);
@@ -399,7 +386,7 @@ private:
             if (job_end) return Status::kJobEndMoving;
             if (pause) return Status::kPauseMoving;
         }
-        if (check_jerk_ && (job_end || pause)) {
+        if (job_end || pause) {
             for (unsigned a = 0; a < Axes; ++a) {
                 if (Status st = check_end_at_rest(end_acceleration(v.cubic[a], v.timing),
                                                   limits_.axis[a], limits_.tick_hz);
@@ -415,7 +402,6 @@ private:
     MotionLimits<Axes> limits_;
     bool configured_ = false;
     bool enforce_travel_ = true;
-    bool check_jerk_ = true;  // off only inside accept_own_batch
     std::uint32_t next_sequence_ = 1;
     LastBatch last_batch_;
     std::uint32_t duplicates_ = 0;

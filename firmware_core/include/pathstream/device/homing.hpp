@@ -1,7 +1,7 @@
 // Homing one axis against a switch: search toward it, back off, approach slowly, set zero.
 //
 // The sequencer is a producer like a bus master: it feeds its own moves to a MotionDevice as
-// wire spans (accept_batch), each move one job (its last span marks the job end, so the
+// wire spans (accept_batch, checked like a host's), each move one job (its last span marks the job end, so the
 // device idles at the move's end by itself), stops the device with a command when the switch
 // is seen, and finally redefines the position with set_position. Every move is a rest-to-rest
 // trapezoid of constant- acceleration Hermite spans (cubic term exactly zero), so the device's
@@ -79,7 +79,8 @@ public:
     AxisMove() = default;
 
     /// Plans `distance` LSB (signed) on `axis` from `start` at up to `velocity` LSB/s within
-    /// `limits`. kBadLimits when no span length gives a usable acceleration step or the creep
+    /// `limits`, its jerk limit included (the device checks the spans like a host's).
+    /// kBadLimits when no span length gives a usable acceleration step or the creep
     /// span fits the limits at no length: every span is settled here, so next() cannot fail
     /// half-way through a move (a jog refused after some of its spans were queued would leave
     /// the device changed by a refused command).
@@ -92,7 +93,17 @@ public:
         limits_ = limits;
         index_ = 0;
         const std::uint64_t hz = limits.tick_hz;
-        const AxisLimits& l = limits.axis[axis];
+        if (hz == 0) return Status::kBadLimits;
+        // Under a jerk limit J the move accelerates at most at J/2 * 1 tick: every join then
+        // steps the acceleration by at most one tick of jerk (ramp to ramp, rest to ramp, ramp
+        // up to ramp down, the last ramp to the creep span), and the spans carry no jerk.
+        if (limits.axis[axis].max_jerk != 0) {
+            const std::uint64_t by_jerk = static_cast<std::uint64_t>(limits.axis[axis].max_jerk) * kJerkUnitLsb / (2 * hz);
+            if (by_jerk < limits_.axis[axis].max_acceleration) {
+                limits_.axis[axis].max_acceleration = static_cast<std::uint32_t>(by_jerk);
+            }
+        }
+        const AxisLimits& l = limits_.axis[axis];
         if (velocity > l.max_velocity) velocity = l.max_velocity;
         // Span length n: the smallest power of two whose per-span tangent step a n^2 / hz^2
         // is at least 2 (tangents stay even); at least 8 ticks.
@@ -107,9 +118,19 @@ public:
         while (static_cast<std::uint64_t>(cruise_) * hz > static_cast<std::uint64_t>(l.max_velocity) * n_ && cruise_ > 2) {
             cruise_ -= 2;
         }
-        // Shrink the cruise tangent until both ramps fit in the distance.
+        // Shrink the cruise tangent until both ramps fit in the distance. A ramp of R spans
+        // to tangent c covers at least R (c/2 - 2) (every rounded tangent is within 2 of
+        // c i / R): a cruise that cannot fit by that bound is halved without summing its
+        // spans, so the sum runs only for R (c - 4) <= distance: R <= 11,586 for a jog's
+        // largest distance, 2^28 LSB, whatever the limits (it was a loop of 10^8 spans).
         for (;;) {
             ramp_spans_ = static_cast<std::uint32_t>((cruise_ + step_ - 1) / step_);
+            if (cruise_ > 4 && static_cast<std::uint64_t>(ramp_spans_) * static_cast<std::uint64_t>(cruise_ - 4) >
+                                   static_cast<std::uint64_t>(remaining_)) {
+                cruise_ = even_floor(static_cast<std::uint64_t>(cruise_) / 2);
+                if (cruise_ < 2) cruise_ = 2;
+                continue;
+            }
             ramp_distance_ = 0;
             for (std::uint32_t i = 0; i < ramp_spans_; ++i) ramp_distance_ += (ramp_tangent(i) + ramp_tangent(i + 1)) / 2;
             if (2 * ramp_distance_ <= remaining_ || cruise_ <= 2) break;
@@ -189,7 +210,8 @@ private:
     }
 
     // Ticks of the remainder at rest from `from` (P1 = P0 + creep, T0 = T1 = 0): the first
-    // of n, 2n, 4n .. that passes the limits; 0 when none up to kMaxSpanTicks does.
+    // of n, 2n, 4n .. that passes the limits (the move's acceleration, the jerk inside); 0
+    // when none up to kMaxSpanTicks does.
     std::uint32_t creep_length(Lsb from) const {
         Span<Axes> s;
         s.basis = Basis::kHermite;
@@ -200,7 +222,14 @@ private:
         s.control[axis_][1] = static_cast<Lsb>(from + sign_ * creep_);
         for (std::uint32_t ticks = n_; ticks <= kMaxSpanTicks; ticks *= 2) {
             s.ticks = ticks;
-            if (stop_detail::check_span(s, limits_) == Status::kOk) return ticks;
+            ValidatedSpan<Axes> v;
+            if (validate_span(s, v) != Status::kOk) continue;
+            bool fits = true;
+            for (unsigned a = 0; a < Axes && fits; ++a) {
+                fits = check_axis_limits(v.cubic[a], v.timing, limits_.axis[a], limits_.tick_hz) == Status::kOk &&
+                       check_axis_jerk(v.cubic[a], v.timing, limits_.axis[a], limits_.tick_hz) == Status::kOk;
+            }
+            if (fits) return ticks;
         }
         return 0;
     }
@@ -418,7 +447,7 @@ private:
                 length += encode_wire_span(w, Axes, bytes + length, sizeof bytes - length);
                 ++count;
             }
-            const Status s = device_.accept_own_batch(device_.last_accepted_sequence() + 1u, count, bytes, length);
+            const Status s = device_.accept_batch(device_.last_accepted_sequence() + 1u, count, bytes, length);
             if (s != Status::kOk) {
                 (void)finish_error(HomingError::kDeviceRefused, s);
                 return false;

@@ -121,7 +121,7 @@ private:
                 length += encode_wire_span(w, Axes, bytes + length, sizeof bytes - length);
                 ++count;
             }
-            if (Status s = device_.accept_own_batch(device_.last_accepted_sequence() + 1u, count, bytes,
+            if (Status s = device_.accept_batch(device_.last_accepted_sequence() + 1u, count, bytes,
                                                 length);
                 s != Status::kOk) {
                 return s;

@@ -54,11 +54,6 @@ public:
         return receiver_.accept_batch(first_sequence, count, payload, length,
                                       static_cast<Between&&>(between));
     }
-    /// DeviceReceiver::accept_own_batch: the device's own jobs (jog, homing). Task context.
-    [[nodiscard]] Status accept_own_batch(std::uint32_t first_sequence, std::uint16_t count,
-                                          const std::uint8_t* payload, std::size_t length) {
-        return receiver_.accept_own_batch(first_sequence, count, payload, length);
-    }
     /// DeviceReceiver::command. Task context.
     [[nodiscard]] Status command(Command c) { return receiver_.command(c); }
     /// DeviceReceiver::start_keeping_pen (the device's own jog). Task context.
