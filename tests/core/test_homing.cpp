@@ -248,6 +248,12 @@ TEST_CASE("homing errors: switch never found, switch stuck, e-stop, bad config, 
         c = config();
         c.axis = 2;
         CHECK(h.start(c) == Status::kBadLimits);
+        c = config();
+        c.backoff = static_cast<std::uint32_t>(kMaxPositionLsb) + 1;  // the latch runs 2 x backoff
+        CHECK(h.start(c) == Status::kBadLimits);
+        CHECK(h.error() == HomingError::kBadConfig);
+        c.backoff = static_cast<std::uint32_t>(kMaxPositionLsb);
+        CHECK(h.start(c) == Status::kOk);
         d.raise_fault(FaultCode::kExternal);
         Lsb out[kAxes];
         d.tick(out);

@@ -259,13 +259,15 @@ public:
     explicit HomingSequencer(MotionDevice<Axes, Capacity>& device) : device_(device) {}
 
     /// Starts homing. The device must be configured and idle (kWrongState otherwise);
-    /// kBadConfig for zero velocities or distances or a bad axis. Task context.
+    /// kBadConfig for zero velocities or distances, a distance above kMaxPositionLsb (2^27) or
+    /// a bad axis. Task context.
     [[nodiscard]] Status start(const HomingConfig& config) {
         config_ = config;
         error_ = HomingError::kNone;
         error_status_ = Status::kOk;
         if (config.axis >= Axes || config.search_velocity == 0 || config.latch_velocity == 0 || config.backoff == 0 ||
-            config.max_travel == 0 || config.max_travel > kMaxPositionLsb || config.pull_off > kMaxPositionLsb) {
+            config.max_travel == 0 || config.max_travel > kMaxPositionLsb || config.backoff > kMaxPositionLsb ||
+            config.pull_off > kMaxPositionLsb) {
             return finish_error(HomingError::kBadConfig, Status::kBadLimits);
         }
         if (!device_.configured()) return finish_error(HomingError::kDeviceRefused, Status::kNotConfigured);
