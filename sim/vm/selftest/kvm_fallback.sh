@@ -2,9 +2,9 @@
 # Host-side test of the harness's accelerator choice: with PATHSTREAM_VM_KVM_ACCEL naming an
 # -accel option qemu cannot start, the harness must say so in one line, run the VM under TCG
 # and pass; a second run must take the cached verdict instead of probing again.
-#   kvm_fallback.sh RUNNER KERNEL_CACHE WORK HARNESS_SCRIPT VM_SELFTEST DATA_FILE
+#   kvm_fallback.sh RUNNER KERNEL_CACHE WORK HARNESS_SCRIPT VM_SELFTEST DATA_FILE HANG_SCRIPT
 set -uo pipefail
-runner=$1 kernel_cache=$2 work=$3 script=$4 program=$5 data=$6
+runner=$1 kernel_cache=$2 work=$3 script=$4 program=$5 data=$6 hang=$7
 rm -rf "$work"
 mkdir -p "$work"
 cache=$work/cache  # its own verdict cache, so this run really probes
@@ -22,9 +22,10 @@ n=$(grep -c "^run_in_vm: accelerator: KVM (-accel kvm,pathstream-cannot-start=on
 grep -q "^run_in_vm: booting .* -accel tcg " "$work/first.log" || fail "the test VM was not booted with -accel tcg"
 grep -q '"accel": "tcg"' "$cache/accel-verdict.json" || fail "no TCG verdict cached in $cache/accel-verdict.json"
 
-# The second run (an overall timeout of 2 s: no boot needed) reads the verdict, probes nothing.
+# The second run (a script that never ends, killed by the overall timeout of 2 s) reads the
+# verdict and probes nothing.
 /usr/bin/python3 "$runner" --kernel-cache "$kernel_cache" --base-cache "$cache" \
-  --work "$work/second" --script "$script" --no-can --quiet --timeout 2 --expect-rc 124 \
+  --work "$work/second" --script "$hang" --no-can --quiet --timeout 2 --expect-rc 124 \
   >"$work/second.log" 2>&1
 rc=$?
 cat "$work/second.log"
