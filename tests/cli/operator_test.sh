@@ -37,7 +37,25 @@ wait_running() {
   done
   fail "the device never ran"; return 1
 }
-stop_device() { kill -INT "$device_pid" 2>/dev/null; wait "$device_pid" 2>/dev/null; }
+# Waits (up to 120 s) for background process $1 and returns its exit status; one that does not
+# end is a hang, not a slow machine: it is reported with the logs and killed (status 124).
+finish() {
+  local pid=$1 what=$2
+  for _ in $(seq 2400); do
+    kill -0 "$pid" 2>/dev/null || { wait "$pid"; return $?; }
+    sleep 0.05
+  done
+  fail "$what did not end within 120 s; stream: $(tail -n 5 "$work/stream1.log" 2>/dev/null); device: $(tail -n 5 "$work/device.log")"
+  kill -KILL "$pid" 2>/dev/null; wait "$pid" 2>/dev/null
+  return 124
+}
+# Runs `pathstream stream --resume` with a bound (a hang fails the step with the logs).
+resume() {
+  timeout -k 5 120 "$bin" stream --resume "$work/j.json" > "$work/stream2.log" 2>&1; local rc=$?
+  [ $rc -eq 124 ] && fail "stream --resume did not end within 120 s: $(tail -n 5 "$work/stream2.log"); device: $(tail -n 5 "$work/device.log")"
+  return $rc
+}
+stop_device() { kill -INT "$device_pid" 2>/dev/null; finish "$device_pid" "the device after SIGINT"; }
 
 # The plan's path ticks and pen-down ticks (the setpoints CSV: tick,...,pen columns).
 "$bin" plan "$drawing" --keep-order -m "$machine" --out "$work/plan.csv" > /dev/null 2>&1 || fail "plan"
@@ -146,7 +164,7 @@ for run in $(seq "$runs"); do
       kill -INT "$stream_pid"
       [ "$presses" = 2 ] && { sleep 0.001; kill -INT "$stream_pid" 2>/dev/null; }
     fi
-    wait "$stream_pid"; rc=$?
+    finish "$stream_pid" "stream after $presses"; rc=$?
     name="run $run, $presses Ctrl-C after $delay s"
     [ "$presses" = kill ] && name="run $run, SIGKILL after $delay s"
     outcome=$(/usr/bin/python3 -c 'import json,sys; print(json.load(open(sys.argv[1]))["outcome"])' "$work/j.json")
@@ -156,12 +174,12 @@ for run in $(seq "$runs"); do
       st=$("$bin" ctl "$target" status --json | /usr/bin/python3 -c 'import json,sys; d=json.load(sys.stdin); print(d["state"])')
       want=holding; [ "$outcome" = stopped ] && want=idle
       [ "$st" = "$want" ] && ok || fail "$name: device $st after the interrupt (journal: $outcome)"
-      "$bin" stream --resume "$work/j.json" > "$work/stream2.log" 2>&1; rc=$?
+      resume; rc=$?
       [ $rc -eq 0 ] && ok || fail "$name: resume exit $rc: $(cat "$work/stream2.log")"
     elif [ $rc -eq 137 ]; then
       # Killed: the device runs out its queue and holds (or ends the job); --resume waits
       # for that, then streams the rest.
-      "$bin" stream --resume "$work/j.json" > "$work/stream2.log" 2>&1; rc=$?
+      resume; rc=$?
       [ $rc -eq 0 ] && ok || fail "$name: resume exit $rc: $(cat "$work/stream2.log")"
     elif [ $rc -eq 0 ]; then
       ok  # the drawing ended before the interrupt arrived
