@@ -294,11 +294,10 @@ int run_sim(const SimCommandOptions& o) {
         return 4;
     }
     if (failed) {
-        // The planner does not plan within a jerk limit yet: say so rather than "a bug".
+        // Name the rule the plan broke: the jerk limit is checked with the others.
         const PlanCheck& c = job.check;
         if (c.jerk_limited && (c.max_jerk_fraction_exact > 1 || c.max_join_acceleration_step_fraction > 1)) {
-            throw PlanError("the plan exceeds the machine's max_jerk (the planner does not plan within a jerk "
-                            "limit yet): see the report above");
+            throw PlanError("the plan exceeds the machine's max_jerk (a planner bug): see the report above");
         }
         throw PlanError("the plan failed its per-tick check (a planner bug): see the report above");
     }
