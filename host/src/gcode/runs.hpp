@@ -1,6 +1,6 @@
 // Collects the pieces of pen-down moves into subpaths: one open subpath per maximal run of
-// pen-down moves with one feed and one path control mode, a polyline while the run has only line pieces, else a Bezier
-// chain.
+// pen-down moves with one feed and one path control mode, a polyline while the run has only
+// line pieces, else a Bezier chain.
 #pragma once
 
 #include <string>

@@ -1,7 +1,8 @@
 // Corner blending: the vertex between two straight segments of one run that turn by less than
 // the stop angle becomes a short curve that stays within a fraction of the chord tolerance of
-// it (or within the subpath's own smaller blend tolerance, G64 P; never in G61 or G61.1), so that the motion crosses the corner at the curvature's speed instead of the speed at
-// which every axis can jump its velocity within one tick (docs/planner.md §3, §8).
+// it (or within the subpath's own smaller blend tolerance, G64 P; never in G61 or G61.1), so
+// that the motion crosses the corner at the curvature's speed instead of the speed at which
+// every axis can jump its velocity within one tick (docs/planner.md §3, §8).
 #include <algorithm>
 #include <cmath>
 

@@ -98,7 +98,8 @@ public:
         // steps the acceleration by at most one tick of jerk (ramp to ramp, rest to ramp, ramp
         // up to ramp down, the last ramp to the creep span), and the spans carry no jerk.
         if (limits.axis[axis].max_jerk != 0) {
-            const std::uint64_t by_jerk = static_cast<std::uint64_t>(limits.axis[axis].max_jerk) * kJerkUnitLsb / (2 * hz);
+            const std::uint64_t by_jerk =
+                static_cast<std::uint64_t>(limits.axis[axis].max_jerk) * kJerkUnitLsb / (2 * hz);
             if (by_jerk < limits_.axis[axis].max_acceleration) {
                 limits_.axis[axis].max_acceleration = static_cast<std::uint32_t>(by_jerk);
             }
@@ -125,8 +126,9 @@ public:
         // largest distance, 2^28 LSB, whatever the limits (it was a loop of 10^8 spans).
         for (;;) {
             ramp_spans_ = static_cast<std::uint32_t>((cruise_ + step_ - 1) / step_);
-            if (cruise_ > 4 && static_cast<std::uint64_t>(ramp_spans_) * static_cast<std::uint64_t>(cruise_ - 4) >
-                                   static_cast<std::uint64_t>(remaining_)) {
+            const std::uint64_t least = static_cast<std::uint64_t>(ramp_spans_) *
+                                        static_cast<std::uint64_t>(cruise_ > 4 ? cruise_ - 4 : 0);
+            if (least > static_cast<std::uint64_t>(remaining_)) {
                 cruise_ = even_floor(static_cast<std::uint64_t>(cruise_) / 2);
                 if (cruise_ < 2) cruise_ = 2;
                 continue;
@@ -147,7 +149,9 @@ public:
         creep_ticks_ = 0;
         if (creep_ != 0) {
             const std::int64_t creep_from = start[axis] + sign_ * (remaining_ - creep_);
-            if (creep_from > kMaxPositionLsb || creep_from < -kMaxPositionLsb) return Status::kBadLimits;
+            if (creep_from > kMaxPositionLsb || creep_from < -kMaxPositionLsb) {
+                return Status::kBadLimits;
+            }
             creep_ticks_ = creep_length(static_cast<Lsb>(creep_from));
             if (creep_ticks_ == 0) return Status::kBadLimits;
         }
@@ -226,8 +230,9 @@ private:
             if (validate_span(s, v) != Status::kOk) continue;
             bool fits = true;
             for (unsigned a = 0; a < Axes && fits; ++a) {
-                fits = check_axis_limits(v.cubic[a], v.timing, limits_.axis[a], limits_.tick_hz) == Status::kOk &&
-                       check_axis_jerk(v.cubic[a], v.timing, limits_.axis[a], limits_.tick_hz) == Status::kOk;
+                const AxisLimits& l = limits_.axis[a];
+                fits = check_axis_limits(v.cubic[a], v.timing, l, limits_.tick_hz) == Status::kOk &&
+                       check_axis_jerk(v.cubic[a], v.timing, l, limits_.tick_hz) == Status::kOk;
             }
             if (fits) return ticks;
         }
