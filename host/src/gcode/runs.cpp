@@ -18,13 +18,6 @@ Vec2 vec(PointRef p) {
     return {p[0], p[1]};
 }
 
-/// Curve segments in a run so far.
-std::size_t segments(const Subpath& run) {
-    const std::size_t m = run.points.size();
-    if (m == 0) return 0;
-    return run.basis == PathBasis::kPolyline ? m - 1 : (m - 1) / 3;
-}
-
 /// A polyline run as the Bezier chain of its line pieces (a curve is joining it).
 void to_bezier_chain(Subpath& run) {
     PointList chain(2);
@@ -84,12 +77,12 @@ void RunBuilder::draw(const Cubic& piece, double feed_mm_s, SourceLocation at,
 void RunBuilder::end_block() {
     if (!open_ || corner_mode_ != CornerMode::kExactStop) return;
     Subpath& run = done_.back();
-    const auto joint = static_cast<std::uint32_t>(segments(run));
+    const auto joint = static_cast<std::uint32_t>(chain_segments(run));
     if (joint > 0 && (run.stops.empty() || run.stops.back() != joint)) run.stops.push_back(joint);
 }
 
 void RunBuilder::close_run() {
-    if (open_ && !done_.back().stops.empty() && done_.back().stops.back() >= segments(done_.back())) {
+    if (open_ && !done_.back().stops.empty() && done_.back().stops.back() >= chain_segments(done_.back())) {
         done_.back().stops.pop_back();
     }
     open_ = false;

@@ -55,18 +55,11 @@ void rotate_open_loop(Subpath& s, std::size_t shift) {
     s.points.push_back(s.points.front());  // Q[shift..m-1], Q[1..shift]
 }
 
-/// Curve segments of a polyline or Bezier chain (Subpath::stops counts joints between them).
-std::size_t segment_count(const Subpath& s) {
-    const std::size_t m = s.points.size();
-    if (s.basis == PathBasis::kBezier) return s.closed ? m / 3 : (m > 0 ? (m - 1) / 3 : 0);
-    return s.closed ? m : (m > 0 ? m - 1 : 0);
-}
-
 /// Subpath::stops after the segments were renumbered: joint k becomes (k * sign + shift) mod n,
 /// kept ascending; a joint landing on the ends (0) is dropped (the motion rests there anyway).
 void renumber_stops(Subpath& r, long long sign, long long shift) {
     if (r.stops.empty()) return;
-    const long long n = static_cast<long long>(segment_count(r));
+    const long long n = static_cast<long long>(chain_segments(r));
     std::vector<std::uint32_t> out;
     out.reserve(r.stops.size());
     for (const std::uint32_t k : r.stops) {
@@ -80,7 +73,7 @@ void renumber_stops(Subpath& r, long long sign, long long shift) {
 /// reversed_subpath in place.
 void reverse_points(Subpath& r) {
     r.points.reverse(r.closed ? 1 : 0);
-    renumber_stops(r, -1, static_cast<long long>(segment_count(r)));
+    renumber_stops(r, -1, static_cast<long long>(chain_segments(r)));
 }
 
 /// rotated_subpath in place (its checks and messages).

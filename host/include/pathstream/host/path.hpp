@@ -59,6 +59,14 @@ struct Subpath {
     std::vector<std::uint32_t> stops{};
 };
 
+/// Curve segments of a polyline or Bezier chain: the joints Subpath::stops counts lie between
+/// them. O(1).
+inline std::size_t chain_segments(const Subpath& s) {
+    const std::size_t m = s.points.size();
+    if (s.basis == PathBasis::kBezier) return s.closed ? m / 3 : (m > 0 ? (m - 1) / 3 : 0);
+    return s.closed ? m : (m > 0 ? m - 1 : 0);
+}
+
 /// A named group of subpaths plotted with one pen (an Inkscape layer, a stroke colour).
 struct PathLayer {
     std::string name;         ///< the layer's label, or the colour ("#ff0000"), or "1", "2"...
