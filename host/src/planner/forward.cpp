@@ -297,6 +297,13 @@ private:
             a = a_hi;
             return true;
         }
+        // The boundary in closed form; rounding may put it a hair outside, so it is verified
+        // and backed off, and the bisection remains for what the closed form cannot place.
+        a = solve_under_beta(k, tau, a_lo, a_hi);
+        for (int back = 0; back < 4 && a > a_lo; ++back) {
+            if (under_beta(k, a, tau)) return true;
+            a -= std::ldexp(1e-12, 2 * back) * (1 + std::fabs(a));
+        }
         double lo = a_lo, hi = a_hi;
         for (int it = 0; it < 64 && hi - lo > 1e-12 * (1 + std::fabs(lo)); ++it) {
             const double m = 0.5 * (lo + hi);
@@ -304,6 +311,45 @@ private:
         }
         a = lo;
         return true;
+    }
+
+    /// under_beta's boundary in closed form: the end of the span moves along the grid as A
+    /// grows (l1 = l0 + V0 tau + A tau^2 / 2), so A is split at the nodes; in each interval the
+    /// nodes passed cap A linearly and the end's x = (V0 + A tau)^2 against beta interpolated
+    /// linearly is a quadratic. The largest A in [a_lo, a_hi] meeting them (a_lo if none).
+    double solve_under_beta(const Knot& k, double tau, double a_lo, double a_hi) const {
+        const double s = k.speed, x0 = s * s, tau2 = tau * tau;
+        const auto a_at = [&](double l) { return 2 * (l - k.lambda - s * tau) / tau2; };
+        const double top = std::min(a_hi, a_at(end_lambda_ + 1e-12));
+        double best = a_lo, cap = top;
+        const std::size_t first = interval(k.lambda);
+        for (std::size_t j = first; j < piece_.last; ++j) {
+            const double lj = g_.lambda[j], lj1 = g_.lambda[j + 1];
+            if (j > first && lj > k.lambda) cap = std::min(cap, (beta_[j] * (1 + 1e-9) + 1e-12 - x0) / (2 * (lj - k.lambda)));
+            const double seg_lo = j == first ? a_lo : a_at(lj);
+            const double seg_hi = j + 1 == piece_.last ? top : a_at(lj1);
+            if (seg_lo > cap) break;
+            const double lo = std::max(seg_lo, a_lo), hi = std::min(seg_hi, cap);
+            if (lo <= hi && lj1 > lj) {
+                // (s + A tau)^2 <= (1 + 1e-9) beta(l1(A)) + 1e-12, beta linear in A here.
+                const double slope = (beta_[j + 1] - beta_[j]) / (lj1 - lj);
+                const double r0 = (1 + 1e-9) * (beta_[j] + slope * (k.lambda + s * tau - lj)) + 1e-12;
+                const double r1 = (1 + 1e-9) * slope * tau2 / 2;
+                const double qa = tau2, qb = 2 * s * tau - r1, qc = x0 - r0;
+                const double disc = qb * qb - 4 * qa * qc;
+                if (disc >= 0) {
+                    const double root = std::sqrt(disc);
+                    // The larger root without cancellation.
+                    const double r_hi = qb <= 0 ? (-qb + root) / (2 * qa) : (2 * qc) / (-qb - root);
+                    const double r_lo = qb <= 0 ? (2 * qc) / (-qb + root) : (-qb - root) / (2 * qa);
+                    if (std::isfinite(r_hi) && r_hi >= lo && (!std::isfinite(r_lo) || r_lo <= hi)) {
+                        best = std::max(best, std::min(hi, r_hi));
+                    }
+                }
+            }
+            if (seg_hi >= top) break;
+        }
+        return best;
     }
 
     /// How far the Hermite span between two knots over tau seconds exceeds the limits: max over
@@ -424,9 +470,9 @@ private:
         double kappa = 0;
         bool corner = false;
         for (std::size_t i = interval(k.lambda); i <= piece_.last && g_.lambda[i] <= end.lambda + 1e-12; ++i) {
-            kappa = std::max(kappa, norm(g_.curvature[i]));
-            if (i + 1 <= piece_.last) kappa = std::max(kappa, norm(g_.curvature[i + 1]));
-            corner = corner || norm(g_.corner_jump[i]) > 0;
+            kappa = std::max(kappa, g_.curvature_norm[i]);
+            if (i + 1 <= piece_.last) kappa = std::max(kappa, g_.curvature_norm[i + 1]);
+            corner = corner || g_.corner[i] != 0;
         }
         const Vec chord = sub(end.q, k.q);
         const double c2 = dot(chord, chord);
@@ -472,7 +518,7 @@ private:
         bool found = false;
         for (std::size_t i = interval(k.lambda); i <= piece_.last && g_.lambda[i] <= k.lambda + reach; ++i) {
             if (g_.lambda[i] > k.lambda + 1e-9 && g_.lambda[i] < end_lambda_ - 1e-9 && i + 1 <= piece_.last &&
-                g_.lambda[i + 1] == g_.lambda[i] && norm(g_.corner_jump[i]) > 0) {
+                g_.lambda[i + 1] == g_.lambda[i] && g_.corner[i] != 0) {
                 c = i;
                 found = true;
                 break;

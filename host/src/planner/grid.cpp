@@ -61,27 +61,51 @@ std::vector<double> segment_nodes(const Cubic& c, double length, const PlanOptio
     if (o.grid_step > 0) {
         k = std::max<std::size_t>(k, static_cast<std::size_t>(std::ceil(std::min(length / o.grid_step, 1e6))));
     }
+    // A node's tangent on either side (they differ only where q' vanishes), computed once.
+    struct Sides {
+        Vec before, after;
+    };
+    const auto sides = [&](double u) {
+        const Vec d = c.d1(u);
+        const double n = norm(d);
+        if (n > 1e-9 * size) {
+            const Vec t = scaled(d, 1 / n);
+            return Sides{t, t};
+        }
+        return Sides{unit_tangent(c, u, size, -1), unit_tangent(c, u, size, +1)};
+    };
+    // turn > max_turn, and turn > 90 degrees, compared as cosines.
+    const double cos_max_turn = std::cos(std::clamp(o.max_turn, 0.0, kPi));
+    struct Interval {
+        double a, b;
+        Vec ta, tb;  ///< tangent after a, before b
+    };
     std::vector<double> out;
-    std::vector<std::pair<double, double>> stack;  // intervals still to examine, last first
+    std::vector<Interval> stack;  // intervals still to examine, last first
+    Sides right = sides(1.0);
     for (std::size_t i = k; i-- > 0;) {
-        stack.emplace_back(static_cast<double>(i) / static_cast<double>(k),
-                           i + 1 == k ? 1.0 : static_cast<double>(i + 1) / static_cast<double>(k));
+        const double a = static_cast<double>(i) / static_cast<double>(k);
+        const double b = i + 1 == k ? 1.0 : static_cast<double>(i + 1) / static_cast<double>(k);
+        const Sides left = sides(a);
+        stack.push_back({a, b, left.after, right.before});
+        right = left;
     }
     out.push_back(0.0);
     while (!stack.empty()) {
-        const auto [a, b] = stack.back();
+        const Interval in = stack.back();
         stack.pop_back();
-        const double turn = angle_between(unit_tangent(c, a, size, +1), unit_tangent(c, b, size, -1));
-        if (turn > o.max_turn) {
-            if (b - a > 1e-7) {
-                const double m = 0.5 * (a + b);
-                stack.emplace_back(m, b);
-                stack.emplace_back(a, m);
+        const double cos_turn = std::clamp(dot(in.ta, in.tb), -1.0, 1.0);
+        if (cos_turn < cos_max_turn) {
+            if (in.b - in.a > 1e-7) {
+                const double m = 0.5 * (in.a + in.b);
+                const Sides mid = sides(m);
+                stack.push_back({m, in.b, mid.after, in.tb});
+                stack.push_back({in.a, m, in.ta, mid.before});
                 continue;
             }
-            if (turn > 0.5 * kPi) cusps.push_back(norm(c.d1(a)) < norm(c.d1(b)) ? a : b);
+            if (cos_turn < 0) cusps.push_back(norm(c.d1(in.a)) < norm(c.d1(in.b)) ? in.a : in.b);
         }
-        out.push_back(b);
+        out.push_back(in.b);
     }
     // A cusp exactly on a node (q' vanishes there, as where a Bezier handle doubles back on a
     // straight line) leaves both neighbouring intervals without a turn, because each end's
@@ -211,10 +235,18 @@ struct Builder {
 
 Cubic to_cubic(const BezierSegment& s) {
     Cubic c;
+    c.axes = std::min(s.p[0].size(), kAxesMax);
     for (std::size_t k = 0; k < 4; ++k) {
         for (std::size_t i = 0; i < s.p[k].size() && i < kAxesMax; ++i) c.p[k][i] = s.p[k][i];
     }
     return c;
+}
+
+double speed_at(const Cubic& c, double u) {
+    const Vec d = c.d1(u);
+    double d2 = 0;
+    for (std::size_t a = 0; a < c.axes; ++a) d2 += d[a] * d[a];
+    return std::sqrt(d2);
 }
 
 double arc_length(const Cubic& c, double u0, double u1) {
@@ -224,7 +256,7 @@ double arc_length(const Cubic& c, double u0, double u1) {
                                     0.2369268850561891, 0.2369268850561891};
     const double h = 0.5 * (u1 - u0), m = 0.5 * (u0 + u1);
     double s = 0;
-    for (int i = 0; i < 5; ++i) s += w[i] * norm(c.d1(m + h * x[i]));
+    for (int i = 0; i < 5; ++i) s += w[i] * speed_at(c, m + h * x[i]);
     return s * h;
 }
 
@@ -263,8 +295,12 @@ PathGrid build_grid(const std::vector<BezierSegment>& segments, const MachinePro
                 }
             }
         }
-        if (s == 0) b.out.cubics.reserve(segments.size());
+        if (s == 0) {
+            b.out.cubics.reserve(segments.size());
+            b.out.cubic_size.reserve(segments.size());
+        }
         b.out.cubics.push_back(to_cubic(segments[s]));
+        b.out.cubic_size.push_back(b.out.cubics.back().size());
         if (s > 0) {
             const double gap = norm(sub(b.out.cubics[s].p[0], b.out.cubics[s - 1].p[3]));
             if (gap > 1e-6) {
@@ -283,6 +319,16 @@ PathGrid build_grid(const std::vector<BezierSegment>& segments, const MachinePro
         }
         b.build_run(s, e);
         s = e + 1;
+    }
+    Grid& g = b.out.grid;
+    const std::size_t n = g.size();
+    g.param_speed.resize(n);
+    g.curvature_norm.resize(n);
+    g.corner.resize(n);
+    for (std::size_t k = 0; k < n; ++k) {
+        g.param_speed[k] = speed_at(b.out.cubics[g.seg[k]], g.u[k]);
+        g.curvature_norm[k] = norm(g.curvature[k]);
+        g.corner[k] = norm(g.corner_jump[k]) > 0 ? 1 : 0;
     }
     return std::move(b.out);
 }
@@ -323,27 +369,46 @@ PathAt path_at(const PathGrid& pg, const Piece& piece, double lambda, std::size_
     const Cubic& c = pg.cubics[g.seg[k]];
     const double u0 = g.u[k], u1 = g.u[k + 1];
     const double target = std::clamp(lambda - l0, 0.0, l1 - l0);
-    // Newton on the arc length, kept inside [lo, hi] by bisection.
+    // Newton on the arc length, kept inside [lo, hi] by bisection, from u(lambda)'s cubic
+    // Hermite interpolant on the interval (du/dlambda = 1 / |q'(u)| at its ends), which is
+    // usually so close that one step lands within the tolerance: the step is then taken
+    // without another quadrature when its quadratic error term, |q''| e^2 / 2 for a step of e
+    // in u, is far below the tolerance.
+    const double tolerance = 1e-12 * (1 + l1);
+    const double h = l1 - l0, w = target / h;
+    const double s0 = g.param_speed[k], s1 = g.param_speed[k + 1];
+    double u;
+    if (s0 > 0 && s1 > 0) {
+        const double w2 = w * w, w3 = w2 * w;
+        u = (2 * w3 - 3 * w2 + 1) * u0 + (w3 - 2 * w2 + w) * h / s0 + (-2 * w3 + 3 * w2) * u1 + (w3 - w2) * h / s1;
+        if (!(u > u0 && u < u1)) u = u0 + (u1 - u0) * w;
+    } else {
+        u = u0 + (u1 - u0) * w;
+    }
     double lo = u0, hi = u1;
-    double u = u0 + (u1 - u0) * target / (l1 - l0);
     for (int it = 0; it < 12; ++it) {
         const double f = arc_length(c, u0, u) - target;
-        if (std::fabs(f) < 1e-12 * (1 + l1)) break;
+        if (std::fabs(f) < tolerance) break;
         if (f > 0) hi = u;
         else lo = u;
-        const double speed = norm(c.d1(u));
+        const double speed = speed_at(c, u);
         double next = speed > 0 ? u - f / speed : 0.5 * (lo + hi);
         if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);
+        const double e = next - u;
         u = next;
+        if (next - lo > 0 && hi - next > 0 && speed > 0 && 0.5 * norm(c.d2(u)) * e * e < 0.1 * tolerance &&
+            std::fabs(f) < 1e-3 * h) {
+            break;
+        }
     }
     r.q = c.point(u);
     const Vec d = c.d1(u);
     const double n = norm(d);
-    if (n > 1e-9 * c.size()) {
+    if (n > 1e-9 * pg.cubic_size[g.seg[k]]) {
         r.t = scaled(d, 1 / n);
     } else {  // at a degenerate point: interpolate the node tangents
-        const double w = (lambda - l0) / (l1 - l0);
-        for (std::size_t i = 0; i < kAxesMax; ++i) r.t[i] = (1 - w) * g.tangent[k][i] + w * g.tangent[k + 1][i];
+        const double wl = (lambda - l0) / (l1 - l0);
+        for (std::size_t i = 0; i < kAxesMax; ++i) r.t[i] = (1 - wl) * g.tangent[k][i] + wl * g.tangent[k + 1][i];
         const double m = norm(r.t);
         if (m > 0) r.t = scaled(r.t, 1 / m);
     }

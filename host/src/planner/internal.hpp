@@ -42,11 +42,13 @@ inline Vec scaled(const Vec& a, double s) {
 /// A Bezier segment in flat form.
 struct Cubic {
     std::array<Vec, 4> p{};
+    /// Axes in use: the evaluations skip the rest (zero), which the hot loops notice.
+    std::size_t axes = kAxesMax;
 
     Vec point(double u) const {
         const double v = 1 - u;
         Vec r{};
-        for (std::size_t i = 0; i < kAxesMax; ++i) {
+        for (std::size_t i = 0; i < axes; ++i) {
             const double a = v * p[0][i] + u * p[1][i], b = v * p[1][i] + u * p[2][i],
                          c = v * p[2][i] + u * p[3][i];
             r[i] = v * (v * a + u * b) + u * (v * b + u * c);
@@ -56,7 +58,7 @@ struct Cubic {
     Vec d1(double u) const {
         const double v = 1 - u;
         Vec r{};
-        for (std::size_t i = 0; i < kAxesMax; ++i) {
+        for (std::size_t i = 0; i < axes; ++i) {
             r[i] = 3 * (v * v * (p[1][i] - p[0][i]) + 2 * u * v * (p[2][i] - p[1][i]) + u * u * (p[3][i] - p[2][i]));
         }
         return r;
@@ -64,7 +66,7 @@ struct Cubic {
     Vec d2(double u) const {
         const double v = 1 - u;
         Vec r{};
-        for (std::size_t i = 0; i < kAxesMax; ++i) {
+        for (std::size_t i = 0; i < axes; ++i) {
             r[i] = 6 * (v * (p[2][i] - 2 * p[1][i] + p[0][i]) + u * (p[3][i] - 2 * p[2][i] + p[1][i]));
         }
         return r;
@@ -78,6 +80,9 @@ struct Cubic {
 };
 
 Cubic to_cubic(const BezierSegment& s);
+
+/// |q'(u)|: the speed of `c`'s parameter.
+double speed_at(const Cubic& c, double u);
 
 /// Arc length of `c` over [u0, u1] by 5-point Gauss-Legendre quadrature of |q'(u)|.
 double arc_length(const Cubic& c, double u0, double u1);
@@ -145,6 +150,10 @@ struct Grid {
     VecArray q, tangent, curvature;  ///< point, unit tangent dq/dl, curvature d2q/dl2
     std::vector<double> feed;        ///< requested speed along the path at the node
     VecArray corner_jump;            ///< tangent jump at a crossed corner (0 elsewhere)
+    // Per node, derived once the grid is complete (finish_grid), for the forward pass's loops.
+    std::vector<double> param_speed;     ///< |dq/du| of the node's segment at u
+    std::vector<double> curvature_norm;  ///< |curvature|
+    std::vector<std::uint8_t> corner;    ///< 1 where corner_jump is not 0
 
     std::size_t size() const { return lambda.size(); }
 };
@@ -173,6 +182,7 @@ struct Run {
 struct PathGrid {
     Grid grid;
     std::vector<Cubic> cubics;
+    std::vector<double> cubic_size;  ///< Cubic::size() of each
     std::vector<Piece> pieces;
     std::vector<Run> runs;
     double pen_down_length = 0, travel_length = 0;
