@@ -251,13 +251,29 @@ private:
     }
 
     /// Node index of the interval holding lambda (lambda[i] <= lambda < lambda[i+1]).
+    /// The lookups come in runs near each other: a short walk from the last answer first, a
+    /// binary search when that does not reach.
     std::size_t interval(double lambda) const {
+        const std::size_t top = piece_.last == piece_.first ? piece_.first : piece_.last - 1;
+        std::size_t i = std::clamp(interval_hint_, piece_.first, top);
+        for (int steps = 0; steps < 8; ++steps) {
+            if (g_.lambda[i] > lambda) {
+                if (i == piece_.first) return interval_hint_ = i;
+                --i;
+            } else if (i < top && g_.lambda[i + 1] <= lambda) {
+                ++i;
+            } else {
+                // lambda[i] <= lambda < lambda[i + 1] (or the top): the last of equal lambdas.
+                while (i < top && g_.lambda[i + 1] <= lambda) ++i;
+                return interval_hint_ = i;
+            }
+        }
         const auto b = g_.lambda.begin();
         auto it = std::upper_bound(b + static_cast<std::ptrdiff_t>(piece_.first),
                                    b + static_cast<std::ptrdiff_t>(piece_.last) + 1, lambda);
-        std::size_t i = static_cast<std::size_t>(it - b);
+        i = static_cast<std::size_t>(it - b);
         i = i == 0 ? 0 : i - 1;
-        return std::clamp(i, piece_.first, piece_.last == piece_.first ? piece_.first : piece_.last - 1);
+        return interval_hint_ = std::clamp(i, piece_.first, top);
     }
 
     double interpolate(const std::vector<double>& v, double lambda) const {
@@ -493,7 +509,7 @@ private:
             }
             const double raw = c2 > 0 ? dot(sub(x, k.q), chord) / c2 : w;
             const double along = std::clamp(raw, 0.0, 1.0);
-            const PathAt p = path_at(pg_, piece_, k.lambda + along * len, h);
+            const PathAt p = path_at(pg_, piece_, k.lambda + along * len, h, false);
             const Vec off = sub(x, p.q);
             // Beyond either end of the chord the cubic has left the span's stretch of path
             // (backwards, or past its end): the whole distance counts, not only the part
@@ -783,6 +799,7 @@ private:
     double end_lambda_ = 0;
     Vec end_q_{};
     std::size_t hint_ = 0;
+    mutable std::size_t interval_hint_ = 0;  ///< interval()'s last answer
 };
 
 }  // namespace

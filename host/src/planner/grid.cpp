@@ -333,7 +333,7 @@ PathGrid build_grid(const std::vector<BezierSegment>& segments, const MachinePro
     return std::move(b.out);
 }
 
-PathAt path_at(const PathGrid& pg, const Piece& piece, double lambda, std::size_t& hint) {
+PathAt path_at(const PathGrid& pg, const Piece& piece, double lambda, std::size_t& hint, bool precise) {
     const Grid& g = pg.grid;
     PathAt r;
     if (piece.first == piece.last) {
@@ -343,6 +343,7 @@ PathAt path_at(const PathGrid& pg, const Piece& piece, double lambda, std::size_
     }
     // Interval [k, k+1] of positive length with lambda[k] <= lambda < lambda[k+1].
     std::size_t k = std::clamp(hint, piece.first, piece.last - 1);
+    for (std::size_t steps = 0; g.lambda[k] > lambda && k > piece.first && steps < 16; ++steps) --k;
     if (g.lambda[k] > lambda) {
         const auto it = std::upper_bound(g.lambda.begin() + static_cast<std::ptrdiff_t>(piece.first),
                                          g.lambda.begin() + static_cast<std::ptrdiff_t>(piece.last) + 1, lambda);
@@ -386,7 +387,7 @@ PathAt path_at(const PathGrid& pg, const Piece& piece, double lambda, std::size_
         u = u0 + (u1 - u0) * w;
     }
     double lo = u0, hi = u1;
-    for (int it = 0; it < 12; ++it) {
+    for (int it = 0; it < (precise ? 12 : 0); ++it) {
         const double f = arc_length(c, u0, u) - target;
         if (std::fabs(f) < tolerance) break;
         if (f > 0) hi = u;

@@ -199,7 +199,10 @@ PathGrid build_grid(const std::vector<BezierSegment>& segments, const MachinePro
 struct PathAt {
     Vec q{}, t{};
 };
-PathAt path_at(const PathGrid& g, const Piece& piece, double lambda, std::size_t& hint);
+/// `precise` = false skips the arc length's refinement: the point is exactly on the path but
+/// its arc length may be off by about 1e-6 of the grid interval (enough for a distance measured
+/// across the path; four times cheaper).
+PathAt path_at(const PathGrid& g, const Piece& piece, double lambda, std::size_t& hint, bool precise = true);
 
 /// Max x in [0, x_max] such that some y in [y_lo, y_hi] satisfies lo_m <= c_m x + d_m y <= hi_m
 /// for every row (each row must contain the origin: lo_m <= 0 <= hi_m, and y_lo <= 0 <= y_hi).
