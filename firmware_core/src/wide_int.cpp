@@ -2,13 +2,27 @@
 
 namespace pathstream {
 
-Int128 operator*(Int128 a, std::int64_t b) {
+Int128 multiply_portable(Int128 a, std::int64_t b) {
     const bool negate = a.negative() != (b < 0);
     const Int128 m = magnitude(a);
     const std::uint64_t bm = b < 0 ? 0 - static_cast<std::uint64_t>(b) : static_cast<std::uint64_t>(b);
     Int128 p = multiply_unsigned(m.lo, bm);
     p.hi += m.hi * bm;
     return negate ? -p : p;
+}
+
+Int128 operator*(Int128 a, std::int64_t b) {
+#if defined(__SIZEOF_INT128__)
+    // The same product modulo 2^128 in one native multiply where the target has one (the
+    // host's planner runs every span's setup through here); Cortex-M takes the portable path.
+    __extension__ using Native = unsigned __int128;
+    const Native x = (static_cast<Native>(a.hi) << 64) | a.lo;
+    const Native y = static_cast<Native>(Int128::from(b).hi) << 64 | Int128::from(b).lo;
+    const Native p = x * y;
+    return Int128{static_cast<std::uint64_t>(p), static_cast<std::uint64_t>(p >> 64)};
+#else
+    return multiply_portable(a, b);
+#endif
 }
 
 FloorDivision floor_divide(Int128 a, std::uint64_t d) {

@@ -53,6 +53,11 @@ TEST_CASE("Int128 multiply agrees with __int128 when the product fits", "[int128
         const auto b = static_cast<std::int64_t>(rng() % (std::uint64_t{1} << b_bits)) *
                        (rng() % 2 ? 1 : -1);
         REQUIRE(native(portable(a) * b) == a * b);
+        REQUIRE(native(pathstream::multiply_portable(portable(a), b)) == a * b);
+        // Beyond 2^127 both keep the product modulo 2^128, alike.
+        const auto big = static_cast<std::int64_t>(rng());
+        const Int128 shifted = portable(static_cast<i128>(static_cast<unsigned __int128>(a) << 64));
+        REQUIRE(pathstream::multiply_portable(shifted, big) == shifted * big);
         const std::uint64_t x = rng(), y = rng();
         REQUIRE(native(pathstream::multiply_unsigned(x, y)) ==
                 static_cast<i128>(static_cast<unsigned __int128>(x) * y));

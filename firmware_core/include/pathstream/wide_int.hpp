@@ -64,6 +64,10 @@ constexpr Int128 multiply_unsigned(std::uint64_t a, std::uint64_t b) {
 /// setup code is called rarely and kept small.
 Int128 operator*(Int128 a, std::int64_t b);
 
+/// The same product from 64-bit words only: what operator* computes on targets without a
+/// native 128-bit type (Cortex-M); on the host, the tests compare it with operator*.
+Int128 multiply_portable(Int128 a, std::int64_t b);
+
 /// Quotient and remainder of a floor division.
 struct FloorDivision {
     Int128 quotient;

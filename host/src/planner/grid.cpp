@@ -322,11 +322,12 @@ PathGrid build_grid(const std::vector<BezierSegment>& segments, const MachinePro
     }
     Grid& g = b.out.grid;
     const std::size_t n = g.size();
-    g.param_speed.resize(n);
+    g.param_pace.resize(n);
     g.curvature_norm.resize(n);
     g.corner.resize(n);
     for (std::size_t k = 0; k < n; ++k) {
-        g.param_speed[k] = speed_at(b.out.cubics[g.seg[k]], g.u[k]);
+        const double speed = speed_at(b.out.cubics[g.seg[k]], g.u[k]);
+        g.param_pace[k] = speed > 0 ? 1 / speed : 0;
         g.curvature_norm[k] = norm(g.curvature[k]);
         g.corner[k] = norm(g.corner_jump[k]) > 0 ? 1 : 0;
     }
@@ -377,11 +378,11 @@ PathAt path_at(const PathGrid& pg, const Piece& piece, double lambda, std::size_
     // in u, is far below the tolerance.
     const double tolerance = 1e-12 * (1 + l1);
     const double h = l1 - l0, w = target / h;
-    const double s0 = g.param_speed[k], s1 = g.param_speed[k + 1];
+    const double p0 = g.param_pace[k], p1 = g.param_pace[k + 1];
     double u;
-    if (s0 > 0 && s1 > 0) {
+    if (p0 > 0 && p1 > 0) {
         const double w2 = w * w, w3 = w2 * w;
-        u = (2 * w3 - 3 * w2 + 1) * u0 + (w3 - 2 * w2 + w) * h / s0 + (-2 * w3 + 3 * w2) * u1 + (w3 - w2) * h / s1;
+        u = (2 * w3 - 3 * w2 + 1) * u0 + (w3 - 2 * w2 + w) * h * p0 + (-2 * w3 + 3 * w2) * u1 + (w3 - w2) * h * p1;
         if (!(u > u0 && u < u1)) u = u0 + (u1 - u0) * w;
     } else {
         u = u0 + (u1 - u0) * w;
