@@ -659,9 +659,11 @@ private:
             double x0 = a_floor, x3 = a_hi;
             double x1 = x3 - kGolden * (x3 - x0), x2 = x0 + kGolden * (x3 - x0);
             Candidate c1 = evaluate(k, x1, m), c2 = evaluate(k, x2, m);
+            Candidate c3 = hi;  // at x3: over the limits, like every point the search dropped
             for (int it = 0; it < 48 && c1.f > 0 && c2.f > 0; ++it) {
                 if (c1.f <= c2.f) {
                     x3 = x2;
+                    c3 = c2;
                     x2 = x1;
                     c2 = c1;
                     x1 = x3 - kGolden * (x3 - x0);
@@ -674,15 +676,23 @@ private:
                     c2 = evaluate(k, x2, m);
                 }
             }
-            const Candidate& best = c1.f <= c2.f ? c1 : c2;
-            if (best.f > 0) return false;
-            lo = best;
+            if (c1.f > 0 && c2.f > 0) return false;
+            // The boundary lies between the highest feasible point (x1 < x2) and the nearest
+            // infeasible one above it, a bracket the search has already narrowed.
+            if (c2.f <= 0) {
+                lo = c2;
+                hi = c3;
+            } else {
+                lo = c1;
+                hi = c2;
+            }
         }
-        // Illinois (regula falsi) for the boundary between feasible lo and infeasible hi.
+        // Illinois (regula falsi) for the boundary between feasible lo and infeasible hi, to
+        // 1e-4 of the acceleration limit (a finer one bought no measurable motion time).
         int side = 0;
         double flo = lo.f, fhi = hi.f;
         for (int it = 0; it < 40; ++it) {
-            if (hi.a - lo.a <= 1e-7 * acc_norm_) break;
+            if (hi.a - lo.a <= 1e-4 * acc_norm_) break;
             double a = lo.a - flo * (hi.a - lo.a) / (fhi - flo);
             if (!(a > lo.a && a < hi.a)) a = 0.5 * (lo.a + hi.a);
             Candidate c = evaluate(k, a, m);
