@@ -212,7 +212,25 @@ void TickChecker::span(const CoreSpan& cs) {
     last_feed_ = feed;
 }
 
-bool TickChecker::over_limits() const {
+void TickChecker::fold_peaks() {
+    for (std::size_t a = 0; a < axes_; ++a) {
+        const AxisPeaks& k = peaks_[a];
+        out_.axis_velocity_fraction[a] = std::max(out_.axis_velocity_fraction[a], k.velocity_allowed / vlim_[a]);
+        out_.max_velocity_fraction_raw = std::max(out_.max_velocity_fraction_raw, k.velocity_raw / vlim_[a]);
+        out_.max_velocity_fraction_exact = std::max(out_.max_velocity_fraction_exact, k.velocity_exact / vlim_[a]);
+        out_.axis_velocity_fraction_exact[a] = std::max(out_.axis_velocity_fraction_exact[a], k.velocity_exact / vlim_[a]);
+        out_.axis_acceleration_fraction[a] =
+            std::max(out_.axis_acceleration_fraction[a], k.acceleration_allowed / alim_[a]);
+        out_.max_acceleration_fraction_raw = std::max(out_.max_acceleration_fraction_raw, k.acceleration_raw / alim_[a]);
+        out_.max_acceleration_fraction_exact =
+            std::max(out_.max_acceleration_fraction_exact, k.acceleration_exact / alim_[a]);
+        out_.axis_acceleration_fraction_exact[a] =
+            std::max(out_.axis_acceleration_fraction_exact[a], k.acceleration_exact / alim_[a]);
+    }
+}
+
+bool TickChecker::over_limits() {
+    fold_peaks();
     for (std::size_t a = 0; a < axes_; ++a) {
         if (out_.axis_velocity_fraction[a] > 1 || out_.axis_acceleration_fraction[a] > 1) return true;
     }
@@ -293,22 +311,20 @@ void TickChecker::visit(const std::array<std::int64_t, kAxesMax>& p, const std::
 }
 
 void TickChecker::velocity(std::size_t a, double d, double de) {
-    const double allowed = std::max(0.0, d - 1) / vlim_[a];
-    out_.axis_velocity_fraction[a] = std::max(out_.axis_velocity_fraction[a], allowed);
-    out_.max_velocity_fraction_raw = std::max(out_.max_velocity_fraction_raw, d / vlim_[a]);
-    out_.max_velocity_fraction_exact = std::max(out_.max_velocity_fraction_exact, de / vlim_[a]);
-    out_.axis_velocity_fraction_exact[a] = std::max(out_.axis_velocity_fraction_exact[a], de / vlim_[a]);
+    AxisPeaks& k = peaks_[a];
+    k.velocity_allowed = std::max(k.velocity_allowed, std::max(0.0, d - 1));
+    k.velocity_raw = std::max(k.velocity_raw, d);
+    k.velocity_exact = std::max(k.velocity_exact, de);
 }
 
 void TickChecker::acceleration(std::size_t a, std::int64_t second, double de) {
     const std::int64_t magnitude = second < 0 ? -second : second;
     out_.axis_max_second_difference[a] = std::max(out_.axis_max_second_difference[a], magnitude);
     const double d = static_cast<double>(magnitude);
-    const double allowed = std::max(0.0, d - 2) / alim_[a];
-    out_.axis_acceleration_fraction[a] = std::max(out_.axis_acceleration_fraction[a], allowed);
-    out_.max_acceleration_fraction_raw = std::max(out_.max_acceleration_fraction_raw, d / alim_[a]);
-    out_.max_acceleration_fraction_exact = std::max(out_.max_acceleration_fraction_exact, de / alim_[a]);
-    out_.axis_acceleration_fraction_exact[a] = std::max(out_.axis_acceleration_fraction_exact[a], de / alim_[a]);
+    AxisPeaks& k = peaks_[a];
+    k.acceleration_allowed = std::max(k.acceleration_allowed, std::max(0.0, d - 2));
+    k.acceleration_raw = std::max(k.acceleration_raw, d);
+    k.acceleration_exact = std::max(k.acceleration_exact, de);
 }
 
 PlanCheck TickChecker::finish() {
@@ -324,6 +340,7 @@ PlanCheck TickChecker::finish() {
     visit(p, e, last_pen_down_, last_feed_);
     // The axes rest after the end: one more second difference, centred on the end point.
     for (std::size_t a = 0; a < axes_; ++a) acceleration(a, p2_[a] - p1_[a], std::fabs(e2_[a] - e1_[a]));
+    fold_peaks();
     for (std::size_t a = 0; a < axes_; ++a) {
         out_.max_velocity_fraction = std::max(out_.max_velocity_fraction, out_.axis_velocity_fraction[a]);
         out_.max_acceleration_fraction = std::max(out_.max_acceleration_fraction, out_.axis_acceleration_fraction[a]);

@@ -422,7 +422,7 @@ public:
     /// Runs the span through the core tick by tick; throws PlanError if the core refuses it.
     void span(const CoreSpan& span);
     /// True when a tick or span so far is over a limit (exactly or after the allowance).
-    bool over_limits() const;
+    bool over_limits();
     /// The held end point and the rest after it; the figures of the whole plan.
     PlanCheck finish();
     /// Called with every executed tick: its number, the core's setpoint (LSB per axis) and
@@ -439,6 +439,16 @@ private:
                bool pen_output, double feed);
     void velocity(std::size_t a, double d, double de);
     void acceleration(std::size_t a, std::int64_t second, double de);
+    /// The peaks below as fractions of the limits, into out_. A tick's figures are kept in LSB
+    /// and divided once here: dividing by a positive limit keeps the order, so the largest
+    /// quotient is the quotient of the largest, bit for bit.
+    void fold_peaks();
+
+    struct AxisPeaks {
+        double velocity_allowed = 0, velocity_raw = 0, velocity_exact = 0;
+        double acceleration_allowed = 0, acceleration_raw = 0, acceleration_exact = 0;
+    };
+    std::array<AxisPeaks, kAxesMax> peaks_{};
 
     const MachineProfile& profile_;
     std::size_t axes_;
