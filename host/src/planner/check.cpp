@@ -39,6 +39,29 @@ double exact_value(const CoreSpan& s, std::size_t axis, std::uint32_t k) {
            scale;
 }
 
+/// exact_value for every tick of one span: the coefficients converted once (same arithmetic,
+/// same results), for the per-tick check's inner loop.
+struct ExactSpan {
+    ExactSpan(const CoreSpan& s, std::size_t axes) : axes_(axes), ticks_(s.ticks), scale_(basis_matrix(s.basis).scale) {
+        for (std::size_t a = 0; a < axes; ++a) {
+            const TickCubic& c = s.cubic[a];
+            k_[a] = {static_cast<double>(c.a), static_cast<double>(c.b), static_cast<double>(c.c),
+                     static_cast<double>(c.d)};
+        }
+    }
+    void at(std::uint32_t k, std::array<double, kAxesMax>& e) const {
+        const double u = static_cast<double>(k) / ticks_;
+        for (std::size_t a = 0; a < axes_; ++a) {
+            const auto& c = k_[a];
+            e[a] = (((c[0] * u + c[1]) * u + c[2]) * u + c[3]) / scale_;
+        }
+    }
+
+    std::size_t axes_;
+    double ticks_, scale_;
+    std::array<std::array<double, 4>, kAxesMax> k_{};
+};
+
 /// Peak |velocity| (LSB/tick) of axis `axis` over span `s` and |acceleration| (LSB/tick^2) at
 /// its two ends, from the core's exact cubic p(u) = (a u^3 + b u^2 + c u + d) / scale, u = k/n:
 /// the velocity is quadratic (peak at an end or where the acceleration crosses 0), the
@@ -201,9 +224,10 @@ void TickChecker::span(const CoreSpan& cs) {
     std::array<std::int64_t, kAxesMax> p{};
     std::array<double, kAxesMax> e{};
     const double feed = feeds_->feed(cs);  // once per span, not per tick
+    const ExactSpan exact(cs, axes_);
     for (std::uint32_t k = 0; k < cs.ticks; ++k) {
         stepper_->tick(p);
-        for (std::size_t a = 0; a < axes_; ++a) e[a] = exact_value(cs, a, k);
+        exact.at(k, e);
         visit(p, e, cs.pen_down, feed);
     }
     // What the held end point after the last span needs (finish), without copying the span.
