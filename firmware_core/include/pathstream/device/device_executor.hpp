@@ -10,6 +10,7 @@
 
 #include "pathstream/device/device_channel.hpp"
 #include "pathstream/device/device_state.hpp"
+#include "pathstream/device/jerk_moves.hpp"
 #include "pathstream/device/motion_limits.hpp"
 #include "pathstream/device/stop_spans.hpp"
 #include "pathstream/setpoint_stream.hpp"
@@ -97,6 +98,8 @@ private:
     // queue slot is reused once the span is done). Default: at rest.
     struct Current {
         std::int32_t tangent[Axes] = {};
+        std::int32_t start_tangent[Axes] = {};  // with the chord: the end acceleration, for a stop
+        std::int32_t chord[Axes] = {};
         std::uint32_t ticks = 1;
         bool job_end = false;
         bool pause_after = false;
@@ -292,7 +295,11 @@ private:
     // The next span becomes the one in progress: its stamp is copied here, where the tick
     // can keep it after the slot is reused.
     void adopt(const PreparedSpan<Axes>& next) {
-        for (unsigned a = 0; a < Axes; ++a) current_.tangent[a] = next.stamp.end_tangent[a];
+        for (unsigned a = 0; a < Axes; ++a) {
+            current_.tangent[a] = next.stamp.end_tangent[a];
+            current_.start_tangent[a] = next.stamp.start_tangent[a];
+            current_.chord[a] = next.stamp.chord[a];
+        }
         current_.ticks = next.ticks;
         current_.job_end = next.stamp.job_end;
         current_.pause_after = next.stamp.pause_after;
@@ -357,12 +364,17 @@ private:
         // T1/n): the span's own length n, exactly T1, for spans of up to kMinInSpanStopBase
         // ticks or when the stop needs n ticks or more; else the ticks the stop needs, so a
         // long span's stop (an underrun after it) is not stretched to the span's length.
+        for (unsigned a = 0; a < Axes; ++a) boundary_acceleration_[a] = TickAcceleration{};
         if (moving) {
             const std::int32_t none[Axes] = {};
             if (velocity_within_span(none, none, current_.tangent, current_.ticks, current_.ticks, limits(),
                                      boundary_tangent_, boundary_ticks_) != Status::kOk) {
                 fault(FaultCode::kStopFailed);
                 return false;
+            }
+            for (unsigned a = 0; a < Axes; ++a) {
+                boundary_acceleration_[a] = hermite_end_acceleration(current_.chord[a], current_.start_tangent[a],
+                                                                     current_.tangent[a], current_.ticks);
             }
         }
         begin_stop(stopping, moving);
@@ -382,10 +394,21 @@ private:
             }
             return;
         }
-        Span<Axes> stop;
-        if (plan_stop(boundary_, boundary_tangent_, boundary_ticks_, limits(), stop) !=
-                Status::kOk ||
-            !start_generated(stop)) {
+        // Under a jerk limit the two-span stop of plan_jerk_stop; where none fits, the one span
+        // of plan_stop (stopping matters more than the jerk limit).
+        JerkMove<Axes> jerk_stop;
+        const bool smooth = has_jerk_limit(limits()) &&
+                            plan_jerk_stop(boundary_, boundary_tangent_, boundary_ticks_, boundary_acceleration_,
+                                           limits(), jerk_stop) == Status::kOk;
+        if (!smooth) {
+            jerk_stop.count = 1;
+            if (plan_stop(boundary_, boundary_tangent_, boundary_ticks_, limits(), jerk_stop.span[0]) !=
+                Status::kOk) {
+                fault(FaultCode::kStopFailed);
+                return;
+            }
+        }
+        if (!start_generated(jerk_stop)) {
             fault(FaultCode::kStopFailed);
             return;
         }
@@ -411,6 +434,12 @@ private:
             fault(FaultCode::kStopFailed);
             return true;
         }
+        for (unsigned a = 0; a < Axes; ++a) {
+            boundary_acceleration_[a] =
+                acceleration_within_span(span->stamp.chord[a], span->stamp.start_tangent[a],
+                                         span->stamp.end_tangent[a], span->ticks, queue.ticks_into_span(),
+                                         boundary_ticks_);
+        }
         bool moving = false;
         for (unsigned a = 0; a < Axes; ++a) moving = moving || boundary_tangent_[a] != 0;
         begin_stop(stopping, moving);
@@ -431,10 +460,26 @@ private:
             set_state(DeviceState::kRunning);
             return;
         }
-        Span<Axes> reentry;
-        if (plan_reentry(rest_, boundary_, boundary_tangent_, boundary_ticks_, limits(), reentry) !=
-                Status::kOk ||
-            !start_generated(reentry)) {
+        // Under a jerk limit the three spans of plan_jerk_reentry, arriving with the acceleration
+        // the path has there: the span a stop inside a span left (its value at the stop), else the
+        // next span's start.
+        JerkMove<Axes> reentry;
+        Status planned = Status::kOk;
+        if (has_jerk_limit(limits())) {
+            TickAcceleration arrival[Axes];
+            const PreparedSpan<Axes>* into = channel_.queue.next_span();
+            for (unsigned a = 0; a < Axes; ++a) {
+                arrival[a] = channel_.queue.span_in_progress() != nullptr || into == nullptr
+                                 ? boundary_acceleration_[a]
+                                 : start_acceleration_of(into->stamp, into->ticks, a);
+            }
+            planned = plan_jerk_reentry(rest_, boundary_, boundary_tangent_, boundary_ticks_, arrival, limits(),
+                                        reentry);
+        } else {
+            reentry.count = 1;
+            planned = plan_reentry(rest_, boundary_, boundary_tangent_, boundary_ticks_, limits(), reentry.span[0]);
+        }
+        if (planned != Status::kOk || !start_generated(reentry)) {
             // No move back onto the path fits in one span: a fault the master sees (rather
             // than a hold that silently never resumes); reset, then restart the job.
             fault(FaultCode::kReentryFailed);
@@ -452,13 +497,22 @@ private:
         set_state(DeviceState::kRunning);
     }
 
-    bool start_generated(const Span<Axes>& span) {
+    // The acceleration at the start of a queued Hermite span (its stamp): (6C - 4T0 - 2T1) / n^2.
+    static TickAcceleration start_acceleration_of(const SpanStamp<Axes>& stamp, std::uint32_t n, unsigned a) {
+        const std::int64_t c = stamp.chord[a], t0 = stamp.start_tangent[a], t1 = stamp.end_tangent[a];
+        return TickAcceleration{6 * c - 4 * t0 - 2 * t1, static_cast<std::uint64_t>(n) * n};
+    }
+
+    bool start_generated(const JerkMove<Axes>& move) {
         Lsb from[Axes];
-        for (unsigned a = 0; a < Axes; ++a) from[a] = span.control[a][0];
+        for (unsigned a = 0; a < Axes; ++a) from[a] = move.span[0].control[a][0];
         generated_.discard_all(from);
         generated_.restart_producer_at(from);
-        if (generated_.push(span) != Status::kOk) return false;
-        generated_left_ = span.ticks;
+        generated_left_ = 0;
+        for (unsigned i = 0; i < move.count; ++i) {
+            if (generated_.push(move.span[i]) != Status::kOk) return false;
+            generated_left_ += move.span[i].ticks;
+        }
         set_motion(Motion::kGenerated);
         return true;
     }
@@ -500,7 +554,7 @@ private:
     std::uint8_t manual_pen_ = 0;  // the operator's pen at rest while idle (set_pen)
     std::uint8_t pen_lead_outputs_ = 0;
     std::uint32_t pen_lead_ticks_ = 0;
-    std::uint32_t generated_left_ = 0;  // ticks of the generated span still to output
+    std::uint32_t generated_left_ = 0;  // ticks of the generated spans still to output
     std::uint64_t generated_ticks_ = 0;
     std::uint64_t job_start_ticks_ = 0;  // path ticks executed when the current job began
     Current current_;
@@ -509,7 +563,8 @@ private:
     Lsb boundary_[Axes] = {};
     std::int32_t boundary_tangent_[Axes] = {};
     std::uint32_t boundary_ticks_ = 1;
-    SetpointStream<Axes, 2> generated_;  // the device's own stop and re-entry spans
+    TickAcceleration boundary_acceleration_[Axes] = {};  // the path's acceleration at boundary_
+    SetpointStream<Axes, 4> generated_;  // the device's own stop and re-entry spans
 };
 
 }  // namespace pathstream::device
