@@ -26,6 +26,9 @@
 #include "pathstream/host/job_journal.hpp"
 #include "pathstream/host/layers.hpp"
 #include "pathstream/host/modbus_stream.hpp"
+#include "pathstream/host/planner.hpp"
+#include "pathstream/host/json_path.hpp"
+#include "pathstream/host/machine.hpp"
 #include "pathstream/host/svg_path.hpp"
 #include "pathstream/sim/can_device.hpp"
 #include "pathstream/sim/can_loopback.hpp"
@@ -357,6 +360,52 @@ TEST_CASE("resume_from: the pen-down approach along the tangent, and errors", "[
           static_cast<std::int64_t>(drawing));
     CHECK_THROWS_AS(host::resume_from(whole, job.plan.spans.size(), rest, limits),
                     std::invalid_argument);
+}
+
+TEST_CASE("resume_from under a jerk limit: the re-entry and the approach keep the acceleration continuous",
+          "[resume][jerk]") {
+    // wave.json planned for the pen plotter with 1e5 mm/s^3 on both axes; resumed from spans
+    // all along it (inside strokes too, where the acceleration is not 0), from a rest point
+    // off the path. The whole resumed job, started at rest, is within the exact jerk rules
+    // (check_plan's jerk meter: each span's jerk, every join's acceleration step, rest at both
+    // ends); the same resume without the jerk limit is not (the test can fail).
+    Job job;
+    job.machine = host::load_machine_profile(std::string(PATHSTREAM_SOURCE_DIR) + "/examples/machines/pen_plotter.json");
+    for (auto& a : job.machine.axes) a.max_jerk = 1e5;
+    const auto segments =
+        host::to_bezier_segments(host::load_json_path(std::string(PATHSTREAM_SOURCE_DIR) + "/examples/wave.json"));
+    job.plan = host::plan_path(segments, job.machine);
+    const host::JobSpans whole = host::job_from_plan(job.plan);
+    const host::DeviceLimitsLsb limits = host::device_limits(job.machine);
+    host::DeviceLimitsLsb plain = limits;
+    plain.max_jerk.assign(plain.max_jerk.size(), 0);
+    REQUIRE(limits.pen_down_ticks > 0);
+    const std::vector<Lsb> start = start_of(job.plan);
+    int resumed_count = 0, plain_over = 0;
+    for (std::size_t first = 1; first < job.plan.spans.size(); first += 5) {
+        const std::vector<Lsb> rest = {start[0] - 3000 + static_cast<Lsb>(first), start[1] + 2000};
+        INFO("resumed from span " << first << " of " << job.plan.spans.size());
+        const host::JobSpans r = host::resume_from(whole, first, rest, limits);
+        const std::size_t lead = r.plan.spans.size() - (job.plan.spans.size() - first);
+        CHECK(lead >= 3);
+        CHECK(lead <= 5);
+        for (std::size_t a = 0; a < 2; ++a) CHECK(r.plan.spans[0].control[a][0] == rest[a]);
+        if (job.plan.spans[first].pen_down) {
+            CHECK(r.plan.spans[lead - 1].pen_down);  // the approach
+            CHECK(r.plan.spans[lead - 1].ticks >= limits.pen_down_ticks);
+        }
+        const host::PlanCheck c = host::check_plan(r.plan, segments, job.machine);
+        CHECK(c.jerk_limited);
+        CHECK(c.max_jerk_fraction_exact <= 1.0);
+        CHECK(c.max_join_acceleration_step_fraction <= 1.0);
+        CHECK(c.max_acceleration_fraction_exact <= 1.0);
+        CHECK(c.max_velocity_fraction_exact <= 1.0);
+        ++resumed_count;
+        const host::PlanCheck p = host::check_plan(host::resume_from(whole, first, rest, plain).plan, segments, job.machine);
+        plain_over += p.max_jerk_fraction_exact > 1.0 || p.max_join_acceleration_step_fraction > 1.0 ? 1 : 0;
+    }
+    CHECK(resumed_count > 10);
+    CHECK(plain_over > 0);
 }
 
 TEST_CASE("job spans and journal files: round trip, changed or damaged files refused", "[resume]") {

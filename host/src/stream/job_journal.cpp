@@ -6,7 +6,9 @@
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
+#include <type_traits>
 
+#include "pathstream/device/jerk_moves.hpp"
 #include "pathstream/device/motion_limits.hpp"
 #include "pathstream/device/stop_spans.hpp"
 #include "pathstream/host/atomic_file.hpp"
@@ -68,6 +70,127 @@ Status reentry_for(const std::vector<Lsb>& from, const std::vector<std::int32_t>
         for (unsigned k = 0; k < 4; ++k) out.control[a][k] = span.control[a][k];
     }
     return Status::kOk;
+}
+
+// Under a jerk limit: the approach (when `approach_ticks` > 0: a span of at least that many
+// ticks ending at `to` with the target's velocity and start acceleration, starting at about no
+// acceleration; jerk_moves.hpp's ramp) and the re-entry from rest onto it (plan_jerk_reentry).
+// `to`, `tangent` and `ticks` describe the target span's start; `out` gets the re-entry spans
+// then the approach.
+template <unsigned Axes>
+Status jerk_reentry_for(const std::vector<Lsb>& from, const std::vector<std::int32_t>& to,
+                        const std::vector<std::int32_t>& tangent, std::uint32_t ticks,
+                        const std::vector<device::TickAcceleration>& arrival, std::uint32_t approach_ticks,
+                        const DeviceLimitsLsb& l, std::vector<Span<Axes>>& out) {
+    device::MotionLimits<Axes> limits;
+    limits.tick_hz = l.tick_hz;
+    limits.pen_down_ticks = l.pen_down_ticks;
+    Lsb f[Axes], t[Axes];
+    std::int32_t g[Axes];
+    device::TickAcceleration acc[Axes];
+    for (unsigned a = 0; a < Axes; ++a) {
+        limits.axis[a].max_velocity = l.max_velocity[a];
+        limits.axis[a].max_acceleration = l.max_acceleration[a];
+        if (l.max_jerk.size() == Axes) limits.axis[a].max_jerk = l.max_jerk[a];
+        f[a] = from[a];
+        t[a] = to[a];
+        g[a] = tangent[a];
+        acc[a] = arrival[a];
+    }
+    out.clear();
+    std::uint32_t into_ticks = ticks;
+    Span<Axes> ramp;
+    if (approach_ticks > 0) {
+        device::TickAcceleration shaped[Axes], start[Axes];
+        device::jerk_detail::toward_zero(acc, limits, shaped);
+        Status s = Status::kStopTooLong;
+        for (std::uint64_t r = approach_ticks; r <= kMaxSpanTicks && s != Status::kOk; r *= 2) {
+            s = device::jerk_detail::acceleration_ramp(false, t, g, ticks, r, acc, shaped, limits, ramp, start);
+            if (s != Status::kOk && !device::jerk_detail::longer_may_pass(s)) return s;
+        }
+        if (s != Status::kOk) return s;
+        for (unsigned a = 0; a < Axes; ++a) {
+            t[a] = ramp.control[a][0];
+            g[a] = ramp.control[a][2];
+            acc[a] = start[a];
+        }
+        into_ticks = ramp.ticks;
+    }
+    device::JerkMove<Axes> move;
+    if (const Status s = device::plan_jerk_reentry(f, t, g, into_ticks, acc, limits, move); s != Status::kOk) return s;
+    for (unsigned i = 0; i < move.count; ++i) out.push_back(move.span[i]);
+    if (approach_ticks > 0) out.push_back(ramp);
+    return Status::kOk;
+}
+
+// The core's timing and exact cubics of a Hermite span built here (the re-entry, the approach),
+// as the planner's spans carry them, so a resumed job checks like a planned one.
+void complete_core_span(CoreSpan& c) {
+    if (make_span_timing(c.basis, c.ticks, c.timing) != Status::kOk) {
+        throw std::range_error("a re-entry span's tick count is out of range");
+    }
+    c.cubic.assign(c.control.size(), TickCubic{});
+    for (std::size_t a = 0; a < c.control.size(); ++a) {
+        const std::int32_t control[4] = {c.control[a][0], c.control[a][1], c.control[a][2], c.control[a][3]};
+        if (const Status s = make_tick_cubic(c.basis, control, c.timing, c.cubic[a]); s != Status::kOk) {
+            throw std::range_error(std::string("the core refuses a re-entry span: ") + status_name(s));
+        }
+    }
+}
+
+template <unsigned Axes>
+CoreSpan to_core(const Span<Axes>& span, std::size_t subpath, bool pen_down) {
+    CoreSpan c;
+    c.basis = Basis::kHermite;
+    c.ticks = span.ticks;
+    c.subpath = subpath;
+    c.pen_down = pen_down;
+    c.control.assign(Axes, {});
+    for (unsigned a = 0; a < Axes; ++a) {
+        for (unsigned k = 0; k < 4; ++k) c.control[a][k] = span.control[a][k];
+    }
+    return c;
+}
+
+// jerk_reentry_for for a run-time axis count: the spans as CoreSpans (the last one the approach,
+// pen down, when there is one).
+Status jerk_reentry(const std::vector<Lsb>& from, const CoreSpan& target, std::uint32_t approach_ticks,
+                    const DeviceLimitsLsb& l, std::vector<CoreSpan>& out) {
+    const std::size_t axes = target.control.size();
+    std::vector<std::int32_t> to(axes), tangent(axes);
+    std::vector<device::TickAcceleration> arrival(axes);
+    for (std::size_t a = 0; a < axes; ++a) {
+        const auto& c = target.control[a];
+        to[a] = c[0];
+        tangent[a] = c[2];
+        // The target's start acceleration: (6 (P1 - P0) - 4 T0 - 2 T1) / n^2 LSB/tick^2.
+        arrival[a] = device::TickAcceleration{
+            6 * (static_cast<std::int64_t>(c[1]) - c[0]) - 4 * static_cast<std::int64_t>(c[2]) - 2 * static_cast<std::int64_t>(c[3]),
+            static_cast<std::uint64_t>(target.ticks) * target.ticks};
+    }
+    const auto run = [&](auto tag) -> Status {
+        constexpr unsigned kAxes = decltype(tag)::value;
+        std::vector<Span<kAxes>> spans;
+        const Status s = jerk_reentry_for<kAxes>(from, to, tangent, target.ticks, arrival, approach_ticks, l, spans);
+        if (s != Status::kOk) return s;
+        out.clear();
+        for (std::size_t i = 0; i < spans.size(); ++i) {
+            const bool approach = approach_ticks > 0 && i + 1 == spans.size();
+            out.push_back(to_core(spans[i], target.subpath, approach));
+        }
+        return Status::kOk;
+    };
+    switch (axes) {
+        case 1: return run(std::integral_constant<unsigned, 1>{});
+        case 2: return run(std::integral_constant<unsigned, 2>{});
+        case 3: return run(std::integral_constant<unsigned, 3>{});
+        case 4: return run(std::integral_constant<unsigned, 4>{});
+        case 5: return run(std::integral_constant<unsigned, 5>{});
+        case 6: return run(std::integral_constant<unsigned, 6>{});
+        case 7: return run(std::integral_constant<unsigned, 7>{});
+        case 8: return run(std::integral_constant<unsigned, 8>{});
+        default: throw std::invalid_argument("1 to 8 axes");
+    }
 }
 
 Status reentry(const std::vector<Lsb>& from, const std::vector<std::int32_t>& to,
@@ -154,6 +277,35 @@ JobSpans resume_from(const JobSpans& job, std::size_t first, const std::vector<L
         out.origin.push_back(origin);
         out.drawing_tick.push_back(tick);
     };
+    // The lead-in spans (re-entry, approach), then the job's own from `first` on.
+    const auto complete = [&](std::vector<CoreSpan> lead) {
+        const std::uint64_t tick = job.drawing_tick[first];
+        for (CoreSpan& c : lead) {
+            complete_core_span(c);
+            add(std::move(c), -1, tick);
+        }
+        for (std::size_t i = first; i < job.plan.spans.size(); ++i) {
+            if (job.origin[i] >= 0) add(job.plan.spans[i], job.origin[i], job.drawing_tick[i]);
+        }
+        std::uint64_t total = 0;
+        for (const CoreSpan& c : out.plan.spans) total += c.ticks;
+        out.plan.total_ticks = total;
+        out.plan.pauses = pauses_of(out.plan.spans);
+        return out;
+    };
+    // Under a jerk limit the re-entry and the approach keep the acceleration continuous too
+    // (jerk_reentry): the approach ends with the span's start acceleration, not none.
+    const bool jerk = std::any_of(limits.max_jerk.begin(), limits.max_jerk.end(), [](std::uint32_t j) { return j != 0; });
+    if (jerk) {
+        const std::uint32_t approach_ticks = target.pen_down ? limits.pen_down_ticks : 0;
+        std::vector<CoreSpan> lead;
+        if (const Status s = jerk_reentry(rest, target, approach_ticks, limits, lead); s != Status::kOk) {
+            throw std::range_error(std::string("no move from where the device rests back onto the drawing fits "
+                                               "the limits and the jerk limit (") +
+                                   status_name(s) + ")");
+        }
+        return complete(std::move(lead));
+    }
     // The pen lands where the span starts: approach along its start tangent, pen down, for
     // whole multiples of its length (k n ticks with tangent k T0: the same velocity, exactly).
     std::vector<CoreSpan> approach;
@@ -188,17 +340,8 @@ JobSpans resume_from(const JobSpans& job, std::size_t first, const std::vector<L
                         "the limits in one span (") +
             status_name(s) + ")");
     }
-    const std::uint64_t tick = job.drawing_tick[first];
-    add(std::move(r), -1, tick);
-    for (CoreSpan& a : approach) add(std::move(a), -1, tick);
-    for (std::size_t i = first; i < job.plan.spans.size(); ++i) {
-        if (job.origin[i] >= 0) add(job.plan.spans[i], job.origin[i], job.drawing_tick[i]);
-    }
-    std::uint64_t total = 0;
-    for (const CoreSpan& s : out.plan.spans) total += s.ticks;
-    out.plan.total_ticks = total;
-    out.plan.pauses = pauses_of(out.plan.spans);
-    return out;
+    approach.insert(approach.begin(), std::move(r));
+    return complete(std::move(approach));
 }
 
 JobSpansWriter::JobSpansWriter(std::string path) : path_(std::move(path)), body_(std::tmpfile()) {

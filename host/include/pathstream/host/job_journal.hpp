@@ -33,9 +33,13 @@ JobSpans job_from_plan(const Plan& plan);
 /// rest at `rest`: a re-entry span (the core's plan_reentry, pen up) that arrives at span
 /// `first`'s start with its start velocity, and, when that span draws and `limits` has a
 /// pen-down delay, a straight approach along its start tangent lasting at least that delay,
-/// with the pen down, so the pen touches where the span starts. Re-entry spans of `job`
-/// itself are skipped. Throws std::invalid_argument when `first` is past the end and
-/// std::range_error when no re-entry fits the limits in one span.
+/// with the pen down, so the pen touches where the span starts. Under a jerk limit (any
+/// `limits.max_jerk`) the acceleration stays continuous within one tick of jerk as well: the
+/// re-entry is plan_jerk_reentry's three or four spans, and the approach a span of at least
+/// the delay that ends with the span's start velocity and acceleration and starts with about
+/// none (a ramp, slightly curved where that acceleration is not along the tangent). Re-entry
+/// spans of `job` itself are skipped. Throws std::invalid_argument when `first` is past the end
+/// and std::range_error when no re-entry fits the limits.
 JobSpans resume_from(const JobSpans& job, std::size_t first, const std::vector<Lsb>& rest,
                      const DeviceLimitsLsb& limits);
 
