@@ -268,7 +268,17 @@ TEST_CASE("resume: the host dies at a seeded moment, the job goes on from the de
 
 TEST_CASE("resume: a stop or a fault at a seeded moment, then a re-entry from where it rests",
           "[resume][modbus][threads]") {
-    const Job job = plan_example("wave.json");
+    // Also under a jerk limit: the device's stop, the resume's re-entry and approach must then
+    // keep the acceleration continuous, or the device refuses the resumed job.
+    const double jerk = GENERATE(0.0, 1e5);
+    INFO("max_jerk " << jerk);
+    Job job = plan_example("wave.json");
+    if (jerk > 0) {
+        for (auto& a : job.machine.axes) a.max_jerk = jerk;
+        job.plan = host::plan_path(host::to_bezier_segments(host::load_json_path(std::string(PATHSTREAM_SOURCE_DIR) +
+                                                                                 "/examples/wave.json")),
+                                   job.machine);
+    }
     const host::JobSpans whole = host::job_from_plan(job.plan);
     const host::DeviceLimitsLsb limits = host::device_limits(job.machine);
     for (unsigned seed = 21; seed < 21 + 2 * seeds_to_run(); ++seed) {
@@ -300,8 +310,15 @@ TEST_CASE("resume: a stop or a fault at a seeded moment, then a re-entry from wh
                 s = wait_for(*link, DeviceState::kIdle);
             } else {
                 const host::StreamReport r = host::stream_modbus(job.plan, job.machine, o);
-                REQUIRE(r.interrupted == 2);
+                REQUIRE(r.interrupted >= 1);
                 s = r.final_status;
+                if (r.interrupted == 1) {
+                    // The hold came to rest before the stream's next look sent the stop (a short
+                    // hold: the request came near a stop of the plan): stop it now.
+                    CHECK(s.state == static_cast<unsigned>(DeviceState::kHolding));
+                    CHECK(link->command(Command::kStop) == Status::kOk);
+                    s = wait_for(*link, DeviceState::kIdle);
+                }
                 CHECK(s.state == static_cast<unsigned>(DeviceState::kIdle));
             }
             // The interrupted run's drawing ticks end with its last completed span; a fault
