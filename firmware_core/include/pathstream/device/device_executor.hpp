@@ -394,8 +394,8 @@ private:
             }
             return;
         }
-        // Under a jerk limit the two-span stop of plan_jerk_stop; where none fits, the one span
-        // of plan_stop (stopping matters more than the jerk limit).
+        // Under a jerk limit the two or three spans of plan_jerk_stop; where none fit, the one
+        // span of plan_stop (stopping matters more than the jerk limit).
         JerkMove<Axes> jerk_stop;
         const bool smooth = has_jerk_limit(limits()) &&
                             plan_jerk_stop(boundary_, boundary_tangent_, boundary_ticks_, boundary_acceleration_,
@@ -460,9 +460,9 @@ private:
             set_state(DeviceState::kRunning);
             return;
         }
-        // Under a jerk limit the three spans of plan_jerk_reentry, arriving with the acceleration
-        // the path has there: the span a stop inside a span left (its value at the stop), else the
-        // next span's start.
+        // Under a jerk limit the three or four spans of plan_jerk_reentry, arriving with the
+        // acceleration the path has there: the span a stop inside a span left (its value at the
+        // stop), else the next span's start.
         JerkMove<Axes> reentry;
         Status planned = Status::kOk;
         if (has_jerk_limit(limits())) {
@@ -480,8 +480,8 @@ private:
             planned = plan_reentry(rest_, boundary_, boundary_tangent_, boundary_ticks_, limits(), reentry.span[0]);
         }
         if (planned != Status::kOk || !start_generated(reentry)) {
-            // No move back onto the path fits in one span: a fault the master sees (rather
-            // than a hold that silently never resumes); reset, then restart the job.
+            // No move back onto the path fits: a fault the master sees (rather than a hold
+            // that silently never resumes); reset, then restart the job.
             fault(FaultCode::kReentryFailed);
             return;
         }
