@@ -137,17 +137,22 @@ constexpr bool longer_may_pass(Status s) {
            s == Status::kAccelerationStep || s == Status::kDifferenceOutOfRange;
 }
 
-/// The smallest j in 1..jmax for which build(j, move) passes, by doubling from `first` and then
-/// bisection (a longer move eases every rule but rounding). kStopTooLong when none does.
+/// The smallest j in 1..jmax for which build(j, move) passes, by doubling from `first` (jmax
+/// itself tried last) and then bisection (a longer move eases every rule but rounding).
+/// kStopTooLong when none does.
 template <unsigned Axes, class Build>
 Status search(std::uint64_t first, std::uint64_t jmax, Build build, JerkMove<Axes>& out) {
     std::uint64_t bad = 0, good = first < 1 ? 1 : first;
     JerkMove<Axes> candidate;
     Status s = Status::kStopTooLong;
     for (;;) {
-        if (good > jmax) return Status::kStopTooLong;
+        if (good > jmax) {
+            if (bad >= jmax) return Status::kStopTooLong;
+            good = jmax;  // the longest allowed, once, before giving up
+        }
         s = build(good, candidate);
         if (!longer_may_pass(s)) break;
+        if (good == jmax) return Status::kStopTooLong;
         bad = good;
         good *= 2;
     }
