@@ -20,6 +20,7 @@
 // image runs three phases, (n, S spans), (2n, S), (n, 2S); differences between them cancel
 // whatever does not scale with the ticks.
 // Exit status: 0 if every asserted figure holds and the counting self-check passes.
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -444,6 +445,24 @@ int main(int argc, char** argv) {
         std::cout << "Horner evaluate_at, n = " << p.n << ": " << fmt(per_call, 1)
                   << " instructions per call (whole call, 128-bit arithmetic and libgcc helpers"
                      " included)\n";
+    }
+    // The device's controlled stop, one call per phase: mean and largest per call.
+    for (const char* kind : {"plain_stop", "jerk_stop"}) {
+        double sum = 0, most = 0;
+        std::size_t count = 0;
+        unsigned axes = 0;
+        for (const Phase& p : phases) {
+            if (p.kind != kind) continue;
+            sum += delta(p, 0);
+            most = std::max(most, delta(p, 0));
+            axes = p.axes;
+            ++count;
+        }
+        if (count == 0) continue;
+        std::cout << (std::string(kind) == "jerk_stop" ? "plan_jerk_stop" : "plan_stop") << "<" << axes
+                  << ">, the controlled stop planned in the tick that takes a hold (" << count
+                  << " seeded states): " << fmt(sum / static_cast<double>(count), 0) << " instructions per call on"
+                  << " average, " << fmt(most, 0) << " at most\n";
     }
     // The whole device: phases (n, S) and (2n, S) of the same axis count; their difference is
     // S n steady ticks of MotionDevice::tick and the driver loop's check per tick.

@@ -21,6 +21,7 @@
 #include <cstdint>
 #include <new>
 
+#include "pathstream/device/jerk_moves.hpp"
 #include "pathstream/device/motion_device.hpp"
 #include "pathstream/device/wire_span.hpp"
 #include "pathstream/setpoint_stream.hpp"
@@ -300,6 +301,40 @@ template <unsigned A>
     report_phase("device", A, n, spans, ticks, 0, ok);
 }
 
+/// The device's controlled stop, planned in the tick that takes a hold: plan_jerk_stop under the
+/// pen plotter's jerk limit (10^5 mm/s^3 at 1 um and 1 kHz: 0.1 LSB/tick^3; 250 LSB/tick,
+/// 3 LSB/tick^2) or plan_stop without one, from a seeded moving state (8-tick spans, up to
+/// 200 LSB/tick, decelerating at up to 1 LSB/tick^2). One call per phase: the report shows the
+/// spread.
+template <unsigned A>
+[[gnu::noinline]] void stop_phase(pathstream::workload::SplitMix64& rng, bool jerk) {
+    namespace dev = pathstream::device;
+    dev::MotionLimits<A> limits;
+    limits.tick_hz = 1000;
+    for (unsigned a = 0; a < A; ++a) {
+        limits.axis[a].max_velocity = 250000;
+        limits.axis[a].max_acceleration = 3000000;
+        limits.axis[a].max_jerk = jerk ? 1000000u : 0u;
+    }
+    constexpr std::uint32_t kTicks = 8;
+    constexpr std::int64_t kQ = 64 * 256;  // the acceleration's denominator
+    Lsb position[A];
+    std::int32_t tangent[A];
+    dev::TickAcceleration acceleration[A];
+    for (unsigned a = 0; a < A; ++a) {
+        position[a] = rng.between(-1000000, 1000000);
+        tangent[a] = rng.between(-200 * kTicks, 200 * kTicks);
+        const std::int64_t against = tangent[a] > 0 ? -1 : 1;
+        acceleration[a] = dev::TickAcceleration{against * rng.between(0, kQ), static_cast<std::uint64_t>(kQ)};
+    }
+    dev::JerkMove<A> move;
+    budget_mark(2 * g_phase);
+    const Status s = jerk ? dev::plan_jerk_stop(position, tangent, kTicks, acceleration, limits, move)
+                          : dev::plan_stop(position, tangent, kTicks, limits, move.span[0]);
+    budget_mark(2 * g_phase + 1);
+    report_phase(jerk ? "jerk_stop" : "plain_stop", A, kTicks, jerk ? move.count : 1, 0, 1, s == Status::kOk);
+}
+
 [[gnu::noinline]] void calibration_phase(std::uint32_t iterations) {
     budget_mark(2 * g_phase);
     budget_calibrate(iterations);
@@ -322,6 +357,8 @@ int main() {
     horner_phase(rng, 65536, 64);   // |Q| >= 2^64: the bit-serial 128/64 division
     device_phase<2>(60, 32);
     device_phase<2>(120, 32);
+    for (int i = 0; i < 8; ++i) stop_phase<2>(rng, true);
+    for (int i = 0; i < 4; ++i) stop_phase<2>(rng, false);
     cortex_m::Line line;
     line.text("budget done phases=").dec(g_phase).text(g_failed ? " FAILED" : " ok").end();
     return g_failed ? 1 : 0;
