@@ -29,18 +29,9 @@ using planner_detail::kAxesMax;
 using planner_detail::PathProjector;
 using planner_detail::Vec;
 
-/// Exact value of a span's cubic at tick k before rounding, in LSB (double Horner in u).
-double exact_value(const CoreSpan& s, std::size_t axis, std::uint32_t k) {
-    const TickCubic& c = s.cubic[axis];
-    const double scale = basis_matrix(s.basis).scale;
-    const double u = static_cast<double>(k) / s.ticks;
-    return (((static_cast<double>(c.a) * u + static_cast<double>(c.b)) * u + static_cast<double>(c.c)) * u +
-            static_cast<double>(c.d)) /
-           scale;
-}
-
-/// exact_value for every tick of one span: the coefficients converted once (same arithmetic,
-/// same results), for the per-tick check's inner loop.
+/// The exact value (before rounding, LSB) of every axis of one span at tick k (0..ticks): the core's cubic in double,
+/// (((a u + b) u + c) u + d) / scale with u = k / ticks, its coefficients converted once for
+/// the per-tick check's inner loop.
 struct ExactSpan {
     ExactSpan(const CoreSpan& s, std::size_t axes) : axes_(axes), ticks_(s.ticks), scale_(basis_matrix(s.basis).scale) {
         for (std::size_t a = 0; a < axes; ++a) {
@@ -231,7 +222,7 @@ void TickChecker::span(const CoreSpan& cs) {
         visit(p, e, cs.pen_down, feed);
     }
     // What the held end point after the last span needs (finish), without copying the span.
-    for (std::size_t a = 0; a < axes_; ++a) last_end_[a] = exact_value(cs, a, cs.ticks);
+    exact.at(cs.ticks, last_end_);
     last_pen_down_ = cs.pen_down;
     last_feed_ = feed;
 }

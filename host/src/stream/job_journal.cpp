@@ -6,12 +6,12 @@
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
-#include <type_traits>
 
 #include "pathstream/device/jerk_moves.hpp"
 #include "pathstream/device/motion_limits.hpp"
 #include "pathstream/device/stop_spans.hpp"
 #include "pathstream/host/atomic_file.hpp"
+#include "pathstream/host/core_span_conversion.hpp"
 #include "pathstream/host/input_error.hpp"
 #include "pathstream/host/json_document.hpp"
 
@@ -42,85 +42,87 @@ std::string fnv1a_hex(const std::string& text) {
     return f.hex();
 }
 
-// The core's plan_reentry for a run-time axis count.
+// The device's limits as the core's functions take them.
 template <unsigned Axes>
-Status reentry_for(const std::vector<Lsb>& from, const std::vector<std::int32_t>& to,
-                   const std::vector<std::int32_t>& tangent, std::uint32_t ticks,
-                   const DeviceLimitsLsb& l, CoreSpan& out) {
+device::MotionLimits<Axes> motion_limits(const DeviceLimitsLsb& l) {
     device::MotionLimits<Axes> limits;
     limits.tick_hz = l.tick_hz;
     limits.pen_down_ticks = l.pen_down_ticks;
-    Lsb f[Axes], t[Axes];
-    std::int32_t g[Axes];
     for (unsigned a = 0; a < Axes; ++a) {
         limits.axis[a].max_velocity = l.max_velocity[a];
         limits.axis[a].max_acceleration = l.max_acceleration[a];
         if (l.max_jerk.size() == Axes) limits.axis[a].max_jerk = l.max_jerk[a];
-        f[a] = from[a];
-        t[a] = to[a];
-        g[a] = tangent[a];
     }
-    Span<Axes> span;
-    const Status s = device::plan_reentry(f, t, g, ticks, limits, span);
-    if (s != Status::kOk) return s;
-    out.basis = Basis::kHermite;
-    out.ticks = span.ticks;
-    out.control.assign(Axes, {});
-    for (unsigned a = 0; a < Axes; ++a) {
-        for (unsigned k = 0; k < 4; ++k) out.control[a][k] = span.control[a][k];
-    }
-    return Status::kOk;
+    return limits;
 }
 
-// Under a jerk limit: the approach (when `approach_ticks` > 0: a span of at least that many
-// ticks ending at `to` with the target's velocity and start acceleration, starting at about no
-// acceleration; jerk_moves.hpp's ramp) and the re-entry from rest onto it (plan_jerk_reentry).
-// `to`, `tangent` and `ticks` describe the target span's start; `out` gets the re-entry spans
-// then the approach.
-template <unsigned Axes>
-Status jerk_reentry_for(const std::vector<Lsb>& from, const std::vector<std::int32_t>& to,
-                        const std::vector<std::int32_t>& tangent, std::uint32_t ticks,
-                        const std::vector<device::TickAcceleration>& arrival, std::uint32_t approach_ticks,
-                        const DeviceLimitsLsb& l, std::vector<Span<Axes>>& out) {
-    device::MotionLimits<Axes> limits;
-    limits.tick_hz = l.tick_hz;
-    limits.pen_down_ticks = l.pen_down_ticks;
-    Lsb f[Axes], t[Axes];
-    std::int32_t g[Axes];
-    device::TickAcceleration acc[Axes];
-    for (unsigned a = 0; a < Axes; ++a) {
-        limits.axis[a].max_velocity = l.max_velocity[a];
-        limits.axis[a].max_acceleration = l.max_acceleration[a];
-        if (l.max_jerk.size() == Axes) limits.axis[a].max_jerk = l.max_jerk[a];
-        f[a] = from[a];
-        t[a] = to[a];
-        g[a] = tangent[a];
-        acc[a] = arrival[a];
-    }
-    out.clear();
-    std::uint32_t into_ticks = ticks;
-    Span<Axes> ramp;
-    if (approach_ticks > 0) {
-        device::TickAcceleration shaped[Axes], start[Axes];
-        device::jerk_detail::toward_zero(acc, limits, shaped);
-        Status s = Status::kStopTooLong;
-        for (std::uint64_t r = approach_ticks; r <= kMaxSpanTicks && s != Status::kOk; r *= 2) {
-            s = device::jerk_detail::acceleration_ramp(false, t, g, ticks, r, acc, shaped, limits, ramp, start);
-            if (s != Status::kOk && !device::jerk_detail::longer_may_pass(s)) return s;
+// The core's plan_reentry for a run-time axis count; `out` keeps its subpath and pen.
+Status reentry(const std::vector<Lsb>& from, const std::vector<std::int32_t>& to,
+               const std::vector<std::int32_t>& tangent, std::uint32_t ticks,
+               const DeviceLimitsLsb& l, CoreSpan& out) {
+    return with_axes(from.size(), [&](auto tag) {
+        constexpr unsigned kAxes = decltype(tag)::value;
+        Lsb f[kAxes], t[kAxes];
+        std::int32_t g[kAxes];
+        for (unsigned a = 0; a < kAxes; ++a) {
+            f[a] = from[a];
+            t[a] = to[a];
+            g[a] = tangent[a];
         }
-        if (s != Status::kOk) return s;
-        for (unsigned a = 0; a < Axes; ++a) {
-            t[a] = ramp.control[a][0];
-            g[a] = ramp.control[a][2];
-            acc[a] = start[a];
+        Span<kAxes> span;
+        const Status s = device::plan_reentry(f, t, g, ticks, motion_limits<kAxes>(l), span);
+        if (s == Status::kOk) out = from_core_span(span, out.subpath, out.pen_down);
+        return s;
+    });
+}
+
+// Under a jerk limit, onto `target`'s start (its velocity and start acceleration): the
+// approach, when `approach_ticks` > 0 (a span of at least that many ticks ending there and
+// starting at about no acceleration: jerk_moves.hpp's ramp, pen down), and the re-entry from rest
+// at `from` onto it (plan_jerk_reentry, pen up). `out`: the re-entry spans, then the approach.
+Status jerk_reentry(const std::vector<Lsb>& from, const CoreSpan& target, std::uint32_t approach_ticks,
+                    const DeviceLimitsLsb& l, std::vector<CoreSpan>& out) {
+    return with_axes(from.size(), [&](auto tag) {
+        constexpr unsigned kAxes = decltype(tag)::value;
+        const device::MotionLimits<kAxes> limits = motion_limits<kAxes>(l);
+        Lsb f[kAxes], t[kAxes];
+        std::int32_t g[kAxes];
+        device::TickAcceleration acc[kAxes];
+        for (unsigned a = 0; a < kAxes; ++a) {
+            const auto& c = target.control[a];
+            f[a] = from[a];
+            t[a] = c[0];
+            g[a] = c[2];
+            // The target's start acceleration: (6 (P1 - P0) - 4 T0 - 2 T1) / n^2 LSB/tick^2.
+            acc[a] = device::TickAcceleration{6 * (static_cast<std::int64_t>(c[1]) - c[0]) -
+                                                  4 * static_cast<std::int64_t>(c[2]) - 2 * static_cast<std::int64_t>(c[3]),
+                                              static_cast<std::uint64_t>(target.ticks) * target.ticks};
         }
-        into_ticks = ramp.ticks;
-    }
-    device::JerkMove<Axes> move;
-    if (const Status s = device::plan_jerk_reentry(f, t, g, into_ticks, acc, limits, move); s != Status::kOk) return s;
-    for (unsigned i = 0; i < move.count; ++i) out.push_back(move.span[i]);
-    if (approach_ticks > 0) out.push_back(ramp);
-    return Status::kOk;
+        std::uint32_t into_ticks = target.ticks;
+        Span<kAxes> ramp;
+        if (approach_ticks > 0) {
+            device::TickAcceleration start[kAxes];
+            if (const Status s =
+                    device::plan_jerk_approach(t, g, target.ticks, acc, approach_ticks, limits, ramp, start);
+                s != Status::kOk) {
+                return s;
+            }
+            for (unsigned a = 0; a < kAxes; ++a) {
+                t[a] = ramp.control[a][0];
+                g[a] = ramp.control[a][2];
+                acc[a] = start[a];
+            }
+            into_ticks = ramp.ticks;
+        }
+        device::JerkMove<kAxes> move;
+        if (const Status s = device::plan_jerk_reentry(f, t, g, into_ticks, acc, limits, move); s != Status::kOk) {
+            return s;
+        }
+        out.clear();
+        for (unsigned i = 0; i < move.count; ++i) out.push_back(from_core_span(move.span[i], target.subpath, false));
+        if (approach_ticks > 0) out.push_back(from_core_span(ramp, target.subpath, true));
+        return Status::kOk;
+    });
 }
 
 // The core's timing and exact cubics of a Hermite span built here (the re-entry, the approach),
@@ -135,86 +137,6 @@ void complete_core_span(CoreSpan& c) {
         if (const Status s = make_tick_cubic(c.basis, control, c.timing, c.cubic[a]); s != Status::kOk) {
             throw std::range_error(std::string("the core refuses a re-entry span: ") + status_name(s));
         }
-    }
-}
-
-template <unsigned Axes>
-CoreSpan to_core(const Span<Axes>& span, std::size_t subpath, bool pen_down) {
-    CoreSpan c;
-    c.basis = Basis::kHermite;
-    c.ticks = span.ticks;
-    c.subpath = subpath;
-    c.pen_down = pen_down;
-    c.control.assign(Axes, {});
-    for (unsigned a = 0; a < Axes; ++a) {
-        for (unsigned k = 0; k < 4; ++k) c.control[a][k] = span.control[a][k];
-    }
-    return c;
-}
-
-// jerk_reentry_for for a run-time axis count: the spans as CoreSpans (the last one the approach,
-// pen down, when there is one).
-Status jerk_reentry(const std::vector<Lsb>& from, const CoreSpan& target, std::uint32_t approach_ticks,
-                    const DeviceLimitsLsb& l, std::vector<CoreSpan>& out) {
-    const std::size_t axes = target.control.size();
-    std::vector<std::int32_t> to(axes), tangent(axes);
-    std::vector<device::TickAcceleration> arrival(axes);
-    for (std::size_t a = 0; a < axes; ++a) {
-        const auto& c = target.control[a];
-        to[a] = c[0];
-        tangent[a] = c[2];
-        // The target's start acceleration: (6 (P1 - P0) - 4 T0 - 2 T1) / n^2 LSB/tick^2.
-        arrival[a] = device::TickAcceleration{
-            6 * (static_cast<std::int64_t>(c[1]) - c[0]) - 4 * static_cast<std::int64_t>(c[2]) - 2 * static_cast<std::int64_t>(c[3]),
-            static_cast<std::uint64_t>(target.ticks) * target.ticks};
-    }
-    const auto run = [&](auto tag) -> Status {
-        constexpr unsigned kAxes = decltype(tag)::value;
-        std::vector<Span<kAxes>> spans;
-        const Status s = jerk_reentry_for<kAxes>(from, to, tangent, target.ticks, arrival, approach_ticks, l, spans);
-        if (s != Status::kOk) return s;
-        out.clear();
-        for (std::size_t i = 0; i < spans.size(); ++i) {
-            const bool approach = approach_ticks > 0 && i + 1 == spans.size();
-            out.push_back(to_core(spans[i], target.subpath, approach));
-        }
-        return Status::kOk;
-    };
-    switch (axes) {
-        case 1: return run(std::integral_constant<unsigned, 1>{});
-        case 2: return run(std::integral_constant<unsigned, 2>{});
-        case 3: return run(std::integral_constant<unsigned, 3>{});
-        case 4: return run(std::integral_constant<unsigned, 4>{});
-        case 5: return run(std::integral_constant<unsigned, 5>{});
-        case 6: return run(std::integral_constant<unsigned, 6>{});
-        case 7: return run(std::integral_constant<unsigned, 7>{});
-        case 8: return run(std::integral_constant<unsigned, 8>{});
-        default: throw std::invalid_argument("1 to 8 axes");
-    }
-}
-
-Status reentry(const std::vector<Lsb>& from, const std::vector<std::int32_t>& to,
-               const std::vector<std::int32_t>& tangent, std::uint32_t ticks,
-               const DeviceLimitsLsb& l, CoreSpan& out) {
-    switch (from.size()) {
-        case 1:
-            return reentry_for<1>(from, to, tangent, ticks, l, out);
-        case 2:
-            return reentry_for<2>(from, to, tangent, ticks, l, out);
-        case 3:
-            return reentry_for<3>(from, to, tangent, ticks, l, out);
-        case 4:
-            return reentry_for<4>(from, to, tangent, ticks, l, out);
-        case 5:
-            return reentry_for<5>(from, to, tangent, ticks, l, out);
-        case 6:
-            return reentry_for<6>(from, to, tangent, ticks, l, out);
-        case 7:
-            return reentry_for<7>(from, to, tangent, ticks, l, out);
-        case 8:
-            return reentry_for<8>(from, to, tangent, ticks, l, out);
-        default:
-            throw std::invalid_argument("1 to 8 axes");
     }
 }
 

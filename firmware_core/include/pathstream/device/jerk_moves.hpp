@@ -131,46 +131,6 @@ Status check_move(const JerkMove<Axes>& move, const TickAcceleration (&start)[Ax
     return Status::kOk;
 }
 
-/// A longer move may pass where this one failed.
-constexpr bool longer_may_pass(Status s) {
-    return s == Status::kAccelerationLimit || s == Status::kVelocityLimit || s == Status::kJerkLimit ||
-           s == Status::kAccelerationStep || s == Status::kDifferenceOutOfRange;
-}
-
-/// The smallest j in 1..jmax for which build(j, move) passes, by doubling from `first` (jmax
-/// itself tried last) and then bisection (a longer move eases every rule but rounding).
-/// kStopTooLong when none does.
-template <unsigned Axes, class Build>
-Status search(std::uint64_t first, std::uint64_t jmax, Build build, JerkMove<Axes>& out) {
-    std::uint64_t bad = 0, good = first < 1 ? 1 : first;
-    JerkMove<Axes> candidate;
-    Status s = Status::kStopTooLong;
-    for (;;) {
-        if (good > jmax) {
-            if (bad >= jmax) return Status::kStopTooLong;
-            good = jmax;  // the longest allowed, once, before giving up
-        }
-        s = build(good, candidate);
-        if (!longer_may_pass(s)) break;
-        if (good == jmax) return Status::kStopTooLong;
-        bad = good;
-        good *= 2;
-    }
-    if (s != Status::kOk) return s;
-    out = candidate;
-    while (good - bad > 1) {  // smallest passing j in (bad, good]
-        const std::uint64_t mid = bad + (good - bad) / 2;
-        if (build(mid, candidate) == Status::kOk) {
-            good = mid;
-            out = candidate;
-        } else {
-            bad = mid;
-        }
-    }
-    return Status::kOk;
-}
-
-
 /// `acceleration` moved towards 0 by up to nine tenths of one tick of jerk per axis (the rest
 /// is room for the rounding of the spans shaped from it): a step the join rule allows, so an
 /// axis whose jerk limit ramps faster than a whole tick can starts from (near) 0.
@@ -230,7 +190,7 @@ Status two_span_stop(const Lsb (&position)[Axes], const std::int32_t (&tangent)[
         const std::uint64_t need = stop_detail::ceil_div(per_a, static_cast<std::uint64_t>(ticks) * ticks);
         if (need > first) first = need;
     }
-    return search(first, kMaxSpanTicks / ticks, build, out);
+    return stop_detail::shortest_passing(first, kMaxSpanTicks / ticks, build, out);
 }
 
 /// plan_jerk_reentry's three spans onto the given acceleration (see there).
@@ -271,7 +231,7 @@ Status three_span_reentry(const Lsb (&from)[Axes], const Lsb (&to)[Axes], const 
         for (unsigned a = 0; a < Axes; ++a) rest[a] = TickAcceleration{};
         return check_move(move, rest, acceleration, limits);
     };
-    return search(1, kMaxSpanTicks / ticks, build, out);
+    return stop_detail::shortest_passing(1, kMaxSpanTicks / ticks, build, out);
 }
 
 /// One span of r ticks (1..kMaxSpanTicks) that takes the acceleration linearly to about 0 (the
@@ -331,6 +291,47 @@ Status acceleration_ramp(bool forward, const Lsb (&position)[Axes], const std::i
     return Status::kOk;
 }
 
+/// The fallbacks the stop and the re-entry share. `sequence(point, tangent, ticks, check,
+/// shape, move)` plans the spans between rest and the path's state at `point` (velocity
+/// tangent/ticks, acceleration `check`), shaped from `shape`. Tried: shaped from the
+/// acceleration itself; from it moved towards 0 (toward_zero); then with a ramp of the fewest
+/// power-of-two ticks that passes, first (`forward`: the stop) or last (the re-entry), the
+/// sequence planned from the ramp's other end.
+template <unsigned Axes, class Sequence>
+Status with_fallbacks(bool forward, const Lsb (&point)[Axes], const std::int32_t (&tangent)[Axes],
+                      std::uint32_t ticks, const TickAcceleration (&acceleration)[Axes],
+                      const MotionLimits<Axes>& limits, Sequence sequence, JerkMove<Axes>& out) {
+    const Status direct = sequence(point, tangent, ticks, acceleration, acceleration, out);
+    if (direct == Status::kOk || !(stop_detail::longer_may_pass(direct) || direct == Status::kStopTooLong)) {
+        return direct;
+    }
+    // Shaped from the acceleration less one tick of jerk's step towards 0 (all of it where the
+    // jerk limit ramps it faster than a whole tick can).
+    TickAcceleration shaped[Axes];
+    toward_zero(acceleration, limits, shaped);
+    if (sequence(point, tangent, ticks, acceleration, shaped, out) == Status::kOk) return Status::kOk;
+    JerkMove<Axes> part;
+    for (std::uint64_t r = 1; r <= kMaxSpanTicks; r *= 2) {
+        Span<Axes> ramp;
+        TickAcceleration other[Axes];
+        const Status s = acceleration_ramp(forward, point, tangent, ticks, r, acceleration, shaped, limits, ramp, other);
+        if (s != Status::kOk && !stop_detail::longer_may_pass(s)) return s;
+        if (s != Status::kOk) continue;
+        Lsb far[Axes];
+        std::int32_t far_tangent[Axes];
+        for (unsigned a = 0; a < Axes; ++a) {
+            far[a] = ramp.control[a][forward ? 1 : 0];
+            far_tangent[a] = ramp.control[a][forward ? 3 : 2];
+        }
+        if (sequence(far, far_tangent, ramp.ticks, other, other, part) != Status::kOk) continue;
+        for (unsigned i = 0; i < part.count; ++i) out.span[forward ? i + 1 : i] = part.span[i];
+        out.span[forward ? 0 : part.count] = ramp;
+        out.count = part.count + 1;
+        return Status::kOk;
+    }
+    return Status::kStopTooLong;
+}
+
 }  // namespace jerk_detail
 
 /// A controlled stop under a jerk limit, from `position` where the motion has velocity
@@ -354,39 +355,12 @@ template <unsigned Axes>
 [[nodiscard]] Status plan_jerk_stop(const Lsb (&position)[Axes], const std::int32_t (&tangent)[Axes],
                                     std::uint32_t ticks, const TickAcceleration (&acceleration)[Axes],
                                     const MotionLimits<Axes>& limits, JerkMove<Axes>& out) {
-    const Status direct = jerk_detail::two_span_stop(position, tangent, ticks, acceleration, acceleration, limits, out);
-    if (direct == Status::kOk || !(jerk_detail::longer_may_pass(direct) || direct == Status::kStopTooLong)) {
-        return direct;
-    }
-    // Shaped from the acceleration less one tick of jerk's step towards 0 (all of it where the
-    // jerk limit ramps it faster than a whole tick can).
-    TickAcceleration shaped[Axes];
-    jerk_detail::toward_zero(acceleration, limits, shaped);
-    if (jerk_detail::two_span_stop(position, tangent, ticks, acceleration, shaped, limits, out) == Status::kOk) {
-        return Status::kOk;
-    }
-    JerkMove<Axes> rest;
-    for (std::uint64_t r = 1; r <= kMaxSpanTicks; r *= 2) {
-        Span<Axes> ramp;
-        TickAcceleration end[Axes];
-        const Status s =
-            jerk_detail::acceleration_ramp(true, position, tangent, ticks, r, acceleration, shaped, limits, ramp, end);
-        if (s != Status::kOk && !jerk_detail::longer_may_pass(s)) return s;
-        if (s != Status::kOk) continue;
-        Lsb from[Axes];
-        std::int32_t ramp_tangent[Axes];
-        for (unsigned a = 0; a < Axes; ++a) {
-            from[a] = ramp.control[a][1];
-            ramp_tangent[a] = ramp.control[a][3];
-        }
-        if (jerk_detail::two_span_stop(from, ramp_tangent, ramp.ticks, end, end, limits, rest) != Status::kOk) continue;
-        out.span[0] = ramp;
-        out.span[1] = rest.span[0];
-        out.span[2] = rest.span[1];
-        out.count = 3;
-        return Status::kOk;
-    }
-    return Status::kStopTooLong;
+    const auto two_spans = [&](const Lsb (&at)[Axes], const std::int32_t (&t)[Axes], std::uint32_t n,
+                               const TickAcceleration (&check)[Axes], const TickAcceleration (&shape)[Axes],
+                               JerkMove<Axes>& move) {
+        return jerk_detail::two_span_stop(at, t, n, check, shape, limits, move);
+    };
+    return jerk_detail::with_fallbacks(true, position, tangent, ticks, acceleration, limits, two_spans, out);
 }
 
 /// The move from rest at `from` back to `to` under a jerk limit, arriving with velocity
@@ -409,38 +383,30 @@ template <unsigned Axes>
                                        const std::int32_t (&tangent)[Axes], std::uint32_t ticks,
                                        const TickAcceleration (&acceleration)[Axes],
                                        const MotionLimits<Axes>& limits, JerkMove<Axes>& out) {
-    const Status direct =
-        jerk_detail::three_span_reentry(from, to, tangent, ticks, acceleration, acceleration, limits, out);
-    if (direct == Status::kOk || !(jerk_detail::longer_may_pass(direct) || direct == Status::kStopTooLong)) {
-        return direct;
-    }
-    TickAcceleration shaped[Axes];  // as plan_jerk_stop's
+    const auto three_spans = [&](const Lsb (&at)[Axes], const std::int32_t (&t)[Axes], std::uint32_t n,
+                                 const TickAcceleration (&check)[Axes], const TickAcceleration (&shape)[Axes],
+                                 JerkMove<Axes>& move) {
+        return jerk_detail::three_span_reentry(from, at, t, n, check, shape, limits, move);
+    };
+    return jerk_detail::with_fallbacks(false, to, tangent, ticks, acceleration, limits, three_spans, out);
+}
+
+/// A pen-down approach under a jerk limit (a host's resume): one span of r ticks, the fewest of
+/// min_ticks, 2 min_ticks, 4 min_ticks .. that passes, ending at `to` with velocity
+/// tangent/ticks (rounded on r ticks) and acceleration `acceleration` and starting with about
+/// none (jerk_detail::acceleration_ramp, backward). `start`: its start acceleration exactly, for
+/// the re-entry onto it. Errors: kStopTooLong when none fits in kMaxSpanTicks. Task context.
+template <unsigned Axes>
+[[nodiscard]] Status plan_jerk_approach(const Lsb (&to)[Axes], const std::int32_t (&tangent)[Axes],
+                                        std::uint32_t ticks, const TickAcceleration (&acceleration)[Axes],
+                                        std::uint32_t min_ticks, const MotionLimits<Axes>& limits, Span<Axes>& out,
+                                        TickAcceleration (&start)[Axes]) {
+    TickAcceleration shaped[Axes];
     jerk_detail::toward_zero(acceleration, limits, shaped);
-    if (jerk_detail::three_span_reentry(from, to, tangent, ticks, acceleration, shaped, limits, out) == Status::kOk) {
-        return Status::kOk;
-    }
-    JerkMove<Axes> lead;
-    for (std::uint64_t r = 1; r <= kMaxSpanTicks; r *= 2) {
-        Span<Axes> ramp;
-        TickAcceleration start[Axes];
+    for (std::uint64_t r = min_ticks < 1 ? 1 : min_ticks; r <= kMaxSpanTicks; r *= 2) {
         const Status s =
-            jerk_detail::acceleration_ramp(false, to, tangent, ticks, r, acceleration, shaped, limits, ramp, start);
-        if (s != Status::kOk && !jerk_detail::longer_may_pass(s)) return s;
-        if (s != Status::kOk) continue;
-        Lsb ramp_start[Axes];
-        std::int32_t ramp_tangent[Axes];
-        for (unsigned a = 0; a < Axes; ++a) {
-            ramp_start[a] = ramp.control[a][0];
-            ramp_tangent[a] = ramp.control[a][2];
-        }
-        if (jerk_detail::three_span_reentry(from, ramp_start, ramp_tangent, ramp.ticks, start, start, limits, lead) !=
-            Status::kOk) {
-            continue;
-        }
-        for (unsigned i = 0; i < 3; ++i) out.span[i] = lead.span[i];
-        out.span[3] = ramp;
-        out.count = 4;
-        return Status::kOk;
+            jerk_detail::acceleration_ramp(false, to, tangent, ticks, r, acceleration, shaped, limits, out, start);
+        if (s == Status::kOk || !stop_detail::longer_may_pass(s)) return s;
     }
     return Status::kStopTooLong;
 }

@@ -32,6 +32,46 @@ constexpr std::uint64_t magnitude64(std::int64_t v) {
 
 constexpr std::uint64_t ceil_div(std::uint64_t a, std::uint64_t b) { return a / b + (a % b != 0 ? 1u : 0u); }
 
+/// A longer move may pass where this one failed: every limit eases with the length (rounding
+/// aside).
+constexpr bool longer_may_pass(Status s) {
+    return s == Status::kAccelerationLimit || s == Status::kVelocityLimit || s == Status::kJerkLimit ||
+           s == Status::kAccelerationStep || s == Status::kDifferenceOutOfRange;
+}
+
+/// The smallest multiple j in first..jmax for which build(j, candidate) passes, by doubling
+/// from `first` (jmax itself tried last) and then bisection; the passing candidate in `out`.
+/// kStopTooLong when none does, or build's status when it is not one a longer move may pass.
+template <class Candidate, class Build>
+Status shortest_passing(std::uint64_t first, std::uint64_t jmax, Build build, Candidate& out) {
+    std::uint64_t bad = 0, good = first < 1 ? 1 : first;
+    Candidate candidate;
+    Status s = Status::kStopTooLong;
+    for (;;) {
+        if (good > jmax) {
+            if (bad >= jmax) return Status::kStopTooLong;
+            good = jmax;
+        }
+        s = build(good, candidate);
+        if (!longer_may_pass(s)) break;
+        if (good == jmax) return Status::kStopTooLong;
+        bad = good;
+        good *= 2;
+    }
+    if (s != Status::kOk) return s;
+    out = candidate;
+    while (good - bad > 1) {  // smallest passing j in (bad, good]
+        const std::uint64_t mid = bad + (good - bad) / 2;
+        if (build(mid, candidate) == Status::kOk) {
+            good = mid;
+            out = candidate;
+        } else {
+            bad = mid;
+        }
+    }
+    return Status::kOk;
+}
+
 }  // namespace stop_detail
 
 /// Tries of the stop search beyond the first estimate (rounding of odd tangents can push the
@@ -175,27 +215,8 @@ template <unsigned Axes>
         }
         return stop_detail::check_span(s, limits);
     };
-    std::uint64_t bad = 0;  // largest j known to fail (0: none tried)
-    std::uint64_t good = 1;
-    Span<Axes> candidate;
-    Status s = build(good, candidate);
-    while (s == Status::kAccelerationLimit || s == Status::kVelocityLimit || s == Status::kDifferenceOutOfRange) {
-        bad = good;
-        good *= 2;
-        s = build(good, candidate);
-    }
-    if (s != Status::kOk) return s;
-    out = candidate;
-    while (good - bad > 1) {  // smallest passing j in (bad, good]
-        const std::uint64_t mid = bad + (good - bad) / 2;
-        if (build(mid, candidate) == Status::kOk) {
-            good = mid;
-            out = candidate;
-        } else {
-            bad = mid;
-        }
-    }
-    return Status::kOk;
+    // build refuses j * ticks > kMaxSpanTicks, so jmax = kMaxSpanTicks bounds nothing it accepts.
+    return stop_detail::shortest_passing(1, kMaxSpanTicks, build, out);
 }
 
 }  // namespace pathstream::device

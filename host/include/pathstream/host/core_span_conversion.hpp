@@ -26,6 +26,22 @@ Span<Axes> to_core_span(const CoreSpan& in, std::uint32_t tag) {
     return s;
 }
 
+/// The host's form of a span the core made (a device move: stop, re-entry), for `subpath`, pen
+/// down or up; its timing and cubics are left for the caller to fill.
+template <unsigned Axes>
+CoreSpan from_core_span(const Span<Axes>& in, std::size_t subpath, bool pen_down) {
+    CoreSpan c;
+    c.basis = in.basis;
+    c.ticks = in.ticks;
+    c.subpath = subpath;
+    c.pen_down = pen_down;
+    c.control.assign(Axes, {});
+    for (unsigned a = 0; a < Axes; ++a) {
+        for (unsigned i = 0; i < 4; ++i) c.control[a][i] = in.control[a][i];
+    }
+    return c;
+}
+
 /// Calls `f(std::integral_constant<unsigned, A>{})` with A = `axes` (1..8) and returns its
 /// result. Throws std::invalid_argument for any other axis count.
 template <typename F>
