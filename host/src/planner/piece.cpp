@@ -72,7 +72,10 @@ PieceMotion plan_piece(WindowLookahead& la, const Piece& piece, const Vec& start
         if (f > site_end) retry = 0;
         const double fail_speed2 = motion.fail_speed * motion.fail_speed;
         const std::size_t w = static_cast<std::size_t>(retry / 2 + 1);
-        const bool whole = retry >= options.max_local_retries / 2;
+        // The whole piece is lowered only by the last two retries: a long piece without stops
+        // (a polyline spiral is one) would otherwise cruise slower everywhere for one stubborn
+        // corner, where more local retries succeed.
+        const bool whole = retry >= options.max_local_retries - 2;
         const std::size_t from = whole ? piece.first : std::max(piece.first, f > 2 * w ? f - 2 * w : 0);
         std::size_t to = whole ? piece.last : std::min(piece.last, f + 8 * w);
         while (to < piece.last && g.lambda[to] <= motion.fail_lambda + motion.fail_speed * la.span_time) ++to;
