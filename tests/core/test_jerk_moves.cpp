@@ -169,6 +169,67 @@ TEST_CASE("plan_jerk_stop: two spans to rest (three with a ramp), every join wit
     CHECK(planned >= plain * 80 / 100);
 }
 
+TEST_CASE("check_move_ends refuses exactly what the validated cubics' end accelerations, jerks and joins refuse",
+          "[device][jerk][stop]") {
+    // Stops planned from random states, checked against their limits scaled by 0.5 to 1.5
+    // (jerk) and 0.8 to 1.2 (acceleration), some with one end tangent moved by a few LSB: the
+    // reference reads every rule off the core's exact cubic (start_acceleration,
+    // end_acceleration, check_axis_jerk, check_acceleration_step), check_move_ends off the
+    // integer Hermite values; their verdicts must agree.
+    std::mt19937_64 rng(test::property_seed());
+    const auto real = [&](double lo, double hi) { return std::uniform_real_distribution<double>(lo, hi)(rng); };
+    int passed = 0, refused = 0;
+    for (int c = 0; c < 3000; ++c) {
+        const Case k = random_case(rng);
+        JerkMove<kAxes> move;
+        if (plan_jerk_stop(k.position, k.tangent, k.ticks, k.acceleration, k.limits, move) != Status::kOk) continue;
+        if (real(0, 1) < 0.3) {
+            Span<kAxes>& s = move.span[static_cast<unsigned>(real(0, move.count - 0.01))];
+            s.control[static_cast<unsigned>(real(0, kAxes - 0.01))][3] += static_cast<std::int32_t>(real(-4, 4));
+        }
+        MotionLimits<kAxes> limits = k.limits;
+        for (unsigned a = 0; a < kAxes; ++a) {
+            AxisLimits& l = limits.axis[a];
+            l.max_acceleration = static_cast<std::uint32_t>(std::clamp(l.max_acceleration * real(0.8, 1.2), 1.0, 4e9));
+            l.max_jerk = static_cast<std::uint32_t>(std::clamp(l.max_jerk * real(0.5, 1.5), 1.0, 4e9));
+        }
+        Status reference = Status::kOk;
+        TickAcceleration previous[kAxes] = {k.acceleration[0], k.acceleration[1]};
+        for (unsigned i = 0; i < move.count && reference == Status::kOk; ++i) {
+            ValidatedSpan<kAxes> v;
+            if (validate_span(move.span[i], v) != Status::kOk) {
+                reference = Status::kControlValueOutOfRange;
+                break;
+            }
+            for (unsigned a = 0; a < kAxes && reference == Status::kOk; ++a) {
+                const AxisLimits& l = limits.axis[a];
+                const TickAcceleration e0 = start_acceleration(v.cubic[a], v.timing);
+                const TickAcceleration e1 = end_acceleration(v.cubic[a], v.timing);
+                const unsigned __int128 hz2 = static_cast<unsigned __int128>(limits.tick_hz) * limits.tick_hz;
+                for (const TickAcceleration& e : {e0, e1}) {
+                    const auto magnitude = static_cast<unsigned __int128>(e.numerator < 0 ? -e.numerator : e.numerator);
+                    if (magnitude * hz2 > static_cast<unsigned __int128>(l.max_acceleration) * e.denominator) {
+                        reference = Status::kAccelerationLimit;
+                    }
+                }
+                if (reference == Status::kOk) reference = check_axis_jerk(v.cubic[a], v.timing, l, limits.tick_hz);
+                if (reference == Status::kOk) reference = check_acceleration_step(e0, previous[a], l, limits.tick_hz);
+                previous[a] = e1;
+            }
+        }
+        for (unsigned a = 0; a < kAxes && reference == Status::kOk; ++a) {
+            reference = check_end_at_rest(previous[a], limits.axis[a], limits.tick_hz);
+        }
+        if (reference == Status::kControlValueOutOfRange) continue;
+        const Status quick = jerk_detail::check_move_ends(move, k.acceleration, nullptr, limits);
+        INFO("case " << c);
+        CHECK((quick == Status::kOk) == (reference == Status::kOk));
+        (quick == Status::kOk ? passed : refused) += 1;
+    }
+    CHECK(passed > 200);
+    CHECK(refused > 200);
+}
+
 TEST_CASE("plan_jerk_stop refuses a stop longer than kMaxSpanTicks", "[device][jerk][stop]") {
     MotionLimits<kAxes> l;
     l.tick_hz = 1000;

@@ -6,11 +6,15 @@
 //                   --nm arm-none-eabi-nm --board mps2-an386 --label "Cortex-M4"
 //                   --image budget.elf [--budget 20]
 //                   [--assert narrow:1=22,2=20,3=20,4=20,8=20] [--assert binary:...]
-//                   [--assert-marginal] [--no-legend] [--timeout 60] [--keep DIR]
+//                   [--assert-marginal] [--assert-stop plain=4480,jerk=40355]
+//                   [--no-legend] [--timeout 60] [--keep DIR]
 //
 // --assert KIND:A=LIMIT,...: for spans of that kind (narrow, binary, wide) and each listed axis
 // count A, tick() per axis per setpoint must be <= LIMIT. The limit is the budget where the
 // budget holds and the best figure reached where it does not, so that any regression fails.
+// --assert-stop plain=MAX,jerk=MAX: the most instructions one call of plan_stop (plain) or
+// plan_jerk_stop (jerk) may execute over the image's seeded states (the best figure reached,
+// like the tick limits: a regression fails).
 //
 // Method (docs/cortex-m.md): the address ranges of budget_tick_<A> (SetpointStream::tick
 // inlined into an out-of-line function), SetpointStream<A,16>::tick_slow (span start, wide
@@ -49,6 +53,7 @@ struct Options {
     std::optional<double> budget;
     std::map<std::string, std::map<unsigned, double>> limits;  // kind -> axes -> max per axis
     bool assert_marginal = false;
+    std::map<std::string, double> stop_limits;  // plain_stop / jerk_stop -> max per call
     bool legend = true;
     int timeout = 60;
 };
@@ -192,6 +197,15 @@ Options parse_options(int argc, char** argv) {
                 if (eq == std::string::npos) die("--assert wants KIND:A=LIMIT,...: " + spec);
                 limits[static_cast<unsigned>(std::stoul(item.substr(0, eq)))] =
                     std::stod(item.substr(eq + 1));
+            }
+        } else if (arg == "--assert-stop") {
+            const std::string spec = value();
+            std::istringstream in(spec);
+            for (std::string item; std::getline(in, item, ',');) {
+                const auto eq = item.find('=');
+                const std::string kind = eq == std::string::npos ? "" : item.substr(0, eq);
+                if (kind != "plain" && kind != "jerk") die("--assert-stop wants plain=MAX,jerk=MAX: " + spec);
+                o.stop_limits[kind + "_stop"] = std::stod(item.substr(eq + 1));
             }
         } else die("unknown argument " + arg);
     }
@@ -462,7 +476,17 @@ int main(int argc, char** argv) {
         std::cout << (std::string(kind) == "jerk_stop" ? "plan_jerk_stop" : "plan_stop") << "<" << axes
                   << ">, the controlled stop planned in the tick that takes a hold (" << count
                   << " seeded states): " << fmt(sum / static_cast<double>(count), 0) << " instructions per call on"
-                  << " average, " << fmt(most, 0) << " at most\n";
+                  << " average, " << fmt(most, 0) << " at most";
+        if (const auto limit = o.stop_limits.find(kind); limit != o.stop_limits.end()) {
+            std::cout << " (asserted <= " << fmt(limit->second, 0) << ")";
+            if (most > limit->second) {
+                std::cout << "\n";
+                fail(std::string(kind) + ": " + fmt(most, 0) + " instructions in one call, over " +
+                     fmt(limit->second, 0));
+                continue;
+            }
+        }
+        std::cout << "\n";
     }
     // The whole device: phases (n, S) and (2n, S) of the same axis count; their difference is
     // S n steady ticks of MotionDevice::tick and the driver loop's check per tick.

@@ -100,12 +100,64 @@ bool set_axis(Span<Axes>& s, unsigned axis, std::int64_t p0, std::int64_t chord,
     return true;
 }
 
+/// The rules of check_move that need only each span's end accelerations, read off its integer
+/// Hermite values ((6C - 4T0 - 2T1) / n^2 and (-6C + 2T0 + 4T1) / n^2, exactly the cubic's):
+/// both ends within the acceleration limit, the jerk inside the span, every join. A necessary
+/// condition of check_move at a fraction of its cost (a few 128-bit products per span and
+/// axis, no span validation), so the searches reject most lengths without validating.
+template <unsigned Axes>
+Status check_move_ends(const JerkMove<Axes>& move, const TickAcceleration (&start)[Axes], const TickAcceleration* end,
+                       const MotionLimits<Axes>& limits) {
+    const std::uint64_t hz = limits.tick_hz;
+    TickAcceleration previous[Axes];
+    for (unsigned a = 0; a < Axes; ++a) previous[a] = start[a];
+    for (unsigned i = 0; i < move.count; ++i) {
+        const Span<Axes>& s = move.span[i];
+        const std::uint64_t n = s.ticks, n2 = n * n;
+        for (unsigned a = 0; a < Axes; ++a) {
+            const AxisLimits& l = limits.axis[a];
+            // |6C| < 2^34, |4T0 + 2T1| < 2^34: each numerator < 2^35, over n^2 < 2^33.
+            const std::int64_t chord = static_cast<std::int64_t>(s.control[a][1]) - s.control[a][0];
+            const std::int64_t t0 = s.control[a][2], t1 = s.control[a][3];
+            const TickAcceleration at_start{6 * chord - 4 * t0 - 2 * t1, n2};
+            const TickAcceleration at_end{-6 * chord + 2 * t0 + 4 * t1, n2};
+            // |N| hz^2 <= A n^2 at both ends (< 2^35 2^34 against < 2^32 2^33).
+            const Int128 bound = multiply_unsigned(l.max_acceleration, n2);
+            const TickAcceleration ends[2] = {at_start, at_end};
+            for (const TickAcceleration& e : ends) {
+                if (bound < multiply_unsigned(stop_detail::magnitude64(e.numerator), hz * hz)) {
+                    return Status::kAccelerationLimit;
+                }
+            }
+            // Jerk (end - start) / n^3: |end - start| hz^3 (< 2^36 2^51) <= J n^3 (< 2^39 2^48).
+            if (l.max_jerk != 0 &&
+                multiply_unsigned(static_cast<std::uint64_t>(l.max_jerk) * kJerkUnitLsb, n2) *
+                        static_cast<std::int64_t>(n) <
+                    multiply_unsigned(stop_detail::magnitude64(at_end.numerator - at_start.numerator), hz * hz * hz)) {
+                return Status::kJerkLimit;
+            }
+            if (Status st = check_acceleration_step(at_start, previous[a], l, limits.tick_hz); st != Status::kOk) {
+                return st;
+            }
+            previous[a] = at_end;
+        }
+    }
+    for (unsigned a = 0; a < Axes; ++a) {
+        const Status st = end == nullptr ? check_end_at_rest(previous[a], limits.axis[a], limits.tick_hz)
+                                         : check_acceleration_step(end[a], previous[a], limits.axis[a], limits.tick_hz);
+        if (st != Status::kOk) return st;
+    }
+    return Status::kOk;
+}
+
 /// Every span of `move` within the velocity, acceleration and jerk limits, and every join
 /// within one tick of jerk: the first span's start against `start`, the last span's end
-/// against `end` (nullptr: rest). The status of the first rule broken.
+/// against `end` (nullptr: rest). The status of the first rule broken (the end-acceleration
+/// rules of check_move_ends first, then the spans validated and checked whole).
 template <unsigned Axes>
 Status check_move(const JerkMove<Axes>& move, const TickAcceleration (&start)[Axes], const TickAcceleration* end,
                   const MotionLimits<Axes>& limits) {
+    if (Status s = check_move_ends(move, start, end, limits); s != Status::kOk) return s;
     TickAcceleration previous[Axes];
     for (unsigned a = 0; a < Axes; ++a) previous[a] = start[a];
     for (unsigned i = 0; i < move.count; ++i) {
