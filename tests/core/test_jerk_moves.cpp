@@ -163,10 +163,11 @@ TEST_CASE("plan_jerk_stop: two spans to rest (three with a ramp), every join wit
     }
     // Where the axes' jerk limits differ widely in LSB, one axis's whole-tick rounding can ask
     // for spans long enough to carry another past its velocity limit: no jerk-limited stop of
-    // this form exists, and the device falls back to plan_stop. With seed 20261122: 1,328 of
-    // 1,569 states (85 %), 219 of them with a ramp first.
+    // this form exists, and the device falls back to plan_stop. With seed 20261122: 1,380 of
+    // 1,569 states (88 %; 1,328 before a ramp could end an axis that is speeding up
+    // decelerating), 271 of them with a ramp first.
     INFO(planned << " planned, " << ramps << " with a ramp first, of " << plain);
-    CHECK(planned >= plain * 80 / 100);
+    CHECK(planned >= plain * 85 / 100);
 }
 
 TEST_CASE("check_move_ends refuses exactly what the validated cubics' end accelerations, jerks and joins refuse",

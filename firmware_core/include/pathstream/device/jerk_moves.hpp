@@ -203,6 +203,32 @@ void toward_zero(const TickAcceleration (&acceleration)[Axes], const MotionLimit
     }
 }
 
+/// The end acceleration (numerator over shape.denominator) of the stop's ramp of r ticks on one
+/// axis: where `shape` points along the velocity tangent/ticks (speeding up), shape less
+/// 0.9 J r against the velocity, but no further than 0.9 of the acceleration limit that way;
+/// else 0 (the ramp takes the acceleration to 0). Cost: a few 128-bit products and divisions.
+inline std::int64_t ramp_end(const TickAcceleration& shape, std::int32_t tangent, std::uint64_t r,
+                             const AxisLimits& limits, std::uint32_t tick_hz) {
+    const std::int64_t n = shape.numerator;
+    if (tangent == 0 || limits.max_jerk == 0 || (n > 0) != (tangent > 0) || n == 0) return 0;
+    const std::uint64_t q = shape.denominator, hz = tick_hz;
+    // 0.9 J r Q = 9 max_jerk 100 r Q / (10 hz^3): below 2^32 2^10 2^16 2^35; 0.9 A Q =
+    // 9 max_acceleration Q / (10 hz^2): below 2^36 2^35.
+    const FloorDivision ramp =
+        floor_divide(multiply_unsigned(static_cast<std::uint64_t>(limits.max_jerk) * 900u * r, q), 10 * hz * hz * hz);
+    const FloorDivision floor =
+        floor_divide(multiply_unsigned(static_cast<std::uint64_t>(limits.max_acceleration) * 9u, q), 10 * hz * hz);
+    // |N| < 2^36 for accelerations within any limit: a cap beyond 2^40 changes nothing.
+    constexpr std::uint64_t kNoCap = std::uint64_t{1} << 40;
+    const std::uint64_t mag = stop_detail::magnitude64(n);
+    const std::uint64_t cap = floor.quotient.hi != 0 || floor.quotient.lo > kNoCap ? kNoCap : floor.quotient.lo;
+    // Along the velocity: mag - ramp, at least -cap.
+    const bool past = ramp.quotient.hi != 0 || ramp.quotient.lo >= mag + cap;
+    const std::int64_t along = past ? -static_cast<std::int64_t>(cap)
+                                    : static_cast<std::int64_t>(mag) - static_cast<std::int64_t>(ramp.quotient.lo);
+    return n > 0 ? along : -along;
+}
+
 /// plan_jerk_stop's two spans from the given acceleration (see there).
 /// `shape`: the acceleration the spans are shaped from (`acceleration` itself, or 0 where the
 /// step from it to 0 is within one tick of jerk); the joins are checked against `acceleration`.
@@ -297,7 +323,7 @@ template <unsigned Axes>
 Status acceleration_ramp(bool forward, const Lsb (&position)[Axes], const std::int32_t (&tangent)[Axes],
                          std::uint32_t ticks, std::uint64_t r, const TickAcceleration (&acceleration)[Axes],
                          const TickAcceleration (&shape)[Axes], const MotionLimits<Axes>& limits, Span<Axes>& ramp,
-                         TickAcceleration (&other)[Axes]) {
+                         TickAcceleration (&other)[Axes], bool decelerate = false) {
     if (r > kMaxSpanTicks) return Status::kStopTooLong;
     ramp = Span<Axes>{};
     ramp.basis = Basis::kHermite;
@@ -308,12 +334,18 @@ Status acceleration_ramp(bool forward, const Lsb (&position)[Axes], const std::i
             return Status::kStopTooLong;
         }
         const std::uint64_t q = shape[a].denominator;
+        // `decelerate`: a stop's ramp ends an axis that is speeding up decelerating instead of
+        // at 0 (ramp_end): ramped only to 0, such an axis keeps speeding up for the whole ramp,
+        // whose length the axis with the slowest ramp sets, and can pass its velocity limit.
+        const std::int64_t e =
+            forward && decelerate ? ramp_end(shape[a], tangent[a], r, limits.axis[a], limits.tick_hz) : 0;
         const Int128 nr2 = Int128::from(shape[a].numerator) * static_cast<std::int64_t>(r * r);
-        // Forward: S = T + A r^2 / 2, chord (A r^2 + 4 T + 2 S) / 6. Backward: T0 = T - A r^2 / 2,
-        // chord (2 T0 + T) / 3.
+        const Int128 er2 = Int128::from(e) * static_cast<std::int64_t>(r * r);
+        // Forward: S = T + (A + E) r^2 / 2 (E the end acceleration), chord (A r^2 + 4 T + 2 S) / 6
+        // (= T + (2 A + E) r^2 / 6). Backward: T0 = T - A r^2 / 2, chord (2 T0 + T) / 3.
         const Int128 tq = Int128::from(2 * t) * static_cast<std::int64_t>(q);
         std::int64_t s = 0, chord = 0;
-        if (!round_quotient(forward ? tq + nr2 : tq - nr2, 2 * q, kMaxTangentLsb, s)) return Status::kStopTooLong;
+        if (!round_quotient(forward ? tq + nr2 + er2 : tq - nr2, 2 * q, kMaxTangentLsb, s)) return Status::kStopTooLong;
         const Int128 chord6 = forward ? nr2 + Int128::from(4 * t + 2 * s) * static_cast<std::int64_t>(q)
                                       : Int128::from(2 * (2 * s + t)) * static_cast<std::int64_t>(q);
         if (!round_quotient(chord6, 6 * q, kMaxTangentLsb, chord)) return Status::kStopTooLong;
@@ -363,23 +395,28 @@ Status with_fallbacks(bool forward, const Lsb (&point)[Axes], const std::int32_t
     toward_zero(acceleration, limits, shaped);
     if (sequence(point, tangent, ticks, acceleration, shaped, out) == Status::kOk) return Status::kOk;
     JerkMove<Axes> part;
+    // A stop's ramp of each length takes the acceleration to 0 first, then (where that fails)
+    // takes the axes that are speeding up on to decelerating (acceleration_ramp's `decelerate`).
     for (std::uint64_t r = 1; r <= kMaxSpanTicks; r *= 2) {
-        Span<Axes> ramp;
-        TickAcceleration other[Axes];
-        const Status s = acceleration_ramp(forward, point, tangent, ticks, r, acceleration, shaped, limits, ramp, other);
-        if (s != Status::kOk && !stop_detail::longer_may_pass(s)) return s;
-        if (s != Status::kOk) continue;
-        Lsb far[Axes];
-        std::int32_t far_tangent[Axes];
-        for (unsigned a = 0; a < Axes; ++a) {
-            far[a] = ramp.control[a][forward ? 1 : 0];
-            far_tangent[a] = ramp.control[a][forward ? 3 : 2];
+        for (int variant = 0; variant < (forward ? 2 : 1); ++variant) {
+            Span<Axes> ramp;
+            TickAcceleration other[Axes];
+            const Status s =
+                acceleration_ramp(forward, point, tangent, ticks, r, acceleration, shaped, limits, ramp, other, variant == 1);
+            if (s != Status::kOk && variant == 0 && !stop_detail::longer_may_pass(s)) return s;
+            if (s != Status::kOk) continue;
+            Lsb far[Axes];
+            std::int32_t far_tangent[Axes];
+            for (unsigned a = 0; a < Axes; ++a) {
+                far[a] = ramp.control[a][forward ? 1 : 0];
+                far_tangent[a] = ramp.control[a][forward ? 3 : 2];
+            }
+            if (sequence(far, far_tangent, ramp.ticks, other, other, part) != Status::kOk) continue;
+            for (unsigned i = 0; i < part.count; ++i) out.span[forward ? i + 1 : i] = part.span[i];
+            out.span[forward ? 0 : part.count] = ramp;
+            out.count = part.count + 1;
+            return Status::kOk;
         }
-        if (sequence(far, far_tangent, ramp.ticks, other, other, part) != Status::kOk) continue;
-        for (unsigned i = 0; i < part.count; ++i) out.span[forward ? i + 1 : i] = part.span[i];
-        out.span[forward ? 0 : part.count] = ramp;
-        out.count = part.count + 1;
-        return Status::kOk;
     }
     return Status::kStopTooLong;
 }
