@@ -4,13 +4,15 @@
 // wire spans (accept_batch, checked like a host's), each move one job (its last span marks the job end, so the
 // device idles at the move's end by itself), stops the device with a command when the switch
 // is seen, and finally redefines the position with set_position. Every move is a rest-to-rest
-// trapezoid of constant- acceleration Hermite spans (cubic term exactly zero), so the device's
-// exact limit check passes them like any planned span; integer math only (docs/gpio.md).
+// trapezoid of constant-acceleration Hermite spans (cubic term exactly zero), or under a jerk
+// limit an S-curve of exact cubics (s_curve_ramp.hpp), so the device's exact limit check
+// passes them like any planned span; integer math only (docs/gpio.md).
 #pragma once
 
 #include <cstdint>
 
 #include "pathstream/device/motion_device.hpp"
+#include "pathstream/device/s_curve_ramp.hpp"
 #include "pathstream/device/stop_spans.hpp"
 
 namespace pathstream::device {
@@ -70,9 +72,12 @@ struct HomingReport {
     HomingError error = HomingError::kNone;
 };
 
-/// A rest-to-rest move of one axis as constant-acceleration spans: ramp up, cruise, ramp down,
-/// and (for the remainder the ramps cannot cover exactly) one short rest-to-rest creep span.
-/// Tangents are even, so every span's end point is an exact integer. Freestanding, no heap.
+/// A rest-to-rest move of one axis: ramp up, cruise, ramp down, and (for the remainder the
+/// ramps cannot cover exactly) one short rest-to-rest creep span. Without a jerk limit the
+/// ramps are constant-acceleration spans (even tangents, so every end point is an exact
+/// integer); under one, S-curves (SCurveRamp: the acceleration ramped at up to the jerk limit
+/// to up to the axis's acceleration limit, continuous at every knot, exact integers too).
+/// Freestanding, no heap.
 template <unsigned Axes>
 class AxisMove {
 public:
@@ -94,6 +99,13 @@ public:
         index_ = 0;
         const std::uint64_t hz = limits.tick_hz;
         if (hz == 0) return Status::kBadLimits;
+        s_curve_ = false;
+        if (limits.axis[axis].max_jerk != 0) {
+            creep_limits(limits);
+            if (const Status st = plan_s_curve(start, velocity, limits); st != Status::kBadLimits) return st;
+            // No S-curve span length fits these limits: the constant-acceleration ramps below.
+            limits_ = limits;
+        }
         // Under a jerk limit J the move accelerates at most at J/2 * 1 tick: every join then
         // steps the acceleration by at most one tick of jerk (ramp to ramp, rest to ramp, ramp
         // up to ramp down, the last ramp to the creep span), and the spans carry no jerk.
@@ -170,6 +182,30 @@ public:
         const std::int64_t ramps = ramp_spans_;
         std::int64_t t0 = 0, t1 = 0;
         w.ticks = n_;
+        if (s_curve_ && i < 2 * ramps + cruise_spans_) {
+            std::int64_t chord = cruise_;
+            t0 = t1 = cruise_;
+            if (i < ramps) {  // up: knot k = i to k + 1, T walking up from 0
+                const auto k = static_cast<std::uint32_t>(i);
+                const std::int64_t a0 = ramp_.at(k), a1 = ramp_.at(k + 1);
+                t0 = walk_;
+                t1 = walk_ + (a0 + a1) / 2;
+                chord = t0 + (2 * a0 + a1) / 6;
+                walk_ = t1;
+            } else if (i >= ramps + cruise_spans_) {  // down: the up span k played backwards
+                const auto k = static_cast<std::uint32_t>(2 * ramps + cruise_spans_ - 1 - i);
+                const std::int64_t a0 = ramp_.at(k), a1 = ramp_.at(k + 1);
+                if (i == ramps + cruise_spans_) walk_ = cruise_;
+                t0 = walk_;
+                t1 = walk_ - (a0 + a1) / 2;
+                chord = t1 + (2 * a0 + a1) / 6;
+                walk_ = t1;
+            }
+            at_[axis_] = static_cast<Lsb>(at_[axis_] + sign_ * chord);
+            fill(w, static_cast<std::int32_t>(sign_ * t0), static_cast<std::int32_t>(sign_ * t1));
+            ++index_;
+            return true;
+        }
         if (i < ramps) {
             t0 = ramp_tangent(static_cast<std::uint32_t>(i));
             t1 = ramp_tangent(static_cast<std::uint32_t>(i + 1));
@@ -206,6 +242,158 @@ private:
     }
 
     std::int64_t total_spans() const { return 2 * static_cast<std::int64_t>(ramp_spans_) + cruise_spans_ + (creep_ != 0 ? 1 : 0); }
+
+    // Spans an S-curve ramp may have (a slower cruise is planned where it would need more).
+    static constexpr std::uint32_t kMaxRampSpans = 1024;
+
+    // The distance of `ramp` planned for `cruise` (its spans' chords summed), or -1 when it has
+    // more spans than kMaxRampSpans or the move's distance (its chords average at least 1).
+    std::int64_t ramp_distance(std::int64_t cruise, SCurveRamp& ramp) const {
+        ramp.plan(cruise);
+        if (ramp.spans > kMaxRampSpans || static_cast<std::int64_t>(ramp.spans) > remaining_) return -1;
+        std::int64_t t = 0, distance = 0;
+        for (std::uint32_t k = 0; k < ramp.spans; ++k) {
+            const std::int64_t a0 = ramp.at(k), a1 = ramp.at(k + 1);
+            distance += t + (2 * a0 + a1) / 6;
+            t += (a0 + a1) / 2;
+        }
+        return distance;
+    }
+
+    // Ticks a creep span of `rest` LSB needs at J/2 * 1 tick of acceleration (its ends' 6 rest /
+    // m^2 <= J / 2: m >= sqrt(12 rest hz^3 / J)), rounded up to the lengths creep_length tries,
+    // the other limits aside: an estimate for choosing the cruise.
+    std::uint64_t creep_estimate(std::uint64_t rest, const MotionLimits<Axes>& limits) const {
+        if (rest == 0) return 0;
+        const std::uint64_t hz = limits.tick_hz;
+        // 12 rest hz^3 (< 2^35 2^51) over J (>= 100).
+        const FloorDivision q = floor_divide(multiply_unsigned(12 * rest, hz * hz * hz),
+                                             std::uint64_t{limits.axis[axis_].max_jerk} * kJerkUnitLsb);
+        if (q.quotient.hi != 0) return std::uint64_t{1} << 32;
+        std::uint64_t x = q.quotient.lo, root = 0, bit = std::uint64_t{1} << 62;
+        while (bit > x) bit >>= 2;
+        for (; bit != 0; bit >>= 2) {  // digit by digit
+            if (x >= root + bit) {
+                x -= root + bit;
+                root = (root >> 1) + bit;
+            } else {
+                root >>= 1;
+            }
+        }
+        // creep_length tries n, 2n, 4n .. ticks.
+        std::uint64_t ticks = n_;
+        while (ticks <= root && ticks < kMaxSpanTicks) ticks *= 2;
+        return ticks;
+    }
+
+    // The creep span's limits under a jerk limit J: its acceleration at most J/2 * 1 tick, so
+    // that it steps the acceleration from and to rest by at most one tick of jerk.
+    void creep_limits(const MotionLimits<Axes>& limits) {
+        const std::uint64_t by_jerk =
+            static_cast<std::uint64_t>(limits.axis[axis_].max_jerk) * kJerkUnitLsb / (2 * std::uint64_t{limits.tick_hz});
+        if (by_jerk < limits_.axis[axis_].max_acceleration) {
+            limits_.axis[axis_].max_acceleration = static_cast<std::uint32_t>(by_jerk);
+        }
+    }
+
+    // The S-curve move (SCurveRamp) on limits with a jerk limit on the axis: spans of n ticks,
+    // the shortest power of two (from 8) on which the jerk and the acceleration limits give
+    // steps of at least 6 in span units (J n^3 >= 6, A n^2 >= 6); the cruise tangent a multiple
+    // of 6, halved until both ramps fit the distance (else the creep span alone). kBadLimits
+    // (and the constant-acceleration move is planned instead) when no span length fits, the
+    // cruise cannot be slow enough, or the creep span fits at no length.
+    Status plan_s_curve(const Lsb (&start)[Axes], std::uint32_t velocity, const MotionLimits<Axes>& limits) {
+        const AxisLimits& l = limits.axis[axis_];
+        const std::uint64_t hz = limits.tick_hz;
+        std::uint32_t n = 8;
+        std::int64_t step = 0, peak = 0;
+        for (;; n *= 2) {
+            if (n > kMaxSpanTicks / 2) return Status::kBadLimits;
+            // J n^3 = max_jerk 100 n^3 / hz^3 (< 2^39 2^45 over > 2^0); A n^2 = max_acceleration n^2 / hz^2.
+            const std::uint64_t n3 = std::uint64_t{n} * n * n;
+            const FloorDivision j = floor_divide(multiply_unsigned(std::uint64_t{l.max_jerk} * kJerkUnitLsb, n3), 6 * hz * hz * hz);
+            const FloorDivision a = floor_divide(multiply_unsigned(l.max_acceleration, std::uint64_t{n} * n), 6 * hz * hz);
+            constexpr std::uint64_t kLarge = std::uint64_t{1} << 40;  // beyond any tangent's reach
+            const std::uint64_t js = j.quotient.hi != 0 || j.quotient.lo > kLarge ? kLarge : j.quotient.lo;
+            const std::uint64_t as = a.quotient.hi != 0 || a.quotient.lo > kLarge ? kLarge : a.quotient.lo;
+            if (js >= 1 && as >= 1) {
+                step = 6 * static_cast<std::int64_t>(js);
+                peak = 6 * static_cast<std::int64_t>(as);
+                break;
+            }
+        }
+        if (step > peak) step = peak;
+        n_ = n;
+        ramp_.step = step;
+        ramp_.peak = peak;
+        if (velocity > l.max_velocity) velocity = l.max_velocity;
+        std::int64_t cruise = static_cast<std::int64_t>(std::uint64_t{velocity} * n / hz / 6 * 6);
+        if (cruise < 6) cruise = 6;
+        if (static_cast<std::uint64_t>(cruise) * hz > std::uint64_t{l.max_velocity} * n) return Status::kBadLimits;
+        // The fastest cruise whose two ramps fit the distance (a ramp's distance grows with its
+        // cruise: bisection over the multiples of 6), then, within 1/8 of it, the one whose move
+        // takes the fewest ticks with the creep span's estimated (at most 16 tries): the creep
+        // starts and ends at rest at J/2 * 1 tick of acceleration, slow for a long remainder.
+        // Bounded work for any limits: at most 47 ramps of at most kMaxRampSpans spans summed.
+        const auto fitting = [&](std::int64_t units, SCurveRamp& ramp) -> std::int64_t {
+            ramp = ramp_;
+            const std::int64_t d = ramp_distance(6 * units, ramp);
+            return d >= 0 && 2 * d <= remaining_ ? d : -1;
+        };
+        SCurveRamp ramp = ramp_;
+        std::int64_t top = cruise / 6;
+        std::int64_t distance = fitting(1, ramp);
+        if (distance < 0) {
+            top = 0;  // not even the slowest ramps fit: the creep span alone
+        } else {
+            std::int64_t low = 1;
+            while (low < top) {
+                const std::int64_t mid = low + (top - low + 1) / 2;
+                if (fitting(mid, ramp) >= 0) {
+                    low = mid;
+                } else {
+                    top = mid - 1;
+                }
+            }
+            std::uint64_t best = ~std::uint64_t{0};
+            for (std::int64_t units = top, tries = 0; units >= 1 && units >= top - top / 8 && tries < 16;
+                 --units, ++tries) {
+                const std::int64_t d = fitting(units, ramp);
+                if (d < 0) continue;
+                const std::int64_t middle = remaining_ - 2 * d;
+                const std::uint64_t ticks =
+                    (2 * std::uint64_t{ramp.spans} + static_cast<std::uint64_t>(middle / (6 * units))) * n_ +
+                    creep_estimate(static_cast<std::uint64_t>(middle % (6 * units)), limits);
+                if (ticks < best) {
+                    best = ticks;
+                    cruise = 6 * units;
+                    distance = d;
+                    ramp_ = ramp;
+                }
+            }
+        }
+        cruise_ = top == 0 ? 6 : cruise;
+        if (top == 0) {
+            ramp_spans_ = 0;
+            ramp_distance_ = 0;
+        } else {
+            ramp_spans_ = ramp_.spans;
+            ramp_distance_ = distance;
+        }
+        const std::int64_t middle = remaining_ - 2 * ramp_distance_;
+        cruise_spans_ = ramp_spans_ == 0 ? 0 : middle / cruise_;
+        creep_ = ramp_spans_ == 0 ? middle : middle % cruise_;
+        creep_ticks_ = 0;
+        walk_ = 0;
+        if (creep_ != 0) {
+            const std::int64_t creep_from = start[axis_] + sign_ * (remaining_ - creep_);
+            if (creep_from > kMaxPositionLsb || creep_from < -kMaxPositionLsb) return Status::kBadLimits;
+            creep_ticks_ = creep_length(static_cast<Lsb>(creep_from));
+            if (creep_ticks_ == 0) return Status::kBadLimits;
+        }
+        s_curve_ = true;
+        return Status::kOk;
+    }
 
     void fill(WireSpan& w, std::int32_t t0, std::int32_t t1) const {
         for (unsigned a = 0; a < Axes; ++a) w.end[a] = at_[a];
@@ -253,6 +441,9 @@ private:
     std::int64_t creep_ = 0;
     std::uint32_t creep_ticks_ = 0;  // length of the creep span, settled by plan()
     std::int64_t index_ = 0;
+    bool s_curve_ = false;   // the ramps are ramp_'s S-curves (a jerk limit on the axis)
+    SCurveRamp ramp_;
+    std::int64_t walk_ = 0;  // S-curve: the tangent at the knot next() is at
 };
 
 /// Homes one axis of a MotionDevice. Task context: call poll() with the switch's level after

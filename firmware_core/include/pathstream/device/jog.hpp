@@ -21,7 +21,8 @@ inline constexpr std::uint8_t kCommandSetPosition = 7;
 inline constexpr std::uint16_t kJogFeedFull = 1000;
 
 /// A jog in progress: the device's own job of rest-to-rest spans (AxisMove: constant
-/// acceleration ramps, cruise, a creep span at rest), fed into the span queue as room frees,
+/// acceleration ramps, or S-curves under a jerk limit, cruise, a creep span at rest), fed into
+/// the span queue as room frees,
 /// each span checked like a host's (continuity, exact limits). Task context only: start() from
 /// the bus handler, service() from the task loop (at least once per span period, 8 ticks on
 /// the example machines, or the queue may run dry and the device underrun-stop).
