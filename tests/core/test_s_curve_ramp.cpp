@@ -97,3 +97,38 @@ TEST_CASE("AxisMove under a jerk limit: S-curves within 1.5x of the optimal S-cu
         }
     }
 }
+
+TEST_CASE("AxisMove under a jerk limit: never faster than the requested velocity", "[device][jog][jerk]") {
+    // A homing latch defines zero at its speed: the ramps and the cruise stay at or under the
+    // requested velocity however slow (the spans lengthen so that a cruise tangent of 6 LSB
+    // fits under it). The creep span at the end (rest to rest) is bounded by the axis's limit.
+    for (const std::uint32_t velocity : {40u, 100u, 1000u, 7000u, 100000u}) {
+        MotionLimits<kAxes> l;
+        l.tick_hz = 1000;
+        for (auto& a : l.axis) {
+            a.max_velocity = 250000;
+            a.max_acceleration = 3000000;
+            a.max_jerk = 1000000;
+        }
+        const Lsb start[kAxes] = {0, 0};
+        AxisMove<kAxes> move;
+        REQUIRE(move.plan(start, 0, 20000, velocity, l) == Status::kOk);
+        WireSpan w;
+        Lsb at = 0;
+        int spans = 0;
+        while (move.next(w)) {
+            const std::int64_t chord = w.end[0] - at;
+            at = w.end[0];
+            ++spans;
+            const bool creep = w.start_tangent[0] == 0 && w.end_tangent[0] == 0;
+            if (creep) continue;
+            INFO("velocity " << velocity << " span " << spans << " of " << w.ticks << " ticks, tangents "
+                             << w.start_tangent[0] << " " << w.end_tangent[0] << ", chord " << chord);
+            // Monotone inside each span (ramps, cruise): the knots carry the peak.
+            CHECK(std::uint64_t(std::max(std::llabs(w.start_tangent[0]), std::llabs(w.end_tangent[0]))) * l.tick_hz <=
+                  std::uint64_t{velocity} * w.ticks);
+        }
+        CHECK(at == 20000);
+        CHECK(spans > 1);
+    }
+}

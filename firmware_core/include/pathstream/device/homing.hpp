@@ -299,12 +299,13 @@ private:
     // The S-curve move (SCurveRamp) on limits with a jerk limit on the axis: spans of n ticks,
     // the shortest power of two (from 8) on which the jerk and the acceleration limits give
     // steps of at least 6 in span units (J n^3 >= 6, A n^2 >= 6); the cruise tangent a multiple
-    // of 6, halved until both ramps fit the distance (else the creep span alone). kBadLimits
-    // (and the constant-acceleration move is planned instead) when no span length fits, the
-    // cruise cannot be slow enough, or the creep span fits at no length.
+    // of 6 at most the requested velocity (n longer where that needs it), as fast as the
+    // distance allows (else the creep span alone). kBadLimits (and the constant-acceleration
+    // move is planned instead) when no span length fits, or the creep span fits at no length.
     Status plan_s_curve(const Lsb (&start)[Axes], std::uint32_t velocity, const MotionLimits<Axes>& limits) {
         const AxisLimits& l = limits.axis[axis_];
         const std::uint64_t hz = limits.tick_hz;
+        if (velocity > l.max_velocity) velocity = l.max_velocity;
         std::uint32_t n = 8;
         std::int64_t step = 0, peak = 0;
         for (;; n *= 2) {
@@ -316,7 +317,9 @@ private:
             constexpr std::uint64_t kLarge = std::uint64_t{1} << 40;  // beyond any tangent's reach
             const std::uint64_t js = j.quotient.hi != 0 || j.quotient.lo > kLarge ? kLarge : j.quotient.lo;
             const std::uint64_t as = a.quotient.hi != 0 || a.quotient.lo > kLarge ? kLarge : a.quotient.lo;
-            if (js >= 1 && as >= 1) {
+            // The cruise tangent, a multiple of 6, must not exceed the requested velocity (a
+            // homing latch defines zero at its speed): spans long enough for 6 LSB at it.
+            if (js >= 1 && as >= 1 && std::uint64_t{velocity} * n >= 6 * hz) {
                 step = 6 * static_cast<std::int64_t>(js);
                 peak = 6 * static_cast<std::int64_t>(as);
                 break;
@@ -326,10 +329,7 @@ private:
         n_ = n;
         ramp_.step = step;
         ramp_.peak = peak;
-        if (velocity > l.max_velocity) velocity = l.max_velocity;
-        std::int64_t cruise = static_cast<std::int64_t>(std::uint64_t{velocity} * n / hz / 6 * 6);
-        if (cruise < 6) cruise = 6;
-        if (static_cast<std::uint64_t>(cruise) * hz > std::uint64_t{l.max_velocity} * n) return Status::kBadLimits;
+        std::int64_t cruise = static_cast<std::int64_t>(std::uint64_t{velocity} * n / hz / 6 * 6);  // >= 6
         // The fastest cruise whose two ramps fit the distance (a ramp's distance grows with its
         // cruise: bisection over the multiples of 6), then, within 1/8 of it, the one whose move
         // takes the fewest ticks with the creep span's estimated (at most 16 tries): the creep
