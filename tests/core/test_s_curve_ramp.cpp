@@ -70,10 +70,10 @@ double s_curve_ticks(double distance, double v, double a, double j, double hz) {
 
 }  // namespace
 
-TEST_CASE("AxisMove under a jerk limit: S-curves within 1.5x of the optimal S-curve's ticks", "[device][jog][jerk]") {
+TEST_CASE("AxisMove under a jerk limit: S-curves within 1.4x of the optimal S-curve's ticks", "[device][jog][jerk]") {
     // The pen plotter in LSB (1 um, 1 kHz, 3000 mm/s^2, 250 mm/s) with 10^5 and 10^6 mm/s^3,
-    // a 100 mm/s jog of 10 and 100 mm; the ramps that accelerated at J/2 * 1 tick took 1.200 /
-    // 3.600 s at 10^5 and 0.336 / 1.200 s at 10^6 for these.
+    // a 100 mm/s jog of 10 and 100 mm: 0.220 / 1.102 s at 10^5 and 0.158 / 1.071 s at 10^6; the
+    // ramps that accelerated at J/2 * 1 tick took 1.200 / 3.600 s and 0.336 / 1.200 s.
     for (const std::uint32_t max_jerk : {1000000u, 10000000u}) {  // units of 100 LSB/s^3
         for (const std::int64_t distance : {10000, -100000}) {
             MotionLimits<kAxes> l;
@@ -92,7 +92,7 @@ TEST_CASE("AxisMove under a jerk limit: S-curves within 1.5x of the optimal S-cu
             const double optimum = s_curve_ticks(static_cast<double>(std::llabs(distance)), 100000, 3000000,
                                                  max_jerk * 100.0, 1000);
             INFO("max_jerk " << max_jerk << " distance " << distance << ": " << ticks << " ticks, optimum " << optimum);
-            CHECK(ticks <= 1.5 * optimum);
+            CHECK(ticks <= 1.4 * optimum);
             CHECK(w.end[1] == start[1] + distance);
         }
     }

@@ -185,7 +185,13 @@ public:
         if (s_curve_ && i < 2 * ramps + cruise_spans_) {
             std::int64_t chord = cruise_;
             t0 = t1 = cruise_;
-            if (i < ramps) {  // up: knot k = i to k + 1, T walking up from 0
+            if (i >= ramps && i < ramps + 3 * dips_) {  // a dip of x: knots 0, -x, x, 0
+                const std::int64_t c = i - ramps, x = dip(c / 3), half = x / 2;
+                const std::int64_t part = c % 3;
+                t0 = part == 0 ? cruise_ : cruise_ - half;
+                t1 = part == 2 ? cruise_ : cruise_ - half;
+                chord = part == 1 ? cruise_ - half - x / 6 : cruise_ - x / 6;
+            } else if (i < ramps) {  // up: knot k = i to k + 1, T walking up from 0
                 const auto k = static_cast<std::uint32_t>(i);
                 const std::int64_t a0 = ramp_.at(k), a1 = ramp_.at(k + 1);
                 t0 = walk_;
@@ -243,6 +249,38 @@ private:
 
     std::int64_t total_spans() const { return 2 * static_cast<std::int64_t>(ramp_spans_) + cruise_spans_ + (creep_ != 0 ? 1 : 0); }
 
+    // The cruise between the S-curve ramps: `spans` spans of tangent `cruise` covering `middle`
+    // LSB, the first 3 * dips of them dipping (knots 0, -x, x, 0 of A: the tangent falls by
+    // x/2 and comes back, and the three spans cover x less than the plain cruise's), the
+    // dips' x summing to dip_total, and a creep span of `creep` (< 6) LSB at rest at the end.
+    // One cruise span more than middle / cruise and dips for the rest of it, so the creep is
+    // the remainder modulo 6 only; where the dips do not fit (too few spans, or a step below
+    // 12), the plain cruise and the whole remainder as the creep.
+    struct Middle {
+        std::int64_t spans = 0, dips = 0, dip_total = 0, creep = 0;
+    };
+    static Middle plan_middle(std::int64_t middle, std::int64_t cruise, std::int64_t step) {
+        Middle m;
+        m.spans = middle / cruise;
+        m.creep = middle % cruise;
+        const std::int64_t highest = step / 12 * 6;  // x <= step / 2: the knots -x, x differ by 2x
+        if (m.creep == 0 || highest < 6) return m;
+        const std::int64_t total = (cruise - m.creep + 5) / 6 * 6;  // what the dips take off
+        const std::int64_t dips = (total + highest - 1) / highest;
+        if (3 * dips > m.spans + 1) return m;
+        m.spans += 1;
+        m.dips = dips;
+        m.dip_total = total;
+        m.creep = total - (cruise - m.creep);  // the remainder modulo 6
+        return m;
+    }
+
+    // The depth x of dip g (0 .. dips_ - 1): dip_total_ shared out in multiples of 6.
+    std::int64_t dip(std::int64_t g) const {
+        const std::int64_t units = dip_total_ / 6, base = units / dips_, extra = units % dips_;
+        return 6 * (base + (g < extra ? 1 : 0));
+    }
+
     // Spans an S-curve ramp may have (a slower cruise is planned where it would need more).
     static constexpr std::uint32_t kMaxRampSpans = 1024;
 
@@ -261,8 +299,8 @@ private:
     }
 
     // Ticks a creep span of `rest` LSB needs at J/2 * 1 tick of acceleration (its ends' 6 rest /
-    // m^2 <= J / 2: m >= sqrt(12 rest hz^3 / J)), rounded up to the lengths creep_length tries,
-    // the other limits aside: an estimate for choosing the cruise.
+    // m^2 <= J / 2: m >= sqrt(12 rest hz^3 / J)), the other limits aside: where creep_length
+    // starts, and an estimate for choosing the cruise.
     std::uint64_t creep_estimate(std::uint64_t rest, const MotionLimits<Axes>& limits) const {
         if (rest == 0) return 0;
         const std::uint64_t hz = limits.tick_hz;
@@ -280,10 +318,7 @@ private:
                 root >>= 1;
             }
         }
-        // creep_length tries n, 2n, 4n .. ticks.
-        std::uint64_t ticks = n_;
-        while (ticks <= root && ticks < kMaxSpanTicks) ticks *= 2;
-        return ticks;
+        return root + 1 < kMaxSpanTicks ? root + 1 : kMaxSpanTicks;
     }
 
     // The creep span's limits under a jerk limit J: its acceleration at most J/2 * 1 tick, so
@@ -360,10 +395,9 @@ private:
                  --units, ++tries) {
                 const std::int64_t d = fitting(units, ramp);
                 if (d < 0) continue;
-                const std::int64_t middle = remaining_ - 2 * d;
-                const std::uint64_t ticks =
-                    (2 * std::uint64_t{ramp.spans} + static_cast<std::uint64_t>(middle / (6 * units))) * n_ +
-                    creep_estimate(static_cast<std::uint64_t>(middle % (6 * units)), limits);
+                const Middle m = plan_middle(remaining_ - 2 * d, 6 * units, ramp.step);
+                const std::uint64_t ticks = (2 * std::uint64_t{ramp.spans} + static_cast<std::uint64_t>(m.spans)) * n_ +
+                                            creep_estimate(static_cast<std::uint64_t>(m.creep), limits);
                 if (ticks < best) {
                     best = ticks;
                     cruise = 6 * units;
@@ -381,14 +415,24 @@ private:
             ramp_distance_ = distance;
         }
         const std::int64_t middle = remaining_ - 2 * ramp_distance_;
-        cruise_spans_ = ramp_spans_ == 0 ? 0 : middle / cruise_;
-        creep_ = ramp_spans_ == 0 ? middle : middle % cruise_;
+        dips_ = dip_total_ = 0;
+        if (ramp_spans_ == 0) {
+            cruise_spans_ = 0;
+            creep_ = middle;
+        } else {
+            const Middle m = plan_middle(middle, cruise_, ramp_.step);
+            cruise_spans_ = m.spans;
+            dips_ = m.dips;
+            dip_total_ = m.dip_total;
+            creep_ = m.creep;
+        }
         creep_ticks_ = 0;
         walk_ = 0;
         if (creep_ != 0) {
             const std::int64_t creep_from = start[axis_] + sign_ * (remaining_ - creep_);
             if (creep_from > kMaxPositionLsb || creep_from < -kMaxPositionLsb) return Status::kBadLimits;
-            creep_ticks_ = creep_length(static_cast<Lsb>(creep_from));
+            creep_ticks_ = creep_length(static_cast<Lsb>(creep_from),
+                                        creep_estimate(static_cast<std::uint64_t>(creep_), limits));
             if (creep_ticks_ == 0) return Status::kBadLimits;
         }
         s_curve_ = true;
@@ -404,7 +448,9 @@ private:
     // Ticks of the remainder at rest from `from` (P1 = P0 + creep, T0 = T1 = 0): the first
     // of n, 2n, 4n .. that passes the limits (the move's acceleration, the jerk inside); 0
     // when none up to kMaxSpanTicks does.
-    std::uint32_t creep_length(Lsb from) const {
+    // `first` (S-curve moves: the bound of creep_estimate): the lengths tried are first,
+    // first + 1, first + 2, first + 4 .. instead.
+    std::uint32_t creep_length(Lsb from, std::uint64_t first = 0) const {
         Span<Axes> s;
         s.basis = Basis::kHermite;
         for (unsigned a = 0; a < Axes; ++a) {
@@ -412,8 +458,10 @@ private:
             s.control[a][2] = s.control[a][3] = 0;
         }
         s.control[axis_][1] = static_cast<Lsb>(from + sign_ * creep_);
-        for (std::uint32_t ticks = n_; ticks <= kMaxSpanTicks; ticks *= 2) {
-            s.ticks = ticks;
+        std::uint64_t step = 0;
+        for (std::uint64_t ticks = first != 0 ? first : n_; ticks <= kMaxSpanTicks;
+             first != 0 ? (ticks += step == 0 ? 1 : step, step = step == 0 ? 1 : 2 * step) : ticks *= 2) {
+            s.ticks = static_cast<std::uint32_t>(ticks);
             ValidatedSpan<Axes> v;
             if (validate_span(s, v) != Status::kOk) continue;
             bool fits = true;
@@ -422,7 +470,7 @@ private:
                 fits = check_axis_limits(v.cubic[a], v.timing, l, limits_.tick_hz) == Status::kOk &&
                        check_axis_jerk(v.cubic[a], v.timing, l, limits_.tick_hz) == Status::kOk;
             }
-            if (fits) return ticks;
+            if (fits) return static_cast<std::uint32_t>(ticks);
         }
         return 0;
     }
@@ -442,6 +490,8 @@ private:
     std::uint32_t creep_ticks_ = 0;  // length of the creep span, settled by plan()
     std::int64_t index_ = 0;
     bool s_curve_ = false;   // the ramps are ramp_'s S-curves (a jerk limit on the axis)
+    std::int64_t dips_ = 0;       // S-curve: dips at the cruise's start (plan_middle)
+    std::int64_t dip_total_ = 0;  // what they take off the plain cruise, LSB
     SCurveRamp ramp_;
     std::int64_t walk_ = 0;  // S-curve: the tangent at the knot next() is at
 };
