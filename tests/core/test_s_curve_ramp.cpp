@@ -132,3 +132,71 @@ TEST_CASE("AxisMove under a jerk limit: never faster than the requested velocity
         CHECK(spans > 1);
     }
 }
+
+TEST_CASE("AxisMove under a jerk limit, random limits: planned or refused, and every span passes the device's rules",
+          "[device][jog][jerk]") {
+    // Limits over their whole ranges (extremes included): plan() either refuses (kBadLimits) or
+    // gives spans that pass the exact limit check, the jerk inside each span and the steps at
+    // every join (rest at both ends), and end exactly on the target.
+    std::mt19937_64 rng(test::property_seed());
+    const auto log_pick = [&](double lo, double hi) {
+        return std::exp(std::uniform_real_distribution<double>(std::log(lo), std::log(hi))(rng));
+    };
+    int planned = 0;
+    for (int c = 0; c < 400; ++c) {
+        MotionLimits<kAxes> l;
+        l.tick_hz = static_cast<std::uint32_t>(log_pick(1, 100000));
+        for (auto& a : l.axis) {
+            a.max_velocity = static_cast<std::uint32_t>(log_pick(1, 4e9));
+            a.max_acceleration = static_cast<std::uint32_t>(log_pick(1, 4e9));
+            a.max_jerk = static_cast<std::uint32_t>(log_pick(1, 4e9));
+        }
+        const auto distance = static_cast<std::int64_t>(log_pick(1, 2.6e8)) * (c % 2 == 0 ? 1 : -1);
+        const auto velocity = static_cast<std::uint32_t>(log_pick(1, 4e9));
+        const Lsb start[kAxes] = {static_cast<Lsb>(-distance / 2), 7};
+        AxisMove<kAxes> move;
+        const Status s = move.plan(start, 0, distance, velocity, l);
+        INFO("case " << c << " hz " << l.tick_hz << " v " << l.axis[0].max_velocity << " a " << l.axis[0].max_acceleration
+                     << " j " << l.axis[0].max_jerk << " distance " << distance << " velocity " << velocity);
+        if (s != Status::kOk) {
+            CHECK(s == Status::kBadLimits);
+            continue;
+        }
+        ++planned;
+        Lsb at[kAxes] = {start[0], start[1]};
+        TickAcceleration previous{};
+        WireSpan w;
+        std::int64_t spans = 0;
+        bool ok = true;
+        constexpr std::int64_t kChecked = 200000;  // a longer move's first spans only
+        while (spans < kChecked && move.next(w) && ok) {
+            ++spans;
+            Span<kAxes> span;
+            span.basis = Basis::kHermite;
+            span.ticks = w.ticks;
+            for (unsigned a = 0; a < kAxes; ++a) {
+                span.control[a][0] = at[a];
+                span.control[a][1] = w.end[a];
+                span.control[a][2] = w.start_tangent[a];
+                span.control[a][3] = w.end_tangent[a];
+                at[a] = w.end[a];
+            }
+            ValidatedSpan<kAxes> v;
+            ok = validate_span(span, v) == Status::kOk;
+            if (!ok) break;
+            const AxisLimits& lim = l.axis[0];
+            ok = check_axis_limits(v.cubic[0], v.timing, lim, l.tick_hz) == Status::kOk &&
+                 check_axis_jerk(v.cubic[0], v.timing, lim, l.tick_hz) == Status::kOk &&
+                 check_acceleration_step(start_acceleration(v.cubic[0], v.timing), previous, lim, l.tick_hz) ==
+                     Status::kOk;
+            previous = end_acceleration(v.cubic[0], v.timing);
+        }
+        INFO("span " << spans);
+        CHECK(ok);
+        if (spans == kChecked) continue;
+        CHECK(check_end_at_rest(previous, l.axis[0], l.tick_hz) == Status::kOk);
+        CHECK(at[0] == start[0] + distance);
+        CHECK(at[1] == start[1]);
+    }
+    CHECK(planned > 50);
+}

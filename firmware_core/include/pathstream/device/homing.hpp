@@ -131,6 +131,11 @@ public:
         while (static_cast<std::uint64_t>(cruise_) * hz > static_cast<std::uint64_t>(l.max_velocity) * n_ && cruise_ > 2) {
             cruise_ -= 2;
         }
+        // Even the slowest cruise (2 LSB per span) is over the velocity limit: the device would
+        // refuse every span, so the move is refused here.
+        if (static_cast<std::uint64_t>(cruise_) * hz > static_cast<std::uint64_t>(l.max_velocity) * n_) {
+            return Status::kBadLimits;
+        }
         // Shrink the cruise tangent until both ramps fit in the distance. A ramp of R spans
         // to tangent c covers at least R (c/2 - 2) (every rounded tangent is within 2 of
         // c i / R): a cruise that cannot fit by that bound is halved without summing its
@@ -360,7 +365,10 @@ private:
                 break;
             }
         }
+        // SCurveRamp's range: step <= peak <= step 2^20 (more than 2^20 levels up to the peak
+        // fits no ramp of kMaxRampSpans spans anyway).
         if (step > peak) step = peak;
+        if (peak / step > (std::int64_t{1} << 20)) peak = step << 20;
         n_ = n;
         ramp_.step = step;
         ramp_.peak = peak;

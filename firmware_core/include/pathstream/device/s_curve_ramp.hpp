@@ -26,8 +26,12 @@ struct SCurveRamp {
     std::int64_t extra_down = 0;  ///< a knot inserted among the falling ones (0: none)
     std::uint32_t spans = 0;      ///< spans of the ramp (knots 0..spans)
 
-    /// Sets the knots for `cruise` (a multiple of 6, >= 6; step and peak set, multiples of 6,
-    /// >= 6). Cost: a square root by bisection over 32 bits. Any context.
+    /// `spans` saturates here.
+    static constexpr std::int64_t kMaxSpans = 0x7fffffff;
+
+    /// Sets the knots for `cruise` (a multiple of 6, 6 .. 2^50; step and peak set, multiples of
+    /// 6, 6 <= step <= peak <= step * 2^20, so that no product here leaves 64 bits). Cost: a
+    /// bisection over the levels. Any context.
     void plan(std::int64_t cruise) {
         // Rising knots up to peak: L of them, the last one peak itself.
         const std::int64_t to_peak = (peak + step - 1) / step;
@@ -55,7 +59,9 @@ struct SCurveRamp {
             extra_up = rest / 12 * 6;
             extra_down = rest - extra_up;
         }
-        spans = static_cast<std::uint32_t>(2 * levels + plateau + (extra_up != 0 ? 1 : 0) + (extra_down != 0 ? 1 : 0) + 1);
+        // Saturated: a plateau of 2^31 knots and more is no ramp anyone plays.
+        const std::int64_t count = 2 * levels + plateau + (extra_up != 0 ? 1 : 0) + (extra_down != 0 ? 1 : 0) + 1;
+        spans = count < kMaxSpans ? static_cast<std::uint32_t>(count) : static_cast<std::uint32_t>(kMaxSpans);
     }
 
     /// A (acceleration * n^2) at knot i (0..spans; 0 at both ends). Cost: a few divisions.
