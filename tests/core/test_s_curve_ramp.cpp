@@ -171,16 +171,8 @@ TEST_CASE("AxisMove under a jerk limit, random limits: planned or refused, and e
         constexpr std::int64_t kChecked = 200000;  // a longer move's first spans only
         while (spans < kChecked && move.next(w) && ok) {
             ++spans;
-            Span<kAxes> span;
-            span.basis = Basis::kHermite;
-            span.ticks = w.ticks;
-            for (unsigned a = 0; a < kAxes; ++a) {
-                span.control[a][0] = at[a];
-                span.control[a][1] = w.end[a];
-                span.control[a][2] = w.start_tangent[a];
-                span.control[a][3] = w.end_tangent[a];
-                at[a] = w.end[a];
-            }
+            const Span<kAxes> span = to_core_span<kAxes>(w, at, 0);
+            for (unsigned a = 0; a < kAxes; ++a) at[a] = w.end[a];
             ValidatedSpan<kAxes> v;
             ok = validate_span(span, v) == Status::kOk;
             if (!ok) break;
