@@ -81,15 +81,16 @@ Run run(std::int64_t distance, std::uint32_t velocity, const MotionLimits<kAxes>
         const AxisLimits& l = check.axis[0];
         if (check_axis_limits(v.cubic[0], v.timing, l, check.tick_hz) != Status::kOk ||
             check_axis_jerk(v.cubic[0], v.timing, l, check.tick_hz) != Status::kOk ||
-            check_acceleration_step(start_acceleration(v.cubic[0], v.timing), previous, l, check.tick_hz) !=
-                Status::kOk) {
+            check_acceleration_step(start_acceleration(v.cubic[0], v.timing), previous, l,
+                                    check.tick_hz) != Status::kOk) {
             return r;
         }
         previous = end_acceleration(v.cubic[0], v.timing);
         r.ticks += w.ticks;
         ++r.spans;
     }
-    r.ok = check_end_at_rest(previous, check.axis[0], check.tick_hz) == Status::kOk && at[0] == distance && at[1] == 0;
+    r.ok = check_end_at_rest(previous, check.axis[0], check.tick_hz) == Status::kOk &&
+           at[0] == distance && at[1] == 0;
     return r;
 }
 
@@ -101,44 +102,60 @@ int main(int argc, char** argv) {
         if (std::strcmp(argv[i], "--markdown") == 0) {
             markdown = true;
         } else if (std::strcmp(argv[i], "--help") == 0) {
-            std::printf("usage: bench_jog [--markdown]\n"
-                        "  Jogs of the pen plotter (1 um LSB, 1 kHz, 3000 mm/s^2) at 100 mm/s under a jerk limit:\n"
-                        "  AxisMove's S-curves against the optimal S-curve and against constant-acceleration\n"
-                        "  ramps at J/2 per tick (the baseline), every span checked with the device's rules.\n"
-                        "  Exit 1 if a move is refused, breaks a rule or misses its target; 2 on a usage error.\n");
+            std::printf(
+                "usage: bench_jog [--markdown]\n"
+                "  Jogs of the pen plotter (1 um LSB, 1 kHz, 3000 mm/s^2) at 100 mm/s under a jerk "
+                "limit:\n"
+                "  AxisMove's S-curves against the optimal S-curve and against "
+                "constant-acceleration\n"
+                "  ramps at J/2 per tick (the baseline), every span checked with the device's "
+                "rules.\n"
+                "  Exit 1 if a move is refused, breaks a rule or misses its target; 2 on a usage "
+                "error.\n");
             return 0;
         } else {
             std::fprintf(stderr, "bench_jog: unknown argument %s (see --help)\n", argv[i]);
             return 2;
         }
     }
-    const char* head = markdown ? "| jerk mm/s^3 | distance mm | S-curve s | spans | J/2 ramps s | optimum s | x optimum | faster than J/2 ramps |\n"
+    const char* head = markdown ? "| jerk mm/s^3 | distance mm | S-curve s | spans | J/2 ramps s | "
+                                  "optimum s | x optimum | faster than J/2 ramps |\n"
                                   "|---:|---:|---:|---:|---:|---:|---:|---:|\n"
-                                : "jerk mm/s^3  distance mm  S-curve s  spans  J/2 ramps s  optimum s  x optimum  faster than J/2 ramps\n";
-    std::printf("bench_jog: pen plotter in LSB (1 um, 1 kHz, 250 mm/s, 3000 mm/s^2), jogs at 100 mm/s\n%s", head);
+                                : "jerk mm/s^3  distance mm  S-curve s  spans  J/2 ramps s  "
+                                  "optimum s  x optimum  faster than J/2 ramps\n";
+    std::printf(
+        "bench_jog: pen plotter in LSB (1 um, 1 kHz, 250 mm/s, 3000 mm/s^2), jogs at 100 mm/s\n%s",
+        head);
     bool failed = false;
-    for (const std::uint32_t max_jerk : {1000000u, 10000000u}) {  // 1e5 and 1e6 mm/s^3 (units of 100 LSB/s^3)
+    for (const std::uint32_t max_jerk :
+         {1000000u, 10000000u}) {  // 1e5 and 1e6 mm/s^3 (units of 100 LSB/s^3)
         const MotionLimits<kAxes> limits = plotter(max_jerk);
         // The baseline: no jerk limit, the acceleration J/2 * 1 tick (J / (2 hz) LSB/s^2).
         MotionLimits<kAxes> baseline = limits;
         for (auto& a : baseline.axis) {
-            a.max_acceleration = static_cast<std::uint32_t>(std::uint64_t{max_jerk} * kJerkUnitLsb / (2 * limits.tick_hz));
+            a.max_acceleration = static_cast<std::uint32_t>(std::uint64_t{max_jerk} * kJerkUnitLsb /
+                                                            (2 * limits.tick_hz));
             a.max_jerk = 0;
         }
         for (const std::int64_t distance : {1000, 10000, 100000, 1000000}) {
             const Run s = run(distance, 100000, limits, limits);
             const Run b = run(distance, 100000, baseline, limits);
             const double jerk_mm = max_jerk * 100.0 * 1e-3;
-            const double optimum = optimal_seconds(static_cast<double>(distance) * 1e-3, 100, 3000, jerk_mm);
+            const double optimum =
+                optimal_seconds(static_cast<double>(distance) * 1e-3, 100, 3000, jerk_mm);
             const double seconds = static_cast<double>(s.ticks) / limits.tick_hz;
             const double base = static_cast<double>(b.ticks) / limits.tick_hz;
             if (!s.ok || !b.ok) failed = true;
-            std::printf(markdown ? "| %.0e | %.0f | %.3f | %llu | %.3f | %.3f | %.2f | %.2fx |%s\n"
-                                 : "%11.0e  %11.0f  %9.3f  %5llu  %11.3f  %9.3f  %9.2f  %20.2fx%s\n",
-                        jerk_mm, static_cast<double>(distance) * 1e-3, seconds, static_cast<unsigned long long>(s.spans), base,
-                        optimum, seconds / optimum, base / seconds, s.ok && b.ok ? "" : "  FAILED (refused, a rule, or the target)");
+            std::printf(
+                markdown ? "| %.0e | %.0f | %.3f | %llu | %.3f | %.3f | %.2f | %.2fx |%s\n"
+                         : "%11.0e  %11.0f  %9.3f  %5llu  %11.3f  %9.3f  %9.2f  %20.2fx%s\n",
+                jerk_mm, static_cast<double>(distance) * 1e-3, seconds,
+                static_cast<unsigned long long>(s.spans), base, optimum, seconds / optimum,
+                base / seconds, s.ok && b.ok ? "" : "  FAILED (refused, a rule, or the target)");
         }
     }
-    std::printf("bench_jog: %s\n", failed ? "FAILED" : "every span within the device's rules, every move on its target");
+    std::printf(
+        "bench_jog: %s\n",
+        failed ? "FAILED" : "every span within the device's rules, every move on its target");
     return failed ? 1 : 0;
 }

@@ -2,9 +2,8 @@
 // AxisMove built on it: the ramp's knots are exact (their sum is the cruise tangent, every step
 // within the jerk and every value within the acceleration), and a jerk-limited move takes close
 // to the time-optimal S-curve's ticks instead of the J/2 * 1 tick ramps it replaced.
-#include <catch2/catch.hpp>
-
 #include <algorithm>
+#include <catch2/catch.hpp>
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
@@ -17,10 +16,13 @@
 using namespace pathstream;
 using namespace pathstream::device;
 
-TEST_CASE("SCurveRamp: the knots sum to the cruise tangent, step by at most `step`, stay within `peak`",
-          "[device][jog][jerk]") {
+TEST_CASE(
+    "SCurveRamp: the knots sum to the cruise tangent, step by at most `step`, stay within `peak`",
+    "[device][jog][jerk]") {
     std::mt19937_64 rng(test::property_seed());
-    const auto pick = [&](std::int64_t lo, std::int64_t hi) { return std::uniform_int_distribution<std::int64_t>(lo, hi)(rng); };
+    const auto pick = [&](std::int64_t lo, std::int64_t hi) {
+        return std::uniform_int_distribution<std::int64_t>(lo, hi)(rng);
+    };
     for (int c = 0; c < 20000; ++c) {
         SCurveRamp r;
         r.step = 6 * pick(1, c % 3 == 0 ? 3 : 200);
@@ -70,7 +72,8 @@ double s_curve_ticks(double distance, double v, double a, double j, double hz) {
 
 }  // namespace
 
-TEST_CASE("AxisMove under a jerk limit: S-curves within 1.4x of the optimal S-curve's ticks", "[device][jog][jerk]") {
+TEST_CASE("AxisMove under a jerk limit: S-curves within 1.4x of the optimal S-curve's ticks",
+          "[device][jog][jerk]") {
     // The pen plotter in LSB (1 um, 1 kHz, 3000 mm/s^2, 250 mm/s) with 10^5 and 10^6 mm/s^3,
     // a 100 mm/s jog of 10 and 100 mm: 0.220 / 1.102 s at 10^5 and 0.158 / 1.071 s at 10^6; the
     // ramps that accelerated at J/2 * 1 tick took 1.200 / 3.600 s and 0.336 / 1.200 s.
@@ -89,16 +92,18 @@ TEST_CASE("AxisMove under a jerk limit: S-curves within 1.4x of the optimal S-cu
             std::uint64_t ticks = 0;
             WireSpan w;
             while (move.next(w)) ticks += w.ticks;
-            const double optimum = s_curve_ticks(static_cast<double>(std::llabs(distance)), 100000, 3000000,
-                                                 max_jerk * 100.0, 1000);
-            INFO("max_jerk " << max_jerk << " distance " << distance << ": " << ticks << " ticks, optimum " << optimum);
+            const double optimum = s_curve_ticks(static_cast<double>(std::llabs(distance)), 100000,
+                                                 3000000, max_jerk * 100.0, 1000);
+            INFO("max_jerk " << max_jerk << " distance " << distance << ": " << ticks
+                             << " ticks, optimum " << optimum);
             CHECK(ticks <= 1.4 * optimum);
             CHECK(w.end[1] == start[1] + distance);
         }
     }
 }
 
-TEST_CASE("AxisMove under a jerk limit: never faster than the requested velocity", "[device][jog][jerk]") {
+TEST_CASE("AxisMove under a jerk limit: never faster than the requested velocity",
+          "[device][jog][jerk]") {
     // A homing latch defines zero at its speed: the ramps and the cruise stay at or under the
     // requested velocity however slow (the spans lengthen so that a cruise tangent of 6 LSB
     // fits under it). The creep span at the end (rest to rest) is bounded by the axis's limit.
@@ -122,10 +127,13 @@ TEST_CASE("AxisMove under a jerk limit: never faster than the requested velocity
             ++spans;
             const bool creep = w.start_tangent[0] == 0 && w.end_tangent[0] == 0;
             if (creep) continue;
-            INFO("velocity " << velocity << " span " << spans << " of " << w.ticks << " ticks, tangents "
-                             << w.start_tangent[0] << " " << w.end_tangent[0] << ", chord " << chord);
+            INFO("velocity " << velocity << " span " << spans << " of " << w.ticks
+                             << " ticks, tangents " << w.start_tangent[0] << " " << w.end_tangent[0]
+                             << ", chord " << chord);
             // Monotone inside each span (ramps, cruise): the knots carry the peak.
-            CHECK(std::uint64_t(std::max(std::llabs(w.start_tangent[0]), std::llabs(w.end_tangent[0]))) * l.tick_hz <=
+            CHECK(std::uint64_t(
+                      std::max(std::llabs(w.start_tangent[0]), std::llabs(w.end_tangent[0]))) *
+                      l.tick_hz <=
                   std::uint64_t{velocity} * w.ticks);
         }
         CHECK(at == 20000);
@@ -133,8 +141,10 @@ TEST_CASE("AxisMove under a jerk limit: never faster than the requested velocity
     }
 }
 
-TEST_CASE("AxisMove under a jerk limit, random limits: planned or refused, and every span passes the device's rules",
-          "[device][jog][jerk]") {
+TEST_CASE(
+    "AxisMove under a jerk limit, random limits: planned or refused, and every span passes the "
+    "device's rules",
+    "[device][jog][jerk]") {
     // Limits over their whole ranges (extremes included): plan() either refuses (kBadLimits) or
     // gives spans that pass the exact limit check, the jerk inside each span and the steps at
     // every join (rest at both ends), and end exactly on the target.
@@ -156,8 +166,9 @@ TEST_CASE("AxisMove under a jerk limit, random limits: planned or refused, and e
         const Lsb start[kAxes] = {static_cast<Lsb>(-distance / 2), 7};
         AxisMove<kAxes> move;
         const Status s = move.plan(start, 0, distance, velocity, l);
-        INFO("case " << c << " hz " << l.tick_hz << " v " << l.axis[0].max_velocity << " a " << l.axis[0].max_acceleration
-                     << " j " << l.axis[0].max_jerk << " distance " << distance << " velocity " << velocity);
+        INFO("case " << c << " hz " << l.tick_hz << " v " << l.axis[0].max_velocity << " a "
+                     << l.axis[0].max_acceleration << " j " << l.axis[0].max_jerk << " distance "
+                     << distance << " velocity " << velocity);
         if (s != Status::kOk) {
             CHECK(s == Status::kBadLimits);
             continue;
@@ -179,8 +190,8 @@ TEST_CASE("AxisMove under a jerk limit, random limits: planned or refused, and e
             const AxisLimits& lim = l.axis[0];
             ok = check_axis_limits(v.cubic[0], v.timing, lim, l.tick_hz) == Status::kOk &&
                  check_axis_jerk(v.cubic[0], v.timing, lim, l.tick_hz) == Status::kOk &&
-                 check_acceleration_step(start_acceleration(v.cubic[0], v.timing), previous, lim, l.tick_hz) ==
-                     Status::kOk;
+                 check_acceleration_step(start_acceleration(v.cubic[0], v.timing), previous, lim,
+                                         l.tick_hz) == Status::kOk;
             previous = end_acceleration(v.cubic[0], v.timing);
         }
         INFO("span " << spans);

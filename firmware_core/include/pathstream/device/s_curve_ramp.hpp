@@ -60,8 +60,10 @@ struct SCurveRamp {
             extra_down = rest - extra_up;
         }
         // Saturated: a plateau of 2^31 knots and more is no ramp anyone plays.
-        const std::int64_t count = 2 * levels + plateau + (extra_up != 0 ? 1 : 0) + (extra_down != 0 ? 1 : 0) + 1;
-        spans = count < kMaxSpans ? static_cast<std::uint32_t>(count) : static_cast<std::uint32_t>(kMaxSpans);
+        const std::int64_t count =
+            2 * levels + plateau + (extra_up != 0 ? 1 : 0) + (extra_down != 0 ? 1 : 0) + 1;
+        spans = count < kMaxSpans ? static_cast<std::uint32_t>(count)
+                                  : static_cast<std::uint32_t>(kMaxSpans);
     }
 
     /// A (acceleration * n^2) at knot i (0..spans; 0 at both ends). Cost: a few divisions.
