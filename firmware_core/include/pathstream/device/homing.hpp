@@ -101,20 +101,10 @@ public:
         if (hz == 0) return Status::kBadLimits;
         s_curve_ = false;
         if (limits.axis[axis].max_jerk != 0) {
-            creep_limits(limits);
+            cap_by_jerk(limits);
             if (const Status st = plan_s_curve(start, velocity, limits); st != Status::kBadLimits) return st;
-            // No S-curve span length fits these limits: the constant-acceleration ramps below.
-            limits_ = limits;
-        }
-        // Under a jerk limit J the move accelerates at most at J/2 * 1 tick: every join then
-        // steps the acceleration by at most one tick of jerk (ramp to ramp, rest to ramp, ramp
-        // up to ramp down, the last ramp to the creep span), and the spans carry no jerk.
-        if (limits.axis[axis].max_jerk != 0) {
-            const std::uint64_t by_jerk =
-                static_cast<std::uint64_t>(limits.axis[axis].max_jerk) * kJerkUnitLsb / (2 * hz);
-            if (by_jerk < limits_.axis[axis].max_acceleration) {
-                limits_.axis[axis].max_acceleration = static_cast<std::uint32_t>(by_jerk);
-            }
+            // No S-curve span length fits these limits: the constant-acceleration ramps below,
+            // on limits_ as capped.
         }
         const AxisLimits& l = limits_.axis[axis];
         if (velocity > l.max_velocity) velocity = l.max_velocity;
@@ -326,9 +316,11 @@ private:
         return root + 1 < kMaxSpanTicks ? root + 1 : kMaxSpanTicks;
     }
 
-    // The creep span's limits under a jerk limit J: its acceleration at most J/2 * 1 tick, so
-    // that it steps the acceleration from and to rest by at most one tick of jerk.
-    void creep_limits(const MotionLimits<Axes>& limits) {
+    // limits_ under a jerk limit J: the axis's acceleration at most J/2 * 1 tick, for the spans
+    // that step it at their joins (the creep span from and to rest; under a jerk limit with no
+    // S-curve, every constant-acceleration span: ramp to ramp, rest to ramp, ramp up to ramp
+    // down), so that every step is at most one tick of jerk and the spans carry no jerk.
+    void cap_by_jerk(const MotionLimits<Axes>& limits) {
         const std::uint64_t by_jerk =
             static_cast<std::uint64_t>(limits.axis[axis_].max_jerk) * kJerkUnitLsb / (2 * std::uint64_t{limits.tick_hz});
         if (by_jerk < limits_.axis[axis_].max_acceleration) {

@@ -152,33 +152,15 @@ Status check_move_ends(const JerkMove<Axes>& move, const TickAcceleration (&star
 
 /// Every span of `move` within the velocity, acceleration and jerk limits, and every join
 /// within one tick of jerk: the first span's start against `start`, the last span's end
-/// against `end` (nullptr: rest). The status of the first rule broken (the end-acceleration
-/// rules of check_move_ends first, then the spans validated and checked whole).
+/// against `end` (nullptr: rest). The status of the first rule broken: the jerk and join
+/// rules of check_move_ends first (exactly the cubic's, from the Hermite values), then each
+/// span validated and checked against the velocity and acceleration limits.
 template <unsigned Axes>
 Status check_move(const JerkMove<Axes>& move, const TickAcceleration (&start)[Axes], const TickAcceleration* end,
                   const MotionLimits<Axes>& limits) {
     if (Status s = check_move_ends(move, start, end, limits); s != Status::kOk) return s;
-    TickAcceleration previous[Axes];
-    for (unsigned a = 0; a < Axes; ++a) previous[a] = start[a];
     for (unsigned i = 0; i < move.count; ++i) {
-        ValidatedSpan<Axes> v;
-        if (Status s = validate_span(move.span[i], v); s != Status::kOk) return s;
-        for (unsigned a = 0; a < Axes; ++a) {
-            const AxisLimits& l = limits.axis[a];
-            if (Status s = check_axis_limits(v.cubic[a], v.timing, l, limits.tick_hz); s != Status::kOk) return s;
-            if (Status s = check_axis_jerk(v.cubic[a], v.timing, l, limits.tick_hz); s != Status::kOk) return s;
-            if (Status s = check_acceleration_step(start_acceleration(v.cubic[a], v.timing), previous[a], l,
-                                                   limits.tick_hz);
-                s != Status::kOk) {
-                return s;
-            }
-            previous[a] = end_acceleration(v.cubic[a], v.timing);
-        }
-    }
-    for (unsigned a = 0; a < Axes; ++a) {
-        const Status s = end == nullptr ? check_end_at_rest(previous[a], limits.axis[a], limits.tick_hz)
-                                        : check_acceleration_step(end[a], previous[a], limits.axis[a], limits.tick_hz);
-        if (s != Status::kOk) return s;
+        if (Status s = stop_detail::check_span(move.span[i], limits); s != Status::kOk) return s;
     }
     return Status::kOk;
 }
