@@ -109,10 +109,12 @@ struct Flood {
             }
         });
     }
-    ~Flood() {
+    // Stops opening connections; after it, `opened` is final.
+    void finish() {
         stop = true;
-        thread.join();
+        if (thread.joinable()) thread.join();
     }
+    ~Flood() { finish(); }
 };
 
 // The device ticked and served on its own thread, real time; the longest gap between two
@@ -172,7 +174,16 @@ TEST_CASE("a slow client and a connection flood do not disturb a stream",
     host::StreamOptions o;
     o.target = "modbus-tcp://127.0.0.1:" + std::to_string(port) + "?unit=1";
     const host::StreamReport report = host::stream_modbus(job.plan, job.machine, o);
+    // A connect returns once the kernel has queued it, before the server's accept: stop the
+    // flood, then give the still-serving device a bounded time to accept what was queued.
+    flood.finish();
     const int flooded = flood.opened;
+    const auto accept_deadline = Clock::now() + std::chrono::seconds(5);
+    while (dt.server->counters().connections_accepted.load() <
+               static_cast<std::uint64_t>(flooded) + 2 &&
+           Clock::now() < accept_deadline) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
     const int dribbled = slow.replies;
     dt.stop = true;
     dt.thread.join();
