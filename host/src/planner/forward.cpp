@@ -92,6 +92,7 @@ public:
             }
             Knot next;
             std::uint32_t ticks = corner_landing(k, next);
+            if (ticks == 0) ticks = dip_landing(k, next);
             for (std::uint32_t m = n_; m >= (short_spans ? 1u : n_) && ticks == 0; --m) {
                 if (step(k, m, next)) ticks = m;
             }
@@ -375,7 +376,7 @@ private:
     /// the tangents), and the junction with the span before (`in`). <= 0: within.
     /// Relative: the check is ratio - 1. The knots are on the LSB grid, k1.v rounded for this
     /// span; k0's velocity is rounded for it here, so this is the span the device runs.
-    double violation(const Knot& k0, const Arrival& in, const Knot& k1, std::uint32_t m) const {
+    double violation(const Knot& k0, const Arrival& in, const Knot& k1, std::uint32_t m, bool caps = true) const {
         const double tau = m * tick_;
         const Vec v0 = span_velocity(k0.v, m);
         const Vec &q0 = k0.q, &q1 = k1.q, &v1 = k1.v;
@@ -407,6 +408,7 @@ private:
             const double cap = interpolate(caps_, std::clamp(k0.lambda + k0.speed * t + 0.5 * acc * t * t,
                                                              k0.lambda, std::max(k0.lambda, k1.lambda)));
             worst = std::max(worst, speed / feed_);
+            if (!caps) continue;
             if (cap > 0) worst = std::max(worst, speed / std::sqrt(cap));
             else if (speed > 0) worst = std::max(worst, 2.0);
         }
@@ -594,6 +596,68 @@ private:
         return 0;
     }
 
+    /// A knot on the next binding dip of beta (a node where beta has a local minimum well
+    /// below the current speed: the start of a corner blend, a tight bend) at beta's speed
+    /// there, reached by constant-acceleration spans: j ticks at one acceleration (taken now
+    /// for at most ticks_per_span of them) and a landing span of m ticks; the fewest j + m
+    /// first, so the dip is reached as early as possible. Returns the ticks of the span taken
+    /// now (0: no dip or no such approach; take a regular span).
+    std::uint32_t dip_landing(const Knot& k, Knot& out) {
+        constexpr std::uint32_t kSpansAhead = 3;
+        const double tau_n = n_ * tick_, horizon = kSpansAhead * tau_n;
+        const double reach = k.speed * horizon + 0.5 * acc_norm_ * horizon * horizon;
+        std::size_t c = 0;
+        bool found = false;
+        for (std::size_t i = std::max(interval(k.lambda), piece_.first + 1);
+             i + 2 <= piece_.last && g_.lambda[i] <= k.lambda + reach; ++i) {
+            // A joint where the curvature steps up (a blend's start, a line entering an arc) and
+            // beta rises after it: landing where beta keeps falling would leave the next spans
+            // on its boundary with no room to follow it in whole ticks.
+            const bool step_up = g_.lambda[i + 1] == g_.lambda[i] && g_.curvature_norm[i + 1] > 2 * g_.curvature_norm[i] + 1e-9;
+            if (step_up && g_.lambda[i] > k.lambda + 1e-9 && g_.lambda[i] < end_lambda_ - 1e-9 && beta_[i] < beta_[i - 1] &&
+                beta_[i] <= beta_[i + 1] && beta_[i + 1] < beta_[i + 2] && beta_[i] < caps_[i] && beta_[i] > 0) {
+                c = i;
+                found = true;
+                break;
+            }
+        }
+        if (!found) return 0;
+        const double lc = g_.lambda[c], xc = beta_[c], vt = std::sqrt(xc);
+        const Vec dir(g_.tangent[c]);
+        const double d_all = lc - k.lambda;
+        const Arrival saved = arrival_;
+        Knot direct;
+        const std::uint32_t direct_ticks = land_on_corner(k, c, dir, xc, direct);
+        for (std::uint32_t total = 1; total <= (kSpansAhead + 1) * n_; ++total) {
+            if (total == direct_ticks) {
+                out = direct;
+                return total;
+            }
+            for (std::uint32_t j = std::min(kSpansAhead * n_, total - 1); j >= 1 && total - j <= n_; --j) {
+                const double tj = j * tick_, tm = (total - j) * tick_;
+                const double a = (d_all - k.speed * tj - (k.speed + vt) * tm / 2) / (tj * tj / 2 + tj * tm / 2);
+                if (k.speed + a * tj < 0 || std::fabs(a) > 1.5 * acc_norm_) continue;
+                const std::uint32_t now_ticks = std::min(j, n_);
+                if (!under_beta(k, a, now_ticks * tick_)) continue;
+                Candidate c1 = evaluate(k, a, now_ticks);
+                if (c1.f > 0 || !(c1.end.lambda < lc - 1e-9)) continue;
+                if (j > n_) {
+                    out = c1.end;
+                    return now_ticks;
+                }
+                arrival_ = Arrival{k, j};
+                Knot e;
+                const std::uint32_t m = land_on_corner(c1.end, c, dir, xc, e);
+                arrival_ = saved;
+                if (m > 0) {
+                    out = c1.end;
+                    return j;
+                }
+            }
+        }
+        return 0;
+    }
+
     /// One span from k that ends exactly on corner node c (velocity along dir, speed^2 <= xc):
     /// the fewest ticks that work. Its speed is the constant-acceleration one, or xc where that
     /// is faster (then the cubic is not of constant path acceleration; it is checked as is).
@@ -723,8 +787,15 @@ private:
     bool finish_ok(const Knot& k, const Arrival& in, std::uint32_t ticks) {
         const double tau = ticks * tick_;
         const Vec v0 = span_velocity(k.v, ticks);
-        if (violation(k, in, end_knot(), ticks) > 0) return false;
+        // A creep from rest over the last half tolerance of the piece runs along its chord, and
+        // every point of that chord is within half the remaining length of the path: the speed
+        // caps (tolerance and span fit at a curvature peak of a few micrometres, which fall to
+        // hundredths of a mm/s) say nothing about it, as for a piece within the tolerance.
+        bool creep = end_lambda_ - k.lambda <= 0.5 * delta_;
+        for (std::size_t i = 0; i < axes_ && creep; ++i) creep = v0[i] == 0;
+        if (violation(k, in, end_knot(), ticks, !creep) > 0) return false;
         if (span_deviation(k, end_knot(), ticks) > deviation_limit_) return false;
+        if (creep) return true;
         // Under the speed caps along the way (corners, feed, chord tolerance): the cubic's speed
         // at eighths of the span against the cap where its point projects onto the chord. (Its
         // accelerations, the bends included, were checked above on the cubic itself.)
@@ -766,7 +837,11 @@ private:
         const double d = end_lambda_ - k.lambda;
         double lo_f, hi_f;
         if (d > (k.speed * tick_ + acc_norm_ * tick_ * tick_) * n_ * n_) return 0;  // far away
-        if (k.speed > 0) {
+        // A knot whose velocity rounds to no motion on the grid starts the final span from rest.
+        const Vec v_grid = span_velocity(k.v, n_);
+        bool moving = false;
+        for (std::size_t i = 0; i < axes_; ++i) moving = moving || v_grid[i] != 0;
+        if (k.speed > 0 && moving) {
             const double kc = 2 * d / (k.speed * tick_);  // ticks at constant deceleration
             lo_f = std::floor(0.75 * kc);
             hi_f = std::ceil(1.5 * kc) + 1;
