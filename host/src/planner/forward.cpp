@@ -486,10 +486,17 @@ private:
         const Vec v0 = span_velocity(k.v, m);
         const double len = end.lambda - k.lambda;
         double kappa = 0;
-        bool corner = false;
+        bool corner = false, curvature_step = false;
         for (std::size_t i = interval(k.lambda); i <= piece_.last && g_.lambda[i] <= end.lambda + 1e-12; ++i) {
             kappa = std::max(kappa, g_.curvature_norm[i]);
-            if (i + 1 <= piece_.last) kappa = std::max(kappa, g_.curvature_norm[i + 1]);
+            if (i + 1 <= piece_.last) {
+                kappa = std::max(kappa, g_.curvature_norm[i + 1]);
+                // A joint where the curvature jumps (a blend's ends): the cubic's distance
+                // from the path has a kink there, which samples at sixths can straddle.
+                curvature_step = curvature_step || (g_.lambda[i + 1] == g_.lambda[i] &&
+                                                    std::fabs(g_.curvature_norm[i + 1] - g_.curvature_norm[i]) >
+                                                        0.5 * std::max(g_.curvature_norm[i], g_.curvature_norm[i + 1]));
+            }
             corner = corner || g_.corner[i] != 0;
         }
         const Vec chord = sub(end.q, k.q);
@@ -502,8 +509,11 @@ private:
         if (!corner && !swings && len * len * kappa / 8 < delta_ / 64) return 0;
         double worst = 0;
         std::size_t h = hint_;
-        for (int s = 1; s < 6; ++s) {
-            const double w = s / 6.0, w2 = w * w, w3 = w2 * w;
+        // At sixths of the span; where it crosses a corner or a curvature step, at every tick
+        // too (up to 24 samples), as check_plan measures it.
+        const int samples = corner || curvature_step ? static_cast<int>(std::clamp<std::uint32_t>(m, 6, 24)) : 6;
+        for (int s = 1; s < samples; ++s) {
+            const double w = static_cast<double>(s) / samples, w2 = w * w, w3 = w2 * w;
             const double h00 = 2 * w3 - 3 * w2 + 1, h10 = w3 - 2 * w2 + w, h01 = -2 * w3 + 3 * w2, h11 = w3 - w2;
             Vec x{};
             for (std::size_t i = 0; i < axes_; ++i) {
