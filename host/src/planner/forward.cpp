@@ -570,27 +570,10 @@ private:
         if (const std::uint32_t m = land_on_corner(k, c, dir, xc, out)) return m;
         // Too near (or too fast) to land from here: a regular span of fewer ticks first, from
         // whose end the landing works (the landing itself is taken at the next knot).
-        const Arrival saved = arrival_;
         // Two spans, j then m ticks, the first with the constant path acceleration that lets the
         // second (also of constant acceleration) arrive at the corner speed: fewest ticks first.
-        const double d_all = lc - k.lambda, vt = std::sqrt(xc);
-        for (std::uint32_t total = 2; total <= 2 * n_; ++total) {
-            for (std::uint32_t j = std::min(n_, total - 1); j >= 1 && total - j <= n_; --j) {
-                const double tj = j * tick_, tm = (total - j) * tick_;
-                const double a = (d_all - k.speed * tj - (k.speed + vt) * tm / 2) / (tj * tj / 2 + tj * tm / 2);
-                if (k.speed + a * tj < 0 || std::fabs(a) > 1.5 * acc_norm_ || !under_beta(k, a, tj)) continue;
-                Candidate c1 = evaluate(k, a, j);
-                if (c1.f > 0 || !(c1.end.lambda < lc - 1e-9)) continue;
-                arrival_ = Arrival{k, j};
-                Knot e;
-                const std::uint32_t m = land_on_corner(c1.end, c, dir, xc, e);
-                arrival_ = saved;
-                if (m > 0) {
-                    out = c1.end;
-                    return j;
-                }
-            }
-        }
+        if (const std::uint32_t j = approach(k, c, dir, xc, 1, 0, Knot{}, out)) return j;
+        const Arrival saved = arrival_;
         for (std::uint32_t j = n_; j >= 1; --j) {
             Knot mid;
             if (!step(k, j, mid) || !(mid.lambda < lc - 1e-9)) continue;
@@ -606,12 +589,11 @@ private:
         return 0;
     }
 
-    /// A knot on the next binding dip of beta (a node where beta has a local minimum well
-    /// below the current speed: the start of a corner blend, a tight bend) at beta's speed
-    /// there, reached by constant-acceleration spans: j ticks at one acceleration (taken now
-    /// for at most ticks_per_span of them) and a landing span of m ticks; the fewest j + m
-    /// first, so the dip is reached as early as possible. Returns the ticks of the span taken
-    /// now (0: no dip or no such approach; take a regular span).
+    /// A knot on the next binding dip of beta (a joint where the curvature steps up, beta is
+    /// under the cap and rises after it: the start of a corner blend, a line entering an arc)
+    /// at beta's speed there, reached by constant-acceleration spans within three regular spans (approach): the
+    /// fewest ticks first, so the dip is reached as early as possible. Returns the ticks of the
+    /// span taken now (0: no dip or no such approach; take a regular span).
     std::uint32_t dip_landing(const Knot& k, Knot& out) {
         constexpr std::uint32_t kSpansAhead = 3;
         const double tau_n = n_ * tick_, horizon = kSpansAhead * tau_n;
@@ -632,25 +614,35 @@ private:
             }
         }
         if (!found) return 0;
-        const double lc = g_.lambda[c], xc = beta_[c], vt = std::sqrt(xc);
         const Vec dir(g_.tangent[c]);
-        const double d_all = lc - k.lambda;
-        const Arrival saved = arrival_;
         Knot direct;
-        const std::uint32_t direct_ticks = land_on_corner(k, c, dir, xc, direct);
-        for (std::uint32_t total = 1; total <= (kSpansAhead + 1) * n_; ++total) {
+        const std::uint32_t direct_ticks = land_on_corner(k, c, dir, beta_[c], direct);
+        return approach(k, c, dir, beta_[c], kSpansAhead, direct_ticks, direct, out);
+    }
+
+    /// The first span of the fewest ticks j + m that reach node c at speed^2 xc along dir: one
+    /// constant path acceleration over j <= spans_ahead * ticks_per_span ticks (taken now for at
+    /// most ticks_per_span of them; the rest is solved again at the next knot), then a landing
+    /// span of m <= ticks_per_span ticks (land_on_corner; `direct`, of `direct_ticks` ticks, is
+    /// the landing from k itself, 0 for none). Where j fits in one span the landing after it is
+    /// checked now. Returns the ticks of the span taken (0: none).
+    std::uint32_t approach(const Knot& k, std::size_t c, const Vec& dir, double xc, std::uint32_t spans_ahead,
+                           std::uint32_t direct_ticks, const Knot& direct, Knot& out) {
+        const double d_all = g_.lambda[c] - k.lambda, vt = std::sqrt(xc);
+        const Arrival saved = arrival_;
+        for (std::uint32_t total = 1; total <= (spans_ahead + 1) * n_; ++total) {
             if (total == direct_ticks) {
                 out = direct;
                 return total;
             }
-            for (std::uint32_t j = std::min(kSpansAhead * n_, total - 1); j >= 1 && total - j <= n_; --j) {
+            for (std::uint32_t j = std::min(spans_ahead * n_, total - 1); j >= 1 && total - j <= n_; --j) {
                 const double tj = j * tick_, tm = (total - j) * tick_;
                 const double a = (d_all - k.speed * tj - (k.speed + vt) * tm / 2) / (tj * tj / 2 + tj * tm / 2);
                 if (k.speed + a * tj < 0 || std::fabs(a) > 1.5 * acc_norm_) continue;
                 const std::uint32_t now_ticks = std::min(j, n_);
                 if (!under_beta(k, a, now_ticks * tick_)) continue;
                 Candidate c1 = evaluate(k, a, now_ticks);
-                if (c1.f > 0 || !(c1.end.lambda < lc - 1e-9)) continue;
+                if (c1.f > 0 || !(c1.end.lambda < g_.lambda[c] - 1e-9)) continue;
                 if (j > n_) {
                     out = c1.end;
                     return now_ticks;
