@@ -373,7 +373,8 @@ private:
     /// axes of |acceleration| / limit (exact: it is linear in a cubic, so its ends bound it) and
     /// peak |velocity| / limit (exact: at the ends or where the acceleration crosses 0), and the
     /// speed at eighths of the span over the feed and the speed cap there (less the rounding of
-    /// the tangents), and the junction with the span before (`in`). <= 0: within.
+    /// the tangents; with `caps` false only the feed), and the junction with the span before
+    /// (`in`). <= 0: within.
     /// Relative: the check is ratio - 1. The knots are on the LSB grid, k1.v rounded for this
     /// span; k0's velocity is rounded for it here, so this is the span the device runs.
     double violation(const Knot& k0, const Arrival& in, const Knot& k1, std::uint32_t m, bool caps = true) const {
@@ -591,9 +592,9 @@ private:
 
     /// A knot on the next binding dip of beta (a joint where the curvature steps up, beta is
     /// under the cap and rises after it: the start of a corner blend, a line entering an arc)
-    /// at beta's speed there, reached by constant-acceleration spans within three regular spans (approach): the
-    /// fewest ticks first, so the dip is reached as early as possible. Returns the ticks of the
-    /// span taken now (0: no dip or no such approach; take a regular span).
+    /// at beta's speed there, reached by constant-acceleration spans within three regular
+    /// spans (approach): the fewest ticks first, so the dip is reached as early as possible.
+    /// Returns the ticks of the span taken now (0: no dip or no such approach).
     std::uint32_t dip_landing(const Knot& k, Knot& out) {
         constexpr std::uint32_t kSpansAhead = 3;
         const double tau_n = n_ * tick_, horizon = kSpansAhead * tau_n;
