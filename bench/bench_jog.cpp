@@ -17,6 +17,7 @@
 #include <cstring>
 #include <string>
 
+#include "core/s_curve_reference.hpp"
 #include "pathstream/device/homing.hpp"
 
 namespace {
@@ -36,25 +37,6 @@ MotionLimits<kAxes> plotter(std::uint32_t max_jerk) {
         a.max_jerk = max_jerk;
     }
     return l;
-}
-
-// Seconds of the time-optimal rest-to-rest S-curve over `distance` at up to v, a, j.
-double optimal_seconds(double distance, double v, double a, double j) {
-    double time = 0;
-    const auto ramp = [&](double peak_speed) {  // one ramp to peak_speed: its distance
-        const double t_jerk = std::min(a / j, std::sqrt(peak_speed / j));
-        const double t_const = std::max(0.0, peak_speed / (j * t_jerk) - t_jerk);
-        time = 2 * t_jerk + t_const;
-        return peak_speed * time / 2;
-    };
-    if (2 * ramp(v) <= distance) return 2 * time + (distance - 2 * ramp(v)) / v;
-    double lo = 0, hi = v;
-    for (int i = 0; i < 200; ++i) {
-        const double mid = 0.5 * (lo + hi);
-        (2 * ramp(mid) <= distance ? lo : hi) = mid;
-    }
-    ramp(lo);
-    return 2 * time;
 }
 
 struct Run {
@@ -142,7 +124,7 @@ int main(int argc, char** argv) {
             const Run b = run(distance, 100000, baseline, limits);
             const double jerk_mm = max_jerk * 100.0 * 1e-3;
             const double optimum =
-                optimal_seconds(static_cast<double>(distance) * 1e-3, 100, 3000, jerk_mm);
+                test::s_curve_seconds(static_cast<double>(distance) * 1e-3, 100, 3000, jerk_mm);
             const double seconds = static_cast<double>(s.ticks) / limits.tick_hz;
             const double base = static_cast<double>(b.ticks) / limits.tick_hz;
             if (!s.ok || !b.ok) failed = true;

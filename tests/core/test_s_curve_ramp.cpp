@@ -10,6 +10,7 @@
 #include <random>
 
 #include "core/property_settings.hpp"
+#include "core/s_curve_reference.hpp"
 #include "pathstream/device/homing.hpp"
 #include "pathstream/device/s_curve_ramp.hpp"
 
@@ -49,27 +50,6 @@ namespace {
 
 constexpr unsigned kAxes = 2;
 
-// Ticks of the time-optimal S-curve over `distance` (LSB) at up to v, a, j (per second), rest to
-// rest (a symmetric profile whose cruise, where it has one, is at v; shorter moves never reach
-// it: the largest peak speed that fits, by bisection).
-double s_curve_ticks(double distance, double v, double a, double j, double hz) {
-    const auto ramp = [&](double peak_speed, double& time) {  // one ramp to peak_speed: distance
-        const double t_jerk = std::min(a / j, std::sqrt(peak_speed / j));
-        const double t_const = std::max(0.0, peak_speed / (j * t_jerk) - t_jerk);
-        time = 2 * t_jerk + t_const;
-        return peak_speed * time / 2;
-    };
-    double time = 0;
-    if (2 * ramp(v, time) <= distance) return (2 * time + (distance - 2 * ramp(v, time)) / v) * hz;
-    double lo = 0, hi = v;
-    for (int i = 0; i < 100; ++i) {
-        const double mid = 0.5 * (lo + hi);
-        (2 * ramp(mid, time) <= distance ? lo : hi) = mid;
-    }
-    ramp(lo, time);
-    return 2 * time * hz;
-}
-
 }  // namespace
 
 TEST_CASE("AxisMove under a jerk limit: S-curves within 1.4x of the optimal S-curve's ticks",
@@ -92,8 +72,10 @@ TEST_CASE("AxisMove under a jerk limit: S-curves within 1.4x of the optimal S-cu
             std::uint64_t ticks = 0;
             WireSpan w;
             while (move.next(w)) ticks += w.ticks;
-            const double optimum = s_curve_ticks(static_cast<double>(std::llabs(distance)), 100000,
-                                                 3000000, max_jerk * 100.0, 1000);
+            const double optimum =
+                test::s_curve_seconds(static_cast<double>(std::llabs(distance)), 100000, 3000000,
+                                      max_jerk * 100.0) *
+                1000;
             INFO("max_jerk " << max_jerk << " distance " << distance << ": " << ticks
                              << " ticks, optimum " << optimum);
             CHECK(ticks <= 1.4 * optimum);

@@ -222,12 +222,8 @@ private:
         // Reachable only if the end is within two spans at the current speed plus full
         // acceleration; cheap test first.
         if (d > v * 2 * tau + acc_norm_ * 2 * tau * tau) return 0;
-        double lim = acc_norm_;
         std::size_t h = hint_;
-        const Vec t_end = path_at(pg_, piece_, end_lambda_, h).t;
-        for (std::size_t i = 0; i < axes_; ++i) {
-            if (std::fabs(t_end[i]) > 1e-12) lim = std::min(lim, acc_[i] / std::fabs(t_end[i]));
-        }
+        const double lim = path_acceleration_limit(path_at(pg_, piece_, end_lambda_, h).t);
         for (std::uint32_t f = 1; f <= n_; ++f) {
             const double tf = f * tick_;
             double lo = std::max(-lim, -v / tau), hi = lim;  // the first span, and V' >= 0
@@ -286,6 +282,23 @@ private:
         if (!(l1 > l0)) return std::min(v[i], v[i + 1]);
         const double w = std::clamp((lambda - l0) / (l1 - l0), 0.0, 1.0);
         return (1 - w) * v[i] + w * v[i + 1];
+    }
+
+    /// The largest path acceleration the axes allow along unit tangent t (no curvature): the
+    /// smallest a_i / |t_i|.
+    double path_acceleration_limit(const Vec& t) const {
+        double lim = acc_norm_;
+        for (std::size_t i = 0; i < axes_; ++i) {
+            if (std::fabs(t[i]) > 1e-12) lim = std::min(lim, acc_[i] / std::fabs(t[i]));
+        }
+        return lim;
+    }
+
+    /// Nodes i and i + 1 are the two sides of a joint whose curvature jumps by more than a
+    /// factor of 2 (a blend's ends, a line meeting an arc).
+    bool curvature_jump(std::size_t i) const {
+        const double before = g_.curvature_norm[i], after = g_.curvature_norm[i + 1];
+        return g_.lambda[i + 1] == g_.lambda[i] && std::max(before, after) > 2 * std::min(before, after) + 1e-9;
     }
 
     /// The lookahead's bound on x = s^2 at arc length l: beta interpolated linearly in x, as
@@ -496,11 +509,9 @@ private:
             kappa = std::max(kappa, g_.curvature_norm[i]);
             if (i + 1 <= piece_.last) {
                 kappa = std::max(kappa, g_.curvature_norm[i + 1]);
-                // A joint where the curvature jumps (a blend's ends): the cubic's distance
-                // from the path has a kink there, which samples at sixths can straddle.
-                curvature_step = curvature_step || (g_.lambda[i + 1] == g_.lambda[i] &&
-                                                    std::fabs(g_.curvature_norm[i + 1] - g_.curvature_norm[i]) >
-                                                        0.5 * std::max(g_.curvature_norm[i], g_.curvature_norm[i + 1]));
+                // The cubic's distance from the path has a kink there, which samples at sixths
+                // can straddle.
+                curvature_step = curvature_step || curvature_jump(i);
             }
             corner = corner || g_.corner[i] != 0;
         }
@@ -610,7 +621,7 @@ private:
             // A joint where the curvature steps up (a blend's start, a line entering an arc) and
             // beta rises after it: landing where beta keeps falling would leave the next spans
             // on its boundary with no room to follow it in whole ticks.
-            const bool step_up = g_.lambda[i + 1] == g_.lambda[i] && g_.curvature_norm[i + 1] > 2 * g_.curvature_norm[i] + 1e-9;
+            const bool step_up = curvature_jump(i) && g_.curvature_norm[i + 1] > g_.curvature_norm[i];
             if (step_up && g_.lambda[i] > k.lambda + 1e-9 && g_.lambda[i] < end_lambda_ - 1e-9 && beta_[i] < beta_[i - 1] &&
                 beta_[i] <= beta_[i + 1] && beta_[i + 1] < beta_[i + 2] && beta_[i] < caps_[i] && beta_[i] > 0) {
                 c = i;
@@ -622,7 +633,9 @@ private:
         const Vec dir(g_.tangent[c]);
         Knot direct;
         const std::uint32_t direct_ticks = land_on_corner(k, c, dir, beta_[c], direct);
-        return approach(k, c, dir, beta_[c], kSpansAhead, direct_ticks, direct, out);
+        const std::uint32_t ticks = approach(k, c, dir, beta_[c], kSpansAhead, direct_ticks, direct, out);
+        on_dip_ = ticks != 0 && out.lambda == g_.lambda[c];  // landed (an approach span ends before it)
+        return ticks;
     }
 
     /// Leaving a dip: the curve ahead holds the path acceleration down only while it lasts, so
@@ -634,10 +647,7 @@ private:
         const double tau = n_ * tick_;
         Knot best;
         bool have = step(k, n_, best);
-        double lim = acc_norm_;
-        for (std::size_t i = 0; i < axes_; ++i) {
-            if (std::fabs(k.v[i]) > 1e-12 && k.speed > 0) lim = std::min(lim, acc_[i] * k.speed / std::fabs(k.v[i]));
-        }
+        const double lim = k.speed > 0 ? path_acceleration_limit(scaled(k.v, 1 / k.speed)) : acc_norm_;
         // J tau = 2 f lim: the end acceleration up to 2 lim above the start's (the set scaled
         // to a largest f of 0.5, 1.5, 2 or 3 was not better on the bench's corner paths; f = 1
         // and 0.5 alone lose 0.04 s on the 1,000-segment spiral).
@@ -717,7 +727,6 @@ private:
         for (std::uint32_t total = 1; total <= (spans_ahead + 1) * n_; ++total) {
             if (total == direct_ticks) {
                 out = direct;
-                on_dip_ = spans_ahead > 1;
                 return total;
             }
             for (std::uint32_t j = std::min(spans_ahead * n_, total - 1); j >= 1 && total - j <= n_; --j) {
