@@ -8,12 +8,14 @@
 // (default 1); e.g. PATHSTREAM_HARD_PATH_CASES=5000 for a long run.
 #include <catch2/catch.hpp>
 
+#include <array>
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
 #include <random>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "pathstream/host/geometry.hpp"
 #include "pathstream/host/machine.hpp"
@@ -251,4 +253,72 @@ TEST_CASE("the cusp of a B-spline that turns back by one LSB plans", "[planner]"
     const PlanCheck check = check_plan(plan, segs, p);
     CHECK(check.within_limits);
     CHECK(check.max_deviation <= p.chord_tolerance + 1.5 * std::sqrt(2.0) * p.mm_per_lsb);
+}
+
+namespace {
+
+/// A 2-axis profile of the every-path test's random kind (feeds and pen delays the pen
+/// plotter's).
+MachineProfile random_kind_profile(double vx, double ax, double vy, double ay, double tick_hz, std::uint32_t ticks,
+                                   double lsb, double tolerance) {
+    MachineProfile p = pen_plotter();
+    p.axes = {{"x", vx, ax}, {"y", vy, ay}};
+    p.tick_hz = tick_hz;
+    p.ticks_per_span = ticks;
+    p.mm_per_lsb = lsb;
+    p.chord_tolerance = tolerance;
+    return p;
+}
+
+/// Plans one subpath of `basis` through `points` and checks the plan exactly.
+void plans_within_limits(PathBasis basis, const std::vector<std::array<double, 2>>& points, const MachineProfile& p) {
+    Path path;
+    path.axes = 2;
+    Subpath s;
+    s.basis = basis;
+    for (const auto& q : points) s.points.push_back({q[0], q[1]});
+    path.subpaths.push_back(s);
+    const auto segs = to_bezier_segments(path);
+    Plan plan;
+    REQUIRE_NOTHROW(plan = plan_path(segs, p));
+    const PlanCheck check = check_plan(plan, segs, p);
+    CHECK(check.within_limits);
+    CHECK(check.max_deviation <= p.chord_tolerance + 1.5 * std::sqrt(2.0) * p.mm_per_lsb);
+    CHECK(check.ticks_checked == plan.total_ticks + 1);
+}
+
+}  // namespace
+
+TEST_CASE("a loop of a few micrometres inside one grid interval plans", "[planner]") {
+    // Seed 8 case 113 of the test above: between two grid nodes a quarter of the segment apart
+    // the tangent turns out by half a radian and back (radius down to 3 um), while the two
+    // nodes' tangents differ by 0.07 rad. The grid saw no turn there, its speed caps rose
+    // linearly to 57 mm/s over the loop, and every span from the knot before it left the path
+    // by twice the tolerance.
+    const MachineProfile p = random_kind_profile(111.02103887229889, 4294.2129554502199, 56.503917638076516,
+                                                 12854.06781548477, 1454.8589791363199, 5, 0.00016975209374201194,
+                                                 0.0042628057302861446);
+    plans_within_limits(PathBasis::kBezier,
+                        {{{34.70008163174623, 17.558419394569494}},
+                         {{35.60085488969719, 16.699240134195296}},
+                         {{35.00752591797628, 17.571838528769476}},
+                         {{35.28110379091141, 16.5785050640717}}},
+                        p);
+}
+
+TEST_CASE("a near-cusp nanometres before a stop does not hold the motion back", "[planner]") {
+    // Seed 9 case 902 of the test above: the Catmull-Rom curve turns back 0.7 um after two
+    // points, a stop; the curvature peak of its tip (speed caps of 1e-5 mm/s) lies 4e-8 mm
+    // before it. Approached as a dip, it held the lookahead at 0.1 mm/s over the 0.27 mm
+    // before it, where no span of 64 whole ticks could follow.
+    const MachineProfile p = random_kind_profile(487.10592378016628, 19231.814146973658, 108.03495770733767,
+                                                 1253.0545145051228, 3818.3933662542127, 11, 0.0018023457700472166,
+                                                 0.024522971390821446);
+    plans_within_limits(PathBasis::kCatmullRom,
+                        {{{4.540303971707901, 25.219321150707678}},
+                         {{31.87338387319543, 36.962707079188526}},
+                         {{0.5529870584445081, 24.885761113571156}},
+                         {{11.283283958180752, 12.020744427191396}},
+                         {{11.28388726972956, 12.020075003750085}}},
+                        p);
 }

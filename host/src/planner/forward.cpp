@@ -583,7 +583,10 @@ private:
         const double dn = norm(dir);
         if (!(dn > 1e-9)) return 0;
         dir = scaled(dir, 1 / dn);
-        if (const std::uint32_t m = land_on_corner(k, c, dir, xc, out)) return m;
+        if (const std::uint32_t m = land_on_corner(k, c, dir, xc, out)) {
+            on_dip_ = true;  // the span leaving the turn may raise its acceleration too (leave_dip)
+            return m;
+        }
         // Too near (or too fast) to land from here: a regular span of fewer ticks first, from
         // whose end the landing works (the landing itself is taken at the next knot).
         // Two spans, j then m ticks, the first with the constant path acceleration that lets the

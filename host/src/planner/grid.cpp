@@ -80,6 +80,24 @@ std::vector<double> segment_nodes(const Cubic& c, double length, const PlanOptio
         double a, b;
         Vec ta, tb;  ///< tangent after a, before b
     };
+    // The end tangents alone miss a turn that goes out and comes back inside the interval (a
+    // loop a few micrometres across, whose caps the nodes would not see). q' over [a, b] is a
+    // quadratic Bezier with control points q'(a), q'(a) + (b - a) q''(a) / 2, q'(b), and every
+    // tangent inside lies in the cone they span: if the two angles of that control polygon
+    // (taken from the end tangents) add up to at most max_turn, no two tangents inside differ
+    // by more.
+    const auto turns_inside = [&](double a, double b, const Vec& ta, const Vec& tb) {
+        const Vec d1 = c.d1(a), d2 = c.d2(a);
+        Vec h1{};
+        for (std::size_t i = 0; i < kAxesMax; ++i) h1[i] = d1[i] + 0.5 * (b - a) * d2[i];
+        const double n1 = norm(h1);
+        if (!(n1 > 0)) return false;
+        // cos(alpha + beta) against cos(max_turn), without acos (this runs for every interval);
+        // an angle over 90 degrees bisects at once, so alpha + beta < pi below.
+        const double ca = std::clamp(dot(ta, h1) / n1, -1.0, 1.0), cb = std::clamp(dot(h1, tb) / n1, -1.0, 1.0);
+        if (ca < 0 || cb < 0) return true;
+        return ca * cb - std::sqrt((1 - ca * ca) * (1 - cb * cb)) < cos_max_turn;
+    };
     std::vector<double> out;
     std::vector<Interval> stack;  // intervals still to examine, last first
     Sides right = sides(1.0);
@@ -95,7 +113,7 @@ std::vector<double> segment_nodes(const Cubic& c, double length, const PlanOptio
         const Interval in = stack.back();
         stack.pop_back();
         const double cos_turn = std::clamp(dot(in.ta, in.tb), -1.0, 1.0);
-        if (cos_turn < cos_max_turn) {
+        if (cos_turn < cos_max_turn || turns_inside(in.a, in.b, in.ta, in.tb)) {
             if (in.b - in.a > 1e-7) {
                 const double m = 0.5 * (in.a + in.b);
                 const Sides mid = sides(m);

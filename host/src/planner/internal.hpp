@@ -241,14 +241,16 @@ void reserve_for_corners(const PathGrid& g, const Limits& limits, const std::vec
 /// 1 / tangential_margin times their acceleration. beta[last] = 0.
 /// With span_time > 0, dips of the speed caps (dip[k]: squared speed, scratch of the same size)
 /// are also approached no faster than spans of that duration can slow down from a knot
-/// (x = s^2 falling by at most 1.9 s / span_time per mm).
+/// (x = s^2 falling by at most 1.9 s / span_time per mm), except dips within `end_zone` mm of
+/// the piece's end: the motion stops there anyway, and the final span is checked against them.
 /// Incremental use: only nodes below `top` are recomputed (beta[top] must be valid), and the
 /// pass stops at the first node below `unchanged_below` whose value does not change. Returns
 /// the lowest node recomputed.
 std::size_t backward_pass(const PathGrid& g, const Piece& piece, const Limits& limits,
                           const std::vector<double>& accel_factor, double tangential_margin,
-                          const std::vector<double>& caps, double span_time, std::vector<double>& dip,
-                          std::vector<double>& beta, std::size_t top = static_cast<std::size_t>(-1),
+                          const std::vector<double>& caps, double span_time, double end_zone,
+                          std::vector<double>& dip, std::vector<double>& beta,
+                          std::size_t top = static_cast<std::size_t>(-1),
                           std::size_t unchanged_below = 0);
 
 /// TOPP-RA forward pass of one piece on its own grid (continuous time, piecewise constant path
@@ -303,6 +305,7 @@ struct WindowLookahead {
     const MachineProfile& profile;
     const PlanOptions& options;
     double span_time;
+    double end_zone;  ///< half an LSB: dips this close to a piece's end are its end (backward_pass)
     std::vector<double> base_caps, caps, local_factor, local_cap, corner_factor, factor, beta, dip;
 };
 

@@ -10,7 +10,8 @@ namespace pathstream::host::planner_detail {
 
 WindowLookahead::WindowLookahead(const PathGrid& grid, const Limits& lim, const MachineProfile& prof,
                                  const PlanOptions& opt)
-    : pg(grid), limits(lim), profile(prof), options(opt), span_time(prof.ticks_per_span / prof.tick_hz) {
+    : pg(grid), limits(lim), profile(prof), options(opt), span_time(prof.ticks_per_span / prof.tick_hz),
+      end_zone(0.5 * prof.mm_per_lsb) {
     const std::size_t n = pg.grid.size();
     base_caps = speed_caps(pg, limits, profile, options);
     if (limits.has_jerk()) jerk_caps(pg, limits, profile, jerk_setup(profile, limits).filter_ticks, base_caps);
@@ -46,7 +47,8 @@ PieceMotion plan_piece(WindowLookahead& la, const Piece& piece, const Vec& start
     // Knots already sent (a piece continued from the last window): never replanned.
     const double floor = carried != nullptr && !carried->spans.empty() ? carried->spans.back().end.lambda : -1.0;
     const auto resume_at = [&](double lambda) { return std::max(lambda, floor + 1e-9 * (1 + std::fabs(floor))); };
-    backward_pass(pg, piece, la.limits, la.factor, options.lookahead_margin, la.caps, la.span_time, la.dip, la.beta);
+    backward_pass(pg, piece, la.limits, la.factor, options.lookahead_margin, la.caps, la.span_time, la.end_zone, la.dip,
+                  la.beta);
     PieceMotion motion = forward_pass(pg, piece, la.limits, la.caps, la.beta, la.profile, options, start_q, carried,
                                       resume_at(g.lambda[piece.first]));
     // Retries are counted per place: a failure beyond the last one's window starts afresh
@@ -93,7 +95,7 @@ PieceMotion plan_piece(WindowLookahead& la, const Piece& piece, const Vec& start
             la.caps[k] = la.base_caps[k] * la.local_cap[k];
         }
         const std::size_t changed = backward_pass(pg, piece, la.limits, la.factor, options.lookahead_margin, la.caps,
-                                                  la.span_time, la.dip, la.beta, to + 1, from);
+                                                  la.span_time, la.end_zone, la.dip, la.beta, to + 1, from);
         const bool short_spans = retry >= 2 * options.max_local_retries / 3;
         // Knots in the interval ending at the first changed node interpolate its beta: resume
         // before that interval (never before what was sent).

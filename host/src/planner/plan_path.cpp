@@ -143,7 +143,7 @@ Plan plan_path(const std::vector<BezierSegment>& segments, const MachineProfile&
         std::vector<double> beta(pg.grid.size(), 0.0), dip(pg.grid.size(), 0.0);
         double t = 0;
         for (const Piece& piece : pg.pieces) {
-            backward_pass(pg, piece, machine, ones, 1.0, full_caps, 0.0, dip, beta);
+            backward_pass(pg, piece, machine, ones, 1.0, full_caps, 0.0, 0.0, dip, beta);
             t += topp_piece_time(pg, piece, machine, ones, beta);
         }
         stats->reference_motion_time = t;
