@@ -4,7 +4,7 @@
 // on random ones that the profile reader accepts. None may fail, and every plan passes the
 // exact per-tick check.
 //
-// Size: PATHSTREAM_HARD_PATH_CASES (default 60) cases from seed PATHSTREAM_HARD_PATH_SEED
+// Size: PATHSTREAM_HARD_PATH_CASES (default 200) cases from seed PATHSTREAM_HARD_PATH_SEED
 // (default 1); e.g. PATHSTREAM_HARD_PATH_CASES=5000 for a long run.
 #include <catch2/catch.hpp>
 
@@ -182,7 +182,7 @@ TEST_CASE("every accepted path plans: cusps, near-cusps, repeated points, tiny l
           "[planner][property]") {
     const char* env_cases = std::getenv("PATHSTREAM_HARD_PATH_CASES");
     const char* env_seed = std::getenv("PATHSTREAM_HARD_PATH_SEED");
-    const int cases = env_cases != nullptr ? std::atoi(env_cases) : 60;
+    const int cases = env_cases != nullptr ? std::atoi(env_cases) : 200;
     const unsigned long seed = env_seed != nullptr ? std::strtoul(env_seed, nullptr, 10) : 1;
     std::mt19937_64 rng(seed);
     const auto log_pick = [&](double lo, double hi) {
@@ -320,5 +320,61 @@ TEST_CASE("a near-cusp nanometres before a stop does not hold the motion back", 
                          {{0.5529870584445081, 24.885761113571156}},
                          {{11.283283958180752, 12.020744427191396}},
                          {{11.28388726972956, 12.020075003750085}}},
+                        p);
+}
+
+TEST_CASE(
+    "a straight line whose knots carry a short span's coarse tangent stays within the tolerance",
+    "[planner]") {
+    // Seed 7 case 1718 of the every-path test, down to one line: spans of a few ticks near the
+    // start round their tangents to 1-3 LSB, 20 degrees off the line, and a long span that
+    // carried such a tangent bulged 11.2 um from it (tolerance plus allowance 10.2 um) where
+    // the straight path let the deviation check be skipped.
+    const MachineProfile p = random_kind_profile(
+        86.109843706323787, 224.95429502410317, 47.071290370628489, 404.0956137956494,
+        1844.9144135113083, 7, 0.0031977467494345548, 0.0034149726530580942);
+    plans_within_limits(
+        PathBasis::kPolyline,
+        {{{19.293535157513258, 23.806025926399705}}, {{3.1549536824823203, 1.1921481761936856}}},
+        p);
+}
+
+TEST_CASE("a closed polyline whose long spans follow short ones stays within the tolerance",
+          "[planner]") {
+    // Seed 3 case 1646: the same bulge on a 61-tick span after 4-tick ones, 17.4 um on a
+    // 5.5 um tolerance.
+    const MachineProfile p = random_kind_profile(
+        86.65961914958757, 259.73459025693643, 36.576314336746783, 9271.1405432070023,
+        997.27120242969647, 5, 0.0049106194504247276, 0.0055158562405181995);
+    Path path;
+    path.axes = 2;
+    Subpath s;
+    s.basis = PathBasis::kPolyline;
+    s.closed = true;
+    s.points = {{19.98020472691209, 29.09674470821436},   {27.79901544539073, 9.393376419246971},
+                {10.044177381604145, 12.893232829264045}, {2.125612054571979, 1.6634117026053366},
+                {17.053020619161664, 1.0930209737898198}, {17.051529734108687, 1.0949718217094513},
+                {2.629569623377795, 22.471573902241598}};
+    path.subpaths.push_back(s);
+    const auto segs = to_bezier_segments(path);
+    Plan plan;
+    REQUIRE_NOTHROW(plan = plan_path(segs, p));
+    const PlanCheck check = check_plan(plan, segs, p);
+    CHECK(check.within_limits);
+    CHECK(check.max_deviation <= p.chord_tolerance + 1.5 * std::sqrt(2.0) * p.mm_per_lsb);
+}
+
+TEST_CASE("tangents are rounded the same way by the planner and the emitter", "[planner]") {
+    // Seed 8 case 2513: a Bezier that turns back; near the turn a 4-tick span hands a 3-tick
+    // one a tangent of exactly 1.5 LSB, which the two scales (an ulp apart) rounded to 1 and 2:
+    // the device got a cubic 1.6 % over the y acceleration limit, and eight replans failed.
+    const MachineProfile p = random_kind_profile(
+        57.012052295653568, 16381.012778318172, 485.35681838914547, 3501.0254965172126,
+        6927.240411578262, 12, 0.00016677236293322913, 0.0029035526114263321);
+    plans_within_limits(PathBasis::kBezier,
+                        {{{30.792585035566717, 35.056739343753016}},
+                         {{30.843624385674815, 34.926599956488595}},
+                         {{30.792512008269423, 35.056779596319515}},
+                         {{9.163414756992411, 11.628031146776255}}},
                         p);
 }

@@ -16,10 +16,19 @@ namespace {
 
 class PieceTimer {
 public:
-    PieceTimer(const PathGrid& pg, const Piece& piece, const Limits& limits, const std::vector<double>& caps,
-               const std::vector<double>& beta, const MachineProfile& profile, const PlanOptions& options)
-        : pg_(pg), g_(pg.grid), piece_(piece), caps_(caps), beta_(beta), axes_(pg.grid.axes),
-          tick_(1.0 / profile.tick_hz), n_(profile.ticks_per_span) {
+    PieceTimer(const PathGrid& pg, const Piece& piece, const Limits& limits,
+               const std::vector<double>& caps, const std::vector<double>& beta,
+               const MachineProfile& profile, const PlanOptions& options)
+        : pg_(pg),
+          g_(pg.grid),
+          piece_(piece),
+          caps_(caps),
+          beta_(beta),
+          axes_(pg.grid.axes),
+          tick_(1.0 / profile.tick_hz),
+          tick_hz_(profile.tick_hz),
+          n_(profile.ticks_per_span),
+          jerk_limited_(limits.has_jerk()) {
         // The spans are checked exactly as the device will run them (end points and tangents
         // rounded to LSB), against the limits less a hair for the double arithmetic.
         constexpr double kExact = 1 - 1e-9;
@@ -80,13 +89,14 @@ public:
         }
         const std::size_t limit = 50'000'000;
         std::size_t stalled = 0;
+        std::uint32_t first_ticks = n_;
         while (out.spans.size() < limit) {
             if (const std::uint32_t f = finish(k); f > 0) {
                 out.spans.push_back({f, end_knot()});
                 return out;
             }
-            if (Knot mid; const std::uint32_t f = land(k, mid)) {
-                out.spans.push_back({n_, mid});
+            if (Knot mid; const std::uint32_t f = land(k, mid, first_ticks)) {
+                out.spans.push_back({first_ticks, mid});
                 out.spans.push_back({f, end_knot()});
                 return out;
             }
@@ -96,8 +106,18 @@ public:
             std::uint32_t ticks = corner_landing(k, next);
             if (ticks == 0) ticks = dip_landing(k, next);
             if (ticks == 0 && leaving_dip) ticks = leave_dip(k, next);
+            const bool regular = ticks == 0;
             for (std::uint32_t m = n_; m >= (short_spans ? 1u : n_) && ticks == 0; --m) {
                 if (step(k, m, next)) ticks = m;
+            }
+            // A regular span that slows down to its end where beta there allows far more was held
+            // down by a dip it passes (one no knot landed on) and kept braking after it: its path
+            // acceleration may rise along it, from braking (at most 0.85 of the limit; 0.5 to 1
+            // were within 0.07 s of each other on the bench's corner paths) to accelerating.
+            if (regular && !jerk_limited_ && ticks == n_ && next.speed < k.speed &&
+                next.speed * next.speed < 0.9 * beta_at(next.lambda) &&
+                steps_between(k.lambda, next.lambda)) {
+                (void)rise_across(k, 0.85, true, next);
             }
             // A run of spans that leave the point on the LSB grid where it is makes no progress
             // the device could see (creeping towards a stop in ever smaller steps): stuck.
@@ -138,7 +158,7 @@ private:
     /// The velocity a span of m ticks carries for v: its tangent dp/du = v m T / lsb rounded to
     /// a whole LSB, as the emitter rounds it.
     Vec span_velocity(const Vec& v, std::uint32_t m) const {
-        const double scale = m * tick_ / lsb_;
+        const double scale = tangent_scale(m, tick_hz_, lsb_);
         Vec r{};
         for (std::size_t i = 0; i < axes_; ++i) r[i] = static_cast<double>(std::llround(v[i] * scale)) / scale;
         return r;
@@ -150,7 +170,7 @@ private:
     /// the tangent may each move one LSB further: the nearest combination within the limits,
     /// else the least violating one (the caller's search then backs off).
     void fit_end(const Knot& k0, const Vec& v0, Knot& k1, std::uint32_t m) const {
-        const double tau = m * tick_, scale = tau / lsb_;
+        const double tau = m * tick_, scale = tangent_scale(m, tick_hz_, lsb_);
         for (std::size_t i = 0; i < axes_; ++i) {
             // In LSB: a0 m^2 = 6 dP - 4 T0 - 2 T1, a1 m^2 = -6 dP + 2 T0 + 4 T1, p'(u) = T.
             const double lim_a = acc_[i] * tau * tau / lsb_, lim_v = vel_[i] * scale;
@@ -210,41 +230,56 @@ private:
         return e;
     }
 
-    /// The last two spans at once, when the end is near: a span of ticks_per_span ticks with
-    /// constant path acceleration A, then a final span of f ticks (1..ticks_per_span) to rest at
-    /// the end. Along the path both spans' end accelerations are affine in A, so for each f the
-    /// A that keep them within the path acceleration limit L (the smallest a_i / |t_i| at the
-    /// end) form an exact interval; its middle, then its ends, are checked on the executed
-    /// spans. Returns the smallest f that works (0: none) and the knot between the two spans.
-    std::uint32_t land(const Knot& k, Knot& mid) {
-        const double tau = n_ * tick_;
+    /// The last two spans at once, when the end is near: a span of m ticks (ticks_per_span / 2
+    /// to ticks_per_span) with constant path acceleration A, then a final span of f ticks
+    /// (1..ticks_per_span) to rest at the end, the fewest m + f first (a shorter first span
+    /// lands at a whole tick where the regular one cannot: the sharp polyline's 1,000 stops
+    /// needed 250 retries with m fixed, 46 with it free). Along the path both spans' end
+    /// accelerations are affine in A, so for each (m, f) the A that keep them within the path
+    /// acceleration limit L (the smallest a_i / |t_i| at the end) form an exact interval; its
+    /// middle, then its ends, are checked on the executed spans. Returns f (0: none), the knot
+    /// between the two spans and m (`first_ticks`).
+    std::uint32_t land(const Knot& k, Knot& mid, std::uint32_t& first_ticks) {
+        const double tau_n = n_ * tick_;
         const double d = end_lambda_ - k.lambda, v = k.speed;
         // Reachable only if the end is within two spans at the current speed plus full
         // acceleration; cheap test first.
-        if (d > v * 2 * tau + acc_norm_ * 2 * tau * tau) return 0;
+        if (d > v * 2 * tau_n + acc_norm_ * 2 * tau_n * tau_n) return 0;
         std::size_t h = hint_;
         const double lim = path_acceleration_limit(path_at(pg_, piece_, end_lambda_, h).t);
-        for (std::uint32_t f = 1; f <= n_; ++f) {
-            const double tf = f * tick_;
-            double lo = std::max(-lim, -v / tau), hi = lim;  // the first span, and V' >= 0
-            hi = std::min(hi, 2 * (d - v * tau) / (tau * tau));  // d' >= 0
-            // Final span along the path: a0 = 6 d'/tf^2 - 4 V'/tf, a1 = -6 d'/tf^2 + 2 V'/tf.
-            const double base = 6 * (d - v * tau) / (tf * tf);
-            const double a0c = base - 4 * v / tf, a0s = -(3 * tau * tau / (tf * tf) + 4 * tau / tf);
-            const double a1c = -base + 2 * v / tf, a1s = 3 * tau * tau / (tf * tf) + 2 * tau / tf;
-            for (const auto& [c, sl] : {std::pair{a0c, a0s}, std::pair{a1c, a1s}}) {
-                double x = (-lim - c) / sl, y = (lim - c) / sl;
-                if (x > y) std::swap(x, y);
-                lo = std::max(lo, x);
-                hi = std::min(hi, y);
-            }
-            if (lo > hi) continue;
-            for (const double a : {0.5 * (lo + hi), hi, lo, lo + 0.75 * (hi - lo), lo + 0.25 * (hi - lo)}) {
-                if (!under_beta(k, a, tau)) continue;
-                Candidate c = evaluate(k, a, n_);
-                if (c.f > 0 || !finish_ok(c.end, Arrival{k, n_}, f)) continue;
-                mid = c.end;
-                return f;
+        const std::uint32_t m_min = jerk_limited_ ? n_ : std::max<std::uint32_t>(1, n_ / 2);
+        for (std::uint32_t total = m_min + 1; total <= 2 * n_; ++total) {
+            for (std::uint32_t m = std::min(n_, total - 1); m >= m_min && total - m <= n_; --m) {
+                const std::uint32_t f = total - m;
+                const double tau = m * tick_;
+                const double tf = f * tick_;
+                double lo = std::max(-lim, -v / tau), hi = lim;      // the first span, and V' >= 0
+                hi = std::min(hi, 2 * (d - v * tau) / (tau * tau));  // d' >= 0
+                // Final span along the path: a0 = 6 d'/tf^2 - 4 V'/tf, a1 = -6 d'/tf^2 + 2 V'/tf.
+                const double base = 6 * (d - v * tau) / (tf * tf);
+                const double a0c = base - 4 * v / tf,
+                             a0s = -(3 * tau * tau / (tf * tf) + 4 * tau / tf);
+                const double a1c = -base + 2 * v / tf,
+                             a1s = 3 * tau * tau / (tf * tf) + 2 * tau / tf;
+                for (const auto& [c, sl] : {std::pair{a0c, a0s}, std::pair{a1c, a1s}}) {
+                    double x = (-lim - c) / sl, y = (lim - c) / sl;
+                    if (x > y) std::swap(x, y);
+                    lo = std::max(lo, x);
+                    hi = std::min(hi, y);
+                }
+                if (lo > hi) continue;
+                for (const double a :
+                     {0.5 * (lo + hi), hi, lo, lo + 0.75 * (hi - lo), lo + 0.25 * (hi - lo)}) {
+                    if (!under_beta(k, a, tau)) continue;
+                    Candidate c = evaluate(k, a, m);
+                    // A knot on the end point that still moves would stop there with a wiggle of
+                    // an LSB (the final span leaves it and comes back), not at rest.
+                    if (c.f > 0 || c.end.q == end_q_ || !finish_ok(c.end, Arrival{k, m}, f))
+                        continue;
+                    mid = c.end;
+                    first_ticks = m;
+                    return f;
+                }
             }
         }
         return 0;
@@ -304,6 +339,22 @@ private:
     /// The lookahead's bound on x = s^2 at arc length l: beta interpolated linearly in x, as
     /// TOPP-RA's constant path acceleration between nodes has it.
     double beta_at(double l) const { return interpolate(beta_, l); }
+
+    /// True when a joint whose curvature jumps (a blend's end) lies between arc lengths l0 and l1
+    /// (searched from node `from`, or from l0's interval): the dips the rising spans and the
+    /// landings on local minima are for. On smooth curves they cost planning time (a tenth more
+    /// on a 10,000-segment random walk) for a few milliseconds of motion either way.
+    bool steps_between(double l0, double l1,
+                       std::size_t from = static_cast<std::size_t>(-1)) const {
+        std::size_t i = from == static_cast<std::size_t>(-1) ? interval(l0) : from;
+        for (std::size_t j = i; j < piece_.last && g_.lambda[j] <= l1; ++j) {
+            if (g_.lambda[j] >= l0 && curvature_jump(j)) return true;
+        }
+        for (std::size_t j = i; j-- > piece_.first && g_.lambda[j] >= l0;) {
+            if (curvature_jump(j)) return true;
+        }
+        return false;
+    }
 
     /// True when constant path acceleration A for tau seconds from k keeps x = s^2 under the
     /// lookahead at every node passed and at the end (x and beta are both linear in between).
@@ -522,12 +573,27 @@ private:
         // back by an axis with little acceleration) swings out behind its start.
         const double tangent_reach = std::max(norm(v0), norm(end.v)) * tau;
         const bool swings = tangent_reach * tangent_reach > 9 * c2;
-        if (!corner && !swings && len * len * kappa / 8 < delta_ / 64) return 0;
+        // The cubic leaves its chord by at most 4/27 of each end tangent's part across it (where
+        // the Hermite basis of a tangent peaks): a tangent rounded on a far shorter span's scale
+        // (a 4-tick span's, carried into a 61-tick one) pointed 11 degrees off a straight line
+        // and bulged 17 um from it where the curvature alone let the check be skipped.
+        const auto bulges = [&] {
+            double across = 0;
+            for (const Vec* t : {&v0, &end.v}) {
+                const double along = c2 > 0 ? dot(*t, chord) / std::sqrt(c2) : 0;
+                across += std::sqrt(std::max(0.0, dot(*t, *t) - along * along));
+            }
+            return 4.0 / 27 * tau * across > 0.25 * delta_;
+        };
+        if (!corner && !swings && len * len * kappa / 8 < delta_ / 64 && !bulges()) return 0;
         double worst = 0;
         std::size_t h = hint_;
         // At sixths of the span; where it crosses a corner or a curvature step, at every tick
-        // too (up to 24 samples), as check_plan measures it.
-        const int samples = corner || curvature_step ? static_cast<int>(std::clamp<std::uint32_t>(m, 6, 24)) : 6;
+        // (a multiple of m, at least 6; at most 256 samples), as check_plan measures it: 24
+        // samples on a 61-tick span across a blend missed the tolerance by 1.4 um between them.
+        const std::uint32_t per_tick = (6 + m - 1) / m * m;
+        const int samples =
+            corner || curvature_step ? static_cast<int>(std::min<std::uint32_t>(per_tick, 256)) : 6;
         for (int s = 1; s < samples; ++s) {
             const double w = static_cast<double>(s) / samples, w2 = w * w, w3 = w2 * w;
             const double h00 = 2 * w3 - 3 * w2 + 1, h10 = w3 - 2 * w2 + w, h01 = -2 * w3 + 3 * w2, h11 = w3 - w2;
@@ -608,10 +674,11 @@ private:
         return 0;
     }
 
-    /// A knot on the next binding dip of beta (a joint where the curvature steps up, beta is
-    /// under the cap and rises after it: the start of a corner blend, a line entering an arc)
-    /// at beta's speed there, reached by constant-acceleration spans within three regular
-    /// spans (approach): the fewest ticks first, so the dip is reached as early as possible.
+    /// A knot on the next dip of beta (a local minimum near a curvature jump, where a blend's
+    /// curvature peaks; or a joint where the curvature steps up, beta is under the cap and rises
+    /// after it: the start of a corner blend, a line entering an arc) at beta's speed there,
+    /// reached by constant-acceleration spans within three regular spans (approach): the fewest
+    /// ticks first, so the dip is reached as early as possible.
     /// Returns the ticks of the span taken now (0: no dip or no such approach).
     std::uint32_t dip_landing(const Knot& k, Knot& out) {
         constexpr std::uint32_t kSpansAhead = 3;
@@ -621,12 +688,21 @@ private:
         bool found = false;
         for (std::size_t i = std::max(interval(k.lambda), piece_.first + 1);
              i + 2 <= piece_.last && g_.lambda[i] <= k.lambda + reach; ++i) {
-            // A joint where the curvature steps up (a blend's start, a line entering an arc) and
-            // beta rises after it: landing where beta keeps falling would leave the next spans
-            // on its boundary with no room to follow it in whole ticks.
-            const bool step_up = curvature_jump(i) && g_.curvature_norm[i + 1] > g_.curvature_norm[i];
-            if (step_up && g_.lambda[i] > k.lambda + 1e-9 && g_.lambda[i] < end_lambda_ - 1e-9 && beta_[i] < beta_[i - 1] &&
-                beta_[i] <= beta_[i + 1] && beta_[i + 1] < beta_[i + 2] && beta_[i] < caps_[i] && beta_[i] > 0) {
+            // A local minimum of beta (inside a blend, where its curvature peaks), or a joint where
+            // the curvature steps up (a blend's start, a line entering an arc) and beta rises
+            // after it: landing where beta keeps falling would leave the next spans on its
+            // boundary with no room to follow it in whole ticks.
+            const bool inside =
+                g_.lambda[i] > k.lambda + 1e-9 && g_.lambda[i] < end_lambda_ - 1e-9 && beta_[i] > 0;
+            const bool local_min = !jerk_limited_ && beta_[i] < beta_[i - 1] &&
+                                   beta_[i] < beta_[i + 1] && g_.lambda[i] > g_.lambda[i - 1] &&
+                                   g_.lambda[i + 1] > g_.lambda[i] &&
+                                   steps_between(g_.lambda[i] - reach, g_.lambda[i] + reach, i);
+            const bool step_up = curvature_jump(i) &&
+                                 g_.curvature_norm[i + 1] > g_.curvature_norm[i] &&
+                                 beta_[i] < beta_[i - 1] && beta_[i] <= beta_[i + 1] &&
+                                 beta_[i + 1] < beta_[i + 2] && beta_[i] < caps_[i];
+            if (inside && (local_min || step_up)) {
                 c = i;
                 found = true;
                 break;
@@ -645,12 +721,22 @@ private:
     /// the span across it may accelerate less at its start and more at its end (the path
     /// acceleration linear in time, A + J (t - tau/2), within the limits checked on the executed
     /// span). The span with the highest end speed among J = 0 (a regular span) and four J > 0,
-    /// each with the largest A under beta and within the limits. Returns its ticks (0: none).
+    /// each with the largest A >= 0 under beta and within the limits. Returns its ticks (0: none).
     std::uint32_t leave_dip(const Knot& k, Knot& out) {
-        const double tau = n_ * tick_;
         Knot best;
-        bool have = step(k, n_, best);
+        const bool have = step(k, n_, best);
+        if (!rise_across(k, 0, have, best)) return 0;
+        out = best;
+        return n_;
+    }
+
+    /// Replaces `best` (a span of ticks_per_span ticks from k, if `have`) by a span whose path
+    /// acceleration rises linearly, A + J (t - tau/2) with A >= -brake times the path
+    /// acceleration limit, where one ends faster. Returns whether there is a span at all.
+    bool rise_across(const Knot& k, double brake, bool have, Knot& best) {
+        const double tau = n_ * tick_;
         const double lim = k.speed > 0 ? path_acceleration_limit(scaled(k.v, 1 / k.speed)) : acc_norm_;
+        const double a_min = -brake * lim;
         // J tau = 2 f lim: the end acceleration up to 2 lim above the start's (the set scaled
         // to a largest f of 0.5, 1.5, 2 or 3 was not better on the bench's corner paths; f = 1
         // and 0.5 alone lose 0.04 s on the 1,000-segment spiral).
@@ -658,10 +744,10 @@ private:
             const double jerk = 2 * frac * lim / tau;
             // The largest A under beta (arithmetic only), then the executed span's limits by
             // regula falsi (Illinois) between a feasible and an infeasible A, as in step.
-            if (!jerk_under_beta(k, 0, jerk, tau)) continue;
+            if (!jerk_under_beta(k, a_min, jerk, tau)) continue;
             double a_beta = lim;
             if (!jerk_under_beta(k, a_beta, jerk, tau)) {
-                double lo = 0, hi = lim;
+                double lo = a_min, hi = lim;
                 for (int it = 0; it < 16; ++it) {
                     const double mid = 0.5 * (lo + hi);
                     (jerk_under_beta(k, mid, jerk, tau) ? lo : hi) = mid;
@@ -670,7 +756,7 @@ private:
             }
             Candidate hi = evaluate(k, a_beta, n_, jerk);
             if (hi.f > 0) {
-                const Candidate lo = evaluate(k, 0, n_, jerk);
+                const Candidate lo = evaluate(k, a_min, n_, jerk);
                 if (lo.f > 0) continue;
                 hi = boundary(k, lo, hi, n_, jerk);
             }
@@ -679,9 +765,7 @@ private:
                 have = true;
             }
         }
-        if (!have) return 0;
-        out = best;
-        return n_;
+        return have;
     }
 
     /// True when the path profile s(t) = V0 + (A - J tau/2) t + J t^2/2 stays non-negative and
@@ -746,7 +830,9 @@ private:
                 }
                 arrival_ = Arrival{k, j};
                 Knot e;
-                const std::uint32_t m = land_on_corner(c1.end, c, dir, xc, e);
+                // The landing of the m = total - j ticks this total stands for (trying every m
+                // made each knot cost O(ticks^3) spans: minutes for one 28-tick path).
+                const std::uint32_t m = land_on_corner(c1.end, c, dir, xc, e, total - j, total - j);
                 arrival_ = saved;
                 if (m > 0) {
                     out = c1.end;
@@ -758,11 +844,13 @@ private:
     }
 
     /// One span from k that ends exactly on corner node c (velocity along dir, speed^2 <= xc):
-    /// the fewest ticks that work. Its speed is the constant-acceleration one, or xc where that
-    /// is faster (then the cubic is not of constant path acceleration; it is checked as is).
-    std::uint32_t land_on_corner(const Knot& k, std::size_t c, const Vec& dir, double xc, Knot& out) {
+    /// the fewest ticks from m_lo to m_hi (0: ticks_per_span) that work. Its speed is the
+    /// constant-acceleration one, or xc where that is faster (then the cubic is not of constant
+    /// path acceleration; it is checked as is).
+    std::uint32_t land_on_corner(const Knot& k, std::size_t c, const Vec& dir, double xc, Knot& out,
+                                 std::uint32_t m_lo = 1, std::uint32_t m_hi = 0) {
         const double lc = g_.lambda[c], d = lc - k.lambda;
-        for (std::uint32_t m = 1; m <= n_; ++m) {
+        for (std::uint32_t m = m_lo; m <= (m_hi == 0 ? n_ : m_hi); ++m) {
             const double tau = m * tick_;
             double v1 = 2 * d / tau - k.speed;
             if (v1 < 0) break;
@@ -976,11 +1064,15 @@ private:
     const std::vector<double>& caps_;
     const std::vector<double>& beta_;
     std::size_t axes_;
-    double tick_;
+    double tick_, tick_hz_;
     std::uint32_t n_;
     Vec acc_{}, vel_{};
     double acc_norm_ = 0;
     bool on_dip_ = false;  ///< the current knot landed on a dip (dip_landing)
+    /// With a jerk limit the jerk stage's filter reshapes the knots' speed profile: the knots
+    /// on local minima of beta, the rising spans across a dip and the shortened span before a
+    /// landing, whose sharper acceleration changes it would have to smooth, are not used.
+    bool jerk_limited_ = false;
     double feed_ = 0;
     double delta_ = 0;
     double lsb_ = 0, root_axes_ = 1, deviation_limit_ = 0;

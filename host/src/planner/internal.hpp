@@ -348,6 +348,14 @@ void validate_plan_inputs(const MachineProfile& profile, const PlanOptions& opti
 /// Ticks of a regular span for `profile` (docs/planner.md §5, span length).
 std::uint32_t regular_span_ticks(const MachineProfile& profile);
 
+/// LSB of tangent per mm/s of velocity on a span of `ticks` ticks: the one formula the forward
+/// pass and the emitter both round tangents with. (Two formulas an ulp apart broke a tie of
+/// 1.5 LSB differently: the device got an exact cubic 1.6 % over a limit the forward pass had
+/// checked within it.)
+inline double tangent_scale(std::uint32_t ticks, double tick_hz, double lsb) {
+    return ticks / tick_hz / lsb;
+}
+
 /// A point on the LSB grid (mm), rounded as the emitter rounds span end points.
 inline Vec on_lsb_grid(const Vec& q, double lsb, std::size_t axes) {
     Vec r{};
