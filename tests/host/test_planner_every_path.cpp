@@ -238,46 +238,11 @@ TEST_CASE("every accepted path plans: cusps, near-cusps, repeated points, tiny l
     CHECK(failures == 0);
 }
 
-TEST_CASE("the cusp of a B-spline that turns back by one LSB plans", "[planner]") {
-    // Points two apart differ by one LSB: the curve stops at the turn and goes back.
-    Path path;
-    path.axes = 2;
-    Subpath s;
-    s.points = {{14.111, 196.545}, {12.675, 196.111}, {11.209, 195.794}, {9.752, 195.439},
-                {11.209, 195.795}, {12.637, 195.336}, {14.108, 195.044}};
-    path.subpaths.push_back(s);
-    const MachineProfile p = pen_plotter();
-    const auto segs = to_bezier_segments(path);
-    Plan plan;
-    REQUIRE_NOTHROW(plan = plan_path(segs, p));
-    const PlanCheck check = check_plan(plan, segs, p);
-    CHECK(check.within_limits);
-    CHECK(check.max_deviation <= p.chord_tolerance + 1.5 * std::sqrt(2.0) * p.mm_per_lsb);
-}
-
 namespace {
 
-/// A 2-axis profile of the every-path test's random kind (feeds and pen delays the pen
-/// plotter's).
-MachineProfile random_kind_profile(double vx, double ax, double vy, double ay, double tick_hz, std::uint32_t ticks,
-                                   double lsb, double tolerance) {
-    MachineProfile p = pen_plotter();
-    p.axes = {{"x", vx, ax}, {"y", vy, ay}};
-    p.tick_hz = tick_hz;
-    p.ticks_per_span = ticks;
-    p.mm_per_lsb = lsb;
-    p.chord_tolerance = tolerance;
-    return p;
-}
-
-/// Plans one subpath of `basis` through `points` and checks the plan exactly.
-void plans_within_limits(PathBasis basis, const std::vector<std::array<double, 2>>& points, const MachineProfile& p) {
-    Path path;
-    path.axes = 2;
-    Subpath s;
-    s.basis = basis;
-    for (const auto& q : points) s.points.push_back({q[0], q[1]});
-    path.subpaths.push_back(s);
+/// Plans `path` and checks the plan exactly: within the limits on every tick and within the
+/// tolerance plus the rounding allowance.
+void plans_within_limits(const Path& path, const MachineProfile& p) {
     const auto segs = to_bezier_segments(path);
     Plan plan;
     REQUIRE_NOTHROW(plan = plan_path(segs, p));
@@ -289,92 +254,113 @@ void plans_within_limits(PathBasis basis, const std::vector<std::array<double, 2
 
 }  // namespace
 
-TEST_CASE("a loop of a few micrometres inside one grid interval plans", "[planner]") {
-    // Seed 8 case 113 of the test above: between two grid nodes a quarter of the segment apart
-    // the tangent turns out by half a radian and back (radius down to 3 um), while the two
-    // nodes' tangents differ by 0.07 rad. The grid saw no turn there, its speed caps rose
-    // linearly to 57 mm/s over the loop, and every span from the knot before it left the path
-    // by twice the tolerance.
-    const MachineProfile p = random_kind_profile(111.02103887229889, 4294.2129554502199, 56.503917638076516,
-                                                 12854.06781548477, 1454.8589791363199, 5, 0.00016975209374201194,
-                                                 0.0042628057302861446);
-    plans_within_limits(PathBasis::kBezier,
-                        {{{34.70008163174623, 17.558419394569494}},
-                         {{35.60085488969719, 16.699240134195296}},
-                         {{35.00752591797628, 17.571838528769476}},
-                         {{35.28110379091141, 16.5785050640717}}},
-                        p);
-}
-
-TEST_CASE("a near-cusp nanometres before a stop does not hold the motion back", "[planner]") {
-    // Seed 9 case 902 of the test above: the Catmull-Rom curve turns back 0.7 um after two
-    // points, a stop; the curvature peak of its tip (speed caps of 1e-5 mm/s) lies 4e-8 mm
-    // before it. Approached as a dip, it held the lookahead at 0.1 mm/s over the 0.27 mm
-    // before it, where no span of 64 whole ticks could follow.
-    const MachineProfile p = random_kind_profile(487.10592378016628, 19231.814146973658, 108.03495770733767,
-                                                 1253.0545145051228, 3818.3933662542127, 11, 0.0018023457700472166,
-                                                 0.024522971390821446);
-    plans_within_limits(PathBasis::kCatmullRom,
-                        {{{4.540303971707901, 25.219321150707678}},
-                         {{31.87338387319543, 36.962707079188526}},
-                         {{0.5529870584445081, 24.885761113571156}},
-                         {{11.283283958180752, 12.020744427191396}},
-                         {{11.28388726972956, 12.020075003750085}}},
-                        p);
-}
-
-TEST_CASE(
-    "a straight line whose knots carry a short span's coarse tangent stays within the tolerance",
-    "[planner]") {
-    // Seed 7 case 1718 of the every-path test, down to one line: spans of a few ticks near the
-    // start round their tangents to 1-3 LSB, 20 degrees off the line, and a long span that
-    // carried such a tangent bulged 11.2 um from it (tolerance plus allowance 10.2 um) where
-    // the straight path let the deviation check be skipped.
-    const MachineProfile p = random_kind_profile(
-        86.109843706323787, 224.95429502410317, 47.071290370628489, 404.0956137956494,
-        1844.9144135113083, 7, 0.0031977467494345548, 0.0034149726530580942);
-    plans_within_limits(
-        PathBasis::kPolyline,
-        {{{19.293535157513258, 23.806025926399705}}, {{3.1549536824823203, 1.1921481761936856}}},
-        p);
-}
-
-TEST_CASE("a closed polyline whose long spans follow short ones stays within the tolerance",
-          "[planner]") {
-    // Seed 3 case 1646: the same bulge on a 61-tick span after 4-tick ones, 17.4 um on a
-    // 5.5 um tolerance.
-    const MachineProfile p = random_kind_profile(
-        86.65961914958757, 259.73459025693643, 36.576314336746783, 9271.1405432070023,
-        997.27120242969647, 5, 0.0049106194504247276, 0.0055158562405181995);
+TEST_CASE("the cusp of a B-spline that turns back by one LSB plans", "[planner]") {
+    // Points two apart differ by one LSB: the curve stops at the turn and goes back.
     Path path;
     path.axes = 2;
     Subpath s;
-    s.basis = PathBasis::kPolyline;
-    s.closed = true;
-    s.points = {{19.98020472691209, 29.09674470821436},   {27.79901544539073, 9.393376419246971},
-                {10.044177381604145, 12.893232829264045}, {2.125612054571979, 1.6634117026053366},
-                {17.053020619161664, 1.0930209737898198}, {17.051529734108687, 1.0949718217094513},
-                {2.629569623377795, 22.471573902241598}};
+    s.points = {{14.111, 196.545}, {12.675, 196.111}, {11.209, 195.794}, {9.752, 195.439},
+                {11.209, 195.795}, {12.637, 195.336}, {14.108, 195.044}};
     path.subpaths.push_back(s);
-    const auto segs = to_bezier_segments(path);
-    Plan plan;
-    REQUIRE_NOTHROW(plan = plan_path(segs, p));
-    const PlanCheck check = check_plan(plan, segs, p);
-    CHECK(check.within_limits);
-    CHECK(check.max_deviation <= p.chord_tolerance + 1.5 * std::sqrt(2.0) * p.mm_per_lsb);
+    plans_within_limits(path, pen_plotter());
 }
 
-TEST_CASE("tangents are rounded the same way by the planner and the emitter", "[planner]") {
-    // Seed 8 case 2513: a Bezier that turns back; near the turn a 4-tick span hands a 3-tick
-    // one a tangent of exactly 1.5 LSB, which the two scales (an ulp apart) rounded to 1 and 2:
-    // the device got a cubic 1.6 % over the y acceleration limit, and eight replans failed.
-    const MachineProfile p = random_kind_profile(
-        57.012052295653568, 16381.012778318172, 485.35681838914547, 3501.0254965172126,
-        6927.240411578262, 12, 0.00016677236293322913, 0.0029035526114263321);
-    plans_within_limits(PathBasis::kBezier,
-                        {{{30.792585035566717, 35.056739343753016}},
-                         {{30.843624385674815, 34.926599956488595}},
-                         {{30.792512008269423, 35.056779596319515}},
-                         {{9.163414756992411, 11.628031146776255}}},
-                        p);
+namespace {
+
+/// A failing case of the every-path test, reduced: a 2-axis profile of its random kind (feeds
+/// and pen delays the pen plotter's) and one subpath.
+struct FoundCase {
+    const char* what;
+    double vx, ax, vy, ay, tick_hz;
+    std::uint32_t ticks_per_span;
+    double lsb, tolerance;
+    PathBasis basis;
+    bool closed;
+    std::vector<std::array<double, 2>> points;
+};
+
+// clang-format off
+const FoundCase kFoundCases[] = {
+    // Between two grid nodes a quarter of the segment apart the tangent turns out by half a
+    // radian and back (radius down to 3 um) while the nodes' tangents differ by 0.07 rad: the
+    // grid saw no turn, its speed caps rose linearly to 57 mm/s over the loop, and every span
+    // from the knot before it left the path by twice the tolerance.
+    {"seed 8 case 113: a loop of a few micrometres inside one grid interval",
+     111.02103887229889, 4294.2129554502199, 56.503917638076516, 12854.06781548477,
+     1454.8589791363199, 5, 0.00016975209374201194, 0.0042628057302861446,
+     PathBasis::kBezier, false,
+     {{34.70008163174623, 17.558419394569494},
+      {35.60085488969719, 16.699240134195296},
+      {35.00752591797628, 17.571838528769476},
+      {35.28110379091141, 16.5785050640717}}},
+    // The curve turns back 0.7 um after two points, a stop; the curvature peak of its tip
+    // (speed caps of 1e-5 mm/s) lies 4e-8 mm before it. Approached as a dip, it held the
+    // lookahead at 0.1 mm/s over the 0.27 mm before it, where no span of 64 whole ticks could
+    // follow.
+    {"seed 9 case 902: a near-cusp nanometres before a stop",
+     487.10592378016628, 19231.814146973658, 108.03495770733767, 1253.0545145051228,
+     3818.3933662542127, 11, 0.0018023457700472166, 0.024522971390821446,
+     PathBasis::kCatmullRom, false,
+     {{4.540303971707901, 25.219321150707678},
+      {31.87338387319543, 36.962707079188526},
+      {0.5529870584445081, 24.885761113571156},
+      {11.283283958180752, 12.020744427191396},
+      {11.28388726972956, 12.020075003750085}}},
+    // Down to one line: spans of a few ticks near the start round their tangents to 1-3 LSB,
+    // 20 degrees off the line, and a long span that carried such a tangent bulged 11.2 um from
+    // it (tolerance plus allowance 10.2 um) where the straight path let the deviation check be
+    // skipped.
+    {"seed 7 case 1718: a line whose knots carry a short span's coarse tangent",
+     86.109843706323787, 224.95429502410317, 47.071290370628489, 404.0956137956494,
+     1844.9144135113083, 7, 0.0031977467494345548, 0.0034149726530580942,
+     PathBasis::kPolyline, false,
+     {{19.293535157513258, 23.806025926399705}, {3.1549536824823203, 1.1921481761936856}}},
+    // The same bulge on a 61-tick span after 4-tick ones, 17.4 um on a 5.5 um tolerance.
+    {"seed 3 case 1646: a closed polyline whose long spans follow short ones",
+     86.65961914958757, 259.73459025693643, 36.576314336746783, 9271.1405432070023,
+     997.27120242969647, 5, 0.0049106194504247276, 0.0055158562405181995,
+     PathBasis::kPolyline, true,
+     {{19.98020472691209, 29.09674470821436},
+      {27.79901544539073, 9.393376419246971},
+      {10.044177381604145, 12.893232829264045},
+      {2.125612054571979, 1.6634117026053366},
+      {17.053020619161664, 1.0930209737898198},
+      {17.051529734108687, 1.0949718217094513},
+      {2.629569623377795, 22.471573902241598}}},
+    // A Bezier that turns back: near the turn a 4-tick span hands a 3-tick one a tangent of
+    // exactly 1.5 LSB, which the planner's and the emitter's scales (an ulp apart) rounded to
+    // 1 and 2: the device got a cubic 1.6 % over the y acceleration limit, and eight replans
+    // failed.
+    {"seed 8 case 2513: a tangent the planner and the emitter must round alike",
+     57.012052295653568, 16381.012778318172, 485.35681838914547, 3501.0254965172126,
+     6927.240411578262, 12, 0.00016677236293322913, 0.0029035526114263321,
+     PathBasis::kBezier, false,
+     {{30.792585035566717, 35.056739343753016},
+      {30.843624385674815, 34.926599956488595},
+      {30.792512008269423, 35.056779596319515},
+      {9.163414756992411, 11.628031146776255}}},
+};
+// clang-format on
+
+}  // namespace
+
+TEST_CASE("cases the every-path test found plan within the limits and the tolerance", "[planner]") {
+    for (const FoundCase& c : kFoundCases) {
+        DYNAMIC_SECTION(c.what) {
+            MachineProfile p = pen_plotter();
+            p.axes = {{"x", c.vx, c.ax}, {"y", c.vy, c.ay}};
+            p.tick_hz = c.tick_hz;
+            p.ticks_per_span = c.ticks_per_span;
+            p.mm_per_lsb = c.lsb;
+            p.chord_tolerance = c.tolerance;
+            Path path;
+            path.axes = 2;
+            Subpath s;
+            s.basis = c.basis;
+            s.closed = c.closed;
+            for (const auto& q : c.points) s.points.push_back({q[0], q[1]});
+            path.subpaths.push_back(s);
+            plans_within_limits(path, p);
+        }
+    }
 }
