@@ -234,7 +234,7 @@ private:
     /// to ticks_per_span) with constant path acceleration A, then a final span of f ticks
     /// (1..ticks_per_span) to rest at the end, the fewest m + f first (a shorter first span
     /// lands at a whole tick where the regular one cannot: the sharp polyline's 1,000 stops
-    /// needed 250 retries with m fixed, 46 with it free). Along the path both spans' end
+    /// needed 250 retries with m fixed, 93 with it free). Along the path both spans' end
     /// accelerations are affine in A, so for each (m, f) the A that keep them within the path
     /// acceleration limit L (the smallest a_i / |t_i| at the end) form an exact interval; its
     /// middle, then its ends, are checked on the executed spans. Returns f (0: none), the knot
