@@ -306,10 +306,9 @@ const FoundCase kFoundCases[] = {
       {0.5529870584445081, 24.885761113571156},
       {11.283283958180752, 12.020744427191396},
       {11.28388726972956, 12.020075003750085}}},
-    // Down to one line: spans of a few ticks near the start round their tangents to 1-3 LSB,
-    // 20 degrees off the line, and a long span that carried such a tangent bulged 11.2 um from
-    // it (tolerance plus allowance 10.2 um) where the straight path let the deviation check be
-    // skipped.
+    // Down to one line: a 97-tick span whose start tangent, rounded where its knot was reached,
+    // points 0.8 degrees off the line bulged 11.2 um from it (tolerance plus allowance 10.2 um)
+    // where the straight path let the deviation check be skipped.
     {"seed 7 case 1718: a line whose knots carry a short span's coarse tangent",
      86.109843706323787, 224.95429502410317, 47.071290370628489, 404.0956137956494,
      1844.9144135113083, 7, 0.0031977467494345548, 0.0034149726530580942,

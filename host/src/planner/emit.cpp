@@ -28,9 +28,10 @@ SpanEmitter::LsbVec SpanEmitter::quantise(const Vec& mm) const {
 }
 
 SpanEmitter::LsbVec SpanEmitter::tangent(const Vec& velocity, std::uint32_t ticks) const {
-    const double scale = tangent_scale(ticks, profile_.tick_hz, profile_.mm_per_lsb);
     LsbVec r{};
-    for (std::size_t i = 0; i < axes_; ++i) r[i] = std::llround(velocity[i] * scale);
+    for (std::size_t i = 0; i < axes_; ++i) {
+        r[i] = tangent_lsb(velocity[i], ticks, profile_.tick_hz, profile_.mm_per_lsb);
+    }
     return r;
 }
 

@@ -110,10 +110,11 @@ public:
             for (std::uint32_t m = n_; m >= (short_spans ? 1u : n_) && ticks == 0; --m) {
                 if (step(k, m, next)) ticks = m;
             }
-            // A regular span that slows down to its end where beta there allows far more was held
-            // down by a dip it passes (one no knot landed on) and kept braking after it: its path
-            // acceleration may rise along it, from braking (at most 0.85 of the limit; 0.5 to 1
-            // were within 0.07 s of each other on the bench's corner paths) to accelerating.
+            // A regular span across a curvature jump that slows down to its end where beta there
+            // allows more (x under 0.9 beta) was held down by a dip it passes (one no knot landed
+            // on) and kept braking after it: its path acceleration may rise along it, with a mean
+            // A >= -0.85 L (-0.5 L to -L were within 0.07 s of each other on the bench's corner
+            // paths; the executed span is checked as every span is).
             if (regular && !jerk_limited_ && ticks == n_ && next.speed < k.speed &&
                 next.speed * next.speed < 0.9 * beta_at(next.lambda) &&
                 steps_between(k.lambda, next.lambda)) {
@@ -160,7 +161,9 @@ private:
     Vec span_velocity(const Vec& v, std::uint32_t m) const {
         const double scale = tangent_scale(m, tick_hz_, lsb_);
         Vec r{};
-        for (std::size_t i = 0; i < axes_; ++i) r[i] = static_cast<double>(std::llround(v[i] * scale)) / scale;
+        for (std::size_t i = 0; i < axes_; ++i) {
+            r[i] = static_cast<double>(tangent_lsb(v[i], m, tick_hz_, lsb_)) / scale;
+        }
         return r;
     }
 
@@ -174,8 +177,10 @@ private:
         for (std::size_t i = 0; i < axes_; ++i) {
             // In LSB: a0 m^2 = 6 dP - 4 T0 - 2 T1, a1 m^2 = -6 dP + 2 T0 + 4 T1, p'(u) = T.
             const double lim_a = acc_[i] * tau * tau / lsb_, lim_v = vel_[i] * scale;
-            const double p0 = std::round(k0.q[i] / lsb_), t0 = std::round(v0[i] * scale);
-            const double p = std::round(k1.q[i] / lsb_), t = std::round(k1.v[i] * scale);
+            const double p0 = std::round(k0.q[i] / lsb_);
+            const double t0 = static_cast<double>(tangent_lsb(v0[i], m, tick_hz_, lsb_));
+            const double p = std::round(k1.q[i] / lsb_);
+            const double t = static_cast<double>(tangent_lsb(k1.v[i], m, tick_hz_, lsb_));
             const auto cost = [&](double p1, double t1) {
                 const double a0 = 6 * (p1 - p0) - 4 * t0 - 2 * t1, a1 = -6 * (p1 - p0) + 2 * t0 + 4 * t1;
                 double peak = std::max(std::fabs(t0), std::fabs(t1));
@@ -247,7 +252,10 @@ private:
         if (d > v * 2 * tau_n + acc_norm_ * 2 * tau_n * tau_n) return 0;
         std::size_t h = hint_;
         const double lim = path_acceleration_limit(path_at(pg_, piece_, end_lambda_, h).t);
-        const std::uint32_t m_min = jerk_limited_ ? n_ : std::max<std::uint32_t>(1, n_ / 2);
+        // At most 16 first-span lengths: with spans of thousands of ticks (the profile allows up
+        // to 65536) the pairs would otherwise be billions at every knot near the end.
+        const std::uint32_t m_min =
+            jerk_limited_ ? n_ : std::max<std::uint32_t>({1, n_ / 2, n_ > 16 ? n_ - 16 : 1});
         for (std::uint32_t total = m_min + 1; total <= 2 * n_; ++total) {
             for (std::uint32_t m = std::min(n_, total - 1); m >= m_min && total - m <= n_; --m) {
                 const std::uint32_t f = total - m;
@@ -272,8 +280,8 @@ private:
                      {0.5 * (lo + hi), hi, lo, lo + 0.75 * (hi - lo), lo + 0.25 * (hi - lo)}) {
                     if (!under_beta(k, a, tau)) continue;
                     Candidate c = evaluate(k, a, m);
-                    // A knot on the end point that still moves would stop there with a wiggle of
-                    // an LSB (the final span leaves it and comes back), not at rest.
+                    // A knot on the end point: moving, the final span would leave it and come back
+                    // (a stop with a wiggle of an LSB); at rest, it would only wait there.
                     if (c.f > 0 || c.end.q == end_q_ || !finish_ok(c.end, Arrival{k, m}, f))
                         continue;
                     mid = c.end;
@@ -546,10 +554,11 @@ private:
         return c;
     }
 
-    /// Largest distance of the executed cubic from the path at sixths of the span, measured
-    /// across the path at the arc length where the cubic's point projects onto the chord.
-    /// Skipped (0) where the span is too short for the curvature it passes to matter:
-    /// chord^2 kappa / 8 < delta / 64.
+    /// Largest distance of the executed cubic from the path at sixths of the span (at every tick
+    /// across a corner or a curvature jump), measured across the path at the arc length where
+    /// the cubic's point projects onto the chord. Skipped (0) where neither the curvature it
+    /// passes (chord^2 kappa / 8 < delta / 64) nor its end tangents can move it off the path: no
+    /// corner, no swing, no bulge (below).
     double span_deviation(const Knot& k, const Knot& end, std::uint32_t m) {
         const double tau = m * tick_;
         const Vec v0 = span_velocity(k.v, m);
@@ -575,8 +584,8 @@ private:
         const bool swings = tangent_reach * tangent_reach > 9 * c2;
         // The cubic leaves its chord by at most 4/27 of each end tangent's part across it (where
         // the Hermite basis of a tangent peaks): a tangent rounded on a far shorter span's scale
-        // (a 4-tick span's, carried into a 61-tick one) pointed 11 degrees off a straight line
-        // and bulged 17 um from it where the curvature alone let the check be skipped.
+        // (a 4-tick span's, carried into a 61-tick one) pointed 12 degrees off a straight line
+        // and bulged 17.4 um from it where the curvature alone let the check be skipped.
         const auto bulges = [&] {
             double across = 0;
             for (const Vec* t : {&v0, &end.v}) {
@@ -588,9 +597,10 @@ private:
         if (!corner && !swings && len * len * kappa / 8 < delta_ / 64 && !bulges()) return 0;
         double worst = 0;
         std::size_t h = hint_;
-        // At sixths of the span; where it crosses a corner or a curvature step, at every tick
-        // (a multiple of m, at least 6; at most 256 samples), as check_plan measures it: 24
-        // samples on a 61-tick span across a blend missed the tolerance by 1.4 um between them.
+        // At sixths of the span; where it crosses a corner or a curvature step, at every tick as
+        // check_plan measures it (a multiple of m, at least 6), on spans of up to 256 ticks
+        // (longer ones get 256 even samples): 24 samples on a 61-tick span across a blend missed
+        // the tolerance by 1.4 um between them.
         const std::uint32_t per_tick = (6 + m - 1) / m * m;
         const int samples =
             corner || curvature_step ? static_cast<int>(std::min<std::uint32_t>(per_tick, 256)) : 6;
@@ -694,7 +704,7 @@ private:
             // boundary with no room to follow it in whole ticks.
             const bool inside =
                 g_.lambda[i] > k.lambda + 1e-9 && g_.lambda[i] < end_lambda_ - 1e-9 && beta_[i] > 0;
-            const bool local_min = !jerk_limited_ && beta_[i] < beta_[i - 1] &&
+            const bool local_min = inside && !jerk_limited_ && beta_[i] < beta_[i - 1] &&
                                    beta_[i] < beta_[i + 1] && g_.lambda[i] > g_.lambda[i - 1] &&
                                    g_.lambda[i + 1] > g_.lambda[i] &&
                                    steps_between(g_.lambda[i] - reach, g_.lambda[i] + reach, i);
@@ -811,12 +821,18 @@ private:
                            std::uint32_t direct_ticks, const Knot& direct, Knot& out) {
         const double d_all = g_.lambda[c] - k.lambda, vt = std::sqrt(xc);
         const Arrival saved = arrival_;
-        for (std::uint32_t total = 1; total <= (spans_ahead + 1) * n_; ++total) {
+        // (spans_ahead + 1) n^2 pairs at most: the same for spans up to 128 ticks, bounded for
+        // the longer spans a profile may ask for.
+        std::uint32_t pairs = 0;
+        constexpr std::uint32_t kMaxPairs = 65536;
+        for (std::uint32_t total = 1; total <= (spans_ahead + 1) * n_ && pairs < kMaxPairs;
+             ++total) {
             if (total == direct_ticks) {
                 out = direct;
                 return total;
             }
             for (std::uint32_t j = std::min(spans_ahead * n_, total - 1); j >= 1 && total - j <= n_; --j) {
+                ++pairs;
                 const double tj = j * tick_, tm = (total - j) * tick_;
                 const double a = (d_all - k.speed * tj - (k.speed + vt) * tm / 2) / (tj * tj / 2 + tj * tm / 2);
                 if (k.speed + a * tj < 0 || std::fabs(a) > 1.5 * acc_norm_) continue;
@@ -1068,10 +1084,11 @@ private:
     std::uint32_t n_;
     Vec acc_{}, vel_{};
     double acc_norm_ = 0;
-    bool on_dip_ = false;  ///< the current knot landed on a dip (dip_landing)
+    bool on_dip_ = false;  ///< the current knot landed on a dip or a corner (leave_dip next)
     /// With a jerk limit the jerk stage's filter reshapes the knots' speed profile: the knots
-    /// on local minima of beta, the rising spans across a dip and the shortened span before a
-    /// landing, whose sharper acceleration changes it would have to smooth, are not used.
+    /// on local minima of beta, the rising spans across a dip no knot landed on and the
+    /// shortened span before a landing, whose sharper acceleration changes it would have to
+    /// smooth, are not used.
     bool jerk_limited_ = false;
     double feed_ = 0;
     double delta_ = 0;

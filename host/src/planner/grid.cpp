@@ -52,7 +52,8 @@ Vec curvature(const Cubic& c, double u, double size, int side) {
 }
 
 /// Parameters of the grid nodes along one segment: uniform in u, then bisected wherever the
-/// tangent turns by more than max_turn between neighbours. A turn above 90 degrees inside an
+/// tangent turns by more than max_turn between neighbours or may turn by more inside the
+/// interval (the bound of turns_inside below). A turn above 90 degrees inside an
 /// interval shorter than 1e-7 in u is a cusp: its parameter goes to `cusps`.
 std::vector<double> segment_nodes(const Cubic& c, double length, const PlanOptions& o,
                                   std::vector<double>& cusps) {

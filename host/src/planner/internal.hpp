@@ -305,7 +305,7 @@ struct WindowLookahead {
     const MachineProfile& profile;
     const PlanOptions& options;
     double span_time;
-    double end_zone;  ///< half an LSB: dips this close to a piece's end are its end (backward_pass)
+    double end_zone;  ///< half an LSB: dips this close to a piece's end count as it (backward_pass)
     std::vector<double> base_caps, caps, local_factor, local_cap, corner_factor, factor, beta, dip;
 };
 
@@ -354,6 +354,12 @@ std::uint32_t regular_span_ticks(const MachineProfile& profile);
 /// checked within it.)
 inline double tangent_scale(std::uint32_t ticks, double tick_hz, double lsb) {
     return ticks / tick_hz / lsb;
+}
+
+/// A velocity (mm/s, one axis) as the tangent of a span of `ticks` ticks in whole LSB: the one
+/// rounding (half away from zero, on tangent_scale) the forward pass and the emitter share.
+inline long long tangent_lsb(double velocity, std::uint32_t ticks, double tick_hz, double lsb) {
+    return std::llround(velocity * tangent_scale(ticks, tick_hz, lsb));
 }
 
 /// A point on the LSB grid (mm), rounded as the emitter rounds span end points.

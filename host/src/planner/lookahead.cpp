@@ -209,9 +209,9 @@ std::size_t backward_pass(const PathGrid& pg, const Piece& piece, const Limits& 
         // A dip of 0 (a node at rest: the piece's end, or one its retries capped there) is no
         // dip to approach span by span: its slope sqrt(0) would hold beta at 0 over the whole
         // piece before it. The end itself is approached by the landings of the forward pass, and
-        // so is a dip at most end_zone before it: a near-cusp's tip nanometres before a stop,
-        // which on the device's grid is the end point itself (its slope held beta at 0.1 mm/s
-        // over the 0.27 mm before it, where no whole-tick span could follow).
+        // so is a dip at most end_zone (half an LSB) before it: a near-cusp's tip nanometres
+        // before a stop, within half an LSB of the end point on the device's grid (its slope held
+        // beta at 0.1 mm/s over the 0.27 mm before it, where no whole-tick span could follow).
         if (span_time > 0 && dip[k + 1] > 0 && g.lambda[piece.last] - g.lambda[k + 1] > end_zone) {
             const double below = dip[k + 1];
             d = std::min(d, below + 1.9 * std::sqrt(below) * std::max(dl, 0.0) / span_time);
