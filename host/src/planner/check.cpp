@@ -83,8 +83,9 @@ namespace planner_detail {
 class FeedTable {
 public:
     explicit FeedTable(const MachineProfile& profile) : profile_(profile) {}
-    void add(const BezierSegment& s) {
-        if (s.feed > 0) (s.pen_down ? down_ : up_).emplace(s.subpath, s.feed);
+    void add(const BezierSegment& s) { add(s.subpath, s.pen_down, s.feed); }
+    void add(std::size_t subpath, bool pen_down, double feed) {
+        if (feed > 0) (pen_down ? down_ : up_).emplace(subpath, feed);
     }
     double feed(const CoreSpan& s) const {
         const auto& m = s.pen_down ? down_ : up_;
@@ -184,7 +185,9 @@ TickChecker::TickChecker(const MachineProfile& profile, const std::vector<Bezier
 
 TickChecker::~TickChecker() = default;
 
-void TickChecker::note_segment(const BezierSegment& segment) { feeds_->add(segment); }
+void TickChecker::note_feed(std::size_t subpath, bool pen_down, double feed) {
+    feeds_->add(subpath, pen_down, feed);
+}
 
 void TickChecker::pen(const PenEvent& e) {
     const std::uint64_t d = delay_ticks(e.down ? profile_.pen_down_delay : profile_.pen_up_delay, profile_.tick_hz);

@@ -433,8 +433,9 @@ public:
     ~TickChecker();
     TickChecker(const TickChecker&) = delete;
     TickChecker& operator=(const TickChecker&) = delete;
-    /// A segment's requested feed (streamed plans give their segments as they are read).
-    void note_segment(const BezierSegment& segment);
+    /// A segment's requested feed (streamed plans give their segments' feeds as they are
+    /// read): the first one of a subpath and pen state counts, as in the constructor.
+    void note_feed(std::size_t subpath, bool pen_down, double feed);
     void pen(const PenEvent& event);
     /// Runs the span through the core tick by tick; throws PlanError if the core refuses it.
     void span(const CoreSpan& span);

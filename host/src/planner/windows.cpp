@@ -6,15 +6,18 @@
 // point, a horizon (more than the longest stopping distance) before the window's end, is
 // kept: there the lookahead already sees as far as it ever would. The next window starts at
 // the segment holding the last kept knot and continues from that knot (the retries never go
-// back before it).
+// back before it). Window N's per-tick check runs on a second thread while window N + 1 is
+// planned; window N goes to the sink once its check passed.
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <optional>
-#include <utility>
 #include <sstream>
+#include <thread>
+#include <utility>
 
 #include "internal.hpp"
+#include "pathstream/host/handoff_worker.hpp"
 
 namespace pathstream::host {
 namespace {
@@ -53,13 +56,40 @@ struct Carry {
     double run_offset = 0;     ///< mm of the current run before `segment`
 };
 
+/// A segment's requested feed, as the per-tick check needs it for the segment's spans.
+struct FeedNote {
+    std::size_t subpath = 0;
+    bool pen_down = false;
+    double feed = 0;
+};
+
+/// A window's events on their way through the per-tick check, with the feeds of the segments
+/// read since the batch before.
+struct CheckBatch {
+    std::vector<PlanEvent> events;
+    std::vector<FeedNote> feeds;
+};
+
 /// One attempt at the whole job with fixed limits.
 class WindowPlanner {
 public:
     WindowPlanner(SegmentSource& source, const MachineProfile& profile, const PlanOptions& options,
-                  const Limits& limits, PlanSink& sink, PlanStats& stats, Progress& report, double lo, double hi)
-        : source_(source), profile_(profile), options_(options), limits_(limits), sink_(sink), st_(stats),
-          report_(report), lo_(lo), hi_(hi), checker_(profile, nullptr, false) {
+                  const Limits& limits, PlanSink& sink, PlanStats& stats, Progress& report,
+                  double lo, double hi)
+        : source_(source),
+          profile_(profile),
+          options_(options),
+          limits_(limits),
+          sink_(sink),
+          st_(stats),
+          report_(report),
+          lo_(lo),
+          hi_(hi),
+          checker_(profile, nullptr, false),
+          check_([this](const CheckBatch& batch) { return check_batch(batch); },
+                 options.check_on_thread && std::thread::hardware_concurrency() > 1
+                     ? HandoffWorker<CheckBatch>::Mode::kThread
+                     : HandoffWorker<CheckBatch>::Mode::kCaller) {
         double a_min = std::numeric_limits<double>::infinity(), v_axes = 0;
         for (std::size_t i = 0; i < profile.axes.size(); ++i) {
             a_min = std::min(a_min, limits.acceleration[i]);
@@ -120,6 +150,7 @@ public:
             }
             if (total_ > 0) report_(lo_ + (hi_ - lo_) * static_cast<double>(carry_.segment) / static_cast<double>(total_));
         }
+        if (!collect_checked()) return fail(check);
         check = checker_.finish();
         if (!check.within_limits) return false;
         totals.spans = spans_;
@@ -144,7 +175,10 @@ private:
     SpanEmitter& emitter() { return *emitter_; }
     std::size_t window_segments() const { return std::clamp<std::size_t>(options_.window_segments, 16, kMaxWindowSegments); }
 
+    /// The check's figures after a failed window; a window still in the check (the one before
+    /// a failed jerk stage) is first finished and, if it passed, sent as it would have been.
     bool fail(PlanCheck& check) {
+        (void)collect_checked();
         check = checker_.finish();
         return false;
     }
@@ -158,7 +192,7 @@ private:
                 break;
             }
             account(s);
-            checker_.note_segment(s);
+            next_.feeds.push_back({s.subpath, s.pen_down, s.feed});
             top_speed_ = std::max(top_speed_, std::min(v_axes_, s.feed));
             buffer_.push_back(std::move(s));
         }
@@ -366,17 +400,24 @@ private:
         return std::clamp(k, piece.first, piece.last);
     }
 
-    /// The window's events through the per-tick check, then to the sink; false when the check
-    /// found a tick over a limit (nothing of this window goes to the sink then).
+    /// The window's events (with the feeds read for them) to the per-tick check, after the
+    /// window before, once its check passed, to the sink. False when a check found a tick over
+    /// a limit (nothing of that window goes to the sink then).
     bool deliver() {
-        std::vector<PlanEvent>& events = delivered_;
-        emitter().take(events);
-        for (const PlanEvent& e : events) {
-            if (e.kind == PlanEvent::Kind::kSpan) checker_.span(e.span);
-            else if (e.kind == PlanEvent::Kind::kPen) checker_.pen(e.pen);
-        }
-        if (checker_.over_limits()) return false;
-        for (const PlanEvent& e : events) {
+        if (!collect_checked()) return false;
+        emitter().take(next_.events);
+        check_.submit(next_);
+        next_.events.clear();
+        next_.feeds.clear();
+        return true;
+    }
+
+    /// Waits for the window in the check and sends its events to the sink; false when its
+    /// check failed; true when it passed or none was in the check.
+    bool collect_checked() {
+        if (!check_.busy()) return true;
+        if (!check_.collect(checked_)) return false;
+        for (const PlanEvent& e : checked_.events) {
             switch (e.kind) {
                 case PlanEvent::Kind::kSpan:
                     sink_.span(e.span);
@@ -395,7 +436,21 @@ private:
         return true;
     }
 
-    std::vector<PlanEvent> delivered_;  ///< the events deliver() hands on (storage reused)
+    /// The check's job (on its thread): the batch's feeds, then its events tick by tick; true
+    /// when every tick so far is within the limits.
+    bool check_batch(const CheckBatch& batch) {
+        for (const FeedNote& f : batch.feeds) checker_.note_feed(f.subpath, f.pen_down, f.feed);
+        for (const PlanEvent& e : batch.events) {
+            if (e.kind == PlanEvent::Kind::kSpan)
+                checker_.span(e.span);
+            else if (e.kind == PlanEvent::Kind::kPen)
+                checker_.pen(e.pen);
+        }
+        return !checker_.over_limits();
+    }
+
+    CheckBatch next_;     ///< the feeds read and then the events of the window being planned
+    CheckBatch checked_;  ///< the window last collected from the check (storage reused)
     SegmentSource& source_;
     const MachineProfile& profile_;
     const PlanOptions& options_;
@@ -419,6 +474,8 @@ private:
     std::size_t spans_ = 0, pens_ = 0, pauses_ = 0;
     double pen_down_length_ = 0, travel_length_ = 0;
     std::size_t last_subpath_ = 0;
+    /// Last: destroyed (joined) before the checker and batches its job uses.
+    HandoffWorker<CheckBatch> check_;
 };
 
 }  // namespace

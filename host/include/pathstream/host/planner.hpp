@@ -57,6 +57,10 @@ struct PlanOptions {
     /// with the job. A window is read further where its lookahead horizon needs it.
     std::size_t window_segments = 2048;
 
+    /// plan_stream checks each window tick by tick on a second thread while it plans the next
+    /// (on a machine with more than one core): the same spans, sooner. False: one thread.
+    bool check_on_thread = true;
+
     int max_replans = 8;          ///< whole-plan retries with lowered limits after a failed check
     int max_local_retries = 24;   ///< per piece: lookahead retries with a locally lowered margin
 };
