@@ -41,6 +41,13 @@ void SpanEmitter::span(const LsbVec& p1, const LsbVec& t0, const LsbVec& t1, std
                        std::size_t subpath, bool pen_down) {
     PlanEvent ev;
     CoreSpan& s = ev.span;
+    if (!spare_.empty()) {  // a span taken back: its vectors' storage, emptied
+        s.control = std::move(spare_.back().control);
+        s.cubic = std::move(spare_.back().cubic);
+        spare_.pop_back();
+        s.control.clear();
+        s.cubic.clear();
+    }
     s.basis = Basis::kHermite;
     s.ticks = ticks;
     s.subpath = subpath;
@@ -192,7 +199,7 @@ void SpanEmitter::finish(std::size_t last_subpath) {
 
 void SpanEmitter::take(std::vector<PlanEvent>& out) {
     // The two buffers trade places, so both keep their capacity from window to window.
-    out.clear();
+    recycle(out);
     if (held_) {  // keep the held-back span for the next call
         PlanEvent last = std::move(events_.back());
         events_.pop_back();
@@ -201,6 +208,13 @@ void SpanEmitter::take(std::vector<PlanEvent>& out) {
     } else {
         out.swap(events_);
     }
+}
+
+void SpanEmitter::recycle(std::vector<PlanEvent>& used) {
+    for (PlanEvent& e : used) {
+        if (e.kind == PlanEvent::Kind::kSpan) spare_.push_back(std::move(e.span));
+    }
+    used.clear();
 }
 
 void SpanEmitter::fail(std::size_t subpath, const std::string& what) {

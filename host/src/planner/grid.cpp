@@ -55,8 +55,15 @@ Vec curvature(const Cubic& c, double u, double size, int side) {
 /// tangent turns by more than max_turn between neighbours or may turn by more inside the
 /// interval (the bound of turns_inside below). A turn above 90 degrees inside an
 /// interval shorter than 1e-7 in u is a cusp: its parameter goes to `cusps`.
-std::vector<double> segment_nodes(const Cubic& c, double length, const PlanOptions& o,
-                                  std::vector<double>& cusps) {
+struct NodeInterval {
+    double a, b;
+    Vec ta, tb;  ///< tangent after a, before b
+};
+
+/// The parameters into `out` (cleared first); `stack` is scratch. Both are the caller's, so
+/// that their storage is reused from segment to segment.
+void segment_nodes(const Cubic& c, double length, const PlanOptions& o, std::vector<double>& cusps,
+                   std::vector<double>& out, std::vector<NodeInterval>& stack) {
     const double size = c.size();
     std::size_t k = std::max<std::size_t>(o.min_nodes_per_segment, 1);
     if (o.grid_step > 0) {
@@ -77,10 +84,6 @@ std::vector<double> segment_nodes(const Cubic& c, double length, const PlanOptio
     };
     // turn > max_turn, and turn > 90 degrees, compared as cosines.
     const double cos_max_turn = std::cos(std::clamp(o.max_turn, 0.0, kPi));
-    struct Interval {
-        double a, b;
-        Vec ta, tb;  ///< tangent after a, before b
-    };
     // The end tangents alone miss a turn that goes out and comes back inside the interval (a
     // loop a few micrometres across, whose caps the nodes would not see). q' over [a, b] is a
     // quadratic Bezier with control points q'(a), q'(a) + (b - a) q''(a) / 2, q'(b), and every
@@ -99,8 +102,8 @@ std::vector<double> segment_nodes(const Cubic& c, double length, const PlanOptio
         if (ca < 0 || cb < 0) return true;
         return ca * cb - std::sqrt((1 - ca * ca) * (1 - cb * cb)) < cos_max_turn;
     };
-    std::vector<double> out;
-    std::vector<Interval> stack;  // intervals still to examine, last first
+    out.clear();
+    stack.clear();  // intervals still to examine, last first
     Sides right = sides(1.0);
     for (std::size_t i = k; i-- > 0;) {
         const double a = static_cast<double>(i) / static_cast<double>(k);
@@ -111,7 +114,7 @@ std::vector<double> segment_nodes(const Cubic& c, double length, const PlanOptio
     }
     out.push_back(0.0);
     while (!stack.empty()) {
-        const Interval in = stack.back();
+        const NodeInterval in = stack.back();
         stack.pop_back();
         const double cos_turn = std::clamp(dot(in.ta, in.tb), -1.0, 1.0);
         if (cos_turn < cos_max_turn || turns_inside(in.a, in.b, in.ta, in.tb)) {
@@ -135,7 +138,6 @@ std::vector<double> segment_nodes(const Cubic& c, double length, const PlanOptio
             cusps.push_back(out[i]);
         }
     }
-    return out;
 }
 
 struct Builder {
@@ -145,6 +147,8 @@ struct Builder {
     PathGrid out;
     double lambda = 0;
     double kappa_stop_ = 0;
+    std::vector<double> nodes_, cusps_;    ///< segment_nodes' output and cusps, storage reused
+    std::vector<NodeInterval> intervals_;  ///< segment_nodes' scratch
 
     void add_node(std::uint32_t seg, double u, double lam, const Vec& q, const Vec& t, const Vec& k,
                   double feed) {
@@ -193,8 +197,10 @@ struct Builder {
             const double length = arc_length(c, 0, 0.5) + arc_length(c, 0.5, 1);
             if (length < kDegenerateMm) continue;
             (run.pen_down ? out.pen_down_length : out.travel_length) += length;
-            std::vector<double> cusps;
-            const std::vector<double> us = segment_nodes(c, length, options, cusps);
+            std::vector<double>& cusps = cusps_;
+            cusps.clear();
+            segment_nodes(c, length, options, cusps, nodes_, intervals_);
+            const std::vector<double>& us = nodes_;
             const std::size_t seg_first = g.size();
             double lam = lambda;
             for (std::size_t i = 0; i < us.size(); ++i) {
@@ -282,7 +288,7 @@ double arc_length(const Cubic& c, double u0, double u1) {
 PathGrid build_grid(const std::vector<BezierSegment>& segments, const MachineProfile& profile,
                     const PlanOptions& options, std::size_t first_index) {
     const std::size_t axes = profile.axes.size();
-    Builder b{segments, profile, options, {}, 0, 0};
+    Builder b{segments, profile, options, {}, 0, 0, {}, {}, {}};
     double a_min = 0;
     for (const auto& a : profile.axes) a_min = a_min == 0 ? a.max_acceleration : std::min(a_min, a.max_acceleration);
     const double tick = 1 / profile.tick_hz;

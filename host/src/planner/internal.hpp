@@ -359,7 +359,17 @@ inline double tangent_scale(std::uint32_t ticks, double tick_hz, double lsb) {
 /// A velocity (mm/s, one axis) as the tangent of a span of `ticks` ticks in whole LSB: the one
 /// rounding (half away from zero, on tangent_scale) the forward pass and the emitter share.
 inline long long tangent_lsb(double velocity, std::uint32_t ticks, double tick_hz, double lsb) {
-    return std::llround(velocity * tangent_scale(ticks, tick_hz, lsb));
+    const double x = velocity * tangent_scale(ticks, tick_hz, lsb);
+    // std::llround inline (it is a library call, and this runs for every axis of every span
+    // tried): below 2^52 the fraction x - trunc(x) is exact, so half away from zero is exact.
+    if (!(std::fabs(x) < 0x1p52)) return std::llround(x);
+    long long i = static_cast<long long>(x);
+    const double fraction = x - static_cast<double>(i);
+    if (fraction >= 0.5)
+        ++i;
+    else if (fraction <= -0.5)
+        --i;
+    return i;
 }
 
 /// A point on the LSB grid (mm), rounded as the emitter rounds span end points.
@@ -538,9 +548,11 @@ public:
     }
     /// The end of the job: the final lift and its dwell, and the held-back span.
     void finish(std::size_t last_subpath);
-    /// The events made since the last call, moved into `out` (cleared first; its storage is
-    /// reused for the next events, so a caller that passes the same vector allocates once).
+    /// The events made since the last call, moved into `out` (emptied first through recycle).
     void take(std::vector<PlanEvent>& out);
+    /// Empties `used` (events already handed on), keeping its spans' storage for the next
+    /// spans: a caller that gives every event back allocates nothing per span once warm.
+    void recycle(std::vector<PlanEvent>& used);
 
     std::uint64_t total_ticks() const { return total_ticks_; }
     std::size_t motion_spans() const { return motion_spans_; }
@@ -567,6 +579,7 @@ private:
     const MachineProfile& profile_;
     std::size_t axes_;
     std::vector<PlanEvent> events_;
+    std::vector<CoreSpan> spare_;  ///< spans taken back by take(), their vectors' storage reused
     bool held_ = false;  ///< events_.back() is a span held back
     bool any_span_ = false, last_pen_down_ = false;
     LsbVec pos_{};

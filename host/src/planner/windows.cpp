@@ -407,7 +407,6 @@ private:
         if (!collect_checked()) return false;
         emitter().take(next_.events);
         check_.submit(next_);
-        next_.events.clear();
         next_.feeds.clear();
         return true;
     }
@@ -433,6 +432,7 @@ private:
                     break;
             }
         }
+        emitter().recycle(checked_.events);
         return true;
     }
 
