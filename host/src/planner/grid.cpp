@@ -51,17 +51,18 @@ Vec curvature(const Cubic& c, double u, double size, int side) {
     return k;
 }
 
-/// Parameters of the grid nodes along one segment: uniform in u, then bisected wherever the
-/// tangent turns by more than max_turn between neighbours or may turn by more inside the
-/// interval (the bound of turns_inside below). A turn above 90 degrees inside an
-/// interval shorter than 1e-7 in u is a cusp: its parameter goes to `cusps`.
+/// An interval of a segment's parameter that segment_nodes still has to examine.
 struct NodeInterval {
     double a, b;
     Vec ta, tb;  ///< tangent after a, before b
 };
 
-/// The parameters into `out` (cleared first); `stack` is scratch. Both are the caller's, so
-/// that their storage is reused from segment to segment.
+/// Parameters of the grid nodes along one segment: uniform in u, then bisected wherever the
+/// tangent turns by more than max_turn between neighbours or may turn by more inside the
+/// interval (the bound of turns_inside below). A turn above 90 degrees inside an
+/// interval shorter than 1e-7 in u is a cusp: its parameter goes to `cusps`. The parameters
+/// go to `out` (cleared first); `stack` is scratch. Both are the caller's, so that their
+/// storage is reused from segment to segment.
 void segment_nodes(const Cubic& c, double length, const PlanOptions& o, std::vector<double>& cusps,
                    std::vector<double>& out, std::vector<NodeInterval>& stack) {
     const double size = c.size();
