@@ -550,9 +550,21 @@ int run_resume(StreamCommandOptions o, const EventChannel& channel) {
                         journal.job);
             std::fflush(stdout);
             const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(600);
+            bool held_at_rest = false;
             while ((s.state == static_cast<unsigned>(device::DeviceState::kRunning) ||
                     (s.state == static_cast<unsigned>(device::DeviceState::kHolding) && s.own_move())) &&
                    std::chrono::steady_clock::now() < deadline) {
+                // Everything it accepted has run and it still runs: it waits at rest for more
+                // (the host died just after a span that ends at rest, a pen change's dwell or an
+                // exact stop), where no underrun comes. Hold it there, as an underrun would have.
+                if (!held_at_rest && s.state == static_cast<unsigned>(device::DeviceState::kRunning) &&
+                    s.last_completed == s.last_accepted) {
+                    held_at_rest = link->command(device::Command::kHold) == Status::kOk;
+                    if (held_at_rest) {
+                        std::printf("resume        the device ran out its queue at rest: holding it there\n");
+                        std::fflush(stdout);
+                    }
+                }
                 std::this_thread::sleep_for(std::chrono::milliseconds(20));
                 s = link->status();
             }
