@@ -37,7 +37,8 @@ public:
     HandoffWorker(Job job, Mode mode) : job_(std::move(job)), mode_(mode) {
         if (mode_ == Mode::kThread) thread_ = std::thread([this] { loop(); });
     }
-    /// Lets a job in progress finish, then joins the thread; an uncollected verdict is dropped.
+    /// Lets the submitted job (running or not yet started) run to its end, then joins the
+    /// thread; an uncollected verdict is dropped.
     ~HandoffWorker() {
         if (!thread_.joinable()) return;
         {
