@@ -161,9 +161,8 @@ private:
     Vec span_velocity(const Vec& v, std::uint32_t m) const {
         const double scale = tangent_scale(m, tick_hz_, lsb_);
         Vec r{};
-        for (std::size_t i = 0; i < axes_; ++i) {
-            r[i] = static_cast<double>(tangent_lsb(v[i], m, tick_hz_, lsb_)) / scale;
-        }
+        for (std::size_t i = 0; i < axes_; ++i)
+            r[i] = static_cast<double>(scaled_tangent_lsb(v[i], scale)) / scale;
         return r;
     }
 
@@ -178,9 +177,9 @@ private:
             // In LSB: a0 m^2 = 6 dP - 4 T0 - 2 T1, a1 m^2 = -6 dP + 2 T0 + 4 T1, p'(u) = T.
             const double lim_a = acc_[i] * tau * tau / lsb_, lim_v = vel_[i] * scale;
             const double p0 = std::round(k0.q[i] / lsb_);
-            const double t0 = static_cast<double>(tangent_lsb(v0[i], m, tick_hz_, lsb_));
+            const double t0 = static_cast<double>(scaled_tangent_lsb(v0[i], scale));
             const double p = std::round(k1.q[i] / lsb_);
-            const double t = static_cast<double>(tangent_lsb(k1.v[i], m, tick_hz_, lsb_));
+            const double t = static_cast<double>(scaled_tangent_lsb(k1.v[i], scale));
             const auto cost = [&](double p1, double t1) {
                 const double a0 = 6 * (p1 - p0) - 4 * t0 - 2 * t1, a1 = -6 * (p1 - p0) + 2 * t0 + 4 * t1;
                 double peak = std::max(std::fabs(t0), std::fabs(t1));
@@ -453,8 +452,12 @@ private:
     /// Relative: the check is ratio - 1. The knots are on the LSB grid, k1.v rounded for this
     /// span; k0's velocity is rounded for it here, so this is the span the device runs.
     double violation(const Knot& k0, const Arrival& in, const Knot& k1, std::uint32_t m, bool caps = true) const {
+        return violation(k0, in, k1, m, span_velocity(k0.v, m), caps);
+    }
+    /// The same with k0's velocity already rounded for this span (v0 = span_velocity(k0.v, m)).
+    double violation(const Knot& k0, const Arrival& in, const Knot& k1, std::uint32_t m,
+                     const Vec& v0, bool caps = true) const {
         const double tau = m * tick_;
-        const Vec v0 = span_velocity(k0.v, m);
         const Vec &q0 = k0.q, &q1 = k1.q, &v1 = k1.v;
         double worst = 0;
         constexpr int kSamples = 7;
@@ -547,8 +550,8 @@ private:
         c.end.q = p.q;
         c.end.v = scaled(p.t, v1);
         fit_end(k, v0, c.end, m);
-        c.f = violation(k, arrival_, c.end, m);
-        c.f = std::max(c.f, span_deviation(k, c.end, m) / deviation_limit_ - 1);
+        c.f = violation(k, arrival_, c.end, m, v0);
+        c.f = std::max(c.f, span_deviation(k, c.end, m, v0) / deviation_limit_ - 1);
         const double b1 = beta_at(c.end.lambda);
         if (v1 * v1 > b1 * (1 + 1e-6) + 1e-9) c.f = std::max(c.f, 1e-3);
         return c;
@@ -560,8 +563,11 @@ private:
     /// passes (chord^2 kappa / 8 < delta / 64) nor its end tangents can move it off the path: no
     /// corner, no swing, no bulge (below).
     double span_deviation(const Knot& k, const Knot& end, std::uint32_t m) {
+        return span_deviation(k, end, m, span_velocity(k.v, m));
+    }
+    /// The same with k's velocity already rounded for this span (v0 = span_velocity(k.v, m)).
+    double span_deviation(const Knot& k, const Knot& end, std::uint32_t m, const Vec& v0) {
         const double tau = m * tick_;
-        const Vec v0 = span_velocity(k.v, m);
         const double len = end.lambda - k.lambda;
         double kappa = 0;
         bool corner = false, curvature_step = false;
@@ -883,9 +889,9 @@ private:
             e.v = scaled(dir, v1);
             const Vec v0 = span_velocity(k.v, m);
             fit_end(k, v0, e, m);
-            double f = violation(k, arrival_, e, m);
+            double f = violation(k, arrival_, e, m, v0);
             if (f > 0) continue;
-            f = std::max(f, span_deviation(k, e, m) / deviation_limit_ - 1);
+            f = std::max(f, span_deviation(k, e, m, v0) / deviation_limit_ - 1);
             if (f > 0) continue;
             out = e;
             return m;

@@ -356,10 +356,10 @@ inline double tangent_scale(std::uint32_t ticks, double tick_hz, double lsb) {
     return ticks / tick_hz / lsb;
 }
 
-/// A velocity (mm/s, one axis) as the tangent of a span of `ticks` ticks in whole LSB: the one
-/// rounding (half away from zero, on tangent_scale) the forward pass and the emitter share.
-inline long long tangent_lsb(double velocity, std::uint32_t ticks, double tick_hz, double lsb) {
-    const double x = velocity * tangent_scale(ticks, tick_hz, lsb);
+/// A velocity (mm/s, one axis) as the tangent of a span in whole LSB, `scale` being the span's
+/// tangent_scale: the one rounding (half away from zero) the forward pass and the emitter share.
+inline long long scaled_tangent_lsb(double velocity, double scale) {
+    const double x = velocity * scale;
     // std::llround inline (it is a library call, and this runs for every axis of every span
     // tried): below 2^52 the fraction x - trunc(x) is exact, so half away from zero is exact.
     if (!(std::fabs(x) < 0x1p52)) return std::llround(x);
@@ -370,6 +370,11 @@ inline long long tangent_lsb(double velocity, std::uint32_t ticks, double tick_h
     else if (fraction <= -0.5)
         --i;
     return i;
+}
+
+/// scaled_tangent_lsb for a span of `ticks` ticks.
+inline long long tangent_lsb(double velocity, std::uint32_t ticks, double tick_hz, double lsb) {
+    return scaled_tangent_lsb(velocity, tangent_scale(ticks, tick_hz, lsb));
 }
 
 /// A point on the LSB grid (mm), rounded as the emitter rounds span end points.
