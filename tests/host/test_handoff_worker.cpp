@@ -15,9 +15,11 @@
 #include "pathstream/host/handoff_worker.hpp"
 #include "pathstream/host/planner.hpp"
 #include "pen_plotter_profile.hpp"
+#include "plan_digest.hpp"
 #include "random_walk_source.hpp"
 
 using namespace pathstream::host;
+using pathstream::host::test::DigestSink;
 using pathstream::host::test::pen_plotter;
 using pathstream::host::test::RandomWalkSource;
 
@@ -162,27 +164,6 @@ TEST_CASE(
 TEST_CASE("plan_stream with the check on its own thread hands the sink what one thread does",
           "[handoff][planner][stream][threads]") {
     const pathstream::host::MachineProfile machine = pen_plotter();
-    struct Digest : PlanSink {
-        std::size_t spans = 0, pens = 0;
-        std::uint64_t hash = 1469598103934665603ull;
-        void mix(std::int64_t v) {
-            hash ^= static_cast<std::uint64_t>(v);
-            hash *= 1099511628211ull;
-        }
-        void span(const CoreSpan& s) override {
-            ++spans;
-            mix(s.ticks);
-            mix(s.pen_down ? 1 : 0);
-            for (const auto& c : s.control) {
-                for (const std::int32_t v : c) mix(v);
-            }
-        }
-        void pen(const PenEvent& e) override {
-            ++pens;
-            mix(e.down ? 1 : 0);
-        }
-        void pause(const PlanPause&) override { mix(-1); }
-    };
     // Small windows: many handoffs, each window planned while the one before is checked.
     for (const std::size_t window : {64u, 2048u}) {
         INFO("windows of " << window << " segments");
@@ -190,15 +171,17 @@ TEST_CASE("plan_stream with the check on its own thread hands the sink what one 
         threaded.window_segments = single.window_segments = window;
         single.check_on_thread = false;
         RandomWalkSource walk_a(3000, 11), walk_b(3000, 11);
-        Digest a, b;
+        DigestSink a, b;
         PlanStats stats_a, stats_b;
         const PlanTotals ta = plan_stream(walk_a, machine, threaded, a, &stats_a);
         const PlanTotals tb = plan_stream(walk_b, machine, single, b, &stats_b);
         CHECK(ta.spans == tb.spans);
         CHECK(ta.total_ticks == tb.total_ticks);
-        CHECK(a.spans == ta.spans);
-        CHECK(a.hash == b.hash);
+        CHECK(a.digest.spans == ta.spans);
+        CHECK(a.digest.hash == b.digest.hash);
         CHECK(a.pens == b.pens);
+        CHECK(a.pen_digest.hash == b.pen_digest.hash);
+        CHECK(a.pauses == b.pauses);
         CHECK(stats_a.replans == stats_b.replans);
     }
 }

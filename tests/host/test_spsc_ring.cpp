@@ -2,7 +2,6 @@
 // ThreadSanitizer, tag [threads]) and a seeded single-thread interleaving against a model;
 // then the planner on its thread through it, against plan_stream on this one.
 #include <catch2/catch.hpp>
-
 #include <cstdint>
 #include <deque>
 #include <random>
@@ -12,9 +11,12 @@
 #include "pathstream/host/planning_thread.hpp"
 #include "pathstream/host/spsc_ring.hpp"
 #include "pen_plotter_profile.hpp"
+#include "plan_digest.hpp"
 #include "random_walk_source.hpp"
 
 using namespace pathstream::host;
+using pathstream::host::test::Digest;
+using pathstream::host::test::DigestSink;
 using pathstream::host::test::pen_plotter;
 using pathstream::host::test::RandomWalkSource;
 
@@ -24,36 +26,6 @@ namespace {
 struct Item {
     std::uint64_t sequence = 0;
     std::uint64_t check = 0;  // ~sequence
-};
-
-// What plan_stream hands a sink, reduced to what crossing the queue must keep.
-struct Digest {
-    std::size_t spans = 0;
-    std::uint64_t ticks = 0;
-    std::uint64_t hash = 1469598103934665603ull;
-    void add(const CoreSpan& s) {
-        ++spans;
-        ticks += s.ticks;
-        const auto mix = [this](std::int64_t v) {
-            hash ^= static_cast<std::uint64_t>(v);
-            hash *= 1099511628211ull;
-        };
-        mix(s.ticks);
-        mix(static_cast<std::int64_t>(s.subpath));
-        mix(s.pen_down ? 1 : 0);
-        mix(s.pause_after ? 1 : 0);
-        for (const auto& c : s.control) {
-            for (const std::int32_t v : c) mix(v);
-        }
-    }
-};
-
-class DigestSink : public PlanSink {
-public:
-    void span(const CoreSpan& s) override { digest.add(s); }
-    void pen(const PenEvent&) override {}
-    void pause(const PlanPause&) override {}
-    Digest digest;
 };
 
 }  // namespace

@@ -28,10 +28,9 @@ SpanEmitter::LsbVec SpanEmitter::quantise(const Vec& mm) const {
 }
 
 SpanEmitter::LsbVec SpanEmitter::tangent(const Vec& velocity, std::uint32_t ticks) const {
+    const double scale = tangent_scale(ticks, profile_.tick_hz, profile_.mm_per_lsb);
     LsbVec r{};
-    for (std::size_t i = 0; i < axes_; ++i) {
-        r[i] = tangent_lsb(velocity[i], ticks, profile_.tick_hz, profile_.mm_per_lsb);
-    }
+    for (std::size_t i = 0; i < axes_; ++i) r[i] = scaled_tangent_lsb(velocity[i], scale);
     return r;
 }
 

@@ -372,11 +372,6 @@ inline long long scaled_tangent_lsb(double velocity, double scale) {
     return i;
 }
 
-/// scaled_tangent_lsb for a span of `ticks` ticks.
-inline long long tangent_lsb(double velocity, std::uint32_t ticks, double tick_hz, double lsb) {
-    return scaled_tangent_lsb(velocity, tangent_scale(ticks, tick_hz, lsb));
-}
-
 /// A point on the LSB grid (mm), rounded as the emitter rounds span end points.
 inline Vec on_lsb_grid(const Vec& q, double lsb, std::size_t axes) {
     Vec r{};
