@@ -189,3 +189,38 @@ TEST_CASE("1 % of frames lost (seeded): lost RPDOs are seen through the demand e
     CHECK(r.demand_mismatches > 0);
     CHECK(r.demand_mismatches <= stale);
 }
+
+TEST_CASE("the first TPDO1s lost: the master waits a few SYNCs for every position before the enable",
+          "[cia402]") {
+    Setup s;
+    Rig rig(2, s.start);
+    host::Cia402Master m(rig.master_bus, rig.hub.clock, s.options());
+    m.configure();
+    // Node 2 answers the first three SYNCs of the job late or not at all (a loaded host): the
+    // job starts once both positions are in, within max_missed_feedback (5) cycles.
+    int tpdo2_dropped = 0;
+    rig.hub.drop = [&](const hal::CanFrame& f) {
+        if (f.id == kTpdo1Base + 2 && tpdo2_dropped < 3) return ++tpdo2_dropped, true;
+        return false;
+    };
+    const host::Cia402Report r = m.run(s.job.plan, s.job.machine, {});
+    INFO(r.message);
+    CHECK(tpdo2_dropped == 3);
+    CHECK(r.completed);
+    CHECK(rig.drives[1]->applied_targets().size() == rig.drives[0]->applied_targets().size());
+}
+
+TEST_CASE("a drive that never answers a SYNC is never enabled", "[cia402]") {
+    Setup s;
+    Rig rig(2, s.start);
+    host::Cia402Master m(rig.master_bus, rig.hub.clock, s.options());
+    m.configure();
+    rig.hub.drop = [](const hal::CanFrame& f) { return f.id == kTpdo1Base + 2; };
+    const host::Cia402Report r = m.run(s.job.plan, s.job.machine, {});
+    CHECK_FALSE(r.completed);
+    CHECK(r.stop == host::Cia402Stop::kFeedbackLost);
+    CHECK_THAT(r.message, Catch::Contains("node 2") && Catch::Contains("TPDO1"));
+    CHECK(rig.drives[0]->applied_targets().empty());
+    CHECK(rig.drives[1]->applied_targets().empty());
+    CHECK(rig.drives[0]->state() != DriveState::kOperationEnabled);
+}

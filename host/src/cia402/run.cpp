@@ -68,16 +68,30 @@ Cia402Report Cia402Master::run(const Plan& plan, const MachineProfile& profile, 
         return finish(false);
     };
 
-    // One harmless cycle (shutdown) to read every drive's position before any enables: a drive
-    // away from the plan's start would jump there as soon as it takes a target.
-    exchange(std::vector<std::uint16_t>(axes, kCwShutdown), target);
-    if (check_health(false) != Cia402Stop::kNone) return stop();
-    for (std::size_t a = 0; a < axes; ++a) {
-        const auto& d = drives_[a];
-        if (d.feedback_cycle != cycle_) {
-            stop_with(Cia402Stop::kFeedbackLost, "node " + std::to_string(d.node) + ": no TPDO1 after the first SYNC");
+    // Harmless cycles (shutdown) until every drive has answered a SYNC with its position, before
+    // any enables: a drive away from the plan's start would jump there as soon as it takes a
+    // target. A drive may answer a cycle late (a busy bus or host: one SYNC's TPDO1 missed 1 run
+    // in 10 on a loaded machine), so it has max_missed_feedback cycles, as during motion.
+    const std::vector<std::uint16_t> shut_down(axes, kCwShutdown);
+    for (unsigned tries = 1;; ++tries) {
+        exchange(shut_down, target);
+        if (check_health(false) != Cia402Stop::kNone) return stop();
+        bool all = true;
+        for (const auto& d : drives_) all = all && d.feedback_cycle == cycle_;
+        if (all) break;
+        if (tries >= options_.max_missed_feedback) {
+            for (const auto& d : drives_) {
+                if (d.feedback_cycle != cycle_) {
+                    stop_with(Cia402Stop::kFeedbackLost, "node " + std::to_string(d.node) + ": no TPDO1 after " +
+                                                             std::to_string(tries) + " SYNCs before the enable");
+                    break;
+                }
+            }
             return stop();
         }
+    }
+    for (std::size_t a = 0; a < axes; ++a) {
+        const auto& d = drives_[a];
         if (std::llabs(std::int64_t{d.position} - target[a]) > options_.start_tolerance) {
             stop_with(Cia402Stop::kStepLimit, "node " + std::to_string(d.node) + " (axis " + profile.axes[a].name +
                                                   ") is at " + std::to_string(d.position) + " LSB, the plan starts at " +
@@ -145,9 +159,8 @@ Cia402Report Cia402Master::run(const Plan& plan, const MachineProfile& profile, 
         if (check_health(true) != Cia402Stop::kNone) return stop();
     }
     if (options_.disable_at_end) {
-        const std::vector<std::uint16_t> shutdown(axes, kCwShutdown);
         for (int i = 0; i < 8; ++i) {
-            exchange(shutdown, target);
+            exchange(shut_down, target);
             bool done = true;
             for (const auto& d : drives_) done = done && d.state() == DriveState::kReadyToSwitchOn;
             if (done) break;

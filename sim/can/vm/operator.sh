@@ -13,13 +13,13 @@ timeout -s KILL 40 pathstream device -m "$data/pen_plotter.json" --no-gpio --can
 dev=$!
 vm_wait 10 rx_ready 1 || vm_fail "pathstream device did not open $iface: $(cat device.out)"
 
-vm_expect 0 pathstream ctl "$target" status --json > status.json 2>&1 || { cat status.json; vm_fail "ctl status"; }
+vm_expect_out 0 status.json pathstream ctl "$target" status --json
 grep -q '"state": "idle"' status.json || vm_fail "ctl status: not idle: $(cat status.json)"
-vm_expect 0 pathstream ctl "$target" jog x 2.5 -m "$data/pen_plotter.json" > jog.out 2>&1 || { cat jog.out; vm_fail "ctl jog"; }
+vm_expect_out 0 jog.out pathstream ctl "$target" jog x 2.5 -m "$data/pen_plotter.json"
 grep -q 'x 2.5000 mm' jog.out || vm_fail "ctl jog: $(cat jog.out)"
-vm_expect 0 pathstream ctl "$target" position x 0 -m "$data/pen_plotter.json" > pos.out 2>&1 || { cat pos.out; vm_fail "ctl position"; }
+vm_expect_out 0 pos.out pathstream ctl "$target" position x 0 -m "$data/pen_plotter.json"
 grep -q 'x 0.0000 mm' pos.out || vm_fail "ctl position: $(cat pos.out)"
-vm_expect 6 pathstream ctl "$target" hold > hold.out 2>&1 || { cat hold.out; vm_fail "ctl hold while idle was not refused"; }
+vm_expect_out 6 hold.out pathstream ctl "$target" hold
 
 # wave.json starts at 0,0: interrupt it part way, then resume from the journal.
 pathstream stream "$data/wave.json" -m "$data/pen_plotter.json" -t "$target" --journal j.json > s1.out 2>&1 &
@@ -32,14 +32,14 @@ wait "$s1"; rc=$?
 cat s1.out
 if [ "$rc" = 7 ]; then
   # Held at rest (the usual case), or stopped when the device had not started yet.
-  vm_expect 0 pathstream ctl "$target" status > held.out 2>&1
+  vm_expect_out 0 held.out pathstream ctl "$target" status
   if grep -q '"outcome": "held"' j.json; then
     grep -q '^state         holding' held.out || vm_fail "device not holding after the interrupt: $(cat held.out)"
   else
     grep -q '"outcome": "stopped"' j.json || vm_fail "journal after the interrupt: $(cat j.json)"
     grep -q '^state         idle' held.out || vm_fail "device not idle after the stop: $(cat held.out)"
   fi
-  vm_expect 0 pathstream stream --resume j.json > s2.out 2>&1 || { cat s2.out; vm_fail "stream --resume failed"; }
+  vm_expect_out 0 s2.out pathstream stream --resume j.json
   cat s2.out
   grep -q "^job .*finished" s2.out || vm_fail "resumed stream did not finish"
 elif [ "$rc" != 0 ]; then

@@ -18,9 +18,9 @@ timeout -s KILL 40 pathstream drive --can "$iface" --node 2 --exit-after 35 > dr
 d2=$!
 vm_wait 10 rx_ready 3 || vm_fail "pathstream drive did not open $iface: $(cat drive1.out drive2.out)"
 
-vm_expect 0 pathstream stream "$data/wave.json" --machine "$data/pen_plotter.json" \
-  --target "can://$iface?node=1&protocol=cia402&cycle=10ms" > stream.out 2>&1 \
-  || { cat stream.out; vm_fail "pathstream stream failed"; }
+vm_expect_out 0 stream.out pathstream stream "$data/wave.json" --machine "$data/pen_plotter.json" \
+  --target "can://$iface?node=1&protocol=cia402&cycle=10ms" \
+  || { cat drive1.out drive2.out; vm_fail "pathstream stream failed"; }
 cat stream.out
 grep -q "^executed .*motion cycles" stream.out || vm_fail "stream did not report completion"
 

@@ -49,7 +49,7 @@ pull 2 pull-down
 
 # 2. Homing against a switch that never closes within max_travel.
 sed 's/"max_travel": 100/"max_travel": 1/' "$profile" > short.json
-vm_expect 6 pathstream device -m short.json --home --can "$iface" --exit-after 5 > dev2.out 2>&1
+vm_expect_out 6 dev2.out pathstream device -m short.json --home --can "$iface" --exit-after 5
 cat dev2.out
 logged "homing x: switch x- not found within 1.000 mm (max_travel)" dev2.out || vm_fail "wrong homing error"
 [ "$(value 1)" = 0 ] || vm_fail "enable high after a failed homing"
