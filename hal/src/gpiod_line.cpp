@@ -181,4 +181,19 @@ std::unique_ptr<DigitalOutput> open_gpiod_output(const GpioLineSpec& spec, const
     return std::make_unique<GpiodOutput>(spec, consumer, initially_active);
 }
 
+GpioLineLocation locate_gpiod_line(const GpioLineSpec& spec) {
+    gpiod_chip* chip = open_chip(spec);
+    GpioLineLocation where;
+    try {
+        gpiod_line* line = find_line(chip, spec);
+        where.chip_name = gpiod_chip_name(chip);
+        where.offset = gpiod_line_offset(line);
+    } catch (...) {
+        gpiod_chip_close(chip);
+        throw;
+    }
+    gpiod_chip_close(chip);
+    return where;
+}
+
 }  // namespace pathstream::hal

@@ -81,6 +81,14 @@ expect device-machine 0 "x 250000 LSB/s 3000000 LSB/s^2" -- "$bin" device -m "$g
 expect device-no-chip 6 'gpio no-such-chip line "17": no GPIO chip is named or labelled "no-such-chip"' -- "$bin" device -m "$work/gpio_nochip.json" --tcp 127.0.0.1:0 --exit-after 0.05
 expect device-home-no-gpio 2 'no "gpio" object: --home has no switches' -- "$bin" device -m "$machine" --home --exit-after 0.05
 expect device-home-needs-machine 2 "--home: needs --machine" -- "$bin" device --home
+vm_profile=$src/sim/gpio/vm/gpio_vm_profile.json
+expect sim-switch-needs-machine 2 "--sim-switch: needs --machine" -- "$bin" device --sim-switch x-=1
+expect sim-switch-bounce-alone 2 "--switch-bounce: needs --sim-switch" -- "$bin" device -m "$vm_profile" --switch-bounce 2
+expect sim-switch-no-gpio 2 "not with --no-gpio" -- "$bin" device -m "$vm_profile" --no-gpio --sim-switch x-=1
+expect sim-switch-unknown 2 "gpio_vm_profile.json has no limit switch z- (its switches: x-, y+)" -- "$bin" device -m "$vm_profile" --sim-switch z-=1
+expect sim-switch-twice 2 "--sim-switch x-: given twice" -- "$bin" device -m "$vm_profile" --sim-switch x-=1 --sim-switch x-=2
+expect sim-switch-form 2 "want NAME=POSITION" -- "$bin" device -m "$vm_profile" --sim-switch x-
+expect sim-switch-position 2 "--sim-switch x-: 'abc' is not a number" -- "$bin" device -m "$vm_profile" --sim-switch x-=abc
 expect stream-lead-in-can 6 "nosuchcan0: no such interface" -- "$bin" stream "$src/examples/rose.json" -m "$machine" -t "can://nosuchcan0?node=1" --lead-in
 expect device-axes-and-machine 2 "the axis count comes from --machine" -- "$bin" device -m "$machine" --axes 3
 

@@ -75,19 +75,20 @@ public:
         io_ = &device.attach_io(w);
     }
 
-    // The switch of `axis` closes at physical `point` and below; none: it never closes.
+    // The switch of `axis` closes at physical `point` and below; none: it never closes. The
+    // device plays it after every tick (sim::MachineSwitches).
     void place_switch(unsigned axis, Lsb point) {
-        placed_[axis] = true;
-        point_[axis] = point;
+        sim::SwitchPlacement p;
+        p.axis = axis;
+        p.side = device::LimitSide::kNegative;
+        p.trigger = point;
+        sim::SimulatedInput& in = switches_[axis];
+        device_.switches().place(p, [&in](bool closed) { in.drive(closed); });
     }
     sim::DeviceIo& io() { return *io_; }
 
     // One tick with the switches following the physical position.
     void tick() {
-        for (unsigned a = 0; a < kAxes; ++a) {
-            const Lsb physical = device_.position(a) - physical_offset_[a];
-            switches_[a].drive(placed_[a] && physical <= point_[a]);
-        }
         const auto before_state = static_cast<DeviceState>(device_.state());
         std::array<Lsb, kAxes> before{};
         for (unsigned a = 0; a < kAxes; ++a) before[a] = device_.position(a);
@@ -98,17 +99,16 @@ public:
         // A position that changes idle at rest is redefined, not moved.
         if (before_state == DeviceState::kIdle && row.state == DeviceState::kIdle) {
             for (unsigned a = 0; a < kAxes; ++a) {
-                if (row.position[a] != before[a]) {
-                    physical_offset_[a] += row.position[a] - before[a];
-                    ++redefinitions_[a];
-                }
+                if (row.position[a] != before[a]) ++redefinitions_[a];
             }
         }
         rows_.push_back(row);
     }
 
     // Where the device's coordinates put physical point `point` of `axis` now.
-    Lsb device_coordinate(unsigned axis, Lsb point) const { return point + physical_offset_[axis]; }
+    Lsb device_coordinate(unsigned axis, Lsb point) const {
+        return point + device_.position(axis) - device_.switches().machine_position(axis);
+    }
     unsigned redefinitions(unsigned axis) const { return redefinitions_[axis]; }
     const std::vector<TickRow>& rows() const { return rows_; }
 
@@ -138,9 +138,6 @@ private:
     sim::SimulatedMotionDevice& device_;
     sim::DeviceIo* io_ = nullptr;
     sim::SimulatedInput switches_[kAxes];
-    bool placed_[kAxes] = {};
-    Lsb point_[kAxes] = {};
-    Lsb physical_offset_[kAxes] = {};
     unsigned redefinitions_[kAxes] = {};
     std::vector<TickRow> rows_;
 };

@@ -191,9 +191,8 @@ TEST_CASE("gpio glue: homing on the simulated plotter, its switch masked, the ot
     CHECK(h.latch_position() <= 2500);
     CHECK(h.latch_position() >= 2497);  // the poll sees the switch one tick late here
     b.glue.mask_limit(0, LimitSide::kNegative, false);
-    // The bench models switches in device coordinates: move the switch with the new zero
-    // (physically it stays where it is).
-    b.place_switch(0, LimitSide::kNegative, 2500 - h.latch_position());
+    // The switch stays where it is on the machine; homing moved the device's zero onto it.
+    CHECK(b.switches.machine_position(0) - b.device.position(0) == h.latch_position());
     // Homing ends on the switch (the latch stop runs past its point). Off it, then back: in
     // the new coordinates the switch point is 0, so moving to -100 trips the armed switch.
     CHECK(b.glue.limit_active(0, LimitSide::kNegative));

@@ -6,6 +6,7 @@
 #include <atomic>
 #include <cmath>
 #include <csignal>
+#include <cstdio>
 #include <functional>
 #include <iostream>
 #include <memory>
@@ -14,6 +15,7 @@
 #include <thread>
 
 #include "pathstream/device/gpio_logic.hpp"
+#include "pathstream/hal/gpio_gpiod.hpp"
 #include "pathstream/hal/modbus_server.hpp"
 #include "pathstream/hal/socketcan_bus.hpp"
 #include "pathstream/host/atomic_file.hpp"
@@ -26,6 +28,7 @@
 #include "pathstream/linux_device/machine_homing.hpp"
 #include "pathstream/linux_device/machine_lines.hpp"
 #include "pathstream/sim/can_device.hpp"
+#include "pathstream/sim/gpio_sim_pull.hpp"
 #include "pathstream/sim/modbus_device.hpp"
 
 namespace pathstream::host {
@@ -206,6 +209,65 @@ void home(sim::SimulatedMotionDevice& device, sim::DeviceIo& io, const MachinePr
     }
 }
 
+// --sim-switch: the profile's limit switches closed by the simulated axes, on the gpio-sim
+// lines the device reads (the kernel delivers their edges as a real pin's). Read and checked
+// before any line is opened: a wrong option is reported as one.
+struct SimSwitch {
+    std::string name;
+    sim::SwitchPlacement placement;
+    GpioLineConfig line;
+};
+
+std::vector<SimSwitch> read_sim_switches(const DeviceCommandOptions& o, const MachineProfile& profile) {
+    const GpioConfig& g = profile.gpio;
+    std::string names;
+    for (const auto& [name, line] : g.limits) names += (names.empty() ? "" : ", ") + name;
+    std::vector<SimSwitch> out;
+    for (const std::string& spec : o.sim_switches) {
+        const auto eq = spec.find('=');
+        if (eq == std::string::npos || eq == 0 || eq + 1 == spec.size()) {
+            throw std::invalid_argument("--sim-switch " + spec + ": want NAME=POSITION, e.g. x-=-5");
+        }
+        SimSwitch sw;
+        sw.name = spec.substr(0, eq);
+        const auto it = std::find_if(g.limits.begin(), g.limits.end(), [&sw](const auto& l) { return l.first == sw.name; });
+        if (it == g.limits.end()) {
+            throw std::invalid_argument("--sim-switch " + spec + ": " + profile.source + " has no limit switch " + sw.name +
+                                        (names.empty() ? " (gpio.limits is empty)" : " (its switches: " + names + ")"));
+        }
+        for (const SimSwitch& other : out) {
+            if (other.name == sw.name) throw std::invalid_argument("--sim-switch " + sw.name + ": given twice");
+        }
+        sw.line = it->second;
+        sim::SwitchPlacement& p = sw.placement;
+        p.axis = axis_index(profile, sw.name.substr(0, sw.name.size() - 1));
+        p.side = sw.name.back() == '+' ? device::LimitSide::kPositive : device::LimitSide::kNegative;
+        p.trigger = parse_position_argument(spec.substr(eq + 1), profile.mm_per_lsb, "--sim-switch " + sw.name);
+        p.hysteresis = static_cast<Lsb>(std::llround(o.switch_hysteresis / profile.mm_per_lsb));
+        p.bounces = o.switch_bounces;
+        p.bounce_ticks = std::max(o.switch_bounce_ticks != 0 ? o.switch_bounce_ticks : 4 * o.switch_bounces,
+                                  2 * o.switch_bounces);
+        p.seed = o.switch_seed + out.size();
+        out.push_back(sw);
+    }
+    return out;
+}
+
+void place_sim_switches(sim::SimulatedMotionDevice& device, const std::vector<SimSwitch>& switches,
+                        const MachineProfile& profile, const DeviceLog& log) {
+    for (const SimSwitch& sw : switches) {
+        const sim::SwitchPlacement& p = sw.placement;
+        const hal::GpioLineLocation where = hal::locate_gpiod_line(linux_device::line_spec(profile.gpio.chip, sw.line));
+        auto pull = std::make_shared<sim::GpioSimPull>(where.chip_name, where.offset, sw.line.active_low);
+        device.switches().place(p, [pull](bool closed) { pull->set(closed); });
+        char text[160];
+        std::snprintf(text, sizeof text, "simulated switch %s at %.4f mm (hysteresis %.4f mm, %u bounces within %u ticks): ",
+                      sw.name.c_str(), static_cast<double>(p.trigger) * profile.mm_per_lsb,
+                      static_cast<double>(p.hysteresis) * profile.mm_per_lsb, p.bounces, p.bounce_ticks);
+        log("gpio", text + pull->path());
+    }
+}
+
 // Configuration, GPIO and homing from the profile, shared by every transport.
 struct Machine {
     std::optional<MachineProfile> profile;
@@ -225,6 +287,7 @@ Machine prepare_machine(sim::SimulatedMotionDevice& device, const DeviceCommandO
     Machine m;
     if (!profile) return m;
     m.profile = profile;
+    const std::vector<SimSwitch> switches = read_sim_switches(o, *profile);
     const DeviceLimitsLsb limits = device_limits(*profile);
     if (Status s = device.configure(limits); s != Status::kOk) {
         throw std::invalid_argument(profile->source + ": the device refused the profile's limits: " + status_name(s));
@@ -250,6 +313,7 @@ Machine prepare_machine(sim::SimulatedMotionDevice& device, const DeviceCommandO
             throw std::invalid_argument(profile->source + ": " + e.what());
         }
     }
+    if (!switches.empty()) place_sim_switches(device, switches, *profile, log);
     if (o.home) {
         if (m.io == nullptr) {
             throw std::invalid_argument(profile->source + ": no \"gpio\" object: --home has no switches to home against");
@@ -393,7 +457,33 @@ void add_device_command(CLI::App& app, DeviceCommandOptions& o) {
     cmd->add_flag(
         "--log-json", o.log_json,
         "print the log as NDJSON (one JSON object per line, docs/events.md) instead of text");
+    cmd->add_option("--sim-switch", o.sim_switches,
+                    "play the profile's limit switch NAME (e.g. x-) from the simulated axis on a gpio-sim chip: "
+                    "closed at POSITION (mm, or LSB with the suffix lsb) and beyond; NAME=POSITION, repeatable "
+                    "(docs/gpio.md)");
+    cmd->add_option("--switch-hysteresis", o.switch_hysteresis,
+                    "with --sim-switch: mm the axis moves back past the trigger before the switch opens")
+        ->capture_default_str()
+        ->check(CLI::Range(0.0, 100.0));
+    cmd->add_option("--switch-bounce", o.switch_bounces,
+                    "with --sim-switch: times the contact opens and closes again after every change")
+        ->capture_default_str()
+        ->check(CLI::Range(0, 100));
+    cmd->add_option("--switch-bounce-ticks", o.switch_bounce_ticks,
+                    "with --sim-switch: ticks the bounces fall within (0: 4 x --switch-bounce; at least 2 x it)")
+        ->capture_default_str()
+        ->check(CLI::Range(0, 100000));
+    cmd->add_option("--switch-seed", o.switch_seed, "with --sim-switch: seed of the bounces' ticks")->capture_default_str();
     cmd->callback([cmd, &o] {
+        if (!o.sim_switches.empty() && o.machine.empty()) {
+            throw CLI::ValidationError("--sim-switch", "needs --machine (the profile's gpio.limits)");
+        }
+        if (!o.sim_switches.empty() && o.no_gpio) {
+            throw CLI::ValidationError("--sim-switch", "drives the profile's GPIO lines: not with --no-gpio");
+        }
+        for (const char* opt : {"--switch-hysteresis", "--switch-bounce", "--switch-bounce-ticks", "--switch-seed"}) {
+            if (cmd->count(opt) > 0 && o.sim_switches.empty()) throw CLI::ValidationError(opt, "needs --sim-switch");
+        }
         if (o.home && o.machine.empty()) throw CLI::ValidationError("--home", "needs --machine (the profile's gpio.home)");
         if (o.no_gpio && o.machine.empty()) throw CLI::ValidationError("--no-gpio", "needs --machine");
         if (o.no_gpio && o.home) throw CLI::ValidationError("--home", "homes against the GPIO switches: not with --no-gpio");

@@ -28,6 +28,13 @@ struct DeviceCommandOptions {
     std::string record;
     double exit_after = 0;  ///< seconds of wall time; 0 = until SIGINT/SIGTERM
     bool log_json = false;  ///< --log-json: the log as NDJSON instead of text
+    /// --sim-switch NAME=POSITION: the profile's limit switch NAME played by its axis on a
+    /// gpio-sim chip, closed at POSITION (mm, or LSB with the suffix lsb) and beyond.
+    std::vector<std::string> sim_switches;
+    double switch_hysteresis = 0.02;  ///< mm the axis moves back past the trigger to open it
+    unsigned switch_bounces = 0;      ///< extra openings and closings after every change
+    unsigned switch_bounce_ticks = 0; ///< ticks they fall within (0: 4 x bounces)
+    std::uint64_t switch_seed = 1;    ///< the bounces' ticks are drawn from this seed
 };
 
 void add_device_command(CLI::App& app, DeviceCommandOptions& options);

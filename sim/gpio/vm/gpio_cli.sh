@@ -1,7 +1,8 @@
 # `pathstream device --machine` on a real kernel's gpio-sim (runs inside the VM; helpers from
 # sim/vm/vm_lib.sh; docs/gpio.md). The CLI opens the profile's lines through libgpiod:
 #   line 0 pen (out), 1 enable (out), 2 estop (in), 3 limit-x = x- (in), 4 limit-y = y+ (in,
-#   active low). The script plays the machine's switches through the sim's pull attributes.
+#   active low). The e-stop is pressed through the sim's pull attribute; the limit switch x- is
+#   played by the device's own simulated axis (--sim-switch), never by the script.
 # 1. A drawing streamed over vcan0 runs with enable high and the pen down on real lines; the
 #    e-stop line stops it; the streamer exits 6 naming the e-stop, enable and pen drop.
 # 2. --home with a switch that never closes: exit 6, "not found within 1.000 mm".
@@ -54,56 +55,48 @@ cat dev2.out
 logged "homing x: switch x- not found within 1.000 mm (max_travel)" dev2.out || vm_fail "wrong homing error"
 [ "$(value 1)" = 0 ] || vm_fail "enable high after a failed homing"
 
-# 3. Homing with the switch played from the device's phase log, then serving.
-timeout -s KILL 60 pathstream device -m "$profile" --home --can "$iface" --node 3 > dev3.out 2>&1 &
+# 3. Homing with the x- switch played by the simulated axis (--sim-switch: closed at -5 mm and
+#    below, 0.05 mm hysteresis, 2 bounces after every change), then serving; a jog back onto the
+#    re-armed switch faults by name.
+sims="--sim-switch x-=-5 --switch-hysteresis 0.05 --switch-bounce 2"
+timeout -s KILL 60 pathstream device -m "$profile" --home --can "$iface" --node 3 $sims > dev3.out 2>&1 &
 dev=$!
 vm_wait 10 logged "x: searching" dev3.out || { cat dev3.out; vm_fail "homing did not start"; }
 vm_wait 5 line_is 1 1 || vm_fail "enable not high while homing"
-usleep 300000
-pull 3 pull-up  # the axis reaches x-
-vm_wait 10 logged "x: backing off" dev3.out || { cat dev3.out; vm_fail "no back-off after the switch closed"; }
-pull 3 pull-down  # ... and leaves it
-vm_wait 10 logged "x: approaching slowly" dev3.out || { cat dev3.out; vm_fail "no slow approach"; }
-usleep 300000
-pull 3 pull-up  # the slow approach reaches it again: the latch
-vm_wait 10 logged "x: pulling off the switch" dev3.out || { cat dev3.out; vm_fail "no pull-off after the latch"; }
-pull 3 pull-down
-vm_wait 10 logged "x: homed: switch point = 0.000 mm" dev3.out || { cat dev3.out; vm_fail "homing did not finish"; }
-vm_wait 10 logged "native CAN node 3 on $iface" dev3.out || { cat dev3.out; vm_fail "not serving after homing"; }
+vm_wait 30 logged "native CAN node 3 on $iface" dev3.out || { cat dev3.out; vm_fail "not serving after homing"; }
+for phase in "x: backing off" "x: approaching slowly" "x: pulling off the switch" \
+             "x: homed: switch point = 0.000 mm"; do
+  logged "$phase" dev3.out || { cat dev3.out; vm_fail "homing did not log '$phase'"; }
+done
 [ "$(value 1)" = 0 ] || vm_fail "enable high after homing (idle)"
-pull 3 pull-up  # the armed switch closes again
+[ "$(value 3)" = 0 ] || vm_fail "x- still closed 1 mm off the switch"
+target="can://$iface?node=3&protocol=native"
+vm_run pathstream ctl "$target" jog x -2 -m "$profile" > jog3.out 2>&1
 vm_wait 10 logged "FAULT at tick .*: limit switch x- (axis 0, negative side)" dev3.out ||
-  { cat dev3.out; vm_fail "the re-armed x- switch did not fault"; }
+  { cat dev3.out jog3.out; vm_fail "the jog onto the re-armed x- switch did not fault"; }
+[ "$(value 3)" = 1 ] || vm_fail "x- not closed where the jog stopped"
 kill -INT "$dev"
 wait "$dev" || { cat dev3.out; vm_fail "the device failed"; }
 cat dev3.out
 released
 
 # 4. Homing and the pen as bus commands: `ctl home` while the device serves, the switch played
-#    from the device's log as in 3; then `ctl pen down` lowers the real pen line at rest.
-timeout -s KILL 60 pathstream device -m "$profile" --can "$iface" --node 3 > dev4.out 2>&1 &
+#    by the axis as in 3; then `ctl pen down` lowers the real pen line at rest.
+timeout -s KILL 60 pathstream device -m "$profile" --can "$iface" --node 3 $sims > dev4.out 2>&1 &
 dev=$!
 vm_wait 10 rx_ready 1 || { cat dev4.out; vm_fail "the device did not open $iface"; }
-target="can://$iface?node=3&protocol=native"
 timeout -s KILL 60 pathstream ctl "$target" home -m "$profile" > ctl4.out 2>&1 &
 ctl=$!
 vm_wait 10 logged "x: searching" dev4.out || { cat dev4.out ctl4.out; vm_fail "ctl home did not start homing"; }
 vm_wait 5 line_is 1 1 || vm_fail "enable not high while homing over the bus"
-usleep 300000
-pull 3 pull-up
-vm_wait 10 logged "x: backing off" dev4.out || { cat dev4.out; vm_fail "no back-off (ctl home)"; }
-pull 3 pull-down
-vm_wait 10 logged "x: approaching slowly" dev4.out || { cat dev4.out; vm_fail "no slow approach (ctl home)"; }
-usleep 300000
-pull 3 pull-up
-vm_wait 10 logged "x: pulling off the switch" dev4.out || { cat dev4.out; vm_fail "no pull-off (ctl home)"; }
-pull 3 pull-down
 wait "$ctl"
 rc=$?
 cat ctl4.out
 [ "$rc" = 0 ] || { cat dev4.out; vm_fail "ctl home exited $rc"; }
 logged "homing        x homed" ctl4.out || vm_fail "ctl home did not report x homed"
-logged "x: homed: switch point = 0.000 mm" dev4.out || { cat dev4.out; vm_fail "the device did not log x homed"; }
+for phase in "x: backing off" "x: approaching slowly" "x: pulling off the switch" "x: homed: switch point = 0.000 mm"; do
+  logged "$phase" dev4.out || { cat dev4.out; vm_fail "ctl home: the device did not log '$phase'"; }
+done
 [ "$(value 0)" = 0 ] || vm_fail "pen down before ctl pen down"
 pathstream ctl "$target" pen down > ctl5.out 2>&1 || { cat ctl5.out; vm_fail "ctl pen down failed"; }
 vm_wait 5 line_is 0 1 || vm_fail "ctl pen down did not lower the pen line"

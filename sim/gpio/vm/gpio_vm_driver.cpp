@@ -2,10 +2,14 @@
 // time) whose e-stop, limit switches, enable and pen lines are gpio-sim lines opened through
 // the libgpiod backend as a machine profile's "gpio" object maps them. Every wait is bounded.
 //
-//   pathstream_gpio_vm_driver run PROFILE DIR MAX_MS
-//       moves until an e-stop or a limit fault comes from outside (the script writes the
-//       sim's pull attributes); DIR/running once enable is up; on e-stop: DIR/estop, waits for
-//       the input's release, resets, DIR/reset; on a fault: prints its name. Exit 0 if one came.
+//   pathstream_gpio_vm_driver run PROFILE DIR MAX_MS [SWITCH=MM ...]
+//       moves (x out to -20 mm and back, then y out to +20 mm and back, again and again) until
+//       an e-stop or a limit fault comes: the e-stop from the script (it writes the line's sim
+//       pull attribute), a limit switch SWITCH (x-, y+, ...) from the axis itself, which closes
+//       it at MM and beyond (sim::MachineSwitches driving the line's gpio-sim pull). DIR/running
+//       once enable is up; on e-stop: DIR/estop, waits for the input's release, resets,
+//       DIR/reset; on a fault: prints its name, DIR/fault. Then it keeps its lines as they are
+//       until DIR/done exists (at most 20 s), so the script can read them. Exit 0 if one came.
 //   pathstream_gpio_vm_driver errors CHIP
 //       the libgpiod backend's errors on the real chip (unknown line name, offset out of
 //       range, a line busy with its holder named).
@@ -15,6 +19,7 @@
 #include <time.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
@@ -30,6 +35,8 @@
 #include "pathstream/host/machine.hpp"
 #include "pathstream/linux_device/machine_lines.hpp"
 #include "pathstream/sim/device_gpio.hpp"
+#include "pathstream/sim/gpio_sim_pull.hpp"
+#include "pathstream/sim/machine_switches.hpp"
 
 namespace {
 
@@ -88,7 +95,8 @@ struct Plotter {
             if (!move.pending()) {
                 Lsb from[2] = {end[0], end[1]};
                 const unsigned axis = leg % 2;
-                const std::int64_t d = (leg / 2) % 2 == 0 ? 20000 : -20000;
+                const std::int64_t out = axis == 0 ? -20000 : 20000;
+                const std::int64_t d = (leg / 2) % 2 == 0 ? out : -out;
                 (void)move.plan(from, axis, d, 100000, device.limits());
                 end[axis] = static_cast<Lsb>(end[axis] + d);
                 ++leg;
@@ -109,13 +117,35 @@ struct Plotter {
         move = device::AxisMove<2>{};
     }
 
-    // One tick at `deadline`: inputs, tick, outputs.
+    // One tick at `deadline`: inputs, tick, outputs, then the switches follow the axes.
     void tick() {
         glue->poll_inputs();
         Lsb out[2];
         device.tick(out);
         glue->update_outputs();
+        if (switches.size() != 0) switches.after_tick(out, 2, device.status().position_applied);
         ++ticks;
+    }
+
+    // A limit switch of the profile ("x-=-15": closed at -15 mm and below) played by its axis
+    // on the line's gpio-sim pull.
+    void place_switch(const host::MachineProfile& p, const std::string& arg) {
+        const auto eq = arg.find('=');
+        const std::string name = arg.substr(0, eq);
+        const auto it = std::find_if(p.gpio.limits.begin(), p.gpio.limits.end(),
+                                     [&name](const auto& l) { return l.first == name; });
+        if (eq == std::string::npos || it == p.gpio.limits.end()) {
+            throw hal::GpioError("switch " + arg + ": want NAME=MM with NAME a limit switch of the profile");
+        }
+        sim::SwitchPlacement sp;
+        sp.axis = name[0] == 'x' ? 0u : 1u;
+        sp.side = name.back() == '+' ? device::LimitSide::kPositive : device::LimitSide::kNegative;
+        sp.trigger = static_cast<Lsb>(std::llround(std::stod(arg.substr(eq + 1)) / p.mm_per_lsb));
+        const hal::GpioLineLocation where = hal::locate_gpiod_line(spec(p.gpio.chip, it->second));
+        auto pull = std::make_shared<sim::GpioSimPull>(where.chip_name, where.offset, it->second.active_low);
+        switches.place(sp, [pull](bool closed) { pull->set(closed); });
+        std::printf("driver: switch %s at %s mm played by axis %u on %s\n", name.c_str(), arg.substr(eq + 1).c_str(),
+                    sp.axis, pull->path().c_str());
     }
 
     Device device;
@@ -124,12 +154,15 @@ struct Plotter {
     std::unique_ptr<hal::DigitalOutput> enable, pen;
     std::unique_ptr<Glue> glue;
     device::AxisMove<2> move;
+    sim::MachineSwitches switches;
     Lsb end[2] = {0, 0};
     unsigned leg = 0;
     std::uint64_t ticks = 0;
 };
 
 void touch(const std::string& path) { std::ofstream(path) << "1\n"; }
+
+bool exists(const std::string& path) { return std::ifstream(path).good(); }
 
 bool write_attr(const std::string& path, const char* value) {
     std::ofstream out(path);
@@ -156,8 +189,24 @@ std::string fault_text(device::FaultCode code) {
     return buf;
 }
 
-int run(const host::MachineProfile& profile, const std::string& dir, std::uint64_t max_ms) {
+// Keeps ticking with the lines as they are until the script has read them (DIR/done), at most
+// 20 s: a fixed hold raced the script on a loaded machine.
+int hold_until_done(Plotter& p, const std::string& dir, std::uint64_t& deadline) {
+    const std::uint64_t period = 1000000;
+    for (int i = 0; i < 20000; ++i) {
+        deadline += period;
+        sleep_until_ns(deadline);
+        p.tick();
+        if (i % 10 == 0 && exists(dir + "/done")) return 0;
+    }
+    std::printf("driver: FAIL: %s/done did not appear within 20 s\n", dir.c_str());
+    return 1;
+}
+
+int run(const host::MachineProfile& profile, const std::string& dir, std::uint64_t max_ms,
+        const std::vector<std::string>& switches) {
     Plotter p(profile);
+    for (const std::string& sw : switches) p.place_switch(profile, sw);
     p.feed();
     if (p.device.command(device::Command::kStart) != Status::kOk) return std::fprintf(stderr, "start refused\n"), 1;
     const std::uint64_t period = 1000000;  // 1 kHz
@@ -197,23 +246,12 @@ int run(const host::MachineProfile& profile, const std::string& dir, std::uint64
                 std::printf("driver: fault: %s\n", fault_text(p.device.fault_code()).c_str());
                 std::fflush(stdout);
                 touch(dir + "/fault");
-                // Hold the lines a moment so the script can see enable low, then leave.
-                for (int i = 0; i < 500; ++i) {
-                    deadline += period;
-                    sleep_until_ns(deadline);
-                    p.tick();
-                }
-                return 0;
+                return hold_until_done(p, dir, deadline);
             }
             if (s == device::DeviceState::kIdle && estop_tick != 0) {
                 std::printf("driver: reset after e-stop: idle, enable %s\n", device::enable_asserted(s) ? "high" : "low");
                 touch(dir + "/reset");
-                for (int i = 0; i < 300; ++i) {
-                    deadline += period;
-                    sleep_until_ns(deadline);
-                    p.tick();
-                }
-                return 0;
+                return hold_until_done(p, dir, deadline);
             }
             last = s;
         }
@@ -317,7 +355,7 @@ int errors(const std::string& chip) {
 
 int usage() {
     std::fprintf(stderr,
-                 "usage: pathstream_gpio_vm_driver run PROFILE DIR MAX_MS\n"
+                 "usage: pathstream_gpio_vm_driver run PROFILE DIR MAX_MS [SWITCH=MM ...]\n"
                  "       pathstream_gpio_vm_driver measure PROFILE PULL_PATH ROUNDS\n"
                  "       pathstream_gpio_vm_driver errors CHIP\n");
     return 2;
@@ -334,11 +372,14 @@ int main(int argc, char** argv) {
             return 1;
         }
     }
-    if (argc != 5) return usage();
+    if (argc < 5) return usage();
     const std::string mode = argv[1];
     try {
         const host::MachineProfile profile = host::load_machine_profile(argv[2]);
-        if (mode == "run") return run(profile, argv[3], std::strtoull(argv[4], nullptr, 10));
+        if (mode == "run") {
+            return run(profile, argv[3], std::strtoull(argv[4], nullptr, 10), std::vector<std::string>(argv + 5, argv + argc));
+        }
+        if (argc != 5) return usage();
         if (mode == "measure") return measure(profile, argv[3], std::atoi(argv[4]));
     } catch (const std::exception& e) {
         std::fprintf(stderr, "pathstream_gpio_vm_driver: %s\n", e.what());

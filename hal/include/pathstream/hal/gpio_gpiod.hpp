@@ -37,4 +37,14 @@ std::unique_ptr<DigitalInput> open_gpiod_input(const GpioLineSpec& spec, const s
 std::unique_ptr<DigitalOutput> open_gpiod_output(const GpioLineSpec& spec, const std::string& consumer,
                                                  bool initially_active = false);
 
+/// A line's place in the kernel: the chip's name ("gpiochip3") and the line's offset on it.
+struct GpioLineLocation {
+    std::string chip_name;
+    unsigned offset = 0;
+};
+
+/// Resolves `spec` (chip by path, name, number or label; line by offset or name) without
+/// requesting the line. Throws GpioError as open_gpiod_input does. Init context.
+GpioLineLocation locate_gpiod_line(const GpioLineSpec& spec);
+
 }  // namespace pathstream::hal

@@ -10,6 +10,7 @@
 #include "pathstream/device/motion_device.hpp"
 #include "pathstream/host/device_setup.hpp"
 #include "pathstream/sim/device_io.hpp"
+#include "pathstream/sim/machine_switches.hpp"
 #include "pathstream/units.hpp"
 
 namespace pathstream::sim {
@@ -53,6 +54,10 @@ public:
     /// it and drives the outputs after it. The lines must outlive the device. Init context.
     virtual DeviceIo& attach_io(const MachineWiring& wiring) = 0;
 
+    /// The machine's switches, played by the axes after every tick (none until placed; a
+    /// switch's line is whatever its MachineSwitches::Line drives). Place them at init.
+    MachineSwitches& switches() { return switches_; }
+
     /// Records every path tick from now on: setpoints[k * axes + axis] is path tick k's.
     void record(bool on) { recording_ = on; }
     const std::vector<Lsb>& recorded_setpoints() const { return setpoints_; }
@@ -65,6 +70,7 @@ public:
     std::uint64_t ticks_run() const { return ticks_run_; }
 
 protected:
+    MachineSwitches switches_;
     bool recording_ = false;
     bool recording_every_tick_ = false;
     std::vector<Lsb> setpoints_;
@@ -86,6 +92,7 @@ public:
         const std::uint64_t before = device_.ticks_executed();
         device_.tick(out);
         if (io_) io_->after_tick();
+        if (this->switches_.size() != 0) this->switches_.after_tick(out, Axes, device_.status().position_applied);
         ++this->ticks_run_;
         if (this->recording_every_tick_) this->every_tick_.insert(this->every_tick_.end(), out, out + Axes);
         if (this->recording_ && device_.ticks_executed() != before) {  // a path tick

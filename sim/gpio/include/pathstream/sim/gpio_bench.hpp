@@ -9,6 +9,7 @@
 
 #include "pathstream/device/motion_device.hpp"
 #include "pathstream/sim/device_gpio.hpp"
+#include "pathstream/sim/machine_switches.hpp"
 #include "pathstream/sim/simulated_input.hpp"
 #include "pathstream/sim/simulated_output.hpp"
 #include "pathstream/sim/virtual_clock.hpp"
@@ -31,22 +32,28 @@ public:
     GpioBench& operator=(const GpioBench&) = delete;
 
     /// A switch that is active while the axis is at or beyond `trigger` (at or below for the
-    /// negative side): the way a cam or an optical flag works.
+    /// negative side): the way a cam or an optical flag works. `trigger` is a machine position:
+    /// the device's coordinates at the first step(); homing's new zero does not move it.
     void place_switch(unsigned axis, device::LimitSide side, Lsb trigger) {
-        placed_[axis][static_cast<unsigned>(side)] = true;
-        trigger_[axis][static_cast<unsigned>(side)] = trigger;
+        SwitchPlacement p;
+        p.axis = axis;
+        p.side = side;
+        p.trigger = trigger;
+        place_switch(p);
+    }
+    /// The same with hysteresis and bounce.
+    void place_switch(const SwitchPlacement& p) {
+        SimulatedInput& in = limit[p.axis][static_cast<unsigned>(p.side)];
+        switches.place(p, [&in, this](bool closed) { in.drive(closed, clock.now()); });
     }
 
     /// One tick: switches follow the last setpoint, inputs are polled, the device ticks, the
     /// outputs follow the new state.
     void step() {
-        for (unsigned a = 0; a < Axes; ++a) {
-            for (unsigned side = 0; side < 2; ++side) {
-                if (!placed_[a][side]) continue;
-                const Lsb p = device.position(a);
-                const Lsb t = trigger_[a][side];
-                limit[a][side].drive(side == 0 ? p <= t : p >= t, clock.now());
-            }
+        if (switches.size() != 0) {
+            Lsb p[Axes];
+            for (unsigned a = 0; a < Axes; ++a) p[a] = device.position(a);
+            switches.after_tick(p, Axes, device.status().position_applied);
         }
         glue.poll_inputs();
         Lsb out[Axes];
@@ -76,6 +83,7 @@ public:
     SimulatedOutput enable{clock};
     SimulatedOutput pen{clock};
     DeviceGpio<Axes, Capacity> glue;
+    MachineSwitches switches;  ///< the switches placed, on the machine's coordinates
     std::vector<std::array<Lsb, Axes>> ticks;      ///< every tick's setpoints
     std::vector<device::DeviceState> states;       ///< the state after every tick
 
@@ -91,9 +99,6 @@ private:
         w.pen = &pen;
         return w;
     }
-
-    bool placed_[Axes][2] = {};
-    Lsb trigger_[Axes][2] = {};
 };
 
 }  // namespace pathstream::sim
