@@ -332,3 +332,69 @@ TEST_CASE("faults stop at once and keep the first code", "[device]") {
     CHECK(d.state() == DeviceState::kIdle);
     CHECK(d.fault_code() == FaultCode::kNone);
 }
+
+TEST_CASE("a request the tick has not taken yet is replaced by the next one; a stop is not", "[device]") {
+    const Lsb start[kAxes] = {0, 0};
+    const auto spans = trapezoid_move<kAxes>(start, 80000, 8);
+
+    SECTION("a hold right after a resume to an underrun: the device stays holding") {
+        // The race a streaming host met under load: it sent resume to a device held by
+        // underrun, then hold (Ctrl-C) before the tick took the resume. The hold was judged
+        // "already in effect" from the published state and not posted, so the resume ran.
+        Device d(start);
+        REQUIRE(d.configure(test_limits<kAxes>()) == Status::kOk);
+        REQUIRE(send(d, 1, spans, 0, 16) == Status::kOk);
+        REQUIRE(d.command(Command::kStart) == Status::kOk);
+        Recorder r;
+        r.run(d, 16 * 8 + 400);
+        REQUIRE(d.state() == DeviceState::kHolding);
+        REQUIRE(d.held_by_underrun());
+        REQUIRE(send(d, 17, spans, 16, 8) == Status::kOk);
+        REQUIRE(d.command(Command::kResume) == Status::kOk);
+        REQUIRE(d.command_pending());
+        REQUIRE(d.command(Command::kHold) == Status::kOk);
+        const auto rest = r.ticks.back();
+        r.run(d, 50);
+        CHECK(d.state() == DeviceState::kHolding);
+        CHECK(r.ticks.back() == rest);
+        CHECK_FALSE(d.command_pending());
+        // Settled: a hold while holding is kOk and posts nothing.
+        CHECK(d.command(Command::kHold) == Status::kOk);
+        CHECK_FALSE(d.command_pending());
+        REQUIRE(d.command(Command::kResume) == Status::kOk);
+        r.run(d, 50);
+        CHECK(d.state() == DeviceState::kRunning);
+        r.check_limits(test_limits<kAxes>());
+    }
+    SECTION("a resume right after a hold while running: the device keeps running") {
+        Device d(start);
+        REQUIRE(d.configure(test_limits<kAxes>()) == Status::kOk);
+        REQUIRE(send(d, 1, spans, 0, 16) == Status::kOk);
+        REQUIRE(d.command(Command::kStart) == Status::kOk);
+        Recorder r;
+        r.run(d, 40);
+        REQUIRE(d.state() == DeviceState::kRunning);
+        REQUIRE(d.command(Command::kHold) == Status::kOk);
+        REQUIRE(d.command(Command::kResume) == Status::kOk);  // posted: replaces the hold
+        r.run(d, 40);
+        CHECK(d.state() == DeviceState::kRunning);
+        CHECK(d.generated_ticks() == 0);
+    }
+    SECTION("a stop not yet taken stays: start, hold and resume are refused") {
+        Device d(start);
+        REQUIRE(d.configure(test_limits<kAxes>()) == Status::kOk);
+        REQUIRE(send(d, 1, spans, 0, 16) == Status::kOk);
+        REQUIRE(d.command(Command::kStart) == Status::kOk);
+        Recorder r;
+        r.run(d, 40);
+        REQUIRE(d.command(Command::kStop) == Status::kOk);
+        CHECK(d.command(Command::kResume) == Status::kWrongState);
+        CHECK(d.command(Command::kHold) == Status::kWrongState);
+        CHECK(d.command(Command::kStart) == Status::kWrongState);
+        CHECK(d.command(Command::kStop) == Status::kOk);
+        r.run(d, 400);
+        CHECK(d.state() == DeviceState::kIdle);
+        CHECK(d.queued_spans() == 0);
+        r.check_limits(test_limits<kAxes>());
+    }
+}

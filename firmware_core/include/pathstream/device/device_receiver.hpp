@@ -125,13 +125,16 @@ public:
     }
 
     /// Requests a command; the next tick applies it (a second request before that tick
-    /// replaces the first). Every value is checked here: kUnknownCommand for a value that is
-    /// no Command; kWrongState when the state does not allow it (start: idle; hold: running;
-    /// resume: holding; stop: running, holding, idle (drops what is queued); reset: fault, or
-    /// e-stop with the input released); kNotConfigured (start before configure);
-    /// kNothingToResume (start with nothing queued, or resume after an underrun with nothing
-    /// queued: nothing would move). Repeating a command already in effect is kOk and posts
-    /// nothing. Cost: one status read.
+    /// replaces the first, except a stop, which stays: later requests but reset are then
+    /// kWrongState, a second stop kOk). Every value is checked here: kUnknownCommand for a
+    /// value that is no Command; kWrongState when the state does not allow it (start: idle;
+    /// hold: running; resume: holding; stop: running, holding, idle (drops what is queued);
+    /// reset: fault, or e-stop with the input released); kNotConfigured (start before
+    /// configure); kNothingToResume (start with nothing queued, or resume after an underrun
+    /// with nothing queued: nothing would move). Repeating a command already in effect is kOk
+    /// and posts nothing, when no request is pending; with one pending (the state it was
+    /// judged in is about to change), it is posted and replaces that one. Cost: one status
+    /// read.
     [[nodiscard]] Status command(Command c) { return post_command(c, 0); }
 
     /// A start that keeps the operator's pen (set_pen) down: the device's own jog, whose
@@ -162,31 +165,43 @@ private:
         const DeviceStatus<Axes> s = status();
         const DeviceState state = s.device_state();
         const bool queued = channel_.queue.queued_spans() != 0;
+        // "Already in effect" is judged from the published state, which a request the tick has
+        // not taken yet is about to change: with one pending, this request is posted and
+        // replaces it (a hold after a resume not yet taken must not leave the resume to run).
+        const std::uint32_t pending = channel_.mailbox.command.load(std::memory_order_relaxed);
+        const bool settled = pending == s.command_applied;
+        // A stop not yet taken is not undone by a later request: the device is stopping.
+        if (!settled && (pending & kMailboxValueMask) == static_cast<std::uint32_t>(Command::kStop) &&
+            c != Command::kReset) {
+            return c == Command::kStop ? Status::kOk : Status::kWrongState;
+        }
         switch (c) {
             case Command::kStart:
                 if (!configured_) return Status::kNotConfigured;
-                if (state == DeviceState::kRunning) return Status::kOk;
-                if (state != DeviceState::kIdle) return Status::kWrongState;
-                if (!queued) return Status::kNothingToResume;
+                if (state == DeviceState::kRunning && settled) return Status::kOk;
+                if (state != DeviceState::kIdle && state != DeviceState::kRunning) return Status::kWrongState;
+                if (state == DeviceState::kIdle && !queued) return Status::kNothingToResume;
                 break;
             case Command::kHold:
-                if (state == DeviceState::kHolding) return Status::kOk;
-                if (state != DeviceState::kRunning) return Status::kWrongState;
+                if (state == DeviceState::kHolding && settled) return Status::kOk;
+                if (state != DeviceState::kRunning && state != DeviceState::kHolding) return Status::kWrongState;
                 break;
             case Command::kResume:
-                if (state == DeviceState::kRunning) return Status::kOk;
-                if (state != DeviceState::kHolding) return Status::kWrongState;
-                if (s.held_by_underrun() && !queued) return Status::kNothingToResume;
+                if (state == DeviceState::kRunning && settled) return Status::kOk;
+                if (state != DeviceState::kHolding && state != DeviceState::kRunning) return Status::kWrongState;
+                if (state == DeviceState::kHolding && s.held_by_underrun() && !queued) {
+                    return Status::kNothingToResume;
+                }
                 break;
             case Command::kStop:
-                if (state == DeviceState::kStopping) return Status::kOk;
+                if (state == DeviceState::kStopping && settled) return Status::kOk;
                 if (state != DeviceState::kRunning && state != DeviceState::kHolding &&
-                    state != DeviceState::kIdle) {
+                    state != DeviceState::kIdle && state != DeviceState::kStopping) {
                     return Status::kWrongState;
                 }
                 break;
             case Command::kReset:
-                if (state == DeviceState::kIdle) return Status::kOk;
+                if (state == DeviceState::kIdle) return Status::kOk;  // nothing to reset
                 if (state != DeviceState::kFault && state != DeviceState::kEstop)
                     return Status::kWrongState;
                 if (state == DeviceState::kEstop &&
