@@ -241,6 +241,13 @@ Path read_path(const PathOptions& o, std::string& gcode_pen) {
 }
 }  // namespace
 
+std::string read_path_input(const PathOptions& o, std::string& format) {
+    format = file_format(o);
+    std::string text = read_input(o.file);
+    if (format.empty()) format = sniff_format(text);
+    return text;
+}
+
 const char* axis_column_name(std::size_t axis) {
     static const char* const kNames[] = {"x", "y", "z", "a", "b", "c", "v", "w"};
     return axis < 8 ? kNames[axis] : "?";

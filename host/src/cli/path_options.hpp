@@ -56,6 +56,12 @@ LoadedPath load_path_report(const PathOptions& options, const MachineProfile* ma
 Path load_path(const PathOptions& options, const MachineProfile* machine = nullptr,
                const std::vector<double>* start = nullptr);
 
+/// The path file's bytes (standard input for "-") and its format: --format, else the file's
+/// extension, else (standard input) what its first characters say ("json", "csv", "svg",
+/// "gcode"; "" for empty standard input). Throws InputError for an unknown extension or a file
+/// that cannot be read.
+std::string read_path_input(const PathOptions& options, std::string& format);
+
 /// How messages name the path file: "<stdin>" for "-", else the file name.
 inline std::string path_display_name(const std::string& file) { return file == "-" ? "<stdin>" : file; }
 

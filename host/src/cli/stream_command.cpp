@@ -13,6 +13,7 @@
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <memory>
 #include <stdexcept>
@@ -29,6 +30,7 @@
 #include "pathstream/host/planning_thread.hpp"
 #include "pathstream/host/progress.hpp"
 #include "pathstream/host/span_supply.hpp"
+#include "job_recipe.hpp"
 #include "plan_command.hpp"
 #include "stream_plan_tap.hpp"
 
@@ -429,7 +431,7 @@ struct JobToStream {
 // operator interrupts again.
 void finish_planning(PlanningThread& planning, bool journal) {
     if (planning.finished() || !journal) return;
-    std::printf("planning      the rest of the job, for --resume (Ctrl-C: skip it; no resume then)\n");
+    std::printf("planning      the rest of the job, for --resume (Ctrl-C: skip it; --resume then plans it again)\n");
     std::fflush(stdout);
     const int interrupts = g_interrupts.load();
     planning.drain([interrupts] { return g_interrupts.load() == interrupts; });
@@ -508,23 +510,98 @@ int stream_job(const JobToStream& job, const MachineProfile& machine, StreamComm
     if (end.job != 0 && s.last_completed + 1 >= end.job) index = s.last_completed + 1 - end.job;
     for (next = supply.place(index); next && next->origin < 0; next = supply.place(++index)) {
     }
-    print_interrupted(end, next, totals, machine, writer.path(), !writer.journal().plan_hash.empty());
+    print_interrupted(end, next, totals, machine, writer.path(),
+                      !writer.journal().plan_hash.empty() || !writer.journal().replan.empty());
     return kExitInterrupted;
+}
+
+// What comes after each programmed pause of a plan in memory (pause_description of each).
+std::vector<std::string> pause_descriptions(const Path& path, const Plan& plan) {
+    std::vector<std::string> out;
+    for (const PlanPause& p : plan.pauses) out.push_back(pause_description(path, p.subpath));
+    return out;
+}
+
+// A journal whose plan was not complete when the stream ended (a host crash while planning):
+// the job planned again from the drawing's copy with the same options, proved against every
+// span the stream had handed on (the partial spans file), its spans file written and the
+// journal updated. Throws InputError when it cannot be, naming what changed.
+JobSpans replan_for_resume(JobJournal& journal, const std::string& journal_path, const std::string& machine_file) {
+    if (journal.replan.empty()) {
+        throw InputError(journal_path, {},
+                         "the job's plan was never complete and the journal has no \"replan\" (written by an older "
+                         "pathstream, or --plan-first): nothing to go on from; stream the drawing again");
+    }
+    const JobRecipe recipe = parse_job_recipe(journal.replan, journal_path);
+    if (const std::string h = file_content_hash(recipe.path.file); h != recipe.input_hash) {
+        throw InputError(recipe.path.file, {},
+                         "the drawing's copy changed since the job started (hash " + h + ", journal " +
+                             recipe.input_hash + "): stream the drawing again");
+    }
+    if (const std::string h = file_content_hash(machine_file); h != recipe.machine_hash) {
+        throw InputError(machine_file, {},
+                         "the machine profile changed since the job started (hash " + h + ", journal " +
+                             recipe.machine_hash + "): resume with the profile the job was planned for");
+    }
+    std::printf("resume        the plan was not complete when the stream ended: planning the job again from %s\n",
+                recipe.path.file.c_str());
+    std::fflush(stdout);
+    const PlannedJob planned =
+        plan_job(recipe.path, machine_file, recipe.lead_in_from ? &*recipe.lead_in_from : nullptr);
+    JobSpans job = job_from_plan(planned.plan);
+    // Every span the stream handed on is in the partial file, flushed before it left the
+    // planner: the new plan must begin with exactly those lines. Planning may have ended (the
+    // spans file written, the partial one removed) just before the journal could say so: then
+    // the spans file is the proof.
+    const std::string partial = partial_spans_path(journal.plan_file);
+    std::string proof = partial;
+    std::ifstream in(partial, std::ios::binary);
+    std::size_t skip = 0;
+    if (!in) {
+        in.clear();
+        in.open(journal.plan_file, std::ios::binary);
+        proof = journal.plan_file;
+        skip = 2;  // its header lines
+    }
+    if (!in && journal.job != 0) {
+        throw InputError(journal_path, {},
+                         "spans were sent, but neither " + partial + " nor " + journal.plan_file +
+                             " is there to prove a new plan against: stream the drawing again");
+    }
+    std::string line;
+    std::size_t proved = 0;
+    std::size_t number = 0;
+    while (in && std::getline(in, line)) {
+        ++number;
+        if (in.eof()) break;  // a last line without its newline was never flushed whole
+        if (number <= skip) continue;
+        if (proved >= job.plan.spans.size() ||
+            line != job_span_line(job.plan.spans[proved], job.origin[proved], job.drawing_tick[proved])) {
+            throw InputError(proof, {number, 1},
+                             "the job planned again differs from the one streamed at span " +
+                                 std::to_string(proved + 1) + " (planned by " + recipe.planner + ", now " +
+                                 planner_identity() + "): stream the drawing again");
+        }
+        ++proved;
+    }
+    std::printf("resume        planned again: %zu spans, the first %zu identical to the ones streamed\n",
+                job.plan.spans.size(), proved);
+    journal.plan_hash = write_job_spans(job, journal.plan_file);
+    journal.pauses = pause_descriptions(planned.path, planned.plan);
+    write_journal(journal, journal_path);
+    std::remove(partial.c_str());
+    return job;
 }
 
 // --resume: the device holds the job (go on streaming, then resume), or rests idle (a
 // re-entry from where it rests to the first span not executed, then the rest of the job).
 int run_resume(StreamCommandOptions o, const EventChannel& channel) {
-    const JobJournal journal = read_journal(o.resume);
+    JobJournal journal = read_journal(o.resume);
     if (o.machine.empty()) o.machine = journal.machine;
     if (o.stream.target.empty()) o.stream.target = journal.target;
     const MachineProfile machine = load_machine_profile(o.machine);
-    if (journal.plan_hash.empty()) {
-        throw InputError(o.resume, {},
-                         "the job's plan was never complete: its stream ended before planning did, so there is "
-                         "nothing to go on from; stream the drawing again");
-    }
-    const JobSpans job = read_job_spans(journal.plan_file, journal.plan_hash);
+    const JobSpans job = journal.plan_hash.empty() ? replan_for_resume(journal, o.resume, o.machine)
+                                                   : read_job_spans(journal.plan_file, journal.plan_hash);
     if (journal.outcome == "finished") {
         std::printf("resume        %s: the job already ran to its end; nothing to do\n", o.resume.c_str());
         return 0;
@@ -626,13 +703,6 @@ int run_resume(StreamCommandOptions o, const EventChannel& channel) {
     PlanSupply supply(resumed.plan);
     return stream_job({supply, &resumed, nullptr, nullptr, nullptr, resumed.subpaths}, machine, o, next, o.resume,
                       nullptr, channel);
-}
-
-// What comes after each programmed pause of a plan in memory (pause_description of each).
-std::vector<std::string> pause_descriptions(const Path& path, const Plan& plan) {
-    std::vector<std::string> out;
-    for (const PlanPause& p : plan.pauses) out.push_back(pause_description(path, p.subpath));
-    return out;
 }
 
 // CiA 402 drives: no device status to follow, so the events are the job's start and end.
@@ -778,6 +848,13 @@ int run_stream(const StreamCommandOptions& o) {
         PlanSupply supply(job.plan);
         return stream_job({supply, &job, nullptr, nullptr, nullptr, job.subpaths}, planned.machine, o, journal,
                           journal_path, nullptr, channel);
+    }
+    if (!journal_path.empty()) {
+        // The plan is made as the stream goes: keep what plans it again after a host crash.
+        const JobRecipe recipe =
+            save_job_recipe(path, o.machine, o.lead_in ? std::optional<std::vector<double>>(rest_mm) : std::nullopt,
+                            std::filesystem::absolute(journal_path + ".input").string());
+        journal.replan = job_recipe_json(recipe);
     }
     return stream_while_planning(prepare_job(path, o.machine, o.lead_in ? &rest_mm : nullptr), o, journal,
                                  journal_path, channel);

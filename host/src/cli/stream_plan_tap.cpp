@@ -8,7 +8,7 @@ namespace pathstream::host {
 
 StreamPlanTap::StreamPlanTap(const PlannedJob& job, const std::string& file, const std::string& spans_file)
     : job_(job), file_(file) {
-    if (!spans_file.empty()) writer_ = std::make_unique<JobSpansWriter>(spans_file);
+    if (!spans_file.empty()) writer_ = std::make_unique<JobSpansWriter>(spans_file, true);
 }
 
 void StreamPlanTap::span(const CoreSpan& s) {

@@ -2,6 +2,8 @@
 #include "pathstream/host/job_journal.hpp"
 
 #include <algorithm>
+#include <cerrno>
+#include <cstring>
 #include <cstdio>
 #include <fstream>
 #include <sstream>
@@ -266,21 +268,43 @@ JobSpans resume_from(const JobSpans& job, std::size_t first, const std::vector<L
     return complete(std::move(approach));
 }
 
-JobSpansWriter::JobSpansWriter(std::string path) : path_(std::move(path)), body_(std::tmpfile()) {
-    if (body_ == nullptr) throw std::runtime_error(path_ + ": cannot make a temporary file for the job's spans");
+JobSpansWriter::JobSpansWriter(std::string path, bool partial)
+    : path_(std::move(path)), body_(partial ? std::fopen(partial_spans_path(path_).c_str(), "w+") : std::tmpfile()),
+      partial_(partial) {
+    if (body_ == nullptr) {
+        throw std::runtime_error((partial ? partial_spans_path(path_) : path_) + ": cannot make a file for the job's spans: " +
+                                 std::strerror(errno));
+    }
 }
 
 JobSpansWriter::~JobSpansWriter() {
     if (body_ != nullptr) std::fclose(body_);
 }
 
+std::string job_span_line(const CoreSpan& s, std::int64_t origin, std::uint64_t drawing_tick) {
+    char buffer[96];
+    std::string line;
+    std::snprintf(buffer, sizeof buffer, "%lld %llu %zu %d %u", static_cast<long long>(origin),
+                  static_cast<unsigned long long>(drawing_tick), s.subpath,
+                  (s.pen_down ? 1 : 0) | (s.pause_after ? 2 : 0), static_cast<unsigned>(s.ticks));
+    line = buffer;
+    for (const auto& c : s.control) {
+        std::snprintf(buffer, sizeof buffer, " %d %d %d %d", c[0], c[1], c[2], c[3]);
+        line += buffer;
+    }
+    return line;
+}
+
+std::string content_hash(const std::string& bytes) { return fnv1a_hex(bytes); }
+
 void JobSpansWriter::add(const CoreSpan& s, std::int64_t origin, std::uint64_t drawing_tick) {
     if (spans_ == 0) axes_ = s.control.size();
-    std::fprintf(body_, "%lld %llu %zu %d %u", static_cast<long long>(origin),
-                 static_cast<unsigned long long>(drawing_tick), s.subpath,
-                 (s.pen_down ? 1 : 0) | (s.pause_after ? 2 : 0), static_cast<unsigned>(s.ticks));
-    for (const auto& c : s.control) std::fprintf(body_, " %d %d %d %d", c[0], c[1], c[2], c[3]);
-    std::fputc('\n', body_);
+    std::string line = job_span_line(s, origin, drawing_tick);
+    line += '\n';
+    if (std::fwrite(line.data(), 1, line.size(), body_) != line.size() || (partial_ && std::fflush(body_) != 0)) {
+        throw std::runtime_error((partial_ ? partial_spans_path(path_) : path_) + ": cannot write the job's spans: " +
+                                 std::strerror(errno));
+    }
     ++spans_;
 }
 
@@ -305,6 +329,7 @@ std::string JobSpansWriter::finish(std::size_t drawing_spans, std::uint64_t draw
     }
     if (std::ferror(body_)) throw std::runtime_error(path_ + ": the job's spans could not be read back");
     f.commit();
+    if (partial_) std::remove(partial_spans_path(path_).c_str());
     return hash.hex();
 }
 
@@ -398,6 +423,7 @@ void write_journal(const JobJournal& j, const std::string& path) {
     d["outcome"] = j.outcome;
     if (!j.error.empty()) d["error"] = j.error;
     if (!j.pauses.empty()) d["pauses"] = j.pauses;
+    if (!j.replan.empty()) d["replan"] = nlohmann::json::parse(j.replan);
     AtomicFile f(path);
     f.stream() << d.dump(2) << '\n';
     f.commit();
@@ -438,6 +464,10 @@ JobJournal read_journal(const std::string& path) {
     get("outcome", j.outcome);
     if (d.contains("error")) get("error", j.error);
     if (d.contains("pauses")) get("pauses", j.pauses);
+    if (d.contains("replan")) {
+        if (!d["replan"].is_object()) check.fail("/replan", "\"replan\" must be an object");
+        j.replan = d["replan"].dump();
+    }
     return j;
 }
 

@@ -43,13 +43,17 @@ JobSpans job_from_plan(const Plan& plan);
 JobSpans resume_from(const JobSpans& job, std::size_t first, const std::vector<Lsb>& rest,
                      const DeviceLimitsLsb& limits);
 
-/// Writes a job's spans file as the spans come, holding none of them: the span lines go to an
-/// anonymous temporary file, and finish() writes `path` atomically (the header, which needs
-/// the totals, first). Nothing appears at `path` before finish(). One thread.
+/// Writes a job's spans file as the spans come, holding none of them: the span lines go to a
+/// temporary file, and finish() writes `path` atomically (the header, which needs the totals,
+/// first). Nothing appears at `path` before finish(). One thread.
 class JobSpansWriter {
 public:
-    /// Throws std::runtime_error when no temporary file can be made.
-    explicit JobSpansWriter(std::string path);
+    /// `partial` false: the lines go to an anonymous temporary file. `partial` true: they go to
+    /// partial_spans_path(path), each flushed to the kernel by add() before it returns, so a
+    /// span handed on after add() is in that file even if the process is killed the next
+    /// instant (a host crash while planning: --resume proves its new plan against it);
+    /// finish() removes it. Throws std::runtime_error when the file cannot be made.
+    explicit JobSpansWriter(std::string path, bool partial = false);
     ~JobSpansWriter();
     JobSpansWriter(const JobSpansWriter&) = delete;
     JobSpansWriter& operator=(const JobSpansWriter&) = delete;
@@ -63,9 +67,19 @@ public:
 private:
     std::string path_;
     std::FILE* body_ = nullptr;
+    bool partial_ = false;
     std::size_t spans_ = 0;
     std::size_t axes_ = 0;
 };
+
+/// Where a partial JobSpansWriter keeps the lines of a spans file not yet finished.
+inline std::string partial_spans_path(const std::string& path) { return path + ".partial"; }
+
+/// One span's line in a spans file (no newline): what JobSpansWriter::add writes.
+std::string job_span_line(const CoreSpan& span, std::int64_t origin, std::uint64_t drawing_tick);
+
+/// The FNV-1a 64 hash of `bytes`, hex (16 digits): the hash the journal keeps of its files.
+std::string content_hash(const std::string& bytes);
 
 /// Writes `job` to `path` atomically (one line per span, with JobSpansWriter); returns its
 /// FNV-1a 64 hash, hex.
@@ -95,6 +109,10 @@ struct JobJournal {
     /// Per programmed pause of the drawing (Plan::pauses, in order): what comes after it, for
     /// the operator (`layer "blue"`). Optional in the file.
     std::vector<std::string> pauses;
+    /// How to plan the job again when its plan was not complete (a stream that plans as it
+    /// goes): a JSON object whose keys the stream command defines (the drawing's copy, the
+    /// path options, hashes). Empty: none. Optional in the file ("replan").
+    std::string replan;
 };
 
 /// Writes `journal` to `path` atomically (JSON).
