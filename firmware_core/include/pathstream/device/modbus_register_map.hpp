@@ -41,8 +41,8 @@ public:
         return Exception::kNone;
     }
 
-    /// FC3: the status mirror, the command register, the configuration block. The span window
-    /// reads back as zeros (it is a mailbox). Anything else: kIllegalDataAddress.
+    /// FC3: the status mirror, the command register, the configuration block. Anything else,
+    /// the span window included (a write-only mailbox): kIllegalDataAddress.
     Exception read_holding_registers(std::uint16_t address, std::uint16_t count, std::uint16_t* out) {
         const std::uint32_t end = static_cast<std::uint32_t>(address) + count;
         if (end <= modbus::status::kCount) return read_input_registers(address, count, out);
@@ -104,7 +104,8 @@ public:
     /// Writes refused since construction.
     std::uint16_t refusals() const { return refusals_; }
 
-private:
+    /// The exception a refused write answers with, from the core's Status (docs/modbus.md,
+    /// "Validation and exceptions"). Any context; no side effects.
     static Exception exception_for(Status s) {
         switch (s) {
             case Status::kQueueFull: return Exception::kServerDeviceBusy;
@@ -115,6 +116,7 @@ private:
         }
     }
 
+private:
     static std::uint32_t u32(const std::uint16_t* r) { return (static_cast<std::uint32_t>(r[0]) << 16) | r[1]; }
     static void put_u32(std::uint16_t* r, std::uint32_t v) {
         r[0] = static_cast<std::uint16_t>(v >> 16);
