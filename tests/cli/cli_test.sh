@@ -27,7 +27,10 @@ printf '{\n  "points": [[0, 0],\n    [1, "x"]]\n}\n' > "$work/bad.json"
 expect bad-file 1 "bad.json:3:9: coordinate must be a number" -- "$bin" setpoints "$work/bad.json" --out "$work/bad.csv"
 if ls "$work"/bad.csv* >/dev/null 2>&1; then echo "FAIL bad-file left output behind"; failures=$((failures + 1)); else passed=$((passed + 1)); fi
 expect bad-option 2 "--ticks-per-span" -- "$bin" setpoints "$src/examples/rose.json" --ticks-per-span 70000
-expect missing-file 2 "File does not exist" -- "$bin" setpoints "$work/nope.json"
+expect missing-file 2 "file: no such file: $work/nope.json" -- "$bin" setpoints "$work/nope.json"
+expect directory-file 2 "is a directory, not a path file" -- "$bin" check "$work"
+out=$("$bin" check "$work/nope.svg" 2>&1)
+[[ "$out" != *" OR "* ]] && passed=$((passed + 1)) || { echo "FAIL missing-file message has CLI11's OR: $out"; failures=$((failures + 1)); }
 expect no-subcommand 2 "A subcommand is required" -- "$bin"
 expect unwritable 3 "cannot create output file" -- "$bin" setpoints "$src/examples/rose.json" --out "$work/no/such/dir/x.csv"
 expect help 0 "--ticks-per-span" -- "$bin" setpoints --help
@@ -82,6 +85,17 @@ expect device-no-chip 6 'gpio no-such-chip line "17": no GPIO chip is named or l
 expect device-home-no-gpio 2 'no "gpio" object: --home has no switches' -- "$bin" device -m "$machine" --home --exit-after 0.05
 expect device-home-needs-machine 2 "--home: needs --machine" -- "$bin" device --home
 vm_profile=$src/sim/gpio/vm/gpio_vm_profile.json
+# serve on a port another serve holds: exit 3, and its temporary state directory is gone.
+serve_port=$(/usr/bin/python3 -c 'import socket; s = socket.socket(); s.bind(("127.0.0.1", 0)); print(s.getsockname()[1])')
+"$bin" serve -m "$machine" -t "modbus-tcp://127.0.0.1:1?unit=1" --listen "127.0.0.1:$serve_port" > "$work/serve1.log" 2>&1 &
+serve_pid=$!
+for _ in $(seq 200); do grep -q "pathstream serve: http" "$work/serve1.log" && break; sleep 0.05; done
+tmp_before=$(ls -d "${TMPDIR:-/tmp}"/pathstream-serve-* 2>/dev/null | wc -l)
+expect serve-port-in-use 3 "cannot listen on 127.0.0.1:$serve_port (in use?)" -- \
+  "$bin" serve -m "$machine" -t "modbus-tcp://127.0.0.1:1?unit=1" --listen "127.0.0.1:$serve_port"
+tmp_after=$(ls -d "${TMPDIR:-/tmp}"/pathstream-serve-* 2>/dev/null | wc -l)
+[ "$tmp_after" -eq "$tmp_before" ] && passed=$((passed + 1)) || { echo "FAIL serve-port-in-use left a state directory"; failures=$((failures + 1)); }
+kill -INT "$serve_pid" 2>/dev/null; wait "$serve_pid" 2>/dev/null
 expect sim-switch-needs-machine 2 "--sim-switch: needs --machine" -- "$bin" device --sim-switch x-=1
 expect sim-switch-bounce-alone 2 "--switch-bounce: needs --sim-switch" -- "$bin" device -m "$vm_profile" --switch-bounce 2
 expect sim-switch-no-gpio 2 "not with --no-gpio" -- "$bin" device -m "$vm_profile" --no-gpio --sim-switch x-=1

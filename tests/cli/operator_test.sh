@@ -111,6 +111,23 @@ wait "$stream_pid"; rc=$?
 [ $rc -eq 0 ] && ok || fail "stream held and resumed by ctl: exit $rc: $(cat "$work/stream0.log")"
 stop_device
 
+# ---- A stop from ctl during a stream: reported as a stop (exit 7, the resume hint), resumable
+start_device 2 || exit 1
+"$bin" stream "$drawing" --keep-order -m "$machine" -t "$target" --journal "$work/js.json" > "$work/stream_stop.log" 2>&1 &
+stream_pid=$!
+wait_running
+out=$("$bin" ctl "$target" stop 2>&1)
+[[ "$out" == *"accepted"* ]] && ok || fail "ctl stop: $out"
+finish "$stream_pid" "stream after ctl stop"; rc=$?
+[ $rc -eq 7 ] && ok || fail "stream stopped by ctl: exit $rc (want 7): $(cat "$work/stream_stop.log")"
+grep -q "^stopped       by another client" "$work/stream_stop.log" && ok || fail "no 'stopped by another client': $(cat "$work/stream_stop.log")"
+grep -q "refused spans" "$work/stream_stop.log" && fail "a ctl stop reported as a refusal: $(cat "$work/stream_stop.log")" || ok
+grep -q "resume with   pathstream stream --resume $work/js.json" "$work/stream_stop.log" && ok || fail "no resume hint after ctl stop"
+timeout -k 5 120 "$bin" stream --resume "$work/js.json" > "$work/stream_stop2.log" 2>&1; rc=$?
+[ $rc -eq 0 ] && ok || fail "resume after ctl stop: exit $rc: $(tail -n 5 "$work/stream_stop2.log")"
+stop_device
+rm -f "$work"/js.json*
+
 # ---- Two layers: the device pauses pen up between them until `ctl resume` ---------------
 start_device 2 || exit 1
 "$bin" stream "$src/examples/two_pens.svg" -m "$machine" -t "$target" --no-journal --lead-in \

@@ -597,3 +597,34 @@ TEST_CASE("pause: a two-layer drawing holds pen up between its layers, resumed f
                       job.plan);
     check_steps_within_limits(*dt.device, job.machine);
 }
+
+TEST_CASE("a stop from another client while streaming ends the stream as a stop, not a refusal",
+          "[resume][modbus][threads]") {
+    // `pathstream ctl TARGET stop` during a stream: the device drops the job's queue, the next
+    // batch no longer joins it and is refused. The stream reports the stop (interrupted 2,
+    // stopped_elsewhere), not "device refused spans ... acceleration limit".
+    const Job job = plan_example("wave.json");
+    for (unsigned seed = 41; seed < 41 + seeds_to_run(); ++seed) {
+        DYNAMIC_SECTION("seed " << seed) {
+            std::mt19937 rng(seed);
+            ModbusDeviceThread dt(start_of(job.plan), 4.0);
+            host::StreamOptions o = options_for(dt.target());
+            const std::uint64_t at =
+                std::uniform_int_distribution<std::uint64_t>(50, job.plan.total_ticks / 2)(rng);
+            bool sent = false;
+            o.observer = [&](const host::StreamTrace& t) {
+                if (sent || t.status.ticks_executed < at) return;
+                const std::unique_ptr<host::DeviceLink> other = host::open_device_link(dt.target(), {});
+                REQUIRE(other->command(Command::kStop) == Status::kOk);
+                sent = true;
+            };
+            const host::StreamReport r = host::stream_modbus(job.plan, job.machine, o);
+            CHECK(sent);
+            CHECK(r.interrupted == 2);
+            CHECK(r.stopped_elsewhere);
+            CHECK(r.final_status.state == static_cast<unsigned>(DeviceState::kIdle));
+            dt.join();
+            check_steps_within_limits(*dt.device, job.machine);
+        }
+    }
+}

@@ -26,7 +26,18 @@ void add_path_options(CLI::App& command, PathOptions& o) {
         .add_option("file", o.file,
                     "path file: .json, .csv, .svg, .gcode/.ngc/.nc/.gc (docs/formats.md); -: standard input")
         ->required()
-        ->check(CLI::IsMember({"-"}) | CLI::ExistingFile);
+        ->check(CLI::Validator(
+            [](std::string& file) -> std::string {
+                // One plain sentence: CLI11's "(... not in {-}) OR (File does not exist ...)"
+                // read like two errors.
+                if (file == "-") return "";
+                std::error_code error;
+                const auto status = std::filesystem::status(file, error);
+                if (!std::filesystem::exists(status)) return "no such file: " + file;
+                if (std::filesystem::is_directory(status)) return file + " is a directory, not a path file";
+                return "";
+            },
+            "FILE or -"));
     command.add_option("--format", o.format, "the path file's format when its name does not tell (or for -)")
         ->check(CLI::IsMember({"json", "csv", "svg", "gcode"}));
     command.add_option("--csv-basis", o.csv_basis, "basis of CSV points")

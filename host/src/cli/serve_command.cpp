@@ -122,7 +122,15 @@ int run_serve(const ServeCommandOptions& o) {
         serve::Server server(c, machine, [machine_file](const std::string& file, const std::vector<std::string>& args) {
             return plan_for_page(file, args, machine_file);
         });
-        server.bind();
+        try {
+            server.bind();
+        } catch (...) {
+            if (temporary) {
+                std::error_code ignored;
+                fs::remove_all(c.state_dir, ignored);
+            }
+            throw;
+        }
         std::printf("pathstream serve: http://%s:%u/%s for %s (machine %s)\n",
                     listen.host.find(':') != std::string::npos ? ("[" + listen.host + "]").c_str() : listen.host.c_str(),
                     server.bound_port(), c.access.token.empty() ? "" : "?token=...", o.target.c_str(),

@@ -164,6 +164,7 @@ struct StreamEnd {
     int interrupted = 0;
     DeviceSnapshot status;
     std::uint32_t job = 0;
+    bool stopped_elsewhere = false;  // interrupted 2 by another client's stop
 };
 
 // What comes after a programmed pause that subpath `subpath` follows: the next layer's name
@@ -295,7 +296,7 @@ StreamEnd stream_over_can(SpanSupply& supply, const MachineProfile& machine, con
             bar.update(v.fraction, v.detail);
         });
     }
-    if (r.interrupted != 0) return {r.interrupted, r.final_status, r.job};
+    if (r.interrupted != 0) return {r.interrupted, r.final_status, r.job, r.stopped_elsewhere};
     const double motion = static_cast<double>(r.ticks_executed) / machine.tick_hz;
     std::printf("streamed      %s (native CAN protocol, node %u)\n", o.stream.target.c_str(), unsigned(t.node));
     std::printf("executed      %llu ticks (%.3f s of motion), %llu spans in %llu batches, last span %u\n",
@@ -329,7 +330,7 @@ StreamEnd stream_over_modbus(SpanSupply& supply, const MachineProfile& machine, 
                               bar.update(v.fraction, v.detail);
                           });
     }
-    if (r.interrupted != 0) return {r.interrupted, r.final_status, r.job};
+    if (r.interrupted != 0) return {r.interrupted, r.final_status, r.job, r.stopped_elsewhere};
     std::printf("streamed      %s\n", o.stream.target.c_str());
     std::printf("executed      %llu ticks (%.3f s of motion), %llu spans in %llu batches, last span %u\n",
                 static_cast<unsigned long long>(r.ticks_executed), static_cast<double>(r.ticks_executed) / machine.tick_hz,
@@ -490,6 +491,14 @@ int stream_job(const JobToStream& job, const MachineProfile& machine, StreamComm
         record_plan();
         writer.finish("failed", e.what());
         events.end("failed", e.what());
+        if (!journal_path.empty() && (!writer.journal().plan_hash.empty() || !writer.journal().replan.empty())) {
+            // A fault or e-stop stops the job where it is: once the device is reset, the journal
+            // goes on from there.
+            std::printf("resume with   pathstream stream --resume %s (after pathstream ctl %s reset, if it "
+                        "faulted)\n",
+                        journal_path.c_str(), o.stream.target.c_str());
+            std::fflush(stdout);
+        }
         throw;
     }
     // The handler stays: a late second Ctrl-C must not cut the report of where it stopped.
@@ -498,6 +507,10 @@ int stream_job(const JobToStream& job, const MachineProfile& machine, StreamComm
         writer.finish("finished");
         events.end("finished", "", events.total_ticks());
         return 0;
+    }
+    if (end.stopped_elsewhere) {
+        std::printf("stopped       by another client (pathstream ctl stop, the page, another host): the device "
+                    "dropped the job's queue and is idle\n");
     }
     if (job.planning != nullptr) finish_planning(*job.planning, !journal_path.empty());
     record_plan();

@@ -73,6 +73,13 @@ std::string last_lines(const std::string& text, std::size_t count) {
 Server::Server(ServerConfig config, MachineProfile machine, PreviewFunction preview)
     : config_(std::move(config)), machine_(std::move(machine)), preview_(std::move(preview)),
       http_(std::make_unique<httplib::Server>()) {
+    // httplib's default sets SO_REUSEPORT, which lets a second server bind the same port and
+    // the kernel share the connections between the two: a page could then start the wrong
+    // machine. SO_REUSEADDR alone only lets a restart take a port left in TIME_WAIT.
+    http_->set_socket_options([](socket_t sock) {
+        int yes = 1;
+        ::setsockopt(sock, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof yes);
+    });
     fs::create_directories(fs::path(config_.state_dir) / "drawing");
     routes();
 }

@@ -58,6 +58,10 @@ public:
             acknowledged_ = s.last_accepted;
         }
         free_slots_ = s.free_slots;
+        // The queue epoch the job lives in (low 16 bits): a change this stream did not ask for
+        // is a stop, fault or e-stop from elsewhere.
+        job_epoch_ = s.epoch;
+        underruns_at_start_ = s.underruns;
         // A held job goes on with a resume (the device's own re-entry) instead of a start.
         const device::Command go = options_.held != nullptr ? device::Command::kResume : device::Command::kStart;
         const auto lead_target =
@@ -80,6 +84,12 @@ public:
                 s = link_.request_status();
                 free_slots_ = s.free_slots;
                 observe(s, interrupt);
+                if (!interrupt.stop_sent() && s.epoch != job_epoch_ &&
+                    s.state == static_cast<std::uint8_t>(device::DeviceState::kIdle) && !job_finished(s)) {
+                    report_.interrupted = 2;  // dropped by another client's stop: report it as a stop
+                    report_.stopped_elsewhere = true;
+                    break;
+                }
                 check_running(s, started && !interrupt.stop_sent());
             }
             if (!started && !interrupt.active() && (queued_ticks(s, next) >= lead_target || all_sent(next))) {
@@ -123,7 +133,8 @@ public:
         report_.job = report_.interrupted != 0 ? base_ : s.finished_job;
         report_.last_completed = s.last_completed - base_ + 1;
         report_.duplicates = s.duplicates;
-        report_.underruns = s.underruns;
+        // This job's underruns: the device counts since it started (16 bits on the bus).
+        report_.underruns = static_cast<std::uint16_t>(s.underruns - underruns_at_start_);
         for (unsigned a = 0; a < axes_; ++a) report_.final_position[a] = feed_.end()[a];
         report_.wall_seconds = std::chrono::duration<double>(Clock::now() - wall_start).count();
         return report_;
@@ -272,6 +283,12 @@ private:
             }
             if (ack.result == static_cast<std::uint8_t>(Status::kQueueFull)) return;  // later (never expected)
             if (ack.result != 0) {
+                // A queue dropped under the stream (another client's stop, a fault) refuses the
+                // next batch: the loop's next status read says what happened.
+                if (link_.request_status().epoch != job_epoch_) {
+                    free_slots_ = 0;
+                    return;
+                }
                 std::ostringstream m;
                 m << "device refused spans " << first - base_ + 1 << ".." << first - base_ + count << ": "
                   << can_result_name(ack.result);
@@ -354,6 +371,8 @@ private:
     CanLink link_;
     unsigned axes_ = 0;
     std::uint32_t base_ = 1;
+    std::uint16_t job_epoch_ = 0;
+    std::uint32_t underruns_at_start_ = 0;
     std::uint32_t acknowledged_ = 0;
     std::uint32_t start_ticks_ = 0;
     std::int32_t plan_start_[8] = {};  // the plan's first point, LSB

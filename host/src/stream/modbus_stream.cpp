@@ -61,6 +61,10 @@ public:
             base_ = s.last_accepted + 1;
             acknowledged_ = s.last_accepted;
         }
+        // The queue epoch the job lives in: a change that this stream did not ask for is a stop,
+        // fault or e-stop from elsewhere.
+        job_epoch_ = s.epoch;
+        underruns_at_start_ = s.underruns;
         // A held job goes on with a resume (the device's own re-entry) instead of a start.
         const device::Command go = options_.held != nullptr ? device::Command::kResume : device::Command::kStart;
         rate_ = profile_.tick_hz;
@@ -93,6 +97,12 @@ public:
             }
             observe(s, interrupt);
             observe_rate(s, started);
+            if (!interrupt.stop_sent() && s.epoch != job_epoch_ &&
+                s.state == static_cast<std::uint16_t>(device::DeviceState::kIdle) && !job_finished(s)) {
+                report_.interrupted = 2;  // dropped by another client's stop: report it as a stop
+                report_.stopped_elsewhere = true;
+                break;
+            }
             check_running(s, started && !interrupt.stop_sent());
             // Start once the lead is queued, or everything is, or the device's queue is full
             // (a lead longer than the queue holds would otherwise never start).
@@ -137,7 +147,8 @@ public:
         report_.job = report_.interrupted != 0 ? base_ : s.finished_job;
         report_.last_completed = s.last_completed;
         report_.duplicates = s.duplicates;
-        report_.underruns = s.underruns;
+        // This job's underruns: the device counts since it started (16 bits on the bus).
+        report_.underruns = static_cast<std::uint16_t>(s.underruns - underruns_at_start_);
         for (unsigned a = 0; a < 8; ++a) report_.final_position[a] = s.position[a];
         const auto& c = link_.client().counters();
         report_.transactions = c.transactions;
@@ -337,6 +348,10 @@ private:
                 return read_status();  // queue fuller than we knew: send later
             }
             if (!e.transient()) {
+                // A queue dropped under the stream (another client's stop, a fault) refuses the
+                // next batch, which no longer joins what the device holds: say what happened.
+                const DeviceStatus now = read_status();
+                if (now.epoch != job_epoch_) return now;
                 std::ostringstream m;
                 m << "device refused spans " << first << ".." << last << ": " << e.what() << refusal();
                 fail(m.str());
@@ -471,6 +486,8 @@ private:
     unsigned axes_ = 0;
     std::int32_t start_[8] = {};
     std::uint32_t base_ = 1;
+    std::uint32_t job_epoch_ = 0;
+    std::uint32_t underruns_at_start_ = 0;
     std::uint32_t acknowledged_ = 0;
     std::uint32_t start_ticks_ = 0;
     Clock::time_point started_at_;

@@ -55,6 +55,7 @@ struct CanStreamReport {
     double wall_seconds = 0;
     std::int32_t final_position[8] = {};  ///< the plan's end point, which the device reached
     int interrupted = 0;                  ///< as StreamReport::interrupted
+    bool stopped_elsewhere = false;       ///< as StreamReport::stopped_elsewhere
     DeviceSnapshot final_status;          ///< the last status read
 };
 

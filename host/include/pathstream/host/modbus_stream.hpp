@@ -74,7 +74,7 @@ struct StreamReport {
     std::uint32_t last_completed = 0;     ///< sequence number of the last span executed
     std::uint32_t job = 0;                ///< the job's id (its first span's sequence number), finished
     std::uint32_t duplicates = 0;         ///< batches the device acknowledged as retries
-    std::uint32_t underruns = 0;
+    std::uint32_t underruns = 0;           ///< this job's: the device's count since the job began
     std::uint64_t transactions = 0;       ///< successful Modbus transactions of every kind
     std::uint64_t status_reads = 0;       ///< of which FC4 status polls (the rest: batches, config, commands)
     std::uint64_t attempts = 0;           ///< requests sent (first tries and retries)
@@ -88,6 +88,10 @@ struct StreamReport {
     /// 0: the job ran to its end; 1: interrupted, the device holds at rest with the rest of
     /// the job queued; 2: interrupted, the device stopped (queue dropped) and is idle.
     int interrupted = 0;
+    /// With interrupted 2: the stop came from another client (`pathstream ctl stop`, the page,
+    /// another host): the device dropped the job's queue (a new epoch) and went idle while this
+    /// stream sent no stop.
+    bool stopped_elsewhere = false;
     DeviceSnapshot final_status;          ///< the last status read
 };
 
