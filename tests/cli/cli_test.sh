@@ -52,6 +52,18 @@ expect eval-unknown-type 1 "unknown file type" -- "$bin" eval "$src/README.md"
 machine="$src/examples/machines/pen_plotter.json"
 expect check 0 "subpaths: 2" -- "$bin" check "$src/examples/rose.json"
 expect check-gcode 0 "valid" -- "$bin" check "$src/examples/leaf.ngc"
+# Order defaults: G-code keeps the program's order unless --order; eval and setpoints keep the
+# file's order and direction; SVG is ordered by default in check.
+printf 'G21 G90\nG0 Z1\nG0 X50 Y0\nG1 Z-1 F600\nG1 X60 Y0\nG0 Z1\nG0 X0 Y0\nG1 Z-1\nG1 X10 Y0\nG0 Z1\nM2\n' > "$work/two_cuts.ngc"
+expect gcode-keeps-order 0 "order: as in the file (G-code keeps the program's order; --order to reorder)" -- \
+  "$bin" check "$work/two_cuts.ngc"
+expect gcode-order-asked 0 "order: pen-up travel from the start" -- "$bin" check "$work/two_cuts.ngc" --order
+expect order-and-keep 2 "excludes" -- "$bin" check "$work/two_cuts.ngc" --order --keep-order
+# A single open B-spline whose end is nearer the origin than its start: eval keeps its direction.
+printf '{"basis": "bspline", "subpaths": [{"points": [[90,90],[60,60],[30,30],[10,10],[1,1]]}]}' > "$work/toward_origin.json"
+first=$("$bin" eval "$work/toward_origin.json" -n 1 -o - 2>/dev/null | sed -n 2p)
+[[ "$first" == 0,0,90,90* ]] && passed=$((passed + 1)) || { echo "FAIL eval-keeps-direction: first row $first"; failures=$((failures + 1)); }
+expect check-orders-json 0 "order: pen-up travel from the start" -- "$bin" check "$work/toward_origin.json"
 expect check-gcode-pen 0 "G-code pen: z (auto: Z goes both above and to or below --gcode-z-down 0 mm)" -- \
   "$bin" check "$src/examples/leaf.ngc" --gcode-pen auto
 printf 'M300 S440\nG0 X1\nG1 X5 Y5\n' > "$work/nopen.ngc"
@@ -163,6 +175,7 @@ for run in csv:keep:120000 json:keep:120000 svg:keep:120000 gcode:keep:120000 \
   flag='--keep-order'
   if [ "$order" = order ]; then
     flag=''
+    [ "$format" = gcode ] && flag='--order'  # G-code keeps the program's order by default
     points='1000 subpaths -> 710 (merged 290)'
     [ "$format" = csv ] && points='1 subpaths -> 1 (merged 0)'
   fi

@@ -109,12 +109,15 @@ TEST_CASE("serve: the page's options become path-option arguments", "[serve]") {
     const auto args = path_arguments(nlohmann::json{{"fit", "a4-landscape"}, {"margin", 10}, {"rotate", 90},
                                                     {"flip_y", true}, {"keep_order", false},
                                                     {"layers", {"2", "--machine=/etc/passwd"}}, {"pause", "none"}});
+    // The box "Order for less travel" on: --order, so that G-code is ordered too (its default
+    // keeps the program's order).
     const std::vector<std::string> want = {"--fit=a4-landscape", "--flip-y", "--layer=--machine=/etc/passwd", "--layer=2",
-                                           "--margin=10", "--pause=none", "--rotate=90"};
+                                           "--margin=10", "--order", "--pause=none", "--rotate=90"};
     std::vector<std::string> sorted = args;
     std::sort(sorted.begin(), sorted.end());
     CHECK(sorted == want);
     CHECK(path_arguments(nlohmann::json::object()).empty());
+    CHECK(path_arguments({{"keep_order", true}}) == std::vector<std::string>{"--keep-order"});
     CHECK_THROWS_AS(path_arguments({{"machine", "x.json"}}), std::invalid_argument);
     CHECK_THROWS_AS(path_arguments({{"fit", "a9"}}), std::invalid_argument);
     CHECK_THROWS_AS(path_arguments({{"rotate", 45}}), std::invalid_argument);

@@ -125,7 +125,7 @@ void print_load_report(const LoadedPath& loaded) {
                     "(merged %zu)\n",
                     r.travel_before, r.travel_after, change, r.subpaths_before, r.subpaths_after, r.merged);
     } else {
-        std::printf("  order: as in the file (--keep-order)\n");
+        std::printf("  order: as in the file (%s)\n", loaded.kept_order_because.c_str());
     }
 }
 

@@ -17,6 +17,7 @@ void add_eval_command(CLI::App& app, EvalOptions& o) {
         "Evaluate the path through the fixed-point core (Horner) at u = j/N, j = 0..N-1, of every span, plus "
         "each subpath's end point; CSV span,u,x,y,... in the path's units");
     add_path_options(*cmd, o.path);
+    o.path.keep_order_by_default = true;  // the file's spans, in its order and direction
     cmd->add_option("--samples-per-span,-n", o.samples_per_span, "N: samples per span")
         ->capture_default_str()
         ->check(CLI::Range(1u, kMaxSpanTicks));

@@ -64,6 +64,8 @@ std::string job_recipe_json(const JobRecipe& r) {
     d["origin"] = p.placement.origin;
     d["translate"] = p.translate;
     d["keep_order"] = p.keep_order;
+    d["order"] = p.order;
+    d["keep_order_by_default"] = p.keep_order_by_default;
     d["merge_tolerance"] = p.merge_tolerance;
     d["order_start"] = p.order_start;
     d["layers"] = p.layers;
@@ -106,6 +108,8 @@ JobRecipe parse_job_recipe(const std::string& json, const std::string& journal) 
     get("origin", p.placement.origin);
     get("translate", p.translate);
     get("keep_order", p.keep_order);
+    if (d.contains("order")) get("order", p.order);
+    if (d.contains("keep_order_by_default")) get("keep_order_by_default", p.keep_order_by_default);
     get("merge_tolerance", p.merge_tolerance);
     get("order_start", p.order_start);
     get("layers", p.layers);

@@ -78,7 +78,13 @@ void add_path_options(CLI::App& command, PathOptions& o) {
         ->check(CLI::IsMember({"top-left", "bottom-left"}));
     command.add_option("--translate", o.translate, "placement: X,Y mm added last");
     // Order (docs/path-order.md).
-    command.add_flag("--keep-order", o.keep_order, "draw the subpaths in file order, as given (no reordering)");
+    CLI::Option* keep = command.add_flag("--keep-order", o.keep_order,
+                                         "draw the subpaths in file order, as given (no reordering)");
+    command
+        .add_flag("--order", o.order,
+                  "order the subpaths for less pen-up travel where the default keeps the file's order (G-code, "
+                  "eval, setpoints)")
+        ->excludes(keep);
     command.add_option("--merge-tolerance", o.merge_tolerance,
                        "mm: open polyline/Bezier subpaths whose ends are this close are joined (0: exact only)")
         ->capture_default_str()
@@ -124,7 +130,7 @@ std::vector<double> parse_numbers(const std::string& text, const std::string& op
 }
 
 /// The file as its reader gives it, by extension; `gcode_pen` gets the G-code pen mode note.
-Path read_path(const PathOptions& o, std::string& gcode_pen);
+Path read_path(const PathOptions& o, std::string& gcode_pen, std::string& format);
 
 /// The G-code reader's options from the command line's.
 GcodeOptions gcode_options(const PathOptions& o) {
@@ -151,7 +157,8 @@ Path read_gcode(const PathOptions& o, const std::string& text, std::string& gcod
 
 LoadedPath load_path_report(const PathOptions& o, const MachineProfile* machine, const std::vector<double>* start) {
     LoadedPath loaded;
-    Path path = read_path(o, loaded.gcode_pen);
+    std::string format;
+    Path path = read_path(o, loaded.gcode_pen, format);
     PlacementOptions placement = o.placement;
     if (!o.translate.empty()) {
         const std::vector<double> xy = parse_numbers(o.translate, "--translate");
@@ -168,7 +175,14 @@ LoadedPath load_path_report(const PathOptions& o, const MachineProfile* machine,
                                : o.pause == "none" ? LayerPause::kNone
                                                    : LayerPause::kPenChange);
     if (machine != nullptr) apply_layer_feeds(path, *machine);
-    if (!o.keep_order) {
+    if (o.keep_order) {
+        loaded.kept_order_because = "--keep-order";
+    } else if (!o.order && format == "gcode") {
+        loaded.kept_order_because = "G-code keeps the program's order; --order to reorder";
+    } else if (!o.order && o.keep_order_by_default) {
+        loaded.kept_order_because = "this command keeps the file's order; --order to reorder";
+    }
+    if (loaded.kept_order_because.empty()) {
         OrderOptions order;
         order.merge_tolerance = o.merge_tolerance;
         if (!o.order_start.empty()) {
@@ -239,8 +253,8 @@ std::string file_format(const PathOptions& o) {
         "unknown file type \"" + ext + "\" (expected .json, .csv, .svg, .gcode, .ngc, .nc or .gc)");
 }
 
-Path read_path(const PathOptions& o, std::string& gcode_pen) {
-    std::string format = file_format(o);  // an unknown extension is refused before reading
+Path read_path(const PathOptions& o, std::string& gcode_pen, std::string& format) {
+    format = file_format(o);  // an unknown extension is refused before reading
     const std::string text = read_input(o.file);
     const std::string name = path_display_name(o.file);
     if (format.empty()) format = sniff_format(text);

@@ -25,6 +25,11 @@ struct PathOptions {
     PlacementOptions placement;         ///< --rotate, --flip-y, --scale, --fit, ... (placement.hpp)
     std::string translate;              ///< --translate "X,Y" (mm), parsed by load_path
     bool keep_order = false;            ///< --keep-order: draw the subpaths as the file lists them
+    bool order = false;                 ///< --order: reorder where the default keeps the file's order
+    /// The command keeps the file's order and direction unless --order (eval, setpoints: they
+    /// show the file's spans). G-code files keep the program's order unless --order, whatever
+    /// the command: reversing a cut flips climb and conventional milling.
+    bool keep_order_by_default = false;
     double merge_tolerance = 0.01;      ///< --merge-tolerance: mm between ends that are joined
     std::string order_start;            ///< --order-start "X,Y,..." (mm); empty: the origin
     std::vector<std::string> layers;    ///< --layer NAME|N (repeatable): plot only these layers
@@ -38,6 +43,9 @@ struct LoadedPath {
     bool placed = false;   ///< a placement option was given
     OrderReport order;
     bool ordered = false;  ///< ordering ran (not --keep-order)
+    /// Why the file's order was kept when it was: "--keep-order", "G-code keeps the program's
+    /// order", "this command keeps the file's order"; empty when ordered.
+    std::string kept_order_because;
     std::string gcode_pen;  ///< G-code files: the pen mode used and why; empty otherwise
 };
 

@@ -48,6 +48,7 @@ void add_setpoints_command(CLI::App& app, SetpointsOptions& o) {
         "Run a path through the firmware core (exact forward differencing) and write every "
         "tick's setpoints as CSV: tick,span,subpath,pen,x,y,... in LSB");
     add_path_options(*cmd, o.path);
+    o.path.keep_order_by_default = true;  // the file's spans, in its order and direction
     cmd->add_option("--out,-o", o.output, "CSV output file; - or none: standard output");
     cmd->add_option("--ticks-per-span", o.ticks_per_span, "ticks each span lasts (default 32, or the profile's)")
         ->check(CLI::Range(1u, kMaxSpanTicks));

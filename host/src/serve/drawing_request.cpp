@@ -84,7 +84,8 @@ std::vector<std::string> path_arguments(const nlohmann::json& options) {
         } else if (key == "flip_y") {
             if (flag_value(v, key)) args.push_back("--flip-y");
         } else if (key == "keep_order") {
-            if (flag_value(v, key)) args.push_back("--keep-order");
+            // The page's box asks for an order either way: G-code too is ordered when it is on.
+            args.push_back(flag_value(v, key) ? "--keep-order" : "--order");
         } else if (key == "csv_closed") {
             if (flag_value(v, key)) args.push_back("--csv-closed");
         } else if (key == "pause") {

@@ -75,7 +75,8 @@ public:
             if (action == StreamInterrupt::Action::kHold) command(static_cast<std::uint8_t>(device::Command::kHold), true);
             if (action == StreamInterrupt::Action::kStop) command(static_cast<std::uint8_t>(device::Command::kStop), true);
             const std::uint64_t lead = queued_ticks(s, next);
-            if (!interrupt.active() && free_slots_ > 0 && (lead < lead_target || !started) && feed_.sendable(next)) {
+            if (!interrupt.active() && free_slots_ > 0 && (lead < lead_target || !started) &&
+                s.state != static_cast<std::uint8_t>(device::DeviceState::kStopping) && feed_.sendable(next)) {
                 send_batch(next);
                 // Flow control: never more than the device's free slots, as last reported.
                 s.last_accepted = acknowledged_;
@@ -283,9 +284,11 @@ private:
             }
             if (ack.result == static_cast<std::uint8_t>(Status::kQueueFull)) return;  // later (never expected)
             if (ack.result != 0) {
-                // A queue dropped under the stream (another client's stop, a fault) refuses the
-                // next batch: the loop's next status read says what happened.
-                if (link_.request_status().epoch != job_epoch_) {
+                // A queue dropped under the stream, or about to be (another client's stop: the
+                // device refuses batches while it stops): the loop's next status reads say what
+                // happened.
+                const pc::Status3 now = link_.request_status();
+                if (now.epoch != job_epoch_ || now.state == static_cast<std::uint8_t>(device::DeviceState::kStopping)) {
                     free_slots_ = 0;
                     return;
                 }

@@ -81,7 +81,8 @@ public:
             if (interrupt.active()) {
                 std::this_thread::sleep_for(std::chrono::milliseconds(options_.poll_interval_ms));
                 s = read_status();
-            } else if (s.free_slots > 0 && (lead < lead_target || !started) && feed_.sendable(next)) {
+            } else if (s.free_slots > 0 && (lead < lead_target || !started) &&
+                       s.state != static_cast<std::uint16_t>(device::DeviceState::kStopping) && feed_.sendable(next)) {
                 s = send_batch(next, s.free_slots);
             } else {
                 bool predicted = false;
@@ -89,7 +90,8 @@ public:
                 // Woken when the lead should have drained to the target: send the next batch
                 // at once (its FC23 answer is the status) instead of polling first. The free
                 // slots known are a lower bound (slots only free up), so the batch fits.
-                if (predicted && s.free_slots > 0 && feed_.sendable(next)) {
+                if (predicted && s.free_slots > 0 &&
+                    s.state != static_cast<std::uint16_t>(device::DeviceState::kStopping) && feed_.sendable(next)) {
                     s = send_batch(next, s.free_slots);
                 } else {
                     s = read_status();
@@ -348,10 +350,13 @@ private:
                 return read_status();  // queue fuller than we knew: send later
             }
             if (!e.transient()) {
-                // A queue dropped under the stream (another client's stop, a fault) refuses the
-                // next batch, which no longer joins what the device holds: say what happened.
+                // A queue dropped under the stream, or about to be (another client's stop: the
+                // device refuses batches while it stops), refuses the next batch, which no longer
+                // joins what the device holds: the loop then says what happened.
                 const DeviceStatus now = read_status();
-                if (now.epoch != job_epoch_) return now;
+                if (now.epoch != job_epoch_ || now.state == static_cast<std::uint16_t>(device::DeviceState::kStopping)) {
+                    return now;
+                }
                 std::ostringstream m;
                 m << "device refused spans " << first << ".." << last << ": " << e.what() << refusal();
                 fail(m.str());
