@@ -44,8 +44,8 @@ TEST_CASE("axis switch: closes at the trigger, opens past the hysteresis", "[gpi
         CHECK_FALSE(s.update(-99));
         CHECK(s.update(-100));
         CHECK(s.update(-150));
-        CHECK(s.update(-95));   // back inside the hysteresis: still closed
-        CHECK(s.update(-90));   // trigger + hysteresis: still closed
+        CHECK(s.update(-95));  // back inside the hysteresis: still closed
+        CHECK(s.update(-90));  // trigger + hysteresis: still closed
         CHECK_FALSE(s.update(-89));
         CHECK_FALSE(s.update(-99));  // open until the trigger again
         CHECK(s.update(-100));
@@ -68,7 +68,8 @@ TEST_CASE("axis switch: closes at the trigger, opens past the hysteresis", "[gpi
     }
 }
 
-TEST_CASE("axis switch: seeded bounce after every change, settled at the new level", "[gpio][switch]") {
+TEST_CASE("axis switch: seeded bounce after every change, settled at the new level",
+          "[gpio][switch]") {
     // Closes at tick 1 and stays closed: 3 bounces within 8 ticks, then steady.
     std::vector<Lsb> closing(20, -200);
     closing[0] = 0;
@@ -89,7 +90,8 @@ TEST_CASE("axis switch: seeded bounce after every change, settled at the new lev
     // Another seed draws other ticks (over a few seeds at least one differs).
     bool differs = false;
     for (std::uint64_t seed = 8; seed < 16; ++seed) {
-        differs = differs || levels(sim::AxisSwitch(negative_at(-100, 0, 3, 8, seed)), closing) != a;
+        differs =
+            differs || levels(sim::AxisSwitch(negative_at(-100, 0, 3, 8, seed)), closing) != a;
     }
     CHECK(differs);
 
@@ -122,7 +124,8 @@ TEST_CASE("machine switches: the device's new zero does not move a switch", "[gp
     CHECK(seen.back());
 }
 
-TEST_CASE("homing against a bouncing switch with hysteresis on the simulated plotter", "[gpio][switch][homing]") {
+TEST_CASE("homing against a bouncing switch with hysteresis on the simulated plotter",
+          "[gpio][switch][homing]") {
     const Lsb start[2] = {8000, 0};
     device::MotionLimits<2> l;
     l.tick_hz = 1000;

@@ -37,7 +37,9 @@ using ExampleDevice = device::MotionDevice<kExampleAxes, 16>;
 using ExampleMap = device::ModbusRegisterMap<kExampleAxes, 16>;
 
 // The device's own Status -> exception mapping, not a copy of it.
-Ex exception_for(Status s) { return ExampleMap::exception_for(s); }
+Ex exception_for(Status s) {
+    return ExampleMap::exception_for(s);
+}
 
 struct DocLine {
     int number = 0;  // 1-based

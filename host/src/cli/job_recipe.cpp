@@ -10,7 +10,9 @@
 
 namespace pathstream::host {
 
-const char* planner_identity() { return "pathstream 0.1.0"; }
+const char* planner_identity() {
+    return "pathstream 0.1.0";
+}
 
 std::string file_content_hash(const std::string& file) {
     std::ifstream in(file, std::ios::binary);
@@ -22,10 +24,13 @@ std::string file_content_hash(const std::string& file) {
 }
 
 JobRecipe save_job_recipe(PathOptions& path, const std::string& machine_file,
-                          const std::optional<std::vector<double>>& lead_in_from, const std::string& copy) {
+                          const std::optional<std::vector<double>>& lead_in_from,
+                          const std::string& copy) {
     std::string format;
     const std::string text = read_path_input(path, format);
-    if (format.empty()) throw InputError(path_display_name(path.file), {}, "standard input is empty: no path to read");
+    if (format.empty())
+        throw InputError(path_display_name(path.file), {},
+                         "standard input is empty: no path to read");
     AtomicFile f(copy);
     f.stream().write(text.data(), static_cast<std::streamsize>(text.size()));
     f.commit();
@@ -81,11 +86,13 @@ JobRecipe parse_job_recipe(const std::string& json, const std::string& journal) 
     JobRecipe r;
     PathOptions& p = r.path;
     const auto get = [&](const char* key, auto& out) {
-        if (!d.contains(key)) throw InputError(journal, {}, std::string("\"replan\" has no \"") + key + "\"");
+        if (!d.contains(key))
+            throw InputError(journal, {}, std::string("\"replan\" has no \"") + key + "\"");
         try {
             d.at(key).get_to(out);
         } catch (const nlohmann::json::exception&) {
-            throw InputError(journal, {}, std::string("\"replan\": \"") + key + "\" has the wrong type");
+            throw InputError(journal, {},
+                             std::string("\"replan\": \"") + key + "\" has the wrong type");
         }
     };
     get("input", p.file);
@@ -114,7 +121,8 @@ JobRecipe parse_job_recipe(const std::string& json, const std::string& journal) 
     get("order_start", p.order_start);
     get("layers", p.layers);
     get("pause", p.pause);
-    if (!d.contains("lead_in_from")) throw InputError(journal, {}, "\"replan\" has no \"lead_in_from\"");
+    if (!d.contains("lead_in_from"))
+        throw InputError(journal, {}, "\"replan\" has no \"lead_in_from\"");
     if (!d["lead_in_from"].is_null()) {
         std::vector<double> from;
         get("lead_in_from", from);

@@ -15,7 +15,7 @@ namespace pathstream::host {
 struct JobRecipe {
     PathOptions path;  ///< file: the drawing's copy; format: the format it was read as
     std::optional<std::vector<double>> lead_in_from;  ///< mm per axis: --lead-in's start
-    std::string input_hash;    ///< content_hash of the copy
+    std::string input_hash;                           ///< content_hash of the copy
     std::string machine_hash;  ///< content_hash of the machine profile's file
     std::string planner;       ///< the program that planned it ("pathstream 0.1.0")
 };
@@ -29,7 +29,8 @@ const char* planner_identity();
 /// at the copy (standard input can be read once). Throws InputError for an unreadable drawing
 /// or profile, std::runtime_error when the copy cannot be written.
 JobRecipe save_job_recipe(PathOptions& path, const std::string& machine_file,
-                          const std::optional<std::vector<double>>& lead_in_from, const std::string& copy);
+                          const std::optional<std::vector<double>>& lead_in_from,
+                          const std::string& copy);
 
 /// The recipe as the journal's JSON object (compact text), and back. parse_job_recipe throws
 /// InputError naming `journal` for a recipe with missing or mistyped keys.

@@ -18,15 +18,15 @@ void write_attribute(const std::string& path, const char* value) {
     if (fd < 0) {
         const int e = errno;
         throw hal::GpioError("gpio-sim: cannot open " + path + ": " + std::strerror(e) +
-                                 (e == ENOENT ? " (is the chip a gpio-sim chip?)" : ""));
+                             (e == ENOENT ? " (is the chip a gpio-sim chip?)" : ""));
     }
     const std::size_t n = std::strlen(value);
     const ssize_t written = ::write(fd, value, n);
     const int e = errno;
     ::close(fd);
     if (written != static_cast<ssize_t>(n)) {
-        throw hal::GpioError("gpio-sim: cannot write '" + std::string(value) + "' to " + path + ": " +
-                                 (written < 0 ? std::strerror(e) : "short write"));
+        throw hal::GpioError("gpio-sim: cannot write '" + std::string(value) + "' to " + path +
+                             ": " + (written < 0 ? std::strerror(e) : "short write"));
     }
 }
 
@@ -39,11 +39,13 @@ GpioSimPull::GpioSimPull(const std::string& chip_name, unsigned offset, bool act
     if (::access(path_.c_str(), W_OK) != 0) {
         const int e = errno;
         throw hal::GpioError("gpio-sim: " + chip_name + " line " + std::to_string(offset) +
-                                 " cannot be driven from outside: " + path_ + ": " + std::strerror(e) +
-                                 (e == ENOENT ? " (not a gpio-sim chip)" : ""));
+                             " cannot be driven from outside: " + path_ + ": " + std::strerror(e) +
+                             (e == ENOENT ? " (not a gpio-sim chip)" : ""));
     }
 }
 
-void GpioSimPull::set(bool active) { write_attribute(path_, active != active_low_ ? "pull-up" : "pull-down"); }
+void GpioSimPull::set(bool active) {
+    write_attribute(path_, active != active_low_ ? "pull-up" : "pull-down");
+}
 
 }  // namespace pathstream::sim

@@ -44,8 +44,9 @@ public:
     /// beyond the trigger, open again once back past trigger -/+ hysteresis; during a bounce
     /// the level flips at the drawn ticks and ends at the settled one.
     bool update(Lsb position) {
-        const bool beyond = placement_.side == device::LimitSide::kNegative ? position <= placement_.trigger
-                                                                              : position >= placement_.trigger;
+        const bool beyond = placement_.side == device::LimitSide::kNegative
+                                ? position <= placement_.trigger
+                                : position >= placement_.trigger;
         const bool back = placement_.side == device::LimitSide::kNegative
                               ? position > placement_.trigger + placement_.hysteresis
                               : position < placement_.trigger - placement_.hysteresis;
@@ -87,7 +88,8 @@ private:
         std::vector<std::uint32_t> all(placement_.bounce_ticks);
         for (std::uint32_t i = 0; i < placement_.bounce_ticks; ++i) all[i] = i + 1;
         for (std::uint32_t i = 0; i < 2 * placement_.bounces; ++i) {
-            const std::uint32_t j = i + static_cast<std::uint32_t>(random_() % (placement_.bounce_ticks - i));
+            const std::uint32_t j =
+                i + static_cast<std::uint32_t>(random_() % (placement_.bounce_ticks - i));
             std::swap(all[i], all[j]);
         }
         flips_.assign(all.begin(), all.begin() + 2 * placement_.bounces);
