@@ -334,18 +334,20 @@ TEST_CASE("faults stop at once and keep the first code", "[device]") {
 }
 
 TEST_CASE("a request the tick has not taken yet is replaced by the next one; a stop is not", "[device]") {
+    // Each section runs on its own device (Catch2 runs the case again per section): 16 spans
+    // of a move queued and started.
     const Lsb start[kAxes] = {0, 0};
     const auto spans = trapezoid_move<kAxes>(start, 80000, 8);
+    Device d(start);
+    REQUIRE(d.configure(test_limits<kAxes>()) == Status::kOk);
+    REQUIRE(send(d, 1, spans, 0, 16) == Status::kOk);
+    REQUIRE(d.command(Command::kStart) == Status::kOk);
+    Recorder r;
 
     SECTION("a hold right after a resume to an underrun: the device stays holding") {
         // The race a streaming host met under load: it sent resume to a device held by
         // underrun, then hold (Ctrl-C) before the tick took the resume. The hold was judged
         // "already in effect" from the published state and not posted, so the resume ran.
-        Device d(start);
-        REQUIRE(d.configure(test_limits<kAxes>()) == Status::kOk);
-        REQUIRE(send(d, 1, spans, 0, 16) == Status::kOk);
-        REQUIRE(d.command(Command::kStart) == Status::kOk);
-        Recorder r;
         r.run(d, 16 * 8 + 400);
         REQUIRE(d.state() == DeviceState::kHolding);
         REQUIRE(d.held_by_underrun());
@@ -367,11 +369,6 @@ TEST_CASE("a request the tick has not taken yet is replaced by the next one; a s
         r.check_limits(test_limits<kAxes>());
     }
     SECTION("a resume right after a hold while running: the device keeps running") {
-        Device d(start);
-        REQUIRE(d.configure(test_limits<kAxes>()) == Status::kOk);
-        REQUIRE(send(d, 1, spans, 0, 16) == Status::kOk);
-        REQUIRE(d.command(Command::kStart) == Status::kOk);
-        Recorder r;
         r.run(d, 40);
         REQUIRE(d.state() == DeviceState::kRunning);
         REQUIRE(d.command(Command::kHold) == Status::kOk);
@@ -381,11 +378,6 @@ TEST_CASE("a request the tick has not taken yet is replaced by the next one; a s
         CHECK(d.generated_ticks() == 0);
     }
     SECTION("a stop not yet taken stays: start, hold and resume are refused") {
-        Device d(start);
-        REQUIRE(d.configure(test_limits<kAxes>()) == Status::kOk);
-        REQUIRE(send(d, 1, spans, 0, 16) == Status::kOk);
-        REQUIRE(d.command(Command::kStart) == Status::kOk);
-        Recorder r;
         r.run(d, 40);
         REQUIRE(d.command(Command::kStop) == Status::kOk);
         CHECK(d.command(Command::kResume) == Status::kWrongState);

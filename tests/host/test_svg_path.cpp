@@ -658,6 +658,14 @@ TEST_CASE("svg: rect, sharp and rounded", "[svg]") {
     CHECK(worst_deviation(clamped, {{15, 20}, 15, 20, 0}) <= 0.01);
     // zero size: nothing
     CHECK(parse(R"(<rect width="0" height="5"/><line x2="1"/>)").subpaths.size() == 1);
+    // One radius zero: square corners (an SVG renderer's test: rx="0" ry="20" drew a diagonal
+    // from (180, 160) to (20, 180) instead of the bottom side).
+    for (const char* radii : {R"(rx="0" ry="20")", R"(rx="20" ry="0")"}) {
+        INFO(radii);
+        const Subpath sq =
+            parse(std::string(R"(<rect x="20" y="20" width="160" height="160" )") + radii + "/>").subpaths.at(0);
+        check_points(sq, lines({{20, 20}, {180, 20}, {180, 180}, {20, 180}, {20, 20}}));
+    }
 }
 
 TEST_CASE("svg: circle and ellipse as four quarter arcs from (cx + rx, cy)", "[svg]") {

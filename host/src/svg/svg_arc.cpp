@@ -175,6 +175,9 @@ std::vector<Cubic> ellipse_cubics(Point center, double rx, double ry, const Affi
 
 std::vector<Cubic> rect_cubics(double x, double y, double width, double height, double rx,
                                double ry, const Affine& to_mm, double tolerance_mm) {
+    // A corner with one zero radius is square (an arc of radius 0 is a straight line): only
+    // then do the sides meet. rx="0" ry="20" once drew a diagonal instead of the bottom side.
+    if (!(rx > 0) || !(ry > 0)) rx = ry = 0;
     const double x0 = x, x1 = x + rx, x2 = x + width - rx, x3 = x + width;
     const double y0 = y, y1 = y + ry, y2 = y + height - ry, y3 = y + height;
     std::vector<Cubic> out;
