@@ -125,6 +125,12 @@ printf '<svg xmlns="http://www.w3.org/2000/svg" width="2000mm" height="900mm" vi
 expect work-area 1 'big.svg:2:1: subpath 1 leaves the work area: it reaches x = 1990.000 mm at (1990.000, 10.000) mm; x travel is 0.000 .. 430.000 mm' -- "$bin" plan "$work/big.svg" -m "$a3"
 expect work-area-fit 0 'every tick checked' -- "$bin" plan "$work/big.svg" -m "$a3" --fit a4
 expect layer-feed 0 '"accent" 2 subpaths 88.0 mm at 40.0 mm/s' -- "$bin" check "$src/examples/two_pens.svg" -m "$a3"
+# Fitted to the whole travel, or to a paper as large as it, a drawing plans: the fit keeps the
+# chord tolerance and one LSB inside. A paper larger than the travel names the one that fits.
+expect fit-area 0 'every tick checked' -- "$bin" plan "$src/examples/landscape.svg" -m "$a3" --fit area
+expect fit-a4-full-height 0 'every tick checked' -- "$bin" plan "$src/examples/landscape.svg" -m "$a3" --fit a4
+expect fit-a3-portrait 2 'the paper (297 x 420 mm) does not fit the machine'"'"'s work area (430 x 297 mm from (0, 0) mm); --fit a3-landscape does' -- \
+  "$bin" plan "$src/examples/landscape.svg" -m "$a3" --fit a3
 
 # Layers and pen changes; one CLI: standard input and -o - everywhere.
 expect layers-plan 0 'layers: 2 ("outline" 2 subpaths' -- "$bin" plan "$src/examples/two_pens.svg" -m "$machine"

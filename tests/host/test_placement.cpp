@@ -127,3 +127,36 @@ TEST_CASE("placement: bad values are refused with the option's name", "[placemen
     o.fit = "a4";
     CHECK_THROWS_AS(place_path(Path{}, o, std::nullopt), std::invalid_argument);
 }
+
+TEST_CASE("placement: a paper larger than the work area names the orientation that fits", "[placement]") {
+    const std::optional<Box2> a3_landscape_area = Box2{0, 0, 430, 297};
+    PlacementOptions o;
+    o.fit = "a3";
+    CHECK_THROWS_WITH(place_path(rectangle(), o, a3_landscape_area),
+                      Catch::Contains("--fit a3: the paper (297 x 420 mm) does not fit the machine's work area "
+                                      "(430 x 297 mm from (0, 0) mm); --fit a3-landscape does"));
+    o.fit = "a2";
+    CHECK_THROWS_WITH(place_path(rectangle(), o, a3_landscape_area), Catch::Contains(", in either orientation"));
+    o.fit = "a3-landscape";
+    CHECK_NOTHROW(place_path(rectangle(), o, a3_landscape_area));
+    CHECK_NOTHROW(place_path(rectangle(), o, std::nullopt));  // no machine: no check
+}
+
+TEST_CASE("placement: a fit keeps the edge clearance from the travel's edges", "[placement]") {
+    const std::optional<Box2> area = Box2{0, 0, 430, 297};
+    PlacementOptions o;
+    o.fit = "area";
+    o.edge_clearance = 0.006;
+    const Box2 b = box_of(place_path(rectangle(), o, area));
+    CHECK(b.x_min >= 0.006 - 1e-9);
+    CHECK(b.y_min >= 0.006 - 1e-9);
+    CHECK(b.x_max <= 430 - 0.006 + 1e-9);
+    CHECK(b.y_max <= 297 - 0.006 + 1e-9);
+    // A paper inside the area, away from its edges, is not changed by the clearance.
+    o.fit = "a5";  // 148 x 210
+    o.align = "center";
+    PlacementOptions without = o;
+    without.edge_clearance = 0;
+    const std::optional<Box2> big = Box2{-10, -10, 430, 297};
+    CHECK(box_of(place_path(rectangle(), o, big)).x_min == box_of(place_path(rectangle(), without, big)).x_min);
+}

@@ -160,6 +160,7 @@ LoadedPath load_path_report(const PathOptions& o, const MachineProfile* machine,
     std::string format;
     Path path = read_path(o, loaded.gcode_pen, format);
     PlacementOptions placement = o.placement;
+    if (machine != nullptr) placement.edge_clearance = machine->chord_tolerance + machine->mm_per_lsb;
     if (!o.translate.empty()) {
         const std::vector<double> xy = parse_numbers(o.translate, "--translate");
         if (xy.size() != 2) throw std::invalid_argument("--translate: give X,Y (2 numbers), got \"" + o.translate + "\"");

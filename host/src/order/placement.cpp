@@ -3,6 +3,7 @@
 
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -104,6 +105,28 @@ Box2 paper_box(const std::string& name) {
                                 "tabloid (add -landscape for the long side along x)");
 }
 
+namespace {
+
+bool box_inside(const Box2& inner, const Box2& outer) {
+    constexpr double kSlack = 1e-9;  // mm: a paper exactly as large as the travel fits
+    return inner.x_min >= outer.x_min - kSlack && inner.y_min >= outer.y_min - kSlack &&
+           inner.x_max <= outer.x_max + kSlack && inner.y_max <= outer.y_max + kSlack;
+}
+
+std::string mm_size(const Box2& b) {
+    char text[64];
+    std::snprintf(text, sizeof text, "%g x %g mm", b.width(), b.height());
+    return text;
+}
+
+std::string mm_corner(const Box2& b) {
+    char text[64];
+    std::snprintf(text, sizeof text, "(%g, %g) mm", b.x_min, b.y_min);
+    return text;
+}
+
+}  // namespace
+
 Path place_path(const Path& path, const PlacementOptions& o, const std::optional<Box2>& area,
                 PlacementReport* report) {
     PlacementReport r;
@@ -142,9 +165,27 @@ Path place_path(const Path& path, const PlacementOptions& o, const std::optional
             target = area;
         } else {
             target = paper_box(o.fit);
+            if (area && !box_inside(*target, *area)) {
+                // The paper lies on the machine from its origin: name the orientation that fits.
+                const bool landscape = o.fit.size() > 10 && o.fit.compare(o.fit.size() - 10, 10, "-landscape") == 0;
+                const std::string other = landscape ? o.fit.substr(0, o.fit.size() - 10) : o.fit + "-landscape";
+                const bool other_fits = box_inside(paper_box(other), *area);
+                throw std::invalid_argument("--fit " + o.fit + ": the paper (" + mm_size(*target) +
+                                            ") does not fit the machine's work area (" + mm_size(*area) + " from " +
+                                            mm_corner(*area) + ")" +
+                                            (other_fits ? "; --fit " + other + " does" : ", in either orientation"));
+            }
         }
         target->x_min += o.margin, target->y_min += o.margin;
         target->x_max -= o.margin, target->y_max -= o.margin;
+        if (area && o.edge_clearance > 0) {
+            // The planner's path may run up to its chord tolerance off the drawing: a fit that
+            // reaches the travel's edge keeps that much inside it.
+            target->x_min = std::max(target->x_min, area->x_min + o.edge_clearance);
+            target->y_min = std::max(target->y_min, area->y_min + o.edge_clearance);
+            target->x_max = std::min(target->x_max, area->x_max - o.edge_clearance);
+            target->y_max = std::min(target->y_max, area->y_max - o.edge_clearance);
+        }
         if (target->width() <= 0 || target->height() <= 0) {
             throw std::invalid_argument("--margin: " + std::to_string(o.margin) + " mm leaves no room in the fit box");
         }

@@ -36,6 +36,10 @@ struct PlacementOptions {
     /// SVG) or "bottom-left" (y grows upward). Decides which edge "top" in `align` means.
     std::string origin = "top-left";
     std::optional<std::pair<double, double>> translate;  ///< mm added last
+    /// mm a fit keeps from the machine's travel edges (not an option: the caller sets the
+    /// planner's chord tolerance plus one LSB, so that no planned tick of a drawing fitted to
+    /// the whole work area leaves it). Used only with a work area.
+    double edge_clearance = 0;
 
     /// Whether any option asks for a change.
     bool active() const {
