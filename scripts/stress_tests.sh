@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Runs the timing-sensitive tests N times in a row beside a CPU hog on every core and reports
 # each test's failures. A test that fails here fails under load somewhere: that is a defect to
-# fix, not a run to repeat (docs/testing.md).
+# fix, not a run to repeat (README.md, "Stress runs").
 #
 #   scripts/stress_tests.sh [N] [options]       N rounds (default 20)
 #     --build-dir DIR     the build to test (default build/default; built first, not configured)
@@ -10,7 +10,8 @@
 #
 # The default set: every VM test (ctest label vm: SocketCAN, gpio-sim, CiA 402), the operator,
 # event and jerk-stream CLI tests, the resume and ctl-link cases of host_tests (Catch2 tags
-# [resume], [threads] cases that stream to a served device), and the browser test.
+# [resume], [threads] cases that stream to a served device), the core's two-thread stop-while-idle
+# case, and the browser test.
 # Each round's ctest output is kept in BUILD/stress/round-K.log; the table at the end gives
 # runs, failures and the rounds that failed for every test, and the exit status is 1 when any
 # run failed. The rounds run one test at a time (ctest -j1): the hogs are the load.
@@ -19,7 +20,7 @@ cd "$(dirname "$0")/.."
 
 rounds=20
 build=build/default
-regex='\.vm$|^cli_operator$|^cli_events$|^cli_jerk_stream$|^browser_serve$|^resume|^ctl.s link|^pause:|stream.*while|^vm\.selftest'
+regex='\.vm$|^cli_operator$|^cli_events$|^cli_jerk_stream$|^browser_serve$|^resume|^ctl.s link|^pause:|stream.*while|^vm\.selftest|^stop while idle: every'
 hogs=$(nproc)
 while [ $# -gt 0 ]; do
   case "$1" in

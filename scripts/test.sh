@@ -8,7 +8,7 @@
 # Every preset runs even when an earlier one failed; a summary of all of them comes last, and
 # the exit status is non-zero when any failed. A failed test fails its preset: nothing is run
 # again. A test that fails only under load is a defect; scripts/stress_tests.sh runs the
-# timing-sensitive ones beside a CPU hog per core to find such tests (docs/testing.md).
+# timing-sensitive ones beside a CPU hog per core to find such tests (README.md, "Stress runs").
 #   scripts/test.sh                 # what CI runs: every preset
 #   scripts/test.sh --quick         # the default preset only
 #   scripts/test.sh asan tsan       # the named presets only
