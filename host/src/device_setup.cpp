@@ -10,7 +10,8 @@ namespace {
 
 std::uint32_t fit_u32(double lsb, const std::string& what) {
     if (!(lsb >= 0) || lsb > 4294967295.0) {
-        throw std::range_error(what + " (" + std::to_string(lsb) + " LSB) does not fit the device's 32-bit values");
+        throw std::range_error(what + " (" + std::to_string(lsb) +
+                               " LSB) does not fit the device's 32-bit values");
     }
     return static_cast<std::uint32_t>(lsb);
 }
@@ -29,12 +30,15 @@ DeviceLimitsLsb device_limits(const MachineProfile& profile) {
     l.tick_hz = static_cast<std::uint32_t>(std::llround(profile.tick_hz));
     for (const AxisLimits& a : profile.axes) {
         // Rounded up: the planner works to the profile's limits exactly.
-        l.max_velocity.push_back(fit_u32(std::ceil(a.max_velocity / profile.mm_per_lsb), "axis " + a.name + " max_velocity"));
-        l.max_acceleration.push_back(
-            fit_u32(std::ceil(a.max_acceleration / profile.mm_per_lsb), "axis " + a.name + " max_acceleration"));
-        l.max_jerk.push_back(a.max_jerk > 0 ? fit_u32(std::ceil(a.max_jerk / profile.mm_per_lsb / device::kJerkUnitLsb),
-                                                      "axis " + a.name + " max_jerk (in 100 LSB/s^3)")
-                                            : 0);
+        l.max_velocity.push_back(fit_u32(std::ceil(a.max_velocity / profile.mm_per_lsb),
+                                         "axis " + a.name + " max_velocity"));
+        l.max_acceleration.push_back(fit_u32(std::ceil(a.max_acceleration / profile.mm_per_lsb),
+                                             "axis " + a.name + " max_acceleration"));
+        l.max_jerk.push_back(
+            a.max_jerk > 0
+                ? fit_u32(std::ceil(a.max_jerk / profile.mm_per_lsb / device::kJerkUnitLsb),
+                          "axis " + a.name + " max_jerk (in 100 LSB/s^3)")
+                : 0);
         const double range = static_cast<double>(kMaxPositionLsb);
         double low = -range, high = range;
         if (a.has_travel) {
@@ -42,7 +46,8 @@ DeviceLimitsLsb device_limits(const MachineProfile& profile) {
             low = std::ceil(a.travel_min / profile.mm_per_lsb - 1e-9);
             high = std::floor(a.travel_max / profile.mm_per_lsb + 1e-9);
             if (low < -range || high > range || low >= high) {
-                throw std::range_error("axis " + a.name + " travel does not fit the device's position range (+-" +
+                throw std::range_error("axis " + a.name +
+                                       " travel does not fit the device's position range (+-" +
                                        std::to_string(kMaxPositionLsb) + " LSB)");
             }
         }
@@ -82,7 +87,8 @@ std::vector<HomingSetup> homing_setups(const MachineProfile& profile) {
         HomingSetup s;
         s.axis_name = h.axis;
         s.switch_name = h.switch_name;
-        s.side = h.switch_name.back() == '+' ? device::LimitSide::kPositive : device::LimitSide::kNegative;
+        s.side = h.switch_name.back() == '+' ? device::LimitSide::kPositive
+                                             : device::LimitSide::kNegative;
         device::HomingConfig& c = s.config;
         c.axis = axis_index(profile, h.axis);
         c.toward_positive = s.side == device::LimitSide::kPositive;

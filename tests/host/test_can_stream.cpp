@@ -1,13 +1,11 @@
 // A planned drawing streamed with the native CAN protocol over the in-process loopback to the
 // simulated device running the core: the device executes, tick for tick, the setpoints
 // `pathstream plan` computes; with lost frames too; bus-off at the device stops the host.
-#include <catch2/catch.hpp>
-
 #include <atomic>
+#include <catch2/catch.hpp>
 #include <thread>
 #include <vector>
 
-#include "stream_support.hpp"
 #include "pathstream/device/can_protocol.hpp"
 #include "pathstream/host/can_stream.hpp"
 #include "pathstream/host/core_playback.hpp"
@@ -18,6 +16,7 @@
 #include "pathstream/sim/can_device.hpp"
 #include "pathstream/sim/can_loopback.hpp"
 #include "pathstream/span.hpp"
+#include "stream_support.hpp"
 
 using namespace pathstream;
 using test::check_recorded;
@@ -50,7 +49,8 @@ struct DeviceThread {
     ~DeviceThread() { join(); }
 };
 
-void check_executed(const Job& job, const sim::SimulatedCanDevice& device, const host::CanStreamReport& report) {
+void check_executed(const Job& job, const sim::SimulatedCanDevice& device,
+                    const host::CanStreamReport& report) {
     const std::size_t axes = job.plan.spans.front().control.size();
     const std::vector<Lsb> expected = plan_setpoints(job.plan, axes);
     const std::vector<Lsb>& got = device.recorded_setpoints();
@@ -64,7 +64,8 @@ void check_executed(const Job& job, const sim::SimulatedCanDevice& device, const
     std::size_t k = 0;
     for (const auto& span : job.plan.spans) {
         for (std::uint32_t t = 0; t < span.ticks; ++t, ++k) {
-            REQUIRE((device.recorded_ticks()[k].outputs & kOutputPenDown) == (span.pen_down ? 1 : 0));
+            REQUIRE((device.recorded_ticks()[k].outputs & kOutputPenDown) ==
+                    (span.pen_down ? 1 : 0));
         }
     }
 }
@@ -96,13 +97,15 @@ Run stream_over_loopback(const Job& job, const sim::CanFaults& faults, double ti
 
 }  // namespace
 
-TEST_CASE("a drawing streamed natively over CAN executes exactly the planned setpoints", "[can][stream][threads]") {
+TEST_CASE("a drawing streamed natively over CAN executes exactly the planned setpoints",
+          "[can][stream][threads]") {
     const Job job = plan_example("wave.json");
     const Run r = stream_over_loopback(job, {});
     check_executed(job, *r.device, r.report);
     CHECK(r.report.spans_sent == job.plan.spans.size());
     CHECK(r.report.retransmissions == 0);
-    CHECK(r.device->refused_batches() == 0);  // never a span the device refuses (queue full included)
+    CHECK(r.device->refused_batches() ==
+          0);  // never a span the device refuses (queue full included)
     CHECK(r.device->duplicates() == 0);
     CHECK(r.bus.frames == r.report.frames_sent + r.report.frames_received);
 }
@@ -141,9 +144,10 @@ TEST_CASE("two drawings in a row natively over CAN, each ending idle at rest, no
     CHECK(dt.device->refused_batches() == 0);
 }
 
-TEST_CASE("over CAN the host reads where the device rests: a plan elsewhere is refused, a lead-in "
-          "from there streams",
-          "[can][stream][threads]") {
+TEST_CASE(
+    "over CAN the host reads where the device rests: a plan elsewhere is refused, a lead-in "
+    "from there streams",
+    "[can][stream][threads]") {
     const Job job = plan_example("wave.json");
     const std::vector<Lsb> rest = {start_of(job.plan)[0] + 12345, start_of(job.plan)[1] - 6789};
     sim::CanLoopback loop;
@@ -177,20 +181,23 @@ TEST_CASE("over CAN the host reads where the device rests: a plan elsewhere is r
     check_recorded(led.plan, *dt.device, 0);
 }
 
-TEST_CASE("natively over CAN with 1 % of the frames lost, the device still executes every span once",
-          "[can][stream][threads]") {
+TEST_CASE(
+    "natively over CAN with 1 % of the frames lost, the device still executes every span once",
+    "[can][stream][threads]") {
     const Job job = plan_example("wave.json");
     sim::CanFaults faults;
     faults.drop_fraction = 0.01;
     faults.seed = 42;
     const Run r = stream_over_loopback(job, faults);
-    check_executed(job, *r.device, r.report);  // no span lost or repeated: every path tick exactly once
+    check_executed(job, *r.device,
+                   r.report);  // no span lost or repeated: every path tick exactly once
     CHECK(r.bus.dropped > 0);
     CHECK(r.report.retransmissions > 0);
     CHECK(r.device->refused_batches() == 0);
 }
 
-TEST_CASE("natively over CAN with a transmit budget per poll, frames wait and nothing is lost", "[can][stream][threads]") {
+TEST_CASE("natively over CAN with a transmit budget per poll, frames wait and nothing is lost",
+          "[can][stream][threads]") {
     const Job job = plan_example("wave.json");
     sim::CanFaults faults;
     faults.tx_budget = 4;
@@ -199,7 +206,8 @@ TEST_CASE("natively over CAN with a transmit budget per poll, frames wait and no
     CHECK(r.device->refused_batches() == 0);
 }
 
-TEST_CASE("bus-off at the device: the host stops with a clear error and the device holds", "[can][stream][threads]") {
+TEST_CASE("bus-off at the device: the host stops with a clear error and the device holds",
+          "[can][stream][threads]") {
     const Job job = plan_example("wave.json");
     sim::CanLoopback loop;
     hal::CanBus& device_bus = loop.add_endpoint();
@@ -224,7 +232,8 @@ TEST_CASE("bus-off at the device: the host stops with a clear error and the devi
     REQUIRE(cut.load());
     CHECK_THAT(message, Catch::Contains("can://loop?node=5: no answer from node 5"));
     // The device saw its bus go off and held (a controlled stop), rather than run on blind.
-    for (int i = 0; i < 200 && dt.device->state() != 2; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    for (int i = 0; i < 200 && dt.device->state() != 2; ++i)
+        std::this_thread::sleep_for(std::chrono::milliseconds(10));
     CHECK(dt.device->state() == 2);  // holding
     dt.join();
 }
@@ -237,7 +246,8 @@ TEST_CASE("bus-off at the host: the streamer stops at once", "[can][stream][thre
     loop.set_bus_off(1, true);
     host::CanStreamOptions o;
     o.node = 5;
-    CHECK_THROWS_WITH(host::stream_can(job.plan, job.machine, host_bus, o), Catch::Contains("bus-off"));
+    CHECK_THROWS_WITH(host::stream_can(job.plan, job.machine, host_bus, o),
+                      Catch::Contains("bus-off"));
 }
 
 TEST_CASE("a silent node: the streamer gives up after the link timeout", "[can][stream][threads]") {
@@ -249,7 +259,8 @@ TEST_CASE("a silent node: the streamer gives up after the link timeout", "[can][
     o.node = 9;
     o.ack_timeout_ms = 20;
     o.link_timeout_seconds = 0.2;
-    CHECK_THROWS_WITH(host::stream_can(job.plan, job.machine, host_bus, o), Catch::Contains("no answer from node 9"));
+    CHECK_THROWS_WITH(host::stream_can(job.plan, job.machine, host_bus, o),
+                      Catch::Contains("no answer from node 9"));
 }
 
 TEST_CASE("can:// targets parse and refuse what is wrong", "[can]") {
@@ -261,7 +272,9 @@ TEST_CASE("can:// targets parse and refuse what is wrong", "[can]") {
     CHECK_THROWS_WITH(host::parse_can_target("can://vcan0"), Catch::Contains("node=N"));
     CHECK_THROWS_WITH(host::parse_can_target("can://vcan0?node=0"), Catch::Contains("1..127"));
     CHECK_THROWS_WITH(host::parse_can_target("can://vcan0?node=128"), Catch::Contains("1..127"));
-    CHECK_THROWS_WITH(host::parse_can_target("can://vcan0?node=5&protocol=x"), Catch::Contains("native or cia402"));
+    CHECK_THROWS_WITH(host::parse_can_target("can://vcan0?node=5&protocol=x"),
+                      Catch::Contains("native or cia402"));
     CHECK_THROWS_WITH(host::parse_can_target("can://?node=5"), Catch::Contains("no CAN interface"));
-    CHECK_THROWS_WITH(host::parse_can_target("can://vcan0?node=5&baud=1"), Catch::Contains("unknown parameter"));
+    CHECK_THROWS_WITH(host::parse_can_target("can://vcan0?node=5&baud=1"),
+                      Catch::Contains("unknown parameter"));
 }

@@ -2,8 +2,6 @@
 // host::stream_modbus): a TCP connection cut mid-frame, a noisy RTU line, a device restarted
 // mid-stream, a queue run dry, and dead peers. Every run is seeded or cut at a fixed frame, so
 // each is deterministic; every wait is bounded.
-#include <catch2/catch.hpp>
-
 #include <arpa/inet.h>
 #include <fcntl.h>
 #include <netinet/in.h>
@@ -16,6 +14,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <catch2/catch.hpp>
 #include <chrono>
 #include <cstdlib>
 #include <filesystem>
@@ -24,7 +23,6 @@
 #include <thread>
 #include <vector>
 
-#include "stream_support.hpp"
 #include "pathstream/device/modbus_map.hpp"
 #include "pathstream/device/motion_device.hpp"
 #include "pathstream/hal/modbus_server.hpp"
@@ -37,13 +35,14 @@
 #include "pathstream/host/planner.hpp"
 #include "pathstream/sim/modbus_device.hpp"
 #include "pathstream/span.hpp"
+#include "stream_support.hpp"
 
 using namespace pathstream;
+using Catch::Matchers::Contains;
 using test::Job;
 using test::plan_example;
 using test::plan_setpoints;
 using test::start_of;
-using Catch::Matchers::Contains;
 using SteadyClock = std::chrono::steady_clock;
 
 namespace {
@@ -51,7 +50,8 @@ namespace {
 namespace st = device::modbus::status;
 
 // The device's recorded path ticks are the plan's setpoints, tick for tick, every span once.
-void check_executed(const Job& job, const sim::SimulatedModbusDevice& device, const host::StreamReport& report) {
+void check_executed(const Job& job, const sim::SimulatedModbusDevice& device,
+                    const host::StreamReport& report) {
     const std::size_t axes = job.plan.spans.front().control.size();
     const std::vector<Lsb> expected = plan_setpoints(job.plan, axes);
     const std::vector<Lsb>& got = device.recorded_setpoints();
@@ -62,7 +62,8 @@ void check_executed(const Job& job, const sim::SimulatedModbusDevice& device, co
         INFO("tick " << i / axes << " axis " << i % axes);
         REQUIRE(got[i] == expected[i]);
     }
-    for (std::size_t a = 0; a < axes; ++a) CHECK(report.final_position[a] == expected[expected.size() - axes + a]);
+    for (std::size_t a = 0; a < axes; ++a)
+        CHECK(report.final_position[a] == expected[expected.size() - axes + a]);
 }
 
 // A status register of a device, read from the thread that serves it (no Catch assertions
@@ -74,7 +75,8 @@ std::uint16_t status_u16(sim::SimulatedModbusDevice& d, std::uint16_t reg) {
 }
 std::uint32_t status_u32(sim::SimulatedModbusDevice& d, std::uint16_t reg) {
     std::uint16_t r[2] = {};
-    if (d.handler().read_input_registers(reg, 2, r) != hal::ModbusException::kNone) return 0xFFFFFFFFu;
+    if (d.handler().read_input_registers(reg, 2, r) != hal::ModbusException::kNone)
+        return 0xFFFFFFFFu;
     return (static_cast<std::uint32_t>(r[0]) << 16) | r[1];
 }
 
@@ -90,15 +92,19 @@ struct Runner {
 };
 
 // Serves `server` and ticks `device` until stopped (the plain device of test_modbus_stream).
-void run_device(Runner& r, sim::SimulatedModbusDevice& device, hal::ModbusServer& server, double time_scale) {
+void run_device(Runner& r, sim::SimulatedModbusDevice& device, hal::ModbusServer& server,
+                double time_scale) {
     r.thread = std::thread([&r, &device, &server, time_scale] {
         sim::DeviceLoopOptions o;
         o.time_scale = time_scale;
-        sim::run_device_loop(device, [&](std::chrono::microseconds w) { server.poll_once(w); }, o, r.stop);
+        sim::run_device_loop(
+            device, [&](std::chrono::microseconds w) { server.poll_once(w); }, o, r.stop);
     });
 }
 
-std::string tcp_target(std::uint16_t port) { return "modbus-tcp://127.0.0.1:" + std::to_string(port) + "?unit=1"; }
+std::string tcp_target(std::uint16_t port) {
+    return "modbus-tcp://127.0.0.1:" + std::to_string(port) + "?unit=1";
+}
 
 int tcp_socket() {
     const int fd = ::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
@@ -199,7 +205,8 @@ private:
                 close_pair();
                 return false;
             }
-            d.pending.erase(d.pending.begin(), d.pending.begin() + static_cast<std::ptrdiff_t>(total));
+            d.pending.erase(d.pending.begin(),
+                            d.pending.begin() + static_cast<std::ptrdiff_t>(total));
         }
         return true;
     }
@@ -242,7 +249,8 @@ private:
                 !pump(client_, server_, requests_, cut_ == Cut::kRequest)) {
                 continue;
             }
-            if ((p[2].revents & (POLLIN | POLLHUP | POLLERR)) != 0) pump(server_, client_, responses_, cut_ == Cut::kResponse);
+            if ((p[2].revents & (POLLIN | POLLHUP | POLLERR)) != 0)
+                pump(server_, client_, responses_, cut_ == Cut::kResponse);
         }
     }
 
@@ -266,8 +274,9 @@ private:
 class FaultLine {
 public:
     FaultLine(double corrupt_rate, double drop_rate, unsigned seed) {
-        const std::filesystem::path program = std::filesystem::canonical("/proc/self/exe").parent_path().parent_path() /
-                                              "sim" / "modbus" / "pathstream_pty_fault_proxy";
+        const std::filesystem::path program =
+            std::filesystem::canonical("/proc/self/exe").parent_path().parent_path() / "sim" /
+            "modbus" / "pathstream_pty_fault_proxy";
         INFO("build the target pathstream_pty_fault_proxy (" << program.string() << ")");
         REQUIRE(std::filesystem::exists(program));
         int out[2];
@@ -278,8 +287,9 @@ public:
         REQUIRE(pid_ >= 0);
         if (pid_ == 0) {
             ::dup2(out[1], STDOUT_FILENO);
-            ::execl(program.c_str(), program.c_str(), "--corrupt-rate", corrupt.c_str(), "--drop-rate", drop.c_str(),
-                    "--seed", seed_text.c_str(), static_cast<char*>(nullptr));
+            ::execl(program.c_str(), program.c_str(), "--corrupt-rate", corrupt.c_str(),
+                    "--drop-rate", drop.c_str(), "--seed", seed_text.c_str(),
+                    static_cast<char*>(nullptr));
             ::_exit(127);
         }
         ::close(out[1]);
@@ -322,22 +332,29 @@ class SwappableHandler final : public hal::ModbusRegisterHandler {
 public:
     sim::SimulatedModbusDevice* device = nullptr;
 
-    hal::ModbusException read_input_registers(std::uint16_t a, std::uint16_t n, std::uint16_t* out) override {
+    hal::ModbusException read_input_registers(std::uint16_t a, std::uint16_t n,
+                                              std::uint16_t* out) override {
         return device->handler().read_input_registers(a, n, out);
     }
-    hal::ModbusException read_holding_registers(std::uint16_t a, std::uint16_t n, std::uint16_t* out) override {
+    hal::ModbusException read_holding_registers(std::uint16_t a, std::uint16_t n,
+                                                std::uint16_t* out) override {
         return device->handler().read_holding_registers(a, n, out);
     }
-    hal::ModbusException write_holding_registers(std::uint16_t a, std::uint16_t n, const std::uint16_t* v) override {
+    hal::ModbusException write_holding_registers(std::uint16_t a, std::uint16_t n,
+                                                 const std::uint16_t* v) override {
         return device->handler().write_holding_registers(a, n, v);
     }
-    hal::ModbusException write_read_holding_registers(std::uint16_t wa, std::uint16_t wn, const std::uint16_t* v,
-                                                      std::uint16_t ra, std::uint16_t rn, std::uint16_t* out) override {
+    hal::ModbusException write_read_holding_registers(std::uint16_t wa, std::uint16_t wn,
+                                                      const std::uint16_t* v, std::uint16_t ra,
+                                                      std::uint16_t rn,
+                                                      std::uint16_t* out) override {
         return device->handler().write_read_holding_registers(wa, wn, v, ra, rn, out);
     }
 };
 
-double seconds_since(SteadyClock::time_point t) { return std::chrono::duration<double>(SteadyClock::now() - t).count(); }
+double seconds_since(SteadyClock::time_point t) {
+    return std::chrono::duration<double>(SteadyClock::now() - t).count();
+}
 
 }  // namespace
 
@@ -372,15 +389,18 @@ TEST_CASE("a TCP connection cut mid-frame: the host reconnects and no span is lo
     check_executed(job, *device, report);
 }
 
-TEST_CASE("an RTU line that corrupts and drops ~1 % of bytes: retries, and the drawing completes exactly",
-          "[modbus][faults][threads]") {
+TEST_CASE(
+    "an RTU line that corrupts and drops ~1 % of bytes: retries, and the drawing completes exactly",
+    "[modbus][faults][threads]") {
     const Job job = plan_example("wave.json");
     FaultLine line(0.006, 0.004, 11);
     const auto device = sim::SimulatedModbusDevice::create(start_of(job.plan));
     device->record(true);
     hal::ModbusServerOptions so;
-    so.byte_timeout = std::chrono::milliseconds(20);  // a frame cut by a dropped byte is given up soon
-    hal::ModbusServer server = hal::ModbusServer::rtu(device->handler(), {line.path_a(), 115200, 'N', 8, 1}, so);
+    so.byte_timeout =
+        std::chrono::milliseconds(20);  // a frame cut by a dropped byte is given up soon
+    hal::ModbusServer server =
+        hal::ModbusServer::rtu(device->handler(), {line.path_a(), 115200, 'N', 8, 1}, so);
     Runner loop;
     run_device(loop, *device, server, 5.0);
 
@@ -400,21 +420,27 @@ TEST_CASE("an RTU line that corrupts and drops ~1 % of bytes: retries, and the d
     const host::StreamReport report = host::stream_modbus(job.plan, job.machine, o);
     loop.join();
 
-    INFO("rtu faults: " << report.transactions << " transactions, " << report.retries << " retries, " << report.batches
-                        << " batches, " << report.wall_seconds << " s, underruns " << report.underruns << ", bad frames "
-                        << server.counters().bad_frames.load() << ", requests " << server.counters().requests.load());
+    INFO("rtu faults: " << report.transactions << " transactions, " << report.retries
+                        << " retries, " << report.batches << " batches, " << report.wall_seconds
+                        << " s, underruns " << report.underruns << ", bad frames "
+                        << server.counters().bad_frames.load() << ", requests "
+                        << server.counters().requests.load());
     CHECK(report.retries > 0);
     CHECK(server.counters().bad_frames.load() > 0);
     check_executed(job, *device, report);
 }
 
-TEST_CASE("a device power-cycled mid-stream (TCP server gone and back on the same port): the host stops with "
-          "'restarted'",
-          "[modbus][faults][threads]") {
+TEST_CASE(
+    "a device power-cycled mid-stream (TCP server gone and back on the same port): the host stops "
+    "with "
+    "'restarted'",
+    "[modbus][faults][threads]") {
     const Job job = plan_example("wave.json");
-    std::unique_ptr<sim::SimulatedModbusDevice> first = sim::SimulatedModbusDevice::create(start_of(job.plan));
+    std::unique_ptr<sim::SimulatedModbusDevice> first =
+        sim::SimulatedModbusDevice::create(start_of(job.plan));
     std::unique_ptr<sim::SimulatedModbusDevice> second;
-    std::optional<hal::ModbusServer> server = hal::ModbusServer::tcp(first->handler(), {"127.0.0.1", 0, 4});
+    std::optional<hal::ModbusServer> server =
+        hal::ModbusServer::tcp(first->handler(), {"127.0.0.1", 0, 4});
     const std::uint16_t port = server->port();
     Runner loop;
     loop.thread = std::thread([&] {
@@ -422,16 +448,21 @@ TEST_CASE("a device power-cycled mid-stream (TCP server gone and back on the sam
         lo.time_scale = 10.0;
         std::atomic<bool> restart{false};
         // Phase 1: the first device until it has accepted 20 spans.
-        sim::run_device_loop(*first, [&](std::chrono::microseconds w) {
-            server->poll_once(w);
-            if (status_u32(*first, st::kLastAcceptedSequence) >= 20 || loop.stop) restart = true;
-        }, lo, restart);
+        sim::run_device_loop(
+            *first,
+            [&](std::chrono::microseconds w) {
+                server->poll_once(w);
+                if (status_u32(*first, st::kLastAcceptedSequence) >= 20 || loop.stop)
+                    restart = true;
+            },
+            lo, restart);
         // Power cycle: every connection closes, a fresh device (same start, unconfigured) serves
         // the same port.
         server.reset();
         second = sim::SimulatedModbusDevice::create(start_of(job.plan));
         server.emplace(hal::ModbusServer::tcp(second->handler(), {"127.0.0.1", port, 4}));
-        sim::run_device_loop(*second, [&](std::chrono::microseconds w) { server->poll_once(w); }, lo, loop.stop);
+        sim::run_device_loop(
+            *second, [&](std::chrono::microseconds w) { server->poll_once(w); }, lo, loop.stop);
     });
     host::StreamOptions o;
     o.target = tcp_target(port);
@@ -441,7 +472,8 @@ TEST_CASE("a device power-cycled mid-stream (TCP server gone and back on the sam
     REQUIRE_THROWS_MATCHES(host::stream_modbus(job.plan, job.machine, o), host::StreamError,
                            Catch::Matchers::Predicate<host::StreamError>(
                                [](const host::StreamError& e) {
-                                   return std::string(e.what()).find("restarted") != std::string::npos;
+                                   return std::string(e.what()).find("restarted") !=
+                                          std::string::npos;
                                },
                                "message says the device restarted"));
     CHECK(seconds_since(t0) < 10);
@@ -466,12 +498,17 @@ TEST_CASE("a device restarted behind a link that stays up (RTU): the host stops 
         sim::DeviceLoopOptions lo;
         lo.time_scale = 10.0;
         std::atomic<bool> restart{false};
-        sim::run_device_loop(*first, [&](std::chrono::microseconds w) {
-            server.poll_once(w);
-            if (status_u32(*first, st::kLastAcceptedSequence) >= 20 || loop.stop) restart = true;
-        }, lo, restart);
+        sim::run_device_loop(
+            *first,
+            [&](std::chrono::microseconds w) {
+                server.poll_once(w);
+                if (status_u32(*first, st::kLastAcceptedSequence) >= 20 || loop.stop)
+                    restart = true;
+            },
+            lo, restart);
         handler.device = second.get();
-        sim::run_device_loop(*second, [&](std::chrono::microseconds w) { server.poll_once(w); }, lo, loop.stop);
+        sim::run_device_loop(
+            *second, [&](std::chrono::microseconds w) { server.poll_once(w); }, lo, loop.stop);
     });
     host::StreamOptions o;
     o.target = "modbus-rtu://" + server.client_device() + "?baud=115200&parity=N&unit=1";
@@ -489,9 +526,11 @@ TEST_CASE("a device restarted behind a link that stays up (RTU): the host stops 
     CHECK((status_u16(*second, st::kFlags) & 1u) == 0);
 }
 
-TEST_CASE("the queue runs dry: the device stops within its limits, reports the underrun, resumes, and the path is "
-          "exact",
-          "[modbus][faults][threads]") {
+TEST_CASE(
+    "the queue runs dry: the device stops within its limits, reports the underrun, resumes, and "
+    "the path is "
+    "exact",
+    "[modbus][faults][threads]") {
     const Job job = plan_example("wave.json");
     const auto device = sim::SimulatedModbusDevice::create(start_of(job.plan));
     device->record(true);
@@ -503,13 +542,17 @@ TEST_CASE("the queue runs dry: the device stops within its limits, reports the u
     loop.thread = std::thread([&] {
         sim::DeviceLoopOptions lo;
         lo.time_scale = 10.0;
-        sim::run_device_loop(*device, [&](std::chrono::microseconds w) {
-            server.poll_once(w);
-            if (status_u16(*device, st::kState) == static_cast<std::uint16_t>(device::DeviceState::kHolding) &&
-                (status_u16(*device, st::kFlags) & 2u) != 0) {
-                saw_underrun_hold = true;
-            }
-        }, lo, loop.stop);
+        sim::run_device_loop(
+            *device,
+            [&](std::chrono::microseconds w) {
+                server.poll_once(w);
+                if (status_u16(*device, st::kState) ==
+                        static_cast<std::uint16_t>(device::DeviceState::kHolding) &&
+                    (status_u16(*device, st::kFlags) & 2u) != 0) {
+                    saw_underrun_hold = true;
+                }
+            },
+            lo, loop.stop);
     });
     // A host too slow for the device: one tick of lead wanted, and 40 ms (400 device ticks at
     // 10x) between polls, so each batch runs out before the next one arrives.
@@ -533,9 +576,11 @@ TEST_CASE("the queue runs dry: the device stops within its limits, reports the u
     const double hz = job.machine.tick_hz;
     for (std::size_t a = 0; a < axes; ++a) {
         const double v_max = job.machine.axes[a].max_velocity / job.machine.mm_per_lsb / hz + 1.0;
-        const double a_max = job.machine.axes[a].max_acceleration / job.machine.mm_per_lsb / (hz * hz) + 2.0;
+        const double a_max =
+            job.machine.axes[a].max_acceleration / job.machine.mm_per_lsb / (hz * hz) + 2.0;
         for (std::size_t k = 1; k + 1 < all.size() / axes; ++k) {
-            const double x0 = all[(k - 1) * axes + a], x1 = all[k * axes + a], x2 = all[(k + 1) * axes + a];
+            const double x0 = all[(k - 1) * axes + a], x1 = all[k * axes + a],
+                         x2 = all[(k + 1) * axes + a];
             INFO("tick " << k << " axis " << a << ": " << x0 << ' ' << x1 << ' ' << x2);
             REQUIRE(std::abs(x2 - x1) <= v_max);
             REQUIRE(std::abs(x2 - 2 * x1 + x0) <= a_max);
@@ -543,7 +588,8 @@ TEST_CASE("the queue runs dry: the device stops within its limits, reports the u
     }
 }
 
-TEST_CASE("a lead longer than the device's queue holds: the host starts when the queue is full", "[modbus][faults][threads]") {
+TEST_CASE("a lead longer than the device's queue holds: the host starts when the queue is full",
+          "[modbus][faults][threads]") {
     const Job job = plan_example("wave.json");
     const auto device = sim::SimulatedModbusDevice::create(start_of(job.plan));
     device->record(true);
@@ -561,7 +607,8 @@ TEST_CASE("a lead longer than the device's queue holds: the host starts when the
     check_executed(job, *device, report);
 }
 
-TEST_CASE("a dead TCP peer (accepts, never answers): StreamError within the link timeout", "[modbus][faults][threads]") {
+TEST_CASE("a dead TCP peer (accepts, never answers): StreamError within the link timeout",
+          "[modbus][faults][threads]") {
     const Job job = plan_example("wave.json");
     SilentListener silent;
     host::StreamOptions o;
@@ -579,7 +626,8 @@ TEST_CASE("a dead TCP peer (accepts, never answers): StreamError within the link
     CHECK(seconds_since(t0) < 10 * o.link_timeout_seconds);
 }
 
-TEST_CASE("nothing listening on the TCP port: StreamError, not a transport exception", "[modbus][faults][threads]") {
+TEST_CASE("nothing listening on the TCP port: StreamError, not a transport exception",
+          "[modbus][faults][threads]") {
     const Job job = plan_example("wave.json");
     std::uint16_t port = 0;
     {
@@ -601,7 +649,8 @@ TEST_CASE("nothing listening on the TCP port: StreamError, not a transport excep
     CHECK(seconds_since(t0) < 10 * o.link_timeout_seconds);
 }
 
-TEST_CASE("a dead RTU peer (a pty nobody serves): StreamError within the link timeout", "[modbus][faults][threads]") {
+TEST_CASE("a dead RTU peer (a pty nobody serves): StreamError within the link timeout",
+          "[modbus][faults][threads]") {
     const Job job = plan_example("wave.json");
     hal::PseudoTerminal unserved(true);
     host::StreamOptions o;

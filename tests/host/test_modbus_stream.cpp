@@ -1,12 +1,10 @@
 // A planned drawing streamed over Modbus TCP and RTU (a pty) to the simulated device running
 // the core: the device executes, tick for tick, the setpoints `pathstream plan` computes.
-#include <catch2/catch.hpp>
-
 #include <atomic>
+#include <catch2/catch.hpp>
 #include <thread>
 #include <vector>
 
-#include "stream_support.hpp"
 #include "pathstream/hal/modbus_server.hpp"
 #include "pathstream/host/core_playback.hpp"
 #include "pathstream/host/geometry.hpp"
@@ -16,6 +14,7 @@
 #include "pathstream/host/planner.hpp"
 #include "pathstream/sim/modbus_device.hpp"
 #include "pathstream/span.hpp"
+#include "stream_support.hpp"
 
 using namespace pathstream;
 using test::check_recorded;
@@ -38,7 +37,8 @@ struct DeviceThread {
         thread = std::thread([this, &server, time_scale] {
             sim::DeviceLoopOptions o;
             o.time_scale = time_scale;
-            sim::run_device_loop(*device, [&](std::chrono::microseconds w) { server.poll_once(w); }, o, stop);
+            sim::run_device_loop(
+                *device, [&](std::chrono::microseconds w) { server.poll_once(w); }, o, stop);
         });
     }
     ~DeviceThread() {
@@ -47,7 +47,8 @@ struct DeviceThread {
     }
 };
 
-void check_executed(const Job& job, const sim::SimulatedModbusDevice& device, const host::StreamReport& report) {
+void check_executed(const Job& job, const sim::SimulatedModbusDevice& device,
+                    const host::StreamReport& report) {
     const std::size_t axes = job.plan.spans.front().control.size();
     const std::vector<Lsb> expected = plan_setpoints(job.plan, axes);
     const std::vector<Lsb>& got = device.recorded_setpoints();
@@ -57,20 +58,23 @@ void check_executed(const Job& job, const sim::SimulatedModbusDevice& device, co
         INFO("tick " << i / axes << " axis " << i % axes);
         REQUIRE(got[i] == expected[i]);
     }
-    for (std::size_t a = 0; a < axes; ++a) CHECK(report.final_position[a] == expected[expected.size() - axes + a]);
+    for (std::size_t a = 0; a < axes; ++a)
+        CHECK(report.final_position[a] == expected[expected.size() - axes + a]);
     CHECK(report.last_completed == job.plan.spans.size());
     // Pen output per path tick equals the plan's pen-down spans.
     std::size_t k = 0;
     for (const auto& span : job.plan.spans) {
         for (std::uint32_t t = 0; t < span.ticks; ++t, ++k) {
-            REQUIRE((device.recorded_ticks()[k].outputs & kOutputPenDown) == (span.pen_down ? 1 : 0));
+            REQUIRE((device.recorded_ticks()[k].outputs & kOutputPenDown) ==
+                    (span.pen_down ? 1 : 0));
         }
     }
 }
 
 }  // namespace
 
-TEST_CASE("a drawing streamed over Modbus TCP executes exactly the planned setpoints", "[modbus][stream][threads]") {
+TEST_CASE("a drawing streamed over Modbus TCP executes exactly the planned setpoints",
+          "[modbus][stream][threads]") {
     const Job job = plan_example("wave.json");
     DeviceThread dt;
     dt.device = sim::SimulatedModbusDevice::create(start_of(job.plan));
@@ -87,7 +91,8 @@ TEST_CASE("a drawing streamed over Modbus TCP executes exactly the planned setpo
     CHECK(report.bytes_sent > 0);
 }
 
-TEST_CASE("a drawing streamed over Modbus RTU on a pty executes exactly the planned setpoints", "[modbus][stream][threads]") {
+TEST_CASE("a drawing streamed over Modbus RTU on a pty executes exactly the planned setpoints",
+          "[modbus][stream][threads]") {
     const Job job = plan_example("wave.json");
     DeviceThread dt;
     dt.device = sim::SimulatedModbusDevice::create(start_of(job.plan));
@@ -102,8 +107,10 @@ TEST_CASE("a drawing streamed over Modbus RTU on a pty executes exactly the plan
     check_executed(job, *dt.device, report);
 }
 
-TEST_CASE("stream with a lead-in: a device resting elsewhere (after homing) gets a pen-up move to the drawing first",
-          "[modbus][stream][threads]") {
+TEST_CASE(
+    "stream with a lead-in: a device resting elsewhere (after homing) gets a pen-up move to the "
+    "drawing first",
+    "[modbus][stream][threads]") {
     const Job drawing = plan_example("rose.json");
     const Lsb rest[2] = {5000, -7000};  // where homing left the machine, not the drawing's start
     DeviceThread dt;
@@ -114,13 +121,16 @@ TEST_CASE("stream with a lead-in: a device resting elsewhere (after homing) gets
     host::StreamOptions o;
     o.target = "modbus-tcp://127.0.0.1:" + std::to_string(server.port()) + "?unit=1";
     // Without the lead-in the streamer refuses, naming both points.
-    CHECK_THROWS_WITH(host::stream_modbus(drawing.plan, drawing.machine, o),
-                      Catch::Contains("device rests at 5000 -7000 LSB but the plan starts at 139322 100000 LSB"));
+    CHECK_THROWS_WITH(
+        host::stream_modbus(drawing.plan, drawing.machine, o),
+        Catch::Contains("device rests at 5000 -7000 LSB but the plan starts at 139322 100000 LSB"));
     const std::vector<Lsb> at = host::modbus_rest_position(drawing.machine, o);
     REQUIRE(at == std::vector<Lsb>{5000, -7000});
-    const host::Path path = host::load_json_path(std::string(PATHSTREAM_SOURCE_DIR) + "/examples/rose.json");
+    const host::Path path =
+        host::load_json_path(std::string(PATHSTREAM_SOURCE_DIR) + "/examples/rose.json");
     std::vector<host::BezierSegment> segments = host::to_bezier_segments(path);
-    host::prepend_lead_in(segments, {at[0] * drawing.machine.mm_per_lsb, at[1] * drawing.machine.mm_per_lsb});
+    host::prepend_lead_in(segments,
+                          {at[0] * drawing.machine.mm_per_lsb, at[1] * drawing.machine.mm_per_lsb});
     Job job{drawing.machine, host::plan_path(segments, drawing.machine)};
     REQUIRE(start_of(job.plan) == std::vector<Lsb>{5000, -7000});
     REQUIRE(job.plan.total_ticks > drawing.plan.total_ticks);

@@ -6,10 +6,10 @@
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 
-#include "pathstream/host/layers.hpp"
 #include "pathstream/host/atomic_file.hpp"
 #include "pathstream/host/core_playback.hpp"
 #include "pathstream/host/input_error.hpp"
+#include "pathstream/host/layers.hpp"
 #include "pathstream/host/planner.hpp"
 #include "pathstream/host/progress.hpp"
 #include "pathstream/host/work_area.hpp"
@@ -17,12 +17,17 @@
 namespace pathstream::host {
 
 void add_plan_command(CLI::App& app, PlanCommandOptions& o) {
-    CLI::App* cmd = app.add_subcommand(
-        "plan", "Plan the path for a machine (near time-optimal under its limits) and write the executed setpoints as "
-                "CSV tick,t,x,y,...,pen in mm");
+    CLI::App* cmd = app.add_subcommand("plan",
+                                       "Plan the path for a machine (near time-optimal under its "
+                                       "limits) and write the executed setpoints as "
+                                       "CSV tick,t,x,y,...,pen in mm");
     add_path_options(*cmd, o.path);
-    cmd->add_option("--machine,-m", o.machine, "machine profile (JSON, docs/formats.md)")->required()->check(CLI::ExistingFile);
-    cmd->add_option("--out,-o", o.output, "CSV output file, - for standard output (the summary then goes to standard error; default: only the summary)");
+    cmd->add_option("--machine,-m", o.machine, "machine profile (JSON, docs/formats.md)")
+        ->required()
+        ->check(CLI::ExistingFile);
+    cmd->add_option("--out,-o", o.output,
+                    "CSV output file, - for standard output (the summary then goes to standard "
+                    "error; default: only the summary)");
     cmd->add_flag("--json", o.json, "print the summary as one JSON document on standard output");
 }
 
@@ -33,9 +38,10 @@ PlannedJob prepare_job(const PathOptions& path_options, const std::string& machi
     // The work area serves --fit area; the lead-in's origin is where the order starts from.
     job.path = load_path(path_options, &job.machine, lead_in_from);
     if (job.machine.axes.size() != job.path.axes) {
-        throw InputError(machine_file, {}, "the machine has " + std::to_string(job.machine.axes.size()) +
-                                               " axes but " + path_options.file + " has " +
-                                               std::to_string(job.path.axes));
+        throw InputError(machine_file, {},
+                         "the machine has " + std::to_string(job.machine.axes.size()) +
+                             " axes but " + path_options.file + " has " +
+                             std::to_string(job.path.axes));
     }
     job.segments = to_bezier_segments(job.path);
     check_work_area(job.segments, job.path, job.machine, path_options.file);
@@ -51,7 +57,8 @@ PlannedJob plan_job(const PathOptions& path_options, const std::string& machine_
         ProgressBar bar("planning");
         job.plan = plan_path(job.segments, job.machine, [&](double f) { bar.update(f); });
     }
-    job.planning_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    job.planning_seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     job.check = check_plan(job.plan, job.segments, job.machine);
     check_plan_travel(job.plan, job.path, job.machine, path_options.file);
     job.span_count = job.plan.spans.size();
@@ -62,22 +69,26 @@ PlannedJob plan_job(const PathOptions& path_options, const std::string& machine_
 
 std::string lsb_to_mm_text(Lsb value, double mm_per_lsb) {
     double lsb_per_mm = 1.0 / mm_per_lsb;
-    if (std::fabs(lsb_per_mm - std::round(lsb_per_mm)) < 1e-9 * lsb_per_mm) lsb_per_mm = std::round(lsb_per_mm);
+    if (std::fabs(lsb_per_mm - std::round(lsb_per_mm)) < 1e-9 * lsb_per_mm)
+        lsb_per_mm = std::round(lsb_per_mm);
     return exact_decimal(value / lsb_per_mm);
 }
 
 void print_plan_summary(const PlannedJob& job, std::ostream& out) {
     const PlanCheck& c = job.check;
     char line[256];
-    std::snprintf(line, sizeof line, "  motion: %.3f s (%llu ticks at %g Hz), %zu spans, %zu pen changes\n",
-                  job.plan.duration, static_cast<unsigned long long>(job.plan.total_ticks), job.machine.tick_hz,
-                  job.span_count, job.pen_count);
+    std::snprintf(line, sizeof line,
+                  "  motion: %.3f s (%llu ticks at %g Hz), %zu spans, %zu pen changes\n",
+                  job.plan.duration, static_cast<unsigned long long>(job.plan.total_ticks),
+                  job.machine.tick_hz, job.span_count, job.pen_count);
     out << line;
-    if (const std::string layers = layers_text(job.path); !layers.empty()) out << "  " << layers << '\n';
-    std::snprintf(line, sizeof line, "  path: %.3f mm drawn, %.3f mm travel; planned in %.3f s\n", job.plan.path_length,
-                  job.plan.travel_length, job.planning_seconds);
+    if (const std::string layers = layers_text(job.path); !layers.empty())
+        out << "  " << layers << '\n';
+    std::snprintf(line, sizeof line, "  path: %.3f mm drawn, %.3f mm travel; planned in %.3f s\n",
+                  job.plan.path_length, job.plan.travel_length, job.planning_seconds);
     out << line;
-    std::snprintf(line, sizeof line, "  max deviation from the path: %.2f um (tolerance %.2f um) at tick %llu\n",
+    std::snprintf(line, sizeof line,
+                  "  max deviation from the path: %.2f um (tolerance %.2f um) at tick %llu\n",
                   c.max_deviation * 1000, job.machine.chord_tolerance * 1000,
                   static_cast<unsigned long long>(c.worst_deviation_tick));
     out << line;
@@ -98,22 +109,26 @@ void print_plan_summary(const PlannedJob& job, std::ostream& out) {
         // J and one tick of J when the profile sets max_jerk.
         if (c.axis_jerk_limit_lsb.at(a) > 0) {
             std::snprintf(line, sizeof line,
-                          "  axis %s: exact cubic jerk %.2f %% of max jerk (%.4g mm/s^3), join acceleration step "
+                          "  axis %s: exact cubic jerk %.2f %% of max jerk (%.4g mm/s^3), join "
+                          "acceleration step "
                           "%.2f %% of one tick of it\n",
-                          job.machine.axes[a].name.c_str(), 100 * c.axis_jerk_fraction_exact.at(a), c.axis_jerk.at(a),
-                          100 * c.axis_join_acceleration_step_fraction.at(a));
+                          job.machine.axes[a].name.c_str(), 100 * c.axis_jerk_fraction_exact.at(a),
+                          c.axis_jerk.at(a), 100 * c.axis_join_acceleration_step_fraction.at(a));
         } else {
-            std::snprintf(line, sizeof line,
-                          "  axis %s: exact cubic jerk %.4g mm/s^3 (%.4g LSB/tick^3), join acceleration step "
-                          "%.4g mm/s^2 (no max_jerk)\n",
-                          job.machine.axes[a].name.c_str(), c.axis_jerk.at(a), c.axis_jerk_lsb.at(a),
-                          c.axis_join_acceleration_step.at(a));
+            std::snprintf(
+                line, sizeof line,
+                "  axis %s: exact cubic jerk %.4g mm/s^3 (%.4g LSB/tick^3), join acceleration step "
+                "%.4g mm/s^2 (no max_jerk)\n",
+                job.machine.axes[a].name.c_str(), c.axis_jerk.at(a), c.axis_jerk_lsb.at(a),
+                c.axis_join_acceleration_step.at(a));
         }
         out << line;
     }
-    std::snprintf(line, sizeof line, "  every tick checked (%llu): %s%s\n", static_cast<unsigned long long>(c.ticks_checked),
+    std::snprintf(line, sizeof line, "  every tick checked (%llu): %s%s\n",
+                  static_cast<unsigned long long>(c.ticks_checked),
                   c.within_limits ? "within limits" : "LIMITS EXCEEDED",
-                  c.drawing_while_pen_moves ? "; MOTION WHILE THE PEN MOVES" : "; no motion while the pen moves");
+                  c.drawing_while_pen_moves ? "; MOTION WHILE THE PEN MOVES"
+                                            : "; no motion while the pen moves");
     out << line;
 }
 
@@ -182,10 +197,11 @@ void write_plan_header(std::size_t axes, std::ostream& csv) {
 }
 
 /// One executed tick as a CSV row.
-void write_plan_row(const PlannedJob& job, std::uint64_t tick, const std::int64_t* setpoint, bool pen_down,
-                    std::ostream& csv) {
+void write_plan_row(const PlannedJob& job, std::uint64_t tick, const std::int64_t* setpoint,
+                    bool pen_down, std::ostream& csv) {
     csv << tick << ',' << exact_decimal(static_cast<double>(tick) / job.machine.tick_hz);
-    for (std::size_t a = 0; a < job.path.axes; ++a) csv << ',' << lsb_to_mm_text(setpoint[a], job.machine.mm_per_lsb);
+    for (std::size_t a = 0; a < job.path.axes; ++a)
+        csv << ',' << lsb_to_mm_text(setpoint[a], job.machine.mm_per_lsb);
     csv << ',' << (pen_down ? 1 : 0) << '\n';
 }
 
@@ -197,9 +213,10 @@ public:
         : job_(job), file_(file), checker_(job.segments, job.machine) {
         if (csv != nullptr) {
             write_plan_header(job.path.axes, *csv);
-            checker_.on_tick([this, csv](std::uint64_t tick, const std::int64_t* setpoint, bool pen_down) {
-                write_plan_row(job_, tick, setpoint, pen_down, *csv);
-            });
+            checker_.on_tick(
+                [this, csv](std::uint64_t tick, const std::int64_t* setpoint, bool pen_down) {
+                    write_plan_row(job_, tick, setpoint, pen_down, *csv);
+                });
         }
     }
     void span(const CoreSpan& s) override {
@@ -216,9 +233,11 @@ public:
         PlanTotals totals;
         {
             ProgressBar bar("planning");
-            totals = plan_stream(source, job_.machine, PlanOptions{}, *this, nullptr, [&](double f) { bar.update(f); });
+            totals = plan_stream(source, job_.machine, PlanOptions{}, *this, nullptr,
+                                 [&](double f) { bar.update(f); });
         }
-        job_.planning_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        job_.planning_seconds =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         job_.check = checker_.finish();
         job_.plan.total_ticks = totals.total_ticks;
         job_.plan.duration = totals.duration;
@@ -247,7 +266,8 @@ int run_plan(const PlanCommandOptions& o) {
     if (o.output.empty()) {
         StreamedPlan(job, o.path.file, nullptr).run();
     } else {
-        write_output(o.output, [&](std::ostream& csv) { StreamedPlan(job, o.path.file, &csv).run(); });
+        write_output(o.output,
+                     [&](std::ostream& csv) { StreamedPlan(job, o.path.file, &csv).run(); });
     }
     const bool failed = !job.check.within_limits || job.check.drawing_while_pen_moves;
     // With --json, standard output holds the document or, on failure, nothing: the text
@@ -261,10 +281,13 @@ int run_plan(const PlanCommandOptions& o) {
     if (failed) {
         // Name the rule the plan broke: the jerk limit is checked with the others.
         const PlanCheck& c = job.check;
-        if (c.jerk_limited && (c.max_jerk_fraction_exact > 1 || c.max_join_acceleration_step_fraction > 1)) {
-            throw PlanError("the plan exceeds the machine's max_jerk (a planner bug): see the summary above");
+        if (c.jerk_limited &&
+            (c.max_jerk_fraction_exact > 1 || c.max_join_acceleration_step_fraction > 1)) {
+            throw PlanError(
+                "the plan exceeds the machine's max_jerk (a planner bug): see the summary above");
         }
-        throw PlanError("the plan failed its per-tick check (a planner bug): see the summary above");
+        throw PlanError(
+            "the plan failed its per-tick check (a planner bug): see the summary above");
     }
     if (o.json) std::cout << plan_summary_json(o, job).dump(2) << '\n';
     return 0;

@@ -4,33 +4,33 @@
 #include <unistd.h>
 
 #include <algorithm>
-#include <cstring>
-#include <deque>
-#include <optional>
 #include <atomic>
 #include <chrono>
-#include <thread>
 #include <csignal>
 #include <cstdio>
+#include <cstring>
+#include <deque>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
+#include <thread>
 
+#include "job_recipe.hpp"
 #include "pathstream/hal/socketcan_bus.hpp"
 #include "pathstream/host/can_stream.hpp"
 #include "pathstream/host/cia402_master.hpp"
 #include "pathstream/host/device_link.hpp"
 #include "pathstream/host/device_setup.hpp"
-#include "pathstream/host/input_error.hpp"
 #include "pathstream/host/events.hpp"
+#include "pathstream/host/input_error.hpp"
 #include "pathstream/host/job_journal.hpp"
 #include "pathstream/host/planning_thread.hpp"
 #include "pathstream/host/progress.hpp"
 #include "pathstream/host/span_supply.hpp"
-#include "job_recipe.hpp"
 #include "plan_command.hpp"
 #include "stream_plan_tap.hpp"
 
@@ -45,7 +45,8 @@ void add_stream_command(CLI::App& app, StreamCommandOptions& o) {
     add_path_options(*cmd, o.path);
     // FILE, --machine and --target come from the journal with --resume.
     cmd->get_option("file")->required(false);
-    cmd->add_option("--machine,-m", o.machine, "machine profile (JSON, docs/formats.md); required unless --resume")
+    cmd->add_option("--machine,-m", o.machine,
+                    "machine profile (JSON, docs/formats.md); required unless --resume")
         ->check(CLI::ExistingFile);
     cmd->add_option("--target,-t", o.stream.target,
                     "device: modbus-tcp://HOST:PORT?unit=N, "
@@ -53,21 +54,27 @@ void add_stream_command(CLI::App& app, StreamCommandOptions& o) {
                     "can://IFACE?node=N&protocol=native or CiA 402 drives "
                     "can://IFACE?node=N&protocol=cia402&cycle=2ms; required unless --resume");
     cmd->add_flag("--lead-in", o.lead_in,
-                  "start with a pen-up move from where the device rests (e.g. after homing) to the drawing's first "
+                  "start with a pen-up move from where the device rests (e.g. after homing) to the "
+                  "drawing's first "
                   "point");
     cmd->add_option("--journal", o.journal,
-                    "job journal, written as the stream goes, for --resume (default: DRAWING.journal.json in the "
+                    "job journal, written as the stream goes, for --resume (default: "
+                    "DRAWING.journal.json in the "
                     "current directory, DRAWING the file's name without its extension)");
     cmd->add_flag("--no-journal", o.no_journal, "write no job journal");
-    cmd->add_flag("--plan-first", o.plan_first,
-                  "plan the whole job before sending anything (the events' totals are known from job_start; "
-                  "memory grows with the job) instead of streaming while the planner works");
-    cmd->add_option("--resume", o.resume,
-                    "continue the drawing of this job journal after a Ctrl-C, a stop, a fault reset, a device "
-                    "restart or a host crash (FILE, --machine and --target default to the journal's)")
+    cmd->add_flag(
+        "--plan-first", o.plan_first,
+        "plan the whole job before sending anything (the events' totals are known from job_start; "
+        "memory grows with the job) instead of streaming while the planner works");
+    cmd->add_option(
+           "--resume", o.resume,
+           "continue the drawing of this job journal after a Ctrl-C, a stop, a fault reset, a "
+           "device "
+           "restart or a host crash (FILE, --machine and --target default to the journal's)")
         ->check(CLI::ExistingFile);
-    cmd->add_option("--hold-timeout", o.hold_timeout_seconds,
-                    "Ctrl-C: seconds for the hold to come to rest before the device is stopped instead")
+    cmd->add_option(
+           "--hold-timeout", o.hold_timeout_seconds,
+           "Ctrl-C: seconds for the hold to come to rest before the device is stopped instead")
         ->capture_default_str()
         ->check(CLI::Range(0.1, 600.0));
     cmd->add_option("--lead", o.stream.lead_seconds,
@@ -104,7 +111,8 @@ std::atomic<int> g_interrupts{0};
 extern "C" void on_stream_signal(int) {
     const int n = g_interrupts.fetch_add(1) + 1;
     static const char hold[] =
-        "\npathstream: interrupt: holding from the current tick (Ctrl-C again: stop and drop the queue)\n";
+        "\npathstream: interrupt: holding from the current tick (Ctrl-C again: stop and drop the "
+        "queue)\n";
     static const char stop[] = "\npathstream: interrupt: stopping\n";
     if (n == 1) {
         (void)!write(2, hold, sizeof hold - 1);
@@ -117,7 +125,8 @@ extern "C" void on_stream_signal(int) {
 // when the state or the acknowledged span changes kind (an interrupt, a fault).
 class JournalWriter {
 public:
-    JournalWriter(std::string path, JobJournal journal) : path_(std::move(path)), journal_(std::move(journal)) {
+    JournalWriter(std::string path, JobJournal journal)
+        : path_(std::move(path)), journal_(std::move(journal)) {
         if (!path_.empty()) write_journal(journal_, path_);
     }
 
@@ -130,7 +139,8 @@ public:
         journal_.last_completed = t.status.last_completed;
         journal_.epoch = t.status.epoch;
         journal_.state = state;
-        journal_.position.assign(t.status.position, t.status.position + std::min<unsigned>(t.status.axes, kMaxAxes));
+        journal_.position.assign(t.status.position,
+                                 t.status.position + std::min<unsigned>(t.status.axes, kMaxAxes));
         const auto now = std::chrono::steady_clock::now();
         if (changed || now - last_write_ > std::chrono::milliseconds(200)) {
             write_journal(journal_, path_);
@@ -171,7 +181,8 @@ struct StreamEnd {
 // where the layer changes, else the subpath and where it is in the file.
 std::string pause_description(const Path& path, std::size_t subpath) {
     const Subpath& s = path.subpaths.at(subpath);
-    const bool new_layer = !path.layers.empty() && (subpath == 0 || path.subpaths[subpath - 1].layer != s.layer);
+    const bool new_layer =
+        !path.layers.empty() && (subpath == 0 || path.subpaths[subpath - 1].layer != s.layer);
     if (new_layer) return "layer \"" + path.layers.at(s.layer).name + "\"";
     return "subpath " + std::to_string(subpath + 1) +
            (s.location.line > 0 ? " (line " + std::to_string(s.location.line) + ")" : "");
@@ -179,7 +190,7 @@ std::string pause_description(const Path& path, std::size_t subpath) {
 
 // Where a span sits in the drawing: for the report of where an interrupted job stopped.
 struct SpanPlace {
-    std::int64_t origin = 0;        // index in the drawing's plan; -1: a re-entry span
+    std::int64_t origin = 0;  // index in the drawing's plan; -1: a re-entry span
     std::size_t subpath = 0;
     std::uint64_t drawing_tick = 0;  // the drawing's tick at its start
 };
@@ -211,10 +222,12 @@ public:
         }
         if (t != Take::kSpan) return t;
         SpanPlace place{static_cast<std::int64_t>(taken_), out.subpath, ticks_};
-        if (job_ != nullptr) place = {job_->origin.at(taken_), out.subpath, job_->drawing_tick.at(taken_)};
+        if (job_ != nullptr)
+            place = {job_->origin.at(taken_), out.subpath, job_->drawing_tick.at(taken_)};
         places_.push_back(place);
         events_.add_span(out);
-        if (pause_pending_ && path_ != nullptr) writer_.add_pause(pause_description(*path_, out.subpath));
+        if (pause_pending_ && path_ != nullptr)
+            writer_.add_pause(pause_description(*path_, out.subpath));
         pause_pending_ = out.pause_after;
         last_subpath_ = out.subpath;
         ticks_ += out.ticks;
@@ -257,8 +270,8 @@ struct BarView {
     double fraction = 0;
     std::string detail;
 };
-BarView bar_view(std::uint64_t ticks, std::optional<std::uint64_t> total, double queued, const JobEvents& events,
-                 const PlanningThread* planning, double tick_hz) {
+BarView bar_view(std::uint64_t ticks, std::optional<std::uint64_t> total, double queued,
+                 const JobEvents& events, const PlanningThread* planning, double tick_hz) {
     char text[96];
     BarView v;
     if (total) {
@@ -266,16 +279,17 @@ BarView bar_view(std::uint64_t ticks, std::optional<std::uint64_t> total, double
         std::snprintf(text, sizeof text, "queue %.2f s", queued);
     } else {
         std::snprintf(text, sizeof text, "%.1f s done, planning %.0f %%, queue %.2f s",
-                      static_cast<double>(ticks) / tick_hz, planning != nullptr ? 100 * planning->fraction() : 0.0,
-                      queued);
+                      static_cast<double>(ticks) / tick_hz,
+                      planning != nullptr ? 100 * planning->fraction() : 0.0, queued);
     }
     const std::string status = events.status_text();
     v.detail = status.empty() ? std::string(text) : std::string(text) + ", " + status;
     return v;
 }
 
-StreamEnd stream_over_can(SpanSupply& supply, const MachineProfile& machine, const StreamCommandOptions& o,
-                          const StreamObserver& observer, const HeldJob* held, const JobEvents& events,
+StreamEnd stream_over_can(SpanSupply& supply, const MachineProfile& machine,
+                          const StreamCommandOptions& o, const StreamObserver& observer,
+                          const HeldJob* held, const JobEvents& events,
                           const PlanningThread* planning) {
     const CanTarget t = parse_can_target(o.stream.target);
     hal::SocketCanBus bus(t.interface_name);
@@ -291,32 +305,41 @@ StreamEnd stream_over_can(SpanSupply& supply, const MachineProfile& machine, con
     CanStreamReport r;
     {
         ProgressBar bar("streaming");
-        r = stream_can(supply, machine, bus, c, [&](std::uint64_t ticks, std::optional<std::uint64_t> total, double queued) {
-            const BarView v = bar_view(ticks, total, queued, events, planning, machine.tick_hz);
-            bar.update(v.fraction, v.detail);
-        });
+        r = stream_can(supply, machine, bus, c,
+                       [&](std::uint64_t ticks, std::optional<std::uint64_t> total, double queued) {
+                           const BarView v =
+                               bar_view(ticks, total, queued, events, planning, machine.tick_hz);
+                           bar.update(v.fraction, v.detail);
+                       });
     }
     if (r.interrupted != 0) return {r.interrupted, r.final_status, r.job, r.stopped_elsewhere};
     const double motion = static_cast<double>(r.ticks_executed) / machine.tick_hz;
-    std::printf("streamed      %s (native CAN protocol, node %u)\n", o.stream.target.c_str(), unsigned(t.node));
-    std::printf("executed      %llu ticks (%.3f s of motion), %llu spans in %llu batches, last span %u\n",
-                static_cast<unsigned long long>(r.ticks_executed), motion,
-                static_cast<unsigned long long>(r.spans_sent), static_cast<unsigned long long>(r.batches),
-                r.last_completed);
-    std::printf("job           %u finished: the device is idle at the drawing's end point\n", r.job);
-    std::printf("bus           %llu frames sent, %llu received, %llu retransmitted batches, %llu timeouts;"
-                " %.1f kbit/s worst case (%.2f %% of 1 Mbit/s)\n",
-                static_cast<unsigned long long>(r.frames_sent), static_cast<unsigned long long>(r.frames_received),
-                static_cast<unsigned long long>(r.retransmissions), static_cast<unsigned long long>(r.timeouts),
-                static_cast<double>(r.bits_sent + r.bits_received) / motion / 1e3,
-                static_cast<double>(r.bits_sent + r.bits_received) / motion / 1e4);
-    std::printf("device        %u underruns, %u duplicate batches acknowledged; wall time %.2f s\n", r.underruns,
-                r.duplicates, r.wall_seconds);
+    std::printf("streamed      %s (native CAN protocol, node %u)\n", o.stream.target.c_str(),
+                unsigned(t.node));
+    std::printf(
+        "executed      %llu ticks (%.3f s of motion), %llu spans in %llu batches, last span %u\n",
+        static_cast<unsigned long long>(r.ticks_executed), motion,
+        static_cast<unsigned long long>(r.spans_sent), static_cast<unsigned long long>(r.batches),
+        r.last_completed);
+    std::printf("job           %u finished: the device is idle at the drawing's end point\n",
+                r.job);
+    std::printf(
+        "bus           %llu frames sent, %llu received, %llu retransmitted batches, %llu timeouts;"
+        " %.1f kbit/s worst case (%.2f %% of 1 Mbit/s)\n",
+        static_cast<unsigned long long>(r.frames_sent),
+        static_cast<unsigned long long>(r.frames_received),
+        static_cast<unsigned long long>(r.retransmissions),
+        static_cast<unsigned long long>(r.timeouts),
+        static_cast<double>(r.bits_sent + r.bits_received) / motion / 1e3,
+        static_cast<double>(r.bits_sent + r.bits_received) / motion / 1e4);
+    std::printf("device        %u underruns, %u duplicate batches acknowledged; wall time %.2f s\n",
+                r.underruns, r.duplicates, r.wall_seconds);
     return {0, r.final_status, r.job};
 }
 
-StreamEnd stream_over_modbus(SpanSupply& supply, const MachineProfile& machine, const StreamCommandOptions& o,
-                             const StreamObserver& observer, const HeldJob* held, const JobEvents& events,
+StreamEnd stream_over_modbus(SpanSupply& supply, const MachineProfile& machine,
+                             const StreamCommandOptions& o, const StreamObserver& observer,
+                             const HeldJob* held, const JobEvents& events,
                              const PlanningThread* planning) {
     StreamOptions options = o.stream;
     options.observer = observer;
@@ -324,61 +347,79 @@ StreamEnd stream_over_modbus(SpanSupply& supply, const MachineProfile& machine, 
     StreamReport r;
     {
         ProgressBar bar("streaming");
-        r = stream_modbus(supply, machine, options,
-                          [&](std::uint64_t ticks, std::optional<std::uint64_t> total, double queued) {
-                              const BarView v = bar_view(ticks, total, queued, events, planning, machine.tick_hz);
-                              bar.update(v.fraction, v.detail);
-                          });
+        r = stream_modbus(
+            supply, machine, options,
+            [&](std::uint64_t ticks, std::optional<std::uint64_t> total, double queued) {
+                const BarView v = bar_view(ticks, total, queued, events, planning, machine.tick_hz);
+                bar.update(v.fraction, v.detail);
+            });
     }
     if (r.interrupted != 0) return {r.interrupted, r.final_status, r.job, r.stopped_elsewhere};
     std::printf("streamed      %s\n", o.stream.target.c_str());
-    std::printf("executed      %llu ticks (%.3f s of motion), %llu spans in %llu batches, last span %u\n",
-                static_cast<unsigned long long>(r.ticks_executed), static_cast<double>(r.ticks_executed) / machine.tick_hz,
-                static_cast<unsigned long long>(r.spans_sent), static_cast<unsigned long long>(r.batches), r.last_completed);
-    std::printf("job           %u finished: the device is idle at the drawing's end point\n", r.job);
+    std::printf(
+        "executed      %llu ticks (%.3f s of motion), %llu spans in %llu batches, last span %u\n",
+        static_cast<unsigned long long>(r.ticks_executed),
+        static_cast<double>(r.ticks_executed) / machine.tick_hz,
+        static_cast<unsigned long long>(r.spans_sent), static_cast<unsigned long long>(r.batches),
+        r.last_completed);
+    std::printf("job           %u finished: the device is idle at the drawing's end point\n",
+                r.job);
     std::printf("final point  ");
     for (std::size_t a = 0; a < machine.axes.size(); ++a) {
-        std::printf(" %s %.4f mm", machine.axes[a].name.c_str(), r.final_position[a] * machine.mm_per_lsb);
+        std::printf(" %s %.4f mm", machine.axes[a].name.c_str(),
+                    r.final_position[a] * machine.mm_per_lsb);
     }
-    std::printf("\nlink          %llu transactions, %llu retries, %llu reconnects, %llu bytes sent, %llu received"
-                " (%.0f B per s of motion)\n",
-                static_cast<unsigned long long>(r.transactions), static_cast<unsigned long long>(r.retries),
-                static_cast<unsigned long long>(r.reconnects), static_cast<unsigned long long>(r.bytes_sent),
-                static_cast<unsigned long long>(r.bytes_received),
-                (r.bytes_sent + r.bytes_received) / (static_cast<double>(r.ticks_executed) / machine.tick_hz));
-    std::printf("device        %u underruns, %u duplicate batches acknowledged; wall time %.2f s\n", r.underruns,
-                r.duplicates, r.wall_seconds);
+    std::printf(
+        "\nlink          %llu transactions, %llu retries, %llu reconnects, %llu bytes sent, %llu "
+        "received"
+        " (%.0f B per s of motion)\n",
+        static_cast<unsigned long long>(r.transactions), static_cast<unsigned long long>(r.retries),
+        static_cast<unsigned long long>(r.reconnects),
+        static_cast<unsigned long long>(r.bytes_sent),
+        static_cast<unsigned long long>(r.bytes_received),
+        (r.bytes_sent + r.bytes_received) /
+            (static_cast<double>(r.ticks_executed) / machine.tick_hz));
+    std::printf("device        %u underruns, %u duplicate batches acknowledged; wall time %.2f s\n",
+                r.underruns, r.duplicates, r.wall_seconds);
     return {0, r.final_status, r.job};
 }
 
 // Where an interrupted job stopped, in the drawing's terms, and how to go on. `next`: the
 // first span of the job not executed to its end (its place, when known); `totals`: the
 // drawing's, when planning got to its end; `resumable`: the journal can resume it.
-void print_interrupted(const StreamEnd& end, std::optional<SpanPlace> next, std::optional<DrawingTotals> totals,
-                       const MachineProfile& machine, const std::string& journal, bool resumable) {
+void print_interrupted(const StreamEnd& end, std::optional<SpanPlace> next,
+                       std::optional<DrawingTotals> totals, const MachineProfile& machine,
+                       const std::string& journal, bool resumable) {
     const DeviceSnapshot& s = end.status;
     std::printf("interrupted   the device %s at",
                 end.interrupted == 1 && s.state == 2 ? "holds at rest (the rest of the job queued)"
                 : s.state == 0                       ? "stopped and is idle (queue dropped)"
                                                      : device_state_name(s.state));
     for (std::size_t a = 0; a < machine.axes.size(); ++a) {
-        std::printf(" %s %.4f mm", machine.axes[a].name.c_str(), s.position[a] * machine.mm_per_lsb);
+        std::printf(" %s %.4f mm", machine.axes[a].name.c_str(),
+                    s.position[a] * machine.mm_per_lsb);
     }
     std::printf(", pen up\n");
     if (next && totals) {
-        std::printf("              stopped before drawing span %lld of %zu (subpath %zu of %zu, tick %llu of %llu)\n",
-                    static_cast<long long>(next->origin) + 1, totals->spans, next->subpath + 1, totals->subpaths,
-                    static_cast<unsigned long long>(next->drawing_tick),
-                    static_cast<unsigned long long>(totals->ticks));
+        std::printf(
+            "              stopped before drawing span %lld of %zu (subpath %zu of %zu, tick %llu "
+            "of %llu)\n",
+            static_cast<long long>(next->origin) + 1, totals->spans, next->subpath + 1,
+            totals->subpaths, static_cast<unsigned long long>(next->drawing_tick),
+            static_cast<unsigned long long>(totals->ticks));
     } else if (next) {
-        std::printf("              stopped before drawing span %lld (subpath %zu, tick %llu; planning did not finish)\n",
-                    static_cast<long long>(next->origin) + 1, next->subpath + 1,
-                    static_cast<unsigned long long>(next->drawing_tick));
+        std::printf(
+            "              stopped before drawing span %lld (subpath %zu, tick %llu; planning did "
+            "not finish)\n",
+            static_cast<long long>(next->origin) + 1, next->subpath + 1,
+            static_cast<unsigned long long>(next->drawing_tick));
     }
     if (journal.empty()) {
         std::printf("resume        not possible: --no-journal\n");
     } else if (!resumable) {
-        std::printf("resume        not possible: planning did not finish, the journal has no plan to go on from\n");
+        std::printf(
+            "resume        not possible: planning did not finish, the journal has no plan to go on "
+            "from\n");
     } else {
         std::printf("resume with   pathstream stream --resume %s\n", journal.c_str());
     }
@@ -406,8 +447,10 @@ void handle_pauses(InterruptOptions& interrupt, const JournalWriter& writer, Job
     interrupt.on_pause = [&writer, &events, target, terminal](std::size_t index) {
         const std::vector<std::string>& pauses = writer.journal().pauses;
         const std::string next = index < pauses.size() ? pauses[index] : "the rest of the job";
-        std::fprintf(stderr, "\npathstream: paused for a pen change, %s next: %s `pathstream ctl %s resume`\n",
-                     next.c_str(), terminal ? "press Enter to go on, or" : "go on with", target.c_str());
+        std::fprintf(
+            stderr,
+            "\npathstream: paused for a pen change, %s next: %s `pathstream ctl %s resume`\n",
+            next.c_str(), terminal ? "press Enter to go on, or" : "go on with", target.c_str());
         events.pause(index, next);
     };
     if (terminal) interrupt.resume_requested = enter_pressed;
@@ -432,7 +475,9 @@ struct JobToStream {
 // operator interrupts again.
 void finish_planning(PlanningThread& planning, bool journal) {
     if (planning.finished() || !journal) return;
-    std::printf("planning      the rest of the job, for --resume (Ctrl-C: skip it; --resume then plans it again)\n");
+    std::printf(
+        "planning      the rest of the job, for --resume (Ctrl-C: skip it; --resume then plans it "
+        "again)\n");
     std::fflush(stdout);
     const int interrupts = g_interrupts.load();
     planning.drain([interrupts] { return g_interrupts.load() == interrupts; });
@@ -457,15 +502,19 @@ int stream_job(const JobToStream& job, const MachineProfile& machine, StreamComm
     std::signal(SIGTERM, on_stream_signal);
     JobEvents events(channel, machine, {"stream", journal.drawing, o.stream.target, job.subpaths});
     if (job.spans != nullptr) {
-        events.set_totals(job.spans->plan.total_ticks, job.spans->plan.spans.size(), job.spans->plan.pauses.size());
+        events.set_totals(job.spans->plan.total_ticks, job.spans->plan.spans.size(),
+                          job.spans->plan.pauses.size());
     }
-    TrackedSupply supply(job.supply, job.spans, events, writer, job.spans == nullptr ? job.path : nullptr);
+    TrackedSupply supply(job.supply, job.spans, events, writer,
+                         job.spans == nullptr ? job.path : nullptr);
     handle_pauses(o.stream.interrupt, writer, events, o.stream.target,
                   o.path.file != "-" && ::isatty(STDIN_FILENO) == 1);
     // Once planning has ended: its totals go to the events, its spans file to the journal.
     bool plan_recorded = job.planning == nullptr;
     std::optional<DrawingTotals> totals;
-    if (job.spans != nullptr) totals = DrawingTotals{job.spans->drawing_spans, job.spans->subpaths, job.spans->drawing_ticks};
+    if (job.spans != nullptr)
+        totals =
+            DrawingTotals{job.spans->drawing_spans, job.spans->subpaths, job.spans->drawing_ticks};
     const auto record_plan = [&] {
         if (plan_recorded || !job.planning->finished()) return;
         plan_recorded = true;
@@ -478,7 +527,8 @@ int stream_job(const JobToStream& job, const MachineProfile& machine, StreamComm
     // Every status read goes to both records: the journal and the events.
     const StreamObserver observer = [&](const StreamTrace& t) {
         record_plan();
-        if (t.job != 0 && t.status.last_completed + 1 >= t.job) supply.executed_before(t.status.last_completed + 1 - t.job);
+        if (t.job != 0 && t.status.last_completed + 1 >= t.job)
+            supply.executed_before(t.status.last_completed + 1 - t.job);
         writer.trace(t);
         events.trace(t);
     };
@@ -491,12 +541,14 @@ int stream_job(const JobToStream& job, const MachineProfile& machine, StreamComm
         record_plan();
         writer.finish("failed", e.what());
         events.end("failed", e.what());
-        if (!journal_path.empty() && (!writer.journal().plan_hash.empty() || !writer.journal().replan.empty())) {
+        if (!journal_path.empty() &&
+            (!writer.journal().plan_hash.empty() || !writer.journal().replan.empty())) {
             // A fault or e-stop stops the job where it is: once the device is reset, the journal
             // goes on from there.
-            std::printf("resume with   pathstream stream --resume %s (after pathstream ctl %s reset, if it "
-                        "faulted)\n",
-                        journal_path.c_str(), o.stream.target.c_str());
+            std::printf(
+                "resume with   pathstream stream --resume %s (after pathstream ctl %s reset, if it "
+                "faulted)\n",
+                journal_path.c_str(), o.stream.target.c_str());
             std::fflush(stdout);
         }
         throw;
@@ -509,8 +561,10 @@ int stream_job(const JobToStream& job, const MachineProfile& machine, StreamComm
         return 0;
     }
     if (end.stopped_elsewhere) {
-        std::printf("stopped       by another client (pathstream ctl stop, the page, another host): the device "
-                    "dropped the job's queue and is idle\n");
+        std::printf(
+            "stopped       by another client (pathstream ctl stop, the page, another host): the "
+            "device "
+            "dropped the job's queue and is idle\n");
     }
     if (job.planning != nullptr) finish_planning(*job.planning, !journal_path.empty());
     record_plan();
@@ -539,25 +593,31 @@ std::vector<std::string> pause_descriptions(const Path& path, const Plan& plan) 
 // the job planned again from the drawing's copy with the same options, proved against every
 // span the stream had handed on (the partial spans file), its spans file written and the
 // journal updated. Throws InputError when it cannot be, naming what changed.
-JobSpans replan_for_resume(JobJournal& journal, const std::string& journal_path, const std::string& machine_file) {
+JobSpans replan_for_resume(JobJournal& journal, const std::string& journal_path,
+                           const std::string& machine_file) {
     if (journal.replan.empty()) {
-        throw InputError(journal_path, {},
-                         "the job's plan was never complete and the journal has no \"replan\" (written by an older "
-                         "pathstream, or --plan-first): nothing to go on from; stream the drawing again");
+        throw InputError(
+            journal_path, {},
+            "the job's plan was never complete and the journal has no \"replan\" (written by an "
+            "older "
+            "pathstream, or --plan-first): nothing to go on from; stream the drawing again");
     }
     const JobRecipe recipe = parse_job_recipe(journal.replan, journal_path);
     if (const std::string h = file_content_hash(recipe.path.file); h != recipe.input_hash) {
         throw InputError(recipe.path.file, {},
-                         "the drawing's copy changed since the job started (hash " + h + ", journal " +
-                             recipe.input_hash + "): stream the drawing again");
+                         "the drawing's copy changed since the job started (hash " + h +
+                             ", journal " + recipe.input_hash + "): stream the drawing again");
     }
     if (const std::string h = file_content_hash(machine_file); h != recipe.machine_hash) {
         throw InputError(machine_file, {},
-                         "the machine profile changed since the job started (hash " + h + ", journal " +
-                             recipe.machine_hash + "): resume with the profile the job was planned for");
+                         "the machine profile changed since the job started (hash " + h +
+                             ", journal " + recipe.machine_hash +
+                             "): resume with the profile the job was planned for");
     }
-    std::printf("resume        the plan was not complete when the stream ended: planning the job again from %s\n",
-                recipe.path.file.c_str());
+    std::printf(
+        "resume        the plan was not complete when the stream ended: planning the job again "
+        "from %s\n",
+        recipe.path.file.c_str());
     std::fflush(stdout);
     const PlannedJob planned =
         plan_job(recipe.path, machine_file, recipe.lead_in_from ? &*recipe.lead_in_from : nullptr);
@@ -589,16 +649,18 @@ JobSpans replan_for_resume(JobJournal& journal, const std::string& journal_path,
         if (in.eof()) break;  // a last line without its newline was never flushed whole
         if (number <= skip) continue;
         if (proved >= job.plan.spans.size() ||
-            line != job_span_line(job.plan.spans[proved], job.origin[proved], job.drawing_tick[proved])) {
+            line != job_span_line(job.plan.spans[proved], job.origin[proved],
+                                  job.drawing_tick[proved])) {
             throw InputError(proof, {number, 1},
                              "the job planned again differs from the one streamed at span " +
-                                 std::to_string(proved + 1) + " (planned by " + recipe.planner + ", now " +
-                                 planner_identity() + "): stream the drawing again");
+                                 std::to_string(proved + 1) + " (planned by " + recipe.planner +
+                                 ", now " + planner_identity() + "): stream the drawing again");
         }
         ++proved;
     }
-    std::printf("resume        planned again: %zu spans, the first %zu identical to the ones streamed\n",
-                job.plan.spans.size(), proved);
+    std::printf(
+        "resume        planned again: %zu spans, the first %zu identical to the ones streamed\n",
+        job.plan.spans.size(), proved);
     journal.plan_hash = write_job_spans(job, journal.plan_file);
     journal.pauses = pause_descriptions(planned.path, planned.plan);
     write_journal(journal, journal_path);
@@ -613,10 +675,12 @@ int run_resume(StreamCommandOptions o, const EventChannel& channel) {
     if (o.machine.empty()) o.machine = journal.machine;
     if (o.stream.target.empty()) o.stream.target = journal.target;
     const MachineProfile machine = load_machine_profile(o.machine);
-    const JobSpans job = journal.plan_hash.empty() ? replan_for_resume(journal, o.resume, o.machine)
-                                                   : read_job_spans(journal.plan_file, journal.plan_hash);
+    const JobSpans job = journal.plan_hash.empty()
+                             ? replan_for_resume(journal, o.resume, o.machine)
+                             : read_job_spans(journal.plan_file, journal.plan_hash);
     if (journal.outcome == "finished") {
-        std::printf("resume        %s: the job already ran to its end; nothing to do\n", o.resume.c_str());
+        std::printf("resume        %s: the job already ran to its end; nothing to do\n",
+                    o.resume.c_str());
         return 0;
     }
     LinkOptions l;
@@ -626,8 +690,8 @@ int run_resume(StreamCommandOptions o, const EventChannel& channel) {
     DeviceSnapshot s;
     const std::size_t spans = job.plan.spans.size();
     const auto ours_now = [&] {
-        return journal.job != 0 && s.last_accepted >= journal.job && s.last_accepted - journal.job < spans &&
-               s.last_completed + 1 >= journal.job;
+        return journal.job != 0 && s.last_accepted >= journal.job &&
+               s.last_accepted - journal.job < spans && s.last_completed + 1 >= journal.job;
     };
     {
         const std::unique_ptr<DeviceLink> link = open_device_link(o.stream.target, l);
@@ -636,22 +700,28 @@ int run_resume(StreamCommandOptions o, const EventChannel& channel) {
         // then holds (underrun) or, with the whole job queued, ends it. Wait for either (at
         // most the queue's length in time, bounded by the link timeout per quiet read).
         if (s.state == static_cast<unsigned>(device::DeviceState::kRunning) && ours_now()) {
-            std::printf("resume        the device still runs job %u from its queue: waiting until it holds or ends\n",
-                        journal.job);
+            std::printf(
+                "resume        the device still runs job %u from its queue: waiting until it holds "
+                "or ends\n",
+                journal.job);
             std::fflush(stdout);
             const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(600);
             bool held_at_rest = false;
             while ((s.state == static_cast<unsigned>(device::DeviceState::kRunning) ||
-                    (s.state == static_cast<unsigned>(device::DeviceState::kHolding) && s.own_move())) &&
+                    (s.state == static_cast<unsigned>(device::DeviceState::kHolding) &&
+                     s.own_move())) &&
                    std::chrono::steady_clock::now() < deadline) {
                 // Everything it accepted has run and it still runs: it waits at rest for more
                 // (the host died just after a span that ends at rest, a pen change's dwell or an
                 // exact stop), where no underrun comes. Hold it there, as an underrun would have.
-                if (!held_at_rest && s.state == static_cast<unsigned>(device::DeviceState::kRunning) &&
+                if (!held_at_rest &&
+                    s.state == static_cast<unsigned>(device::DeviceState::kRunning) &&
                     s.last_completed == s.last_accepted) {
                     held_at_rest = link->command(device::Command::kHold) == Status::kOk;
                     if (held_at_rest) {
-                        std::printf("resume        the device ran out its queue at rest: holding it there\n");
+                        std::printf(
+                            "resume        the device ran out its queue at rest: holding it "
+                            "there\n");
                         std::fflush(stdout);
                     }
                 }
@@ -661,8 +731,8 @@ int run_resume(StreamCommandOptions o, const EventChannel& channel) {
         }
     }
     if (s.axes != machine.axes.size()) {
-        throw StreamError(o.stream.target + ": device has " + std::to_string(s.axes) + " axes, the profile " +
-                          std::to_string(machine.axes.size()));
+        throw StreamError(o.stream.target + ": device has " + std::to_string(s.axes) +
+                          " axes, the profile " + std::to_string(machine.axes.size()));
     }
     const bool ours = ours_now();
     if (s.state == static_cast<unsigned>(device::DeviceState::kIdle) && journal.job != 0 &&
@@ -675,18 +745,22 @@ int run_resume(StreamCommandOptions o, const EventChannel& channel) {
         done.state = device_state_name(s.state);
         done.position.assign(s.position, s.position + machine.axes.size());
         write_journal(done, o.resume);
-        std::printf("resume        the device ran job %u to its end after the host stopped; nothing to do\n",
-                    journal.job);
+        std::printf(
+            "resume        the device ran job %u to its end after the host stopped; nothing to "
+            "do\n",
+            journal.job);
         return 0;
     }
-    if (s.state == static_cast<unsigned>(device::DeviceState::kHolding) && ours && s.epoch == journal.epoch &&
-        (s.flags & 1u) != 0) {
-        std::printf("resume        the device holds job %u at span %u of %zu: streaming the rest, then resume\n",
-                    journal.job, s.last_completed + 1 - journal.job, spans);
+    if (s.state == static_cast<unsigned>(device::DeviceState::kHolding) && ours &&
+        s.epoch == journal.epoch && (s.flags & 1u) != 0) {
+        std::printf(
+            "resume        the device holds job %u at span %u of %zu: streaming the rest, then "
+            "resume\n",
+            journal.job, s.last_completed + 1 - journal.job, spans);
         const HeldJob held{journal.job, s.last_accepted};
         PlanSupply supply(job.plan);
-        return stream_job({supply, &job, nullptr, nullptr, nullptr, job.subpaths}, machine, o, journal, o.resume,
-                          &held, channel);
+        return stream_job({supply, &job, nullptr, nullptr, nullptr, job.subpaths}, machine, o,
+                          journal, o.resume, &held, channel);
     }
     if (s.state != static_cast<unsigned>(device::DeviceState::kIdle)) {
         throw StreamError(o.stream.target + ": device is " + device_state_name(s.state) +
@@ -701,21 +775,26 @@ int run_resume(StreamCommandOptions o, const EventChannel& channel) {
         first = s.last_completed + 1 - journal.job;
     } else if (journal.job != 0 && journal.last_completed + 1 >= journal.job) {
         first = journal.last_completed + 1 - journal.job;
-        std::printf("resume        the device does not know job %u (restarted?): from the journal's last record, "
-                    "span %zu\n", journal.job, first);
+        std::printf(
+            "resume        the device does not know job %u (restarted?): from the journal's last "
+            "record, "
+            "span %zu\n",
+            journal.job, first);
     }
     std::vector<Lsb> rest(s.position, s.position + machine.axes.size());
     const JobSpans resumed = resume_from(job, first, rest, device_limits(machine));
-    std::printf("resume        from where the device rests, back onto the drawing at span %lld of %zu (tick %llu)\n",
-                static_cast<long long>(resumed.origin[resumed.origin.size() - (spans - first)]) + 1,
-                job.drawing_spans, static_cast<unsigned long long>(resumed.drawing_tick.front()));
+    std::printf(
+        "resume        from where the device rests, back onto the drawing at span %lld of %zu "
+        "(tick %llu)\n",
+        static_cast<long long>(resumed.origin[resumed.origin.size() - (spans - first)]) + 1,
+        job.drawing_spans, static_cast<unsigned long long>(resumed.drawing_tick.front()));
     JobJournal next = journal;
     next.job = 0;
     next.outcome = "streaming";
     next.error.clear();
     PlanSupply supply(resumed.plan);
-    return stream_job({supply, &resumed, nullptr, nullptr, nullptr, resumed.subpaths}, machine, o, next, o.resume,
-                      nullptr, channel);
+    return stream_job({supply, &resumed, nullptr, nullptr, nullptr, resumed.subpaths}, machine, o,
+                      next, o.resume, nullptr, channel);
 }
 
 // CiA 402 drives: no device status to follow, so the events are the job's start and end.
@@ -744,8 +823,9 @@ int stream_cia402(const PlannedJob& planned, const std::string& url, const Event
 
 // Plans `job` on the planning thread and streams its spans as they come (docs/cli.md,
 // "Planning while streaming"): the first batch goes out once the first window is planned.
-int stream_while_planning(const PlannedJob& job, const StreamCommandOptions& o, const JobJournal& journal,
-                          const std::string& journal_path, const EventChannel& channel) {
+int stream_while_planning(const PlannedJob& job, const StreamCommandOptions& o,
+                          const JobJournal& journal, const std::string& journal_path,
+                          const EventChannel& channel) {
     const std::string spans_file =
         journal_path.empty() ? "" : std::filesystem::absolute(journal_path + ".plan").string();
     StreamPlanTap tap(job, o.path.file, spans_file);
@@ -771,8 +851,8 @@ int stream_while_planning(const PlannedJob& job, const StreamCommandOptions& o, 
         CoreSpan none;
         (void)planning.take(none);
     }
-    return stream_job({planning, nullptr, &planning, &tap, &job.path, job.path.subpaths.size()}, job.machine, o,
-                      journal, journal_path, nullptr, channel);
+    return stream_job({planning, nullptr, &planning, &tap, &job.path, job.path.subpaths.size()},
+                      job.machine, o, journal, journal_path, nullptr, channel);
 }
 
 // The events' file, opened before anything is planned or sent (so a bad path costs nothing).
@@ -788,12 +868,17 @@ EventChannel open_events(const StreamCommandOptions& o) {
 int run_stream(const StreamCommandOptions& o) {
     const EventChannel channel = open_events(o);
     if (!o.resume.empty()) {
-        if (o.lead_in) throw std::invalid_argument("--resume: --lead-in does not apply (the resume plans its own move)");
+        if (o.lead_in)
+            throw std::invalid_argument(
+                "--resume: --lead-in does not apply (the resume plans its own move)");
         return run_resume(o, channel);
     }
-    if (o.path.file.empty()) throw std::invalid_argument("stream: FILE is required (or --resume JOURNAL)");
-    if (o.machine.empty()) throw std::invalid_argument("stream: --machine is required (or --resume JOURNAL)");
-    if (o.stream.target.empty()) throw std::invalid_argument("stream: --target is required (or --resume JOURNAL)");
+    if (o.path.file.empty())
+        throw std::invalid_argument("stream: FILE is required (or --resume JOURNAL)");
+    if (o.machine.empty())
+        throw std::invalid_argument("stream: --machine is required (or --resume JOURNAL)");
+    if (o.stream.target.empty())
+        throw std::invalid_argument("stream: --target is required (or --resume JOURNAL)");
     const std::string& url = o.stream.target;
     // From here a Ctrl-C is ours: one during planning ends the command before anything is sent
     // (a background job's SIGINT, ignored by default, would otherwise be lost).
@@ -809,7 +894,8 @@ int run_stream(const StreamCommandOptions& o) {
     // The path order starts where the device rests (its first subpath is the one nearest to
     // it), so the drawing begins where the pen is: read it first, as --lead-in does.
     PathOptions path = o.path;
-    const bool cia402 = url.rfind("can://", 0) == 0 && url.find("protocol=cia402") != std::string::npos;
+    const bool cia402 =
+        url.rfind("can://", 0) == 0 && url.find("protocol=cia402") != std::string::npos;
     const bool order_from_rest = !cia402 && !path.keep_order && path.order_start.empty();
     if (o.lead_in || order_from_rest) {
         const MachineProfile machine = load_machine_profile(o.machine);
@@ -843,7 +929,8 @@ int run_stream(const StreamCommandOptions& o) {
     journal.target = url;
     journal.machine = std::filesystem::absolute(o.machine).string();
     journal.drawing = path_display_name(o.path.file);
-    const std::string journal_path = o.no_journal ? "" : (o.journal.empty() ? default_journal_path(o.path.file) : o.journal);
+    const std::string journal_path =
+        o.no_journal ? "" : (o.journal.empty() ? default_journal_path(o.path.file) : o.journal);
     if (cia402 || o.plan_first) {
         const PlannedJob planned = plan_job(path, o.machine, o.lead_in ? &rest_mm : nullptr);
         if (g_interrupts.load() > 0) {
@@ -859,18 +946,18 @@ int run_stream(const StreamCommandOptions& o) {
         journal.pauses = pause_descriptions(planned.path, planned.plan);
         const JobSpans job = job_from_plan(planned.plan);
         PlanSupply supply(job.plan);
-        return stream_job({supply, &job, nullptr, nullptr, nullptr, job.subpaths}, planned.machine, o, journal,
-                          journal_path, nullptr, channel);
+        return stream_job({supply, &job, nullptr, nullptr, nullptr, job.subpaths}, planned.machine,
+                          o, journal, journal_path, nullptr, channel);
     }
     if (!journal_path.empty()) {
         // The plan is made as the stream goes: keep what plans it again after a host crash.
-        const JobRecipe recipe =
-            save_job_recipe(path, o.machine, o.lead_in ? std::optional<std::vector<double>>(rest_mm) : std::nullopt,
-                            std::filesystem::absolute(journal_path + ".input").string());
+        const JobRecipe recipe = save_job_recipe(
+            path, o.machine, o.lead_in ? std::optional<std::vector<double>>(rest_mm) : std::nullopt,
+            std::filesystem::absolute(journal_path + ".input").string());
         journal.replan = job_recipe_json(recipe);
     }
-    return stream_while_planning(prepare_job(path, o.machine, o.lead_in ? &rest_mm : nullptr), o, journal,
-                                 journal_path, channel);
+    return stream_while_planning(prepare_job(path, o.machine, o.lead_in ? &rest_mm : nullptr), o,
+                                 journal, journal_path, channel);
 }
 
 }  // namespace pathstream::host

@@ -13,15 +13,15 @@
 #include <vector>
 
 #include "can_link.hpp"
-#include "stream_interrupt.hpp"
-#include "pathstream/host/device_link.hpp"
 #include "pathstream/device/can_protocol.hpp"
 #include "pathstream/device/motion_device.hpp"
 #include "pathstream/device/wire_span.hpp"
+#include "pathstream/host/device_link.hpp"
 #include "pathstream/host/device_setup.hpp"
 #include "pathstream/host/wire_plan.hpp"
-#include "wire_feed.hpp"
 #include "pathstream/status.hpp"
+#include "stream_interrupt.hpp"
+#include "wire_feed.hpp"
 
 namespace pathstream::host {
 namespace {
@@ -31,8 +31,13 @@ using Clock = std::chrono::steady_clock;
 
 class CanStreamer {
 public:
-    CanStreamer(SpanSupply& supply, const MachineProfile& profile, hal::CanBus& bus, const CanStreamOptions& options)
-        : feed_(supply), profile_(profile), options_(options), node_(options.node), link_(bus, options, report_) {}
+    CanStreamer(SpanSupply& supply, const MachineProfile& profile, hal::CanBus& bus,
+                const CanStreamOptions& options)
+        : feed_(supply),
+          profile_(profile),
+          options_(options),
+          node_(options.node),
+          link_(bus, options, report_) {}
 
     /// Identity and state checked, the device's rest position (LSB per axis, status E).
     std::vector<Lsb> rest_position() {
@@ -63,7 +68,8 @@ public:
         job_epoch_ = s.epoch;
         underruns_at_start_ = s.underruns;
         // A held job goes on with a resume (the device's own re-entry) instead of a start.
-        const device::Command go = options_.held != nullptr ? device::Command::kResume : device::Command::kStart;
+        const device::Command go =
+            options_.held != nullptr ? device::Command::kResume : device::Command::kStart;
         const auto lead_target =
             static_cast<std::uint64_t>(std::ceil(options_.lead_seconds * profile_.tick_hz));
         bool started = false;
@@ -72,11 +78,14 @@ public:
         while (true) {
             if (feed_.error()) interrupt.force_hold();
             const StreamInterrupt::Action action = interrupt.next_action(started);
-            if (action == StreamInterrupt::Action::kHold) command(static_cast<std::uint8_t>(device::Command::kHold), true);
-            if (action == StreamInterrupt::Action::kStop) command(static_cast<std::uint8_t>(device::Command::kStop), true);
+            if (action == StreamInterrupt::Action::kHold)
+                command(static_cast<std::uint8_t>(device::Command::kHold), true);
+            if (action == StreamInterrupt::Action::kStop)
+                command(static_cast<std::uint8_t>(device::Command::kStop), true);
             const std::uint64_t lead = queued_ticks(s, next);
             if (!interrupt.active() && free_slots_ > 0 && (lead < lead_target || !started) &&
-                s.state != static_cast<std::uint8_t>(device::DeviceState::kStopping) && feed_.sendable(next)) {
+                s.state != static_cast<std::uint8_t>(device::DeviceState::kStopping) &&
+                feed_.sendable(next)) {
                 send_batch(next);
                 // Flow control: never more than the device's free slots, as last reported.
                 s.last_accepted = acknowledged_;
@@ -86,30 +95,37 @@ public:
                 free_slots_ = s.free_slots;
                 observe(s, interrupt);
                 if (!interrupt.stop_sent() && s.epoch != job_epoch_ &&
-                    s.state == static_cast<std::uint8_t>(device::DeviceState::kIdle) && !job_finished(s)) {
-                    report_.interrupted = 2;  // dropped by another client's stop: report it as a stop
+                    s.state == static_cast<std::uint8_t>(device::DeviceState::kIdle) &&
+                    !job_finished(s)) {
+                    report_.interrupted =
+                        2;  // dropped by another client's stop: report it as a stop
                     report_.stopped_elsewhere = true;
                     break;
                 }
                 check_running(s, started && !interrupt.stop_sent());
             }
-            if (!started && !interrupt.active() && (queued_ticks(s, next) >= lead_target || all_sent(next))) {
+            if (!started && !interrupt.active() &&
+                (queued_ticks(s, next) >= lead_target || all_sent(next))) {
                 command(static_cast<std::uint8_t>(go), false);
                 started = true;
                 started_at_ = Clock::now();
             }
-            if (!interrupt.active() && s.state == static_cast<std::uint8_t>(device::DeviceState::kHolding) &&
+            if (!interrupt.active() &&
+                s.state == static_cast<std::uint8_t>(device::DeviceState::kHolding) &&
                 (s.flags & pc::kFlagHeldByUnderrun) != 0 && s.queued > 0) {
                 command(static_cast<std::uint8_t>(device::Command::kResume), true);
             }
-            if (pauses.observe(snapshot_of(s), s.ticks_executed - start_ticks_) && !interrupt.active()) {
+            if (pauses.observe(snapshot_of(s), s.ticks_executed - start_ticks_) &&
+                !interrupt.active()) {
                 command(static_cast<std::uint8_t>(device::Command::kResume), true);
             }
             if (progress) {
-                progress(static_cast<std::uint32_t>(s.ticks_executed - start_ticks_), feed_.total_ticks(),
+                progress(static_cast<std::uint32_t>(s.ticks_executed - start_ticks_),
+                         feed_.total_ticks(),
                          static_cast<double>(queued_ticks(s, next)) / profile_.tick_hz);
             }
-            feed_.release_before(std::min(next, completed_count(s)));  // executed: never needed again
+            feed_.release_before(
+                std::min(next, completed_count(s)));  // executed: never needed again
             // The plan is one job (its last span marks the end): done when the device reports
             // it finished, idle at its end point.
             if (job_finished(s)) break;
@@ -122,8 +138,10 @@ public:
             // The plan failed while the job ran: the device holds at rest (or never started);
             // drop the rest of its queue, then report the plan's error.
             command(static_cast<std::uint8_t>(device::Command::kStop), true);
-            const auto deadline = Clock::now() + std::chrono::duration<double>(options_.interrupt.hold_timeout_seconds);
-            while (s.state != static_cast<std::uint8_t>(device::DeviceState::kIdle) && Clock::now() < deadline) {
+            const auto deadline = Clock::now() + std::chrono::duration<double>(
+                                                     options_.interrupt.hold_timeout_seconds);
+            while (s.state != static_cast<std::uint8_t>(device::DeviceState::kIdle) &&
+                   Clock::now() < deadline) {
                 std::this_thread::sleep_for(std::chrono::milliseconds(options_.poll_interval_ms));
                 s = link_.request_status();
             }
@@ -150,7 +168,9 @@ private:
         }
     }
 
-    [[noreturn]] void fail(const std::string& what) const { throw StreamError(options_.name + ": " + what); }
+    [[noreturn]] void fail(const std::string& what) const {
+        throw StreamError(options_.name + ": " + what);
+    }
 
     // A held job (docs/cli.md, "Interrupt and resume"): the device must hold it, configured,
     // with no span of it dropped; returns the index of the first span it has not accepted.
@@ -160,10 +180,11 @@ private:
         if ((s.flags & pc::kFlagConfigured) == 0) {
             fail("device lost its configuration: it restarted; resume from its rest instead");
         }
-        if (s.last_accepted < h.job || !feed_.available(s.last_accepted - h.job) || s.last_completed + 1 < h.job) {
+        if (s.last_accepted < h.job || !feed_.available(s.last_accepted - h.job) ||
+            s.last_completed + 1 < h.job) {
             std::ostringstream m;
-            m << "device holds spans up to " << s.last_accepted << ", not job " << h.job << " of " << feed_.count()
-              << " spans";
+            m << "device holds spans up to " << s.last_accepted << ", not job " << h.job << " of "
+              << feed_.count() << " spans";
             fail(m.str());
         }
         base_ = h.job;
@@ -188,8 +209,8 @@ private:
                         device::DeviceState wanted = device::DeviceState::kIdle) {
         std::ostringstream m;
         if (s.version != pc::kProtocolVersion) {
-            m << "device speaks native CAN protocol version " << unsigned(s.version) << ", this host "
-              << unsigned(pc::kProtocolVersion);
+            m << "device speaks native CAN protocol version " << unsigned(s.version)
+              << ", this host " << unsigned(pc::kProtocolVersion);
             fail(m.str());
         }
         if (s.axes != axes_) {
@@ -220,18 +241,23 @@ private:
 
     void configure() {
         const DeviceLimitsLsb l = limits_or_fail();
-        std::vector<pc::Frame> frames{pc::encode_config(node_, 0, static_cast<std::uint8_t>(axes_), l.tick_hz)};
+        std::vector<pc::Frame> frames{
+            pc::encode_config(node_, 0, static_cast<std::uint8_t>(axes_), l.tick_hz)};
         for (unsigned a = 0; a < axes_; ++a) {
-            frames.push_back(pc::encode_config(node_, pc::config_item_velocity(a), static_cast<std::uint8_t>(axes_),
+            frames.push_back(pc::encode_config(node_, pc::config_item_velocity(a),
+                                               static_cast<std::uint8_t>(axes_),
                                                l.max_velocity[a]));
             frames.push_back(pc::encode_config(node_, pc::config_item_acceleration(a),
-                                               static_cast<std::uint8_t>(axes_), l.max_acceleration[a]));
-            frames.push_back(pc::encode_config(node_, pc::config_item_min_position(a), static_cast<std::uint8_t>(axes_),
+                                               static_cast<std::uint8_t>(axes_),
+                                               l.max_acceleration[a]));
+            frames.push_back(pc::encode_config(node_, pc::config_item_min_position(a),
+                                               static_cast<std::uint8_t>(axes_),
                                                static_cast<std::uint32_t>(l.min_position[a])));
-            frames.push_back(pc::encode_config(node_, pc::config_item_max_position(a), static_cast<std::uint8_t>(axes_),
+            frames.push_back(pc::encode_config(node_, pc::config_item_max_position(a),
+                                               static_cast<std::uint8_t>(axes_),
                                                static_cast<std::uint32_t>(l.max_position[a])));
-            frames.push_back(pc::encode_config(node_, pc::config_item_jerk(a), static_cast<std::uint8_t>(axes_),
-                                               l.max_jerk[a]));
+            frames.push_back(pc::encode_config(node_, pc::config_item_jerk(a),
+                                               static_cast<std::uint8_t>(axes_), l.max_jerk[a]));
         }
         frames.push_back(pc::encode_config(node_, pc::kConfigItemPenDown,
                                            static_cast<std::uint8_t>(axes_), l.pen_down_ticks));
@@ -241,7 +267,9 @@ private:
             pc::Ack ack;
             if (!link_.wait_ack(pc::kAckConfig, last_item, ack)) continue;
             if (ack.result == pc::kResultIncomplete) continue;  // a configuration frame was lost
-            if (ack.result != 0) fail("device refused the configuration (tick rate and limits): " + can_result_name(ack.result));
+            if (ack.result != 0)
+                fail("device refused the configuration (tick rate and limits): " +
+                     can_result_name(ack.result));
             return;
         }
     }
@@ -273,30 +301,35 @@ private:
             link_.send(pc::encode_span_start(node_, start));
             const std::size_t frames = pc::data_frames(payload.size());
             for (std::size_t i = 0; i < frames; ++i) {
-                link_.send(pc::encode_span_data(node_, static_cast<std::uint8_t>(i), payload.data(), payload.size()));
+                link_.send(pc::encode_span_data(node_, static_cast<std::uint8_t>(i), payload.data(),
+                                                payload.size()));
             }
             pc::Ack ack;
-            if (!link_.wait_ack(pc::kAckSpans, first, ack)) continue;  // lost frames or a lost ack: again
+            if (!link_.wait_ack(pc::kAckSpans, first, ack))
+                continue;  // lost frames or a lost ack: again
             free_slots_ = ack.free_slots;
             if (ack.result == pc::kResultIncomplete) {
                 ++report_.incomplete;
                 continue;
             }
-            if (ack.result == static_cast<std::uint8_t>(Status::kQueueFull)) return;  // later (never expected)
+            if (ack.result == static_cast<std::uint8_t>(Status::kQueueFull))
+                return;  // later (never expected)
             if (ack.result != 0) {
                 // A queue dropped under the stream, or about to be (another client's stop: the
                 // device refuses batches while it stops): the loop's next status reads say what
                 // happened.
                 const pc::Status3 now = link_.request_status();
-                if (now.epoch != job_epoch_ || now.state == static_cast<std::uint8_t>(device::DeviceState::kStopping)) {
+                if (now.epoch != job_epoch_ ||
+                    now.state == static_cast<std::uint8_t>(device::DeviceState::kStopping)) {
                     free_slots_ = 0;
                     return;
                 }
                 std::ostringstream m;
-                m << "device refused spans " << first - base_ + 1 << ".." << first - base_ + count << ": "
-                  << can_result_name(ack.result);
+                m << "device refused spans " << first - base_ + 1 << ".." << first - base_ + count
+                  << ": " << can_result_name(ack.result);
                 if (ack.result == static_cast<std::uint8_t>(Status::kBadSequence)) {
-                    m << " (it restarted, or another master streams to node " << unsigned(node_) << ")";
+                    m << " (it restarted, or another master streams to node " << unsigned(node_)
+                      << ")";
                 }
                 fail(m.str());
             }
@@ -334,27 +367,32 @@ private:
     // restarted: its queue is gone.
     void check_running(const pc::Status3& s, bool started) {
         std::ostringstream m;
-        if (s.last_accepted < acknowledged_ || s.ticks_executed < start_ticks_ || (s.flags & pc::kFlagConfigured) == 0) {
-            m << "device restarted mid-stream (it reports sequence " << s.last_accepted << " and " << s.ticks_executed
-              << " ticks; it had acknowledged " << acknowledged_
+        if (s.last_accepted < acknowledged_ || s.ticks_executed < start_ticks_ ||
+            (s.flags & pc::kFlagConfigured) == 0) {
+            m << "device restarted mid-stream (it reports sequence " << s.last_accepted << " and "
+              << s.ticks_executed << " ticks; it had acknowledged " << acknowledged_
               << "): stopping; the drawing is incomplete, restart it from the beginning";
             fail(m.str());
         }
         if (s.state == static_cast<std::uint8_t>(device::DeviceState::kFault) ||
             s.state == static_cast<std::uint8_t>(device::DeviceState::kEstop)) {
-            m << "device stopped in " << device_state_name(s.state) << fault_suffix(s.state, s.fault_code) << " after span "
+            m << "device stopped in " << device_state_name(s.state)
+              << fault_suffix(s.state, s.fault_code) << " after span "
               << (s.last_completed >= base_ ? s.last_completed - base_ + 1 : 0);
             fail(m.str());
         }
         // The device applies a start at its next tick: idle right after the acknowledged start
         // is the start still pending, not a stop, until it has been seen running or has had
         // ample time (half a second) to tick.
-        if (started && s.state != static_cast<std::uint8_t>(device::DeviceState::kIdle)) seen_running_ = true;
+        if (started && s.state != static_cast<std::uint8_t>(device::DeviceState::kIdle))
+            seen_running_ = true;
         const bool start_pending =
-            !seen_running_ && std::chrono::duration<double>(Clock::now() - started_at_).count() < 0.5;
+            !seen_running_ &&
+            std::chrono::duration<double>(Clock::now() - started_at_).count() < 0.5;
         if (started && s.state == static_cast<std::uint8_t>(device::DeviceState::kIdle) &&
             !start_pending && !job_finished(s)) {
-            m << "device went idle after span " << s.last_completed << " (stopped by another master?)";
+            m << "device went idle after span " << s.last_completed
+              << " (stopped by another master?)";
             fail(m.str());
         }
     }
@@ -388,12 +426,14 @@ private:
 
 CanTarget parse_can_target(const std::string& url) {
     const std::string scheme = "can://";
-    if (url.compare(0, scheme.size(), scheme) != 0) throw std::invalid_argument("not a can:// target: " + url);
+    if (url.compare(0, scheme.size(), scheme) != 0)
+        throw std::invalid_argument("not a can:// target: " + url);
     const std::string rest = url.substr(scheme.size());
     const auto q = rest.find('?');
     CanTarget t;
     t.interface_name = rest.substr(0, q);
-    if (t.interface_name.empty()) throw std::invalid_argument(url + ": no CAN interface (can://IFACE?node=N)");
+    if (t.interface_name.empty())
+        throw std::invalid_argument(url + ": no CAN interface (can://IFACE?node=N)");
     bool have_node = false;
     std::string query = q == std::string::npos ? "" : rest.substr(q + 1);
     std::istringstream in(query);
@@ -401,7 +441,8 @@ CanTarget parse_can_target(const std::string& url) {
     while (std::getline(in, item, '&')) {
         if (item.empty()) continue;
         const auto eq = item.find('=');
-        const std::string key = item.substr(0, eq), value = eq == std::string::npos ? "" : item.substr(eq + 1);
+        const std::string key = item.substr(0, eq),
+                          value = eq == std::string::npos ? "" : item.substr(eq + 1);
         if (key == "node") {
             std::size_t used = 0;
             int n = -1;
@@ -417,7 +458,8 @@ CanTarget parse_can_target(const std::string& url) {
             have_node = true;
         } else if (key == "protocol") {
             if (value != "native" && value != "cia402") {
-                throw std::invalid_argument(url + ": protocol must be native or cia402, not '" + value + "'");
+                throw std::invalid_argument(url + ": protocol must be native or cia402, not '" +
+                                            value + "'");
             }
             t.protocol = value;
         } else {

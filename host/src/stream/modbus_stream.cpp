@@ -10,17 +10,17 @@
 #include <thread>
 #include <vector>
 
+#include "modbus_link.hpp"
 #include "pathstream/device/modbus_map.hpp"
 #include "pathstream/device/motion_device.hpp"
 #include "pathstream/device/wire_span.hpp"
-#include "pathstream/host/device_setup.hpp"
-#include "pathstream/host/wire_plan.hpp"
-#include "wire_feed.hpp"
-#include "modbus_link.hpp"
-#include "stream_interrupt.hpp"
 #include "pathstream/hal/modbus_client.hpp"
 #include "pathstream/hal/modbus_error.hpp"
+#include "pathstream/host/device_setup.hpp"
+#include "pathstream/host/wire_plan.hpp"
 #include "pathstream/status.hpp"
+#include "stream_interrupt.hpp"
+#include "wire_feed.hpp"
 
 namespace pathstream::host {
 namespace {
@@ -66,9 +66,11 @@ public:
         job_epoch_ = s.epoch;
         underruns_at_start_ = s.underruns;
         // A held job goes on with a resume (the device's own re-entry) instead of a start.
-        const device::Command go = options_.held != nullptr ? device::Command::kResume : device::Command::kStart;
+        const device::Command go =
+            options_.held != nullptr ? device::Command::kResume : device::Command::kStart;
         rate_ = profile_.tick_hz;
-        const std::uint64_t lead_target = static_cast<std::uint64_t>(std::ceil(options_.lead_seconds * profile_.tick_hz));
+        const std::uint64_t lead_target =
+            static_cast<std::uint64_t>(std::ceil(options_.lead_seconds * profile_.tick_hz));
         bool started = false;
         StreamInterrupt interrupt(options_.interrupt);
         PauseWatch pauses(options_.interrupt, feed_.pauses());
@@ -82,7 +84,8 @@ public:
                 std::this_thread::sleep_for(std::chrono::milliseconds(options_.poll_interval_ms));
                 s = read_status();
             } else if (s.free_slots > 0 && (lead < lead_target || !started) &&
-                       s.state != static_cast<std::uint16_t>(device::DeviceState::kStopping) && feed_.sendable(next)) {
+                       s.state != static_cast<std::uint16_t>(device::DeviceState::kStopping) &&
+                       feed_.sendable(next)) {
                 s = send_batch(next, s.free_slots);
             } else {
                 bool predicted = false;
@@ -91,7 +94,8 @@ public:
                 // at once (its FC23 answer is the status) instead of polling first. The free
                 // slots known are a lower bound (slots only free up), so the batch fits.
                 if (predicted && s.free_slots > 0 &&
-                    s.state != static_cast<std::uint16_t>(device::DeviceState::kStopping) && feed_.sendable(next)) {
+                    s.state != static_cast<std::uint16_t>(device::DeviceState::kStopping) &&
+                    feed_.sendable(next)) {
                     s = send_batch(next, s.free_slots);
                 } else {
                     s = read_status();
@@ -100,7 +104,8 @@ public:
             observe(s, interrupt);
             observe_rate(s, started);
             if (!interrupt.stop_sent() && s.epoch != job_epoch_ &&
-                s.state == static_cast<std::uint16_t>(device::DeviceState::kIdle) && !job_finished(s)) {
+                s.state == static_cast<std::uint16_t>(device::DeviceState::kIdle) &&
+                !job_finished(s)) {
                 report_.interrupted = 2;  // dropped by another client's stop: report it as a stop
                 report_.stopped_elsewhere = true;
                 break;
@@ -114,7 +119,8 @@ public:
                 started = true;
                 started_at_ = Clock::now();
             }
-            if (!interrupt.active() && s.state == static_cast<std::uint16_t>(device::DeviceState::kHolding) &&
+            if (!interrupt.active() &&
+                s.state == static_cast<std::uint16_t>(device::DeviceState::kHolding) &&
                 (s.flags & 2u) != 0 && s.queued > 0) {
                 command(device::Command::kResume, true);
             }
@@ -122,7 +128,8 @@ public:
                 command(device::Command::kResume, true);
             }
             if (progress) {
-                progress(static_cast<std::uint32_t>(s.ticks_executed - start_ticks_), feed_.total_ticks(),
+                progress(static_cast<std::uint32_t>(s.ticks_executed - start_ticks_),
+                         feed_.total_ticks(),
                          static_cast<double>(queued_ticks(s, next)) / profile_.tick_hz);
             }
             // The plan is one job (its last span marks the end): done when the device reports
@@ -137,8 +144,10 @@ public:
             // The plan failed while the job ran: the device holds at rest (or never started);
             // drop the rest of its queue, then report the plan's error.
             command(device::Command::kStop, true);
-            const auto deadline = Clock::now() + std::chrono::duration<double>(options_.interrupt.hold_timeout_seconds);
-            while (s.state != static_cast<std::uint16_t>(device::DeviceState::kIdle) && Clock::now() < deadline) {
+            const auto deadline = Clock::now() + std::chrono::duration<double>(
+                                                     options_.interrupt.hold_timeout_seconds);
+            while (s.state != static_cast<std::uint16_t>(device::DeviceState::kIdle) &&
+                   Clock::now() < deadline) {
                 std::this_thread::sleep_for(std::chrono::milliseconds(options_.poll_interval_ms));
                 s = read_status();
             }
@@ -170,11 +179,13 @@ private:
     std::size_t continue_held(const DeviceStatus& s) {
         check_identity(s, false, device::DeviceState::kHolding);
         const HeldJob& h = *options_.held;
-        if ((s.flags & 1u) == 0) fail("device lost its configuration: it restarted; resume from its rest instead");
-        if (s.last_accepted < h.job || !feed_.available(s.last_accepted - h.job) || s.last_completed + 1 < h.job) {
+        if ((s.flags & 1u) == 0)
+            fail("device lost its configuration: it restarted; resume from its rest instead");
+        if (s.last_accepted < h.job || !feed_.available(s.last_accepted - h.job) ||
+            s.last_completed + 1 < h.job) {
             std::ostringstream m;
-            m << "device holds spans up to " << s.last_accepted << ", not job " << h.job << " of " << feed_.count()
-              << " spans";
+            m << "device holds spans up to " << s.last_accepted << ", not job " << h.job << " of "
+              << feed_.count() << " spans";
             fail(m.str());
         }
         base_ = h.job;
@@ -215,11 +226,13 @@ private:
                         device::DeviceState wanted = device::DeviceState::kIdle) {
         std::ostringstream m;
         if (s.magic != mb::kMagic) {
-            m << "not a pathstream device (register 0 is 0x" << std::hex << s.magic << ", expected 0x5053)";
+            m << "not a pathstream device (register 0 is 0x" << std::hex << s.magic
+              << ", expected 0x5053)";
             fail(m.str());
         }
         if (s.version != mb::kProtocolVersion) {
-            m << "device speaks protocol version " << s.version << ", this host " << mb::kProtocolVersion;
+            m << "device speaks protocol version " << s.version << ", this host "
+              << mb::kProtocolVersion;
             fail(m.str());
         }
         if (s.axes != axes_) {
@@ -275,7 +288,8 @@ private:
         try {
             link_.transact([&] { link_.client().write_registers(mb::kConfig, r); });
         } catch (const hal::ModbusError& e) {
-            fail(std::string("device refused the configuration (tick rate and limits): ") + e.what() + refusal());
+            fail(std::string("device refused the configuration (tick rate and limits): ") +
+                 e.what() + refusal());
         }
         configured_ = true;
     }
@@ -297,7 +311,9 @@ private:
         try {
             link_.write_command(c);
         } catch (const hal::ModbusError& e) {
-            if (!tolerate_refusal) fail(std::string("device refused command ") + std::to_string(static_cast<int>(c)) + ": " + e.what() + refusal());
+            if (!tolerate_refusal)
+                fail(std::string("device refused command ") + std::to_string(static_cast<int>(c)) +
+                     ": " + e.what() + refusal());
         }
     }
 
@@ -330,11 +346,10 @@ private:
             ++count;
         }
         const std::uint32_t first = base_ + static_cast<std::uint32_t>(next);
-        std::vector<std::uint16_t> window = {static_cast<std::uint16_t>(first >> 16),
-                                             static_cast<std::uint16_t>(first & 0xFFFFu),
-                                             static_cast<std::uint16_t>(count),
-                                             static_cast<std::uint16_t>(payload.size()),
-                                             device::crc16_modbus(payload.data(), payload.size())};
+        std::vector<std::uint16_t> window = {
+            static_cast<std::uint16_t>(first >> 16), static_cast<std::uint16_t>(first & 0xFFFFu),
+            static_cast<std::uint16_t>(count), static_cast<std::uint16_t>(payload.size()),
+            device::crc16_modbus(payload.data(), payload.size())};
         for (std::size_t i = 0; i < payload.size(); i += 2) {
             const std::uint16_t low = i + 1 < payload.size() ? payload[i + 1] : 0;
             window.push_back(static_cast<std::uint16_t>((payload[i] << 8) | low));
@@ -354,21 +369,25 @@ private:
                 // device refuses batches while it stops), refuses the next batch, which no longer
                 // joins what the device holds: the loop then says what happened.
                 const DeviceStatus now = read_status();
-                if (now.epoch != job_epoch_ || now.state == static_cast<std::uint16_t>(device::DeviceState::kStopping)) {
+                if (now.epoch != job_epoch_ ||
+                    now.state == static_cast<std::uint16_t>(device::DeviceState::kStopping)) {
                     return now;
                 }
                 std::ostringstream m;
-                m << "device refused spans " << first << ".." << last << ": " << e.what() << refusal();
+                m << "device refused spans " << first << ".." << last << ": " << e.what()
+                  << refusal();
                 fail(m.str());
             }
             // The batch may or may not have been applied (a lost response). Resend nothing
             // blind: ask the device what it accepted, and try smaller batches, which a noisy
             // line lets through far more often (each byte is a chance to lose the frame).
             shrink_batches(count);
-            const double silent = std::chrono::duration<double>(Clock::now() - last_batch_ok_).count();
+            const double silent =
+                std::chrono::duration<double>(Clock::now() - last_batch_ok_).count();
             if (silent > options_.link_timeout_seconds) {
                 std::ostringstream m;
-                m << "no batch got through for " << std::lround(silent) << " s (" << e.what() << ")";
+                m << "no batch got through for " << std::lround(silent) << " s (" << e.what()
+                  << ")";
                 fail(m.str());
             }
             const DeviceStatus s = read_status();
@@ -382,7 +401,8 @@ private:
         last_batch_ok_ = Clock::now();
         if (link_.client().counters().retries != retries_before) {
             shrink_batches(count);
-        } else if (++clean_batches_ >= kCleanBatchesToGrow && batch_limit_ < device::kMaxBatchSpans) {
+        } else if (++clean_batches_ >= kCleanBatchesToGrow &&
+                   batch_limit_ < device::kMaxBatchSpans) {
             batch_limit_ = std::min<std::size_t>(device::kMaxBatchSpans, 2 * batch_limit_);
             clean_batches_ = 0;
         }
@@ -429,14 +449,16 @@ private:
     void observe_rate(const DeviceStatus& s, bool started) {
         const auto now = Clock::now();
         const double dt = std::chrono::duration<double>(now - rate_time_).count();
-        if (!started || s.state != static_cast<std::uint16_t>(device::DeviceState::kRunning) || s.ticks_executed < rate_ticks_) {
+        if (!started || s.state != static_cast<std::uint16_t>(device::DeviceState::kRunning) ||
+            s.ticks_executed < rate_ticks_) {
             rate_time_ = now;
             rate_ticks_ = s.ticks_executed;
             return;
         }
         if (dt < 0.02) return;
         const double observed = static_cast<double>(s.ticks_executed - rate_ticks_) / dt;
-        if (observed > 0) rate_ = std::max(rate_, observed);  // never assume slower than seen: no underrun
+        if (observed > 0)
+            rate_ = std::max(rate_, observed);  // never assume slower than seen: no underrun
         rate_time_ = now;
         rate_ticks_ = s.ticks_executed;
     }
@@ -444,11 +466,13 @@ private:
     // A device whose sequence or tick count went backwards lost its queue: it restarted.
     void check_restart(const DeviceStatus& s) const {
         if (s.magic != mb::kMagic) fail("status block lost its magic number: not the same device");
-        if (s.last_accepted < acknowledged_ || s.ticks_executed < start_ticks_ || (configured_ && (s.flags & 1u) == 0)) {
+        if (s.last_accepted < acknowledged_ || s.ticks_executed < start_ticks_ ||
+            (configured_ && (s.flags & 1u) == 0)) {
             std::ostringstream m;
-            m << "device restarted mid-stream (it reports sequence " << s.last_accepted << " and " << s.ticks_executed
-              << " ticks" << ((s.flags & 1u) == 0 ? ", unconfigured" : "") << "; it had acknowledged "
-              << acknowledged_ << "): stopping; the drawing is incomplete, restart it from the beginning";
+            m << "device restarted mid-stream (it reports sequence " << s.last_accepted << " and "
+              << s.ticks_executed << " ticks" << ((s.flags & 1u) == 0 ? ", unconfigured" : "")
+              << "; it had acknowledged " << acknowledged_
+              << "): stopping; the drawing is incomplete, restart it from the beginning";
             fail(m.str());
         }
     }
@@ -458,8 +482,8 @@ private:
         check_restart(s);
         if (s.state == static_cast<std::uint16_t>(device::DeviceState::kFault) ||
             s.state == static_cast<std::uint16_t>(device::DeviceState::kEstop)) {
-            m << "device stopped in " << device_state_name(s.state) << fault_suffix(s.state, s.fault_code) << " after "
-              << s.last_completed << " spans";
+            m << "device stopped in " << device_state_name(s.state)
+              << fault_suffix(s.state, s.fault_code) << " after " << s.last_completed << " spans";
             fail(m.str());
         }
         // The device applies a start at its next tick: idle right after the acknowledged start
@@ -472,7 +496,8 @@ private:
             std::chrono::duration<double>(Clock::now() - started_at_).count() < 0.5;
         if (started && s.state == static_cast<std::uint16_t>(device::DeviceState::kIdle) &&
             !job_finished(s) && !start_pending) {
-            m << "device went idle after span " << s.last_completed << " (stopped by another master?)";
+            m << "device went idle after span " << s.last_completed
+              << " (stopped by another master?)";
             fail(m.str());
         }
     }
@@ -519,15 +544,15 @@ std::vector<Lsb> modbus_rest_position(const MachineProfile& profile, const Strea
     return s.rest_position();
 }
 
-StreamReport stream_modbus(const Plan& plan, const MachineProfile& profile, const StreamOptions& options,
-                           const StreamProgress& progress) {
+StreamReport stream_modbus(const Plan& plan, const MachineProfile& profile,
+                           const StreamOptions& options, const StreamProgress& progress) {
     PlanSupply supply(plan);
     Streamer s(supply, profile, options);
     return s.run(plan_progress(progress));
 }
 
-StreamReport stream_modbus(SpanSupply& supply, const MachineProfile& profile, const StreamOptions& options,
-                           const SupplyProgress& progress) {
+StreamReport stream_modbus(SpanSupply& supply, const MachineProfile& profile,
+                           const StreamOptions& options, const SupplyProgress& progress) {
     Streamer s(supply, profile, options);
     return s.run(progress);
 }

@@ -8,8 +8,8 @@
 #include <string>
 #include <vector>
 
-#include "pathstream/device/homing.hpp"
 #include "pathstream/device/gpio_logic.hpp"
+#include "pathstream/device/homing.hpp"
 #include "pathstream/host/machine.hpp"
 
 namespace pathstream::host {
@@ -48,9 +48,9 @@ std::string fault_suffix(unsigned state, std::uint16_t fault_code);
 
 /// One axis's homing in the device's units, and which switch ends it.
 struct HomingSetup {
-    std::string axis_name;          ///< "x"
-    std::string switch_name;        ///< "x-"
-    device::HomingConfig config;    ///< axis, direction, velocities and distances in LSB
+    std::string axis_name;        ///< "x"
+    std::string switch_name;      ///< "x-"
+    device::HomingConfig config;  ///< axis, direction, velocities and distances in LSB
     device::LimitSide side = device::LimitSide::kNegative;
 };
 
