@@ -107,7 +107,7 @@ struct ModbusClient::Impl {
             const int err = errno;
             ++counters.connect_failures;
             throw ModbusError(ModbusError::Kind::kConnectFailed,
-                              context + ": cannot connect (" + modbus_strerror(err) + ")");
+                              context + ": cannot connect (" + modbus_strerror(err) + ")", 0, err);
         }
         open = true;
         if (ever_connected) ++counters.reconnects;

@@ -1,6 +1,7 @@
 #include "pathstream/host/device_setup.hpp"
 
 #include <cmath>
+#include <cstdio>
 #include <stdexcept>
 
 #include "pathstream/host/machine.hpp"
@@ -71,6 +72,18 @@ std::string fault_text(std::uint16_t fault_code) {
 std::string fault_suffix(unsigned state, std::uint16_t fault_code) {
     if (state != static_cast<unsigned>(device::DeviceState::kFault)) return "";
     return " (" + fault_text(fault_code) + ")";
+}
+
+std::string position_text(const MachineProfile& profile, const std::int32_t* lsb,
+                          std::size_t count) {
+    std::string mm, raw;
+    char value[48];
+    for (std::size_t a = 0; a < count && a < profile.axes.size(); ++a) {
+        std::snprintf(value, sizeof value, "%.4f", lsb[a] * profile.mm_per_lsb);
+        mm += (a ? " " : "") + profile.axes[a].name + " " + value;
+        raw += (a ? " " : "") + std::to_string(lsb[a]);
+    }
+    return mm + " mm (" + raw + " LSB)";
 }
 
 unsigned axis_index(const MachineProfile& profile, const std::string& name) {

@@ -38,6 +38,7 @@ planning=$(awk -v a="$t0" -v b="$(date +%s.%N)" 'BEGIN { printf "%.3f", b - a }'
 device_pid=
 start_device() {
   rm -f record.csv
+  : > device.log  # not left to the child: the loop below would read the last device's address
   "$bin" device -m "$machine" --no-gpio --tcp 127.0.0.1:0 --position 100,100 --time-scale 30 \
     --record record.csv --exit-after 600 > device.log 2>&1 &
   device_pid=$!

@@ -19,6 +19,9 @@ device_pid=
 
 # Starts the simulated device at the drawing's start on a free port; sets $target.
 start_device() {
+  # Emptied here, not by the child's redirection: until the child runs, the loop below would
+  # read the last device's address from the old log.
+  : > "$work/device.log"
   "$bin" device -m "$machine" --no-gpio --tcp 127.0.0.1:0 --position 139.322,100 --time-scale "$1" \
     --record "$work/record.csv" --exit-after 300 > "$work/device.log" 2>&1 &
   device_pid=$!
@@ -127,6 +130,23 @@ timeout -k 5 120 "$bin" stream --resume "$work/js.json" > "$work/stream_stop2.lo
 [ $rc -eq 0 ] && ok || fail "resume after ctl stop: exit $rc: $(tail -n 5 "$work/stream_stop2.log")"
 stop_device
 rm -f "$work"/js.json*
+
+# ---- The lead-in is the default; --no-lead-in refuses a device resting elsewhere (in mm) and
+# leaves no file behind, as does every stream the device took nothing of.
+start_device 20 || exit 1
+out=$("$bin" stream "$src/examples/two_pens.svg" -m "$machine" -t "$target" --journal "$work/nl.json" \
+  --no-lead-in --pause none < /dev/null 2>&1); rc=$?
+[ $rc -eq 6 ] && [[ "$out" == *"device rests at x 139.3220 y 100.0000 mm (139322 100000 LSB) but the plan starts at x "* ]] &&
+  [[ "$out" == *"journal       none kept: the device took nothing of this job"* ]] && ok ||
+  fail "--no-lead-in away from the start: exit $rc: $out"
+[ -z "$(ls "$work"/nl.json* 2>/dev/null)" ] && ok || fail "--no-lead-in left files: $(ls "$work"/nl.json*)"
+out=$("$bin" stream "$src/examples/two_pens.svg" -m "$machine" -t "$target" --journal "$work/nl.json" \
+  --pause none < /dev/null 2>&1); rc=$?
+[ $rc -eq 0 ] && [[ "$out" == *"lead-in       from the device's rest position x 139.3220 mm y 100.0000 mm"* ]] && ok ||
+  fail "the default lead-in: exit $rc: $out"
+[ -f "$work/nl.json" ] && [ -f "$work/nl.json.plan" ] && ok || fail "a finished stream kept no journal"
+stop_device
+rm -f "$work"/nl.json*
 
 # ---- Two layers: the device pauses pen up between them until `ctl resume` ---------------
 start_device 2 || exit 1

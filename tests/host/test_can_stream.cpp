@@ -9,6 +9,7 @@
 #include "pathstream/device/can_protocol.hpp"
 #include "pathstream/host/can_stream.hpp"
 #include "pathstream/host/core_playback.hpp"
+#include "pathstream/host/device_setup.hpp"
 #include "pathstream/host/geometry.hpp"
 #include "pathstream/host/json_path.hpp"
 #include "pathstream/host/machine.hpp"
@@ -168,9 +169,9 @@ TEST_CASE(
         message = e.what();
     }
     const std::vector<Lsb> start = start_of(job.plan);
-    const std::string expected = "device rests at " + std::to_string(rest[0]) + " " +
-                                 std::to_string(rest[1]) + " LSB but the plan starts at " +
-                                 std::to_string(start[0]) + " " + std::to_string(start[1]) + " LSB";
+    const std::string expected =
+        "device rests at " + host::position_text(job.machine, rest.data(), 2) +
+        " but the plan starts at " + host::position_text(job.machine, start.data(), 2);
     INFO(message);
     CHECK(message.find(expected) != std::string::npos);
     CHECK(dt.device->recorded_setpoints().empty());  // nothing moved

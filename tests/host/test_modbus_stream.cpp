@@ -123,7 +123,9 @@ TEST_CASE(
     // Without the lead-in the streamer refuses, naming both points.
     CHECK_THROWS_WITH(
         host::stream_modbus(drawing.plan, drawing.machine, o),
-        Catch::Contains("device rests at 5000 -7000 LSB but the plan starts at 139322 100000 LSB"));
+        Catch::Contains(
+            "device rests at x 5.0000 y -7.0000 mm (5000 -7000 LSB) but the plan starts at "
+            "x 139.3220 y 100.0000 mm (139322 100000 LSB)"));
     const std::vector<Lsb> at = host::modbus_rest_position(drawing.machine, o);
     REQUIRE(at == std::vector<Lsb>{5000, -7000});
     const host::Path path =

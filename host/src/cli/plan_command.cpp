@@ -45,7 +45,17 @@ PlannedJob prepare_job(const PathOptions& path_options, const std::string& machi
     }
     job.segments = to_bezier_segments(job.path);
     check_work_area(job.segments, job.path, job.machine, path_options.file);
-    if (lead_in_from != nullptr) prepend_lead_in(job.segments, *lead_in_from);
+    if (lead_in_from != nullptr && !job.segments.empty()) {
+        // The device rests on the LSB grid: at the start's grid point it needs no move (a
+        // travel shorter than an LSB would be a span that goes nowhere).
+        const PathPoint& start = job.segments.front().p[0];
+        bool at_start = lead_in_from->size() == start.size();
+        for (std::size_t a = 0; at_start && a < start.size(); ++a) {
+            at_start = std::llround((*lead_in_from)[a] / job.machine.mm_per_lsb) ==
+                       std::llround(start[a] / job.machine.mm_per_lsb);
+        }
+        if (!at_start) prepend_lead_in(job.segments, *lead_in_from);
+    }
     return job;
 }
 

@@ -53,10 +53,14 @@ void add_stream_command(CLI::App& app, StreamCommandOptions& o) {
                     "modbus-rtu:///dev/ttyX?baud=115200&parity=N&unit=1, "
                     "can://IFACE?node=N&protocol=native or CiA 402 drives "
                     "can://IFACE?node=N&protocol=cia402&cycle=2ms; required unless --resume");
-    cmd->add_flag("--lead-in", o.lead_in,
-                  "start with a pen-up move from where the device rests (e.g. after homing) to the "
-                  "drawing's first "
-                  "point");
+    CLI::Option* lead_in = cmd->add_flag(
+        "--lead-in", o.lead_in,
+        "start with a pen-up move from where the device rests (e.g. after homing) to the drawing's "
+        "first point: the default for Modbus and native CAN targets");
+    cmd->add_flag(
+           "--no-lead-in", o.no_lead_in,
+           "plan no lead-in: refuse a device that does not rest at the drawing's first point")
+        ->excludes(lead_in);
     cmd->add_option("--journal", o.journal,
                     "job journal, written as the stream goes, for --resume (default: "
                     "DRAWING.journal.json in the "
@@ -430,6 +434,38 @@ std::string default_journal_path(const std::string& drawing) {
     return std::filesystem::path(drawing).stem().string() + ".journal.json";
 }
 
+// True when the job of this journal never had a span accepted by the device: nothing of it
+// moved, and a resume would only start it again. False when it cannot be read (kept then).
+bool nothing_taken(const std::string& journal_path) {
+    try {
+        const JobJournal j = read_journal(journal_path);
+        return j.job == 0 || j.acknowledged + 1 == j.job;
+    } catch (const std::exception&) {
+        return !std::filesystem::exists(journal_path);
+    }
+}
+
+// A first stream that ends before the device took any of its spans (refused, unreachable,
+// interrupted while planning) leaves no files: no journal, no spans file, no drawing copy.
+class JobFilesGuard {
+public:
+    explicit JobFilesGuard(std::string journal_path) : journal_(std::move(journal_path)) {}
+    JobFilesGuard(const JobFilesGuard&) = delete;
+    JobFilesGuard& operator=(const JobFilesGuard&) = delete;
+    ~JobFilesGuard() {
+        if (journal_.empty() || !nothing_taken(journal_)) return;
+        const std::string plan = std::filesystem::absolute(journal_ + ".plan").string();
+        for (const std::string& f : {journal_, plan, partial_spans_path(plan),
+                                     std::filesystem::absolute(journal_ + ".input").string()}) {
+            std::error_code ignored;
+            std::filesystem::remove(f, ignored);
+        }
+    }
+
+private:
+    std::string journal_;
+};
+
 // A line typed at the terminal (Enter) since the last look; never waits.
 bool enter_pressed() {
     pollfd p{STDIN_FILENO, POLLIN, 0};
@@ -537,12 +573,24 @@ int stream_job(const JobToStream& job, const MachineProfile& machine, StreamComm
         end = can ? stream_over_can(supply, machine, o, observer, held, events, job.planning)
                   : stream_over_modbus(supply, machine, o, observer, held, events, job.planning);
     } catch (const std::exception& e) {
-        if (job.planning != nullptr) finish_planning(*job.planning, !journal_path.empty());
+        const JobJournal& so_far = writer.journal();
+        const bool taken =
+            held != nullptr || (so_far.job != 0 && so_far.acknowledged + 1 != so_far.job);
+        if (job.planning != nullptr) {
+            if (taken) {
+                finish_planning(*job.planning, !journal_path.empty());
+            } else {
+                job.planning->cancel();  // nothing to resume: no plan needed
+            }
+        }
         record_plan();
         writer.finish("failed", e.what());
         events.end("failed", e.what());
-        if (!journal_path.empty() &&
-            (!writer.journal().plan_hash.empty() || !writer.journal().replan.empty())) {
+        if (!taken && !journal_path.empty() && held == nullptr && journal_path != o.resume) {
+            std::printf("journal       none kept: the device took nothing of this job\n");
+            std::fflush(stdout);
+        } else if (!journal_path.empty() &&
+                   (!writer.journal().plan_hash.empty() || !writer.journal().replan.empty())) {
             // A fault or e-stop stops the job where it is: once the device is reset, the journal
             // goes on from there.
             std::printf(
@@ -868,9 +916,10 @@ EventChannel open_events(const StreamCommandOptions& o) {
 int run_stream(const StreamCommandOptions& o) {
     const EventChannel channel = open_events(o);
     if (!o.resume.empty()) {
-        if (o.lead_in)
-            throw std::invalid_argument(
-                "--resume: --lead-in does not apply (the resume plans its own move)");
+        if (o.lead_in || o.no_lead_in)
+            throw std::invalid_argument(std::string("--resume: ") +
+                                        (o.lead_in ? "--lead-in" : "--no-lead-in") +
+                                        " does not apply (the resume plans its own move)");
         return run_resume(o, channel);
     }
     if (o.path.file.empty())
@@ -892,12 +941,19 @@ int run_stream(const StreamCommandOptions& o) {
     }
     std::vector<double> rest_mm;
     // The path order starts where the device rests (its first subpath is the one nearest to
-    // it), so the drawing begins where the pen is: read it first, as --lead-in does.
+    // it), so the drawing begins where the pen is, and the lead-in goes from there to it.
     PathOptions path = o.path;
     const bool cia402 =
         url.rfind("can://", 0) == 0 && url.find("protocol=cia402") != std::string::npos;
+    if (cia402 && o.lead_in) {
+        throw std::invalid_argument(
+            "--lead-in: CiA 402 drives must stand at the drawing's first point (docs/cia402.md); "
+            "the lead-in "
+            "is for Modbus and native CAN targets");
+    }
+    const bool lead_in = !cia402 && !o.no_lead_in;
     const bool order_from_rest = !cia402 && !path.keep_order && path.order_start.empty();
-    if (o.lead_in || order_from_rest) {
+    if (lead_in || order_from_rest) {
         const MachineProfile machine = load_machine_profile(o.machine);
         std::vector<Lsb> rest;
         if (o.stream.target.rfind("can://", 0) == 0) {
@@ -913,12 +969,12 @@ int run_stream(const StreamCommandOptions& o) {
             rest = modbus_rest_position(machine, o.stream);
         }
         for (const Lsb p : rest) rest_mm.push_back(p * machine.mm_per_lsb);
-        if (o.lead_in) {
+        if (lead_in) {
             std::printf("lead-in       from the device's rest position");
             for (std::size_t a = 0; a < rest_mm.size(); ++a) {
                 std::printf(" %s %.4f mm", machine.axes[a].name.c_str(), rest_mm[a]);
             }
-            std::printf("\n");
+            std::printf(" (none when it rests at the drawing's start)\n");
         } else {
             for (std::size_t a = 0; a < rest_mm.size(); ++a) {
                 path.order_start += (a ? "," : "") + exact_decimal(rest_mm[a]);
@@ -931,8 +987,9 @@ int run_stream(const StreamCommandOptions& o) {
     journal.drawing = path_display_name(o.path.file);
     const std::string journal_path =
         o.no_journal ? "" : (o.journal.empty() ? default_journal_path(o.path.file) : o.journal);
+    const JobFilesGuard files(journal_path);
     if (cia402 || o.plan_first) {
-        const PlannedJob planned = plan_job(path, o.machine, o.lead_in ? &rest_mm : nullptr);
+        const PlannedJob planned = plan_job(path, o.machine, lead_in ? &rest_mm : nullptr);
         if (g_interrupts.load() > 0) {
             std::printf("interrupted   while planning: nothing was sent to the device\n");
             return kExitInterrupted;
@@ -952,11 +1009,11 @@ int run_stream(const StreamCommandOptions& o) {
     if (!journal_path.empty()) {
         // The plan is made as the stream goes: keep what plans it again after a host crash.
         const JobRecipe recipe = save_job_recipe(
-            path, o.machine, o.lead_in ? std::optional<std::vector<double>>(rest_mm) : std::nullopt,
+            path, o.machine, lead_in ? std::optional<std::vector<double>>(rest_mm) : std::nullopt,
             std::filesystem::absolute(journal_path + ".input").string());
         journal.replan = job_recipe_json(recipe);
     }
-    return stream_while_planning(prepare_job(path, o.machine, o.lead_in ? &rest_mm : nullptr), o,
+    return stream_while_planning(prepare_job(path, o.machine, lead_in ? &rest_mm : nullptr), o,
                                  journal, journal_path, channel);
 }
 

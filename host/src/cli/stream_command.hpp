@@ -13,7 +13,11 @@ struct StreamCommandOptions {
     PathOptions path;
     std::string machine;
     StreamOptions stream;
-    bool lead_in = false;  ///< plan a pen-up move from where the device rests
+    /// A pen-up move from where the device rests to the drawing's start is planned by default
+    /// (Modbus and native CAN); --no-lead-in refuses a device resting elsewhere instead.
+    /// --lead-in (the default) is kept for scripts; CiA 402 targets refuse it.
+    bool lead_in = false;
+    bool no_lead_in = false;
     std::string journal;   ///< job journal path ("" : DRAWING-STEM.journal.json in the current directory)
     bool no_journal = false;
     std::string resume;    ///< continue the job of this journal

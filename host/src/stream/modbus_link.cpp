@@ -2,6 +2,7 @@
 #include "modbus_link.hpp"
 
 #include <algorithm>
+#include <cerrno>
 #include <span>
 
 #include "pathstream/device/modbus_map.hpp"
@@ -28,13 +29,21 @@ hal::ModbusClientOptions client_options(const StreamOptions& o) {
 }
 
 // The first connection, tried until link_timeout_seconds have passed; then a StreamError like
-// every other dead link, not the transport's error.
+// every other dead link, not the transport's error. A refused TCP connection ends it at once:
+// the host answered that nothing listens on that port, and waiting would not change that
+// (a device still starting binds its port before it prints its address).
 hal::ModbusClient connect(const StreamOptions& o) {
     const auto begin = Clock::now();
     while (true) {
         try {
             return hal::ModbusClient(o.target, client_options(o));
         } catch (const hal::ModbusError& e) {
+            if (e.os_error() == ECONNREFUSED) {
+                throw StreamError(
+                    o.target +
+                    ": cannot connect to the device: nothing listens there (connection "
+                    "refused); is the device running, and is this its port?");
+            }
             if (std::chrono::duration<double>(Clock::now() - begin).count() >
                 o.link_timeout_seconds) {
                 throw StreamError(o.target + ": cannot connect to the device (" + e.what() + ")");

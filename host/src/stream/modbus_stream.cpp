@@ -250,11 +250,11 @@ private:
         }
         for (unsigned a = 0; a < axes_ && check_start; ++a) {
             if (s.position[a] != start_[a]) {
-                m << "device rests at";
-                for (unsigned b = 0; b < axes_; ++b) m << ' ' << s.position[b];
-                m << " LSB but the plan starts at";
-                for (unsigned b = 0; b < axes_; ++b) m << ' ' << start_[b];
-                m << " LSB (--lead-in plans a pen-up move from where it rests)";
+                std::int32_t rest[8] = {};
+                for (unsigned b = 0; b < axes_; ++b) rest[b] = s.position[b];
+                m << "device rests at " << position_text(profile_, rest, axes_)
+                  << " but the plan starts at " << position_text(profile_, start_, axes_)
+                  << " (stream without --no-lead-in moves there pen up first)";
                 fail(m.str());
             }
         }

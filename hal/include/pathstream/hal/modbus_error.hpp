@@ -20,20 +20,29 @@ public:
         kBadFrame,           ///< a response arrived but was corrupt or did not match the request
     };
 
-    /// `exception_code` is the wire value (1..255) for kExceptionResponse, 0 otherwise.
-    ModbusError(Kind kind, const std::string& message, std::uint8_t exception_code = 0)
-        : std::runtime_error(message), kind_(kind), exception_code_(exception_code) {}
+    /// `exception_code` is the wire value (1..255) for kExceptionResponse, 0 otherwise;
+    /// `os_error` the errno of a failed connect (kConnectFailed), 0 otherwise.
+    ModbusError(Kind kind, const std::string& message, std::uint8_t exception_code = 0,
+                int os_error = 0)
+        : std::runtime_error(message),
+          kind_(kind),
+          exception_code_(exception_code),
+          os_error_(os_error) {}
 
     Kind kind() const noexcept { return kind_; }
     /// The device's exception code (ModbusException values, or others such as 0x0B from a
     /// gateway); 0 unless kind() == kExceptionResponse.
     std::uint8_t exception_code() const noexcept { return exception_code_; }
+    /// The system's error number of a failed connect (ECONNREFUSED: nothing listens there),
+    /// 0 for the other kinds.
+    int os_error() const noexcept { return os_error_; }
     /// True for the kinds that a retry may cure (everything but kExceptionResponse).
     bool transient() const noexcept { return kind_ != Kind::kExceptionResponse; }
 
 private:
     Kind kind_;
     std::uint8_t exception_code_;
+    int os_error_;
 };
 
 /// "timeout", "connection lost", ... for messages and logs. No allocation.

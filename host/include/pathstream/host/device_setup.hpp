@@ -46,6 +46,11 @@ std::string fault_text(std::uint16_t fault_code);
 /// " (<fault_text>)" for the fault state, "" for any other state (a DeviceState number).
 std::string fault_suffix(unsigned state, std::uint16_t fault_code);
 
+/// A device position as the operator reads it: "x 12.3450 y 0.0000 mm (12345 0 LSB)", each
+/// axis by its profile name; `count` values of `lsb` (at most the profile's axes).
+std::string position_text(const MachineProfile& profile, const std::int32_t* lsb,
+                          std::size_t count);
+
 /// One axis's homing in the device's units, and which switch ends it.
 struct HomingSetup {
     std::string axis_name;        ///< "x"
