@@ -4,13 +4,16 @@
 #include <cmath>
 #include <fstream>
 #include <limits>
+#include <memory>
 #include <optional>
 #include <pugixml.hpp>
 #include <sstream>
 #include <unordered_map>
 
 #include "pathstream/host/input_error.hpp"
+#include "pathstream/host/svg_clip.hpp"
 #include "pathstream/host/svg_path.hpp"
+#include "pathstream/host/svg_warnings.hpp"
 
 namespace pathstream::host {
 namespace {
@@ -29,6 +32,14 @@ constexpr std::size_t kMaxDepth = 500;
 // (<use>) cannot turn a small file into unbounded geometry (about 200 bytes of memory a piece).
 constexpr std::size_t kPiecesBase = 250000;
 constexpr std::size_t kPiecesPerByte = 16;
+// Steps of clipping (segments flattened, grid cells visited, edges tested): a base plus 64 per
+// byte, so that a huge hatch against a finely flattened clip ends in an error, not a long run.
+constexpr std::uint64_t kClipWorkBase = 20000000;
+constexpr std::uint64_t kClipWorkPerByte = 64;
+// clipPath elements clipped by further clipPath elements, one within the other.
+constexpr std::size_t kMaxClipChain = 16;
+// The languages of systemLanguage tests the reader accepts (docs/formats-svg.md).
+constexpr const char* kReaderLanguage = "en";
 constexpr double kMmPerPx = 25.4 / 96.0;
 constexpr double kNoBase = std::numeric_limits<double>::quiet_NaN();
 constexpr std::size_t kNoLayer = static_cast<std::size_t>(-1);
@@ -63,8 +74,8 @@ struct State {
     Affine to_mm;            // user units of this element -> mm
     double width = kNoBase;  // viewport size in user units, for percentages
     double height = kNoBase;
-    bool visible = true;  // inherited 'visibility'
-    std::string stroke = "none";  // inherited 'stroke', kept for SvgReadInfo::strokes
+    bool visible = true;           // inherited 'visibility'
+    std::string stroke = "none";   // inherited 'stroke', kept for SvgReadInfo::strokes
     std::size_t layer = kNoLayer;  // the Inkscape layer the element is in (index in layers_)
 };
 
@@ -80,7 +91,11 @@ struct Cascaded {
 // The properties the reader uses, after the cascade.
 struct Style {
     Cascaded display, visibility, stroke, transform, origin;
+    Cascaded clip_path, clip_rule, overflow;
+    Cascaded mask, filter, marker, marker_start, marker_mid, marker_end, fill;  // warnings only
 };
+
+using ClipRegions = std::vector<std::shared_ptr<const svg::ClipRegion>>;
 
 class Reader {
 public:
@@ -94,6 +109,7 @@ public:
             info->style_rules = sheet_.rules();
             info->location_bytes_scanned = locator_.bytes_scanned();
             info->locations = locator_.lookups();
+            info->warnings = warnings_.lines(file_);
         }
         return path;
     }
@@ -136,7 +152,8 @@ private:
             if (outside) path_.layers.push_back({"(outside layers)", {}, 0, ""});
             for (PathLayer& l : layers_) path_.layers.push_back(std::move(l));
             for (std::size_t i = 0; i < path_.subpaths.size(); ++i) {
-                path_.subpaths[i].layer = subpath_layers_[i] == kNoLayer ? 0 : subpath_layers_[i] + shift;
+                path_.subpaths[i].layer =
+                    subpath_layers_[i] == kNoLayer ? 0 : subpath_layers_[i] + shift;
                 const std::string colour = normal_colour(strokes_[i]);
                 std::string& pen = path_.layers[path_.subpaths[i].layer].pen;
                 if (colour == "none") continue;
@@ -151,7 +168,8 @@ private:
             path_.subpaths[i].layer = static_cast<std::size_t>(at - colours.begin());
             if (at == colours.end()) {
                 colours.push_back(colour);
-                path_.layers.push_back({colour, path_.subpaths[i].location, 0, colour == "none" ? "" : colour});
+                path_.layers.push_back(
+                    {colour, path_.subpaths[i].location, 0, colour == "none" ? "" : colour});
             }
         }
         if (colours.size() < 2) {
@@ -163,13 +181,16 @@ private:
     // One spelling per colour: lower case, #rgb as #rrggbb, CSS's basic colour names as hex.
     static std::string normal_colour(std::string c) {
         c = lower(trim(c));
-        if (c.size() == 4 && c[0] == '#') c = std::string("#") + c[1] + c[1] + c[2] + c[2] + c[3] + c[3];
+        if (c.size() == 4 && c[0] == '#')
+            c = std::string("#") + c[1] + c[1] + c[2] + c[2] + c[3] + c[3];
         static const std::pair<const char*, const char*> kNamed[] = {
-            {"black", "#000000"},  {"silver", "#c0c0c0"}, {"gray", "#808080"},   {"grey", "#808080"},
-            {"white", "#ffffff"},  {"maroon", "#800000"}, {"red", "#ff0000"},    {"purple", "#800080"},
-            {"fuchsia", "#ff00ff"}, {"magenta", "#ff00ff"}, {"green", "#008000"}, {"lime", "#00ff00"},
-            {"olive", "#808000"},  {"yellow", "#ffff00"}, {"navy", "#000080"},   {"blue", "#0000ff"},
-            {"teal", "#008080"},   {"aqua", "#00ffff"},   {"cyan", "#00ffff"},   {"orange", "#ffa500"}};
+            {"black", "#000000"},   {"silver", "#c0c0c0"}, {"gray", "#808080"},
+            {"grey", "#808080"},    {"white", "#ffffff"},  {"maroon", "#800000"},
+            {"red", "#ff0000"},     {"purple", "#800080"}, {"fuchsia", "#ff00ff"},
+            {"magenta", "#ff00ff"}, {"green", "#008000"},  {"lime", "#00ff00"},
+            {"olive", "#808000"},   {"yellow", "#ffff00"}, {"navy", "#000080"},
+            {"blue", "#0000ff"},    {"teal", "#008080"},   {"aqua", "#00ffff"},
+            {"cyan", "#00ffff"},    {"orange", "#ffa500"}};
         for (const auto& [name, hex] : kNamed)
             if (c == name) return hex;
         return c.empty() ? "none" : c;
@@ -178,7 +199,9 @@ private:
     // A top-level Inkscape layer (<g inkscape:groupmode="layer">; sublayers belong to theirs):
     // named by its label, else its id, else its number.
     void enter_layer(pugi::xml_node n, State& state) {
-        if (state.layer != kNoLayer || std::string(n.attribute("inkscape:groupmode").value()) != "layer") return;
+        if (state.layer != kNoLayer ||
+            std::string(n.attribute("inkscape:groupmode").value()) != "layer")
+            return;
         std::string name = trim(n.attribute("inkscape:label").value());
         if (name.empty()) name = trim(n.attribute("id").value());
         if (name.empty()) name = std::to_string(layers_.size() + 1);
@@ -315,16 +338,25 @@ private:
         attribute(st.stroke, "stroke");
         attribute(st.transform, "transform");
         attribute(st.origin, "transform-origin");
+        attribute(st.clip_path, "clip-path");
+        attribute(st.clip_rule, "clip-rule");
+        attribute(st.overflow, "overflow");
+        attribute(st.mask, "mask");
+        attribute(st.filter, "filter");
+        attribute(st.marker_start, "marker-start");
+        attribute(st.marker_mid, "marker-mid");
+        attribute(st.marker_end, "marker-end");
+        attribute(st.fill, "fill");
         std::vector<const svg::CssDeclaration*> sheet;
         if (!sheet_.empty()) {
-            sheet = sheet_.match(svg_name(n), n.attribute("id").value(),
-                                 n.attribute("class").value());
+            sheet =
+                sheet_.match(svg_name(n), n.attribute("id").value(), n.attribute("class").value());
         }
         std::vector<svg::CssDeclaration> inline_style;
         if (const pugi::xml_attribute a = n.attribute("style")) {
             try {
-                inline_style = svg::parse_css_declarations(a.value(),
-                                                           attribute_offsets(n, "style").second);
+                inline_style =
+                    svg::parse_css_declarations(a.value(), attribute_offsets(n, "style").second);
             } catch (const svg::CssError& error) {
                 throw InputError(file_, locate(error.offset), error.what());
             }
@@ -335,6 +367,16 @@ private:
                              : d.name == "stroke"           ? &st.stroke
                              : d.name == "transform"        ? &st.transform
                              : d.name == "transform-origin" ? &st.origin
+                             : d.name == "clip-path"        ? &st.clip_path
+                             : d.name == "clip-rule"        ? &st.clip_rule
+                             : d.name == "overflow"         ? &st.overflow
+                             : d.name == "mask"             ? &st.mask
+                             : d.name == "filter"           ? &st.filter
+                             : d.name == "marker"           ? &st.marker
+                             : d.name == "marker-start"     ? &st.marker_start
+                             : d.name == "marker-mid"       ? &st.marker_mid
+                             : d.name == "marker-end"       ? &st.marker_end
+                             : d.name == "fill"             ? &st.fill
                                                             : nullptr;
             if (slot) *slot = {d.value, true, true, d.name_offset};
         };
@@ -346,7 +388,8 @@ private:
                 if (d.important == important) apply(d);
             }
         }
-        for (Cascaded* keyword : {&st.display, &st.visibility, &st.stroke})
+        for (Cascaded* keyword :
+             {&st.display, &st.visibility, &st.stroke, &st.clip_rule, &st.overflow})
             keyword->value = lower(keyword->value);
         return st;
     }
@@ -367,7 +410,8 @@ private:
     Affine transform(pugi::xml_node n, const Style& st, double width, double height) const {
         if (!st.transform.set) return {};
         const auto parse = [&](const Cascaded& c, const char* attribute, auto&& f) {
-            if (!c.css) return with_attribute(n, attribute, [&](std::string_view) { return f(c.value); });
+            if (!c.css)
+                return with_attribute(n, attribute, [&](std::string_view) { return f(c.value); });
             try {
                 return f(c.value);
             } catch (const svg::ValueError& e) {
@@ -439,6 +483,7 @@ private:
     // ---- the walk ---------------------------------------------------------------------------
 
     void root_svg(pugi::xml_node n) {
+        if (!conditions_hold(n)) return;  // e.g. a drawing for another language: nothing
         State state;
         const Style st = style(n);
         inherit(st, state);
@@ -480,9 +525,25 @@ private:
         }
     }
 
+    // SVG's conditional processing, on every element (not only in <switch>): the reader
+    // supports no extensions, and its one language is kReaderLanguage, which matches a
+    // systemLanguage entry equal to it or starting with it and '-' ("en", "en-US").
     static bool conditions_hold(pugi::xml_node n) {
-        // <switch>: we know no extensions or languages, so any such test fails.
-        return !n.attribute("requiredExtensions") && !n.attribute("systemLanguage");
+        if (n.attribute("requiredExtensions")) return false;
+        const pugi::xml_attribute languages = n.attribute("systemLanguage");
+        if (!languages) return true;
+        const std::string_view want = kReaderLanguage;
+        const std::string list = languages.value();
+        for (std::size_t i = 0; i <= list.size();) {
+            std::size_t end = list.find(',', i);
+            if (end == std::string::npos) end = list.size();
+            const std::string tag = lower(trim(std::string_view(list).substr(i, end - i)));
+            if (tag == want || (tag.size() > want.size() &&
+                                tag.compare(0, want.size(), want) == 0 && tag[want.size()] == '-'))
+                return true;
+            i = end + 1;
+        }
+        return false;
     }
 
     // Counts one level of nesting for the walk below it.
@@ -493,24 +554,33 @@ private:
 
     void element(pugi::xml_node n, const State& parent) {
         if (depth_ >= kMaxDepth) {
-            fail_at(n, nullptr, "elements nested more than " + std::to_string(kMaxDepth) +
-                                    " deep (the reader's limit)");
+            fail_at(n, nullptr,
+                    "elements nested more than " + std::to_string(kMaxDepth) +
+                        " deep (the reader's limit)");
         }
         ++depth_;
         const DepthGuard guard{depth_};
         const std::string name = svg_name(n);
-        if (name.empty()) return;
+        if (name.empty() || !conditions_hold(n)) return;
         const Style st = style(n);
         if (st.display.value == "none") return;
         State state = parent;
         inherit(st, state);
-        static const char* const kDrawn[] = {"g",    "a",    "switch",  "svg",  "use",
-                                             "path", "rect", "circle",  "ellipse",
-                                             "line", "polyline", "polygon"};
+        static const char* const kDrawn[] = {"g",       "a",    "switch",   "svg",
+                                             "use",     "path", "rect",     "circle",
+                                             "ellipse", "line", "polyline", "polygon"};
         if (std::find(std::begin(kDrawn), std::end(kDrawn), name) == std::end(kDrawn))
-            return;  // defs, symbol, text, image, metadata, title, style, ...
+            return not_drawn(n, name);
+        unapplied(n, st);
         const Affine own = transform(n, st, parent.width, parent.height);
+        const std::size_t start = path_.subpaths.size();
+        draw(n, name, parent, own, state);
+        if (st.clip_path.set && st.clip_path.value != "none")
+            clip_path(n, st, parent.to_mm * own, parent, start);
+    }
 
+    void draw(pugi::xml_node n, const std::string& name, const State& parent, const Affine& own,
+              State& state) {
         if (name == "g") enter_layer(n, state);
         if (name == "g" || name == "a" || name == "switch") {
             state.to_mm = parent.to_mm * own;
@@ -556,7 +626,18 @@ private:
             state.height = (*box)[3];
         }
         if (state.to_mm.determinant() == 0) return;
+        const std::size_t start = path_.subpaths.size();
         children(n, state);
+        // overflow: hidden is the default of <svg> and <symbol>: what is outside is cut.
+        const std::string overflow = style(n).overflow.value;
+        if (overflow == "visible" || overflow == "auto" || path_.subpaths.size() == start) return;
+        if (!std::isfinite(width) || !std::isfinite(height)) return;
+        svg::Ring rect{to_mm({0, 0}), to_mm({width, 0}), to_mm({width, height}),
+                       to_mm({0, height})};
+        std::vector<svg::ClipShape> shapes(1);
+        shapes[0].rings.push_back(std::move(rect));
+        clip_subpaths(start, {std::make_shared<const svg::ClipRegion>(std::move(shapes))},
+                      element_location(n));
     }
 
     // <use href="#id">: the element with that id, drawn here, moved by x and y. A <symbol>
@@ -593,8 +674,7 @@ private:
                 };
                 viewport(target,
                          to_mm * transform(target, target_style, parent.width, parent.height),
-                         side("width", parent.width),
-                         side("height", parent.height), state);
+                         side("width", parent.width), side("height", parent.height), state);
             }
         } else {
             state.to_mm = to_mm;
@@ -619,6 +699,323 @@ private:
         }
         const auto it = ids_.find(id);
         return it == ids_.end() ? pugi::xml_node() : it->second;
+    }
+
+    // ---- what is not drawn --------------------------------------------------------------
+
+    // An SVG element that is not geometry: silent when it is not meant to be drawn where it
+    // stands (definitions, metadata), a warning when it draws something the reader cannot.
+    void not_drawn(pugi::xml_node n, const std::string& name) {
+        static const char* const kSilent[] = {
+            "defs",           "title",     "desc",          "metadata",
+            "style",          "script",    "symbol",        "clipPath",
+            "mask",           "marker",    "pattern",       "linearGradient",
+            "radialGradient", "stop",      "filter",        "view",
+            "cursor",         "animate",   "animateMotion", "animateTransform",
+            "animateColor",   "set",       "mpath",         "discard",
+            "font",           "font-face", "glyph",         "missing-glyph",
+            "hkern",          "vkern",     "color-profile", "solidcolor",
+            "meshgradient",   "hatch"};
+        if (std::find(std::begin(kSilent), std::end(kSilent), name) != std::end(kSilent)) return;
+        static const char* const kText[] = {"text",     "tspan",    "textPath", "tref",
+                                            "flowRoot", "flowPara", "flowSpan", "flowRegion"};
+        const bool text = std::find(std::begin(kText), std::end(kText), name) != std::end(kText);
+        if (clip_building_ > 0) {
+            if (clip_problem_.empty())
+                clip_problem_ = "holds a <" + name + ">, which the reader cannot clip to";
+            return;
+        }
+        const bool known = text || name == "image" || name == "foreignObject" || name == "video" ||
+                           name == "audio" || name == "canvas" || name == "iframe" ||
+                           name == "mesh";
+        warnings_.add("<" + name + "> is not drawn" +
+                          (text    ? " (convert text to paths to plot it)"
+                           : known ? ""
+                                   : " (an element the reader does not know)"),
+                      element_location(n));
+    }
+
+    // Where a cascaded property was set: its attribute, or its CSS declaration.
+    SourceLocation place(pugi::xml_node n, const Cascaded& c, const char* attribute) const {
+        return c.css ? locate(c.offset) : attribute_location(n, attribute);
+    }
+
+    // Properties of a drawn element whose effect the reader does not draw.
+    void unapplied(pugi::xml_node n, const Style& st) {
+        if (clip_building_ > 0) return;
+        const auto url = [](const Cascaded& c) { return c.set && c.value.rfind("url(", 0) == 0; };
+        if (url(st.mask))
+            warnings_.add("mask is not applied (drawn unmasked)", place(n, st.mask, "mask"));
+        if (st.filter.set && st.filter.value != "none" && !st.filter.value.empty())
+            warnings_.add("filter is not applied", place(n, st.filter, "filter"));
+        const std::pair<const Cascaded*, const char*> markers[] = {
+            {&st.marker, "marker"},
+            {&st.marker_start, "marker-start"},
+            {&st.marker_mid, "marker-mid"},
+            {&st.marker_end, "marker-end"}};
+        for (const auto& [c, attribute] : markers) {
+            if (url(*c)) warnings_.add("markers are not drawn", place(n, *c, attribute));
+        }
+        for (const auto& [c, attribute] :
+             {std::pair{&st.fill, "fill"}, std::pair{&st.stroke, "stroke"}}) {
+            if (!url(*c)) continue;
+            const pugi::xml_node paint = element_by_id(url_id(c->value));
+            const std::string kind = paint ? svg_name(paint) : "";
+            if (kind == "pattern" || kind == "hatch")
+                warnings_.add("<" + kind + "> content is not drawn", place(n, *c, attribute));
+        }
+    }
+
+    // The id of "url(#id)" (quotes allowed), or "" when the value is no such reference.
+    static std::string url_id(const std::string& value) {
+        if (value.rfind("url(", 0) != 0) return "";
+        const std::size_t close = value.find(')');
+        if (close == std::string::npos) return "";
+        std::string inner = trim(std::string_view(value).substr(4, close - 4));
+        if (inner.size() >= 2 && (inner[0] == '"' || inner[0] == '\'') && inner.back() == inner[0])
+            inner = trim(std::string_view(inner).substr(1, inner.size() - 2));
+        return inner.size() >= 2 && inner[0] == '#' ? inner.substr(1) : "";
+    }
+
+    // ---- clipping ---------------------------------------------------------------------------
+
+    // Cuts what `n` drew (the subpaths from `start` on) by its clip-path, in the user space
+    // `user_to_mm`; a clip that cannot be applied is a warning and the content stays whole.
+    void clip_path(pugi::xml_node n, const Style& st, const Affine& user_to_mm, const State& parent,
+                   std::size_t start) {
+        if (clip_building_ > 0) {  // a clip of a clip's content: a union of intersections
+            if (clip_problem_.empty()) clip_problem_ = "has content with its own clip-path";
+            return;
+        }
+        if (path_.subpaths.size() == start) return;
+        ClipRegions regions;
+        const std::string problem =
+            build_clip(st.clip_path.value, user_to_mm, parent, start, regions);
+        const SourceLocation at = place(n, st.clip_path, "clip-path");
+        if (!problem.empty()) return warnings_.add(problem + "; drawn unclipped", at);
+        clip_subpaths(start, regions, at);
+    }
+
+    // The regions (a point must be in every one) of the clip-path value `value`, or why they
+    // cannot be made.
+    std::string build_clip(const std::string& value, const Affine& user_to_mm, const State& parent,
+                           std::size_t start, ClipRegions& regions) {
+        const std::string id = url_id(value);
+        if (id.empty()) return "clip-path '" + value + "' is not a url(#id) (not supported)";
+        const pugi::xml_node clip = element_by_id(id);
+        if (!clip) return "clip-path refers to #" + id + ", which does not exist";
+        if (svg_name(clip) != "clipPath")
+            return "clip-path refers to #" + id + ", a <" + svg_name(clip) + ">, not a <clipPath>";
+        if (std::find(clip_stack_.begin(), clip_stack_.end(), clip) != clip_stack_.end())
+            return "clip-path #" + id + " refers to itself (circular reference)";
+        if (clip_stack_.size() >= kMaxClipChain)
+            return "clip paths clipped more than " + std::to_string(kMaxClipChain) + " deep";
+        const Style clip_style = style(clip);
+        Affine map = user_to_mm;
+        if (trim(clip.attribute("clipPathUnits").value()) == "objectBoundingBox") {
+            const auto box = user_box(start, user_to_mm);
+            if (!box || (*box)[2] <= 0 || (*box)[3] <= 0) {
+                regions.push_back(
+                    std::make_shared<const svg::ClipRegion>(std::vector<svg::ClipShape>{}));
+                warnings_.add(
+                    "clip-path in objectBoundingBox units on content without an area "
+                    "hides it",
+                    element_location(clip));
+                return "";
+            }
+            map = map * Affine{(*box)[2], 0, 0, (*box)[3], (*box)[0], (*box)[1]};
+        }
+        map = map * transform(clip, clip_style, parent.width, parent.height);
+        if (map.determinant() == 0) {  // a collapsed clip has no inside
+            regions.push_back(
+                std::make_shared<const svg::ClipRegion>(std::vector<svg::ClipShape>{}));
+            return "";
+        }
+        State inside = parent;
+        inside.to_mm = map;
+        inside.visible = true;
+        inherit(clip_style, inside);
+        const svg::FillRule clip_rule = rule(clip_style.clip_rule, svg::FillRule::kNonZero);
+        std::vector<svg::ClipShape> shapes;
+        clip_stack_.push_back(clip);
+        ++clip_building_;
+        for (pugi::xml_node child = clip.first_child(); child; child = child.next_sibling()) {
+            if (child.type() != pugi::node_element) continue;
+            const std::size_t from = path_.subpaths.size();
+            element(child, inside);
+            if (!clip_problem_.empty()) break;
+            svg::ClipShape shape;
+            shape.rule = rule(style(child).clip_rule, clip_rule);
+            for (std::size_t i = from; i < path_.subpaths.size(); ++i)
+                shape.rings.push_back(ring(path_.subpaths[i]));
+            truncate(from);
+            if (!shape.rings.empty()) shapes.push_back(std::move(shape));
+        }
+        --clip_building_;
+        std::string problem;
+        if (!clip_problem_.empty()) {
+            problem = "clip-path #" + id + " " + clip_problem_;
+            clip_problem_.clear();
+        }
+        if (problem.empty()) {
+            regions.push_back(std::make_shared<const svg::ClipRegion>(std::move(shapes)));
+            if (clip_style.clip_path.set && clip_style.clip_path.value != "none")
+                problem =
+                    build_clip(clip_style.clip_path.value, user_to_mm, parent, start, regions);
+        }
+        clip_stack_.pop_back();
+        return problem;
+    }
+
+    static svg::FillRule rule(const Cascaded& c, svg::FillRule inherited) {
+        if (c.value == "evenodd") return svg::FillRule::kEvenOdd;
+        if (c.value == "nonzero") return svg::FillRule::kNonZero;
+        return inherited;
+    }
+
+    // Drops the subpaths from `from` on (and what runs parallel to them).
+    void truncate(std::size_t from) {
+        path_.subpaths.resize(from);
+        strokes_.resize(from);
+        subpath_layers_.resize(from);
+    }
+
+    // A subpath's pieces in mm: a polyline's as straight cubics.
+    static std::vector<svg::Cubic> pieces_of(const Subpath& s) {
+        std::vector<svg::Cubic> out;
+        const auto at = [&](std::size_t i) { return Point{s.points[i][0], s.points[i][1]}; };
+        if (s.basis == PathBasis::kPolyline) {
+            for (std::size_t i = 0; i + 1 < s.points.size(); ++i)
+                out.push_back(svg::line_cubic(at(i), at(i + 1)));
+        } else {
+            for (std::size_t i = 0; i + 3 < s.points.size(); i += 3)
+                out.push_back({at(i), at(i + 1), at(i + 2), at(i + 3)});
+        }
+        return out;
+    }
+
+    // A clip shape's subpath flattened within the tolerance (closed implicitly, as a fill is).
+    svg::Ring ring(const Subpath& s) {
+        svg::Ring out;
+        for (const svg::Cubic& c : pieces_of(s)) {
+            if (out.empty()) out.push_back(c[0]);
+            const std::size_t n = svg::flatten_count(c, tolerance_mm_);
+            charge_clip_work(n, s.location);
+            for (std::size_t k = 1; k <= n; ++k) {
+                const double t = static_cast<double>(k) / static_cast<double>(n), u = 1 - t;
+                out.push_back(k == n ? c[3]
+                                     : Point{u * u * u * c[0].x + 3 * u * u * t * c[1].x +
+                                                 3 * u * t * t * c[2].x + t * t * t * c[3].x,
+                                             u * u * u * c[0].y + 3 * u * u * t * c[1].y +
+                                                 3 * u * t * t * c[2].y + t * t * t * c[3].y});
+            }
+        }
+        return out;
+    }
+
+    void charge_clip_work(std::uint64_t n, SourceLocation at) {
+        clip_work_ += n;
+        if (clip_work_ > clip_budget()) {
+            throw InputError(file_, at,
+                             "clipping needs more than " + std::to_string(clip_budget()) +
+                                 " steps (the reader's limit for a file of " +
+                                 std::to_string(text_.size()) + " bytes)");
+        }
+    }
+
+    std::uint64_t clip_budget() const { return kClipWorkBase + kClipWorkPerByte * text_.size(); }
+
+    // The bounding box {x, y, width, height} of the subpaths from `start` on in the user
+    // space `user_to_mm` maps from (curves by their extremes); none when there are none.
+    std::optional<std::array<double, 4>> user_box(std::size_t start,
+                                                  const Affine& user_to_mm) const {
+        const double det = user_to_mm.determinant();
+        const Affine& m = user_to_mm;
+        const Affine inverse{m.d / det,
+                             -m.b / det,
+                             -m.c / det,
+                             m.a / det,
+                             (m.c * m.f - m.d * m.e) / det,
+                             (m.b * m.e - m.a * m.f) / det};
+        double lo[2] = {std::numeric_limits<double>::infinity(),
+                        std::numeric_limits<double>::infinity()};
+        double hi[2] = {-lo[0], -lo[1]};
+        const auto add = [&](double v, int axis) {
+            lo[axis] = std::min(lo[axis], v);
+            hi[axis] = std::max(hi[axis], v);
+        };
+        for (std::size_t i = start; i < path_.subpaths.size(); ++i) {
+            for (const svg::Cubic& mm : pieces_of(path_.subpaths[i])) {
+                svg::Cubic c;
+                for (int k = 0; k < 4; ++k) c[k] = inverse(mm[k]);
+                for (int axis = 0; axis < 2; ++axis) {
+                    const auto v = [&](int k) { return axis == 0 ? c[k].x : c[k].y; };
+                    const auto at = [&](double t) {
+                        const double u = 1 - t;
+                        return u * u * u * v(0) + 3 * u * u * t * v(1) + 3 * u * t * t * v(2) +
+                               t * t * t * v(3);
+                    };
+                    add(v(0), axis);
+                    add(v(3), axis);
+                    // Extremes inside: the roots of the derivative a t^2 + b t + c.
+                    const double a = -v(0) + 3 * v(1) - 3 * v(2) + v(3);
+                    const double b = 2 * (v(0) - 2 * v(1) + v(2)), q = v(1) - v(0);
+                    std::vector<double> roots;
+                    if (std::fabs(a) < 1e-12) {
+                        if (b != 0) roots.push_back(-q / b);
+                    } else if (const double disc = b * b - 4 * a * q; disc >= 0) {
+                        roots.push_back((-b + std::sqrt(disc)) / (2 * a));
+                        roots.push_back((-b - std::sqrt(disc)) / (2 * a));
+                    }
+                    for (const double t : roots) {
+                        if (t > 0 && t < 1) add(at(t), axis);
+                    }
+                }
+            }
+        }
+        if (!(lo[0] <= hi[0])) return std::nullopt;
+        return std::array<double, 4>{lo[0], lo[1], hi[0] - lo[0], hi[1] - lo[1]};
+    }
+
+    // Replaces the subpaths from `start` on by their parts inside every region.
+    void clip_subpaths(std::size_t start, const ClipRegions& regions, SourceLocation at) {
+        std::vector<Subpath> kept;
+        std::vector<std::string> strokes;
+        std::vector<std::size_t> layers;
+        const std::uint64_t budget = clip_budget();
+        for (std::size_t i = start; i < path_.subpaths.size(); ++i) {
+            svg::CubicSubpaths chains{pieces_of(path_.subpaths[i])};
+            for (const auto& region : regions) {
+                svg::CubicSubpaths cut;
+                for (const auto& chain : chains) {
+                    try {
+                        for (auto& part :
+                             svg::clip_chain(chain, *region, tolerance_mm_, clip_work_, budget))
+                            cut.push_back(std::move(part));
+                    } catch (const svg::ValueError&) {
+                        charge_clip_work(budget, at);  // names the limit at the clip
+                    }
+                }
+                chains = std::move(cut);
+            }
+            for (const auto& chain : chains) {
+                bool straight = true;
+                for (const svg::Cubic& c : chain) straight = straight && svg::is_straight(c);
+                Subpath sp = subpath_of(
+                    chain.size(), [&](std::size_t k) { return chain[k]; }, straight,
+                    path_.subpaths[i].location);
+                if (sp.points.empty()) continue;
+                kept.push_back(std::move(sp));
+                strokes.push_back(strokes_[i]);
+                layers.push_back(subpath_layers_[i]);
+            }
+        }
+        truncate(start);
+        for (std::size_t k = 0; k < kept.size(); ++k) {
+            path_.subpaths.push_back(std::move(kept[k]));
+            strokes_.push_back(std::move(strokes[k]));
+            subpath_layers_.push_back(layers[k]);
+        }
     }
 
     void geometry(pugi::xml_node n, const std::string& name, const State& state) {
@@ -702,33 +1099,49 @@ private:
             const bool straight =
                 std::all_of(pieces.begin(), pieces.end(),
                             [](const svg::Cubic& c) { return c == svg::line_cubic(c[0], c[3]); });
-            Subpath sp;
-            sp.basis = straight ? PathBasis::kPolyline : PathBasis::kBezier;
-            sp.closed = false;
-            sp.location = at;
-            // At most this many points: no growth by doubling.
-            sp.points.reserve((straight ? 1 : 3) * pieces.size() + 1, 2);
-            for (const svg::Cubic& c : pieces) {
-                Point mm[4];
-                bool degenerate = true;
-                for (int k = 0; k < 4; ++k) {
-                    mm[k] = to_mm(c[k]);
-                    degenerate = degenerate &&
-                                 std::hypot(mm[k].x - mm[0].x, mm[k].y - mm[0].y) <= kDegenerateMm;
-                }
-                if (degenerate) continue;
-                for (int k = sp.points.empty() ? 0 : 1; k < 4; ++k) {
-                    if (straight && (k == 1 || k == 2)) continue;  // a polyline keeps the ends
-                    check(mm[k].x, at);
-                    check(mm[k].y, at);
-                    sp.points.push_back({mm[k].x, mm[k].y});
-                }
-            }
+            // Mapped one at a time: a copy of 10^6 pieces in mm would cost 64 MB.
+            Subpath sp = subpath_of(
+                pieces.size(),
+                [&](std::size_t i) {
+                    svg::Cubic mm;
+                    for (int k = 0; k < 4; ++k) mm[k] = to_mm(pieces[i][k]);
+                    return mm;
+                },
+                straight, at);
             if (sp.points.empty()) continue;
             path_.subpaths.push_back(std::move(sp));
             strokes_.push_back(state.stroke);
             subpath_layers_.push_back(state.layer);
         }
+    }
+
+    // A subpath of pieces in mm (a polyline of their ends when `straight`), without the pieces
+    // smaller than kDegenerateMm; checked against the coordinate range.
+    // piece(i) gives piece i of `count` in mm.
+    template <class Piece>
+    Subpath subpath_of(std::size_t count, Piece&& piece, bool straight, SourceLocation at) const {
+        Subpath sp;
+        sp.basis = straight ? PathBasis::kPolyline : PathBasis::kBezier;
+        sp.closed = false;
+        sp.location = at;
+        // At most this many points: no growth by doubling.
+        sp.points.reserve((straight ? 1 : 3) * count + 1, 2);
+        for (std::size_t i = 0; i < count; ++i) {
+            const svg::Cubic mm = piece(i);
+            bool degenerate = true;
+            for (int k = 0; k < 4; ++k) {
+                degenerate =
+                    degenerate && std::hypot(mm[k].x - mm[0].x, mm[k].y - mm[0].y) <= kDegenerateMm;
+            }
+            if (degenerate) continue;
+            for (int k = sp.points.empty() ? 0 : 1; k < 4; ++k) {
+                if (straight && (k == 1 || k == 2)) continue;  // a polyline keeps the ends
+                check(mm[k].x, at);
+                check(mm[k].y, at);
+                sp.points.push_back({mm[k].x, mm[k].y});
+            }
+        }
+        return sp;
     }
 
     void check(double mm, SourceLocation at) const {
@@ -755,9 +1168,14 @@ private:
     std::size_t depth_ = 0;   // elements being walked, nested
     std::size_t pieces_ = 0;  // curve pieces emitted so far
     svg::StyleSheet sheet_;
-    std::vector<std::string> strokes_;  // parallel to path_.subpaths
+    std::vector<std::string> strokes_;         // parallel to path_.subpaths
     std::vector<std::size_t> subpath_layers_;  // parallel to path_.subpaths: index in layers_
     std::vector<PathLayer> layers_;            // Inkscape layers in document order
+    svg::WarningLog warnings_;
+    std::vector<pugi::xml_node> clip_stack_;  // clipPath elements being built, for cycles
+    std::size_t clip_building_ = 0;           // > 0 while a clipPath's content is walked
+    std::string clip_problem_;                // why the clipPath being built cannot clip
+    std::uint64_t clip_work_ = 0;             // clipping steps so far (clip_budget())
 };
 
 }  // namespace

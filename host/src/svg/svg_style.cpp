@@ -1,6 +1,7 @@
 // A small CSS subset for <style> elements and style attributes (docs/formats-svg.md): enough for
 // the class rules editors write (Illustrator hides layers with .st2{display:none}).
 #include <algorithm>
+#include <iterator>
 
 #include "pathstream/host/svg_path.hpp"
 
@@ -8,8 +9,12 @@ namespace pathstream::host::svg {
 namespace {
 
 // The properties the reader uses; declarations of others are dropped when a sheet is read.
-constexpr std::string_view kUsed[] = {"display", "visibility", "stroke", "transform",
-                                      "transform-origin"};
+// Beyond what decides the geometry: clipping, and what the reader warns it does not draw.
+constexpr std::string_view kUsed[] = {
+    "display",   "visibility",   "stroke",     "transform",  "transform-origin",
+    "clip-path", "clip-rule",    "overflow",   "mask",       "filter",
+    "marker",    "marker-start", "marker-mid", "marker-end", "fill"};
+static_assert(std::size(kUsed) == StyleSheet::kProperties);
 
 bool is_space(char c) {
     return c == ' ' || c == '\t' || c == '\r' || c == '\n' || c == '\f';
@@ -17,8 +22,8 @@ bool is_space(char c) {
 
 // CSS identifier characters (escapes are not supported: such selectors never match).
 bool is_ident(char c) {
-    return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') ||
-           c == '-' || c == '_' || static_cast<unsigned char>(c) >= 0x80;
+    return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '-' ||
+           c == '_' || static_cast<unsigned char>(c) >= 0x80;
 }
 
 std::string_view trim(std::string_view s) {
@@ -33,8 +38,10 @@ std::string blank_comments(std::string_view text, std::size_t base) {
     char quote = 0;
     for (std::size_t i = 0; i < out.size(); ++i) {
         if (quote) {
-            if (out[i] == '\\') ++i;
-            else if (out[i] == quote) quote = 0;
+            if (out[i] == '\\')
+                ++i;
+            else if (out[i] == quote)
+                quote = 0;
         } else if (out[i] == '"' || out[i] == '\'') {
             quote = out[i];
         } else if (out[i] == '/' && i + 1 < out.size() && out[i + 1] == '*') {
@@ -55,8 +62,10 @@ std::size_t find_outside(std::string_view t, std::size_t i, std::string_view sto
     for (; i < t.size(); ++i) {
         const char c = t[i];
         if (quote) {
-            if (c == '\\') ++i;
-            else if (c == quote) quote = 0;
+            if (c == '\\')
+                ++i;
+            else if (c == quote)
+                quote = 0;
         } else if (c == '"' || c == '\'') {
             quote = c;
         } else if (c == '(') {
@@ -250,8 +259,8 @@ std::vector<const CssDeclaration*> StyleSheet::match(std::string_view type, std:
     gather(by_type_, std::string(type));
     gather(by_type_, "*");
 
-    std::array<std::array<Slot, 2>, 5> best{};
-    std::array<std::array<std::uint32_t, 2>, 5> best_specificity{};
+    std::array<std::array<Slot, 2>, kProperties> best{};
+    std::array<std::array<std::uint32_t, 2>, kProperties> best_specificity{};
     for (const std::size_t k : candidates) {
         const Rule& r = rules_[k];
         bool ok = (r.type.empty() || r.type == type) && (r.id.empty() || r.id == id);

@@ -58,6 +58,10 @@ struct SvgReadInfo {
     std::size_t locations = 0;
     /// Rules read from <style> elements (one per selector of a selector list).
     std::size_t style_rules = 0;
+    /// What was not drawn or not applied ("file:line:col: what"), one line per kind with a
+    /// count and the first place: text, images, masks, filters, markers, pattern fills, clips
+    /// that cannot be applied (docs/formats-svg.md, "Warnings").
+    std::vector<std::string> warnings;
 };
 
 /// Line and column (1-based; columns count UTF-8 characters; a leading byte order mark does
@@ -78,7 +82,7 @@ public:
 
 private:
     std::string_view text_;
-    std::size_t begin_ = 0;                   // after the byte order mark
+    std::size_t begin_ = 0;                    // after the byte order mark
     std::vector<SourceLocation> checkpoints_;  // place of byte k * kStride
     std::size_t scanned_ = 0;
     std::size_t lookups_ = 0;
@@ -193,7 +197,8 @@ public:
 std::vector<CssDeclaration> parse_css_declarations(std::string_view text, std::size_t base = 0);
 
 /// The rules of a document's <style> elements, for the properties the reader uses (display,
-/// visibility, stroke, transform, transform-origin). A selector is a compound of an optional
+/// visibility, stroke, transform, transform-origin, clip-path, clip-rule, overflow, and mask,
+/// filter, marker*, fill for its warnings). A selector is a compound of an optional
 /// type (or *) and any number of .class and #id; selector lists are split into one rule per
 /// selector. Other selectors (combinators, attributes, pseudo-classes, escapes) never match;
 /// at-rules (@media, @import, ...) are skipped with their blocks.
@@ -201,6 +206,8 @@ class StyleSheet {
 public:
     /// Rules per document, counting every selector of a list: more are refused.
     static constexpr std::size_t kMaxRules = 10000;
+    /// Properties the sheet keeps declarations of (the others are dropped when read).
+    static constexpr std::size_t kProperties = 15;
 
     /// Adds the rules of one style sheet text whose first byte is at `base` in the document.
     /// Throws CssError on an unclosed comment or block, a '}' without a rule, or more than
@@ -228,7 +235,8 @@ private:
         std::string id;
         std::vector<std::string> classes;
         std::uint32_t specificity = 0;
-        std::array<std::array<Slot, 2>, 5> slots{};  // per used property, normal and !important
+        std::array<std::array<Slot, 2>, kProperties>
+            slots{};  // per used property, normal and !important
     };
     void add_rule(std::string_view selector, std::size_t block);
 
