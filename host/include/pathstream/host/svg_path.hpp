@@ -28,7 +28,11 @@ struct SvgReadInfo;
 /// points at 1/3 and 2/3; quadratics are degree-elevated exactly; elliptical arcs, circles and
 /// ellipses are approximated within `tolerance_mm` (measured in mm after all transforms).
 /// Pieces whose four points lie within 1e-9 mm of each other are dropped, and so are
-/// subpaths left empty.
+/// subpaths left empty. Strokes are cut at their clip-path and at nested <svg>/<symbol>
+/// viewports (a cut piece becomes straight pieces within `tolerance_mm`); elements failing
+/// their systemLanguage ("en" passes) or requiredExtensions test are not drawn. What is not
+/// drawn or not applied (text, images, masks, filters, markers, clips that cannot be applied)
+/// goes to info->warnings, one line per kind.
 /// Throws InputError ("file:line:col: what is wrong") on malformed XML, a root that is not
 /// <svg>, bad path data, transforms, lengths, units, viewBox or points lists, non-finite
 /// numbers, negative sizes, coordinates beyond 1e6 mm, and a document without drawable
