@@ -69,6 +69,9 @@ expect check-gcode-pen 0 "G-code pen: z (auto: Z goes both above and to or below
 printf 'M300 S440\nG0 X1\nG1 X5 Y5\n' > "$work/nopen.ngc"
 expect check-gcode-motion 0 "G-code pen: motion (auto: no M3/M4 and Z never crosses --gcode-z-down 0 mm, so G1 draws and G0 travels)" -- \
   "$bin" check "$work/nopen.ngc" --gcode-pen auto
+printf '<svg xmlns="http://www.w3.org/2000/svg" width="100mm" height="100mm" viewBox="0 0 100 100">\n<text x="1" y="2">a</text><text>b</text>\n<path d="M0 0 L 10 10" stroke="black"/></svg>\n' > "$work/text.svg"
+expect check-svg-warning 0 "pathstream: warning: $work/text.svg:2:1: <text> is not drawn (convert text to paths to plot it) (2 times; the first here)" -- \
+  "$bin" check "$work/text.svg"
 expect check-gcode-warning 0 "pathstream: warning: $work/nopen.ngc:1:1: M300 skipped" -- \
   "$bin" check "$work/nopen.ngc" --gcode-pen motion
 expect check-gcode-ignore 1 "m301.ngc:1:1: unsupported M code M301" -- \

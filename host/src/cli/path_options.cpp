@@ -261,7 +261,14 @@ Path read_path(const PathOptions& o, std::string& gcode_pen, std::string& format
     if (format.empty()) format = sniff_format(text);
     if (format.empty()) throw InputError(name, {}, "standard input is empty: no path to read");
     if (format == "json") return parse_json_path(text, name, o.tolerance);
-    if (format == "svg") return parse_svg_path(text, name, o.tolerance);
+    if (format == "svg") {
+        // What the drawing has and the plot will not (text, images, clips it cannot apply):
+        // said once per kind, never dropped in silence.
+        svg::SvgReadInfo info;
+        Path path = parse_svg_path(text, name, o.tolerance, &info);
+        for (const std::string& warning : info.warnings) std::cerr << "pathstream: warning: " << warning << '\n';
+        return path;
+    }
     if (format == "csv") return parse_csv_path(text, name, basis_from_name(o.csv_basis), o.csv_closed);
     return read_gcode(o, text, gcode_pen);
 }

@@ -27,6 +27,7 @@
 #include "pathstream/host/device_setup.hpp"
 #include "pathstream/host/events.hpp"
 #include "pathstream/host/input_error.hpp"
+#include "pathstream/host/job_estimate.hpp"
 #include "pathstream/host/job_journal.hpp"
 #include "pathstream/host/planning_thread.hpp"
 #include "pathstream/host/progress.hpp"
@@ -267,24 +268,29 @@ private:
     std::size_t last_subpath_ = 0;
 };
 
-// The progress bar's fraction and detail: the queue level, then where the job is and the
-// device's state; while planning goes on the job's length is not known: the motion done and
-// how far planning got instead.
+// The progress bar's fraction, ETA and detail: the fraction of the whole drawing and the motion
+// left (estimated while planning goes on, marked "~"), then the queue level, how far planning
+// got while it runs, and where the job is.
 struct BarView {
     double fraction = 0;
+    ProgressEta eta;
     std::string detail;
 };
 BarView bar_view(std::uint64_t ticks, std::optional<std::uint64_t> total, double queued,
                  const JobEvents& events, const PlanningThread* planning, double tick_hz) {
     char text[96];
     BarView v;
-    if (total) {
+    if (const std::optional<JobEvents::Progress> p = events.progress(ticks)) {
+        v.fraction = p->fraction;
+        v.eta = {static_cast<double>(p->ticks_left) / tick_hz, p->estimated};
+    } else if (total) {
         v.fraction = *total > 0 ? static_cast<double>(ticks) / static_cast<double>(*total) : 1.0;
+    }
+    if (total || planning == nullptr || planning->finished()) {
         std::snprintf(text, sizeof text, "queue %.2f s", queued);
     } else {
-        std::snprintf(text, sizeof text, "%.1f s done, planning %.0f %%, queue %.2f s",
-                      static_cast<double>(ticks) / tick_hz,
-                      planning != nullptr ? 100 * planning->fraction() : 0.0, queued);
+        std::snprintf(text, sizeof text, "planning %.0f %%, queue %.2f s",
+                      100 * planning->fraction(), queued);
     }
     const std::string status = events.status_text();
     v.detail = status.empty() ? std::string(text) : std::string(text) + ", " + status;
@@ -313,7 +319,7 @@ StreamEnd stream_over_can(SpanSupply& supply, const MachineProfile& machine,
                        [&](std::uint64_t ticks, std::optional<std::uint64_t> total, double queued) {
                            const BarView v =
                                bar_view(ticks, total, queued, events, planning, machine.tick_hz);
-                           bar.update(v.fraction, v.detail);
+                           bar.update(v.fraction, v.detail, v.eta);
                        });
     }
     if (r.interrupted != 0) return {r.interrupted, r.final_status, r.job, r.stopped_elsewhere};
@@ -355,7 +361,7 @@ StreamEnd stream_over_modbus(SpanSupply& supply, const MachineProfile& machine,
             supply, machine, options,
             [&](std::uint64_t ticks, std::optional<std::uint64_t> total, double queued) {
                 const BarView v = bar_view(ticks, total, queued, events, planning, machine.tick_hz);
-                bar.update(v.fraction, v.detail);
+                bar.update(v.fraction, v.detail, v.eta);
             });
     }
     if (r.interrupted != 0) return {r.interrupted, r.final_status, r.job, r.stopped_elsewhere};
@@ -504,6 +510,8 @@ struct JobToStream {
     const StreamPlanTap* tap = nullptr;
     const Path* path = nullptr;
     std::size_t subpaths = 0;  // of the whole drawing
+    // The job's ticks estimated while planning goes on (JobEvents::set_progress_basis).
+    std::function<std::optional<std::uint64_t>()> estimate;
 };
 
 // After a stream that ended early (an interrupt, a device error) while planning still runs:
@@ -541,6 +549,12 @@ int stream_job(const JobToStream& job, const MachineProfile& machine, StreamComm
         events.set_totals(job.spans->plan.total_ticks, job.spans->plan.spans.size(),
                           job.spans->plan.pauses.size());
     }
+    // A resume counts the whole drawing: what ran before it comes first.
+    const std::uint64_t before =
+        job.spans != nullptr && held == nullptr && !job.spans->drawing_tick.empty()
+            ? job.spans->drawing_tick.front()
+            : 0;
+    events.set_progress_basis(before, job.estimate);
     TrackedSupply supply(job.supply, job.spans, events, writer,
                          job.spans == nullptr ? job.path : nullptr);
     handle_pauses(o.stream.interrupt, writer, events, o.stream.target,
@@ -807,7 +821,7 @@ int run_resume(StreamCommandOptions o, const EventChannel& channel) {
             journal.job, s.last_completed + 1 - journal.job, spans);
         const HeldJob held{journal.job, s.last_accepted};
         PlanSupply supply(job.plan);
-        return stream_job({supply, &job, nullptr, nullptr, nullptr, job.subpaths}, machine, o,
+        return stream_job({supply, &job, nullptr, nullptr, nullptr, job.subpaths, {}}, machine, o,
                           journal, o.resume, &held, channel);
     }
     if (s.state != static_cast<unsigned>(device::DeviceState::kIdle)) {
@@ -841,8 +855,8 @@ int run_resume(StreamCommandOptions o, const EventChannel& channel) {
     next.outcome = "streaming";
     next.error.clear();
     PlanSupply supply(resumed.plan);
-    return stream_job({supply, &resumed, nullptr, nullptr, nullptr, resumed.subpaths}, machine, o,
-                      next, o.resume, nullptr, channel);
+    return stream_job({supply, &resumed, nullptr, nullptr, nullptr, resumed.subpaths, {}}, machine,
+                      o, next, o.resume, nullptr, channel);
 }
 
 // CiA 402 drives: no device status to follow, so the events are the job's start and end.
@@ -899,7 +913,12 @@ int stream_while_planning(const PlannedJob& job, const StreamCommandOptions& o,
         CoreSpan none;
         (void)planning.take(none);
     }
-    return stream_job({planning, nullptr, &planning, &tap, &job.path, job.path.subpaths.size()},
+    const JobEstimate estimate(job.segments, job.machine);
+    return stream_job({planning, nullptr, &planning, &tap, &job.path, job.path.subpaths.size(),
+                       [&estimate, &tap]() -> std::optional<std::uint64_t> {
+                           const StreamPlanTap::Planned p = tap.planned();
+                           return estimate.total_ticks(p.mm, p.ticks);
+                       }},
                       job.machine, o, journal, journal_path, nullptr, channel);
 }
 
@@ -1003,8 +1022,8 @@ int run_stream(const StreamCommandOptions& o) {
         journal.pauses = pause_descriptions(planned.path, planned.plan);
         const JobSpans job = job_from_plan(planned.plan);
         PlanSupply supply(job.plan);
-        return stream_job({supply, &job, nullptr, nullptr, nullptr, job.subpaths}, planned.machine,
-                          o, journal, journal_path, nullptr, channel);
+        return stream_job({supply, &job, nullptr, nullptr, nullptr, job.subpaths, {}},
+                          planned.machine, o, journal, journal_path, nullptr, channel);
     }
     if (!journal_path.empty()) {
         // The plan is made as the stream goes: keep what plans it again after a host crash.

@@ -2,6 +2,7 @@
 // device's travel check and the job journal's spans file.
 #pragma once
 
+#include <atomic>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -32,12 +33,23 @@ public:
     /// empty without a file.
     const std::string& spans_hash() const { return hash_; }
 
+    /// What planning has made so far, for the job's estimate: its ticks and the mm of path
+    /// (each span's chord) they cover. Any thread: one atomic word written by the planning
+    /// thread per span and read whole (ticks below 2^32, mm below 4,294 m; beyond, saturated).
+    struct Planned {
+        std::uint64_t ticks = 0;
+        double mm = 0;
+    };
+    Planned planned() const;
+
 private:
     const PlannedJob& job_;
     const std::string& file_;
     std::unique_ptr<JobSpansWriter> writer_;
     std::size_t spans_ = 0;
     std::uint64_t ticks_ = 0;
+    double mm_ = 0;
+    std::atomic<std::uint64_t> planned_{0};  ///< ticks << 32 | micrometres: planned()
     std::size_t subpaths_ = 0;
     std::string hash_;
 };

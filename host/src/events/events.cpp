@@ -255,26 +255,41 @@ void JobEvents::enter_spans(const JobSample& s) {
     }
 }
 
+void JobEvents::set_progress_basis(std::uint64_t before, std::function<std::optional<std::uint64_t>()> estimate) {
+    ticks_before_job_ = before;
+    estimate_ = std::move(estimate);
+}
+
+std::optional<JobEvents::Progress> JobEvents::progress(std::uint64_t ticks) const {
+    std::optional<std::uint64_t> total = total_ticks_;
+    const bool estimated = !total && estimate_;
+    if (estimated) total = estimate_();
+    if (!total) return std::nullopt;
+    Progress p;
+    p.estimated = estimated;
+    // An estimate may fall short of what already ran: never past the end before the end.
+    const std::uint64_t job = estimated ? std::max(*total, ticks + 1) : *total;
+    const std::uint64_t whole = ticks_before_job_ + job;
+    p.fraction = whole > 0 ? std::min(1.0, static_cast<double>(ticks_before_job_ + std::min(ticks, job)) /
+                                               static_cast<double>(whole))
+                           : 1.0;
+    p.ticks_left = job - std::min(ticks, job);
+    return p;
+}
+
 // A progress event at most progress_hz times a second (simulated seconds for sim).
 void JobEvents::on_progress(const JobSample& s) {
     EventJson e = event("progress");
     const double clock = s.sim_seconds ? e["sim_t"].get<double>() : e["t"].get<double>();
     if (last_progress_ && clock - *last_progress_ < 1.0 / channel_.progress_hz) return;
     last_progress_ = clock;
-    if (total_ticks_) {
-        const double total = static_cast<double>(*total_ticks_);
-        const std::uint64_t left = *total_ticks_ - std::min(s.ticks, *total_ticks_);
-        e["fraction"] = total > 0 ? rounded(static_cast<double>(s.ticks) / total, 1e6) : 1.0;
-        e["ticks"] = s.ticks;
-        e["plan_ticks"] = *total_ticks_;
-        e["eta_s"] = rounded(static_cast<double>(left) / machine_.tick_hz, 1e6);
-    } else {
-        // Still planning: how far the job goes is not known yet.
-        e["fraction"] = nullptr;
-        e["ticks"] = s.ticks;
-        e["plan_ticks"] = nullptr;
-        e["eta_s"] = nullptr;
-    }
+    const std::optional<Progress> p = progress(s.ticks);
+    // Without totals or an estimate (still planning): how far the job goes is not known yet.
+    e["fraction"] = p ? EventJson(rounded(p->fraction, 1e6)) : EventJson(nullptr);
+    e["ticks"] = s.ticks;
+    e["plan_ticks"] = total_json(total_ticks_);
+    e["eta_s"] = p ? EventJson(rounded(static_cast<double>(p->ticks_left) / machine_.tick_hz, 1e6)) : EventJson(nullptr);
+    e["estimated"] = p && p->estimated;
     e["queue_s"] = rounded(static_cast<double>(s.queued_ticks) / machine_.tick_hz, 1e6);
     e["queue_spans"] = s.queued_spans ? EventJson(*s.queued_spans) : EventJson(nullptr);
     e["position_mm"] = position_json(s.position);

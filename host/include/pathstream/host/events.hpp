@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <deque>
+#include <functional>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -98,6 +99,22 @@ public:
     /// The job's ticks, when known.
     std::optional<std::uint64_t> total_ticks() const { return total_ticks_; }
 
+    /// What a progress event's fraction and ETA count. `before`: the drawing's ticks run
+    /// before this stream (a resume: the fraction is of the whole drawing, `before` plus this
+    /// job). `estimate`: the job's ticks estimated while they are not known (called from this
+    /// object's thread at each progress event; nullopt or an empty function: none), marked
+    /// `"estimated": true`.
+    void set_progress_basis(std::uint64_t before,
+                            std::function<std::optional<std::uint64_t>()> estimate);
+    /// The fraction of the whole drawing done after `ticks` of this job, the job's ticks left and
+    /// whether they are estimated; nullopt while nothing is known. For the progress bar too.
+    struct Progress {
+        double fraction = 0;
+        std::uint64_t ticks_left = 0;
+        bool estimated = false;
+    };
+    std::optional<Progress> progress(std::uint64_t ticks) const;
+
     /// job_start, once (later calls do nothing); `job`: the device's job id when known.
     void start(std::optional<std::uint32_t> job);
     /// The events a sample shows: hold, stop, state, fault, underrun, subpath, pen, progress.
@@ -144,6 +161,8 @@ private:
     std::uint64_t ticks_added_ = 0;
     std::optional<std::uint64_t> total_ticks_;
     std::optional<std::uint64_t> total_spans_, total_pauses_;
+    std::uint64_t ticks_before_job_ = 0;
+    std::function<std::optional<std::uint64_t>()> estimate_;
     std::optional<double> sim_seconds_;  ///< of the last sample (sim events carry it)
     bool started_event_ = false, ended_ = false;
     double start_t_ = 0;
