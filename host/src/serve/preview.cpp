@@ -14,6 +14,7 @@ struct Vertex {
     double x = 0, y = 0;
     std::uint64_t tick = 0;
     bool pen = false;
+    std::size_t layer = 0;  ///< Path::layers index of the subpath the piece ending here belongs to
 };
 
 // Distance of p from the line through a and b (from a, when they coincide).
@@ -36,7 +37,8 @@ public:
             kept_.push_back(v);
             return;
         }
-        if (!run_.empty() && (v.pen != run_.front().pen || run_.size() >= kMaxRun || !fits(v))) {
+        if (!run_.empty() &&
+            (v.pen != run_.front().pen || v.layer != run_.front().layer || run_.size() >= kMaxRun || !fits(v))) {
             kept_.push_back(run_.back());
             run_.clear();
         }
@@ -84,14 +86,15 @@ nlohmann::ordered_json preview_json(const Plan& plan, const Path& path, const Ma
     for (std::size_t i = 0; i < plan.spans.size(); ++i) {
         const CoreSpan& s = plan.spans[i];
         // The planner's spans are Hermite (P0, P1, T0, T1): P0 where it starts, P1 where it ends.
-        if (i == 0) simplifier.add({s.control.at(0)[0] * mm, ax > 1 ? s.control.at(1)[0] * mm : 0.0, 0, false});
+        const std::size_t layer = s.subpath < path.subpaths.size() ? path.subpaths[s.subpath].layer : 0;
+        if (i == 0) simplifier.add({s.control.at(0)[0] * mm, ax > 1 ? s.control.at(1)[0] * mm : 0.0, 0, false, layer});
         const double dx = (s.control.at(0)[1] - s.control.at(0)[0]) * mm;
         const double dy = ax > 1 ? (s.control.at(1)[1] - s.control.at(1)[0]) * mm : 0.0;
         const std::size_t bin = std::min(bins - 1, static_cast<std::size_t>(static_cast<double>(tick) / total * static_cast<double>(bins)));
         bin_speed[bin] = std::max(bin_speed[bin], std::hypot(dx, dy) * machine.tick_hz / s.ticks);
         tick += s.ticks;
         if (s.pen_down) drawn_subpaths.insert(s.subpath);
-        simplifier.add({s.control.at(0)[1] * mm, ax > 1 ? s.control.at(1)[1] * mm : 0.0, tick, s.pen_down});
+        simplifier.add({s.control.at(0)[1] * mm, ax > 1 ? s.control.at(1)[1] * mm : 0.0, tick, s.pen_down, layer});
     }
     const std::vector<Vertex> vertices = simplifier.finish();
 
@@ -118,6 +121,8 @@ nlohmann::ordered_json preview_json(const Plan& plan, const Path& path, const Ma
     std::vector<double> xs, ys;
     std::vector<std::uint64_t> ticks;
     std::vector<int> pens;
+    std::vector<std::size_t> layers;
+    layers.reserve(vertices.size());
     xs.reserve(vertices.size());
     ys.reserve(vertices.size());
     ticks.reserve(vertices.size());
@@ -127,8 +132,9 @@ nlohmann::ordered_json preview_json(const Plan& plan, const Path& path, const Ma
         ys.push_back(rounded(v.y, 4));
         ticks.push_back(v.tick);
         pens.push_back(v.pen ? 1 : 0);
+        layers.push_back(v.layer);
     }
-    out["path"] = {{"x", xs}, {"y", ys}, {"tick", ticks}, {"pen", pens}};
+    out["path"] = {{"x", xs}, {"y", ys}, {"tick", ticks}, {"pen", pens}, {"layer", layers}};
     std::vector<double> t, v;
     for (std::size_t b = 0; b < bins; ++b) {
         t.push_back(rounded(plan.duration * (static_cast<double>(b) + 0.5) / static_cast<double>(bins), 4));

@@ -22,9 +22,11 @@ struct PreviewOptions {
 ///    tick_hz, spans, pen_changes, pauses, layers, drawn_length_mm, travel_length_mm) and
 ///    subpaths (the pen-down subpaths planned);
 ///  work_area: the machine's x-y travel box in mm, or null;
-///  path: parallel arrays x, y (mm), tick (the plan's tick at that vertex) and pen (1 when
-///    the piece ending at the vertex draws), from the first span's start point through every
-///    span's end point, merged as `options` says;
+///  path: parallel arrays x, y (mm), tick (the plan's tick at that vertex), pen (1 when
+///    the piece ending at the vertex draws) and layer (the index in summary.layers, which
+///    lists every layer of the drawing whether chosen or not, of the subpath that piece
+///    belongs to; 0 without layers), from the first span's start point through every span's
+///    end point, merged as `options` says (never across a change of pen or layer);
 ///  speed: t (s) and v (mm/s), the fastest span speed in each of up to speed_samples bins;
 ///  pauses: the ticks of the programmed pauses.
 /// Cost: one pass over the spans (a few vertices' work per span). Any thread.

@@ -12,6 +12,7 @@
 #include "drawing_request.hpp"
 #include "pathstream/host/device_link.hpp"
 #include "pathstream/host/device_setup.hpp"
+#include "pathstream/host/placement.hpp"
 #include "serve/web_assets.hpp"
 
 namespace pathstream::host::serve {
@@ -41,6 +42,25 @@ std::string cookie_value(const std::string& cookies, const std::string& name) {
         at = end + 1;
     }
     return "";
+}
+
+void replace_all(std::string& text, const std::string& what, const std::string& with) {
+    if (what.empty()) return;
+    for (std::size_t at = text.find(what); at != std::string::npos; at = text.find(what, at + with.size())) {
+        text.replace(at, what.size(), with);
+    }
+}
+
+// The paper a fit names, where placement puts it (from the machine's origin), with the margin
+// the drawing keeps from its edges; null for no fit or a fit to the work area.
+Json paper_json(const nlohmann::json& options) {
+    if (!options.is_object() || !options.contains("fit") || !options["fit"].is_string()) return nullptr;
+    const std::string fit = options["fit"].get<std::string>();
+    if (fit.empty() || fit == "area") return nullptr;
+    const Box2 b = paper_box(fit);
+    const nlohmann::json margin = options.value("margin", nlohmann::json(0));
+    return Json{{"name", fit},        {"x_min", b.x_min}, {"y_min", b.y_min}, {"x_max", b.x_max},
+                {"y_max", b.y_max}, {"margin_mm", margin.is_number() ? margin.get<double>() : 0.0}};
 }
 
 std::string number_text(double v) {
@@ -127,10 +147,15 @@ std::string Server::drawing_file() const {
     return drawing_name_;
 }
 
-// Messages name the drawing as the page knows it, never the server's directory.
+// Messages name the drawing as the page knows it and never the server's directory (by
+// default a temporary one, gone with the server): the command line's "resume with pathstream
+// stream --resume JOURNAL" is the page's Resume job.
 std::string Server::clean_message(std::string message) const {
-    const std::string dir = (fs::path(config_.state_dir) / "drawing").string() + "/";
-    for (std::size_t at = message.find(dir); at != std::string::npos; at = message.find(dir)) message.erase(at, dir.size());
+    const fs::path state(config_.state_dir);
+    replace_all(message, "pathstream stream --resume " + (state / "job.journal.json").string(), "Resume job on the page");
+    replace_all(message, (state / "drawing").string() + "/", "");
+    replace_all(message, state.string() + "/", "");
+    replace_all(message, state.string(), "the server's state directory");
     return message;
 }
 
@@ -162,7 +187,57 @@ Json Server::plan_preview(const std::vector<std::string>& args) const {
     return p;
 }
 
-Server::Reply Server::upload(const std::string& given_name, const std::string& body) {
+Json Server::placed_preview(const nlohmann::json& options) {
+    try {
+        Json p = plan_preview(arguments(options));
+        p["paper"] = paper_json(options);
+        p["options"] = options.is_object() ? Json(options) : Json::object();
+        const std::lock_guard<std::mutex> lock(preview_mutex_);
+        last_preview_ = p;
+        return p;
+    } catch (...) {
+        // What the pages show is what Start would run: a drawing that cannot be planned has
+        // no preview.
+        const std::lock_guard<std::mutex> lock(preview_mutex_);
+        last_preview_ = nullptr;
+        throw;
+    }
+}
+
+Server::Reply Server::last_preview() const {
+    const std::lock_guard<std::mutex> lock(preview_mutex_);
+    if (last_preview_.is_null()) return {404, error_body("no preview: no drawing is loaded, or it could not be planned")};
+    Json p = last_preview_;
+    p["ok"] = true;
+    return {200, p};
+}
+
+// The whole job's ticks as its first stream planned them (stream --plan-first), kept next to
+// its journal: a resumed job is counted as a part of it.
+void Server::remember_whole_job(const std::string& job_start_line) {
+    try {
+        const nlohmann::json e = nlohmann::json::parse(job_start_line);
+        if (!e.contains("plan_ticks") || !e["plan_ticks"].is_number_unsigned()) return;
+        const std::uint64_t ticks = e["plan_ticks"].get<std::uint64_t>();
+        std::ofstream out(fs::path(config_.state_dir) / "job.whole.json", std::ios::trunc);
+        out << Json{{"plan_ticks", ticks}}.dump() << "\n";
+    } catch (const std::exception&) {
+        // Not a job_start line the page can count on: a resumed job then counts for itself.
+    }
+}
+
+Json Server::whole_job_ticks() const {
+    std::ifstream in(fs::path(config_.state_dir) / "job.whole.json");
+    if (!in) return nullptr;
+    try {
+        const nlohmann::json j = nlohmann::json::parse(in);
+        if (j.contains("plan_ticks") && j["plan_ticks"].is_number_unsigned()) return j["plan_ticks"].get<std::uint64_t>();
+    } catch (const std::exception&) {
+    }
+    return nullptr;
+}
+
+Server::Reply Server::upload(const std::string& given_name, const std::string& body, const nlohmann::json& options) {
     const std::string name = upload_file_name(given_name);
     const fs::path dir = fs::path(config_.state_dir) / "drawing";
     if (job_running()) return {409, error_body("a job is running: wait for it to end, or stop it")};
@@ -174,18 +249,26 @@ Server::Reply Server::upload(const std::string& given_name, const std::string& b
         if (!out.flush()) return {500, error_body("cannot store the drawing")};
         drawing_name_ = name;
     }
-    return preview(Json::object());
+    try {
+        return preview(options);
+    } catch (const std::exception& e) {
+        // Stored but not planned (a reader's error, a placement that does not fit): the page
+        // shows no preview, and other options may place it.
+        Json answer = error_body(clean_message(e.what()));
+        answer["drawing"] = name;
+        return {422, answer};
+    }
 }
 
 Server::Reply Server::preview(const nlohmann::json& options) {
-    Json p = plan_preview(arguments(options));
+    Json p = placed_preview(options);
     p["ok"] = true;
     return {200, p};
 }
 
 bool Server::job_running() const { return job_running_.load(); }
 
-bool Server::start_child(const std::string& kind, std::vector<std::string> argv) {
+bool Server::start_child(const std::string& kind, std::vector<std::string> argv, const Json& whole_ticks) {
     const std::lock_guard<std::mutex> lock(job_mutex_);
     if (job_running_.load() || stopping_.load()) return false;
     if (job_thread_.joinable()) job_thread_.join();
@@ -194,7 +277,12 @@ bool Server::start_child(const std::string& kind, std::vector<std::string> argv)
     stop_requested_.store(false);
     job_running_.store(true);
     for (const char* k : {"job_start", "progress", "job_end", "pause"}) hub_.forget(k);
-    hub_.publish(Json{{"event", "process"}, {"kind", kind}, {"running", true}, {"drawing", drawing_file()}}.dump(),
+    hub_.publish(Json{{"event", "process"},
+                      {"kind", kind},
+                      {"running", true},
+                      {"drawing", drawing_file()},
+                      {"whole_plan_ticks", whole_ticks}}
+                     .dump(),
                  "process");
     job_thread_ = std::thread([this, kind, child = job_.get()] {
         std::string errors, outcome;
@@ -209,6 +297,7 @@ bool Server::start_child(const std::string& kind, std::vector<std::string> argv)
                         if (line.find(std::string("\"outcome\":\"") + o + "\"") != std::string::npos) outcome = o;
                     }
                 }
+                if (sticky == "job_start" && kind == "stream") remember_whole_job(line);
                 hub_.publish(line, sticky);
                 // The stream holds at the first signal and says so; a second one stops it.
                 if (sticky.empty() && stop_requested_.load() &&
@@ -222,7 +311,7 @@ bool Server::start_child(const std::string& kind, std::vector<std::string> argv)
         if (stop_requested_.load() && outcome == "held") {
             const ChildOutput r = run_child({config_.executable, "ctl", config_.target, "stop", "--wait=10"}, config_.state_dir);
             hub_.publish(Json{{"event", "command"}, {"verb", "stop"}, {"ok", r.exit_code == 0},
-                              {"error", r.exit_code == 0 ? "" : last_lines(r.err, 1)}}
+                              {"error", r.exit_code == 0 ? "" : clean_message(last_lines(r.err, 1))}}
                              .dump());
         }
         Json end{{"event", "process"}, {"kind", kind}, {"running", false}, {"exit", exit_code}};
@@ -237,7 +326,7 @@ bool Server::start_child(const std::string& kind, std::vector<std::string> argv)
 Server::Reply Server::run_job(const nlohmann::json& options) {
     if (job_running()) return {409, error_body("a job is running already")};
     const std::vector<std::string> args = arguments(options);
-    Json p = plan_preview(args);  // throws for a drawing that cannot be planned: nothing starts
+    Json p = placed_preview(options);  // throws for a drawing that cannot be planned: nothing starts
     std::vector<std::string> argv = {config_.executable, "stream", drawing_file()};
     argv.insert(argv.end(), args.begin(), args.end());
     // --plan-first: the page shows the job's length from job_start on (web/app.js reads it
@@ -258,7 +347,7 @@ Server::Reply Server::resume() {
     if (!fs::exists(journal)) return {409, error_body("no job journal: nothing was streamed from this page yet")};
     const std::vector<std::string> argv = {config_.executable, "stream", "--resume=" + journal.string(),
                                            "--events=-", "--events-rate=" + number_text(config_.events_rate)};
-    if (!start_child("resume", argv)) return {409, error_body("a job is running already")};
+    if (!start_child("resume", argv, whole_job_ticks())) return {409, error_body("a job is running already")};
     return {200, Json{{"ok", true}}};
 }
 
@@ -329,9 +418,9 @@ Server::Reply Server::control(const nlohmann::json& request) {
             body["result"] = r.out;
         }
     }
-    if (r.exit_code != 0) body["error"] = last_lines(r.err, 1);
+    if (r.exit_code != 0) body["error"] = clean_message(last_lines(r.err, 1));
     hub_.publish(Json{{"event", "command"}, {"verb", verb}, {"ok", r.exit_code == 0},
-                      {"error", r.exit_code == 0 ? "" : last_lines(r.err, 1)}}
+                      {"error", r.exit_code == 0 ? "" : clean_message(last_lines(r.err, 1))}}
                      .dump());
     return {r.exit_code == 0 ? 200 : 422, body};
 }
@@ -453,10 +542,19 @@ void Server::routes() {
     h.Post("/api/drawing", [this](const httplib::Request& req, httplib::Response& res) {
         Reply reply;
         try {
-            reply = upload(req.get_param_value("name"), req.body);
+            nlohmann::json options = nlohmann::json::object();
+            if (req.has_param("options")) options = nlohmann::json::parse(req.get_param_value("options"));
+            reply = upload(req.get_param_value("name"), req.body, options);
+        } catch (const nlohmann::json::parse_error&) {
+            reply = {400, error_body("options: not JSON")};
         } catch (const std::exception& e) {
             reply = {422, error_body(clean_message(e.what()))};
         }
+        res.status = reply.status;
+        res.set_content(reply.body.dump(), "application/json");
+    });
+    h.Get("/api/preview", [this](const httplib::Request&, httplib::Response& res) {
+        const Reply reply = last_preview();
         res.status = reply.status;
         res.set_content(reply.body.dump(), "application/json");
     });

@@ -64,16 +64,23 @@ public:
 private:
     struct Reply;
     void routes();
-    Reply upload(const std::string& name, const std::string& body);
+    Reply upload(const std::string& name, const std::string& body, const nlohmann::json& options);
     Reply preview(const nlohmann::json& options);
     Reply run_job(const nlohmann::json& options);
     Reply simulate(const nlohmann::json& options);
     Reply resume();
+    Reply last_preview() const;
+    /// Plans the drawing with the page's options: the preview with `paper` and `options`,
+    /// kept as the last preview (cleared when planning throws, which it passes on).
+    nlohmann::ordered_json placed_preview(const nlohmann::json& options);
+    void remember_whole_job(const std::string& job_start_line);
+    nlohmann::ordered_json whole_job_ticks() const;
     Reply control(const nlohmann::json& request);
     nlohmann::ordered_json state() const;
     std::vector<std::string> arguments(const nlohmann::json& options) const;
     nlohmann::ordered_json plan_preview(const std::vector<std::string>& args) const;
-    bool start_child(const std::string& kind, std::vector<std::string> argv);
+    bool start_child(const std::string& kind, std::vector<std::string> argv,
+                     const nlohmann::ordered_json& whole_ticks = nullptr);
     bool job_running() const;
     void poll_device();
     std::string drawing_file() const;
@@ -94,6 +101,8 @@ private:
     mutable std::mutex drawing_mutex_;
     std::string drawing_name_;         ///< the stored drawing's file name; empty: none
     mutable std::mutex plan_mutex_;    ///< one plan at a time (they are CPU-bound)
+    mutable std::mutex preview_mutex_;
+    nlohmann::ordered_json last_preview_;  ///< the last preview answered; null: none
 
     mutable std::mutex job_mutex_;
     std::unique_ptr<ChildProcess> job_;
