@@ -119,6 +119,7 @@ expect sim-switch-twice 2 "--sim-switch x-: given twice" -- "$bin" device -m "$v
 expect sim-switch-form 2 "want NAME=POSITION" -- "$bin" device -m "$vm_profile" --sim-switch x-
 expect sim-switch-position 2 "--sim-switch x-: 'abc' is not a number" -- "$bin" device -m "$vm_profile" --sim-switch x-=abc
 expect stream-lead-in-can 6 "nosuchcan0: no such interface" -- "$bin" stream "$src/examples/rose.json" -m "$machine" -t "can://nosuchcan0?node=1" --lead-in
+expect margin-without-fit 2 "--margin requires --fit" -- "$bin" check "$src/examples/landscape.svg" --margin 10
 expect stream-lead-in-twice 2 "--lead-in excludes --no-lead-in" -- "$bin" stream "$src/examples/rose.json" -m "$machine" -t "modbus-tcp://127.0.0.1:1" --lead-in --no-lead-in
 expect stream-lead-in-cia402 2 "--lead-in: CiA 402 drives must stand at the drawing's first point" -- "$bin" stream "$src/examples/rose.json" -m "$machine" -t "can://vcan0?node=1&protocol=cia402" --lead-in
 expect stream-resume-lead-in 2 "--resume: --no-lead-in does not apply" -- "$bin" stream --resume "$src/examples/rose.json" --no-lead-in

@@ -61,11 +61,12 @@ void add_path_options(CLI::App& command, PathOptions& o) {
     command.add_flag("--flip-y", o.placement.flip_y, "placement: mirror y (y -> -y)");
     command.add_option("--scale", o.placement.scale, "placement: scale x and y by this factor about the origin")
         ->check(CLI::PositiveNumber);
-    command.add_option("--fit", o.placement.fit,
+    CLI::Option* fit = command.add_option("--fit", o.placement.fit,
                        "placement: scale (keeping the aspect) and align into: area (the machine's work area, needs "
                        "--machine) or a paper a0..a6, letter, legal, tabloid (add -landscape)");
     command.add_option("--margin", o.placement.margin, "placement: mm kept free on every side with --fit")
-        ->check(CLI::NonNegativeNumber);
+        ->check(CLI::NonNegativeNumber)
+        ->needs(fit);
     command.add_option("--align", o.placement.align,
                        "placement: where in the --fit box (default center); without --fit, that point of the drawing "
                        "goes to (0, 0)")

@@ -8,8 +8,12 @@
 
 namespace pathstream::host {
 
-/// Writes to "PATH.tmp-XXXX" and renames onto PATH in commit(); a writer destroyed without
+/// Writes to "PATH.tmp-PID" and renames onto PATH in commit(); a writer destroyed without
 /// commit() (an error, an exception) removes its temporary file, so PATH is never half-written.
+/// A SIGINT, SIGTERM or SIGHUP that would end the process while the file is open (no other
+/// handler installed) removes it too, then ends the process as the signal would have. One
+/// AtomicFile at a time per process has that protection (the commands write one at a time);
+/// construct and destroy it from the main thread.
 class AtomicFile {
 public:
     explicit AtomicFile(std::string path);
@@ -26,6 +30,7 @@ private:
     std::string temp_;
     std::ofstream out_;
     bool committed_ = false;
+    bool guarded_ = false;  ///< this file's temporary name is the one the signal handler removes
 };
 
 /// Runs `write` on standard output when `output` is "-" (or empty: the command's default
