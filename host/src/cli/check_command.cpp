@@ -11,6 +11,8 @@
 
 #include "pathstream/host/layers.hpp"
 #include "pathstream/host/geometry.hpp"
+#include "pathstream/host/input_error.hpp"
+#include "pathstream/host/work_area.hpp"
 
 namespace pathstream::host {
 
@@ -209,6 +211,17 @@ int run_check(const CheckOptions& o) {
     const std::optional<MachineProfile> machine =
         o.machine.empty() ? std::nullopt : std::optional<MachineProfile>(load_machine_profile(o.machine));
     const LoadedPath loaded = load_path_report(o.path, machine ? &*machine : nullptr);
+    if (machine) {
+        // What plan and stream would refuse first, checked here too: the axes, then the travel.
+        if (machine->axes.size() != loaded.path.axes) {
+            throw InputError(o.machine, {}, "the machine has " + std::to_string(machine->axes.size()) +
+                                                " axes but " + o.path.file + " has " +
+                                                std::to_string(loaded.path.axes));
+        }
+        for_each_bezier_segment(loaded.path, [&](const BezierSegment& s) {
+            check_segment_work_area(s, loaded.path, *machine, o.path.file);
+        });
+    }
     const CheckFigures figures = measure(loaded.path);
     if (o.json) {
         std::cout << summary_json(o, loaded, figures).dump(2) << '\n';

@@ -32,30 +32,33 @@ SourceLocation location_of(const Path& path, std::size_t subpath) {
 
 }  // namespace
 
-void check_work_area(const std::vector<BezierSegment>& segments, const Path& path,
-                     const MachineProfile& profile, const std::string& file) {
+void check_segment_work_area(const BezierSegment& s, const Path& path,
+                             const MachineProfile& profile, const std::string& file) {
+    if (!s.pen_down) return;
     const std::size_t axes = profile.axes.size();
-    for (const BezierSegment& s : segments) {
-        if (!s.pen_down) continue;
-        for (std::size_t a = 0; a < axes && a < s.p[0].size(); ++a) {
-            const AxisLimits& l = profile.axes[a];
-            if (!l.has_travel) continue;
-            for (double t : extreme_parameters(s, a)) {
-                const double v = bezier_point(s, t)[a];
-                if (v >= l.travel_min - 1e-6 && v <= l.travel_max + 1e-6) continue;
-                throw InputError(file, location_of(path, s.subpath),
-                                 "subpath " + std::to_string(s.subpath + 1) +
-                                     " leaves the work area: it reaches " + l.name + " = " + mm(v) +
-                                     " mm at " + point_text(s, t, axes) + "; " + l.name +
-                                     " travel is " + mm(l.travel_min) + " .. " + mm(l.travel_max) +
-                                     " mm (" + profile.source + ")");
-            }
+    for (std::size_t a = 0; a < axes && a < s.p[0].size(); ++a) {
+        const AxisLimits& l = profile.axes[a];
+        if (!l.has_travel) continue;
+        for (double t : extreme_parameters(s, a)) {
+            const double v = bezier_point(s, t)[a];
+            if (v >= l.travel_min - 1e-6 && v <= l.travel_max + 1e-6) continue;
+            throw InputError(file, location_of(path, s.subpath),
+                             "subpath " + std::to_string(s.subpath + 1) +
+                                 " leaves the work area: it reaches " + l.name + " = " + mm(v) +
+                                 " mm at " + point_text(s, t, axes) + "; " + l.name +
+                                 " travel is " + mm(l.travel_min) + " .. " + mm(l.travel_max) +
+                                 " mm (" + profile.source + ")");
         }
     }
 }
 
-void check_span_travel(const CoreSpan& s, std::size_t index, const Path& path, const MachineProfile& profile,
-                       const std::string& file) {
+void check_work_area(const std::vector<BezierSegment>& segments, const Path& path,
+                     const MachineProfile& profile, const std::string& file) {
+    for (const BezierSegment& s : segments) check_segment_work_area(s, path, profile, file);
+}
+
+void check_span_travel(const CoreSpan& s, std::size_t index, const Path& path,
+                       const MachineProfile& profile, const std::string& file) {
     const bool any = std::any_of(profile.axes.begin(), profile.axes.end(),
                                  [](const AxisLimits& l) { return l.has_travel; });
     if (!any) return;
@@ -70,10 +73,10 @@ void check_span_travel(const CoreSpan& s, std::size_t index, const Path& path, c
         const double from = s.control[a][0] * profile.mm_per_lsb;
         throw InputError(
             file, location_of(path, s.subpath),
-            "planned span " + std::to_string(index + 1) + " (subpath " + std::to_string(s.subpath + 1) +
-                (s.pen_down ? "" : ", pen-up travel") + ", from " + axis.name + " = " + mm(from) +
-                " mm) could leave the " + axis.name + " travel " + mm(axis.travel_min) + " .. " +
-                mm(axis.travel_max) +
+            "planned span " + std::to_string(index + 1) + " (subpath " +
+                std::to_string(s.subpath + 1) + (s.pen_down ? "" : ", pen-up travel") + ", from " +
+                axis.name + " = " + mm(from) + " mm) could leave the " + axis.name + " travel " +
+                mm(axis.travel_min) + " .. " + mm(axis.travel_max) +
                 " mm, and the device would refuse it: the path runs within the chord tolerance (" +
                 mm(profile.chord_tolerance) + " mm) of the edge; move it inside by that much");
     }
@@ -81,7 +84,8 @@ void check_span_travel(const CoreSpan& s, std::size_t index, const Path& path, c
 
 void check_plan_travel(const Plan& plan, const Path& path, const MachineProfile& profile,
                        const std::string& file) {
-    for (std::size_t i = 0; i < plan.spans.size(); ++i) check_span_travel(plan.spans[i], i, path, profile, file);
+    for (std::size_t i = 0; i < plan.spans.size(); ++i)
+        check_span_travel(plan.spans[i], i, path, profile, file);
 }
 
 }  // namespace pathstream::host

@@ -13,6 +13,11 @@
 
 namespace pathstream::host {
 
+/// check_work_area for one segment (nothing for pen-up travel): for readers that visit the
+/// segments one at a time (for_each_bezier_segment) and keep none.
+void check_segment_work_area(const BezierSegment& segment, const Path& path,
+                             const MachineProfile& profile, const std::string& file);
+
 /// Throws InputError "FILE:LINE:COL: subpath K leaves the work area: ..." for the first
 /// pen-down segment of `segments` whose curve (its exact extremes per axis, not its control
 /// points) goes beyond an axis's travel by more than 1 nm. `path` gives the subpaths'
@@ -23,8 +28,8 @@ void check_work_area(const std::vector<BezierSegment>& segments, const Path& pat
 
 /// check_plan_travel for one span (`index` counts from 0, for the message), as a streamed
 /// plan comes out.
-void check_span_travel(const CoreSpan& span, std::size_t index, const Path& path, const MachineProfile& profile,
-                       const std::string& file);
+void check_span_travel(const CoreSpan& span, std::size_t index, const Path& path,
+                       const MachineProfile& profile, const std::string& file);
 
 /// Throws InputError naming the subpath when a planned span could leave an axis's travel by
 /// the device's proof (device::check_axis_travel on the span's exact cubic): the spans follow
