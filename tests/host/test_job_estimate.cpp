@@ -6,6 +6,7 @@
 #include <memory>
 #include <string>
 
+#include "pathstream/host/core_spans.hpp"
 #include "pathstream/host/events.hpp"
 #include "pathstream/host/job_estimate.hpp"
 #include "pathstream/host/machine.hpp"
@@ -100,4 +101,31 @@ TEST_CASE("progress events: an estimate while planning, the whole drawing after 
     CHECK(q->fraction == Approx(2500.0 / 4000.0));
     CHECK(q->ticks_left == 1500);
     channel.writer.reset();
+}
+
+TEST_CASE("the bar's pen is the device's output: up at a pause inside a pen-down job",
+          "[host][events]") {
+    const MachineProfile m = two_axes();
+    EventChannel channel;
+    JobEvents events(channel, m, {"stream", "d.svg", "modbus-tcp://x", 1});
+    CoreSpan span;
+    span.ticks = 100;
+    span.pen_down = true;
+    events.add_span(span);
+    events.add_span(span);
+    JobSample s;
+    s.state = 1;  // running
+    s.started = true;
+    s.next_span = 1;
+    s.ticks = 150;
+    s.pen_output = true;
+    events.sample(s);
+    CHECK(events.status_text().find("pen down") != std::string::npos);
+    s.state = 2;  // holding at a programmed pause: the device raised the pen
+    s.pen_output = false;
+    events.sample(s);
+    CHECK(events.status_text().find("pen up") != std::string::npos);
+    s.pen_output.reset();  // no status of the pen (sim): the span's
+    events.sample(s);
+    CHECK(events.status_text().find("pen down") != std::string::npos);
 }

@@ -158,6 +158,7 @@ void JobEvents::start(std::optional<std::uint32_t> job) {
 
 void JobEvents::sample(const JobSample& s) {
     sim_seconds_ = s.sim_seconds;
+    pen_output_ = s.pen_output;
     if (first_sample_) {
         // A held job continues: the spans before this one were entered in an earlier run.
         entered_ = static_cast<long long>(s.next_span) - 1;
@@ -334,6 +335,7 @@ void JobEvents::trace(const StreamTrace& t) {
     std::copy(d.position, d.position + kMaxAxes, s.position);
     s.hold_requested = t.hold_requested;
     s.stop_requested = t.stop_requested;
+    s.pen_output = d.pen_down();
     sample(s);
 }
 
@@ -367,7 +369,7 @@ std::string JobEvents::status_text() const {
     const auto add = [&](const std::string& part) { text += (text.empty() ? "" : ", ") + part; };
     if (subpath_)
         add("subpath " + std::to_string(*subpath_ + 1) + "/" + std::to_string(info_.subpaths));
-    if (running_seen_) add(pen_down_ ? "pen down" : "pen up");
+    if (running_seen_) add(pen_output_.value_or(pen_down_) ? "pen down" : "pen up");
     if (state_) add(device_state_name(*state_));
     return text;
 }

@@ -78,6 +78,7 @@ struct JobSample {
     Lsb position[kMaxAxes] = {};           ///< setpoints, LSB per axis
     bool hold_requested = false;           ///< an interrupt asked for a hold
     bool stop_requested = false;           ///< an interrupt (or the hold timeout) for a stop
+    std::optional<bool> pen_output;        ///< the device's pen output now; sim: none
 };
 
 /// Turns samples of one job into events (docs/events.md) and keeps what the stream's progress
@@ -130,7 +131,9 @@ public:
     void end(const std::string& outcome, const std::string& error = "",
              std::optional<std::uint64_t> ticks = std::nullopt);
 
-    /// "subpath 2/5, pen down, running": the progress bar's detail (empty parts left out).
+    /// "subpath 2/5, pen down, running": the progress bar's detail (empty parts left out). The
+    /// pen is the device's output when its status says (at a pause it rests pen up inside a
+    /// pen-down job), else that of the span executing.
     std::string status_text() const;
 
 private:
@@ -163,6 +166,7 @@ private:
     std::optional<std::uint64_t> total_spans_, total_pauses_;
     std::uint64_t ticks_before_job_ = 0;
     std::function<std::optional<std::uint64_t>()> estimate_;
+    std::optional<bool> pen_output_;     ///< of the last sample: what status_text() says
     std::optional<double> sim_seconds_;  ///< of the last sample (sim events carry it)
     bool started_event_ = false, ended_ = false;
     double start_t_ = 0;
