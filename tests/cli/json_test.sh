@@ -76,7 +76,7 @@ same("basis", find(r"0: (\w+),")[0], doc["subpaths"][0]["basis"])
 
 run plan plan "$src/examples/rose.json" -m "$machine"
 compare plan '
-dur, ticks, hz, spans, pens = find(r"motion: (\S+) s \((\d+) ticks at (\S+) Hz\), (\d+) spans, (\d+) pen changes")
+dur, ticks, hz, spans, pens = find(r"motion: (\S+) s \((\d+) ticks at (\S+) Hz\), (\d+) spans, (\d+) pen lifts and lowers")
 same("duration", dur, "%.3f" % doc["duration_s"]); same("ticks", ticks, doc["ticks"])
 same("tick rate", hz, "%g" % doc["tick_hz"]); same("spans", spans, doc["spans"])
 same("pen changes", pens, doc["pen_changes"])
@@ -108,7 +108,7 @@ same("lsb", lsb, "%.6g" % doc["machine"]["mm_per_lsb"])
 same("plant", find(r"plant +(.*)$")[0], doc["plant"]["description"])
 planned, simulated = find(r"duration +(\S+) s planned; (\S+) s simulated")
 same("planned", planned, "%.3f" % doc["planned_duration_s"]); same("simulated", simulated, "%.3f" % doc["simulated_duration_s"])
-drawn, travel, switches = find(r"path +(\S+) mm pen-down, (\S+) mm travel, (\d+) pen switches")
+drawn, travel, switches = find(r"path +(\S+) mm pen-down, (\S+) mm travel, (\d+) pen lifts and lowers")
 same("drawn", drawn, "%.2f" % doc["drawn_length_mm"]); same("travel", travel, "%.2f" % doc["travel_length_mm"])
 same("switches", switches, doc["pen_switches"])
 downs, ups, down_s, pct, dwell = find(r"pen +(\d+) down, (\d+) up; down (\S+) s \((\d+) %\), dwells (\S+) s")

@@ -142,7 +142,7 @@ out=$("$bin" stream "$src/examples/two_pens.svg" -m "$machine" -t "$target" --jo
 [ -z "$(ls "$work"/nl.json* 2>/dev/null)" ] && ok || fail "--no-lead-in left files: $(ls "$work"/nl.json*)"
 out=$("$bin" stream "$src/examples/two_pens.svg" -m "$machine" -t "$target" --journal "$work/nl.json" \
   --pause none < /dev/null 2>&1); rc=$?
-[ $rc -eq 0 ] && [[ "$out" == *"lead-in       from the device's rest position x 139.3220 mm y 100.0000 mm"* ]] && ok ||
+[ $rc -eq 0 ] && [[ "$out" == *"lead-in       pen up from where the device rests, x 139.3220 mm y 100.0000 mm, to the drawing's start"* ]] && ok ||
   fail "the default lead-in: exit $rc: $out"
 [ -f "$work/nl.json" ] && [ -f "$work/nl.json.plan" ] && ok || fail "a finished stream kept no journal"
 stop_device

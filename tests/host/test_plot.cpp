@@ -521,7 +521,7 @@ TEST_CASE("the report shows the run's figures", "[plot]") {
                                "(64x)",
                                "120.00 mm pen-down",
                                "40.00 mm travel",
-                               "2 pen switches",
+                               "2 pen lifts and lowers",
                                "3201 ticks",
                                "400 spans",
                                "0 underruns",
@@ -601,6 +601,6 @@ TEST_CASE("a drawing simulated on the servo plant, plotted and reported end to e
             CHECK(fs::file_size(f) < 400000);
     }
     const std::string report = plot::text_report(plan, nullptr, m, setpoints, sim::run_summary(r));
-    CHECK(report.find("4 pen switches") != std::string::npos);
+    CHECK(report.find("4 pen lifts and lowers") != std::string::npos);
     if (keep != nullptr) std::ofstream(out / "report.txt") << report;
 }

@@ -88,7 +88,7 @@ void print_plan_summary(const PlannedJob& job, std::ostream& out) {
     const PlanCheck& c = job.check;
     char line[256];
     std::snprintf(line, sizeof line,
-                  "  motion: %.3f s (%llu ticks at %g Hz), %zu spans, %zu pen changes\n",
+                  "  motion: %.3f s (%llu ticks at %g Hz), %zu spans, %zu pen lifts and lowers\n",
                   job.plan.duration, static_cast<unsigned long long>(job.plan.total_ticks),
                   job.machine.tick_hz, job.span_count, job.pen_count);
     out << line;

@@ -472,6 +472,28 @@ private:
     std::string journal_;
 };
 
+// Says where the job starts: at the device's rest position, or after a pen-up lead-in from it
+// (prepare_job put one first when the two differ on the LSB grid).
+void print_lead_in(const PlannedJob& job, const std::vector<double>& rest_mm) {
+    std::string at;
+    char value[48];
+    for (std::size_t a = 0; a < rest_mm.size() && a < job.machine.axes.size(); ++a) {
+        std::snprintf(value, sizeof value, " %s %.4f mm", job.machine.axes[a].name.c_str(),
+                      rest_mm[a]);
+        at += value;
+    }
+    const bool moved = !job.segments.empty() && !job.segments.front().pen_down &&
+                       job.segments.size() > 1 &&
+                       job.segments.front().p[0] == PathPoint(rest_mm.begin(), rest_mm.end());
+    if (moved) {
+        std::printf("lead-in       pen up from where the device rests,%s, to the drawing's start\n",
+                    at.c_str());
+    } else {
+        std::printf("start         the device rests at the drawing's start,%s: no lead-in\n",
+                    at.c_str());
+    }
+}
+
 // A line typed at the terminal (Enter) since the last look; never waits.
 bool enter_pressed() {
     pollfd p{STDIN_FILENO, POLLIN, 0};
@@ -988,13 +1010,7 @@ int run_stream(const StreamCommandOptions& o) {
             rest = modbus_rest_position(machine, o.stream);
         }
         for (const Lsb p : rest) rest_mm.push_back(p * machine.mm_per_lsb);
-        if (lead_in) {
-            std::printf("lead-in       from the device's rest position");
-            for (std::size_t a = 0; a < rest_mm.size(); ++a) {
-                std::printf(" %s %.4f mm", machine.axes[a].name.c_str(), rest_mm[a]);
-            }
-            std::printf(" (none when it rests at the drawing's start)\n");
-        } else {
+        if (!lead_in) {
             for (std::size_t a = 0; a < rest_mm.size(); ++a) {
                 path.order_start += (a ? "," : "") + exact_decimal(rest_mm[a]);
             }
@@ -1009,6 +1025,7 @@ int run_stream(const StreamCommandOptions& o) {
     const JobFilesGuard files(journal_path);
     if (cia402 || o.plan_first) {
         const PlannedJob planned = plan_job(path, o.machine, lead_in ? &rest_mm : nullptr);
+        if (lead_in) print_lead_in(planned, rest_mm);
         if (g_interrupts.load() > 0) {
             std::printf("interrupted   while planning: nothing was sent to the device\n");
             return kExitInterrupted;
@@ -1032,8 +1049,9 @@ int run_stream(const StreamCommandOptions& o) {
             std::filesystem::absolute(journal_path + ".input").string());
         journal.replan = job_recipe_json(recipe);
     }
-    return stream_while_planning(prepare_job(path, o.machine, lead_in ? &rest_mm : nullptr), o,
-                                 journal, journal_path, channel);
+    const PlannedJob prepared = prepare_job(path, o.machine, lead_in ? &rest_mm : nullptr);
+    if (lead_in) print_lead_in(prepared, rest_mm);
+    return stream_while_planning(prepared, o, journal, journal_path, channel);
 }
 
 }  // namespace pathstream::host

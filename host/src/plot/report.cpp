@@ -147,7 +147,7 @@ std::string text_report(const Plan& plan, const PlanCheck* check, const MachineP
         o << " (" << fmt("%.3g", run.simulated_seconds / run.wall_seconds) << "x)";
     o << (run.realtime ? ", paced" : "") << "\n";
     o << "  path       " << fmt("%.2f", plan.path_length) << " mm pen-down, "
-      << fmt("%.2f", plan.travel_length) << " mm travel, " << run.pen_switches << " pen switches\n";
+      << fmt("%.2f", plan.travel_length) << " mm travel, " << run.pen_switches << " pen lifts and lowers\n";
     {
         const double total = static_cast<double>(f.executed_ticks);
         const double down_ticks = static_cast<double>(f.pen_down_ticks);
