@@ -183,6 +183,7 @@ void for_each_bezier_segment(const Path& path, const std::function<void(const Be
             seg.dwell_pen_down = first && sp.dwell_pen_down;
             while (stops && next_stop != sp.stops.end() && *next_stop < joint) ++next_stop;
             seg.stop_before = stops && !first && next_stop != sp.stops.end() && *next_stop == joint;
+            seg.segment = static_cast<std::uint32_t>(joint);
             ++joint;
             first = false;
             any = true;

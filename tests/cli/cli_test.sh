@@ -120,7 +120,7 @@ expect sim-switch-form 2 "want NAME=POSITION" -- "$bin" device -m "$vm_profile" 
 expect sim-switch-position 2 "--sim-switch x-: 'abc' is not a number" -- "$bin" device -m "$vm_profile" --sim-switch x-=abc
 expect stream-lead-in-can 6 "nosuchcan0: no such interface" -- "$bin" stream "$src/examples/rose.json" -m "$machine" -t "can://nosuchcan0?node=1" --lead-in
 printf 'G21 G90\nG0 X10 Y10\nG1 Z-1 F1000\nG1 X50 Y10\nG1 X500 Y10\n' > "$work/wide.ngc"
-expect check-machine-travel 1 "wide.ngc:4:1: subpath 1 leaves the work area: it reaches x = 500.000 mm" -- \
+expect check-machine-travel 1 "wide.ngc:5:1: subpath 1 leaves the work area: it reaches x = 500.000 mm" -- \
   "$bin" check "$work/wide.ngc" -m "$src/examples/machines/a3_plotter.json"
 expect margin-without-fit 2 "--margin requires --fit" -- "$bin" check "$src/examples/landscape.svg" --margin 10
 expect stream-lead-in-twice 2 "--lead-in excludes --no-lead-in" -- "$bin" stream "$src/examples/rose.json" -m "$machine" -t "modbus-tcp://127.0.0.1:1" --lead-in --no-lead-in

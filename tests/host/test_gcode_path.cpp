@@ -7,7 +7,11 @@
 #include <string>
 
 #include "pathstream/host/gcode_path.hpp"
+#include "pathstream/host/geometry.hpp"
 #include "pathstream/host/input_error.hpp"
+#include "pathstream/host/machine.hpp"
+#include "pathstream/host/path_order.hpp"
+#include "pathstream/host/work_area.hpp"
 
 using namespace pathstream::host;
 
@@ -653,4 +657,37 @@ TEST_CASE("G-code: bad options and missing files", "[host][gcode]") {
     CHECK_THROWS_AS(gcode("G0 Z-1\nG1 X1", z), std::invalid_argument);
     CHECK_THROWS_WITH(load_gcode_path("/nonexistent/p.ngc"),
                       "/nonexistent/p.ngc: cannot open file");
+}
+
+TEST_CASE("G-code keeps each move's line: a travel error names the move that crosses", "[gcode][workarea]") {
+    MachineProfile m;
+    m.tick_hz = 1000;
+    m.mm_per_lsb = 0.001;
+    m.axes = {{"x", 200, 2000, true, 0, 430}, {"y", 200, 2000, true, 0, 297}};
+    m.source = "m.json";
+    const Path path = parse_gcode_path("G21 G90\nG0 X10 Y10\nG1 Z-1 F1000\nG1 X50 Y10\nG2 X90 Y10 I20 J0\n"
+                                       "G1 X500 Y10\nG1 X10 Y20\n",
+                                       "t.ngc");
+    REQUIRE(path.subpaths.size() == 1);
+    const Subpath& run = path.subpaths[0];
+    REQUIRE(run.segment_lines.size() == chain_segments(run));
+    CHECK(run.segment_lines.front() == 4);
+    CHECK(run.segment_lines.back() == 7);
+    try {
+        check_work_area(to_bezier_segments(path), path, m, "t.ngc");
+        FAIL("x 500 mm passed a 430 mm travel");
+    } catch (const InputError& e) {
+        CHECK_THAT(e.what(), Catch::StartsWith("t.ngc:6:1: subpath 1 leaves the work area"));
+    }
+    // Reversed, each segment keeps its line: the first crossing met is now line 7's move, which
+    // leaves x 500 mm (line 6's comes after it).
+    Path reversed = path;
+    reversed.subpaths[0] = reversed_subpath(run);
+    CHECK(reversed.subpaths[0].segment_lines.front() == 7);
+    try {
+        check_work_area(to_bezier_segments(reversed), reversed, m, "t.ngc");
+        FAIL("x 500 mm passed a 430 mm travel");
+    } catch (const InputError& e) {
+        CHECK_THAT(e.what(), Catch::StartsWith("t.ngc:7:1:"));
+    }
 }

@@ -66,6 +66,8 @@ void RunBuilder::draw(const Cubic& piece, double feed_mm_s, SourceLocation at,
         throw std::logic_error("RunBuilder::draw: piece does not start where the run ends");
     }
     Subpath& run = done_.back();
+    // One curve segment per piece, as a polyline and as a Bezier chain alike.
+    run.segment_lines.push_back(static_cast<std::uint32_t>(at.line));
     if (run.basis == PathBasis::kPolyline && is_line_piece(piece)) {
         run.points.push_back(point(piece.p[3]));  // the planner makes the same cubic of it
         return;

@@ -42,6 +42,7 @@ Subpath rotated_open_loop(const Subpath& s, std::size_t shift) {
     if (shift == 0) return s;
     Subpath r = s;
     r.points.clear();
+    r.segment_lines.clear();
     r.points.append(s.points, shift, s.points.size());
     r.points.append(s.points, 1, shift + 1);
     return r;
@@ -50,6 +51,7 @@ Subpath rotated_open_loop(const Subpath& s, std::size_t shift) {
 /// rotated_open_loop in place: the same points, none copied but Q[shift] once.
 void rotate_open_loop(Subpath& s, std::size_t shift) {
     if (shift == 0) return;
+    s.segment_lines.clear();
     s.points.erase_front(1);  // Q[1..m-1]
     s.points.rotate(shift - 1);
     s.points.push_back(s.points.front());  // Q[shift..m-1], Q[1..shift]
@@ -74,6 +76,7 @@ void renumber_stops(Subpath& r, long long sign, long long shift) {
 void reverse_points(Subpath& r) {
     r.points.reverse(r.closed ? 1 : 0);
     renumber_stops(r, -1, static_cast<long long>(chain_segments(r)));
+    std::reverse(r.segment_lines.begin(), r.segment_lines.end());  // segment k is now n - 1 - k
 }
 
 /// rotated_subpath in place (its checks and messages).
@@ -84,6 +87,7 @@ void rotate_points(Subpath& r, std::size_t shift) {
         throw std::invalid_argument("rotated_subpath: a Bezier chain starts only at on-curve points (shift " +
                                     std::to_string(shift) + " is not a multiple of 3)");
     }
+    r.segment_lines.clear();
     r.points.rotate(shift);
     renumber_stops(r, 1, -static_cast<long long>(r.basis == PathBasis::kBezier ? shift / 3 : shift));
 }
@@ -663,6 +667,7 @@ Path merge_touching(const Path& path, double tolerance, std::size_t* merged) {
         out.subpaths.push_back(in[a]);
         if (!joinable(in[a])) continue;
         Subpath& chain = out.subpaths.back();
+        const std::size_t joins_before = joins;
         for (;;) {  // forward from the chain's last point
             const auto [b, side] = find(chain, chain.points.back());
             if (b == in.size()) break;
@@ -681,6 +686,7 @@ Path merge_touching(const Path& path, double tolerance, std::size_t* merged) {
             same_basis(chain, prev);
             chain.points.prepend(prev.points, 0, prev.points.size() - 1);
         }
+        if (joins != joins_before) chain.segment_lines.clear();  // joined: the lines no longer match
     }
     if (merged != nullptr) *merged = joins;
     return out;

@@ -30,6 +30,17 @@ SourceLocation location_of(const Path& path, std::size_t subpath) {
     return subpath < path.subpaths.size() ? path.subpaths[subpath].location : SourceLocation{};
 }
 
+// The move a segment comes from where the reader kept it (G-code), else its subpath's start.
+SourceLocation location_of(const Path& path, const BezierSegment& s) {
+    if (s.subpath < path.subpaths.size()) {
+        const Subpath& sp = path.subpaths[s.subpath];
+        if (sp.segment_lines.size() == chain_segments(sp) && s.segment < sp.segment_lines.size()) {
+            return {sp.segment_lines[s.segment], 1};
+        }
+    }
+    return location_of(path, s.subpath);
+}
+
 }  // namespace
 
 void check_segment_work_area(const BezierSegment& s, const Path& path,
@@ -42,7 +53,7 @@ void check_segment_work_area(const BezierSegment& s, const Path& path,
         for (double t : extreme_parameters(s, a)) {
             const double v = bezier_point(s, t)[a];
             if (v >= l.travel_min - 1e-6 && v <= l.travel_max + 1e-6) continue;
-            throw InputError(file, location_of(path, s.subpath),
+            throw InputError(file, location_of(path, s),
                              "subpath " + std::to_string(s.subpath + 1) +
                                  " leaves the work area: it reaches " + l.name + " = " + mm(v) +
                                  " mm at " + point_text(s, t, axes) + "; " + l.name +

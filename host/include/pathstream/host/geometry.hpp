@@ -16,6 +16,7 @@ struct BezierSegment {
     std::array<PathPoint, 4> p;
     bool pen_down = true;     ///< false: pen-up travel between subpaths
     std::size_t subpath = 0;  ///< index into Path::subpaths (travel: the subpath it leads to)
+    std::uint32_t segment = 0;  ///< the subpath's curve segment it is (0 for travel)
     double feed = 0;          ///< requested speed, mm/s (Subpath::feed); 0: the machine profile's
                               ///< feed (travel_feed for pen-up travel)
     /// Set on a subpath's first drawing segment only (Subpath's fields of the same names): a

@@ -57,6 +57,10 @@ struct Subpath {
     /// where the subpath's curve segment k starts (a polyline's point k, a Bezier chain's
     /// point 3k). Other bases and modes: empty.
     std::vector<std::uint32_t> stops{};
+    /// G-code: the program line of each curve segment (chain_segments of them), so that an
+    /// error names the move, not the subpath's first line. Empty from the other readers, and
+    /// after an order step that rotates or joins the subpath (reversing keeps them).
+    std::vector<std::uint32_t> segment_lines{};
 };
 
 /// Curve segments of a polyline or Bezier chain: the joints Subpath::stops counts lie between
