@@ -1,7 +1,7 @@
 # An operator's session over native CAN on a real kernel (runs inside the VM; helpers from
 # sim/vm/vm_lib.sh): `pathstream device --can vcan0 --node 5` in the background, then
 # `pathstream ctl` status, jog and set position, a stream interrupted by SIGINT (the device
-# holds at rest, exit 7) and continued with `stream --resume`, and a `--lead-in` stream that
+# holds at rest, exit 7) and continued with `stream --resume`, and a stream with the lead-in that
 # reads the device's rest position from status frame E.
 iface=vcan0
 data=/pathstream/data
@@ -47,10 +47,12 @@ elif [ "$rc" != 0 ]; then
 fi
 grep -q '"outcome": "finished"' j.json || vm_fail "journal at the end: $(cat j.json)"
 
-# The device rests at wave.json's end (60, 0): a lead-in from there over CAN.
-vm_expect 0 pathstream stream "$data/wave.json" -m "$data/pen_plotter.json" -t "$target" --lead-in --no-journal \
-  > s3.out 2>&1 || { cat s3.out; vm_fail "--lead-in over CAN failed"; }
-grep -q '^lead-in       from the device.s rest position x 60.0000 mm y 0.0000 mm' s3.out || vm_fail "lead-in: $(cat s3.out)"
+# The device rests at wave.json's end (60, 0): drawn in the file's direction (--keep-order; the
+# order would start at the nearer end), the default lead-in goes from there to (0, 0) over CAN.
+vm_expect 0 pathstream stream "$data/wave.json" -m "$data/pen_plotter.json" -t "$target" --keep-order --no-journal \
+  > s3.out 2>&1 || { cat s3.out; vm_fail "the lead-in over CAN failed"; }
+grep -q '^lead-in       pen up from where the device rests, x 60.0000 mm y 0.0000 mm, to the drawing.s start' s3.out ||
+  vm_fail "lead-in: $(cat s3.out)"
 
 kill -INT "$dev"
 wait "$dev"
