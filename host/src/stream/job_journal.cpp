@@ -344,7 +344,10 @@ JobSpans read_job_spans(const std::string& path, const std::string& expected_has
     if (!in) throw InputError(path, {}, "cannot open the job's spans");
     std::ostringstream whole;
     whole << in.rdbuf();
-    const std::string contents = whole.str();
+    return parse_job_spans(whole.str(), path, expected_hash);
+}
+
+JobSpans parse_job_spans(const std::string& contents, const std::string& path, const std::string& expected_hash) {
     if (!expected_hash.empty() && fnv1a_hex(contents) != expected_hash) {
         throw InputError(path, {},
                          "the job's spans changed since the journal was written (hash " +
@@ -434,7 +437,10 @@ JobJournal read_journal(const std::string& path) {
     if (!in) throw InputError(path, {}, "cannot open the journal");
     std::ostringstream whole;
     whole << in.rdbuf();
-    const std::string text = whole.str();
+    return parse_journal(whole.str(), path);
+}
+
+JobJournal parse_journal(const std::string& text, const std::string& path) {
     const nlohmann::json d = parse_json_document(text, path);
     const JsonChecker check(text, path);
     if (!d.is_object() || d.value("format", "") != "pathstream job journal 1") {

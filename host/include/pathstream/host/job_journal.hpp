@@ -62,7 +62,8 @@ public:
     void add(const CoreSpan& span, std::int64_t origin, std::uint64_t drawing_tick);
     /// Writes the file (the whole drawing's spans, ticks and subpaths in the header); returns
     /// its FNV-1a 64 hash, hex. Throws std::runtime_error when the file cannot be written.
-    std::string finish(std::size_t drawing_spans, std::uint64_t drawing_ticks, std::size_t subpaths);
+    std::string finish(std::size_t drawing_spans, std::uint64_t drawing_ticks,
+                       std::size_t subpaths);
 
 private:
     std::string path_;
@@ -73,7 +74,9 @@ private:
 };
 
 /// Where a partial JobSpansWriter keeps the lines of a spans file not yet finished.
-inline std::string partial_spans_path(const std::string& path) { return path + ".partial"; }
+inline std::string partial_spans_path(const std::string& path) {
+    return path + ".partial";
+}
 
 /// One span's line in a spans file (no newline): what JobSpansWriter::add writes.
 std::string job_span_line(const CoreSpan& span, std::int64_t origin, std::uint64_t drawing_tick);
@@ -87,6 +90,10 @@ std::string write_job_spans(const JobSpans& job, const std::string& path);
 /// Reads what write_job_spans wrote. Throws InputError (`path:line:col: what`) for anything
 /// else, and when the contents do not hash to `expected_hash` (unless it is empty).
 JobSpans read_job_spans(const std::string& path, const std::string& expected_hash);
+/// read_job_spans on `contents` already read, `path` naming them in errors. Cost: O(bytes);
+/// memory O(spans), never more than the text holds.
+JobSpans parse_job_spans(const std::string& contents, const std::string& path,
+                         const std::string& expected_hash);
 
 /// The journal: what was streamed where, and how far the device got.
 struct JobJournal {
@@ -119,5 +126,7 @@ struct JobJournal {
 void write_journal(const JobJournal& journal, const std::string& path);
 /// Reads a journal. Throws InputError naming the file, line and column, or the missing key.
 JobJournal read_journal(const std::string& path);
+/// read_journal on `text` already read, `path` naming it in errors.
+JobJournal parse_journal(const std::string& text, const std::string& path);
 
 }  // namespace pathstream::host
