@@ -148,6 +148,24 @@ out=$("$bin" stream "$src/examples/two_pens.svg" -m "$machine" -t "$target" --jo
 stop_device
 rm -f "$work"/nl.json*
 
+# ---- The default journal of a job the device may still hold is not replaced by a new stream
+start_device 4 || exit 1
+(cd "$work" && timeout -s INT 1.5 "$bin" stream "$src/examples/rose.json" -m "$machine" -t "$target" \
+  < /dev/null > "$work/dj1.log" 2>&1); rc=$?
+out=$(cd "$work" && "$bin" stream "$src/examples/rose.json" -m "$machine" -t "$target" < /dev/null 2>&1); rc2=$?
+if grep -q "resume with" "$work/dj1.log"; then
+  [ $rc2 -eq 2 ] && [[ "$out" == *"rose.journal.json: the journal of job 1"*"continue it with \`pathstream stream --resume rose.journal.json\`"* ]] &&
+    ok || fail "a second stream replaced the journal of an interrupted job: exit $rc2: $out"
+  (cd "$work" && timeout -k 5 120 "$bin" stream --resume rose.journal.json < /dev/null > "$work/dj2.log" 2>&1) &&
+    ok || fail "resume of the kept journal: $(tail -n 5 "$work/dj2.log")"
+else
+  ok; ok  # the drawing ended before the interrupt
+fi
+out=$(cd "$work" && "$bin" stream "$src/examples/rose.json" -m "$machine" -t "$target" < /dev/null 2>&1) &&
+  ok || fail "a stream after the finished job: $out"
+stop_device
+rm -f "$work"/rose.journal.json*
+
 # ---- Two layers: the device pauses pen up between them until `ctl resume` ---------------
 start_device 2 || exit 1
 "$bin" stream "$src/examples/two_pens.svg" -m "$machine" -t "$target" --no-journal --lead-in \

@@ -628,3 +628,11 @@ TEST_CASE("a stop from another client while streaming ends the stream as a stop,
         }
     }
 }
+
+TEST_CASE("resume reads a journal and its spans from regular files only", "[resume]") {
+    // A journal edited to name /dev/zero as its plan would be read without end.
+    CHECK_THROWS_WITH(host::read_job_spans("/dev/zero", ""),
+                      Catch::Contains("/dev/zero: not a regular file: a job's spans are a file that stream writes"));
+    CHECK_THROWS_WITH(host::read_journal("/dev/null"),
+                      Catch::Contains("/dev/null: not a regular file: a journal is a file that stream writes"));
+}

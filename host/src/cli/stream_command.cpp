@@ -494,6 +494,24 @@ void print_lead_in(const PlannedJob& job, const std::vector<double>& rest_mm) {
     }
 }
 
+// A second stream of a drawing from the same directory would replace the default journal of a
+// job the device may still hold, and with it the only way to resume that job: refused, before
+// anything is sent, unless that job ended or the device took nothing of it.
+void refuse_unfinished_journal(const std::string& journal_path) {
+    JobJournal old;
+    try {
+        old = read_journal(journal_path);
+    } catch (const std::exception&) {
+        return;  // none, or not a journal: nothing to keep
+    }
+    if (old.outcome == "finished" || old.job == 0 || old.acknowledged + 1 == old.job) return;
+    throw std::invalid_argument(journal_path + ": the journal of job " + std::to_string(old.job) +
+                                " (" + old.outcome + ", device state " + old.state +
+                                ") is there: continue it with `pathstream stream --resume " +
+                                journal_path +
+                                "`; to draw anew, remove it or give --journal another name");
+}
+
 // A line typed at the terminal (Enter) since the last look; never waits.
 bool enter_pressed() {
     pollfd p{STDIN_FILENO, POLLIN, 0};
@@ -980,6 +998,9 @@ int run_stream(const StreamCommandOptions& o) {
             "bad target URL '" + url +
             "': unknown scheme (want modbus-tcp://, modbus-rtu:// or can://)");
     }
+    const std::string journal_path =
+        o.no_journal ? "" : (o.journal.empty() ? default_journal_path(o.path.file) : o.journal);
+    if (o.journal.empty() && !journal_path.empty()) refuse_unfinished_journal(journal_path);
     std::vector<double> rest_mm;
     // The path order starts where the device rests (its first subpath is the one nearest to
     // it), so the drawing begins where the pen is, and the lead-in goes from there to it.
@@ -1020,8 +1041,6 @@ int run_stream(const StreamCommandOptions& o) {
     journal.target = url;
     journal.machine = std::filesystem::absolute(o.machine).string();
     journal.drawing = path_display_name(o.path.file);
-    const std::string journal_path =
-        o.no_journal ? "" : (o.journal.empty() ? default_journal_path(o.path.file) : o.journal);
     const JobFilesGuard files(journal_path);
     if (cia402 || o.plan_first) {
         const PlannedJob planned = plan_job(path, o.machine, lead_in ? &rest_mm : nullptr);

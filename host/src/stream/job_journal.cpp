@@ -5,6 +5,7 @@
 #include <cerrno>
 #include <cstring>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
@@ -340,6 +341,11 @@ std::string write_job_spans(const JobSpans& job, const std::string& path) {
 }
 
 JobSpans read_job_spans(const std::string& path, const std::string& expected_hash) {
+    // A journal edited to name a device or a FIFO (/dev/zero) would be read without end.
+    std::error_code ec;
+    if (std::filesystem::exists(path, ec) && !std::filesystem::is_regular_file(path, ec)) {
+        throw InputError(path, {}, "not a regular file: a job's spans are a file that stream writes");
+    }
     std::ifstream in(path, std::ios::binary);
     if (!in) throw InputError(path, {}, "cannot open the job's spans");
     std::ostringstream whole;
@@ -433,6 +439,10 @@ void write_journal(const JobJournal& j, const std::string& path) {
 }
 
 JobJournal read_journal(const std::string& path) {
+    std::error_code ec;
+    if (std::filesystem::exists(path, ec) && !std::filesystem::is_regular_file(path, ec)) {
+        throw InputError(path, {}, "not a regular file: a journal is a file that stream writes");
+    }
     std::ifstream in(path, std::ios::binary);
     if (!in) throw InputError(path, {}, "cannot open the journal");
     std::ostringstream whole;
