@@ -81,27 +81,58 @@ TEST_CASE("a JSON index finds values by pointer and bytes by line", "[host][json
     CHECK_FALSE(index.trailing_byte());
 }
 
-TEST_CASE("points arrays read flat report what the document tree did, where it did", "[host][json]") {
+TEST_CASE("points arrays read flat report what the document tree did, where it did",
+          "[host][json]") {
     // Rows of numbers are read flat; their errors are found after parsing, located as before.
-    CHECK(error_of("{\"points\": [[0, 0],\n [1, 1, 2]]}") == "t.json:2:2: point has 3 coordinates, expected 2");
-    CHECK(error_of("{\"subpaths\": [{\"points\": [[0, 0], [1, 1]]},\n {\"points\": [[0, 0], [1, 1e7]]}]}")
-              .rfind("t.json:2:26: coordinate 1e+07 is out of range", 0) == 0);
-    CHECK(error_of("{\"points\": [[], [1, 1]]}") == "t.json:1:13: point has 0 coordinates (1 to 8 axes)");
+    CHECK(error_of("{\"points\": [[0, 0],\n [1, 1, 2]]}") ==
+          "t.json:2:2: point has 3 coordinates, expected 2");
+    CHECK(
+        error_of(
+            "{\"subpaths\": [{\"points\": [[0, 0], [1, 1]]},\n {\"points\": [[0, 0], [1, 1e7]]}]}")
+            .rfind("t.json:2:26: coordinate 1e+07 is out of range", 0) == 0);
+    CHECK(error_of("{\"points\": [[], [1, 1]]}") ==
+          "t.json:1:13: point has 0 coordinates (1 to 8 axes)");
     // Anything else in them goes into the tree from where it appears, rows read so far too.
-    CHECK(error_of("{\"points\": [[0, 0], [1, \"x\"]]}") == "t.json:1:25: coordinate must be a number");
-    CHECK(error_of("{\"points\": [[0, 0], 7]}") == "t.json:1:21: point must be an array of coordinates");
-    CHECK(error_of("{\"points\": [[0, 0], [[1], 1]]}") == "t.json:1:22: coordinate must be a number");
-    CHECK(error_of("{\"points\": [[0, 0], {\"x\": 1}]}") == "t.json:1:21: point must be an array of coordinates");
+    CHECK(error_of("{\"points\": [[0, 0], [1, \"x\"]]}") ==
+          "t.json:1:25: coordinate must be a number");
+    CHECK(error_of("{\"points\": [[0, 0], 7]}") ==
+          "t.json:1:21: point must be an array of coordinates");
+    CHECK(error_of("{\"points\": [[0, 0], [[1], 1]]}") ==
+          "t.json:1:22: coordinate must be a number");
+    CHECK(error_of("{\"points\": [[0, 0], {\"x\": 1}]}") ==
+          "t.json:1:21: point must be an array of coordinates");
     // Elsewhere, arrays of arrays stay in the tree (knots are numbers, not rows).
-    CHECK(error_of("{\"points\": [[0, 0], [1, 1]], \"closed\": [[1]]}") == "t.json:1:40: closed must be true or false");
+    CHECK(error_of("{\"points\": [[0, 0], [1, 1]], \"closed\": [[1]]}") ==
+          "t.json:1:40: closed must be true or false");
     // A flat array is an empty one in the document: the reader still sees the points.
     FlatNumberArrays flat;
     flat.where = {"/subpaths/*/points"};
-    const nlohmann::json document =
-        parse_json_document("{\"subpaths\": [{\"points\": [[0, 1], [2, 3, 4]]}, {\"points\": 5}]}", "t.json", &flat);
+    const nlohmann::json document = parse_json_document(
+        "{\"subpaths\": [{\"points\": [[0, 1], [2, 3, 4]]}, {\"points\": 5}]}", "t.json", &flat);
     CHECK(document["subpaths"][0]["points"] == nlohmann::json::array());
     CHECK(document["subpaths"][1]["points"] == 5);
     REQUIRE(flat.found.count("/subpaths/0/points") == 1);
     CHECK(flat.found["/subpaths/0/points"].values == std::vector<double>{0, 1, 2, 3, 4});
     CHECK(flat.found["/subpaths/0/points"].widths == std::vector<std::uint8_t>{2, 3});
+}
+
+TEST_CASE("JSON nested past the reader's limit is refused at the first bracket too deep",
+          "[host][json]") {
+    // 8 million levels once took 84 s and 1.9 GB before the error; now one pass over the bytes.
+    const std::string deep = std::string(8'000'000, '[') + std::string(8'000'000, ']');
+    try {
+        (void)parse_json_document(deep, "t.json");
+        FAIL("parsed 8 million levels");
+    } catch (const InputError& e) {
+        CHECK(std::string(e.what()) ==
+              "t.json:1:257: invalid JSON: nested more than 256 levels deep (the reader's limit)");
+    }
+    // Brackets inside strings do not count; 256 levels are read.
+    const std::string in_string = R"({"units": "mm", "note": ")" + std::string(1000, '[') +
+                                  R"(", "points": [[0, 0], [1, 1]]})";
+    CHECK_NOTHROW(parse_json_document(in_string, "t.json"));
+    const std::string at_limit = std::string(256, '[') + std::string(256, ']');
+    CHECK_NOTHROW(parse_json_document(at_limit, "t.json"));
+    const std::string escaped = R"({"a": "\"[[[", "b": 1})";
+    CHECK_NOTHROW(parse_json_document(escaped, "t.json"));
 }

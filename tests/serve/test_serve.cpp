@@ -99,6 +99,11 @@ TEST_CASE("serve: upload names stay inside the server's directory", "[serve]") {
     CHECK(upload_file_name("C:\\drawings\\leaf.NGC") == "leaf.NGC");
     CHECK(upload_file_name("my drawing (1).svg") == "my_drawing__1_.svg");
     CHECK(upload_file_name("...hidden.json") == "hidden.json");
+    // Never an option of the commands it is handed to.
+    CHECK(upload_file_name("-h.csv") == "_h.csv");
+    CHECK(upload_file_name("--machine=x.json") == "__machine_x.json");
+    CHECK(upload_file_name("-mfoo.csv") == "_mfoo.csv");
+    CHECK(upload_file_name(".-h.svg") == "_h.svg");
     CHECK_THROWS_AS(upload_file_name("passwd"), std::invalid_argument);
     CHECK_THROWS_AS(upload_file_name("x.exe"), std::invalid_argument);
     CHECK_THROWS_AS(upload_file_name("../"), std::invalid_argument);

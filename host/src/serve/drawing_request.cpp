@@ -40,6 +40,9 @@ std::string upload_file_name(const std::string& name) {
         if (!std::isalnum(static_cast<unsigned char>(c)) && c != '.' && c != '_' && c != '-') c = '_';
     }
     while (!base.empty() && base.front() == '.') base.erase(0, 1);
+    // The name is an argument of the commands the server runs: one starting with '-' would be
+    // an option there (-h.csv: --help; -mfoo.csv: --machine).
+    for (std::size_t i = 0; i < base.size() && base[i] == '-'; ++i) base[i] = '_';
     if (base.size() > 100) base = base.substr(base.size() - 100);
     const std::size_t dot = base.rfind('.');
     static const std::set<std::string> extensions = {"json", "csv", "svg", "gcode", "ngc", "nc", "gc"};
