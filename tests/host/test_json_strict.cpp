@@ -136,3 +136,13 @@ TEST_CASE("JSON nested past the reader's limit is refused at the first bracket t
     const std::string escaped = R"({"a": "\"[[[", "b": 1})";
     CHECK_NOTHROW(parse_json_document(escaped, "t.json"));
 }
+
+TEST_CASE("an error quoting a huge token stays short", "[host][json]") {
+    // A number of a million digits: the message names it, cut in the middle.
+    const std::string text = R"({"units": "mm", "points": [[0, 1)" + std::string(1'000'000, '0') + "]]}";
+    const std::string message = error_of(text);
+    INFO(message.substr(0, 200));
+    CHECK(message.rfind("t.json:1:", 0) == 0);
+    CHECK(message.size() < 1200);
+    CHECK(message.find("bytes left out") != std::string::npos);
+}
