@@ -93,6 +93,30 @@ TEST_CASE("serve: beyond loopback every request carries the token", "[serve]") {
     CHECK(refusal(p, cross));
 }
 
+TEST_CASE("serve: the token cookie is the server's token, set for a right ?token= only", "[serve]") {
+    AccessPolicy p;
+    p.token = "s3cret";
+    p.loopback = false;
+    RequestFacts r;
+    r.method = "GET";
+    r.query_token = "s3cret";
+    CHECK(token_cookie(p, r, "pathstream_token") == "pathstream_token=s3cret; Path=/; HttpOnly; SameSite=Strict");
+    // A wrong ?token= next to a right Bearer header passes the check, but its bytes (cookie
+    // attributes here) never reach Set-Cookie.
+    r.authorization = "Bearer s3cret";
+    r.query_token = "x; Domain=evil.example; Max-Age=99999999";
+    CHECK_FALSE(refusal(p, r));
+    CHECK_FALSE(token_cookie(p, r, "pathstream_token"));
+    r.query_token.clear();
+    CHECK_FALSE(token_cookie(p, r, "pathstream_token"));
+    CHECK_FALSE(token_cookie(AccessPolicy{}, r, "pathstream_token"));  // no token configured
+    CHECK_FALSE(token_problem("a1B2-c3_D4.e5~"));
+    CHECK(token_problem("a;b"));
+    CHECK(token_problem("a b"));
+    CHECK(token_problem("\"x\""));
+    CHECK(token_problem(""));
+}
+
 TEST_CASE("serve: upload names stay inside the server's directory", "[serve]") {
     CHECK(upload_file_name("landscape.svg") == "landscape.svg");
     CHECK(upload_file_name("../../etc/x.svg") == "x.svg");

@@ -56,12 +56,18 @@ extern "C" void on_serve_signal(int) { g_stop.store(true); }
 
 std::string read_token(const ServeCommandOptions& o) {
     if (!o.token.empty() && !o.token_file.empty()) throw std::invalid_argument("serve: --token or --token-file, not both");
-    if (o.token_file.empty()) return o.token;
+    if (o.token_file.empty()) {
+        if (o.token.empty()) return o.token;
+        if (const auto why = serve::token_problem(o.token)) throw std::invalid_argument("serve: --token: " + *why);
+        return o.token;
+    }
     std::ifstream in(o.token_file);
     std::string line;
     std::getline(in, line);
     while (!line.empty() && (line.back() == '\r' || line.back() == ' ')) line.pop_back();
     if (line.empty()) throw std::invalid_argument("serve: --token-file " + o.token_file + ": the first line is empty");
+    if (const auto why = serve::token_problem(line))
+        throw std::invalid_argument("serve: --token-file " + o.token_file + ": " + *why);
     return line;
 }
 

@@ -61,6 +61,23 @@ std::optional<std::string> refusal(const AccessPolicy& policy, const RequestFact
     return std::nullopt;
 }
 
+std::optional<std::string> token_cookie(const AccessPolicy& policy, const RequestFacts& request,
+                                        const std::string& cookie_name) {
+    if (policy.token.empty() || !same_secret(request.query_token, policy.token)) return std::nullopt;
+    return cookie_name + "=" + policy.token + "; Path=/; HttpOnly; SameSite=Strict";
+}
+
+std::optional<std::string> token_problem(const std::string& token) {
+    if (token.empty()) return "the token is empty";
+    for (const char c : token) {
+        const auto u = static_cast<unsigned char>(c);
+        if (u <= 0x20 || u == 0x7F || c == '"' || c == ',' || c == ';' || c == '\\') {
+            return "the token holds a character a cookie cannot carry (controls, space, '\"', ',', ';', '\\')";
+        }
+    }
+    return std::nullopt;
+}
+
 ListenAddress parse_listen_address(const std::string& listen) {
     const std::size_t colon = listen.rfind(':');
     if (colon == std::string::npos || colon == 0 || colon + 1 == listen.size()) {

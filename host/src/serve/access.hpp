@@ -35,6 +35,16 @@ bool is_loopback_host(const std::string& host);
 /// thread.
 std::optional<std::string> refusal(const AccessPolicy& policy, const RequestFacts& request);
 
+/// The cookie that keeps the page's token: set only when this request's ?token= is the token
+/// (a wrong one, or one sent next to a valid Bearer header, sets nothing), and made of the
+/// server's own token, never of the request's bytes. nullopt when none is to be set.
+std::optional<std::string> token_cookie(const AccessPolicy& policy, const RequestFacts& request,
+                                        const std::string& cookie_name);
+
+/// Why `token` cannot be a token (it travels in a cookie and a query): empty, or characters a
+/// cookie value cannot hold (controls, space, '"', ',', ';', '\\'); nothing when it can.
+std::optional<std::string> token_problem(const std::string& token);
+
 /// Where to listen, from --listen.
 struct ListenAddress {
     std::string host;   ///< as given, without the brackets of an IPv6 address

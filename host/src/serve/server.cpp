@@ -514,10 +514,7 @@ void Server::routes() {
         res.set_header("X-Frame-Options", "DENY");
         res.set_header("Referrer-Policy", "no-referrer");
         // The page keeps the token as a cookie that only this origin's requests carry.
-        if (!config_.access.token.empty() && !facts.query_token.empty()) {
-            res.set_header("Set-Cookie", std::string(kCookie) + "=" + facts.query_token +
-                                             "; Path=/; HttpOnly; SameSite=Strict");
-        }
+        if (const auto cookie = token_cookie(config_.access, facts, kCookie)) res.set_header("Set-Cookie", *cookie);
         return httplib::Server::HandlerResponse::Unhandled;
     });
     const auto json_handler = [this](auto&& body) {
