@@ -444,8 +444,7 @@ std::string default_journal_path(const std::string& drawing) {
 // moved, and a resume would only start it again. False when it cannot be read (kept then).
 bool nothing_taken(const std::string& journal_path) {
     try {
-        const JobJournal j = read_journal(journal_path);
-        return j.job == 0 || j.acknowledged + 1 == j.job;
+        return read_journal(journal_path).nothing_accepted();
     } catch (const std::exception&) {
         return !std::filesystem::exists(journal_path);
     }
@@ -504,7 +503,7 @@ void refuse_unfinished_journal(const std::string& journal_path) {
     } catch (const std::exception&) {
         return;  // none, or not a journal: nothing to keep
     }
-    if (old.outcome == "finished" || old.job == 0 || old.acknowledged + 1 == old.job) return;
+    if (old.outcome == "finished" || old.nothing_accepted()) return;
     throw std::invalid_argument(journal_path + ": the journal of job " + std::to_string(old.job) +
                                 " (" + old.outcome + ", device state " + old.state +
                                 ") is there: continue it with `pathstream stream --resume " +
@@ -627,9 +626,7 @@ int stream_job(const JobToStream& job, const MachineProfile& machine, StreamComm
         end = can ? stream_over_can(supply, machine, o, observer, held, events, job.planning)
                   : stream_over_modbus(supply, machine, o, observer, held, events, job.planning);
     } catch (const std::exception& e) {
-        const JobJournal& so_far = writer.journal();
-        const bool taken =
-            held != nullptr || (so_far.job != 0 && so_far.acknowledged + 1 != so_far.job);
+        const bool taken = held != nullptr || !writer.journal().nothing_accepted();
         if (job.planning != nullptr) {
             if (taken) {
                 finish_planning(*job.planning, !journal_path.empty());

@@ -120,6 +120,10 @@ struct JobJournal {
     /// goes): a JSON object whose keys the stream command defines (the drawing's copy, the
     /// path options, hashes). Empty: none. Optional in the file ("replan").
     std::string replan;
+
+    /// True while the device has accepted none of the job's spans (no batch yet, or the
+    /// acknowledged number still the one before the job's first): nothing of it can have moved.
+    bool nothing_accepted() const { return job == 0 || acknowledged + 1 == job; }
 };
 
 /// Writes `journal` to `path` atomically (JSON).
