@@ -24,7 +24,7 @@ packages=(
   # real-kernel test VM (SocketCAN vcan, gpio-sim): emulator, initramfs tools
   qemu-system-x86 busybox-static cpio
   # pathstream serve: the HTTP server library; its page's tests drive Debian's Chromium
-  libcpp-httplib-dev chromium
+  libboost-dev chromium
 )
 # Node.js and npm for the browser tests, from Debian unless a node is installed already.
 command -v node > /dev/null && command -v npm > /dev/null || packages+=(nodejs npm)

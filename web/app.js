@@ -235,7 +235,7 @@ async function refreshPreview() {
   const serial = ++previewSerial;
   const r = await api('/api/preview', { options: options() });
   if (serial !== previewSerial) return;  // a newer request is on its way
-  if (!r.ok) { failed(r.error); return; }
+  if (!r.ok) { $('drawing-name').textContent = page.drawing; failed(r.error); return; }
   showError('');
   showPreview(r);
 }
@@ -270,7 +270,8 @@ function wire() {
     showError('');
     $('sim-report').hidden = true;
     $('start').disabled = true;
-    const r = await api('/api/run', { options: options() });
+    // The run names the drawing this page previewed: another page's upload in between is refused.
+    const r = await api('/api/run', { options: options(), drawing_hash: page.preview ? page.preview.drawing_hash : '' });
     if (!r.ok) {
       if (page.jobRunning) { showError(r.error); return; }
       failed(r.error);
@@ -394,6 +395,10 @@ function onEvent(e) {
       scheduleDraw();
       break;
     }
+    case 'planning':
+      // A long preview's progress (the server plans in a child it stops after --plan-timeout).
+      $('drawing-name').textContent = `${e.file}: planning ${percent(e.fraction)}, about ${minutes(e.estimated_s)} of motion`;
+      break;
     case 'pause':
       $('job-text').textContent = `paused for a pen change (${e.pause} of ${e.pauses}), next ${e.next}: press Resume`;
       break;

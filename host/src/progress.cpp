@@ -21,7 +21,9 @@ std::size_t terminal_width(std::FILE* stream) {
     return 80;
 }
 
-std::string seconds_text(double seconds) {
+}  // namespace
+
+std::string duration_text(double seconds) {
     char text[32];
     if (seconds < 100) {
         std::snprintf(text, sizeof text, "%.0f s", std::ceil(seconds));
@@ -33,8 +35,6 @@ std::string seconds_text(double seconds) {
     }
     return text;
 }
-
-}  // namespace
 
 ProgressBar::ProgressBar(std::string label, std::FILE* stream)
     : ProgressBar(std::move(label), stream, isatty(fileno(stream)) != 0) {}
@@ -62,9 +62,9 @@ std::string ProgressBar::render(const std::string& label, double fraction, doubl
         std::snprintf(done, sizeof done, "  %.1f s", elapsed);
         after += done;
     } else if (eta.seconds) {
-        after += std::string("  ETA ") + mark + seconds_text(std::max(0.0, *eta.seconds));
+        after += std::string("  ETA ") + mark + duration_text(std::max(0.0, *eta.seconds));
     } else if (fraction > 0.01 && elapsed > 0.2) {
-        after += "  ETA " + seconds_text(elapsed * (1.0 - fraction) / fraction);
+        after += "  ETA " + duration_text(elapsed * (1.0 - fraction) / fraction);
     }
     if (!detail.empty()) after += "  " + detail;
     // label + " [" + bar + "] " + after, kept under `width` so that a terminal never wraps it

@@ -106,7 +106,7 @@ serve_port=$(/usr/bin/python3 -c 'import socket; s = socket.socket(); s.bind(("1
 serve_pid=$!
 for _ in $(seq 200); do grep -q "pathstream serve: http" "$work/serve1.log" && break; sleep 0.05; done
 tmp_before=$(ls -d "${TMPDIR:-/tmp}"/pathstream-serve-* 2>/dev/null | wc -l)
-expect serve-port-in-use 3 "cannot listen on 127.0.0.1:$serve_port (in use?)" -- \
+expect serve-port-in-use 3 "cannot listen on 127.0.0.1:$serve_port (Address already in use)" -- \
   "$bin" serve -m "$machine" -t "modbus-tcp://127.0.0.1:1?unit=1" --listen "127.0.0.1:$serve_port"
 tmp_after=$(ls -d "${TMPDIR:-/tmp}"/pathstream-serve-* 2>/dev/null | wc -l)
 [ "$tmp_after" -eq "$tmp_before" ] && passed=$((passed + 1)) || { echo "FAIL serve-port-in-use left a state directory"; failures=$((failures + 1)); }

@@ -9,6 +9,7 @@
 #include "pathstream/host/atomic_file.hpp"
 #include "pathstream/host/core_playback.hpp"
 #include "pathstream/host/input_error.hpp"
+#include "pathstream/host/job_estimate.hpp"
 #include "pathstream/host/layers.hpp"
 #include "pathstream/host/planner.hpp"
 #include "pathstream/host/progress.hpp"
@@ -29,6 +30,22 @@ void add_plan_command(CLI::App& app, PlanCommandOptions& o) {
                     "CSV output file, - for standard output (the summary then goes to standard "
                     "error; default: only the summary)");
     cmd->add_flag("--json", o.json, "print the summary as one JSON document on standard output");
+    cmd->add_flag("--preview", o.preview,
+                  "print planning progress as JSON lines, then the preview document of `pathstream serve` "
+                  "(the path simplified, speed bins, figures) as one JSON line");
+    cmd->add_option("--max-motion", o.max_motion,
+                    "s: refuse, before planning, a job estimated to move for longer (0: no limit)")
+        ->capture_default_str()
+        ->check(CLI::NonNegativeNumber);
+}
+
+void refuse_long_motion(const PlannedJob& job, double max_motion_s) {
+    if (max_motion_s <= 0 || job.segments.empty()) return;
+    const double estimate = JobEstimate(job.segments, job.machine).model_seconds();
+    if (estimate > max_motion_s) {
+        throw PlanError("the job moves for about " + duration_text(estimate) + " (estimated before planning), longer than " +
+                        duration_text(max_motion_s) + " (--max-motion)");
+    }
 }
 
 PlannedJob prepare_job(const PathOptions& path_options, const std::string& machine_file,
@@ -272,7 +289,9 @@ int run_plan(const PlanCommandOptions& o) {
     }
     // The plan is streamed: checked, and written as CSV rows when asked, as it is made (an
     // output file appears whole or not at all).
+    if (o.preview) return run_plan_preview(o);
     PlannedJob job = prepare_job(o.path, o.machine, nullptr);
+    refuse_long_motion(job, o.max_motion);
     if (o.output.empty()) {
         StreamedPlan(job, o.path.file, nullptr).run();
     } else {

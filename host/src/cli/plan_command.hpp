@@ -16,10 +16,16 @@ struct PlanCommandOptions {
     std::string machine;
     std::string output;
     bool json = false;  ///< --json: one JSON document on standard output instead of text
+    bool preview = false;   ///< --preview: the web page's preview document (plan_preview.cpp)
+    double max_motion = 0;  ///< --max-motion: s; a job estimated to move longer is refused; 0: no limit
 };
 
 void add_plan_command(CLI::App& app, PlanCommandOptions& options);
 int run_plan(const PlanCommandOptions& options);
+/// `plan --preview`: planning progress as JSON lines, then the preview document `pathstream
+/// serve` shows, one line, on standard output.
+int run_plan_preview(const PlanCommandOptions& options);
+
 
 /// What plan and sim share: the path, the machine, the geometry, the plan and its check.
 struct PlannedJob {
@@ -46,6 +52,9 @@ PlannedJob plan_job(const PathOptions& path, const std::string& machine_file,
 
 /// The summary lines both commands print (duration, lengths, deviation, limit fractions).
 void print_plan_summary(const PlannedJob& job, std::ostream& out);
+/// Throws PlanError when the job's estimated motion time passes `max_motion_s` (> 0), naming
+/// both; before any planning.
+void refuse_long_motion(const PlannedJob& job, double max_motion_s);
 
 /// Millimetres of an LSB count, as the shortest exact decimal (one division, see eval).
 std::string lsb_to_mm_text(Lsb value, double mm_per_lsb);

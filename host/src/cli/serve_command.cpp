@@ -47,6 +47,19 @@ void add_serve_command(CLI::App& app, ServeCommandOptions& o) {
     cmd->add_option("--events-rate", o.events_rate, "progress updates per second sent to the page")
         ->capture_default_str()
         ->check(CLI::Range(1.0, 50.0));
+    cmd->add_option("--plan-timeout", o.plan_timeout, "s a preview, run or simulation may plan before it is stopped")
+        ->capture_default_str()
+        ->check(CLI::Range(1.0, 86400.0));
+    cmd->add_option("--max-motion-hours", o.max_motion_hours,
+                    "refuse, before planning, a drawing estimated to move for longer")
+        ->capture_default_str()
+        ->check(CLI::Range(0.001, 1000.0));
+    cmd->add_option("--max-connections", o.max_connections, "open connections in total")
+        ->capture_default_str()
+        ->check(CLI::Range(8, 100000));
+    cmd->add_option("--max-connections-per-client", o.max_connections_per_client, "open connections per client address")
+        ->capture_default_str()
+        ->check(CLI::Range(4, 100000));
 }
 
 namespace {
@@ -71,28 +84,6 @@ std::string read_token(const ServeCommandOptions& o) {
     return line;
 }
 
-// The preview of `file` under path options `arguments`: parsed by the same option parser as
-// every path command, planned by plan_job (what `plan` prints).
-nlohmann::ordered_json plan_for_page(const std::string& file, const std::vector<std::string>& arguments,
-                                     const std::string& machine) {
-    CLI::App parser{"preview"};
-    PathOptions options;
-    add_path_options(parser, options);
-    std::vector<std::string> args = {file};
-    args.insert(args.end(), arguments.begin(), arguments.end());
-    std::vector<std::string> reversed(args.rbegin(), args.rend());  // CLI11 takes them last first
-    try {
-        parser.parse(reversed);
-    } catch (const CLI::ParseError& e) {
-        throw std::invalid_argument(std::string("options: ") + e.what());
-    }
-    const PlannedJob job = plan_job(options, machine);
-    if (!job.check.within_limits || job.check.drawing_while_pen_moves) {
-        throw PlanError("the plan failed its per-tick check (a planner bug)");
-    }
-    return serve::preview_json(job.plan, job.path, job.machine);
-}
-
 }  // namespace
 
 int run_serve(const ServeCommandOptions& o) {
@@ -111,6 +102,10 @@ int run_serve(const ServeCommandOptions& o) {
     c.executable = serve::self_executable();
     c.events_rate = o.events_rate;
     c.max_upload_bytes = static_cast<std::size_t>(o.max_upload_mb * 1024 * 1024);
+    c.plan_timeout_s = o.plan_timeout;
+    c.max_motion_s = o.max_motion_hours * 3600;
+    c.limits.connections = o.max_connections;
+    c.limits.connections_per_client = o.max_connections_per_client;
     bool temporary = false;
     if (o.state_dir.empty()) {
         std::string pattern = (fs::temp_directory_path() / "pathstream-serve-XXXXXX").string();
@@ -122,12 +117,9 @@ int run_serve(const ServeCommandOptions& o) {
         c.state_dir = fs::absolute(o.state_dir).string();
     }
     MachineProfile machine = load_machine_profile(o.machine);
-    const std::string machine_file = c.machine_file;
     int status = 0;
     {
-        serve::Server server(c, machine, [machine_file](const std::string& file, const std::vector<std::string>& args) {
-            return plan_for_page(file, args, machine_file);
-        });
+        serve::Server server(c, machine);
         try {
             server.bind();
         } catch (...) {

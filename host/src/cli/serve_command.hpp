@@ -17,6 +17,10 @@ struct ServeCommandOptions {
     std::string state_dir;               ///< --state-dir: drawing and journal ("": a new temporary directory)
     double max_upload_mb = 16;
     double events_rate = 10;             ///< progress updates per second to the page
+    double plan_timeout = 60;            ///< s a preview, run or simulation may plan
+    double max_motion_hours = 24;        ///< a longer job (estimated) is refused before planning
+    std::size_t max_connections = 512;
+    std::size_t max_connections_per_client = 256;
 };
 
 /// Adds the `serve` subcommand and its options, parsed into `options` (which must outlive

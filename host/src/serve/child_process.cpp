@@ -82,12 +82,21 @@ ChildProcess::~ChildProcess() {
     close_fd(err_);
 }
 
-int ChildProcess::wait(const std::function<void(const std::string&)>& on_line, std::string& error_text) {
+int ChildProcess::wait(const std::function<void(const std::string&)>& on_line, std::string& error_text,
+                       const std::function<bool()>& abandon) {
     std::string line;
     char buffer[8192];
+    bool killed = false;
     while (out_ >= 0 || err_ >= 0) {
+        if (abandon && !killed && abandon()) {
+            killed = true;
+            const std::lock_guard<std::mutex> lock(mutex_);
+            if (!reaped_) ::kill(-pid_, SIGKILL);  // its own process group (POSIX_SPAWN_SETPGROUP)
+        }
         pollfd fds[2] = {{out_, POLLIN, 0}, {err_, POLLIN, 0}};
-        if (::poll(fds, 2, -1) < 0) {
+        const int ready = ::poll(fds, 2, abandon && !killed ? 100 : -1);
+        if (ready == 0) continue;
+        if (ready < 0) {
             if (errno == EINTR) continue;
             break;
         }
@@ -132,10 +141,11 @@ void ChildProcess::signal(int signal) {
     if (!reaped_) ::kill(pid_, signal);
 }
 
-ChildOutput run_child(const std::vector<std::string>& argv, const std::string& cwd) {
+ChildOutput run_child(const std::vector<std::string>& argv, const std::string& cwd,
+                      const std::function<bool()>& abandon) {
     ChildProcess child(argv, cwd);
     ChildOutput r;
-    r.exit_code = child.wait([&](const std::string& line) { r.out += line + '\n'; }, r.err);
+    r.exit_code = child.wait([&](const std::string& line) { r.out += line + '\n'; }, r.err, abandon);
     return r;
 }
 

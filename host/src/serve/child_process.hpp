@@ -26,8 +26,10 @@ public:
     /// Reads until the child closes both pipes, calling `on_line` for every standard output
     /// line (without its newline) and keeping the last 16 KiB of standard error in
     /// `error_text`; then reaps it. Returns its exit status (128 + N when signal N ended it).
-    /// Call once, from one thread.
-    int wait(const std::function<void(const std::string&)>& on_line, std::string& error_text);
+    /// Call once, from one thread. `abandon` (optional), asked every 100 ms, kills the child's
+    /// process group when it returns true (the exit status is then 128 + SIGKILL).
+    int wait(const std::function<void(const std::string&)>& on_line, std::string& error_text,
+             const std::function<bool()>& abandon = {});
 
     /// Sends `signal` unless the child was reaped already. Any thread.
     void signal(int signal);
@@ -47,8 +49,9 @@ struct ChildOutput {
     std::string err;
 };
 
-/// Runs `argv` to its end (see ChildProcess), collecting its output.
-ChildOutput run_child(const std::vector<std::string>& argv, const std::string& cwd);
+/// Runs `argv` to its end (see ChildProcess), collecting its output; `abandon` as in wait().
+ChildOutput run_child(const std::vector<std::string>& argv, const std::string& cwd,
+                      const std::function<bool()>& abandon = {});
 
 /// The path of the running executable (/proc/self/exe), to start its other commands.
 std::string self_executable();

@@ -1,6 +1,5 @@
 #include "server.hpp"
 
-#include <httplib.h>
 #include <signal.h>
 
 #include <chrono>
@@ -10,9 +9,12 @@
 #include <stdexcept>
 
 #include "drawing_request.hpp"
+#include "http_server.hpp"
 #include "pathstream/host/device_link.hpp"
 #include "pathstream/host/device_setup.hpp"
+#include "pathstream/host/job_journal.hpp"
 #include "pathstream/host/placement.hpp"
+#include "pathstream/host/progress.hpp"
 #include "serve/web_assets.hpp"
 
 namespace pathstream::host::serve {
@@ -31,18 +33,6 @@ namespace {
 constexpr const char* kCookie = "pathstream_token";
 
 Json error_body(const std::string& message) { return Json{{"ok", false}, {"error", message}}; }
-
-std::string cookie_value(const std::string& cookies, const std::string& name) {
-    std::size_t at = 0;
-    while (at < cookies.size()) {
-        const std::size_t end = std::min(cookies.find(';', at), cookies.size());
-        std::string item = cookies.substr(at, end - at);
-        while (!item.empty() && item.front() == ' ') item.erase(0, 1);
-        if (item.rfind(name + "=", 0) == 0) return item.substr(name.size() + 1);
-        at = end + 1;
-    }
-    return "";
-}
 
 void replace_all(std::string& text, const std::string& what, const std::string& with) {
     if (what.empty()) return;
@@ -90,44 +80,30 @@ std::string last_lines(const std::string& text, std::size_t count) {
 
 }  // namespace
 
-Server::Server(ServerConfig config, MachineProfile machine, PreviewFunction preview)
-    : config_(std::move(config)), machine_(std::move(machine)), preview_(std::move(preview)),
-      http_(std::make_unique<httplib::Server>()) {
-    // httplib's default sets SO_REUSEPORT, which lets a second server bind the same port and
-    // the kernel share the connections between the two: a page could then start the wrong
-    // machine. SO_REUSEADDR alone only lets a restart take a port left in TIME_WAIT.
-    http_->set_socket_options([](socket_t sock) {
-        int yes = 1;
-        ::setsockopt(sock, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof yes);
-    });
+Server::Server(ServerConfig config, MachineProfile machine)
+    : config_(std::move(config)), machine_(std::move(machine)) {
+    HttpLimits limits = config_.limits;
+    limits.body_bytes = config_.max_upload_bytes;
+    http_ = std::make_unique<HttpServer>(limits, hub_);
     fs::create_directories(fs::path(config_.state_dir) / "drawing");
     routes();
 }
 
 Server::~Server() {
     stop();
+    http_.reset();
     if (poller_.joinable()) poller_.join();
     if (job_thread_.joinable()) job_thread_.join();
 }
 
 void Server::bind() {
-    if (config_.port == 0) {
-        const int port = http_->bind_to_any_port(config_.listen_host);
-        if (port <= 0) throw std::runtime_error("serve: cannot listen on " + config_.listen_host);
-        bound_port_ = static_cast<unsigned>(port);
-    } else {
-        if (!http_->bind_to_port(config_.listen_host, static_cast<int>(config_.port))) {
-            throw std::runtime_error("serve: cannot listen on " + config_.listen_host + ":" +
-                                     std::to_string(config_.port) + " (in use?)");
-        }
-        bound_port_ = config_.port;
-    }
+    bound_port_ = http_->bind(config_.listen_host, config_.port);
     config_.access.port = bound_port_;
 }
 
 void Server::run() {
     poller_ = std::thread([this] { poll_device(); });
-    http_->listen_after_bind();
+    http_->run();
 }
 
 void Server::stop() {
@@ -145,6 +121,11 @@ void Server::stop() {
 std::string Server::drawing_file() const {
     const std::lock_guard<std::mutex> lock(drawing_mutex_);
     return drawing_name_;
+}
+
+std::string Server::drawing_hash() const {
+    const std::lock_guard<std::mutex> lock(drawing_mutex_);
+    return drawing_hash_;
 }
 
 // Messages name the drawing as the page knows it and never the server's directory (by
@@ -172,12 +153,47 @@ std::vector<std::string> Server::arguments(const nlohmann::json& options) const 
     return args;
 }
 
-Json Server::plan_preview(const std::vector<std::string>& args) const {
+// The preview planned by `pathstream plan --preview` in a child process: killed when its
+// client leaves, a newer plan replaces it, the server stops or it passes the time budget,
+// and whatever memory it took is the system's again when it ends.
+Json Server::plan_preview(const std::vector<std::string>& args, const CancelToken& cancel) {
     const std::string name = drawing_file();
     if (name.empty()) throw std::invalid_argument("no drawing loaded");
-    const std::lock_guard<std::mutex> lock(plan_mutex_);
-    Json p = preview_((fs::path(config_.state_dir) / "drawing" / name).string(), args);
+    if (cancel.cancelled()) throw std::runtime_error("planning cancelled");
+    std::vector<std::string> argv = {config_.executable, "plan", "--machine=" + config_.machine_file, "--preview",
+                                     "--max-motion=" + number_text(config_.max_motion_s)};
+    argv.insert(argv.end(), args.begin(), args.end());
+    argv.insert(argv.end(), {"--", name});
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(config_.plan_timeout_s);
+    bool late = false;
+    double estimated_s = -1;
+    std::string document, errors;
+    ChildProcess child(argv, (fs::path(config_.state_dir) / "drawing").string());
+    const int exit_code = child.wait(
+        [&](const std::string& line) {
+            if (line.rfind("{\"event\":\"planning\"", 0) == 0) {
+                const nlohmann::json e = nlohmann::json::parse(line, nullptr, false);
+                if (e.is_object() && e.value("estimated_s", -1.0) >= 0) estimated_s = e.value("estimated_s", -1.0);
+                hub_.publish(line);
+                return;
+            }
+            document = line;
+        },
+        errors,
+        [&] {
+            late = std::chrono::steady_clock::now() > deadline;
+            return late || cancel.cancelled() || stopping_.load();
+        });
+    if (late) {
+        std::string message = "planning stopped after " + duration_text(config_.plan_timeout_s) + " (serve --plan-timeout)";
+        if (estimated_s >= 0) message += ": the job moves for about " + duration_text(estimated_s);
+        throw std::runtime_error(message);
+    }
+    if (cancel.cancelled() || stopping_.load()) throw std::runtime_error("planning cancelled");
+    if (exit_code != 0) throw std::runtime_error(last_lines(errors, 1));
+    Json p = Json::parse(document);
     p["drawing"] = name;
+    p["drawing_hash"] = drawing_hash();
     std::vector<double> start;
     {
         const std::lock_guard<std::mutex> device_lock(device_mutex_);
@@ -187,9 +203,9 @@ Json Server::plan_preview(const std::vector<std::string>& args) const {
     return p;
 }
 
-Json Server::placed_preview(const nlohmann::json& options) {
+Json Server::placed_preview(const nlohmann::json& options, const CancelToken& cancel) {
     try {
-        Json p = plan_preview(arguments(options));
+        Json p = plan_preview(arguments(options), cancel);
         p["paper"] = paper_json(options);
         p["options"] = options.is_object() ? Json(options) : Json::object();
         const std::lock_guard<std::mutex> lock(preview_mutex_);
@@ -237,9 +253,18 @@ Json Server::whole_job_ticks() const {
     return nullptr;
 }
 
-Server::Reply Server::upload(const std::string& given_name, const std::string& body, const nlohmann::json& options) {
+void Server::claim_planning(const CancelToken& cancel) {
+    const std::lock_guard<std::mutex> lock(newest_plan_mutex_);
+    newest_plan_.cancel();
+    newest_plan_ = cancel;
+}
+
+Server::Reply Server::upload(const std::string& given_name, const std::string& body, const nlohmann::json& options,
+                             const CancelToken& cancel) {
     const std::string name = upload_file_name(given_name);
     const fs::path dir = fs::path(config_.state_dir) / "drawing";
+    claim_planning(cancel);
+    const std::lock_guard<std::mutex> gate(gate_);
     if (job_running()) return {409, error_body("a job is running: wait for it to end, or stop it")};
     {
         const std::lock_guard<std::mutex> lock(drawing_mutex_);
@@ -248,9 +273,12 @@ Server::Reply Server::upload(const std::string& given_name, const std::string& b
         out.write(body.data(), static_cast<std::streamsize>(body.size()));
         if (!out.flush()) return {500, error_body("cannot store the drawing")};
         drawing_name_ = name;
+        drawing_hash_ = content_hash(body);
     }
     try {
-        return preview(options);
+        Json p = placed_preview(options, cancel);
+        p["ok"] = true;
+        return {200, p};
     } catch (const std::exception& e) {
         // Stored but not planned (a reader's error, a placement that does not fit): the page
         // shows no preview, and other options may place it.
@@ -260,8 +288,10 @@ Server::Reply Server::upload(const std::string& given_name, const std::string& b
     }
 }
 
-Server::Reply Server::preview(const nlohmann::json& options) {
-    Json p = placed_preview(options);
+Server::Reply Server::preview(const nlohmann::json& options, const CancelToken& cancel) {
+    claim_planning(cancel);
+    const std::lock_guard<std::mutex> gate(gate_);
+    Json p = placed_preview(options, cancel);
     p["ok"] = true;
     return {200, p};
 }
@@ -309,7 +339,8 @@ bool Server::start_child(const std::string& kind, std::vector<std::string> argv,
         // A hold that came to rest before the second signal was seen: the stop drops the
         // queue as `ctl stop` does (the journal resumes from where the device rests).
         if (stop_requested_.load() && outcome == "held") {
-            const ChildOutput r = run_child({config_.executable, "ctl", config_.target, "stop", "--wait=10"}, config_.state_dir);
+            const ChildOutput r =
+                run_child({config_.executable, "ctl", "--wait=10", "--", config_.target, "stop"}, config_.state_dir);
             hub_.publish(Json{{"event", "command"}, {"verb", "stop"}, {"ok", r.exit_code == 0},
                               {"error", r.exit_code == 0 ? "" : clean_message(last_lines(r.err, 1))}}
                              .dump());
@@ -323,12 +354,19 @@ bool Server::start_child(const std::string& kind, std::vector<std::string> argv,
     return true;
 }
 
-Server::Reply Server::run_job(const nlohmann::json& options) {
+Server::Reply Server::run_job(const nlohmann::json& options, const std::string& previewed_hash,
+                             const CancelToken& cancel) {
+    claim_planning(cancel);
+    // Upload, preview and run one at a time: the file streamed is the one this plan previews.
+    const std::lock_guard<std::mutex> gate(gate_);
     if (job_running()) return {409, error_body("a job is running already")};
+    const std::string name = drawing_file();
+    if (!previewed_hash.empty() && previewed_hash != drawing_hash()) {
+        return {409, error_body("the drawing changed since this page's preview: " + name + " is loaded now")};
+    }
     const std::vector<std::string> args = arguments(options);
-    Json p = placed_preview(options);  // throws for a drawing that cannot be planned: nothing starts
-    std::vector<std::string> argv = {config_.executable, "stream", drawing_file()};
-    argv.insert(argv.end(), args.begin(), args.end());
+    Json p = placed_preview(options, cancel);  // throws for a drawing that cannot be planned: nothing starts
+    std::vector<std::string> argv = {config_.executable, "stream"};
     // --plan-first: the page shows the job's length from job_start on (web/app.js reads it
     // there), which a stream planned as it goes only knows at its end.
     for (const std::string& a : {std::string("--machine=") + config_.machine_file, "--target=" + config_.target,
@@ -337,6 +375,8 @@ Server::Reply Server::run_job(const nlohmann::json& options) {
                                  "--journal=" + (fs::path(config_.state_dir) / "job.journal.json").string()}) {
         argv.push_back(a);
     }
+    argv.insert(argv.end(), args.begin(), args.end());
+    argv.insert(argv.end(), {"--", name});
     if (!start_child("stream", argv)) return {409, error_body("a job is running already")};
     p["ok"] = true;
     return {200, p};
@@ -346,19 +386,27 @@ Server::Reply Server::resume() {
     const fs::path journal = fs::path(config_.state_dir) / "job.journal.json";
     if (!fs::exists(journal)) return {409, error_body("no job journal: nothing was streamed from this page yet")};
     const std::vector<std::string> argv = {config_.executable, "stream", "--resume=" + journal.string(),
-                                           "--events=-", "--events-rate=" + number_text(config_.events_rate)};
+                                           "--events=-", "--events-rate=" + number_text(config_.events_rate), "--"};
     if (!start_child("resume", argv, whole_job_ticks())) return {409, error_body("a job is running already")};
     return {200, Json{{"ok", true}}};
 }
 
-Server::Reply Server::simulate(const nlohmann::json& options) {
+Server::Reply Server::simulate(const nlohmann::json& options, const CancelToken& cancel) {
+    claim_planning(cancel);
+    const std::lock_guard<std::mutex> gate(gate_);
     const std::string name = drawing_file();
     if (name.empty()) return {409, error_body("no drawing loaded")};
-    std::vector<std::string> argv = {config_.executable, "sim", name};
+    std::vector<std::string> argv = {config_.executable, "sim", "--machine=" + config_.machine_file};
     const std::vector<std::string> args = arguments(options);
     argv.insert(argv.end(), args.begin(), args.end());
-    argv.push_back("--machine=" + config_.machine_file);
-    const ChildOutput r = run_child(argv, (fs::path(config_.state_dir) / "drawing").string());
+    argv.insert(argv.end(), {"--", name});
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(config_.plan_timeout_s);
+    bool late = false;
+    const ChildOutput r = run_child(argv, (fs::path(config_.state_dir) / "drawing").string(), [&] {
+        late = std::chrono::steady_clock::now() > deadline;
+        return late || cancel.cancelled() || stopping_.load();
+    });
+    if (late) return {422, error_body("the simulation stopped after " + duration_text(config_.plan_timeout_s) + " (serve --plan-timeout)")};
     Json body{{"ok", r.exit_code == 0}, {"exit", r.exit_code}, {"report", clean_message(r.out)}};
     if (r.exit_code != 0) body["error"] = clean_message(last_lines(r.err, 3));
     return {r.exit_code == 0 ? 200 : 422, body};
@@ -379,7 +427,10 @@ Server::Reply Server::control(const nlohmann::json& request) {
         }
         return {200, Json{{"ok", true}, {"message", "stopping the job"}}};
     }
-    std::vector<std::string> argv = {config_.executable, "ctl", config_.target, verb};
+    // Options first, then `--`: no value from the page can become an option.
+    std::vector<std::string> argv = {config_.executable, "ctl", "--machine=" + config_.machine_file, "--json",
+                                     "--wait=60"};
+    std::vector<std::string> positional = {"--", config_.target, verb};
     const auto axis_name = [&](const nlohmann::json& v) {
         if (!v.is_string()) throw std::invalid_argument("axis: want an axis name");
         for (const AxisLimits& a : machine_.axes) {
@@ -391,15 +442,14 @@ Server::Reply Server::control(const nlohmann::json& request) {
     } else if (verb == "home") {
     } else if (verb == "pen") {
         if (!request.contains("down") || !request["down"].is_boolean()) throw std::invalid_argument("pen: want down true or false");
-        argv.push_back(request["down"].get<bool>() ? "down" : "up");
+        positional.push_back(request["down"].get<bool>() ? "down" : "up");
     } else if (verb == "jog") {
-        argv.push_back(axis_name(request.value("axis", nlohmann::json())));
+        positional.push_back(axis_name(request.value("axis", nlohmann::json())));
         const nlohmann::json d = request.value("distance_mm", nlohmann::json());
         if (!d.is_number() || !std::isfinite(d.get<double>()) || d.get<double>() == 0 || std::fabs(d.get<double>()) > 10000) {
             throw std::invalid_argument("jog: want distance_mm, not 0, at most 10000 either way");
         }
-        // A negative number stays a positional argument for ctl's parser (as `jog y -3`).
-        argv.push_back(number_text(d.get<double>()));
+        positional.push_back(number_text(d.get<double>()));
         if (request.contains("feed")) {
             const nlohmann::json f = request["feed"];
             if (!f.is_number() || !(f.get<double>() > 0) || f.get<double>() > 1e6) throw std::invalid_argument("jog: feed in mm/s, > 0");
@@ -408,7 +458,7 @@ Server::Reply Server::control(const nlohmann::json& request) {
     } else {
         return {400, error_body("unknown verb '" + verb + "'")};
     }
-    argv.insert(argv.begin() + 4, {"--machine=" + config_.machine_file, "--json", "--wait=60"});
+    argv.insert(argv.end(), positional.begin(), positional.end());
     const ChildOutput r = run_child(argv, config_.state_dir);
     Json body{{"ok", r.exit_code == 0}, {"verb", verb}};
     if (!r.out.empty()) {
@@ -492,114 +542,109 @@ void Server::poll_device() {
     }
 }
 
+namespace {
+
+HttpResponse json_response(int status, const Json& body) { return {status, "application/json", body.dump(), {}}; }
+
+// A stop goes to the lane no other work waits in. The body is small; anything larger is not a stop.
+Lane control_lane(const HttpRequest& request) {
+    if (request.body.size() > 4096) return Lane::command;
+    const nlohmann::json j = nlohmann::json::parse(request.body, nullptr, false);
+    return j.is_object() && j.value("verb", nlohmann::json()) == "stop" ? Lane::stop : Lane::command;
+}
+
+}  // namespace
+
 void Server::routes() {
-    httplib::Server& h = *http_;
-    h.new_task_queue = [] { return new httplib::ThreadPool(16); };
-    h.set_payload_max_length(config_.max_upload_bytes);
-    h.set_pre_routing_handler([this](const httplib::Request& req, httplib::Response& res) {
+    HttpServer& h = *http_;
+    h.on_head([this](const HttpRequest& req) {
         RequestFacts facts;
         facts.method = req.method;
-        facts.host = req.get_header_value("Host");
-        facts.origin = req.get_header_value("Origin");
-        facts.authorization = req.get_header_value("Authorization");
-        facts.query_token = req.get_param_value("token");
-        facts.cookie_token = cookie_value(req.get_header_value("Cookie"), kCookie);
+        facts.host = req.header("host");
+        facts.origin = req.header("origin");
+        facts.authorization = req.header("authorization");
+        facts.query_token = req.param("token");
+        facts.cookie_token = cookie_value(req.header("cookie"), kCookie);
+        HeadVerdict verdict;
         if (const auto why = refusal(config_.access, facts)) {
-            res.status = 403;
-            res.set_content(error_body("refused: " + *why).dump(), "application/json");
-            return httplib::Server::HandlerResponse::Handled;
+            verdict.refusal = json_response(403, error_body("refused: " + *why));
+            return verdict;
         }
-        res.set_header("Cache-Control", "no-store");
-        res.set_header("X-Content-Type-Options", "nosniff");
-        res.set_header("X-Frame-Options", "DENY");
-        res.set_header("Referrer-Policy", "no-referrer");
+        verdict.headers = {{"Cache-Control", "no-store"},
+                           {"X-Content-Type-Options", "nosniff"},
+                           {"X-Frame-Options", "DENY"},
+                           {"Referrer-Policy", "no-referrer"}};
         // The page keeps the token as a cookie that only this origin's requests carry.
-        if (const auto cookie = token_cookie(config_.access, facts, kCookie)) res.set_header("Set-Cookie", *cookie);
-        return httplib::Server::HandlerResponse::Unhandled;
+        if (const auto cookie = token_cookie(config_.access, facts, kCookie)) verdict.headers.emplace_back("Set-Cookie", *cookie);
+        return verdict;
     });
     const auto json_handler = [this](auto&& body) {
-        return [this, body](const httplib::Request& req, httplib::Response& res) {
+        return [this, body](const HttpRequest& req, const CancelToken& cancel) {
             Reply reply;
             try {
                 nlohmann::json request = req.body.empty() ? nlohmann::json::object() : nlohmann::json::parse(req.body);
-                reply = body(req, request);
+                reply = body(req, request, cancel);
             } catch (const nlohmann::json::parse_error&) {
                 reply = {400, error_body("the request body is not JSON")};
-            } catch (const std::invalid_argument& e) {
-                reply = {422, error_body(clean_message(e.what()))};
             } catch (const std::exception& e) {
                 // Input errors (file:line:col), planning failures: what the CLI would print.
                 reply = {422, error_body(clean_message(e.what()))};
             }
-            res.status = reply.status;
-            res.set_content(reply.body.dump(), "application/json");
+            return json_response(reply.status, reply.body);
         };
     };
-    h.Get("/api/state", json_handler([this](const httplib::Request&, const nlohmann::json&) { return Reply{200, state()}; }));
-    h.Post("/api/drawing", [this](const httplib::Request& req, httplib::Response& res) {
+    h.route("GET", "/api/state", Lane::command, json_handler([this](const HttpRequest&, const nlohmann::json&, const CancelToken&) {
+        return Reply{200, state()};
+    }));
+    h.route("POST", "/api/drawing", Lane::work, [this](const HttpRequest& req, const CancelToken& cancel) {
         Reply reply;
         try {
             nlohmann::json options = nlohmann::json::object();
-            if (req.has_param("options")) options = nlohmann::json::parse(req.get_param_value("options"));
-            reply = upload(req.get_param_value("name"), req.body, options);
+            if (req.has_param("options")) options = nlohmann::json::parse(req.param("options"));
+            reply = upload(req.param("name"), req.body, options, cancel);
         } catch (const nlohmann::json::parse_error&) {
             reply = {400, error_body("options: not JSON")};
         } catch (const std::exception& e) {
             reply = {422, error_body(clean_message(e.what()))};
         }
-        res.status = reply.status;
-        res.set_content(reply.body.dump(), "application/json");
+        return json_response(reply.status, reply.body);
     });
-    h.Get("/api/preview", [this](const httplib::Request&, httplib::Response& res) {
+    h.route("GET", "/api/preview", Lane::command, [this](const HttpRequest&, const CancelToken&) {
         const Reply reply = last_preview();
-        res.status = reply.status;
-        res.set_content(reply.body.dump(), "application/json");
+        return json_response(reply.status, reply.body);
     });
-    h.Post("/api/preview", json_handler([this](const httplib::Request&, const nlohmann::json& j) {
-        return preview(j.value("options", nlohmann::json::object()));
+    h.route("POST", "/api/preview", Lane::work, json_handler([this](const HttpRequest&, const nlohmann::json& j, const CancelToken& cancel) {
+        return preview(j.value("options", nlohmann::json::object()), cancel);
     }));
-    h.Post("/api/run", json_handler([this](const httplib::Request&, const nlohmann::json& j) {
-        return run_job(j.value("options", nlohmann::json::object()));
+    h.route("POST", "/api/run", Lane::work, json_handler([this](const HttpRequest&, const nlohmann::json& j, const CancelToken& cancel) {
+        const nlohmann::json hash = j.value("drawing_hash", nlohmann::json(""));
+        if (!hash.is_string()) throw std::invalid_argument("drawing_hash: want the preview's drawing_hash");
+        return run_job(j.value("options", nlohmann::json::object()), hash.get<std::string>(), cancel);
     }));
-    h.Post("/api/simulate", json_handler([this](const httplib::Request&, const nlohmann::json& j) {
-        return simulate(j.value("options", nlohmann::json::object()));
+    h.route("POST", "/api/simulate", Lane::work, json_handler([this](const HttpRequest&, const nlohmann::json& j, const CancelToken& cancel) {
+        return simulate(j.value("options", nlohmann::json::object()), cancel);
     }));
-    h.Post("/api/resume", json_handler([this](const httplib::Request&, const nlohmann::json&) { return resume(); }));
-    h.Post("/api/control", json_handler([this](const httplib::Request&, const nlohmann::json& j) { return control(j); }));
-    h.Get("/api/events", [this](const httplib::Request&, httplib::Response& res) {
-        auto cursor = std::make_shared<std::uint64_t>(0);
-        auto first = std::make_shared<bool>(true);
-        res.set_chunked_content_provider("text/event-stream", [this, cursor, first](std::size_t, httplib::DataSink& sink) {
-            std::string out;
-            if (*first) {
-                *first = false;
-                out = "retry: 1000\n\n";
-                for (const HubEvent& e : hub_.sticky(*cursor)) out += "data: " + e.json + "\n\n";
-            } else {
-                const std::vector<HubEvent> events = hub_.wait_after(*cursor, std::chrono::milliseconds(2000));
-                if (stopping_.load()) {
-                    sink.done();
-                    return false;
-                }
-                if (events.empty()) out = ": idle\n\n";
-                for (const HubEvent& e : events) {
-                    out += "data: " + e.json + "\n\n";
-                    *cursor = e.sequence;
-                }
-            }
-            return sink.write(out.data(), out.size());
-        });
-    });
-    h.Get(R"(/[A-Za-z0-9_.\-]*)", [](const httplib::Request& req, httplib::Response& res) {
+    h.route("POST", "/api/resume", Lane::command, json_handler([this](const HttpRequest&, const nlohmann::json&, const CancelToken&) {
+        return resume();
+    }));
+    h.route("POST", "/api/control", control_lane, json_handler([this](const HttpRequest&, const nlohmann::json& j, const CancelToken&) {
+        return control(j);
+    }));
+    h.events("/api/events");
+    h.fallback([](const HttpRequest& req, const CancelToken&) {
+        HttpResponse res;
         const WebAsset* asset = find_web_asset(req.path);
         if (!asset) {
             res.status = 404;
-            return;
+            res.body = error_body("no such page").dump();
+            return res;
         }
-        res.set_header("Content-Security-Policy",
-                       "default-src 'self'; img-src 'self' data: blob:; style-src 'self'; script-src 'self'; "
-                       "connect-src 'self'; frame-ancestors 'none'");
-        res.set_content(reinterpret_cast<const char*>(asset->data), asset->size, asset->content_type);
+        res.headers.emplace_back("Content-Security-Policy",
+                                 "default-src 'self'; img-src 'self' data: blob:; style-src 'self'; script-src 'self'; "
+                                 "connect-src 'self'; frame-ancestors 'none'");
+        res.content_type = asset->content_type;
+        res.body.assign(reinterpret_cast<const char*>(asset->data), asset->size);
+        return res;
     });
 }
 

@@ -15,13 +15,12 @@
 #include "access.hpp"
 #include "child_process.hpp"
 #include "event_hub.hpp"
+#include "http_types.hpp"
 #include "pathstream/host/machine.hpp"
 
-namespace httplib {
-class Server;
-}
-
 namespace pathstream::host::serve {
+
+class HttpServer;
 
 /// Everything the server is started with; read-only once it runs.
 struct ServerConfig {
@@ -35,18 +34,16 @@ struct ServerConfig {
     double events_rate = 10;          ///< stream --events-rate: progress updates per second
     double status_hz = 10;            ///< device status reads per second
     std::size_t max_upload_bytes = 16u << 20;
+    HttpLimits limits;                ///< body_bytes comes from max_upload_bytes
+    double plan_timeout_s = 60;       ///< a preview's or run's planning is stopped after this
+    double max_motion_s = 86400;      ///< a job estimated to move longer is refused before planning
 };
-
-/// Plans the drawing `file` with path options `arguments` (as a path command's command line
-/// after FILE) and returns preview_json's document. Throws what plan_job throws.
-using PreviewFunction =
-    std::function<nlohmann::ordered_json(const std::string& file, const std::vector<std::string>& arguments)>;
 
 /// The HTTP server and what runs behind it: a device status poller thread, at most one job
 /// (a `stream` or `sim` child) with its reader thread, and the event hub the pages listen to.
 class Server {
 public:
-    Server(ServerConfig config, MachineProfile machine, PreviewFunction preview);
+    Server(ServerConfig config, MachineProfile machine);
     ~Server();
     Server(const Server&) = delete;
     Server& operator=(const Server&) = delete;
@@ -64,21 +61,27 @@ public:
 private:
     struct Reply;
     void routes();
-    Reply upload(const std::string& name, const std::string& body, const nlohmann::json& options);
-    Reply preview(const nlohmann::json& options);
-    Reply run_job(const nlohmann::json& options);
-    Reply simulate(const nlohmann::json& options);
+    Reply upload(const std::string& name, const std::string& body, const nlohmann::json& options,
+                 const CancelToken& cancel);
+    Reply preview(const nlohmann::json& options, const CancelToken& cancel);
+    /// Streams the drawing as placed by `options`; `previewed_hash` (when not empty) is the
+    /// drawing_hash of the preview the page shows, refused when another drawing is loaded.
+    Reply run_job(const nlohmann::json& options, const std::string& previewed_hash, const CancelToken& cancel);
+    /// Cancels the plan that was newest until now: `cancel` is the newest.
+    void claim_planning(const CancelToken& cancel);
+    std::string drawing_hash() const;
+    Reply simulate(const nlohmann::json& options, const CancelToken& cancel);
     Reply resume();
     Reply last_preview() const;
     /// Plans the drawing with the page's options: the preview with `paper` and `options`,
     /// kept as the last preview (cleared when planning throws, which it passes on).
-    nlohmann::ordered_json placed_preview(const nlohmann::json& options);
+    nlohmann::ordered_json placed_preview(const nlohmann::json& options, const CancelToken& cancel);
     void remember_whole_job(const std::string& job_start_line);
     nlohmann::ordered_json whole_job_ticks() const;
     Reply control(const nlohmann::json& request);
     nlohmann::ordered_json state() const;
     std::vector<std::string> arguments(const nlohmann::json& options) const;
-    nlohmann::ordered_json plan_preview(const std::vector<std::string>& args) const;
+    nlohmann::ordered_json plan_preview(const std::vector<std::string>& args, const CancelToken& cancel);
     bool start_child(const std::string& kind, std::vector<std::string> argv,
                      const nlohmann::ordered_json& whole_ticks = nullptr);
     bool job_running() const;
@@ -88,8 +91,7 @@ private:
 
     ServerConfig config_;
     MachineProfile machine_;
-    PreviewFunction preview_;
-    std::unique_ptr<httplib::Server> http_;
+    std::unique_ptr<HttpServer> http_;
     unsigned bound_port_ = 0;
     EventHub hub_;
     std::atomic<bool> stopping_{false};
@@ -100,7 +102,10 @@ private:
 
     mutable std::mutex drawing_mutex_;
     std::string drawing_name_;         ///< the stored drawing's file name; empty: none
-    mutable std::mutex plan_mutex_;    ///< one plan at a time (they are CPU-bound)
+    std::string drawing_hash_;         ///< content_hash of its bytes
+    std::mutex gate_;  ///< upload, preview, run and simulate one at a time: a run streams what it previewed
+    std::mutex newest_plan_mutex_;
+    CancelToken newest_plan_;          ///< the plan running or waiting last: a newer one cancels it
     mutable std::mutex preview_mutex_;
     nlohmann::ordered_json last_preview_;  ///< the last preview answered; null: none
 

@@ -9,6 +9,9 @@
 
 namespace pathstream::host {
 
+/// A duration as a person reads it: "42 s", "12 min 05 s", "6.7 h".
+std::string duration_text(double seconds);
+
 /// What a line says after the percentage: the time left, when the caller knows it better than
 /// an extrapolation of the wall time (motion left at the tick rate, after a resume too), and
 /// whether it and the fraction are an estimate (the job's length not planned yet).
