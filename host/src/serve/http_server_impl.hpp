@@ -11,6 +11,7 @@
 #include <optional>
 #include <thread>
 
+#include "http_head.hpp"
 #include "http_server.hpp"
 #include "work_lanes.hpp"
 
@@ -20,6 +21,14 @@ namespace net = boost::asio;
 namespace beast = boost::beast;
 namespace http = beast::http;
 using tcp = net::ip::tcp;
+
+using RequestParser = http::request_parser<http::string_body>;
+
+/// Sets the parser's byte limits from `limits` (before the head is read).
+void bound_parser(RequestParser& parser, const HttpLimits& limits);
+/// The head a parser read (or failed to, `ec`) as the handlers see it, or its refusal.
+HeadOutcome head_outcome(beast::error_code ec, const RequestParser& parser,
+                         const HttpLimits& limits);
 
 struct HttpRoute {
     std::string method, path;
@@ -104,7 +113,7 @@ private:
     std::uint64_t id_;
     State state_ = State::head;
     beast::flat_buffer buffer_;
-    std::optional<http::request_parser<http::string_body>> parser_;
+    std::optional<RequestParser> parser_;
     HttpRequest request_;
     const HttpRoute* route_ = nullptr;
     std::vector<std::pair<std::string, std::string>> extra_headers_;

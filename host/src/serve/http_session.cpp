@@ -14,12 +14,6 @@ std::string error_json(const std::string& message) {
     return nlohmann::json{{"ok", false}, {"error", message}}.dump();
 }
 
-std::string megabytes(std::size_t bytes) {
-    char text[32];
-    std::snprintf(text, sizeof text, "%.3g MB", static_cast<double>(bytes) / (1024.0 * 1024.0));
-    return text;
-}
-
 }  // namespace
 
 HttpSession::HttpSession(HttpServer::Impl& server, tcp::socket socket, std::string client,
@@ -57,8 +51,7 @@ void HttpSession::close() {
 void HttpSession::read_head() {
     state_ = State::head;
     parser_.emplace();
-    parser_->header_limit(static_cast<std::uint32_t>(server_.limits.header_bytes));
-    parser_->body_limit(server_.limits.body_bytes);
+    bound_parser(*parser_, server_.limits);
     request_ = HttpRequest{};
     route_ = nullptr;
     extra_headers_.clear();
@@ -71,31 +64,13 @@ void HttpSession::read_head() {
 
 void HttpSession::on_head(beast::error_code ec) {
     if (state_ == State::closed) return;
-    if (ec == http::error::header_limit)
-        return refuse(431, "the request head is larger than " +
-                               std::to_string(server_.limits.header_bytes) + " bytes");
-    if (ec == http::error::body_limit) {  // a Content-Length past the limit: refused before the
-                                          // body is sent
-        return refuse(413, "the body is " + megabytes(parser_->content_length().value_or(0)) +
-                               ", more than the limit of " + megabytes(server_.limits.body_bytes));
+    if (ec && ec != http::error::header_limit && ec != http::error::body_limit) {
+        return close();  // the deadline, the client gone, or not HTTP
     }
-    if (ec) return close();  // the deadline, the client gone, or not HTTP
-    const auto& head = parser_->get();
-    std::size_t fields = 0;
-    for (const auto& field : head) {
-        if (++fields > server_.limits.header_fields) {
-            return refuse(431, "the request has more than " +
-                                   std::to_string(server_.limits.header_fields) + " header fields");
-        }
-        request_.headers.emplace_back(lower(std::string(field.name_string())),
-                                      std::string(field.value()));
-    }
-    request_.method = std::string(head.method_string());
-    request_.target = std::string(head.target());
+    HeadOutcome head = head_outcome(ec, *parser_, server_.limits);
+    if (head.status != 0) return refuse(head.status, head.reason);
+    request_ = std::move(head.request);
     request_.client = client_;
-    const std::size_t q = request_.target.find('?');
-    request_.path = request_.target.substr(0, q);
-    if (q != std::string::npos) request_.query = parse_query(request_.target.substr(q + 1));
     if (server_.head_check) {
         HeadVerdict verdict = server_.head_check(request_);
         if (verdict.refusal) {
@@ -116,8 +91,8 @@ void HttpSession::on_head(beast::error_code ec) {
     }
     if (const auto length = parser_->content_length();
         length && *length > server_.limits.body_bytes) {
-        return refuse(413, "the body is " + megabytes(*length) + ", more than the limit of " +
-                               megabytes(server_.limits.body_bytes));
+        return refuse(413, "the body is " + megabytes_text(*length) + ", more than the limit of " +
+                               megabytes_text(server_.limits.body_bytes));
     }
     if (parser_->is_done()) return dispatch();
     if (lower(request_.header("expect")) == "100-continue") {
@@ -145,7 +120,7 @@ void HttpSession::on_body(beast::error_code ec) {
     if (state_ == State::closed) return;
     if (ec == http::error::body_limit) {
         return refuse(
-            413, "the body is larger than the limit of " + megabytes(server_.limits.body_bytes));
+            413, "the body is larger than the limit of " + megabytes_text(server_.limits.body_bytes));
     }
     if (ec) return close();
     dispatch();
@@ -248,7 +223,7 @@ void HttpSession::drain() {
     stream_.async_read_some(buffer_.prepare(16 * 1024),
                             [self = shared_from_this()](beast::error_code ec, std::size_t n) {
                                 self->drained_ += n;
-                                if (ec || self->drained_ > (1u << 20)) return self->close();
+                                if (ec || self->drained_ > (64u << 20)) return self->close();
                                 self->drain();
                             });
 }
