@@ -156,10 +156,14 @@ out=$(cd "$work" && "$bin" stream "$src/examples/rose.json" -m "$machine" -t "$t
 if grep -q "resume with" "$work/dj1.log"; then
   [ $rc2 -eq 2 ] && [[ "$out" == *"rose.journal.json: the journal of job 1"*"continue it with \`pathstream stream --resume rose.journal.json\`"* ]] &&
     ok || fail "a second stream replaced the journal of an interrupted job: exit $rc2: $out"
+  # Named explicitly, the same journal is kept the same way.
+  out=$(cd "$work" && "$bin" stream "$src/examples/rose.json" -m "$machine" -t "$target" --journal rose.journal.json < /dev/null 2>&1); rc2=$?
+  [ $rc2 -eq 2 ] && [[ "$out" == *"give --replace-journal or another --journal"* ]] &&
+    ok || fail "--journal replaced the journal of an interrupted job: exit $rc2: $out"
   (cd "$work" && timeout -k 5 120 "$bin" stream --resume rose.journal.json < /dev/null > "$work/dj2.log" 2>&1) &&
     ok || fail "resume of the kept journal: $(tail -n 5 "$work/dj2.log")"
 else
-  ok; ok  # the drawing ended before the interrupt
+  ok; ok; ok  # the drawing ended before the interrupt
 fi
 out=$(cd "$work" && "$bin" stream "$src/examples/rose.json" -m "$machine" -t "$target" < /dev/null 2>&1) &&
   ok || fail "a stream after the finished job: $out"

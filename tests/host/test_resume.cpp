@@ -470,6 +470,26 @@ TEST_CASE("job spans and journal files: round trip, changed or damaged files ref
         bad << "{\"format\": \"pathstream job journal 1\", \"target\": 3}";
     }
     CHECK_THROWS_WITH(host::read_journal(dir + "/j2.json"), Catch::Contains("j2.json:1:"));
+    // Bound to its job: an edited job id, or the spans of another job with their own hash, are
+    // refused by the journal reader, before any device is asked; progress and target may change.
+    const auto edited = [&](const std::string& from, const std::string& to) {
+        std::ifstream in(dir + "/j.json");
+        std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+        const std::size_t at = text.find(from);
+        REQUIRE(at != std::string::npos);
+        text.replace(at, from.size(), to);
+        std::ofstream out(dir + "/j3.json");
+        out << text;
+        return dir + "/j3.json";
+    };
+    CHECK_THROWS_WITH(host::read_journal(edited("\"job\": 7", "\"job\": 8")),
+                      Catch::Contains("\"binding\" does not match"));
+    CHECK_THROWS_WITH(host::read_journal(edited("\"plan_hash\": \"" + hash, "\"plan_hash\": \"0000000000000000")),
+                      Catch::Contains("\"binding\" does not match"));
+    CHECK_THROWS_WITH(host::read_journal(edited("\"plan_file\": \"", "\"plan_file\": \"/other")),
+                      Catch::Contains("j3.json:"));
+    CHECK(host::read_journal(edited("\"last_completed\": 33", "\"last_completed\": 40")).last_completed == 40);
+    CHECK(host::read_journal(edited("127.0.0.1:1502", "127.0.0.1:1503")).target == "modbus-tcp://127.0.0.1:1503");
 }
 
 TEST_CASE("ctl's link: status and every command over Modbus TCP, refusals by name",

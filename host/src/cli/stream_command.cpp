@@ -67,6 +67,8 @@ void add_stream_command(CLI::App& app, StreamCommandOptions& o) {
                     "DRAWING.journal.json in the "
                     "current directory, DRAWING the file's name without its extension)");
     cmd->add_flag("--no-journal", o.no_journal, "write no job journal");
+    cmd->add_flag("--replace-journal", o.replace_journal,
+                  "start anew even when the journal holds a job that did not finish (it is replaced)");
     cmd->add_flag(
         "--plan-first", o.plan_first,
         "plan the whole job before sending anything (the events' totals are known from job_start; "
@@ -493,9 +495,10 @@ void print_lead_in(const PlannedJob& job, const std::vector<double>& rest_mm) {
     }
 }
 
-// A second stream of a drawing from the same directory would replace the default journal of a
-// job the device may still hold, and with it the only way to resume that job: refused, before
-// anything is sent, unless that job ended or the device took nothing of it.
+// A second stream to the same journal (the default one of a drawing streamed again from the
+// same directory, or the same --journal) would replace the journal of a job the device may
+// still hold, and with it the only way to resume that job: refused, before anything is sent,
+// unless that job ended, the device took nothing of it, or --replace-journal says so.
 void refuse_unfinished_journal(const std::string& journal_path) {
     JobJournal old;
     try {
@@ -508,7 +511,7 @@ void refuse_unfinished_journal(const std::string& journal_path) {
                                 " (" + old.outcome + ", device state " + old.state +
                                 ") is there: continue it with `pathstream stream --resume " +
                                 journal_path +
-                                "`; to draw anew, remove it or give --journal another name");
+                                "`; to draw anew, give --replace-journal or another --journal");
 }
 
 // A line typed at the terminal (Enter) since the last look; never waits.
@@ -997,7 +1000,7 @@ int run_stream(const StreamCommandOptions& o) {
     }
     const std::string journal_path =
         o.no_journal ? "" : (o.journal.empty() ? default_journal_path(o.path.file) : o.journal);
-    if (o.journal.empty() && !journal_path.empty()) refuse_unfinished_journal(journal_path);
+    if (!o.replace_journal && !journal_path.empty()) refuse_unfinished_journal(journal_path);
     std::vector<double> rest_mm;
     // The path order starts where the device rests (its first subpath is the one nearest to
     // it), so the drawing begins where the pen is, and the lead-in goes from there to it.

@@ -20,6 +20,7 @@ struct StreamCommandOptions {
     bool no_lead_in = false;
     std::string journal;   ///< job journal path ("" : DRAWING-STEM.journal.json in the current directory)
     bool no_journal = false;
+    bool replace_journal = false;  ///< --replace-journal: an unfinished job's journal may be replaced
     std::string resume;    ///< continue the job of this journal
     double hold_timeout_seconds = 10;  ///< Ctrl-C: a hold not at rest by then becomes a stop
     std::string events;                ///< --events: NDJSON events to this file ("-": stdout)

@@ -371,6 +371,9 @@ Server::Reply Server::run_job(const nlohmann::json& options, const std::string& 
     // there), which a stream planned as it goes only knows at its end.
     for (const std::string& a : {std::string("--machine=") + config_.machine_file, "--target=" + config_.target,
                                  std::string("--lead-in"), std::string("--plan-first"), std::string("--events=-"),
+                                 // Start on the page draws anew: the last job's journal goes
+                                 // (Resume job continues it instead).
+                                 std::string("--replace-journal"),
                                  "--events-rate=" + number_text(config_.events_rate),
                                  "--journal=" + (fs::path(config_.state_dir) / "job.journal.json").string()}) {
         argv.push_back(a);

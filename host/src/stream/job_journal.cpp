@@ -415,6 +415,14 @@ JobSpans parse_job_spans(const std::string& contents, const std::string& path, c
     return job;
 }
 
+std::string journal_binding(const JobJournal& j) {
+    // The fields that say which job this is and what it draws; the progress fields and the
+    // target (resume may name the device anew) change legitimately and are left out.
+    return content_hash("pathstream job binding 1\n" + j.machine + '\n' + j.drawing + '\n' + j.plan_file + '\n' +
+                        j.plan_hash + '\n' + std::to_string(j.job) + '\n' + std::to_string(j.epoch) + '\n' +
+                        j.replan);
+}
+
 void write_journal(const JobJournal& j, const std::string& path) {
     nlohmann::json d;
     d["format"] = "pathstream job journal 1";
@@ -433,6 +441,7 @@ void write_journal(const JobJournal& j, const std::string& path) {
     if (!j.error.empty()) d["error"] = j.error;
     if (!j.pauses.empty()) d["pauses"] = j.pauses;
     if (!j.replan.empty()) d["replan"] = nlohmann::json::parse(j.replan);
+    d["binding"] = journal_binding(j);
     AtomicFile f(path);
     f.stream() << d.dump(2) << '\n';
     f.commit();
@@ -483,6 +492,13 @@ JobJournal parse_journal(const std::string& text, const std::string& path) {
     if (d.contains("replan")) {
         if (!d["replan"].is_object()) check.fail("/replan", "\"replan\" must be an object");
         j.replan = d["replan"].dump();
+    }
+    std::string binding;
+    get("binding", binding);
+    if (binding != journal_binding(j)) {
+        check.fail("/binding",
+                   "the journal's job, plan or drawing is not the one it was written with (\"binding\" does not match): "
+                   "an edited or swapped journal is never resumed");
     }
     return j;
 }

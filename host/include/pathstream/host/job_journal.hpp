@@ -126,9 +126,14 @@ struct JobJournal {
     bool nothing_accepted() const { return job == 0 || acknowledged + 1 == job; }
 };
 
-/// Writes `journal` to `path` atomically (JSON).
+/// The hash that binds a journal to its job: content_hash over the machine, drawing, plan file,
+/// plan hash, job id, epoch and replan (not the progress fields, not the target). Written as
+/// "binding"; a journal whose binding does not match its fields is refused.
+std::string journal_binding(const JobJournal& journal);
+/// Writes `journal` to `path` atomically (JSON), with its binding.
 void write_journal(const JobJournal& journal, const std::string& path);
-/// Reads a journal. Throws InputError naming the file, line and column, or the missing key.
+/// Reads a journal. Throws InputError naming the file, line and column, or the missing key,
+/// or "binding" when the journal's identity fields were changed after it was written.
 JobJournal read_journal(const std::string& path);
 /// read_journal on `text` already read, `path` naming it in errors.
 JobJournal parse_journal(const std::string& text, const std::string& path);
