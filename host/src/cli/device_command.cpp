@@ -112,20 +112,43 @@ public:
         last_ = v;
     }
 
-    // After every Modbus poll: connections accepted and closed since the last one.
+    // After every Modbus poll: connections accepted and closed since the last one. At most
+    // kConnectionLines lines in kConnectionWindow; beyond them a client that connects and
+    // leaves in a loop is counted, and one line per window says how many.
     void after_poll(const hal::ModbusServer& server) {
         const hal::ModbusServerCounters& c = server.counters();
         const std::uint64_t closed = c.connections_closed.load(),
                             accepted = c.connections_accepted.load();
+        const auto now = std::chrono::steady_clock::now();
+        if (now - window_start_ >= kConnectionWindow) {
+            if (quiet_accepted_ + quiet_closed_ > 0) {
+                log_("connections",
+                     std::to_string(quiet_accepted_) + " more clients connected and " + std::to_string(quiet_closed_) +
+                         " disconnected in " + std::to_string(kConnectionWindow.count()) + " s (" +
+                         std::to_string(open_after(accepted, closed)) + " open)",
+                     {{"connected", quiet_accepted_}, {"disconnected", quiet_closed_},
+                      {"open", open_after(accepted, closed)}});
+            }
+            window_start_ = now;
+            window_lines_ = quiet_accepted_ = quiet_closed_ = 0;
+        }
         while (accepted_ < accepted) {
             ++accepted_;
-            log_("connect", "client connected (" + std::to_string(open()) + " open)",
-                 {{"open", open()}});
+            if (window_lines_ < kConnectionLines) {
+                ++window_lines_;
+                log_("connect", "client connected (" + std::to_string(open()) + " open)", {{"open", open()}});
+            } else {
+                ++quiet_accepted_;
+            }
         }
         while (closed_ < closed && closed_ < accepted_) {
             ++closed_;
-            log_("disconnect", "client disconnected (" + std::to_string(open()) + " open)",
-                 {{"open", open()}});
+            if (window_lines_ < kConnectionLines) {
+                ++window_lines_;
+                log_("disconnect", "client disconnected (" + std::to_string(open()) + " open)", {{"open", open()}});
+            } else {
+                ++quiet_closed_;
+            }
         }
     }
 
@@ -135,7 +158,13 @@ private:
     static constexpr unsigned kEstop = static_cast<unsigned>(device::DeviceState::kEstop);
     static constexpr unsigned kIdle = static_cast<unsigned>(device::DeviceState::kIdle);
 
+    static constexpr unsigned kConnectionLines = 20;
+    static constexpr std::chrono::seconds kConnectionWindow{10};
+
     std::uint64_t open() const { return accepted_ - closed_; }
+    static std::uint64_t open_after(std::uint64_t accepted, std::uint64_t closed) {
+        return accepted > closed ? accepted - closed : 0;
+    }
 
     void job_start(const DeviceView& v, std::uint64_t tick) {
         started_job_ = v.job;
@@ -179,6 +208,9 @@ private:
     DeviceView last_;
     std::uint32_t started_job_ = 0;
     std::uint64_t accepted_ = 0, closed_ = 0;
+    std::chrono::steady_clock::time_point window_start_ = std::chrono::steady_clock::now();
+    unsigned window_lines_ = 0;
+    std::uint64_t quiet_accepted_ = 0, quiet_closed_ = 0;
 };
 
 // Homes in real time (times --time-scale), before any bus is served: a host cannot start a
@@ -327,10 +359,16 @@ Machine prepare_machine(sim::SimulatedMotionDevice& device, const DeviceCommandO
     return m;
 }
 
-sim::DeviceLoopOptions loop_options(const DeviceCommandOptions& o) {
+// The pacing: `o`'s time scale; an idle device that has changed nothing for 1,000 ticks (any
+// pen dwell or homing wait long over) ticks at most 1,000 times a second of wall time, so that
+// its CPU does not grow with --time-scale. A request wakes it within a millisecond.
+sim::DeviceLoopOptions loop_options(const DeviceCommandOptions& o, const sim::SimulatedMotionDevice& device) {
     sim::DeviceLoopOptions loop;
     loop.time_scale = o.time_scale;
     loop.run_for = std::chrono::milliseconds(static_cast<long>(o.exit_after * 1000));
+    loop.at_rest = [&device] {
+        return device.state() == static_cast<std::uint8_t>(device::DeviceState::kIdle) && device.unchanged_ticks() >= 1000;
+    };
     return loop;
 }
 
@@ -355,7 +393,7 @@ int run_can_device(const DeviceCommandOptions& o, const std::vector<Lsb>& start,
             machine.after_tick(log);
         },
         [&] { return device->tick_hz(); },
-        [&](std::chrono::microseconds w) { device->serve(bus, w); }, loop_options(o), g_stop);
+        [&](std::chrono::microseconds w) { device->serve(bus, w); }, loop_options(o, *device), g_stop);
     const hal::SocketCanCounters& c = bus.counters();
     log("stopped",
         "stopped after " + std::to_string(device->ticks_run()) + " ticks, " +
@@ -412,7 +450,7 @@ int run_modbus_device(const DeviceCommandOptions& o, const std::vector<Lsb>& sta
             server.poll_once(w);
             watch.after_poll(server);
         },
-        loop_options(o), g_stop);
+        loop_options(o, *device), g_stop);
     log("stopped",
         "stopped after " + std::to_string(device->ticks_run()) + " ticks, " +
             std::to_string(server.counters().requests.load()) + " requests (" +

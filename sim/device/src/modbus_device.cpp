@@ -1,3 +1,4 @@
+#include <algorithm>
 #include "pathstream/sim/modbus_device.hpp"
 
 #include <stdexcept>
@@ -91,7 +92,14 @@ std::uint64_t run_paced_loop(const std::function<void()>& tick, const std::funct
             tick();
             ++ticks;
             const std::uint32_t hz = tick_hz() != 0 ? tick_hz() : 1000;
-            due_seconds += 1.0 / (hz * options.time_scale);
+            const double period = 1.0 / (hz * options.time_scale);
+            due_seconds += period;
+            // At rest, faster than rest_tick_hz: the next tick a rest period of wall time from
+            // now, the idle ticks in between dropped (nothing happens in them to make up).
+            if (options.at_rest && 1.0 / period > options.rest_tick_hz && options.at_rest()) {
+                due_seconds = std::max(due_seconds, elapsed + 1.0 / options.rest_tick_hz);
+                break;
+            }
         }
         const double wait = due_seconds - elapsed;
         serve(std::chrono::microseconds(wait > 0 ? static_cast<long>(wait * 1e6) : 0));

@@ -3,6 +3,8 @@
 // homing (DeviceIo). The bus side differs; this part is written once.
 #pragma once
 
+#include <cstring>
+#include <type_traits>
 #include <cstdint>
 #include <memory>
 #include <vector>
@@ -68,6 +70,9 @@ public:
     void record_every_tick(bool on) { recording_every_tick_ = on; }
     const std::vector<Lsb>& every_tick_setpoints() const { return every_tick_; }
     std::uint64_t ticks_run() const { return ticks_run_; }
+    /// Consecutive ticks, up to the last, that changed nothing in the device's status but its
+    /// tick count: how long it has been at rest (a dwell or a wait for the host included).
+    std::uint64_t unchanged_ticks() const { return unchanged_ticks_; }
 
 protected:
     MachineSwitches switches_;
@@ -77,6 +82,7 @@ protected:
     std::vector<Lsb> every_tick_;
     std::vector<DeviceTick> ticks_;
     std::uint64_t ticks_run_ = 0;
+    std::uint64_t unchanged_ticks_ = 0;
 };
 
 /// The shared half of a simulated device class: `Interface` (a SimulatedMotionDevice) with
@@ -92,6 +98,13 @@ public:
         const std::uint64_t before = device_.ticks_executed();
         device_.tick(out);
         if (io_) io_->after_tick();
+        // The status but its tick count (the words after tick_count and before tick_check,
+        // then every word after it), against the last tick's.
+        static_assert(std::has_unique_object_representations_v<device::DeviceStatus<Axes>>, "compared bytewise");
+        device::DeviceStatus<Axes> now = device_.status();
+        now.tick_count = now.tick_check = 0;
+        this->unchanged_ticks_ = std::memcmp(&now, &last_status_, sizeof now) == 0 ? this->unchanged_ticks_ + 1 : 0;
+        last_status_ = now;
         if (this->switches_.size() != 0) this->switches_.after_tick(out, Axes, device_.status().position_applied);
         ++this->ticks_run_;
         if (this->recording_every_tick_) this->every_tick_.insert(this->every_tick_.end(), out, out + Axes);
@@ -137,6 +150,7 @@ protected:
 
     device::MotionDevice<Axes, Capacity> device_;
     std::unique_ptr<DeviceIo> io_;
+    device::DeviceStatus<Axes> last_status_{};
 };
 
 }  // namespace pathstream::sim
