@@ -143,8 +143,18 @@ start_device device1 || exit 1
 [ $rc -eq 0 ] && ok || fail "stream --events -: exit $rc: $(cat stream1.err)"
 grep -q "^job           1 finished" stream1.err && ok || fail "stream: the text report is not on stderr"
 check_events stream1.ndjson stream 5 finished full && ok || fail "stream full run events"
+# A client that connects and leaves in a loop: at most 20 connection lines in a 10 s window.
+/usr/bin/python3 - "$target" <<'PY'
+import socket, sys
+host, port = sys.argv[1].split("//")[1].split("?")[0].rsplit(":", 1)
+for _ in range(200):
+    socket.create_connection((host, int(port))).close()
+PY
+for _ in $(seq 100); do [ "$(grep -c '"event":"disconnect"' "$work/device1.ndjson")" -ge 10 ] && break; sleep 0.05; done
 stop_device
 check_device_log device1.ndjson && ok || fail "device --log-json lines"
+lines=$(grep -c '"event":"\(connect\|disconnect\)"' "$work/device1.ndjson")
+[ "$lines" -le 22 ] && ok || fail "200 connections wrote $lines connection lines (at most 20 a window, and the stream's)"
 
 # ---- stream: Ctrl-C mid-stream holds the job -----------------------------------------------
 start_device device2 || exit 1
