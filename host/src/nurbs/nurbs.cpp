@@ -51,9 +51,12 @@ void insert_knot(std::vector<double>& knots, std::vector<Point>& points, int p, 
     points = std::move(next);
 }
 
-// The Bezier spans (p + 1 homogeneous points each) of the curve over its domain.
+// The Bezier spans (p + 1 homogeneous points each) of the curve over its domain. Knot
+// insertion is local: a span's Bezier points depend only on its p + 1 control points and 2p + 2
+// knots, so each span is refined on a copy of those alone, O(p^3) per span and linear in the
+// control points (refining the whole curve at once was quadratic: every insertion copied it).
 std::vector<std::vector<Point>> bezier_spans(const Nurbs& c) {
-    const int p = c.degree;
+    const auto p = static_cast<std::size_t>(c.degree);
     const std::size_t n = c.points.size();
     std::vector<Point> points(n);
     for (std::size_t i = 0; i < n; ++i) {
@@ -62,23 +65,24 @@ std::vector<std::vector<Point>> bezier_spans(const Nurbs& c) {
         for (double& x : points[i]) x *= w;
         points[i].push_back(w);
     }
-    std::vector<double> knots = c.knots;
-    const double lo = knots[static_cast<std::size_t>(p)], hi = knots[n];
-    std::vector<double> breaks;
-    for (double u : c.knots) {
-        if (u >= lo && u <= hi && (breaks.empty() || breaks.back() != u)) breaks.push_back(u);
-    }
-    for (double u : breaks) {
-        while (std::count(knots.begin(), knots.end(), u) < p) insert_knot(knots, points, p, u);
-    }
+    const auto count = [](const std::vector<double>& knots, double u) {
+        return static_cast<std::size_t>(std::count(knots.begin(), knots.end(), u));
+    };
     std::vector<std::vector<Point>> spans;
-    for (std::size_t b = 0; b + 1 < breaks.size(); ++b) {
+    for (std::size_t i = p; i < n; ++i) {
+        const double a = c.knots[i], b = c.knots[i + 1];
+        if (!(a < b)) continue;  // an empty span: a repeated knot
+        std::vector<double> knots(c.knots.begin() + static_cast<std::ptrdiff_t>(i - p),
+                                  c.knots.begin() + static_cast<std::ptrdiff_t>(i + p + 2));
+        std::vector<Point> local(points.begin() + static_cast<std::ptrdiff_t>(i - p),
+                                 points.begin() + static_cast<std::ptrdiff_t>(i + 1));
+        while (count(knots, a) < p) insert_knot(knots, local, c.degree, a);
+        while (count(knots, b) < p) insert_knot(knots, local, c.degree, b);
         // The last knot equal to the span's start: its p + 1 points end there.
         std::size_t k = 0;
-        while (k + 1 < knots.size() && knots[k + 1] <= breaks[b]) ++k;
-        const auto pp = static_cast<std::size_t>(p);
-        spans.emplace_back(points.begin() + static_cast<std::ptrdiff_t>(k - pp),
-                           points.begin() + static_cast<std::ptrdiff_t>(k + 1));
+        while (k + 1 < knots.size() && knots[k + 1] <= a) ++k;
+        spans.emplace_back(local.begin() + static_cast<std::ptrdiff_t>(k - p),
+                           local.begin() + static_cast<std::ptrdiff_t>(k + 1));
     }
     return spans;
 }
