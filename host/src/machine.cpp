@@ -128,9 +128,8 @@ public:
                 const std::string ptr = "/layer_feeds/" + json_pointer_token(name);
                 p.layer_feeds.emplace_back(name, number(value, ptr, "layer feed", 0, 1e5, true, "mm/s"));
                 if (p.layer_feeds.back().second < min_velocity(p)) {
-                    fail(ptr, "layer feed " + format(p.layer_feeds.back().second) +
-                                  " mm/s is below 1 LSB per span: planning would crawl (allowed: >= " +
-                                  format(min_velocity(p)) + " mm/s)");
+                    fail(ptr, "layer feed " + format(p.layer_feeds.back().second) + " mm/s is below " +
+                                  min_velocity_reason(p) + " (allowed: >= " + format(min_velocity(p)) + " mm/s)");
                 }
             }
         }
@@ -148,14 +147,16 @@ private:
         const double a_min = min_acceleration(p);
         const std::string grid = "(" + format(p.mm_per_lsb) + " mm/LSB, " + format(p.tick_hz) + " Hz, " +
                                  format(n) + " ticks per span)";
+        const std::string floor = v_min > kSlowestVelocity ? "1 LSB per span " + grid + ": planning would crawl"
+                                                           : min_velocity_reason(p);
         for (std::size_t i = 0; i < p.axes.size(); ++i) {
             const AxisLimits& a = p.axes[i];
             const std::string ptr = "/axes/" + std::to_string(i);
             if (a.max_velocity < v_min) {
                 fail(ptr + "/max_velocity",
-                     "max_velocity " + format(a.max_velocity) + " mm/s is below 1 LSB per span " + grid +
-                         ": planning would crawl (allowed: >= " + format(v_min) +
-                         " mm/s; or raise ticks_per_span, or lower tick_hz)");
+                     "max_velocity " + format(a.max_velocity) + " mm/s is below " + floor + " (allowed: >= " +
+                         format(v_min) + " mm/s" +
+                         (v_min > kSlowestVelocity ? "; or raise ticks_per_span, or lower tick_hz)" : ")"));
             }
             if (a.max_acceleration < a_min) {
                 fail(ptr + "/max_acceleration",
@@ -208,8 +209,8 @@ private:
             if (feed >= v_min) return;
             const bool given = root.contains(key);
             fail(given ? std::string("/") + key : std::string(),
-                 std::string(key) + (given ? " " : " (default) ") + format(feed) + " mm/s is below 1 LSB per span " +
-                     grid + ": planning would crawl (allowed: >= " + format(v_min) + " mm/s)");
+                 std::string(key) + (given ? " " : " (default) ") + format(feed) + " mm/s is below " + floor +
+                     " (allowed: >= " + format(v_min) + " mm/s)");
         };
         check_feed("feed", p.feed);
         check_feed("travel_feed", p.travel_feed);
@@ -324,11 +325,22 @@ private:
 
 }  // namespace
 
-double min_velocity(const MachineProfile& p) { return p.mm_per_lsb * p.tick_hz / p.ticks_per_span; }
+namespace {
+
+double grid_velocity(const MachineProfile& p) { return p.mm_per_lsb * p.tick_hz / p.ticks_per_span; }
+
+}  // namespace
+
+double min_velocity(const MachineProfile& p) { return std::max(grid_velocity(p), kSlowestVelocity); }
+
+std::string min_velocity_reason(const MachineProfile& p) {
+    if (grid_velocity(p) >= kSlowestVelocity) return "1 LSB per span: planning would crawl";
+    return "1 mm an hour: a drawing would plan and run for days";
+}
 
 double min_acceleration(const MachineProfile& p) {
     const double span_seconds = p.ticks_per_span / p.tick_hz;
-    return min_velocity(p) / span_seconds;
+    return grid_velocity(p) / span_seconds;
 }
 
 MachineProfile parse_machine_profile(const std::string& text, const std::string& file) {

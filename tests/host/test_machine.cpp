@@ -96,6 +96,18 @@ TEST_CASE("profiles the planner cannot work with are refused at the value, with 
     CHECK(error_of(std::string("{") + kAxes + ", \"travel_feed\": 1e-9}").find("m.json:1:89: travel_feed 1e-09 mm/s") ==
           0);
     CHECK(error_of(std::string("{") + kAxes + ", \"layer_feeds\": {\"red\": 1e-9}}").find("m.json:1:97: layer feed 1e-09 mm/s is below 1 LSB per span") == 0);
+    // On a fine grid 1 LSB per span can be slower than any drawing should plan at (1.25e-6
+    // mm/s at 1e-6 mm, 10 Hz: 179 mm of star.csv would take 4.5 years): 1 mm an hour is the
+    // floor then, for every speed.
+    const std::string fine = R"("mm_per_lsb": 1e-6, "tick_hz": 10, "feed": 0.001, "travel_feed": 0.001)";
+    CHECK(error_of(R"({"axes": [{"name": "x", "max_velocity": 1.25e-6, "max_acceleration": 1000}], )" + fine + "}") ==
+          "m.json:1:41: max_velocity 1.25e-06 mm/s is below 1 mm an hour: a drawing would plan and run for days "
+          "(allowed: >= 0.000277778 mm/s)");
+    CHECK(error_of(R"({"axes": [{"name": "x", "max_velocity": 0.001, "max_acceleration": 1000}], )" + fine + "}") ==
+          "no error");
+    CHECK(error_of(R"({"axes": [{"name": "x", "max_velocity": 0.001, "max_acceleration": 1000}], "mm_per_lsb": 1e-6, )"
+                   R"("tick_hz": 10, "feed": 0.0001})")
+              .find("feed 0.0001 mm/s is below 1 mm an hour") != std::string::npos);
 }
 
 TEST_CASE("spans longer than the work area at full speed are refused", "[host][machine]") {

@@ -79,13 +79,19 @@ struct MachineProfile {
     double tick_seconds() const { return 1.0 / tick_hz; }
 };
 
-/// Slowest speed a profile may ask for, mm/s: 1 LSB per span (mm_per_lsb * tick_hz /
-/// ticks_per_span). Below it the spans' whole-LSB ends advance by less than one LSB per
-/// span and planning crawls through ever more ticks. O(1).
-double min_velocity(const MachineProfile& profile);
+/// 1 mm an hour, mm/s: the slowest speed any profile may ask for. A drawing at that speed
+/// already plans and runs for days (1 LSB per span on a fine grid can be slower still).
+inline constexpr double kSlowestVelocity = 1.0 / 3600.0;
 
-/// Lowest max_acceleration a profile may give an axis, mm/s^2: the one that gains
-/// min_velocity() within one span (mm_per_lsb * tick_hz^2 / ticks_per_span^2). O(1).
+/// Slowest speed a profile may ask for, mm/s: 1 LSB per span (mm_per_lsb * tick_hz /
+/// ticks_per_span; below it the spans' whole-LSB ends advance by less than one LSB per span
+/// and planning crawls through ever more ticks), or kSlowestVelocity when that is faster. O(1).
+double min_velocity(const MachineProfile& profile);
+/// Which of the two floors min_velocity() is, and why, for messages. O(1).
+std::string min_velocity_reason(const MachineProfile& profile);
+
+/// Lowest max_acceleration a profile may give an axis, mm/s^2: the one that gains 1 LSB per
+/// span of speed within one span (mm_per_lsb * tick_hz^2 / ticks_per_span^2). O(1).
 double min_acceleration(const MachineProfile& profile);
 
 /// Parses a machine profile JSON document. Throws InputError ("file:line:col: ...") on
