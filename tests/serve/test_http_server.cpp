@@ -117,7 +117,7 @@ HttpResponse ok(const std::string& body) {
 }  // namespace
 
 TEST_CASE("http: a stop answers while every other kind of client holds the server",
-          "[serve][http]") {
+          "[serve][http][threads]") {
     HttpLimits limits;
     std::atomic<int> planning{0};
     RunningServer s(limits, [&](HttpServer& h) {
@@ -154,7 +154,7 @@ TEST_CASE("http: a stop answers while every other kind of client holds the serve
     CHECK(planning.load() == 2);  // the other two plans wait in the work lane's queue
 }
 
-TEST_CASE("http: a head that does not end within the deadline is closed", "[serve][http]") {
+TEST_CASE("http: a head that does not end within the deadline is closed", "[serve][http][threads]") {
     HttpLimits limits;
     limits.header_deadline = 300ms;
     RunningServer s(limits, [](HttpServer& h) {
@@ -179,7 +179,7 @@ TEST_CASE("http: a head that does not end within the deadline is closed", "[serv
 }
 
 TEST_CASE("http: heads too large or with too many fields get 431 before any handler",
-          "[serve][http]") {
+          "[serve][http][threads]") {
     HttpLimits limits;
     std::atomic<int> handled{0};
     RunningServer s(limits, [&](HttpServer& h) {
@@ -207,7 +207,7 @@ TEST_CASE("http: heads too large or with too many fields get 431 before any hand
     CHECK(handled.load() == 0);
 }
 
-TEST_CASE("http: a body past the limit is refused as it arrives, chunked or not", "[serve][http]") {
+TEST_CASE("http: a body past the limit is refused as it arrives, chunked or not", "[serve][http][threads]") {
     HttpLimits limits;
     limits.body_bytes = 64 * 1024;
     std::atomic<int> handled{0};
@@ -240,7 +240,7 @@ TEST_CASE("http: a body past the limit is refused as it arrives, chunked or not"
     CHECK(handled.load() == 1);
 }
 
-TEST_CASE("http: a client that leaves cancels the work it asked for", "[serve][http]") {
+TEST_CASE("http: a client that leaves cancels the work it asked for", "[serve][http][threads]") {
     HttpLimits limits;
     std::atomic<int> started{0}, cancelled{0};
     RunningServer s(limits, [&](HttpServer& h) {
@@ -262,7 +262,7 @@ TEST_CASE("http: a client that leaves cancels the work it asked for", "[serve][h
 }
 
 TEST_CASE("http: an event listener that does not read is dropped; one that reads is not",
-          "[serve][http]") {
+          "[serve][http][threads]") {
     HttpLimits limits;
     limits.event_backlog_bytes = 1u << 20;
     limits.write_deadline = 500ms;
@@ -303,7 +303,7 @@ TEST_CASE("http: an event listener that does not read is dropped; one that reads
 }
 
 TEST_CASE("http: at the connection cap an idle connection makes room for a request",
-          "[serve][http]") {
+          "[serve][http][threads]") {
     HttpLimits limits;
     limits.connections = 16;
     limits.connections_per_client = 8;
