@@ -23,7 +23,7 @@
 #include "pathstream/host/can_stream.hpp"
 #include "pathstream/host/geometry.hpp"
 #include "pathstream/host/json_path.hpp"
-#include "pathstream/host/machine.hpp"
+#include "pathstream/machine/machine.hpp"
 #include "pathstream/host/planner.hpp"
 #include "pathstream/sim/can_device.hpp"
 #include "pathstream/sim/can_loopback.hpp"

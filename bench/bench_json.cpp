@@ -15,8 +15,8 @@
 #include <cstdlib>
 #include <string>
 
-#include "pathstream/host/input_error.hpp"
-#include "pathstream/host/json_locate.hpp"
+#include "pathstream/machine/input_error.hpp"
+#include "pathstream/machine/json_locate.hpp"
 #include "pathstream/host/json_path.hpp"
 
 using namespace pathstream::host;

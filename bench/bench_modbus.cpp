@@ -38,7 +38,7 @@
 #include "pathstream/hal/modbus_server.hpp"
 #include "pathstream/host/geometry.hpp"
 #include "pathstream/host/json_path.hpp"
-#include "pathstream/host/machine.hpp"
+#include "pathstream/machine/machine.hpp"
 #include "pathstream/host/modbus_stream.hpp"
 #include "pathstream/host/planner.hpp"
 #include "pathstream/sim/modbus_device.hpp"

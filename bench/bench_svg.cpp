@@ -21,7 +21,7 @@
 #include <string>
 #include <vector>
 
-#include "pathstream/host/input_error.hpp"
+#include "pathstream/machine/input_error.hpp"
 #include "pathstream/host/svg_path.hpp"
 
 using namespace pathstream::host;

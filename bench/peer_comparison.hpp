@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "pathstream/host/machine.hpp"
+#include "pathstream/machine/machine.hpp"
 #include "pathstream/host/path.hpp"
 #include "reference_planners/tick_sampling.hpp"
 

@@ -5,7 +5,7 @@
 #include <cstddef>
 #include <string>
 
-#include "pathstream/host/machine.hpp"
+#include "pathstream/machine/machine.hpp"
 #include "pathstream/host/path.hpp"
 
 namespace pathstream::bench {

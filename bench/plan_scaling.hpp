@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "pathstream/host/machine.hpp"
+#include "pathstream/machine/machine.hpp"
 
 namespace pathstream::bench {
 

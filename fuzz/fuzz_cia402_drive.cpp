@@ -4,7 +4,7 @@
 // nor its mode of operation nor its interpolation period.
 #include "device_fingerprint.hpp"
 #include "fuzz_support.hpp"
-#include "pathstream/host/cia402_protocol.hpp"
+#include "pathstream/machine/cia402_protocol.hpp"
 #include "pathstream/sim/can_loopback.hpp"
 #include "pathstream/sim/cia402_drive.hpp"
 

@@ -4,7 +4,7 @@
 
 #include "fuzz_support.hpp"
 #include "pathstream/device/motion_limits.hpp"
-#include "pathstream/host/machine.hpp"
+#include "pathstream/machine/machine.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
     using namespace pathstream;

@@ -9,7 +9,7 @@
 #include <exception>
 #include <string>
 
-#include "pathstream/host/input_error.hpp"
+#include "pathstream/machine/input_error.hpp"
 #include "pathstream/host/path.hpp"
 
 namespace pathstream::fuzz {

@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """Which folder includes which: every `#include "pathstream/..."` in production code, as an
-arrow between layers: core (firmware_core), hal, host (the libraries under host/src but its
-CLI and web server), linux_device (the device runtime), sim (what stands in for hardware), app
+arrow between layers: core (firmware_core), hal, machine (what host and device share), host
+(the libraries under host/src but its CLI and web server), linux_device (the device runtime), sim (what stands in for hardware), app
 (host/src/cli, host/src/serve, host/src/main.cpp: the executable). ALLOWED says which arrows
 may exist: down only, and host and the device runtime never into each other. Arrows that break
 it today are listed in scripts/include_arrows_known.txt with their counts, to be removed as the
@@ -15,14 +15,15 @@ import os
 import re
 import sys
 
-RANK = {"core": 0, "hal": 1, "host": 2, "linux_device": 3, "sim": 4, "app": 5}
+RANK = {"core": 0, "hal": 1, "machine": 2, "host": 3, "linux_device": 4, "sim": 5, "app": 6}
 ALLOWED = {
     "core": set(),
     "hal": {"core"},
-    "host": {"core", "hal"},
-    "linux_device": {"core", "hal"},
-    "sim": {"core", "hal", "linux_device"},
-    "app": {"core", "hal", "host", "linux_device", "sim"},
+    "machine": {"core", "hal"},
+    "host": {"core", "hal", "machine"},
+    "linux_device": {"core", "hal", "machine"},
+    "sim": {"core", "hal", "machine", "linux_device"},
+    "app": {"core", "hal", "machine", "host", "linux_device", "sim"},
 }
 source = sys.argv[1]
 
@@ -33,6 +34,8 @@ def layer_of_file(path):
         return "core"
     if rel.startswith("hal/"):
         return "hal"
+    if rel.startswith("machine/"):
+        return "machine"
     if rel.startswith(("host/src/cli/", "host/src/serve/")) or rel == "host/src/main.cpp":
         return "app"
     if rel.startswith("host/"):
@@ -48,11 +51,11 @@ def layer_of_include(name):
     part = name.split("/")
     if len(part) == 2 or part[1] == "device":
         return "core"
-    return {"hal": "hal", "host": "host", "linux_device": "linux_device", "sim": "sim"}.get(part[1])
+    return {"hal": "hal", "machine": "machine", "host": "host", "linux_device": "linux_device", "sim": "sim"}.get(part[1])
 
 
 arrows = collections.Counter()
-for folder in ("firmware_core", "hal", "host", "linux_device", "sim"):
+for folder in ("firmware_core", "hal", "machine", "host", "linux_device", "sim"):
     for root, dirs, files in os.walk(os.path.join(source, folder)):
         dirs[:] = [d for d in dirs if d not in ("node_modules", "build")]
         for f in files:

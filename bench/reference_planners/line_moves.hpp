@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "pathstream/host/geometry.hpp"
-#include "pathstream/host/machine.hpp"
+#include "pathstream/machine/machine.hpp"
 
 namespace pathstream::bench {
 

@@ -6,7 +6,7 @@
 #include <string>
 #include <utility>
 
-#include "pathstream/host/core_span_conversion.hpp"
+#include "pathstream/machine/core_span_conversion.hpp"
 #include "pathstream/setpoint_stream.hpp"
 
 namespace pathstream::host {

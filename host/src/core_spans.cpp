@@ -4,7 +4,7 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "pathstream/host/input_error.hpp"
+#include "pathstream/machine/input_error.hpp"
 #include "pathstream/status.hpp"
 #include "pathstream/tick_cubic.hpp"
 
@@ -151,14 +151,6 @@ std::vector<CoreSpan> subpath_spans(const Path& path, std::size_t s, const std::
 }
 
 }  // namespace
-
-Lsb core_value_at(const CoreSpan& span, std::size_t axis, std::uint32_t k) {
-    Lsb v = 0;
-    if (axis >= span.cubic.size() || evaluate_at(span.cubic[axis], span.timing, k, v) != Status::kOk) {
-        throw std::logic_error("core_value_at: span not validated by uniform_core_spans, or tick beyond it");
-    }
-    return v;
-}
 
 std::vector<CoreSpan> uniform_core_spans(const Path& path, const std::string& file,
                                          double mm_per_lsb, std::uint32_t ticks_per_span) {

@@ -9,7 +9,7 @@
 #include <string_view>
 #include <vector>
 
-#include "pathstream/host/input_error.hpp"
+#include "pathstream/machine/input_error.hpp"
 
 namespace pathstream::host {
 

@@ -7,8 +7,8 @@
 #include <stdexcept>
 #include <sstream>
 
-#include "pathstream/host/input_error.hpp"
-#include "pathstream/host/json_document.hpp"
+#include "pathstream/machine/input_error.hpp"
+#include "pathstream/machine/json_document.hpp"
 #include "nurbs/nurbs.hpp"
 
 namespace pathstream::host {

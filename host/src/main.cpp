@@ -8,7 +8,7 @@
 #include <system_error>
 #include <iostream>
 
-#include "pathstream/host/input_error.hpp"
+#include "pathstream/machine/input_error.hpp"
 #include "pathstream/host/planner.hpp"
 #include "cli/check_command.hpp"
 #include "cli/ctl_command.hpp"

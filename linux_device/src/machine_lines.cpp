@@ -2,7 +2,7 @@
 
 #include <stdexcept>
 
-#include "pathstream/host/device_setup.hpp"
+#include "pathstream/machine/device_setup.hpp"
 
 namespace pathstream::linux_device {
 

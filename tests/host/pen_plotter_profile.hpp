@@ -1,7 +1,7 @@
 // The pen plotter's machine profile (examples/machines/pen_plotter.json) for planner tests.
 #pragma once
 
-#include "pathstream/host/machine.hpp"
+#include "pathstream/machine/machine.hpp"
 
 namespace pathstream::host::test {
 

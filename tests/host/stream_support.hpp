@@ -8,7 +8,7 @@
 #include "pathstream/host/core_playback.hpp"
 #include "pathstream/host/geometry.hpp"
 #include "pathstream/host/json_path.hpp"
-#include "pathstream/host/machine.hpp"
+#include "pathstream/machine/machine.hpp"
 #include "pathstream/host/planner.hpp"
 #include "pathstream/sim/simulated_motion_device.hpp"
 #include "pathstream/span.hpp"

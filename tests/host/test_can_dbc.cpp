@@ -8,7 +8,7 @@
 #include <sstream>
 
 #include "pathstream/device/can_protocol.hpp"
-#include "pathstream/host/can_dbc.hpp"
+#include "pathstream/machine/can_dbc.hpp"
 
 using namespace pathstream;
 namespace pc = device::can;

@@ -14,7 +14,7 @@
 #include "pathstream/host/core_playback.hpp"
 #include "pathstream/host/geometry.hpp"
 #include "pathstream/host/json_path.hpp"
-#include "pathstream/host/machine.hpp"
+#include "pathstream/machine/machine.hpp"
 #include "pathstream/host/planner.hpp"
 #include "pathstream/host/plot.hpp"
 

@@ -7,7 +7,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "pathstream/host/device_setup.hpp"
+#include "pathstream/machine/device_setup.hpp"
 #include "pathstream/host/planner.hpp"
 #include "pathstream/tick_cubic.hpp"
 

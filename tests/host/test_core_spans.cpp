@@ -2,7 +2,7 @@
 #include <catch2/catch.hpp>
 
 #include "pathstream/host/core_spans.hpp"
-#include "pathstream/host/input_error.hpp"
+#include "pathstream/machine/input_error.hpp"
 #include "pathstream/host/json_path.hpp"
 
 using namespace pathstream::host;

@@ -4,7 +4,7 @@
 #include <string>
 
 #include "pathstream/host/csv_path.hpp"
-#include "pathstream/host/input_error.hpp"
+#include "pathstream/machine/input_error.hpp"
 
 using namespace pathstream::host;
 

@@ -10,8 +10,8 @@
 
 #include "pathstream/device/gpio_logic.hpp"
 #include "pathstream/device/motion_device.hpp"
-#include "pathstream/host/device_setup.hpp"
-#include "pathstream/host/machine.hpp"
+#include "pathstream/machine/device_setup.hpp"
+#include "pathstream/machine/machine.hpp"
 #include "pathstream/linux_device/machine_homing.hpp"
 #include "pathstream/sim/can_device.hpp"
 #include "pathstream/sim/modbus_device.hpp"

@@ -11,7 +11,7 @@
 
 #include "pathstream/host/gcode_path.hpp"
 #include "pathstream/host/geometry.hpp"
-#include "pathstream/host/input_error.hpp"
+#include "pathstream/machine/input_error.hpp"
 #include "pathstream/host/path_order.hpp"
 #include "pathstream/host/planner.hpp"
 #include "pen_plotter_profile.hpp"

@@ -8,8 +8,8 @@
 
 #include "pathstream/host/gcode_path.hpp"
 #include "pathstream/host/geometry.hpp"
-#include "pathstream/host/input_error.hpp"
-#include "pathstream/host/machine.hpp"
+#include "pathstream/machine/input_error.hpp"
+#include "pathstream/machine/machine.hpp"
 #include "pathstream/host/path_order.hpp"
 #include "pathstream/host/work_area.hpp"
 

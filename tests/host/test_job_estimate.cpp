@@ -9,7 +9,7 @@
 #include "pathstream/host/core_spans.hpp"
 #include "pathstream/host/events.hpp"
 #include "pathstream/host/job_estimate.hpp"
-#include "pathstream/host/machine.hpp"
+#include "pathstream/machine/machine.hpp"
 
 using namespace pathstream;
 using namespace pathstream::host;

@@ -1,7 +1,7 @@
 // The JSON path reader: valid documents, and each kind of broken one with its exact message.
 #include <catch2/catch.hpp>
 
-#include "pathstream/host/input_error.hpp"
+#include "pathstream/machine/input_error.hpp"
 #include "pathstream/host/json_path.hpp"
 
 using namespace pathstream::host;

@@ -2,9 +2,9 @@
 // values costs a bounded number of passes over the document, however many there are.
 #include <catch2/catch.hpp>
 
-#include "pathstream/host/input_error.hpp"
-#include "pathstream/host/json_document.hpp"
-#include "pathstream/host/json_locate.hpp"
+#include "pathstream/machine/input_error.hpp"
+#include "pathstream/machine/json_document.hpp"
+#include "pathstream/machine/json_locate.hpp"
 #include "pathstream/host/json_path.hpp"
 
 using namespace pathstream::host;

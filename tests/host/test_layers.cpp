@@ -8,7 +8,7 @@
 #include "pathstream/device/wire_span.hpp"
 #include "pathstream/host/geometry.hpp"
 #include "pathstream/host/layers.hpp"
-#include "pathstream/host/machine.hpp"
+#include "pathstream/machine/machine.hpp"
 #include "pathstream/host/planner.hpp"
 #include "pathstream/host/svg_path.hpp"
 #include "pathstream/host/wire_plan.hpp"

@@ -3,8 +3,8 @@
 
 #include <cmath>
 
-#include "pathstream/host/input_error.hpp"
-#include "pathstream/host/machine.hpp"
+#include "pathstream/machine/input_error.hpp"
+#include "pathstream/machine/machine.hpp"
 
 using namespace pathstream::host;
 

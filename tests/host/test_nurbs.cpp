@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "pathstream/host/gcode_path.hpp"
-#include "pathstream/host/input_error.hpp"
+#include "pathstream/machine/input_error.hpp"
 #include "pathstream/host/json_path.hpp"
 
 using namespace pathstream::host;

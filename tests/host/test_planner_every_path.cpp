@@ -18,7 +18,7 @@
 #include <vector>
 
 #include "pathstream/host/geometry.hpp"
-#include "pathstream/host/machine.hpp"
+#include "pathstream/machine/machine.hpp"
 #include "pathstream/host/planner.hpp"
 #include "pen_plotter_profile.hpp"
 

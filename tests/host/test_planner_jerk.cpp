@@ -16,7 +16,7 @@
 #include "pathstream/host/gcode_path.hpp"
 #include "pathstream/host/geometry.hpp"
 #include "pathstream/host/json_path.hpp"
-#include "pathstream/host/machine.hpp"
+#include "pathstream/machine/machine.hpp"
 #include "pathstream/host/planner.hpp"
 #include "pathstream/host/svg_path.hpp"
 

@@ -3,7 +3,7 @@
 #include <catch2/catch.hpp>
 #include <string>
 
-#include "pathstream/host/input_error.hpp"
+#include "pathstream/machine/input_error.hpp"
 #include "pathstream/host/svg_path.hpp"
 
 using namespace pathstream::host;

@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "pathstream/host/input_error.hpp"
+#include "pathstream/machine/input_error.hpp"
 #include "pathstream/host/svg_clip.hpp"
 #include "pathstream/host/svg_path.hpp"
 

@@ -4,7 +4,7 @@
 #include <cmath>
 #include <string>
 
-#include "pathstream/host/input_error.hpp"
+#include "pathstream/machine/input_error.hpp"
 #include "pathstream/host/svg_path.hpp"
 
 using namespace pathstream::host;

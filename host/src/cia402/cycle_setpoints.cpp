@@ -3,7 +3,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "pathstream/host/core_span_conversion.hpp"
+#include "pathstream/machine/core_span_conversion.hpp"
 #include "pathstream/setpoint_stream.hpp"
 
 namespace pathstream::host::cia402 {

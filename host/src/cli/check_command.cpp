@@ -11,7 +11,7 @@
 
 #include "pathstream/host/layers.hpp"
 #include "pathstream/host/geometry.hpp"
-#include "pathstream/host/input_error.hpp"
+#include "pathstream/machine/input_error.hpp"
 #include "pathstream/host/work_area.hpp"
 
 namespace pathstream::host {

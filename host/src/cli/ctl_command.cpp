@@ -12,8 +12,8 @@
 #include <thread>
 
 #include "pathstream/device/operator_commands.hpp"
-#include "pathstream/host/device_setup.hpp"
-#include "pathstream/host/machine.hpp"
+#include "pathstream/machine/device_setup.hpp"
+#include "pathstream/machine/machine.hpp"
 #include "pathstream/host/modbus_stream.hpp"
 #include "position_argument.hpp"
 

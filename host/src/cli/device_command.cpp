@@ -19,11 +19,11 @@
 #include "pathstream/hal/modbus_server.hpp"
 #include "pathstream/hal/socketcan_bus.hpp"
 #include "pathstream/host/atomic_file.hpp"
-#include "pathstream/host/core_span_conversion.hpp"
+#include "pathstream/machine/core_span_conversion.hpp"
 #include "pathstream/host/device_link.hpp"
-#include "pathstream/host/device_setup.hpp"
+#include "pathstream/machine/device_setup.hpp"
 #include "pathstream/host/events.hpp"
-#include "pathstream/host/machine.hpp"
+#include "pathstream/machine/machine.hpp"
 #include "pathstream/host/modbus_stream.hpp"
 #include "pathstream/linux_device/machine_homing.hpp"
 #include "pathstream/linux_device/machine_lines.hpp"
@@ -115,12 +115,13 @@ public:
     // After every Modbus poll: connections accepted and closed since the last one. At most
     // kConnectionLines lines in kConnectionWindow; beyond them a client that connects and
     // leaves in a loop is counted, and one line per window says how many.
-    void after_poll(const hal::ModbusServer& server) {
+    // `last`: the device stops, the counted connections are said now.
+    void after_poll(const hal::ModbusServer& server, bool last = false) {
         const hal::ModbusServerCounters& c = server.counters();
         const std::uint64_t closed = c.connections_closed.load(),
                             accepted = c.connections_accepted.load();
         const auto now = std::chrono::steady_clock::now();
-        if (now - window_start_ >= kConnectionWindow) {
+        if (now - window_start_ >= kConnectionWindow || last) {
             if (quiet_accepted_ + quiet_closed_ > 0) {
                 log_("connections",
                      std::to_string(quiet_accepted_) + " more clients connected and " + std::to_string(quiet_closed_) +
@@ -451,6 +452,7 @@ int run_modbus_device(const DeviceCommandOptions& o, const std::vector<Lsb>& sta
             watch.after_poll(server);
         },
         loop_options(o, *device), g_stop);
+    watch.after_poll(server, true);
     log("stopped",
         "stopped after " + std::to_string(device->ticks_run()) + " ticks, " +
             std::to_string(server.counters().requests.load()) + " requests (" +

@@ -7,7 +7,7 @@
 
 #include "pathstream/host/atomic_file.hpp"
 #include "pathstream/host/core_spans.hpp"
-#include "pathstream/host/machine.hpp"
+#include "pathstream/machine/machine.hpp"
 
 namespace pathstream::host {
 

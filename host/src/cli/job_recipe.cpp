@@ -5,7 +5,7 @@
 #include <sstream>
 
 #include "pathstream/host/atomic_file.hpp"
-#include "pathstream/host/input_error.hpp"
+#include "pathstream/machine/input_error.hpp"
 #include "pathstream/host/job_journal.hpp"
 
 namespace pathstream::host {

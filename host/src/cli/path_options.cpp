@@ -15,7 +15,7 @@
 #include "pathstream/host/csv_path.hpp"
 #include "pathstream/host/gcode_path.hpp"
 #include "pathstream/host/layers.hpp"
-#include "pathstream/host/input_error.hpp"
+#include "pathstream/machine/input_error.hpp"
 #include "pathstream/host/json_path.hpp"
 #include "pathstream/host/svg_path.hpp"
 

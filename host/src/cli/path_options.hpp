@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "pathstream/host/machine.hpp"
+#include "pathstream/machine/machine.hpp"
 #include "pathstream/host/path.hpp"
 #include "pathstream/host/path_order.hpp"
 #include "pathstream/host/placement.hpp"

@@ -8,7 +8,7 @@
 
 #include "pathstream/host/atomic_file.hpp"
 #include "pathstream/host/core_playback.hpp"
-#include "pathstream/host/input_error.hpp"
+#include "pathstream/machine/input_error.hpp"
 #include "pathstream/host/job_estimate.hpp"
 #include "pathstream/host/layers.hpp"
 #include "pathstream/host/planner.hpp"

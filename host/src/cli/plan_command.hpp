@@ -6,7 +6,7 @@
 
 #include "path_options.hpp"
 #include "pathstream/host/geometry.hpp"
-#include "pathstream/host/machine.hpp"
+#include "pathstream/machine/machine.hpp"
 #include "pathstream/host/plan.hpp"
 
 namespace pathstream::host {

@@ -12,8 +12,8 @@
 #include "path_options.hpp"
 #include "pathstream/host/core_playback.hpp"
 #include "pathstream/host/core_spans.hpp"
-#include "pathstream/host/input_error.hpp"
-#include "pathstream/host/machine.hpp"
+#include "pathstream/machine/input_error.hpp"
+#include "pathstream/machine/machine.hpp"
 
 namespace pathstream::host {
 namespace {

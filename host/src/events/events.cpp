@@ -13,7 +13,7 @@
 
 #include "pathstream/device/device_state.hpp"
 #include "pathstream/host/device_link.hpp"
-#include "pathstream/host/device_setup.hpp"
+#include "pathstream/machine/device_setup.hpp"
 
 namespace pathstream::host {
 namespace {

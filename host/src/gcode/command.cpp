@@ -6,7 +6,7 @@
 #include <string_view>
 
 #include "cursor.hpp"
-#include "pathstream/host/input_error.hpp"
+#include "pathstream/machine/input_error.hpp"
 
 namespace pathstream::host::gcode {
 

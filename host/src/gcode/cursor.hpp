@@ -6,7 +6,7 @@
 #include <string>
 #include <string_view>
 
-#include "pathstream/host/input_error.hpp"
+#include "pathstream/machine/input_error.hpp"
 #include "pathstream/host/path.hpp"
 
 namespace pathstream::host::gcode {

@@ -10,7 +10,7 @@
 #include <string_view>
 
 #include "interpreter.hpp"
-#include "pathstream/host/input_error.hpp"
+#include "pathstream/machine/input_error.hpp"
 #include "program.hpp"
 
 namespace pathstream::host {

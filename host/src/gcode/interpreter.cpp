@@ -4,7 +4,7 @@
 #include <cmath>
 #include <sstream>
 
-#include "pathstream/host/input_error.hpp"
+#include "pathstream/machine/input_error.hpp"
 
 namespace pathstream::host::gcode {
 

@@ -5,7 +5,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "pathstream/host/input_error.hpp"
+#include "pathstream/machine/input_error.hpp"
 
 namespace pathstream::host::gcode {
 

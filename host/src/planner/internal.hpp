@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "pathstream/host/geometry.hpp"
-#include "pathstream/host/machine.hpp"
+#include "pathstream/machine/machine.hpp"
 #include "pathstream/host/plan.hpp"
 #include "pathstream/host/planner.hpp"
 

@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "pathstream/host/core_spans.hpp"
-#include "pathstream/host/machine.hpp"
+#include "pathstream/machine/machine.hpp"
 #include "pathstream/host/plan.hpp"
 
 namespace pathstream::host::planner_detail {

@@ -3,7 +3,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "pathstream/host/machine.hpp"
+#include "pathstream/machine/machine.hpp"
 #include "pathstream/host/path.hpp"
 #include "pathstream/host/plan.hpp"
 

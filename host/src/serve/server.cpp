@@ -11,7 +11,7 @@
 #include "drawing_request.hpp"
 #include "http_server.hpp"
 #include "pathstream/host/device_link.hpp"
-#include "pathstream/host/device_setup.hpp"
+#include "pathstream/machine/device_setup.hpp"
 #include "pathstream/host/job_journal.hpp"
 #include "pathstream/host/placement.hpp"
 #include "pathstream/host/progress.hpp"

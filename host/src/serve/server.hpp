@@ -16,7 +16,7 @@
 #include "child_process.hpp"
 #include "event_hub.hpp"
 #include "http_types.hpp"
-#include "pathstream/host/machine.hpp"
+#include "pathstream/machine/machine.hpp"
 
 namespace pathstream::host::serve {
 

@@ -17,7 +17,7 @@
 #include "pathstream/device/motion_device.hpp"
 #include "pathstream/device/wire_span.hpp"
 #include "pathstream/host/device_link.hpp"
-#include "pathstream/host/device_setup.hpp"
+#include "pathstream/machine/device_setup.hpp"
 #include "pathstream/host/wire_plan.hpp"
 #include "pathstream/status.hpp"
 #include "stream_interrupt.hpp"

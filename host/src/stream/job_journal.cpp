@@ -14,9 +14,9 @@
 #include "pathstream/device/motion_limits.hpp"
 #include "pathstream/device/stop_spans.hpp"
 #include "pathstream/host/atomic_file.hpp"
-#include "pathstream/host/core_span_conversion.hpp"
-#include "pathstream/host/input_error.hpp"
-#include "pathstream/host/json_document.hpp"
+#include "pathstream/machine/core_span_conversion.hpp"
+#include "pathstream/machine/input_error.hpp"
+#include "pathstream/machine/json_document.hpp"
 
 namespace pathstream::host {
 namespace {

@@ -16,7 +16,7 @@
 #include "pathstream/device/wire_span.hpp"
 #include "pathstream/hal/modbus_client.hpp"
 #include "pathstream/hal/modbus_error.hpp"
-#include "pathstream/host/device_setup.hpp"
+#include "pathstream/machine/device_setup.hpp"
 #include "pathstream/host/wire_plan.hpp"
 #include "pathstream/status.hpp"
 #include "stream_interrupt.hpp"

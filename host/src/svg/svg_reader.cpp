@@ -10,7 +10,7 @@
 #include <sstream>
 #include <unordered_map>
 
-#include "pathstream/host/input_error.hpp"
+#include "pathstream/machine/input_error.hpp"
 #include "pathstream/host/svg_clip.hpp"
 #include "pathstream/host/svg_path.hpp"
 #include "pathstream/host/svg_warnings.hpp"

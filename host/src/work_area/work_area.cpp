@@ -5,8 +5,8 @@
 #include <sstream>
 
 #include "pathstream/device/motion_limits.hpp"
-#include "pathstream/host/device_setup.hpp"
-#include "pathstream/host/input_error.hpp"
+#include "pathstream/machine/device_setup.hpp"
+#include "pathstream/machine/input_error.hpp"
 
 namespace pathstream::host {
 namespace {

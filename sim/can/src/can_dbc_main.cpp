@@ -4,7 +4,7 @@
 #include <cstdlib>
 #include <iostream>
 
-#include "pathstream/host/can_dbc.hpp"
+#include "pathstream/machine/can_dbc.hpp"
 
 int main(int argc, char** argv) {
     const long node = argc > 1 ? std::strtol(argv[1], nullptr, 10) : 1;

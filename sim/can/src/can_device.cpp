@@ -5,7 +5,7 @@
 
 #include "pathstream/device/can_node.hpp"
 #include "pathstream/device/motion_device.hpp"
-#include "pathstream/host/core_span_conversion.hpp"
+#include "pathstream/machine/core_span_conversion.hpp"
 
 namespace pathstream::sim {
 namespace {

@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "pathstream/hal/can_bus.hpp"
-#include "pathstream/host/cia402_protocol.hpp"
+#include "pathstream/machine/cia402_protocol.hpp"
 #include "pathstream/sim/cia402_drive.hpp"
 #include "pathstream/sim/plant.hpp"
 

@@ -10,7 +10,7 @@
 #include <stdexcept>
 
 #include "pathstream/hal/linux_clock.hpp"
-#include "pathstream/host/core_span_conversion.hpp"
+#include "pathstream/machine/core_span_conversion.hpp"
 #include "pathstream/setpoint_stream.hpp"
 #include "pathstream/sim/simulated_output.hpp"
 #include "pathstream/sim/virtual_clock.hpp"

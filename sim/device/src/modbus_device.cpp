@@ -6,7 +6,7 @@
 #include <thread>
 
 #include "pathstream/device/modbus_register_map.hpp"
-#include "pathstream/host/core_span_conversion.hpp"
+#include "pathstream/machine/core_span_conversion.hpp"
 
 namespace pathstream::sim {
 namespace {

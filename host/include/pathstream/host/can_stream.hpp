@@ -6,7 +6,7 @@
 #include <string>
 
 #include "pathstream/hal/can_bus.hpp"
-#include "pathstream/host/machine.hpp"
+#include "pathstream/machine/machine.hpp"
 #include "pathstream/host/modbus_stream.hpp"  // StreamError, StreamProgress
 #include "pathstream/host/plan.hpp"
 

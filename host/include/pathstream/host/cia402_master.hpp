@@ -12,8 +12,8 @@
 
 #include "pathstream/hal/can_bus.hpp"
 #include "pathstream/hal/clock.hpp"
-#include "pathstream/host/cia402_protocol.hpp"
-#include "pathstream/host/machine.hpp"
+#include "pathstream/machine/cia402_protocol.hpp"
+#include "pathstream/machine/machine.hpp"
 #include "pathstream/host/modbus_stream.hpp"
 #include "pathstream/host/plan.hpp"
 

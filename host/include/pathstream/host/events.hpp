@@ -14,7 +14,7 @@
 #include <string>
 #include <vector>
 
-#include "pathstream/host/machine.hpp"
+#include "pathstream/machine/machine.hpp"
 #include "pathstream/host/modbus_stream.hpp"
 #include "pathstream/host/plan.hpp"
 #include "pathstream/units.hpp"

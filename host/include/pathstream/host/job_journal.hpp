@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "pathstream/host/device_setup.hpp"
+#include "pathstream/machine/device_setup.hpp"
 #include "pathstream/host/plan.hpp"
 
 namespace pathstream::host {

@@ -9,7 +9,7 @@
 #include <string>
 
 #include "pathstream/host/device_link.hpp"
-#include "pathstream/host/machine.hpp"
+#include "pathstream/machine/machine.hpp"
 #include "pathstream/host/plan.hpp"
 #include "pathstream/host/span_supply.hpp"
 

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "pathstream/host/point_list.hpp"
+#include "pathstream/machine/source_location.hpp"
 
 namespace pathstream::host {
 
@@ -24,12 +25,6 @@ enum class CornerMode {
     kBlend,      ///< round vertices within Subpath::blend_tolerance (G64, the default)
     kExactPath,  ///< go through every vertex exactly, slowing as the turn needs (G61)
     kExactStop,  ///< also come to rest at the joints in Subpath::stops (G61.1: each block's end)
-};
-
-/// Where a value came from in its input file (1-based), for error messages.
-struct SourceLocation {
-    std::size_t line = 0;
-    std::size_t column = 0;
 };
 
 /// A connected piece of the path, drawn pen-down.

@@ -6,7 +6,7 @@
 
 #include "pathstream/host/core_spans.hpp"
 #include "pathstream/host/geometry.hpp"
-#include "pathstream/host/machine.hpp"
+#include "pathstream/machine/machine.hpp"
 
 namespace pathstream::host {
 

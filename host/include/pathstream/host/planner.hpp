@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "pathstream/host/geometry.hpp"
-#include "pathstream/host/machine.hpp"
+#include "pathstream/machine/machine.hpp"
 #include "pathstream/host/core_spans.hpp"
 #include "pathstream/host/plan.hpp"
 

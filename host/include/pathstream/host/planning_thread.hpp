@@ -11,7 +11,7 @@
 #include <optional>
 #include <thread>
 
-#include "pathstream/host/machine.hpp"
+#include "pathstream/machine/machine.hpp"
 #include "pathstream/host/planner.hpp"
 #include "pathstream/host/span_supply.hpp"
 #include "pathstream/host/spsc_ring.hpp"

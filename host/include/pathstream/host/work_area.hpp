@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "pathstream/host/geometry.hpp"
-#include "pathstream/host/machine.hpp"
+#include "pathstream/machine/machine.hpp"
 #include "pathstream/host/path.hpp"
 #include "pathstream/host/plan.hpp"
 

@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "pathstream/host/device_setup.hpp"
+#include "pathstream/machine/device_setup.hpp"
 #include "pathstream/sim/device_io.hpp"
 #include "pathstream/sim/simulated_motion_device.hpp"
 

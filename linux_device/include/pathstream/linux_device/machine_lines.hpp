@@ -9,7 +9,7 @@
 #include "pathstream/hal/digital_output.hpp"
 #include "pathstream/hal/gpio.hpp"
 #include "pathstream/hal/gpio_gpiod.hpp"
-#include "pathstream/host/machine.hpp"
+#include "pathstream/machine/machine.hpp"
 #include "pathstream/sim/device_io.hpp"
 
 namespace pathstream::linux_device {

@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "pathstream/hal/clock.hpp"
-#include "pathstream/host/machine.hpp"
+#include "pathstream/machine/machine.hpp"
 #include "pathstream/host/plan.hpp"
 #include "pathstream/host/plot.hpp"
 #include "pathstream/sim/plant.hpp"

@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "pathstream/device/motion_device.hpp"
-#include "pathstream/host/device_setup.hpp"
+#include "pathstream/machine/device_setup.hpp"
 #include "pathstream/sim/device_io.hpp"
 #include "pathstream/sim/machine_switches.hpp"
 #include "pathstream/units.hpp"

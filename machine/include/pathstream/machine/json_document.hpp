@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "pathstream/host/json_locate.hpp"
+#include "pathstream/machine/json_locate.hpp"
 
 namespace pathstream::host {
 

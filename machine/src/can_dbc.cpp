@@ -1,6 +1,6 @@
 // DBC text from the protocol's declaration (device/can_protocol.hpp): one BO_ per message,
 // one SG_ per signal (little-endian, scale 1), comments with the meaning, value tables.
-#include "pathstream/host/can_dbc.hpp"
+#include "pathstream/machine/can_dbc.hpp"
 
 #include <sstream>
 #include <stdexcept>

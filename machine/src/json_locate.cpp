@@ -1,4 +1,4 @@
-#include "pathstream/host/json_locate.hpp"
+#include "pathstream/machine/json_locate.hpp"
 
 #include <algorithm>
 #include <cstring>

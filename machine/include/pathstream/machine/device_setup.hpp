@@ -10,7 +10,7 @@
 
 #include "pathstream/device/gpio_logic.hpp"
 #include "pathstream/device/homing.hpp"
-#include "pathstream/host/machine.hpp"
+#include "pathstream/machine/machine.hpp"
 
 namespace pathstream::host {
 

@@ -1,4 +1,4 @@
-#include "pathstream/host/machine.hpp"
+#include "pathstream/machine/machine.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -10,8 +10,8 @@
 #include <utility>
 
 #include "pathstream/device/motion_limits.hpp"
-#include "pathstream/host/input_error.hpp"
-#include "pathstream/host/json_document.hpp"
+#include "pathstream/machine/input_error.hpp"
+#include "pathstream/machine/json_document.hpp"
 #include "pathstream/units.hpp"
 
 namespace pathstream::host {

@@ -1,9 +1,9 @@
-#include "pathstream/host/json_document.hpp"
+#include "pathstream/machine/json_document.hpp"
 
 #include <algorithm>
 #include <string_view>
 
-#include "pathstream/host/input_error.hpp"
+#include "pathstream/machine/input_error.hpp"
 
 namespace pathstream::host {
 

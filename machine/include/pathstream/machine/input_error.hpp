@@ -5,7 +5,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "pathstream/host/path.hpp"
+#include "pathstream/machine/source_location.hpp"
 
 namespace pathstream::host {
 

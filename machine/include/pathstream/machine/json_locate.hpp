@@ -9,7 +9,7 @@
 #include <string_view>
 #include <vector>
 
-#include "pathstream/host/path.hpp"
+#include "pathstream/machine/source_location.hpp"
 
 namespace pathstream::host {
 

@@ -1,10 +1,10 @@
-#include "pathstream/host/device_setup.hpp"
+#include "pathstream/machine/device_setup.hpp"
 
 #include <cmath>
 #include <cstdio>
 #include <stdexcept>
 
-#include "pathstream/host/machine.hpp"
+#include "pathstream/machine/machine.hpp"
 
 namespace pathstream::host {
 namespace {

@@ -6,7 +6,7 @@
 #include <stdexcept>
 #include <utility>
 
-#include "pathstream/host/core_spans.hpp"
+#include "pathstream/machine/core_span.hpp"
 #include "pathstream/span.hpp"
 
 namespace pathstream::host {

@@ -2,7 +2,7 @@
 #include <cstdio>
 #include <string>
 
-#include "pathstream/host/cia402_protocol.hpp"
+#include "pathstream/machine/cia402_protocol.hpp"
 
 namespace pathstream::host::cia402 {
 namespace {
