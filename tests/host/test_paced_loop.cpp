@@ -12,7 +12,8 @@
 using namespace pathstream;
 using namespace std::chrono_literals;
 
-TEST_CASE("paced loop: at rest, ticks at most at the rest rate however fast the time scale", "[sim][pacing]") {
+TEST_CASE("paced loop: at rest, ticks at most at the rest rate however fast the time scale",
+          "[sim][pacing]") {
     std::atomic<bool> stop{false};
     std::uint64_t ticks = 0, serves = 0;
     sim::DeviceLoopOptions o;
@@ -32,7 +33,8 @@ TEST_CASE("paced loop: at rest, ticks at most at the rest rate however fast the 
     CHECK(ticks >= 1);
 }
 
-TEST_CASE("paced loop: a device that leaves rest is paced at its time scale again", "[sim][pacing]") {
+TEST_CASE("paced loop: a device that leaves rest is paced at its time scale again",
+          "[sim][pacing]") {
     std::atomic<bool> stop{false};
     std::uint64_t ticks = 0, resting_serves = 0, long_running_waits = 0;
     bool resting = true;

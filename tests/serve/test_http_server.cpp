@@ -154,7 +154,8 @@ TEST_CASE("http: a stop answers while every other kind of client holds the serve
     CHECK(planning.load() == 2);  // the other two plans wait in the work lane's queue
 }
 
-TEST_CASE("http: a head that does not end within the deadline is closed", "[serve][http][threads]") {
+TEST_CASE("http: a head that does not end within the deadline is closed",
+          "[serve][http][threads]") {
     HttpLimits limits;
     limits.header_deadline = 300ms;
     RunningServer s(limits, [](HttpServer& h) {
@@ -207,7 +208,8 @@ TEST_CASE("http: heads too large or with too many fields get 431 before any hand
     CHECK(handled.load() == 0);
 }
 
-TEST_CASE("http: a body past the limit is refused as it arrives, chunked or not", "[serve][http][threads]") {
+TEST_CASE("http: a body past the limit is refused as it arrives, chunked or not",
+          "[serve][http][threads]") {
     HttpLimits limits;
     limits.body_bytes = 64 * 1024;
     std::atomic<int> handled{0};

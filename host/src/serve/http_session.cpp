@@ -119,8 +119,8 @@ void HttpSession::read_body() {
 void HttpSession::on_body(beast::error_code ec) {
     if (state_ == State::closed) return;
     if (ec == http::error::body_limit) {
-        return refuse(
-            413, "the body is larger than the limit of " + megabytes_text(server_.limits.body_bytes));
+        return refuse(413, "the body is larger than the limit of " +
+                               megabytes_text(server_.limits.body_bytes));
     }
     if (ec) return close();
     dispatch();

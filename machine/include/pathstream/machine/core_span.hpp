@@ -20,9 +20,10 @@ struct CoreSpan {
     std::vector<std::array<std::int32_t, 4>> control;  ///< per axis: P0..P3 (Hermite P0 P1 T0 T1)
     std::size_t subpath = 0;                           ///< index in Path::subpaths
     bool pen_down = true;                              ///< false for travel between subpaths
-    bool pause_after = false;  ///< a programmed pause follows: the device holds at its end (at rest)
-    SpanTiming timing;                                 ///< the core's timing, once validated
-    std::vector<TickCubic> cubic;                      ///< the core's exact cubic per axis
+    bool pause_after =
+        false;          ///< a programmed pause follows: the device holds at its end (at rest)
+    SpanTiming timing;  ///< the core's timing, once validated
+    std::vector<TickCubic> cubic;  ///< the core's exact cubic per axis
 };
 
 /// The core's exact value of `span` on `axis` at tick k (0..ticks), via Horner. The span must
