@@ -19,18 +19,12 @@
 #include "cli/serve_command.hpp"
 #include "cli/setpoints_command.hpp"
 #include "cli/sim_command.hpp"
+#include "cli/exit_codes.hpp"
 #include "cli/stream_command.hpp"
 #include "pathstream/hal/gpio_gpiod.hpp"
 #include "pathstream/hal/modbus_error.hpp"
 
-namespace {
-constexpr int kExitInput = 1;
-constexpr int kExitUsage = 2;
-constexpr int kExitOutput = 3;
-constexpr int kExitInternal = 4;
-constexpr int kExitPlanning = 5;
-constexpr int kExitDevice = 6;
-}  // namespace
+using namespace pathstream::host;
 
 int main(int argc, char** argv) {
     CLI::App app{"pathstream: exact spline paths to timed setpoints for plotters and servo axes"};

@@ -1,5 +1,6 @@
 #include "device_command.hpp"
 
+#include "exit_codes.hpp"
 #include "position_argument.hpp"
 
 #include <algorithm>
@@ -545,7 +546,7 @@ int run_device(const DeviceCommandOptions& o) {
         if (o.position.size() != axes) {
             std::cerr << "pathstream device: --position has " << o.position.size() << " values for " << axes
                       << " axes\n";
-            return 2;
+            return kExitUsage;
         }
         const double mm_per_lsb = profile ? profile->mm_per_lsb : 0.001;
         for (unsigned a = 0; a < axes; ++a) start[a] = parse_position_argument(o.position[a], mm_per_lsb, "--position");

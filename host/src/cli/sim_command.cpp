@@ -5,6 +5,7 @@
 #include <iostream>
 #include <nlohmann/json.hpp>
 
+#include "exit_codes.hpp"
 #include "pathstream/host/events.hpp"
 #include "pathstream/host/layers.hpp"
 #include "pathstream/host/planner.hpp"
@@ -291,7 +292,7 @@ int run_sim(const SimCommandOptions& o) {
     }
     if (result.underruns != 0) {
         std::cerr << "pathstream: the device ran dry " << result.underruns << " times (a streaming bug)\n";
-        return 4;
+        return kExitInternal;
     }
     if (failed) {
         // Name the rule the plan broke: the jerk limit is checked with the others.

@@ -4,6 +4,7 @@
 #include <CLI/CLI.hpp>
 #include <string>
 
+#include "exit_codes.hpp"
 #include "path_options.hpp"
 #include "pathstream/host/modbus_stream.hpp"
 
@@ -29,10 +30,6 @@ struct StreamCommandOptions {
     /// from job_start; memory grows with the job), instead of streaming while planning.
     bool plan_first = false;
 };
-
-/// Exit status of a stream interrupted by Ctrl-C or SIGTERM: the device holds at rest or
-/// stopped, and the journal can resume the drawing.
-inline constexpr int kExitInterrupted = 7;
 
 void add_stream_command(CLI::App& app, StreamCommandOptions& options);
 int run_stream(const StreamCommandOptions& options);
