@@ -462,7 +462,9 @@ Server::Reply Server::control(const nlohmann::json& request) {
         return {400, error_body("unknown verb '" + verb + "'")};
     }
     argv.insert(argv.end(), positional.begin(), positional.end());
-    const ChildOutput r = run_child(argv, config_.state_dir);
+    // A command waits for the device (home: up to a minute); the server's stop does not wait
+    // for it (the device goes on, as it does when `ctl` at a terminal is interrupted).
+    const ChildOutput r = run_child(argv, config_.state_dir, [this] { return stopping_.load(); });
     Json body{{"ok", r.exit_code == 0}, {"verb", verb}};
     if (!r.out.empty()) {
         try {
