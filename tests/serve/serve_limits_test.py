@@ -8,8 +8,9 @@ client would, with Python's standard library only:
   at a time, while a job streams: POST /api/control {"verb":"stop"} is answered and the job
   ends held or stopped (its journal kept);
 * the 29-byte job (`G1 X400` at F1: 6.7 h of motion): its preview is cancelled when the
-  client leaves (no planning child left) and stopped at --plan-timeout with the job's motion
-  time in the message; the server's memory stays near its idle figure;
+  client leaves (no planning child left); there, back and there again (20 h) it is stopped at
+  --plan-timeout with the job's motion time in the message, at a tenth (67 h) refused before
+  planning by --max-motion-hours; the server's memory stays near its idle figure;
 * bodies past --max-upload-mb, chunked and not: 413, nothing stored;
 * 200 KB of request headers: 431, the server's memory bounded;
 * an upload named `-h.csv` is stored as `_h.csv` and a run of it streams it (no option);
@@ -192,13 +193,22 @@ c.close()
 t0 = time.time()
 wait_for("the planning child is gone once its client left", lambda: not planning_children(server.pid), 20)
 print(f"figure: planning child killed {1000 * (time.time() - t0):.0f} ms after its client left", flush=True)
+# The same move there, back and there again (20 h of motion) plans for longer than
+# --plan-timeout on any machine (the 29-byte job alone takes from 10 s to a minute): stopped, its
+# motion time named.
+slow = b"G21 G90\nG1 Z-1 F1\nG1 X400\nG1 X0\nG1 X400\nM2\n"
 t0 = time.time()
-status, answer = upload("tiny.gcode", tiny)
+status, answer = upload("slow.gcode", slow)
 took = time.time() - t0
 message = answer.get("error", "")
-check(status == 422 and "planning stopped after 10 s (serve --plan-timeout)" in message and "6.7 h" in message,
-      f"the 29-byte job is stopped at --plan-timeout, its motion time named: {status} {message}")
-print(f"figure: the 29-byte upload answered in {took:.2f} s (--plan-timeout 10)", flush=True)
+check(status == 422 and "planning stopped after 10 s (serve --plan-timeout)" in message and "20.0 h" in message,
+      f"a 20 h job is stopped at --plan-timeout, its motion time named: {status} {message}")
+print(f"figure: the 20 h job's upload answered in {took:.2f} s (--plan-timeout 10)", flush=True)
+# At a tenth of it (67 h), past --max-motion-hours (24): refused before any planning.
+status, answer = upload("longer.gcode", b"G21 G90\nG1 Z-1 F0.1\nG1 X400\nM2\n")
+message = answer.get("error", "")
+check(status == 422 and "the job moves for about 66.7 h (estimated before planning), longer than 24.0 h" in message,
+      f"a 67 h job is refused before planning: {status} {message}")
 after_rss = rss_kb(server.pid)
 check(after_rss < idle_rss + 32 * 1024, f"server memory {after_rss / 1024:.1f} MB, idle {idle_rss / 1024:.1f} MB")
 print(f"figure: server memory after the 29-byte job {after_rss / 1024:.1f} MB", flush=True)
