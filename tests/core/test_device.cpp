@@ -333,7 +333,7 @@ TEST_CASE("faults stop at once and keep the first code", "[device]") {
     CHECK(d.fault_code() == FaultCode::kNone);
 }
 
-TEST_CASE("a request the tick has not taken yet is replaced by the next one; a stop is not", "[device]") {
+TEST_CASE("a request the tick has not taken yet is replaced by the next one, a stop is not", "[device]") {
     // Each section runs on its own device (Catch2 runs the case again per section): 16 spans
     // of a move queued and started.
     const Lsb start[kAxes] = {0, 0};

@@ -55,7 +55,7 @@ TEST_CASE("fault names say which switch, on which axis and side", "[device][gpio
     CHECK(untouched == 'z');
 }
 
-TEST_CASE("enables are asserted only while the device may move; the pen then or by the operator", "[device][gpio]") {
+TEST_CASE("enables are asserted only while the device may move, the pen then or by the operator", "[device][gpio]") {
     CHECK_FALSE(enable_asserted(DeviceState::kIdle));
     CHECK(enable_asserted(DeviceState::kRunning));
     CHECK(enable_asserted(DeviceState::kHolding));

@@ -149,7 +149,7 @@ TEST_CASE("operator's pen: a job's start, a fault and the e-stop raise it", "[de
     CHECK(d.outputs() == 0);
 }
 
-TEST_CASE("home without a homing port is refused by name; bad arguments by value", "[device][homing]") {
+TEST_CASE("home without a homing port is refused by name, bad arguments by value", "[device][homing]") {
     const Lsb start[kAxes] = {0, 0};
     Device d(start);
     REQUIRE(d.configure(limits()) == Status::kOk);

@@ -128,7 +128,7 @@ TEST_CASE("travel proof: never passes a span whose curve leaves, exact at the ed
     CHECK(check_axis_travel(cubic, timing, edge) == Status::kOutsideTravel);
 }
 
-TEST_CASE("travel: bad limits refused; a batch leaving it refused whole", "[device][travel]") {
+TEST_CASE("travel: bad limits refused, a batch leaving it refused whole", "[device][travel]") {
     CHECK(check_limits(limits(5, 5)) == Status::kBadLimits);
     CHECK(check_limits(limits(-static_cast<std::int32_t>(kMaxPositionLsb) - 1, 0)) == Status::kBadLimits);
     const Lsb start[kAxes] = {46000, 1000};
@@ -139,7 +139,7 @@ TEST_CASE("travel: bad limits refused; a batch leaving it refused whole", "[devi
     CHECK(queue_move(d, 50000) == Status::kOk);  // to the very edge
 }
 
-TEST_CASE("travel: a jog must end inside; from outside it may come back in", "[device][travel]") {
+TEST_CASE("travel: a jog must end inside, from outside it may come back in", "[device][travel]") {
     const Lsb start[kAxes] = {-3000, 1000};  // outside on x (homing's pull-off past the edge)
     Device d(start);
     REQUIRE(d.configure(limits(0, 50000)) == Status::kOk);
@@ -163,7 +163,7 @@ TEST_CASE("travel: a jog must end inside; from outside it may come back in", "[d
     CHECK(d.position(0) == 50000);
 }
 
-TEST_CASE("travel over Modbus: written with the limits, read back; zeros mean none", "[device][travel]") {
+TEST_CASE("travel over Modbus: written with the limits, read back, zeros mean none", "[device][travel]") {
     const Lsb start[kAxes] = {0, 0};
     Device d(start);
     ModbusRegisterMap<kAxes, 16> m(d);

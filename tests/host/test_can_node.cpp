@@ -64,7 +64,7 @@ struct Fixture {
 
 }  // namespace
 
-TEST_CASE("CAN node: a batch over frames is accepted whole; a resend is a duplicate", "[can]") {
+TEST_CASE("CAN node: a batch over frames is accepted whole, a resend is a duplicate", "[can]") {
     Fixture f;
     f.configure();
     const auto p = f.batch(3, 0);
@@ -94,7 +94,7 @@ TEST_CASE("CAN node: a lost data frame refuses the batch as incomplete, changing
     CHECK(f.dev.queued_spans() == 3);
 }
 
-TEST_CASE("CAN node: a lost last data frame leaves no answer; data without a start is ignored", "[can]") {
+TEST_CASE("CAN node: a lost last data frame leaves no answer, data without a start is ignored", "[can]") {
     Fixture f;
     f.configure();
     const auto p = f.batch(2, 0);  // 2 x 28 bytes: 8 data frames
@@ -118,7 +118,7 @@ TEST_CASE("CAN node: bad sequence and limits are refused with the core status", 
     CHECK(f.node.refused_batches() == 1);
 }
 
-TEST_CASE("CAN node: configuration needs every item; commands and status answer", "[can]") {
+TEST_CASE("CAN node: configuration needs every item, commands and status answer", "[can]") {
     Fixture f;
     f.feed(pc::encode_config(5, 0, 2, 1000));
     f.feed(pc::encode_config(5, pc::config_item_acceleration(1), 2, 5));

@@ -50,7 +50,7 @@ TEST_CASE("shallow vertices are blended within the tolerance and crossed faster"
     CHECK(static_cast<double>(blended_stats.motion_ticks) / p.tick_hz >= blended_stats.reference_motion_time);
 }
 
-TEST_CASE("sharp vertices still stop; a blend never crosses a pen change", "[planner][blend]") {
+TEST_CASE("sharp vertices still stop, a blend never crosses a pen change", "[planner][blend]") {
     const MachineProfile p = pen_plotter();
     const Path square = polygon(4, 20);
     const auto segments = to_bezier_segments(square);

@@ -70,7 +70,7 @@ TEST_CASE("CSV: comments, blank lines, whitespace, CRLF, a BOM, signs and expone
     CHECK(sp.points[2] == PathPoint{0.5, 7, 0});  // 1e-400 underflows to 0
 }
 
-TEST_CASE("CSV: 1 to 8 columns; the basis and closed flag are the caller's", "[host][csv]") {
+TEST_CASE("CSV: 1 to 8 columns, the basis and closed flag are the caller's", "[host][csv]") {
     const Path one = csv("t\n1\n2\n3\n", PathBasis::kCatmullRom, true);
     CHECK(one.axes == 1);
     CHECK(one.subpaths[0].basis == PathBasis::kCatmullRom);

@@ -123,7 +123,7 @@ TEST_CASE("device setup: limits and homing in LSB from the profile", "[host][gpi
     CHECK_THROWS_WITH(host::device_limits(huge), Catch::Contains("axis x max_velocity"));
 }
 
-TEST_CASE("device io: the configured device is the one a host would configure; e-stop and limits act per tick",
+TEST_CASE("device io: the configured device is the one a host would configure, e-stop and limits act per tick",
           "[host][gpio]") {
     for (bool can : {false, true}) {
         Machine m(can ? std::unique_ptr<sim::SimulatedMotionDevice>(sim::SimulatedCanDevice::create({20000, 0}, 1))

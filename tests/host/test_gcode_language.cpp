@@ -282,7 +282,7 @@ TEST_CASE("G-code: O-word nesting budget", "[gcode]") {
     CHECK(error_of(deep) == "t.ngc:1001:1: O-word blocks nested more than 1000 deep");
 }
 
-TEST_CASE("G-code: call arguments zero the rest; repeat rounds", "[gcode]") {
+TEST_CASE("G-code: call arguments zero the rest, repeat rounds", "[gcode]") {
     // #2 is 7 before the call; the call gives only #1, so #2 reads 0 inside and 7 after.
     const Path p = run("o1 sub\nG1 X#1 Y#2\no1 endsub\n#2=7\nG1 Z-1\no1 call [3]\nG1 Y#2\n");
     REQUIRE(p.subpaths.size() == 1);

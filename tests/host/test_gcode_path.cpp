@@ -179,7 +179,7 @@ TEST_CASE(
     CHECK(q.subpaths[0].location.column == 3);
 }
 
-TEST_CASE("G-code: words need no spaces; case, comments, line numbers and % are ignored",
+TEST_CASE("G-code: words need no spaces, case, comments, line numbers and % are ignored",
           "[host][gcode]") {
     const Path p = gcode(
         "%\n(header comment)\r\nn10 g21g90 ; set up\nN20 G0X1Y2(move)Z1\nN30G1z0f120\n"
@@ -191,7 +191,7 @@ TEST_CASE("G-code: words need no spaces; case, comments, line numbers and % are 
     check_points(p.subpaths[0], line_chain({{1, 2}, {4, 6}}));
 }
 
-TEST_CASE("G-code: the motion mode persists; G0 is travel and ends the run", "[host][gcode]") {
+TEST_CASE("G-code: the motion mode persists, G0 is travel and ends the run", "[host][gcode]") {
     const Path p = gcode("G0 Z-1\nG1 X10\nY10\nG0 X20\nX30\nG1 Y20\nX40\n");
     REQUIRE(p.subpaths.size() == 2);
     check_points(p.subpaths[0], line_chain({{0, 0}, {10, 0}, {10, 10}}));
@@ -254,7 +254,7 @@ TEST_CASE("G-code: incremental distances (G91) and back to absolute (G90)", "[ho
     check_points(p.subpaths[0], line_chain({{10, 10}, {15, 10}, {15, 15}, {10, 10}, {0, 0}}));
 }
 
-TEST_CASE("G-code: feeds in mm/s; a new F in a pen-down run starts a new subpath",
+TEST_CASE("G-code: feeds in mm/s, a new F in a pen-down run starts a new subpath",
           "[host][gcode]") {
     const Path p = gcode(
         "G0 Z-1\nG1 X10 F600\nX20\nX30 F1200\nX40 F1200\nF600\nX50\nG0 Z1\nF300\nG0 X60\nG1 "
@@ -288,7 +288,7 @@ TEST_CASE("G-code: zero-length pieces are dropped and empty runs skipped", "[hos
     CHECK(p.subpaths[0].location.line == 9);
 }
 
-TEST_CASE("G-code: accepted codes change no geometry; M2 and M30 end the program", "[host][gcode]") {
+TEST_CASE("G-code: accepted codes change no geometry, M2 and M30 end the program", "[host][gcode]") {
     const Path p = gcode(
         "G17 G21 G40 G49 G54 G61 G80 G90 G94 G91.1 T1 S500\nG4 P0.5\nG64 P0.01 Q0.01\nG61.1\n"
         "M3 S100\nM5\nG0 Z-1\nG1 X10\nM30\nthis is @ not G-code\n");
@@ -440,7 +440,7 @@ TEST_CASE("G-code: tiny arcs rounded to 4 decimals", "[host][gcode]") {
 
 // ---- splines ------------------------------------------------------------------------------
 
-TEST_CASE("G-code: G5 cubics; I J omitted after a G5 reflect the previous control point",
+TEST_CASE("G-code: G5 cubics, I J omitted after a G5 reflect the previous control point",
           "[host][gcode]") {
     const Path p =
         gcode("G0 X0 Y0 Z-1\nG5 X10 Y0 I2 J3 P-2 Q3\nG5 X20 Y0 P-2 Q-3\nF60\nX30 Y5 P0 Q1\n");

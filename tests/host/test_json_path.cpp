@@ -26,7 +26,7 @@ TEST_CASE("a one-subpath document with defaults", "[host][json]") {
     CHECK(p.subpaths[0].points[1] == PathPoint{1.0, 2.5});
 }
 
-TEST_CASE("subpaths inherit and override basis and closed; inches convert", "[host][json]") {
+TEST_CASE("subpaths inherit and override basis and closed, inches convert", "[host][json]") {
     const Path p = parse_json_path(R"({"units": "in", "basis": "catmull-rom", "closed": true,
         "subpaths": [{"points": [[0,0,0],[1,0,0],[1,1,0]]},
                      {"basis": "bezier", "closed": false, "points": [[0,0,1],[1,0,1],[1,1,1],[0,1,1]]}]})",

@@ -82,7 +82,7 @@ TEST_CASE("placement: align top-left depends on the origin corner", "[placement]
     CHECK(b.y_max == Approx(210));  // y up: the top edge is y = 210
 }
 
-TEST_CASE("placement: fit area uses the work area; align without fit", "[placement]") {
+TEST_CASE("placement: fit area uses the work area, align without fit", "[placement]") {
     PlacementOptions o;
     o.fit = "area";
     const Box2 area{100, 0, 300, 200};

@@ -294,7 +294,7 @@ TEST_CASE("long spans stay on the path", "[planner]") {
     plan_and_check(path_of({circle(3, 60)}), p);
 }
 
-TEST_CASE("tiny limits still plan; impossible input gives a clear error", "[planner]") {
+TEST_CASE("tiny limits still plan, impossible input gives a clear error", "[planner]") {
     SECTION("tiny limits") {
         MachineProfile p = profile(0.5, 2);
         const Planned r = plan_and_check(path_of({polyline({{0, 0}, {1, 0.5}})}), p);

@@ -44,7 +44,7 @@ TEST_CASE("a progress line fits the terminal: the bar narrows, then the detail i
     CHECK(ProgressBar::render("streaming", 0.5, 2.0, detail, {}, 80).substr(76) == "...");
 }
 
-TEST_CASE("a given ETA replaces the wall-time extrapolation; an estimate is marked",
+TEST_CASE("a given ETA replaces the wall-time extrapolation, an estimate is marked",
           "[host][progress]") {
     // After a resume the fraction counts the whole drawing while the wall time counts this
     // run only: the ETA must come from the motion left.

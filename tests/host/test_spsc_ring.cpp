@@ -139,7 +139,7 @@ TEST_CASE("PlanningThread: the spans cross the queue as plan_stream makes them, 
     CHECK(tapped.digest.hash == reference.digest.hash);
 }
 
-TEST_CASE("PlanningThread: an error on the planning thread reaches the consumer; cancel ends a waiting planner",
+TEST_CASE("PlanningThread: an error on the planning thread reaches the consumer, cancel ends a waiting planner",
           "[spsc][planner][threads]") {
     const MachineProfile machine = pen_plotter();
     class FailingTap : public PlanSink {

@@ -456,7 +456,7 @@ TEST_CASE("svg: random arcs under random affine maps stay within the tolerance",
     CHECK(pieces > 100);
 }
 
-TEST_CASE("svg: radii too small are scaled up; zero radii give a line; equal end points nothing",
+TEST_CASE("svg: radii too small are scaled up, zero radii give a line, equal end points nothing",
           "[svg]") {
     const Subpath s = one("M 0 0 A 1 2 0 0 1 20 0");  // scaled by 10: rx 10, ry 20, centre (10, 0)
     CHECK(worst_deviation(s, {{10, 0}, 10, 20, 0}) <= 0.01);
@@ -575,7 +575,7 @@ TEST_CASE("svg: width in mm with a viewBox scales user units", "[svg]") {
     CHECK(near_point(first_end(h), {100, 50}));
 }
 
-TEST_CASE("svg: px at 96 per inch; no viewBox means one user unit is one px", "[svg]") {
+TEST_CASE("svg: px at 96 per inch, no viewBox means one user unit is one px", "[svg]") {
     const Path p = with_root(R"(width="960" height="480")", R"(<path d="M 96 0 L 192 48"/>)");
     CHECK(near_point(first_start(p), {25.4, 0}));
     CHECK(near_point(first_end(p), {50.8, 12.7}));

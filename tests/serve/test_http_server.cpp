@@ -263,7 +263,7 @@ TEST_CASE("http: a client that leaves cancels the work it asked for", "[serve][h
     CHECK(cancelled.load() == 1);
 }
 
-TEST_CASE("http: an event listener that does not read is dropped; one that reads is not",
+TEST_CASE("http: an event listener that does not read is dropped, one that reads is not",
           "[serve][http][threads]") {
     HttpLimits limits;
     limits.event_backlog_bytes = 1u << 20;
