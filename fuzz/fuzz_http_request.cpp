@@ -30,18 +30,12 @@ void check_request(const HttpRequest& r, const HttpLimits& limits) {
     policy.loopback = false;
     policy.port = 8080;
     policy.token = kToken;
-    RequestFacts facts;
-    facts.method = r.method;
-    facts.host = r.header("host");
-    facts.origin = r.header("origin");
-    facts.authorization = r.header("authorization");
-    facts.query_token = r.param("token");
-    facts.cookie_token = cookie_value(r.header("cookie"), "pathstream_token");
+    const RequestFacts facts = request_facts(r);
     if (!refusal(policy, facts) && facts.authorization != std::string("Bearer ") + kToken &&
         facts.query_token != kToken && facts.cookie_token != kToken) {
         fuzz::violated("a request without the token let through");
     }
-    if (const auto cookie = token_cookie(policy, facts, "pathstream_token");
+    if (const auto cookie = token_cookie(policy, facts, kTokenCookie);
         cookie && cookie->find(kToken) == std::string::npos) {
         fuzz::violated("a cookie that is not the server's token");
     }

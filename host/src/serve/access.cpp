@@ -94,4 +94,15 @@ ListenAddress parse_listen_address(const std::string& listen) {
     return a;
 }
 
+RequestFacts request_facts(const HttpRequest& request) {
+    RequestFacts facts;
+    facts.method = request.method;
+    facts.host = request.header("host");
+    facts.origin = request.header("origin");
+    facts.authorization = request.header("authorization");
+    facts.query_token = request.param("token");
+    facts.cookie_token = cookie_value(request.header("cookie"), kTokenCookie);
+    return facts;
+}
+
 }  // namespace pathstream::host::serve

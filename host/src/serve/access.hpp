@@ -4,6 +4,8 @@
 #include <optional>
 #include <string>
 
+#include "http_types.hpp"
+
 namespace pathstream::host::serve {
 
 /// What the server was started with, for the checks below. Plain value, read-only once built.
@@ -22,6 +24,13 @@ struct RequestFacts {
     std::string query_token;    ///< ?token= (the first page load cannot set headers)
     std::string cookie_token;   ///< the pathstream_token cookie the page got with its first load
 };
+
+/// The name of the cookie that carries the token once the page has loaded.
+inline constexpr const char* kTokenCookie = "pathstream_token";
+
+/// The facts of `request` the checks look at: its method, Host, Origin and Authorization
+/// headers, its ?token= and its kTokenCookie. Task context (the I/O thread); copies the values.
+RequestFacts request_facts(const HttpRequest& request);
 
 /// True for "127.x.y.z", "::1", "[::1]" and "localhost": addresses no other machine reaches.
 bool is_loopback_host(const std::string& host);

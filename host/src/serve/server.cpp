@@ -30,7 +30,6 @@ struct Server::Reply {
 
 namespace {
 
-constexpr const char* kCookie = "pathstream_token";
 
 Json error_body(const std::string& message) { return Json{{"ok", false}, {"error", message}}; }
 
@@ -563,13 +562,7 @@ Lane control_lane(const HttpRequest& request) {
 void Server::routes() {
     HttpServer& h = *http_;
     h.on_head([this](const HttpRequest& req) {
-        RequestFacts facts;
-        facts.method = req.method;
-        facts.host = req.header("host");
-        facts.origin = req.header("origin");
-        facts.authorization = req.header("authorization");
-        facts.query_token = req.param("token");
-        facts.cookie_token = cookie_value(req.header("cookie"), kCookie);
+        const RequestFacts facts = request_facts(req);
         HeadVerdict verdict;
         if (const auto why = refusal(config_.access, facts)) {
             verdict.refusal = json_response(403, error_body("refused: " + *why));
@@ -580,7 +573,7 @@ void Server::routes() {
                            {"X-Frame-Options", "DENY"},
                            {"Referrer-Policy", "no-referrer"}};
         // The page keeps the token as a cookie that only this origin's requests carry.
-        if (const auto cookie = token_cookie(config_.access, facts, kCookie)) verdict.headers.emplace_back("Set-Cookie", *cookie);
+        if (const auto cookie = token_cookie(config_.access, facts, kTokenCookie)) verdict.headers.emplace_back("Set-Cookie", *cookie);
         return verdict;
     });
     const auto json_handler = [this](auto&& body) {
