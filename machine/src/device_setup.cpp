@@ -63,6 +63,12 @@ DeviceLimitsLsb device_limits(const MachineProfile& profile) {
     return l;
 }
 
+const char* device_state_name(unsigned state) {
+    static const char* const names[] = {"idle",     "running", "holding",
+                                        "stopping", "fault",   "e-stop"};
+    return state < 6 ? names[state] : "unknown";
+}
+
 std::string fault_text(std::uint16_t fault_code) {
     char name[64];
     device::fault_name(static_cast<device::FaultCode>(fault_code), name, sizeof name);

@@ -11,7 +11,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "pathstream/host/atomic_file.hpp"
+#include "pathstream/machine/atomic_file.hpp"
 
 namespace fs = std::filesystem;
 using pathstream::host::AtomicFile;

@@ -15,7 +15,7 @@
 #include "pathstream/machine/device_setup.hpp"
 #include "pathstream/machine/machine.hpp"
 #include "pathstream/host/modbus_stream.hpp"
-#include "position_argument.hpp"
+#include "pathstream/machine/position_argument.hpp"
 
 namespace pathstream::host {
 namespace {

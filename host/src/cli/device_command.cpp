@@ -1,7 +1,7 @@
 #include "device_command.hpp"
 
 #include "exit_codes.hpp"
-#include "position_argument.hpp"
+#include "pathstream/machine/position_argument.hpp"
 
 #include <algorithm>
 #include <atomic>
@@ -19,7 +19,7 @@
 #include "pathstream/hal/gpio_gpiod.hpp"
 #include "pathstream/hal/modbus_server.hpp"
 #include "pathstream/hal/socketcan_bus.hpp"
-#include "pathstream/host/atomic_file.hpp"
+#include "pathstream/machine/atomic_file.hpp"
 #include "pathstream/machine/core_span_conversion.hpp"
 #include "pathstream/host/device_link.hpp"
 #include "pathstream/machine/device_setup.hpp"

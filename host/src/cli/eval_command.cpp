@@ -5,7 +5,7 @@
 #include <optional>
 #include <stdexcept>
 
-#include "pathstream/host/atomic_file.hpp"
+#include "pathstream/machine/atomic_file.hpp"
 #include "pathstream/host/core_spans.hpp"
 #include "pathstream/machine/machine.hpp"
 

@@ -6,7 +6,7 @@
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 
-#include "pathstream/host/atomic_file.hpp"
+#include "pathstream/machine/atomic_file.hpp"
 #include "pathstream/host/core_playback.hpp"
 #include "pathstream/machine/input_error.hpp"
 #include "pathstream/host/job_estimate.hpp"

@@ -8,7 +8,7 @@
 #include <stdexcept>
 #include <utility>
 
-#include "pathstream/host/atomic_file.hpp"
+#include "pathstream/machine/atomic_file.hpp"
 #include "path_options.hpp"
 #include "pathstream/host/core_playback.hpp"
 #include "pathstream/host/core_spans.hpp"

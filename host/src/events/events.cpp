@@ -43,18 +43,6 @@ std::FILE* take_standard_output() {
 
 }  // namespace
 
-std::string iso8601_utc(std::chrono::system_clock::time_point t) {
-    const std::time_t seconds = std::chrono::system_clock::to_time_t(t);
-    std::tm utc{};
-    gmtime_r(&seconds, &utc);
-    char text[40];
-    const std::size_t n = std::strftime(text, sizeof text, "%Y-%m-%dT%H:%M:%S", &utc);
-    const auto ms =
-        std::chrono::duration_cast<std::chrono::milliseconds>(t.time_since_epoch()).count() % 1000;
-    std::snprintf(text + n, sizeof text - n, ".%03dZ", static_cast<int>(ms < 0 ? ms + 1000 : ms));
-    return text;
-}
-
 NdjsonWriter::NdjsonWriter(std::FILE* file) : NdjsonWriter(file, false) {}
 
 NdjsonWriter::NdjsonWriter(std::FILE* file, bool owned) : file_(file), owned_(owned) {}

@@ -11,7 +11,7 @@
 #include <cstring>
 #include <stdexcept>
 
-#include "pathstream/host/atomic_file.hpp"
+#include "pathstream/machine/atomic_file.hpp"
 #include "pathstream/host/plot.hpp"
 
 extern char** environ;

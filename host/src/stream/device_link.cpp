@@ -11,12 +11,6 @@
 
 namespace pathstream::host {
 
-const char* device_state_name(unsigned state) {
-    static const char* const names[] = {"idle",     "running", "holding",
-                                        "stopping", "fault",   "e-stop"};
-    return state < 6 ? names[state] : "unknown";
-}
-
 const char* command_verb(device::Command c) {
     switch (c) {
         case device::Command::kStart:

@@ -13,7 +13,7 @@
 #include "pathstream/device/jerk_moves.hpp"
 #include "pathstream/device/motion_limits.hpp"
 #include "pathstream/device/stop_spans.hpp"
-#include "pathstream/host/atomic_file.hpp"
+#include "pathstream/machine/atomic_file.hpp"
 #include "pathstream/machine/core_span_conversion.hpp"
 #include "pathstream/machine/input_error.hpp"
 #include "pathstream/machine/json_document.hpp"

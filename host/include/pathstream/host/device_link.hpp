@@ -12,6 +12,7 @@
 #include "pathstream/device/device_state.hpp"
 #include "pathstream/device/homing.hpp"
 #include "pathstream/hal/can_bus.hpp"
+#include "pathstream/machine/device_setup.hpp"
 #include "pathstream/span.hpp"
 #include "pathstream/status.hpp"
 #include "pathstream/units.hpp"
@@ -63,10 +64,6 @@ struct DeviceSnapshot {
 const char* axis_homing_name(device::AxisHoming h);
 /// Why homing failed: "switch not found", ... ("none" for kNone).
 const char* homing_error_name(device::HomingError e);
-
-/// "idle", "running", "holding", "stopping", "fault", "e-stop" (a DeviceState number), else
-/// "unknown".
-const char* device_state_name(unsigned state);
 
 /// A command's verb as `pathstream ctl` spells it ("start", "hold", ...).
 const char* command_verb(device::Command c);

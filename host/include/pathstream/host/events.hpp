@@ -14,17 +14,13 @@
 #include <string>
 #include <vector>
 
+#include "pathstream/machine/event_json.hpp"
 #include "pathstream/machine/machine.hpp"
 #include "pathstream/host/modbus_stream.hpp"
 #include "pathstream/host/plan.hpp"
 #include "pathstream/units.hpp"
 
 namespace pathstream::host {
-
-using EventJson = nlohmann::ordered_json;
-
-/// `t` as ISO-8601 UTC with milliseconds: "2025-01-31T12:34:56.789Z".
-std::string iso8601_utc(std::chrono::system_clock::time_point t);
 
 /// Writes NDJSON lines, each flushed at once so that a reader sees every event as it happens.
 class NdjsonWriter {

@@ -40,6 +40,10 @@ DeviceLimitsLsb device_limits(const MachineProfile& profile);
 /// Index of the axis called `name` in the profile. Throws std::invalid_argument if none.
 unsigned axis_index(const MachineProfile& profile, const std::string& name);
 
+/// "idle", "running", "holding", "stopping", "fault", "e-stop" (a DeviceState number), else
+/// "unknown".
+const char* device_state_name(unsigned state);
+
 /// A device's fault code as its name: "limit switch x- (axis 0, negative side)",
 /// "external fault", "fault 0x1234" (device::fault_name).
 std::string fault_text(std::uint16_t fault_code);

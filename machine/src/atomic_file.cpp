@@ -1,4 +1,4 @@
-#include "pathstream/host/atomic_file.hpp"
+#include "pathstream/machine/atomic_file.hpp"
 
 #include <unistd.h>
 

@@ -1,4 +1,4 @@
-#include "position_argument.hpp"
+#include "pathstream/machine/position_argument.hpp"
 
 #include <algorithm>
 #include <cmath>
