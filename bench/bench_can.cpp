@@ -25,7 +25,7 @@
 #include "pathstream/host/json_path.hpp"
 #include "pathstream/machine/machine.hpp"
 #include "pathstream/host/planner.hpp"
-#include "pathstream/sim/can_device.hpp"
+#include "pathstream/linux_device/can_motion_device.hpp"
 #include "pathstream/sim/can_loopback.hpp"
 
 using namespace pathstream;
@@ -82,12 +82,12 @@ Row measure(const host::Plan& plan2, const host::MachineProfile& m2, unsigned ax
     hal::CanBus& host_bus = loop.add_endpoint();
     std::vector<Lsb> start;
     for (const auto& c : plan.spans.front().control) start.push_back(c[0]);
-    auto device = sim::SimulatedCanDevice::create(start, 1);
+    auto device = linux_device::CanMotionDevice::create(start, 1);
     std::atomic<bool> stop{false};
     std::thread t([&] {
-        sim::DeviceLoopOptions o;
+        linux_device::DeviceLoopOptions o;
         o.time_scale = time_scale;
-        sim::run_can_device_loop(*device, device_bus, o, stop);
+        linux_device::run_can_device_loop(*device, device_bus, o, stop);
     });
     host::CanStreamOptions o;
     o.node = 1;

@@ -41,7 +41,7 @@
 #include "pathstream/machine/machine.hpp"
 #include "pathstream/host/modbus_stream.hpp"
 #include "pathstream/host/planner.hpp"
-#include "pathstream/sim/modbus_device.hpp"
+#include "pathstream/linux_device/modbus_motion_device.hpp"
 
 using namespace pathstream;
 
@@ -129,13 +129,13 @@ std::vector<Lsb> start_of(const host::Plan& plan) {
 template <typename MakeServer, typename Target>
 host::StreamReport stream_once(const Job& job, double time_scale, const host::StreamOptions& base, MakeServer make_server,
                                Target target_of) {
-    const auto device = sim::SimulatedModbusDevice::create(start_of(job.plan));
+    const auto device = linux_device::ModbusMotionDevice::create(start_of(job.plan));
     hal::ModbusServer server = make_server(device->handler());
     std::atomic<bool> stop{false};
     std::thread loop([&] {
-        sim::DeviceLoopOptions o;
+        linux_device::DeviceLoopOptions o;
         o.time_scale = time_scale;
-        sim::run_device_loop(*device, [&](std::chrono::microseconds w) { server.poll_once(w); }, o, stop);
+        linux_device::run_device_loop(*device, [&](std::chrono::microseconds w) { server.poll_once(w); }, o, stop);
     });
     host::StreamOptions o = base;
     o.target = target_of(server);

@@ -12,14 +12,14 @@
 #include "pathstream/host/planner.hpp"
 #include "cli/check_command.hpp"
 #include "cli/ctl_command.hpp"
-#include "cli/device_command.hpp"
+#include "device_command.hpp"
 #include "cli/drive_command.hpp"
 #include "cli/eval_command.hpp"
 #include "cli/plan_command.hpp"
 #include "cli/serve_command.hpp"
 #include "cli/setpoints_command.hpp"
 #include "cli/sim_command.hpp"
-#include "cli/exit_codes.hpp"
+#include "pathstream/machine/exit_codes.hpp"
 #include "cli/stream_command.hpp"
 #include "pathstream/hal/gpio_gpiod.hpp"
 #include "pathstream/hal/modbus_error.hpp"
@@ -42,8 +42,8 @@ int main(int argc, char** argv) {
     pathstream::host::add_eval_command(app, eval);
     pathstream::host::StreamCommandOptions stream;
     pathstream::host::add_stream_command(app, stream);
-    pathstream::host::DeviceCommandOptions device;
-    pathstream::host::add_device_command(app, device);
+    pathstream::device_cli::DeviceCommandOptions device;
+    pathstream::device_cli::add_device_command(app, device);
     pathstream::host::DriveCommandOptions drive;
     pathstream::host::add_drive_command(app, drive);
     pathstream::host::CtlCommandOptions ctl;
@@ -69,7 +69,7 @@ int main(int argc, char** argv) {
         if (app.got_subcommand("plan")) return pathstream::host::run_plan(plan);
         if (app.got_subcommand("sim")) return pathstream::host::run_sim(sim);
         if (app.got_subcommand("stream")) return pathstream::host::run_stream(stream);
-        if (app.got_subcommand("device")) return pathstream::host::run_device(device);
+        if (app.got_subcommand("device")) return pathstream::device_cli::run_device(device);
         if (app.got_subcommand("drive")) return pathstream::host::run_drive(drive);
         if (app.got_subcommand("ctl")) return pathstream::host::run_ctl(ctl);
         if (app.got_subcommand("serve")) return pathstream::host::run_serve(serve);

@@ -27,7 +27,7 @@ const char* phase_text(device::HomingPhase p) {
     }
 }
 
-std::string failure(const sim::SimulatedMotionDevice& d, const sim::DeviceIo& io, const host::HomingSetup& s, double q) {
+std::string failure(const linux_device::AnyMotionDevice& d, const linux_device::DeviceIo& io, const host::HomingSetup& s, double q) {
     const device::HomingConfig& c = s.config;
     std::string why;
     switch (io.homing_error()) {
@@ -60,7 +60,7 @@ std::string failure(const sim::SimulatedMotionDevice& d, const sim::DeviceIo& io
 
 }  // namespace
 
-HomingRunLog::HomingRunLog(const sim::SimulatedMotionDevice& device, const sim::DeviceIo& io,
+HomingRunLog::HomingRunLog(const linux_device::AnyMotionDevice& device, const linux_device::DeviceIo& io,
                            std::vector<host::HomingSetup> setups, double mm_per_lsb)
     : device_(device), io_(io), setups_(std::move(setups)), mm_per_lsb_(mm_per_lsb) {}
 
@@ -98,7 +98,7 @@ void HomingRunLog::after_tick(const HomingLog& log) {
     busy_ = busy;
 }
 
-void set_homing_plan(sim::DeviceIo& io, const std::vector<host::HomingSetup>& setups) {
+void set_homing_plan(linux_device::DeviceIo& io, const std::vector<host::HomingSetup>& setups) {
     std::vector<device::HomingAxis> plan;
     for (const host::HomingSetup& s : setups) plan.push_back({s.config, s.side});
     if (io.set_homing_plan(plan.data(), static_cast<unsigned>(plan.size())) == Status::kOk) return;
@@ -113,7 +113,7 @@ void set_homing_plan(sim::DeviceIo& io, const std::vector<host::HomingSetup>& se
     throw HomingFailed("gpio.home: an axis is homed twice, or beyond the device's axes");
 }
 
-std::vector<HomedAxis> home_axes(sim::SimulatedMotionDevice& device, sim::DeviceIo& io, const std::vector<host::HomingSetup>& setups,
+std::vector<HomedAxis> home_axes(linux_device::AnyMotionDevice& device, linux_device::DeviceIo& io, const std::vector<host::HomingSetup>& setups,
                                  double mm_per_lsb, const RunTicksUntil& run_until, const HomingLog& log) {
     set_homing_plan(io, setups);
     std::vector<HomedAxis> homed;

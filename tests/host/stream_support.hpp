@@ -10,7 +10,7 @@
 #include "pathstream/host/json_path.hpp"
 #include "pathstream/machine/machine.hpp"
 #include "pathstream/host/planner.hpp"
-#include "pathstream/sim/simulated_motion_device.hpp"
+#include "pathstream/linux_device/any_motion_device.hpp"
 #include "pathstream/span.hpp"
 #include "pathstream/units.hpp"
 
@@ -70,7 +70,7 @@ inline Job plan_example_from(const std::string& name, const std::vector<Lsb>& fr
 
 /// The device's recorded path ticks from path tick `first` on are `plan`'s setpoints, tick for
 /// tick, pen included.
-inline void check_recorded(const host::Plan& plan, const sim::SimulatedMotionDevice& device,
+inline void check_recorded(const host::Plan& plan, const linux_device::AnyMotionDevice& device,
                            std::size_t first) {
     const std::size_t axes = plan.spans.front().control.size();
     const std::vector<Lsb> expected = plan_setpoints(plan, axes);

@@ -16,9 +16,10 @@
 #include "pathstream/hal/modbus_server.hpp"
 #include "pathstream/host/can_stream.hpp"
 #include "pathstream/host/device_link.hpp"
-#include "pathstream/sim/can_device.hpp"
+#include "pathstream/linux_device/can_motion_device.hpp"
 #include "pathstream/sim/can_loopback.hpp"
-#include "pathstream/sim/modbus_device.hpp"
+#include "pathstream/linux_device/modbus_motion_device.hpp"
+#include "pathstream/sim/machine_switches.hpp"
 #include "pathstream/sim/simulated_input.hpp"
 
 using namespace pathstream;
@@ -67,12 +68,13 @@ struct TickRow {
 class HomingRig {
 public:
     // Physical and device coordinates agree at the start.
-    explicit HomingRig(sim::SimulatedMotionDevice& device) : device_(device) {
+    explicit HomingRig(linux_device::AnyMotionDevice& device) : device_(device) {
         REQUIRE(device.configure(limits()) == Status::kOk);
         device.record(true);
-        sim::MachineWiring w;
+        linux_device::MachineWiring w;
         for (unsigned a = 0; a < kAxes; ++a) w.limit[a][0] = &switches_[a];
         io_ = &device.attach_io(w);
+        device.observe_ticks(&machine_switches_);
     }
 
     // The switch of `axis` closes at physical `point` and below; none: it never closes. The
@@ -83,9 +85,9 @@ public:
         p.side = device::LimitSide::kNegative;
         p.trigger = point;
         sim::SimulatedInput& in = switches_[axis];
-        device_.switches().place(p, [&in](bool closed) { in.drive(closed); });
+        machine_switches_.place(p, [&in](bool closed) { in.drive(closed); });
     }
-    sim::DeviceIo& io() { return *io_; }
+    linux_device::DeviceIo& io() { return *io_; }
 
     // One tick with the switches following the physical position.
     void tick() {
@@ -107,7 +109,7 @@ public:
 
     // Where the device's coordinates put physical point `point` of `axis` now.
     Lsb device_coordinate(unsigned axis, Lsb point) const {
-        return point + device_.position(axis) - device_.switches().machine_position(axis);
+        return point + device_.position(axis) - machine_switches_.machine_position(axis);
     }
     unsigned redefinitions(unsigned axis) const { return redefinitions_[axis]; }
     const std::vector<TickRow>& rows() const { return rows_; }
@@ -135,32 +137,33 @@ public:
     }
 
 private:
-    sim::SimulatedMotionDevice& device_;
-    sim::DeviceIo* io_ = nullptr;
+    linux_device::AnyMotionDevice& device_;
+    linux_device::DeviceIo* io_ = nullptr;
     sim::SimulatedInput switches_[kAxes];
+    sim::MachineSwitches machine_switches_;
     unsigned redefinitions_[kAxes] = {};
     std::vector<TickRow> rows_;
 };
 
 // A Modbus TCP device with the rig, ticked fast on its own thread.
 struct ModbusRig {
-    std::unique_ptr<sim::SimulatedModbusDevice> device;
+    std::unique_ptr<linux_device::ModbusMotionDevice> device;
     std::unique_ptr<HomingRig> rig;
     std::unique_ptr<hal::ModbusServer> server;
     std::atomic<bool> stop{false};
     std::thread thread;
 
     explicit ModbusRig(const std::vector<Lsb>& start) {
-        device = sim::SimulatedModbusDevice::create(start);
+        device = linux_device::ModbusMotionDevice::create(start);
         rig = std::make_unique<HomingRig>(*device);
         server = std::make_unique<hal::ModbusServer>(
             hal::ModbusServer::tcp(device->handler(), {"127.0.0.1", 0, 4}));
     }
     void run() {
         thread = std::thread([this] {
-            sim::DeviceLoopOptions o;
+            linux_device::DeviceLoopOptions o;
             o.time_scale = 20.0;
-            sim::run_paced_loop(
+            linux_device::run_paced_loop(
                 [&] { rig->tick(); }, [&] { return device->tick_hz(); },
                 [&](std::chrono::microseconds w) {
                     server->poll_once(w);
@@ -291,16 +294,16 @@ TEST_CASE("home and pen over native CAN: status E reports each axis, status A th
     sim::CanLoopback loop;
     hal::CanBus& device_bus = loop.add_endpoint();
     hal::CanBus& host_bus = loop.add_endpoint();
-    std::unique_ptr<sim::SimulatedCanDevice> device = sim::SimulatedCanDevice::create(start, 7);
+    std::unique_ptr<linux_device::CanMotionDevice> device = linux_device::CanMotionDevice::create(start, 7);
     HomingRig rig(*device);
     rig.place_switch(0, -3000);
     const device::HomingAxis plan[] = {homing_axis(0, 300000)};
     REQUIRE(rig.io().set_homing_plan(plan, 1) == Status::kOk);
     std::atomic<bool> stop{false};
     std::thread t([&] {
-        sim::DeviceLoopOptions o;
+        linux_device::DeviceLoopOptions o;
         o.time_scale = 20.0;
-        sim::run_paced_loop([&] { rig.tick(); }, [&] { return device->tick_hz(); },
+        linux_device::run_paced_loop([&] { rig.tick(); }, [&] { return device->tick_hz(); },
                             [&](std::chrono::microseconds w) { device->serve(device_bus, w); }, o, stop);
     });
     host::CanStreamOptions c;

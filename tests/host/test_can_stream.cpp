@@ -14,7 +14,7 @@
 #include "pathstream/host/json_path.hpp"
 #include "pathstream/machine/machine.hpp"
 #include "pathstream/host/planner.hpp"
-#include "pathstream/sim/can_device.hpp"
+#include "pathstream/linux_device/can_motion_device.hpp"
 #include "pathstream/sim/can_loopback.hpp"
 #include "pathstream/span.hpp"
 #include "stream_support.hpp"
@@ -32,15 +32,15 @@ namespace {
 
 // The device on loopback endpoint 0, served and ticked on its own thread.
 struct DeviceThread {
-    std::unique_ptr<sim::SimulatedCanDevice> device;
+    std::unique_ptr<linux_device::CanMotionDevice> device;
     std::atomic<bool> stop{false};
     std::thread thread;
 
     void run(hal::CanBus& bus, double time_scale) {
         thread = std::thread([this, &bus, time_scale] {
-            sim::DeviceLoopOptions o;
+            linux_device::DeviceLoopOptions o;
             o.time_scale = time_scale;
-            sim::run_can_device_loop(*device, bus, o, stop);
+            linux_device::run_can_device_loop(*device, bus, o, stop);
         });
     }
     void join() {
@@ -50,7 +50,7 @@ struct DeviceThread {
     ~DeviceThread() { join(); }
 };
 
-void check_executed(const Job& job, const sim::SimulatedCanDevice& device,
+void check_executed(const Job& job, const linux_device::CanMotionDevice& device,
                     const host::CanStreamReport& report) {
     const std::size_t axes = job.plan.spans.front().control.size();
     const std::vector<Lsb> expected = plan_setpoints(job.plan, axes);
@@ -73,7 +73,7 @@ void check_executed(const Job& job, const sim::SimulatedCanDevice& device,
 
 struct Run {
     host::CanStreamReport report;
-    std::unique_ptr<sim::SimulatedCanDevice> device;
+    std::unique_ptr<linux_device::CanMotionDevice> device;
     sim::CanLoopbackCounters bus;
 };
 
@@ -82,7 +82,7 @@ Run stream_over_loopback(const Job& job, const sim::CanFaults& faults, double ti
     hal::CanBus& device_bus = loop.add_endpoint();
     hal::CanBus& host_bus = loop.add_endpoint();
     DeviceThread dt;
-    dt.device = sim::SimulatedCanDevice::create(start_of(job.plan), 5);
+    dt.device = linux_device::CanMotionDevice::create(start_of(job.plan), 5);
     dt.device->record(true);
     dt.run(device_bus, time_scale);
     host::CanStreamOptions o;
@@ -122,7 +122,7 @@ TEST_CASE("two drawings in a row natively over CAN, each ending idle at rest, no
     hal::CanBus& device_bus = loop.add_endpoint();
     hal::CanBus& host_bus = loop.add_endpoint();
     DeviceThread dt;
-    dt.device = sim::SimulatedCanDevice::create(start_of(first.plan), 5);
+    dt.device = linux_device::CanMotionDevice::create(start_of(first.plan), 5);
     dt.device->record(true);
     dt.run(device_bus, 20.0);
     host::CanStreamOptions o;
@@ -155,7 +155,7 @@ TEST_CASE(
     hal::CanBus& device_bus = loop.add_endpoint();
     hal::CanBus& host_bus = loop.add_endpoint();
     DeviceThread dt;
-    dt.device = sim::SimulatedCanDevice::create(rest, 5);
+    dt.device = linux_device::CanMotionDevice::create(rest, 5);
     dt.device->record(true);
     dt.run(device_bus, 20.0);
     host::CanStreamOptions o;
@@ -214,7 +214,7 @@ TEST_CASE("bus-off at the device: the host stops with a clear error and the devi
     hal::CanBus& device_bus = loop.add_endpoint();
     hal::CanBus& host_bus = loop.add_endpoint();
     DeviceThread dt;
-    dt.device = sim::SimulatedCanDevice::create(start_of(job.plan), 5);
+    dt.device = linux_device::CanMotionDevice::create(start_of(job.plan), 5);
     dt.run(device_bus, 1.0);
     host::CanStreamOptions o;
     o.node = 5;

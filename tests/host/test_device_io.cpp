@@ -13,8 +13,8 @@
 #include "pathstream/machine/device_setup.hpp"
 #include "pathstream/machine/machine.hpp"
 #include "pathstream/linux_device/machine_homing.hpp"
-#include "pathstream/sim/can_device.hpp"
-#include "pathstream/sim/modbus_device.hpp"
+#include "pathstream/linux_device/can_motion_device.hpp"
+#include "pathstream/linux_device/modbus_motion_device.hpp"
 #include "pathstream/sim/simulated_input.hpp"
 #include "pathstream/sim/simulated_output.hpp"
 #include "pathstream/sim/virtual_clock.hpp"
@@ -45,7 +45,7 @@ const char* kProfile = R"({
 // The simulated machine around a device: switches at physical positions (the device's
 // coordinates change when homing sets zero; `offset` maps them back).
 struct Machine {
-    explicit Machine(std::unique_ptr<sim::SimulatedMotionDevice> d) : dev(std::move(d)) {
+    explicit Machine(std::unique_ptr<linux_device::AnyMotionDevice> d) : dev(std::move(d)) {
         wiring.estop = &estop;
         wiring.limit[0][0] = &x_min;
         wiring.limit[1][1] = &y_max;
@@ -80,20 +80,20 @@ struct Machine {
         };
     }
 
-    std::unique_ptr<sim::SimulatedMotionDevice> dev;
+    std::unique_ptr<linux_device::AnyMotionDevice> dev;
     sim::VirtualClock clock;
     sim::SimulatedInput estop, x_min, y_max;
     sim::SimulatedOutput enable{clock}, pen{clock};
-    sim::MachineWiring wiring;
-    sim::DeviceIo* io = nullptr;
+    linux_device::MachineWiring wiring;
+    linux_device::DeviceIo* io = nullptr;
     Lsb x_switch = 10000, y_switch = 50000;
     Lsb offset[2] = {0, 0};
 };
 
 host::MachineProfile profile() { return host::parse_machine_profile(kProfile, "m.json"); }
 
-std::unique_ptr<sim::SimulatedMotionDevice> modbus_device(Lsb x, Lsb y) {
-    return sim::SimulatedModbusDevice::create({x, y});
+std::unique_ptr<linux_device::AnyMotionDevice> modbus_device(Lsb x, Lsb y) {
+    return linux_device::ModbusMotionDevice::create({x, y});
 }
 
 }  // namespace
@@ -126,7 +126,7 @@ TEST_CASE("device setup: limits and homing in LSB from the profile", "[host][gpi
 TEST_CASE("device io: the configured device is the one a host would configure, e-stop and limits act per tick",
           "[host][gpio]") {
     for (bool can : {false, true}) {
-        Machine m(can ? std::unique_ptr<sim::SimulatedMotionDevice>(sim::SimulatedCanDevice::create({20000, 0}, 1))
+        Machine m(can ? std::unique_ptr<linux_device::AnyMotionDevice>(linux_device::CanMotionDevice::create({20000, 0}, 1))
                       : modbus_device(20000, 0));
         REQUIRE(m.dev->configure(host::device_limits(profile())) == Status::kOk);
         CHECK(m.dev->tick_hz() == 1000);
@@ -151,7 +151,7 @@ TEST_CASE("device io: the configured device is the one a host would configure, e
 
 TEST_CASE("device io: homing x then y from the profile, pulled off the switches", "[host][gpio][homing]") {
     for (bool can : {false, true}) {
-        Machine m(can ? std::unique_ptr<sim::SimulatedMotionDevice>(sim::SimulatedCanDevice::create({25000, 30000}, 1))
+        Machine m(can ? std::unique_ptr<linux_device::AnyMotionDevice>(linux_device::CanMotionDevice::create({25000, 30000}, 1))
                       : modbus_device(25000, 30000));
         const host::MachineProfile p = profile();
         REQUIRE(m.dev->configure(host::device_limits(p)) == Status::kOk);

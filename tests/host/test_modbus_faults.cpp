@@ -33,7 +33,7 @@
 #include "pathstream/machine/machine.hpp"
 #include "pathstream/host/modbus_stream.hpp"
 #include "pathstream/host/planner.hpp"
-#include "pathstream/sim/modbus_device.hpp"
+#include "pathstream/linux_device/modbus_motion_device.hpp"
 #include "pathstream/span.hpp"
 #include "stream_support.hpp"
 
@@ -50,7 +50,7 @@ namespace {
 namespace st = device::modbus::status;
 
 // The device's recorded path ticks are the plan's setpoints, tick for tick, every span once.
-void check_executed(const Job& job, const sim::SimulatedModbusDevice& device,
+void check_executed(const Job& job, const linux_device::ModbusMotionDevice& device,
                     const host::StreamReport& report) {
     const std::size_t axes = job.plan.spans.front().control.size();
     const std::vector<Lsb> expected = plan_setpoints(job.plan, axes);
@@ -68,12 +68,12 @@ void check_executed(const Job& job, const sim::SimulatedModbusDevice& device,
 
 // A status register of a device, read from the thread that serves it (no Catch assertions
 // here: they are not thread-safe; a bad address reads as 0xFFFF, which no check expects).
-std::uint16_t status_u16(sim::SimulatedModbusDevice& d, std::uint16_t reg) {
+std::uint16_t status_u16(linux_device::ModbusMotionDevice& d, std::uint16_t reg) {
     std::uint16_t r = 0;
     if (d.handler().read_input_registers(reg, 1, &r) != hal::ModbusException::kNone) return 0xFFFF;
     return r;
 }
-std::uint32_t status_u32(sim::SimulatedModbusDevice& d, std::uint16_t reg) {
+std::uint32_t status_u32(linux_device::ModbusMotionDevice& d, std::uint16_t reg) {
     std::uint16_t r[2] = {};
     if (d.handler().read_input_registers(reg, 2, r) != hal::ModbusException::kNone)
         return 0xFFFFFFFFu;
@@ -92,12 +92,12 @@ struct Runner {
 };
 
 // Serves `server` and ticks `device` until stopped (the plain device of test_modbus_stream).
-void run_device(Runner& r, sim::SimulatedModbusDevice& device, hal::ModbusServer& server,
+void run_device(Runner& r, linux_device::ModbusMotionDevice& device, hal::ModbusServer& server,
                 double time_scale) {
     r.thread = std::thread([&r, &device, &server, time_scale] {
-        sim::DeviceLoopOptions o;
+        linux_device::DeviceLoopOptions o;
         o.time_scale = time_scale;
-        sim::run_device_loop(
+        linux_device::run_device_loop(
             device, [&](std::chrono::microseconds w) { server.poll_once(w); }, o, r.stop);
     });
 }
@@ -330,7 +330,7 @@ private:
 // behind a link that stayed up (a gateway's TCP connection, a serial line). Device thread only.
 class SwappableHandler final : public hal::ModbusRegisterHandler {
 public:
-    sim::SimulatedModbusDevice* device = nullptr;
+    linux_device::ModbusMotionDevice* device = nullptr;
 
     hal::ModbusException read_input_registers(std::uint16_t a, std::uint16_t n,
                                               std::uint16_t* out) override {
@@ -363,7 +363,7 @@ TEST_CASE("a TCP connection cut mid-frame: the host reconnects and no span is lo
     const bool response_lost = GENERATE(true, false);
     const Job job = plan_example("wave.json");
     REQUIRE(job.plan.spans.size() > 40);  // several batches: the cut falls mid-stream
-    const auto device = sim::SimulatedModbusDevice::create(start_of(job.plan));
+    const auto device = linux_device::ModbusMotionDevice::create(start_of(job.plan));
     device->record(true);
     hal::ModbusServer server = hal::ModbusServer::tcp(device->handler(), {"127.0.0.1", 0, 4});
     Runner loop;
@@ -394,7 +394,7 @@ TEST_CASE(
     "[modbus][faults][threads]") {
     const Job job = plan_example("wave.json");
     FaultLine line(0.006, 0.004, 11);
-    const auto device = sim::SimulatedModbusDevice::create(start_of(job.plan));
+    const auto device = linux_device::ModbusMotionDevice::create(start_of(job.plan));
     device->record(true);
     hal::ModbusServerOptions so;
     so.byte_timeout =
@@ -436,19 +436,19 @@ TEST_CASE(
     "'restarted'",
     "[modbus][faults][threads]") {
     const Job job = plan_example("wave.json");
-    std::unique_ptr<sim::SimulatedModbusDevice> first =
-        sim::SimulatedModbusDevice::create(start_of(job.plan));
-    std::unique_ptr<sim::SimulatedModbusDevice> second;
+    std::unique_ptr<linux_device::ModbusMotionDevice> first =
+        linux_device::ModbusMotionDevice::create(start_of(job.plan));
+    std::unique_ptr<linux_device::ModbusMotionDevice> second;
     std::optional<hal::ModbusServer> server =
         hal::ModbusServer::tcp(first->handler(), {"127.0.0.1", 0, 4});
     const std::uint16_t port = server->port();
     Runner loop;
     loop.thread = std::thread([&] {
-        sim::DeviceLoopOptions lo;
+        linux_device::DeviceLoopOptions lo;
         lo.time_scale = 10.0;
         std::atomic<bool> restart{false};
         // Phase 1: the first device until it has accepted 20 spans.
-        sim::run_device_loop(
+        linux_device::run_device_loop(
             *first,
             [&](std::chrono::microseconds w) {
                 server->poll_once(w);
@@ -459,9 +459,9 @@ TEST_CASE(
         // Power cycle: every connection closes, a fresh device (same start, unconfigured) serves
         // the same port.
         server.reset();
-        second = sim::SimulatedModbusDevice::create(start_of(job.plan));
+        second = linux_device::ModbusMotionDevice::create(start_of(job.plan));
         server.emplace(hal::ModbusServer::tcp(second->handler(), {"127.0.0.1", port, 4}));
-        sim::run_device_loop(
+        linux_device::run_device_loop(
             *second, [&](std::chrono::microseconds w) { server->poll_once(w); }, lo, loop.stop);
     });
     host::StreamOptions o;
@@ -488,17 +488,17 @@ TEST_CASE(
 TEST_CASE("a device restarted behind a link that stays up (RTU): the host stops with 'restarted'",
           "[modbus][faults][threads]") {
     const Job job = plan_example("wave.json");
-    const auto first = sim::SimulatedModbusDevice::create(start_of(job.plan));
-    const auto second = sim::SimulatedModbusDevice::create(start_of(job.plan));
+    const auto first = linux_device::ModbusMotionDevice::create(start_of(job.plan));
+    const auto second = linux_device::ModbusMotionDevice::create(start_of(job.plan));
     SwappableHandler handler;
     handler.device = first.get();
     hal::ModbusServer server = hal::ModbusServer::rtu_pty(handler);
     Runner loop;
     loop.thread = std::thread([&] {
-        sim::DeviceLoopOptions lo;
+        linux_device::DeviceLoopOptions lo;
         lo.time_scale = 10.0;
         std::atomic<bool> restart{false};
-        sim::run_device_loop(
+        linux_device::run_device_loop(
             *first,
             [&](std::chrono::microseconds w) {
                 server.poll_once(w);
@@ -507,7 +507,7 @@ TEST_CASE("a device restarted behind a link that stays up (RTU): the host stops 
             },
             lo, restart);
         handler.device = second.get();
-        sim::run_device_loop(
+        linux_device::run_device_loop(
             *second, [&](std::chrono::microseconds w) { server.poll_once(w); }, lo, loop.stop);
     });
     host::StreamOptions o;
@@ -532,7 +532,7 @@ TEST_CASE(
     "exact",
     "[modbus][faults][threads]") {
     const Job job = plan_example("wave.json");
-    const auto device = sim::SimulatedModbusDevice::create(start_of(job.plan));
+    const auto device = linux_device::ModbusMotionDevice::create(start_of(job.plan));
     device->record(true);
     device->record_every_tick(true);
     hal::ModbusServer server = hal::ModbusServer::tcp(device->handler(), {"127.0.0.1", 0, 4});
@@ -540,9 +540,9 @@ TEST_CASE(
     bool saw_underrun_hold = false;
     Runner loop;
     loop.thread = std::thread([&] {
-        sim::DeviceLoopOptions lo;
+        linux_device::DeviceLoopOptions lo;
         lo.time_scale = 10.0;
-        sim::run_device_loop(
+        linux_device::run_device_loop(
             *device,
             [&](std::chrono::microseconds w) {
                 server.poll_once(w);
@@ -591,7 +591,7 @@ TEST_CASE(
 TEST_CASE("a lead longer than the device's queue holds: the host starts when the queue is full",
           "[modbus][faults][threads]") {
     const Job job = plan_example("wave.json");
-    const auto device = sim::SimulatedModbusDevice::create(start_of(job.plan));
+    const auto device = linux_device::ModbusMotionDevice::create(start_of(job.plan));
     device->record(true);
     hal::ModbusServer server = hal::ModbusServer::tcp(device->handler(), {"127.0.0.1", 0, 4});
     Runner loop;

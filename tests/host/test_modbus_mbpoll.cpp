@@ -18,7 +18,7 @@
 
 #include "pathstream/device/modbus_map.hpp"
 #include "pathstream/hal/modbus_server.hpp"
-#include "pathstream/sim/modbus_device.hpp"
+#include "pathstream/linux_device/modbus_motion_device.hpp"
 
 using namespace pathstream;
 using Catch::Matchers::Contains;
@@ -66,13 +66,13 @@ std::map<int, long> values(const std::string& out) {
 
 // Serves the device and ticks it (real time) until destroyed.
 struct DeviceThread {
-    std::unique_ptr<sim::SimulatedModbusDevice> device;
+    std::unique_ptr<linux_device::ModbusMotionDevice> device;
     hal::ModbusServer* server = nullptr;
     std::atomic<bool> stop{false};
     std::thread thread;
     void run() {
         thread = std::thread([this] {
-            sim::run_device_loop(*device, [&](std::chrono::microseconds w) { server->poll_once(w); }, {}, stop);
+            linux_device::run_device_loop(*device, [&](std::chrono::microseconds w) { server->poll_once(w); }, {}, stop);
         });
     }
     void halt() {
@@ -127,8 +127,8 @@ void check_device(const std::string& program, const std::string& link) {
     CHECK(v.at(st::kVersion + 1) == mb::kProtocolVersion);
     CHECK(v.at(st::kState + 1) == 0);  // idle
     CHECK(v.at(st::kFaultCode + 1) == 0);
-    CHECK(v.at(st::kFreeSlots + 1) == sim::kModbusDeviceCapacity);
-    CHECK(v.at(st::kCapacity + 1) == sim::kModbusDeviceCapacity);
+    CHECK(v.at(st::kFreeSlots + 1) == linux_device::kModbusDeviceCapacity);
+    CHECK(v.at(st::kCapacity + 1) == linux_device::kModbusDeviceCapacity);
 
     // Positions as 32-bit integers, big-endian word order: the start the device was made with.
     const std::string pos = mbpoll(program, link + " -r " + std::to_string(st::kPositions + 1) + " -c 2 -t 3:int -B -1");
@@ -184,7 +184,7 @@ TEST_CASE("mbpoll reads the simulated device's status block and drives its comma
     }
     SECTION("TCP, ephemeral port") {
         DeviceThread dt;
-        dt.device = sim::SimulatedModbusDevice::create({1234, -70000});
+        dt.device = linux_device::ModbusMotionDevice::create({1234, -70000});
         hal::ModbusServer server = hal::ModbusServer::tcp(dt.device->handler(), {"127.0.0.1", 0, 4});
         dt.server = &server;
         const HaltBeforeServer guard{dt};
@@ -193,7 +193,7 @@ TEST_CASE("mbpoll reads the simulated device's status block and drives its comma
     }
     SECTION("RTU on a pty, 115200 8N1") {
         DeviceThread dt;
-        dt.device = sim::SimulatedModbusDevice::create({1234, -70000});
+        dt.device = linux_device::ModbusMotionDevice::create({1234, -70000});
         hal::ModbusServer server = hal::ModbusServer::rtu_pty(dt.device->handler());
         dt.server = &server;
         const HaltBeforeServer guard{dt};

@@ -17,7 +17,7 @@
 
 #include "pathstream/hal/modbus_server.hpp"
 #include "pathstream/host/modbus_stream.hpp"
-#include "pathstream/sim/modbus_device.hpp"
+#include "pathstream/linux_device/modbus_motion_device.hpp"
 #include "stream_support.hpp"
 
 using namespace pathstream;
@@ -120,14 +120,14 @@ struct Flood {
 // The device ticked and served on its own thread, real time; the longest gap between two
 // ticks is kept for the figures (printed, never asserted).
 struct DeviceThread {
-    std::unique_ptr<sim::SimulatedModbusDevice> device;
+    std::unique_ptr<linux_device::ModbusMotionDevice> device;
     std::unique_ptr<hal::ModbusServer> server;
     std::atomic<bool> stop{false};
     std::atomic<std::int64_t> longest_gap_us{0};
     std::thread thread;
 
     explicit DeviceThread(const std::vector<Lsb>& start) {
-        device = sim::SimulatedModbusDevice::create(start);
+        device = linux_device::ModbusMotionDevice::create(start);
         device->record(true);
         // A byte timeout with room for a loaded machine's scheduling: the dribbler's 90 ms
         // gaps must stay under it even when its thread wakes late.
@@ -137,7 +137,7 @@ struct DeviceThread {
             hal::ModbusServer::tcp(device->handler(), {"127.0.0.1", 0}, options));
         thread = std::thread([this] {
             Clock::time_point last = Clock::now();
-            sim::run_paced_loop(
+            linux_device::run_paced_loop(
                 [&] {
                     const Clock::time_point now = Clock::now();
                     const auto gap =

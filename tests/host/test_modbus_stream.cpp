@@ -12,7 +12,7 @@
 #include "pathstream/machine/machine.hpp"
 #include "pathstream/host/modbus_stream.hpp"
 #include "pathstream/host/planner.hpp"
-#include "pathstream/sim/modbus_device.hpp"
+#include "pathstream/linux_device/modbus_motion_device.hpp"
 #include "pathstream/span.hpp"
 #include "stream_support.hpp"
 
@@ -29,15 +29,15 @@ namespace {
 
 // Runs the device loop on its own thread until stopped.
 struct DeviceThread {
-    std::unique_ptr<sim::SimulatedModbusDevice> device;
+    std::unique_ptr<linux_device::ModbusMotionDevice> device;
     std::atomic<bool> stop{false};
     std::thread thread;
 
     void run(hal::ModbusServer& server, double time_scale) {
         thread = std::thread([this, &server, time_scale] {
-            sim::DeviceLoopOptions o;
+            linux_device::DeviceLoopOptions o;
             o.time_scale = time_scale;
-            sim::run_device_loop(
+            linux_device::run_device_loop(
                 *device, [&](std::chrono::microseconds w) { server.poll_once(w); }, o, stop);
         });
     }
@@ -47,7 +47,7 @@ struct DeviceThread {
     }
 };
 
-void check_executed(const Job& job, const sim::SimulatedModbusDevice& device,
+void check_executed(const Job& job, const linux_device::ModbusMotionDevice& device,
                     const host::StreamReport& report) {
     const std::size_t axes = job.plan.spans.front().control.size();
     const std::vector<Lsb> expected = plan_setpoints(job.plan, axes);
@@ -77,7 +77,7 @@ TEST_CASE("a drawing streamed over Modbus TCP executes exactly the planned setpo
           "[modbus][stream][threads]") {
     const Job job = plan_example("wave.json");
     DeviceThread dt;
-    dt.device = sim::SimulatedModbusDevice::create(start_of(job.plan));
+    dt.device = linux_device::ModbusMotionDevice::create(start_of(job.plan));
     dt.device->record(true);
     hal::ModbusServer server = hal::ModbusServer::tcp(dt.device->handler(), {"127.0.0.1", 0, 4});
     dt.run(server, 10.0);
@@ -95,7 +95,7 @@ TEST_CASE("a drawing streamed over Modbus RTU on a pty executes exactly the plan
           "[modbus][stream][threads]") {
     const Job job = plan_example("wave.json");
     DeviceThread dt;
-    dt.device = sim::SimulatedModbusDevice::create(start_of(job.plan));
+    dt.device = linux_device::ModbusMotionDevice::create(start_of(job.plan));
     dt.device->record(true);
     hal::ModbusServer server = hal::ModbusServer::rtu_pty(dt.device->handler());
     dt.run(server, 10.0);
@@ -114,7 +114,7 @@ TEST_CASE(
     const Job drawing = plan_example("rose.json");
     const Lsb rest[2] = {5000, -7000};  // where homing left the machine, not the drawing's start
     DeviceThread dt;
-    dt.device = sim::SimulatedModbusDevice::create({rest[0], rest[1]});
+    dt.device = linux_device::ModbusMotionDevice::create({rest[0], rest[1]});
     dt.device->record(true);
     hal::ModbusServer server = hal::ModbusServer::tcp(dt.device->handler(), {"127.0.0.1", 0, 4});
     dt.run(server, 20.0);
@@ -179,7 +179,7 @@ static void two_drawings_in_a_row(DeviceThread& dt, const std::string& target,
 TEST_CASE("two drawings in a row over Modbus TCP, each ending idle at rest, no manual step",
           "[modbus][stream][threads]") {
     DeviceThread dt;
-    dt.device = sim::SimulatedModbusDevice::create(start_of(plan_example("wave.json").plan));
+    dt.device = linux_device::ModbusMotionDevice::create(start_of(plan_example("wave.json").plan));
     dt.device->record(true);
     hal::ModbusServer server = hal::ModbusServer::tcp(dt.device->handler(), {"127.0.0.1", 0, 4});
     dt.run(server, 20.0);
@@ -190,7 +190,7 @@ TEST_CASE("two drawings in a row over Modbus TCP, each ending idle at rest, no m
 TEST_CASE("two drawings in a row over Modbus RTU, each ending idle at rest, no manual step",
           "[modbus][stream][threads]") {
     DeviceThread dt;
-    dt.device = sim::SimulatedModbusDevice::create(start_of(plan_example("wave.json").plan));
+    dt.device = linux_device::ModbusMotionDevice::create(start_of(plan_example("wave.json").plan));
     dt.device->record(true);
     hal::ModbusServer server = hal::ModbusServer::rtu_pty(dt.device->handler());
     dt.run(server, 20.0);

@@ -7,7 +7,7 @@
 #include <chrono>
 #include <thread>
 
-#include "pathstream/sim/modbus_device.hpp"
+#include "pathstream/linux_device/modbus_motion_device.hpp"
 
 using namespace pathstream;
 using namespace std::chrono_literals;
@@ -16,12 +16,12 @@ TEST_CASE("paced loop: at rest, ticks at most at the rest rate however fast the 
           "[sim][pacing]") {
     std::atomic<bool> stop{false};
     std::uint64_t ticks = 0, serves = 0;
-    sim::DeviceLoopOptions o;
+    linux_device::DeviceLoopOptions o;
     o.time_scale = 1000;  // 1 MHz of ticks at 1 kHz
     o.run_for = 200ms;
     o.at_rest = [] { return true; };
     o.rest_tick_hz = 1000;
-    const std::uint64_t ran = sim::run_paced_loop([&] { ++ticks; }, [] { return 1000u; },
+    const std::uint64_t ran = linux_device::run_paced_loop([&] { ++ticks; }, [] { return 1000u; },
                                                   [&](std::chrono::microseconds w) {
                                                       ++serves;
                                                       std::this_thread::sleep_for(w);
@@ -38,10 +38,10 @@ TEST_CASE("paced loop: a device that leaves rest is paced at its time scale agai
     std::atomic<bool> stop{false};
     std::uint64_t ticks = 0, resting_serves = 0, long_running_waits = 0;
     bool resting = true;
-    sim::DeviceLoopOptions o;
+    linux_device::DeviceLoopOptions o;
     o.time_scale = 1000;
     o.at_rest = [&] { return resting; };
-    sim::run_paced_loop(
+    linux_device::run_paced_loop(
         [&] {
             ++ticks;
             if (ticks == 5) resting = false;  // a request arrived: no more rest

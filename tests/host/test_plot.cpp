@@ -17,6 +17,7 @@
 #include "pathstream/host/plan.hpp"
 #include "pathstream/host/plot.hpp"
 #include "pathstream/sim/device.hpp"
+#include "sim_plots.hpp"
 #include "pathstream/status.hpp"
 #include "pathstream/tick_cubic.hpp"
 
@@ -581,13 +582,13 @@ TEST_CASE("a drawing simulated on the servo plant, plotted and reported end to e
     options.plant = sim::PlantModel::kServo;
     options.servo.bandwidth_hz = 30;
     options.settle_ticks = 100;
-    const sim::SimulationResult r = sim::simulate(plan, m, options);
+    const sim::SimulationResult r = sim::simulate(plan.spans, m, options);
     CHECK(r.underruns == 0);
     CHECK(r.pen_switch_ticks.size() == 4);
     REQUIRE(plan.pen.size() == 4);
     for (std::size_t i = 0; i < 4; ++i) CHECK(r.pen_switch_ticks[i] == plan.pen[i].tick);
 
-    const plot::TickSeries setpoints = sim::setpoint_series(r), plant = sim::plant_series(r);
+    const plot::TickSeries setpoints = host::setpoint_series(r), plant = host::plant_series(r);
     const char* keep = std::getenv("PATHSTREAM_PLOT_DIR");
     TempDir temp;
     const fs::path out = keep != nullptr ? fs::path(keep) : temp.path;
@@ -600,7 +601,7 @@ TEST_CASE("a drawing simulated on the servo plant, plotted and reported end to e
         if (f.size() > 4 && f.compare(f.size() - 4, 4, ".svg") == 0)
             CHECK(fs::file_size(f) < 400000);
     }
-    const std::string report = plot::text_report(plan, nullptr, m, setpoints, sim::run_summary(r));
+    const std::string report = plot::text_report(plan, nullptr, m, setpoints, host::run_summary(r));
     CHECK(report.find("4 pen lifts and lowers") != std::string::npos);
     if (keep != nullptr) std::ofstream(out / "report.txt") << report;
 }

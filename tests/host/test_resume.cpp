@@ -30,9 +30,9 @@
 #include "pathstream/host/json_path.hpp"
 #include "pathstream/machine/machine.hpp"
 #include "pathstream/host/svg_path.hpp"
-#include "pathstream/sim/can_device.hpp"
+#include "pathstream/linux_device/can_motion_device.hpp"
 #include "pathstream/sim/can_loopback.hpp"
-#include "pathstream/sim/modbus_device.hpp"
+#include "pathstream/linux_device/modbus_motion_device.hpp"
 #include "stream_support.hpp"
 
 using namespace pathstream;
@@ -49,7 +49,7 @@ using device::DeviceState;
 // The simulated Modbus device served over TCP (or RTU on a pty pair) and ticked on its own
 // thread.
 struct ModbusDeviceThread {
-    std::unique_ptr<sim::SimulatedModbusDevice> device;
+    std::unique_ptr<linux_device::ModbusMotionDevice> device;
     std::unique_ptr<hal::ModbusServer> server;
     std::atomic<bool> stop{false};
     std::thread thread;
@@ -60,7 +60,7 @@ struct ModbusDeviceThread {
     ModbusDeviceThread(const std::vector<Lsb>& start, double time_scale,
                        const host::DeviceLimitsLsb* limits = nullptr, bool over_rtu = false)
         : rtu(over_rtu) {
-        device = sim::SimulatedModbusDevice::create(start);
+        device = linux_device::ModbusMotionDevice::create(start);
         if (limits != nullptr) REQUIRE(device->configure(*limits) == Status::kOk);
         device->record(true);
         device->record_every_tick(true);
@@ -68,9 +68,9 @@ struct ModbusDeviceThread {
             rtu ? hal::ModbusServer::rtu_pty(device->handler())
                 : hal::ModbusServer::tcp(device->handler(), {"127.0.0.1", 0, 4}));
         thread = std::thread([this, time_scale] {
-            sim::DeviceLoopOptions o;
+            linux_device::DeviceLoopOptions o;
             o.time_scale = time_scale;
-            sim::run_device_loop(
+            linux_device::run_device_loop(
                 *device, [&](std::chrono::microseconds w) { server->poll_once(w); }, o, stop);
         });
     }
@@ -113,7 +113,7 @@ struct Executed {
     std::vector<std::uint8_t> pen;
 };
 
-Executed drawing_ticks(const sim::SimulatedMotionDevice& d, std::size_t kept,
+Executed drawing_ticks(const linux_device::AnyMotionDevice& d, std::size_t kept,
                        std::size_t resumed_from, std::size_t reentry_ticks) {
     const unsigned axes = d.axes();
     Executed e;
@@ -149,7 +149,7 @@ void check_equals_plan(const Executed& e, const host::Plan& plan) {
 
 // No tick the device output (path, stop, re-entry, rest) steps further than the limit allows
 // (one LSB of rounding on top of the exact velocity).
-void check_steps_within_limits(const sim::SimulatedMotionDevice& d,
+void check_steps_within_limits(const linux_device::AnyMotionDevice& d,
                                const host::MachineProfile& machine) {
     const host::DeviceLimitsLsb l = host::device_limits(machine);
     const auto& s = d.every_tick_setpoints();
@@ -539,14 +539,14 @@ TEST_CASE("ctl's link over native CAN: status, commands, a hold of a running str
     hal::CanBus& device_bus = loop.add_endpoint();
     hal::CanBus& host_bus = loop.add_endpoint();
     hal::CanBus& ctl_bus = loop.add_endpoint();
-    std::unique_ptr<sim::SimulatedCanDevice> device =
-        sim::SimulatedCanDevice::create(start_of(job.plan), 5);
+    std::unique_ptr<linux_device::CanMotionDevice> device =
+        linux_device::CanMotionDevice::create(start_of(job.plan), 5);
     device->record(true);
     std::atomic<bool> stop{false};
     std::thread t([&] {
-        sim::DeviceLoopOptions o;
+        linux_device::DeviceLoopOptions o;
         o.time_scale = 4.0;
-        sim::run_can_device_loop(*device, device_bus, o, stop);
+        linux_device::run_can_device_loop(*device, device_bus, o, stop);
     });
     host::CanStreamOptions c;
     c.node = 5;

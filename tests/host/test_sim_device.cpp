@@ -11,6 +11,7 @@
 #include "pathstream/host/core_spans.hpp"
 #include "pathstream/host/plan.hpp"
 #include "pathstream/sim/device.hpp"
+#include "sim_plots.hpp"
 #include "pathstream/sim/plant.hpp"
 #include "pathstream/sim/simulated_output.hpp"
 #include "pathstream/sim/virtual_clock.hpp"
@@ -126,7 +127,7 @@ TEST_CASE("the simulated device plays a plan tick for tick as the core's evaluat
     const MachineProfile profile = profile_for(2);
     std::vector<double> fractions;
     const SimulationResult r =
-        sim::simulate(plan, profile, SimOptions{}, [&](double f) { fractions.push_back(f); });
+        sim::simulate(plan.spans, profile, SimOptions{}, [&](double f) { fractions.push_back(f); });
 
     REQUIRE(r.axes == 2);
     REQUIRE(r.plan_ticks == plan.total_ticks);
@@ -170,11 +171,11 @@ TEST_CASE("the simulated device plays a plan tick for tick as the core's evaluat
     CHECK(std::is_sorted(fractions.begin(), fractions.end()));
     CHECK(fractions.back() == 1.0);
 
-    const auto setpoints = sim::setpoint_series(r);
+    const auto setpoints = host::setpoint_series(r);
     CHECK(setpoints.ticks() == r.ticks);
     CHECK(setpoints.quantum_mm == 0.001);
     CHECK(setpoints.at(10, 0) == Approx(3.0));
-    const auto summary = sim::run_summary(r);
+    const auto summary = host::run_summary(r);
     CHECK(summary.pen_switches == 2);
     CHECK(summary.spans == 5);
     CHECK(summary.max_following_error_mm.empty());
@@ -192,7 +193,7 @@ TEST_CASE("every axis count from 1 to 8 runs on its own SetpointStream instance"
         for (int i = 0; i < 40; ++i)
             spans.push_back(line(i % 2 ? to : from, i % 2 ? from : to, 3, i % 3 == 0));
         const Plan plan = make_plan(spans);
-        const SimulationResult r = sim::simulate(plan, profile_for(axes), SimOptions{});
+        const SimulationResult r = sim::simulate(plan.spans, profile_for(axes), SimOptions{});
         INFO("axes " << axes);
         CHECK(r.axes == axes);
         CHECK(r.ticks == 121);
@@ -214,7 +215,7 @@ TEST_CASE("servo plant on a ramp lags by the analytic steady-state error", "[sim
         options.plant = PlantModel::kServo;
         options.servo.bandwidth_hz = 20;
         options.servo.damping = zeta;
-        const SimulationResult r = sim::simulate(plan, profile, options);
+        const SimulationResult r = sim::simulate(plan.spans, profile, options);
         const double omega = 2 * std::numbers::pi * 20, v = 50.0, t = 0.001;
         // Continuous lag 2 zeta v / omega; the setpoint held over the tick (zero-order hold)
         // adds half a tick, since the position is sampled at the instant the setpoint is issued.
@@ -230,7 +231,7 @@ TEST_CASE("servo plant on a ramp lags by the analytic steady-state error", "[sim
         }
         CHECK(r.following[0].rms_mm > 0);
         CHECK(r.following[0].rms_mm < r.following[0].max_mm);
-        const auto summary = sim::run_summary(r);
+        const auto summary = host::run_summary(r);
         REQUIRE(summary.max_following_error_mm.size() == 1);
         CHECK(summary.plant.find("servo") != std::string::npos);
     }
@@ -247,7 +248,7 @@ TEST_CASE("servo plant step response matches the analytic one and settles", "[si
         options.servo.bandwidth_hz = 25;
         options.servo.damping = zeta;
         options.settle_ticks = 100;
-        const SimulationResult r = sim::simulate(plan, profile, options);
+        const SimulationResult r = sim::simulate(plan.spans, profile, options);
         CHECK(r.ticks == 10 + 1 + 600 + 1 + 100);
         const double omega = 2 * std::numbers::pi * 25;
         const double wd = omega * std::sqrt(std::fabs(1 - zeta * zeta));
@@ -301,7 +302,7 @@ TEST_CASE("a plan the device refuses stops the simulation with the core's status
         const Plan plan =
             make_plan({line({0, 0}, {100, 0}, 4, true), line({101, 0}, {200, 0}, 4, true)});
         try {
-            (void)sim::simulate(plan, profile, SimOptions{});
+            (void)sim::simulate(plan.spans, profile, SimOptions{});
             FAIL("expected a runtime_error");
         } catch (const std::runtime_error& e) {
             CHECK(std::string(e.what()) ==
@@ -312,13 +313,13 @@ TEST_CASE("a plan the device refuses stops the simulation with the core's status
     SECTION("invalid span") {
         Plan plan = make_plan({line({0, 0}, {100, 0}, 4, true), line({100, 0}, {200, 0}, 4, true)});
         plan.spans[1].ticks = 0;  // hand-broken after validation
-        CHECK_THROWS_WITH(sim::simulate(plan, profile, SimOptions{}),
+        CHECK_THROWS_WITH(sim::simulate(plan.spans, profile, SimOptions{}),
                           "span 1 (tag 2): the device refused it: tick count out of range");
     }
     SECTION("axis counts") {
         const Plan plan = make_plan({line({0, 0}, {100, 0}, 4, true)});
-        CHECK_THROWS_AS(sim::simulate(plan, profile_for(3), SimOptions{}), std::invalid_argument);
-        CHECK_THROWS_AS(sim::simulate(Plan{}, profile, SimOptions{}), std::invalid_argument);
+        CHECK_THROWS_AS(sim::simulate(plan.spans, profile_for(3), SimOptions{}), std::invalid_argument);
+        CHECK_THROWS_AS(sim::simulate({}, profile, SimOptions{}), std::invalid_argument);
     }
 }
 
@@ -329,7 +330,7 @@ TEST_CASE("a producer that cannot keep up starves the queue: underruns are count
     SimOptions options;
     options.producer_interval_ticks = 10;  // one span every 10 ticks, each lasting 4
     options.max_pushes_per_run = 1;
-    const SimulationResult r = sim::simulate(plan, profile_for(1), options);
+    const SimulationResult r = sim::simulate(plan.spans, profile_for(1), options);
     CHECK(r.underruns == 19 * 6);  // after the first span, 6 idle ticks per 10
     CHECK(r.stream.spans_completed == 20);
     CHECK(r.stream.ticks_executed == 80);
@@ -340,24 +341,24 @@ TEST_CASE("a producer that cannot keep up starves the queue: underruns are count
         const auto d = r.setpoint(k, 0) - r.setpoint(k - 1, 0);
         REQUIRE((d == 0 || d == 25));
     }
-    CHECK(sim::simulate(plan, profile_for(1), SimOptions{}).underruns == 0);
+    CHECK(sim::simulate(plan.spans, profile_for(1), SimOptions{}).underruns == 0);
 }
 
 TEST_CASE("pacing waits for every tick on the clock, in order, and counts late ticks", "[sim]") {
     const Plan plan = drawing_plan();
     SECTION("on time") {
         ScriptedClock clock(0);
-        const SimulationResult r = sim::simulate_paced(plan, profile_for(2), SimOptions{}, clock);
+        const SimulationResult r = sim::simulate_paced(plan.spans, profile_for(2), SimOptions{}, clock);
         REQUIRE(clock.waits.size() == r.ticks);
         for (std::uint64_t k = 0; k < r.ticks; ++k) REQUIRE(clock.waits[k] == k);
         CHECK(r.paced);
         CHECK(r.late_ticks == 0);
         CHECK(r.pen_switch_ticks == std::vector<std::uint64_t>{10, 43});  // device ticks
-        CHECK(sim::run_summary(r).realtime);
+        CHECK(host::run_summary(r).realtime);
     }
     SECTION("behind") {
         ScriptedClock clock(2);
-        const SimulationResult r = sim::simulate_paced(plan, profile_for(2), SimOptions{}, clock);
+        const SimulationResult r = sim::simulate_paced(plan.spans, profile_for(2), SimOptions{}, clock);
         CHECK(r.late_ticks == r.ticks);
         CHECK(r.pen_switch_ticks ==
               std::vector<std::uint64_t>{10, 43});  // lateness does not move them
@@ -365,7 +366,7 @@ TEST_CASE("pacing waits for every tick on the clock, in order, and counts late t
     SECTION("the real-time option uses the Linux clock") {
         SimOptions options;
         options.realtime = true;
-        const SimulationResult r = sim::simulate(plan, profile_for(2), options);
+        const SimulationResult r = sim::simulate(plan.spans, profile_for(2), options);
         CHECK(r.paced);
         CHECK(r.ticks == 49);
     }

@@ -12,7 +12,7 @@
 #include "pathstream/hal/modbus_server.hpp"
 #include "pathstream/host/modbus_stream.hpp"
 #include "pathstream/host/planning_thread.hpp"
-#include "pathstream/sim/modbus_device.hpp"
+#include "pathstream/linux_device/modbus_motion_device.hpp"
 #include "pen_plotter_profile.hpp"
 #include "random_walk_source.hpp"
 #include "stream_support.hpp"
@@ -25,18 +25,18 @@ namespace {
 
 // The simulated device serving Modbus TCP on a free port, ticking on its own thread.
 struct TcpDevice {
-    std::unique_ptr<sim::SimulatedModbusDevice> device;
+    std::unique_ptr<linux_device::ModbusMotionDevice> device;
     std::optional<hal::ModbusServer> server;
     std::atomic<bool> stop{false};
     std::thread thread;
 
-    TcpDevice(const std::vector<Lsb>& rest, double time_scale) : device(sim::SimulatedModbusDevice::create(rest)) {
+    TcpDevice(const std::vector<Lsb>& rest, double time_scale) : device(linux_device::ModbusMotionDevice::create(rest)) {
         device->record(true);
         server.emplace(hal::ModbusServer::tcp(device->handler(), {"127.0.0.1", 0, 4}));
         thread = std::thread([this, time_scale] {
-            sim::DeviceLoopOptions o;
+            linux_device::DeviceLoopOptions o;
             o.time_scale = time_scale;
-            sim::run_device_loop(*device, [&](std::chrono::microseconds w) { server->poll_once(w); }, o, stop);
+            linux_device::run_device_loop(*device, [&](std::chrono::microseconds w) { server->poll_once(w); }, o, stop);
         });
     }
     std::string target() const { return "modbus-tcp://127.0.0.1:" + std::to_string(server->port()) + "?unit=1"; }

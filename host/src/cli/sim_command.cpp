@@ -5,7 +5,7 @@
 #include <iostream>
 #include <nlohmann/json.hpp>
 
-#include "exit_codes.hpp"
+#include "pathstream/machine/exit_codes.hpp"
 #include "pathstream/host/events.hpp"
 #include "pathstream/host/layers.hpp"
 #include "pathstream/host/planner.hpp"
@@ -13,6 +13,7 @@
 #include "pathstream/host/progress.hpp"
 #include "pathstream/sim/device.hpp"
 #include "plan_command.hpp"
+#include "sim_plots.hpp"
 
 namespace pathstream::host {
 
@@ -230,7 +231,7 @@ sim::SimulationResult simulate_job(const SimCommandOptions& o, const PlannedJob&
     ProgressBar bar(o.realtime ? "running (real time)" : "simulating");
     events.start(std::nullopt);
     try {
-        return sim::simulate(job.plan, job.machine, options, [&](double f) { bar.update(f); });
+        return sim::simulate(job.plan.spans, job.machine, options, [&](double f) { bar.update(f); });
     } catch (const std::exception& e) {
         events.end("failed", e.what());
         throw;
@@ -262,9 +263,9 @@ int run_sim(const SimCommandOptions& o) {
     JobEvents events(channel, job.plan, job.machine,
                      {"sim", path_display_name(o.path.file), "sim", count_subpaths(job.plan)});
     const sim::SimulationResult result = simulate_job(o, job, events);
-    const plot::TickSeries executed = sim::setpoint_series(result);
-    const plot::TickSeries plant = sim::plant_series(result);
-    const plot::RunSummary run = sim::run_summary(result);
+    const plot::TickSeries executed = setpoint_series(result);
+    const plot::TickSeries plant = plant_series(result);
+    const plot::RunSummary run = run_summary(result);
     const bool servo = result.plant == sim::PlantModel::kServo;
     const bool failed =
         result.underruns != 0 || !job.check.within_limits || job.check.drawing_while_pen_moves;

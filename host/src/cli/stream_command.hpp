@@ -4,7 +4,7 @@
 #include <CLI/CLI.hpp>
 #include <string>
 
-#include "exit_codes.hpp"
+#include "pathstream/machine/exit_codes.hpp"
 #include "path_options.hpp"
 #include "pathstream/host/modbus_stream.hpp"
 

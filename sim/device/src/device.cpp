@@ -47,11 +47,11 @@ void start_point(const CoreSpan& first, Lsb (&start)[Axes]) {
 }
 
 template <unsigned Axes>
-SimulationResult run(const host::Plan& plan, const host::MachineProfile& profile,
+SimulationResult run(const std::vector<CoreSpan>& spans, const host::MachineProfile& profile,
                      const SimOptions& options, hal::Clock* pacing, const Progress& progress) {
     using Stream = SetpointStream<Axes, kQueueCapacity>;
     const auto wall_start = std::chrono::steady_clock::now();
-    const std::size_t span_count = plan.spans.size();
+    const std::size_t span_count = spans.size();
 
     SimulationResult r;
     r.axes = Axes;
@@ -60,10 +60,10 @@ SimulationResult run(const host::Plan& plan, const host::MachineProfile& profile
     r.plant = options.plant;
     r.servo = options.servo;
     r.paced = pacing != nullptr;
-    for (const CoreSpan& s : plan.spans) r.plan_ticks += s.ticks;
+    for (const CoreSpan& s : spans) r.plan_ticks += s.ticks;
 
     Lsb start[Axes];
-    start_point<Axes>(plan.spans.front(), start);
+    start_point<Axes>(spans.front(), start);
     auto stream = std::make_unique<Stream>(start);  // ~13 KB at 8 axes: heap on the host
 
     VirtualClock device_time;          // the device's tick counter
@@ -89,7 +89,7 @@ SimulationResult run(const host::Plan& plan, const host::MachineProfile& profile
         std::uint32_t pushed = 0;
         while (next < span_count &&
                (options.max_pushes_per_run == 0 || pushed < options.max_pushes_per_run)) {
-            const Status s = stream->push(host::to_core_span<Axes>(plan.spans[next], static_cast<std::uint32_t>(next + 1)));
+            const Status s = stream->push(host::to_core_span<Axes>(spans[next], static_cast<std::uint32_t>(next + 1)));
             if (s == Status::kQueueFull) {
                 ++r.stream.queue_full;
                 break;
@@ -167,19 +167,19 @@ SimulationResult run(const host::Plan& plan, const host::MachineProfile& profile
     return r;
 }
 
-SimulationResult dispatch(const host::Plan& plan, const host::MachineProfile& profile,
+SimulationResult dispatch(const std::vector<CoreSpan>& spans, const host::MachineProfile& profile,
                           const SimOptions& options, hal::Clock* pacing, const Progress& progress) {
-    if (plan.spans.empty())
-        throw std::invalid_argument("the plan has no spans: nothing to simulate");
-    const std::size_t axes = plan.spans.front().control.size();
+    if (spans.empty())
+        throw std::invalid_argument("no spans: nothing to simulate");
+    const std::size_t axes = spans.front().control.size();
     if (axes < 1 || axes > kMaxAxes) {
         throw std::invalid_argument("the plan has " + std::to_string(axes) +
                                     " axes; the device supports 1 to 8");
     }
-    for (std::size_t i = 0; i < plan.spans.size(); ++i) {
-        if (plan.spans[i].control.size() != axes) {
+    for (std::size_t i = 0; i < spans.size(); ++i) {
+        if (spans[i].control.size() != axes) {
             throw std::invalid_argument("span " + std::to_string(i) + " has " +
-                                        std::to_string(plan.spans[i].control.size()) +
+                                        std::to_string(spans[i].control.size()) +
                                         " axes, the first span " + std::to_string(axes));
         }
     }
@@ -193,77 +193,23 @@ SimulationResult dispatch(const host::Plan& plan, const host::MachineProfile& pr
             "the machine profile needs a positive tick rate and mm per LSB");
     }
     return host::with_axes(axes, [&](auto n) {
-        return run<decltype(n)::value>(plan, profile, options, pacing, progress);
+        return run<decltype(n)::value>(spans, profile, options, pacing, progress);
     });
-}
-
-host::plot::TickSeries series_base(const SimulationResult& r, std::string name) {
-    host::plot::TickSeries s;
-    s.name = std::move(name);
-    s.tick_hz = r.tick_hz;
-    s.axes = r.axes;
-    s.pen_down = r.pen;
-    return s;
-}
-
-std::string plant_description(const SimulationResult& r) {
-    if (r.plant == PlantModel::kIdeal) return "ideal (position = setpoint)";
-    char text[96];
-    std::snprintf(text, sizeof text, "servo, 2nd order, f_n %.4g Hz, zeta %.3g",
-                  r.servo.bandwidth_hz, r.servo.damping);
-    return text;
 }
 
 }  // namespace
 
-SimulationResult simulate(const host::Plan& plan, const host::MachineProfile& profile,
+SimulationResult simulate(const std::vector<CoreSpan>& spans, const host::MachineProfile& profile,
                           const SimOptions& options, const Progress& progress) {
-    if (!options.realtime) return dispatch(plan, profile, options, nullptr, progress);
+    if (!options.realtime) return dispatch(spans, profile, options, nullptr, progress);
     hal::LinuxClock clock(profile.tick_hz);
-    return dispatch(plan, profile, options, &clock, progress);
+    return dispatch(spans, profile, options, &clock, progress);
 }
 
-SimulationResult simulate_paced(const host::Plan& plan, const host::MachineProfile& profile,
+SimulationResult simulate_paced(const std::vector<CoreSpan>& spans, const host::MachineProfile& profile,
                                 const SimOptions& options, hal::Clock& pacing,
                                 const Progress& progress) {
-    return dispatch(plan, profile, options, &pacing, progress);
-}
-
-host::plot::TickSeries setpoint_series(const SimulationResult& r) {
-    host::plot::TickSeries s = series_base(r, "setpoints");
-    s.quantum_mm = r.mm_per_lsb;
-    s.position.reserve(r.setpoints.size());
-    for (Lsb v : r.setpoints) s.position.push_back(v * r.mm_per_lsb);
-    return s;
-}
-
-host::plot::TickSeries plant_series(const SimulationResult& r) {
-    host::plot::TickSeries s =
-        series_base(r, r.plant == PlantModel::kServo ? "servo plant" : "ideal plant");
-    s.quantum_mm = r.plant == PlantModel::kServo ? 0 : r.mm_per_lsb;
-    s.position = r.positions;
-    return s;
-}
-
-host::plot::RunSummary run_summary(const SimulationResult& r) {
-    host::plot::RunSummary s;
-    s.target = "simulated device";
-    s.plant = plant_description(r);
-    s.ticks = r.ticks;
-    s.spans = r.spans_pushed;
-    s.pen_switches = r.pen_switch_ticks.size();
-    s.underruns = r.underruns;
-    s.late_ticks = r.late_ticks;
-    s.realtime = r.paced;
-    s.simulated_seconds = r.simulated_seconds;
-    s.wall_seconds = r.wall_seconds;
-    if (r.plant == PlantModel::kServo) {
-        for (const FollowingError& f : r.following) {
-            s.max_following_error_mm.push_back(f.max_mm);
-            s.rms_following_error_mm.push_back(f.rms_mm);
-        }
-    }
-    return s;
+    return dispatch(spans, profile, options, &pacing, progress);
 }
 
 }  // namespace pathstream::sim

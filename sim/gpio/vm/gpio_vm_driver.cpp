@@ -34,7 +34,7 @@
 #include "pathstream/machine/input_error.hpp"
 #include "pathstream/machine/machine.hpp"
 #include "pathstream/linux_device/machine_lines.hpp"
-#include "pathstream/sim/device_gpio.hpp"
+#include "pathstream/linux_device/device_gpio.hpp"
 #include "pathstream/sim/gpio_sim_pull.hpp"
 #include "pathstream/sim/machine_switches.hpp"
 
@@ -42,7 +42,7 @@ namespace {
 
 using namespace pathstream;
 using Device = device::MotionDevice<2, 64>;
-using Glue = sim::DeviceGpio<2, 64>;
+using Glue = linux_device::DeviceGpio<2, 64>;
 
 std::uint64_t now_ns() {
     timespec ts{};
@@ -65,7 +65,7 @@ struct Plotter {
         if (g.has_estop) estop = hal::open_gpiod_input(spec(g.chip, g.estop), "pathstream-estop");
         if (g.has_enable) enable = hal::open_gpiod_output(spec(g.chip, g.enable), "pathstream-enable");
         if (g.has_pen) pen = hal::open_gpiod_output(spec(g.chip, g.pen), "pathstream-pen");
-        sim::DeviceWiring<2> w;
+        linux_device::DeviceWiring<2> w;
         w.estop = estop.get();
         w.enable = enable.get();
         w.pen = pen.get();

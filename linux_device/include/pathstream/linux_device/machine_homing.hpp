@@ -9,8 +9,8 @@
 #include <vector>
 
 #include "pathstream/machine/device_setup.hpp"
-#include "pathstream/sim/device_io.hpp"
-#include "pathstream/sim/simulated_motion_device.hpp"
+#include "pathstream/linux_device/device_io.hpp"
+#include "pathstream/linux_device/any_motion_device.hpp"
 
 namespace pathstream::linux_device {
 
@@ -41,13 +41,13 @@ using HomingLog = std::function<void(const std::string& line)>;
 class HomingRunLog {
 public:
     /// `setups` are the plan's axes (set_homing_plan). `device` and `io` must outlive it.
-    HomingRunLog(const sim::SimulatedMotionDevice& device, const sim::DeviceIo& io,
+    HomingRunLog(const linux_device::AnyMotionDevice& device, const linux_device::DeviceIo& io,
                  std::vector<host::HomingSetup> setups, double mm_per_lsb);
     void after_tick(const HomingLog& log);
 
 private:
-    const sim::SimulatedMotionDevice& device_;
-    const sim::DeviceIo& io_;
+    const linux_device::AnyMotionDevice& device_;
+    const linux_device::DeviceIo& io_;
     std::vector<host::HomingSetup> setups_;
     double mm_per_lsb_;
     bool busy_ = false;
@@ -58,12 +58,12 @@ private:
 
 /// Gives `io` the axes a bus's home command may home (`setups`, in order). Throws
 /// HomingFailed naming the switch when one is not wired.
-void set_homing_plan(sim::DeviceIo& io, const std::vector<host::HomingSetup>& setups);
+void set_homing_plan(linux_device::DeviceIo& io, const std::vector<host::HomingSetup>& setups);
 
 /// Homes `setups` in order, each as a homing run of one axis (so the bus status reports it).
 /// Sets the plan (set_homing_plan) first. `device` must be configured and idle, `io` attached to it.
 /// Throws HomingFailed (with the device stopped: idle, or in fault/e-stop if that ended it).
-std::vector<HomedAxis> home_axes(sim::SimulatedMotionDevice& device, sim::DeviceIo& io, const std::vector<host::HomingSetup>& setups,
+std::vector<HomedAxis> home_axes(linux_device::AnyMotionDevice& device, linux_device::DeviceIo& io, const std::vector<host::HomingSetup>& setups,
                                  double mm_per_lsb, const RunTicksUntil& run_until, const HomingLog& log);
 
 }  // namespace pathstream::linux_device

@@ -10,7 +10,7 @@
 #include "pathstream/hal/gpio.hpp"
 #include "pathstream/hal/gpio_gpiod.hpp"
 #include "pathstream/machine/machine.hpp"
-#include "pathstream/sim/device_io.hpp"
+#include "pathstream/linux_device/device_io.hpp"
 
 namespace pathstream::linux_device {
 
@@ -34,7 +34,7 @@ public:
     ~MachineLines();
 
     /// Pointers into the owned lines; valid while this object lives.
-    const sim::MachineWiring& wiring() const { return wiring_; }
+    const linux_device::MachineWiring& wiring() const { return wiring_; }
     /// "enable=enable estop=estop pen=0 x-=limit-x ..." on chip: what was opened, for the log.
     const std::string& summary() const { return summary_; }
 
@@ -42,7 +42,7 @@ private:
     MachineLines() = default;
     std::vector<std::unique_ptr<hal::DigitalInput>> inputs_;
     std::vector<std::unique_ptr<hal::DigitalOutput>> outputs_;
-    sim::MachineWiring wiring_;
+    linux_device::MachineWiring wiring_;
     std::string summary_;
 };
 

@@ -10,8 +10,7 @@
 
 #include "pathstream/hal/clock.hpp"
 #include "pathstream/machine/machine.hpp"
-#include "pathstream/host/plan.hpp"
-#include "pathstream/host/plot.hpp"
+#include "pathstream/machine/core_span.hpp"
 #include "pathstream/sim/plant.hpp"
 #include "pathstream/units.hpp"
 
@@ -99,30 +98,23 @@ struct SimulationResult {
 /// fraction done.
 using Progress = std::function<void(double fraction)>;
 
-/// Runs `plan` on the simulated device: a SetpointStream<axes, kQueueCapacity> (axes = the
+/// Runs `spans` (a plan's) on the simulated device: a SetpointStream<axes, kQueueCapacity> (axes = the
 /// spans' axis count, 1..8) starting at the first span's start point, a producer pushing the
-/// plan's spans (Span::tag = index + 1, outputs = kOutputPenDown on pen-down spans) whenever
+/// spans (Span::tag = index + 1, outputs = kOutputPenDown on pen-down spans) whenever
 /// there is room, one tick() per clock tick, the pen output set from outputs() after each
 /// tick, and the plant stepped with the tick's setpoint. Virtual time (as fast as possible)
 /// unless options.realtime (hal::LinuxClock at profile.tick_hz).
 /// Throws std::invalid_argument for an empty plan, spans whose axis count differs from the
 /// profile's, or bad servo parameters; std::runtime_error ("span I (tag T): the device
 /// refused it: <status name>") when push() answers anything but kOk or kQueueFull.
-SimulationResult simulate(const host::Plan& plan, const host::MachineProfile& profile,
+SimulationResult simulate(const std::vector<host::CoreSpan>& spans, const host::MachineProfile& profile,
                           const SimOptions& options, const Progress& progress = {});
 
 /// The same run paced by `pacing` (options.realtime is ignored): before tick k the device
 /// calls pacing.wait_until(k), and counts the tick late when pacing.now() > k afterwards.
 /// Tests inject a clock here to check the pacing without measuring wall time.
-SimulationResult simulate_paced(const host::Plan& plan, const host::MachineProfile& profile,
+SimulationResult simulate_paced(const std::vector<host::CoreSpan>& spans, const host::MachineProfile& profile,
                                 const SimOptions& options, hal::Clock& pacing,
                                 const Progress& progress = {});
-
-/// The setpoints in mm as a plot series ("setpoints", quantum = mm_per_lsb).
-host::plot::TickSeries setpoint_series(const SimulationResult& result);
-/// The plant positions as a plot series ("ideal plant" or "servo plant", continuous).
-host::plot::TickSeries plant_series(const SimulationResult& result);
-/// The run's figures for host::plot::text_report.
-host::plot::RunSummary run_summary(const SimulationResult& result);
 
 }  // namespace pathstream::sim

@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "pathstream/device/motion_device.hpp"
-#include "pathstream/sim/device_gpio.hpp"
+#include "pathstream/linux_device/device_gpio.hpp"
 #include "pathstream/sim/machine_switches.hpp"
 #include "pathstream/sim/simulated_input.hpp"
 #include "pathstream/sim/simulated_output.hpp"
@@ -82,14 +82,14 @@ public:
     SimulatedInput limit[Axes][2];
     SimulatedOutput enable{clock};
     SimulatedOutput pen{clock};
-    DeviceGpio<Axes, Capacity> glue;
+    linux_device::DeviceGpio<Axes, Capacity> glue;
     MachineSwitches switches;  ///< the switches placed, on the machine's coordinates
     std::vector<std::array<Lsb, Axes>> ticks;      ///< every tick's setpoints
     std::vector<device::DeviceState> states;       ///< the state after every tick
 
 private:
-    DeviceWiring<Axes> wiring() {
-        DeviceWiring<Axes> w;
+    linux_device::DeviceWiring<Axes> wiring() {
+        linux_device::DeviceWiring<Axes> w;
         w.estop = &estop;
         for (unsigned a = 0; a < Axes; ++a) {
             w.limit[a][0] = &limit[a][0];

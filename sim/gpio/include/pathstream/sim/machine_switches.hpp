@@ -9,13 +9,15 @@
 #include <utility>
 #include <vector>
 
+#include "pathstream/linux_device/any_motion_device.hpp"
 #include "pathstream/sim/axis_switch.hpp"
 #include "pathstream/units.hpp"
 
 namespace pathstream::sim {
 
 /// Task context, the thread that ticks the device; host simulation only (allocates at place()).
-class MachineSwitches {
+/// A device plays them once given to AnyMotionDevice::observe_ticks.
+class MachineSwitches final : public linux_device::TickObserver {
 public:
     /// Called with the contact's level (true: closed, the input active) whenever it changes.
     using Line = std::function<void(bool closed)>;
@@ -31,7 +33,7 @@ public:
     /// After every tick: `position` holds the setpoints it output (device coordinates, one per
     /// axis), `positions_set` the device's count of applied position settings. A change of that
     /// count means the coordinates jumped while the axes stood still: the machine did not move.
-    void after_tick(const Lsb* position, unsigned axes, std::uint32_t positions_set) {
+    void after_tick(const Lsb* position, unsigned axes, std::uint32_t positions_set) override {
         if (offset_.size() != axes) {
             offset_.assign(axes, 0);
             last_.assign(position, position + axes);

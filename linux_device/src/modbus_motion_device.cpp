@@ -1,14 +1,12 @@
-#include <algorithm>
-#include "pathstream/sim/modbus_device.hpp"
+#include "pathstream/linux_device/modbus_motion_device.hpp"
 
 #include <stdexcept>
 #include <string>
-#include <thread>
 
 #include "pathstream/device/modbus_register_map.hpp"
 #include "pathstream/machine/core_span_conversion.hpp"
 
-namespace pathstream::sim {
+namespace pathstream::linux_device {
 namespace {
 
 // Adapts the core's register map (no virtual functions, its own exception enum) to the
@@ -45,10 +43,10 @@ private:
 };
 
 template <unsigned Axes>
-class Device final : public MotionDeviceBase<Axes, kModbusDeviceCapacity, SimulatedModbusDevice> {
+class Device final : public MotionDeviceBase<Axes, kModbusDeviceCapacity, ModbusMotionDevice> {
 public:
     explicit Device(const Lsb (&start)[Axes])
-        : MotionDeviceBase<Axes, kModbusDeviceCapacity, SimulatedModbusDevice>(start), map_(this->device_), handler_(map_) {}
+        : MotionDeviceBase<Axes, kModbusDeviceCapacity, ModbusMotionDevice>(start), map_(this->device_), handler_(map_) {}
 
     hal::ModbusRegisterHandler& handler() override { return handler_; }
 
@@ -57,7 +55,7 @@ public:
 
     void tick() override {
         map_.service();
-        MotionDeviceBase<Axes, kModbusDeviceCapacity, SimulatedModbusDevice>::tick();
+        MotionDeviceBase<Axes, kModbusDeviceCapacity, ModbusMotionDevice>::tick();
     }
 
 private:
@@ -67,8 +65,8 @@ private:
 
 }  // namespace
 
-std::unique_ptr<SimulatedModbusDevice> SimulatedModbusDevice::create(const std::vector<Lsb>& start) {
-    return host::with_axes(start.size(), [&](auto axes) -> std::unique_ptr<SimulatedModbusDevice> {
+std::unique_ptr<ModbusMotionDevice> ModbusMotionDevice::create(const std::vector<Lsb>& start) {
+    return host::with_axes(start.size(), [&](auto axes) -> std::unique_ptr<ModbusMotionDevice> {
         constexpr unsigned A = decltype(axes)::value;
         Lsb s[A];
         for (unsigned a = 0; a < A; ++a) s[a] = start[a];
@@ -76,38 +74,7 @@ std::unique_ptr<SimulatedModbusDevice> SimulatedModbusDevice::create(const std::
     });
 }
 
-std::uint64_t run_paced_loop(const std::function<void()>& tick, const std::function<std::uint32_t()>& tick_hz,
-                             const std::function<void(std::chrono::microseconds)>& serve,
-                             const DeviceLoopOptions& options, const std::atomic<bool>& stop) {
-    using clock = std::chrono::steady_clock;
-    if (!(options.time_scale > 0)) throw std::invalid_argument("time scale must be positive");
-    const auto begin = clock::now();
-    std::uint64_t ticks = 0;
-    double due_seconds = 0;  // tick k is due at begin + the sum of the tick periods before it
-    while (!stop.load(std::memory_order_relaxed)) {
-        const auto now = clock::now();
-        if (options.run_for.count() > 0 && now - begin >= options.run_for) break;
-        const double elapsed = std::chrono::duration<double>(now - begin).count();
-        while (due_seconds <= elapsed) {
-            tick();
-            ++ticks;
-            const std::uint32_t hz = tick_hz() != 0 ? tick_hz() : 1000;
-            const double period = 1.0 / (hz * options.time_scale);
-            due_seconds += period;
-            // At rest, faster than rest_tick_hz: the next tick a rest period of wall time from
-            // now, the idle ticks in between dropped (nothing happens in them to make up).
-            if (options.at_rest && 1.0 / period > options.rest_tick_hz && options.at_rest()) {
-                due_seconds = std::max(due_seconds, elapsed + 1.0 / options.rest_tick_hz);
-                break;
-            }
-        }
-        const double wait = due_seconds - elapsed;
-        serve(std::chrono::microseconds(wait > 0 ? static_cast<long>(wait * 1e6) : 0));
-    }
-    return ticks;
-}
-
-std::uint64_t run_device_loop(SimulatedModbusDevice& device,
+std::uint64_t run_device_loop(ModbusMotionDevice& device,
                               const std::function<void(std::chrono::microseconds)>& server_poll,
                               const DeviceLoopOptions& options, const std::atomic<bool>& stop) {
     return run_paced_loop([&] { device.tick(); }, [&] { return device.tick_hz(); },
@@ -115,4 +82,4 @@ std::uint64_t run_device_loop(SimulatedModbusDevice& device,
                           options, stop);
 }
 
-}  // namespace pathstream::sim
+}  // namespace pathstream::linux_device

@@ -1,6 +1,7 @@
-// `pathstream device`: the simulated device (the firmware core) serving Modbus TCP or RTU or
-// the native CAN protocol; with --machine configured from a profile and wired to its GPIO
-// lines (e-stop, limit switches, enable, pen), with --home homed before it serves.
+// `pathstream device` (and `pathstream-device`): the device runtime (the firmware core) serving
+// Modbus TCP or RTU or the native CAN protocol; with --machine configured from a profile and
+// wired to its GPIO lines (e-stop, limit switches, enable, pen), with --home homed before it
+// serves; with --sim-switch the profile's limit switches played by a simulated machine.
 #pragma once
 
 #include <CLI/CLI.hpp>
@@ -8,26 +9,15 @@
 #include <string>
 #include <vector>
 
-namespace pathstream::host {
+#include "pathstream/linux_device/device_runtime.hpp"
+
+namespace pathstream::device_cli {
 
 struct DeviceCommandOptions {
     unsigned axes = 2;
     std::vector<std::string> position;  ///< per axis: mm, or LSB with the suffix "lsb"; default all zero
-    std::string tcp = "127.0.0.1:1502";
-    bool rtu_pty = false;
-    std::string rtu_device;
-    int baud = 115200;
-    std::string parity = "N";
-    int unit = 1;
-    std::string can_interface;  ///< native CAN on this SocketCAN interface instead of Modbus
-    unsigned node = 1;          ///< CAN node id
     std::string machine;        ///< profile: configuration, GPIO lines and homing
-    bool no_gpio = false;       ///< with --machine: do not open the profile's GPIO lines
-    bool home = false;          ///< home the profile's gpio.home axes before serving
-    double time_scale = 1.0;
-    std::string record;
-    double exit_after = 0;  ///< seconds of wall time; 0 = until SIGINT/SIGTERM
-    bool log_json = false;  ///< --log-json: the log as NDJSON instead of text
+    linux_device::DeviceRunOptions run;  ///< what to serve and how
     /// --sim-switch NAME=POSITION: the profile's limit switch NAME played by its axis on a
     /// gpio-sim chip, closed at POSITION (mm, or LSB with the suffix lsb) and beyond.
     std::vector<std::string> sim_switches;
@@ -37,7 +27,12 @@ struct DeviceCommandOptions {
     std::uint64_t switch_seed = 1;    ///< the bounces' ticks are drawn from this seed
 };
 
+/// Adds the `device` subcommand to `app`, its values read into `options` (which must outlive
+/// the parse). Init context.
 void add_device_command(CLI::App& app, DeviceCommandOptions& options);
+/// Runs the device until SIGINT, SIGTERM or --exit-after; returns the exit code (docs/cli.md,
+/// "Exit codes") after printing one line for any failure. Main thread; installs the signal
+/// handlers.
 int run_device(const DeviceCommandOptions& options);
 
-}  // namespace pathstream::host
+}  // namespace pathstream::device_cli

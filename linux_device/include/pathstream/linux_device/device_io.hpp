@@ -11,9 +11,9 @@
 #include "pathstream/device/homing_run.hpp"
 #include "pathstream/device/operator_commands.hpp"
 #include "pathstream/device/motion_device.hpp"
-#include "pathstream/sim/device_gpio.hpp"
+#include "pathstream/linux_device/device_gpio.hpp"
 
-namespace pathstream::sim {
+namespace pathstream::linux_device {
 
 /// Which line does what for up to kMaxAxes axes; null = not fitted. The lines are not owned.
 struct MachineWiring {
@@ -170,4 +170,4 @@ private:
     device::LimitSide homing_side_ = device::LimitSide::kNegative;
 };
 
-}  // namespace pathstream::sim
+}  // namespace pathstream::linux_device

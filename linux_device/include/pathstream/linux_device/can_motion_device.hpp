@@ -1,4 +1,4 @@
-// The simulated native CAN device: the firmware core's MotionDevice behind the native CAN
+// The native CAN device: the firmware core's MotionDevice behind the native CAN
 // protocol (device::can::CanNode) on any hal::CanBus, ticked on the steady clock. What
 // `pathstream device --can IFACE --node N` runs and what the CAN streaming tests talk to.
 #pragma once
@@ -10,21 +10,22 @@
 #include <vector>
 
 #include "pathstream/hal/can_bus.hpp"
-#include "pathstream/sim/modbus_device.hpp"  // DeviceTick, DeviceLoopOptions
+#include "pathstream/linux_device/any_motion_device.hpp"
+#include "pathstream/linux_device/paced_loop.hpp"
 #include "pathstream/units.hpp"
 
-namespace pathstream::sim {
+namespace pathstream::linux_device {
 
-/// Span queue depth of the simulated CAN device.
+/// Span queue depth of the CAN device.
 inline constexpr std::uint32_t kCanDeviceCapacity = 64;
 
 /// A MotionDevice<axes, kCanDeviceCapacity> with its CAN node, type-erased over the axis
 /// count. Not thread-safe: one thread serves and ticks it.
-class SimulatedCanDevice : public SimulatedMotionDevice {
+class CanMotionDevice : public AnyMotionDevice {
 public:
     /// `start`: initial position (LSB), its size is the axis count (1..8); `node` 1..127.
     /// Throws std::invalid_argument otherwise.
-    static std::unique_ptr<SimulatedCanDevice> create(const std::vector<Lsb>& start, std::uint8_t node);
+    static std::unique_ptr<CanMotionDevice> create(const std::vector<Lsb>& start, std::uint8_t node);
 
     /// Handles the frames `bus` delivers within `wait` (at least one wait for the first,
     /// then whatever is already there) and sends the answers; answers the bus refuses
@@ -42,7 +43,7 @@ public:
 
 /// Serves `bus` and ticks `device` on the steady clock (options.time_scale times real time)
 /// until `stop` or options.run_for. Returns the ticks run.
-std::uint64_t run_can_device_loop(SimulatedCanDevice& device, hal::CanBus& bus, const DeviceLoopOptions& options,
+std::uint64_t run_can_device_loop(CanMotionDevice& device, hal::CanBus& bus, const DeviceLoopOptions& options,
                                   const std::atomic<bool>& stop);
 
-}  // namespace pathstream::sim
+}  // namespace pathstream::linux_device

@@ -1,6 +1,6 @@
-// What every simulated bus device (Modbus, native CAN) shares: a MotionDevice ticked by the
-// host, per-tick recording, self-configuration from a machine profile, and optional GPIO and
-// homing (DeviceIo). The bus side differs; this part is written once.
+// What every bus device (Modbus, native CAN) shares: a MotionDevice ticked by a Linux thread,
+// per-tick recording, self-configuration from a machine profile, and optional GPIO and homing
+// (DeviceIo). The bus side differs; this part is written once.
 #pragma once
 
 #include <cstring>
@@ -11,11 +11,10 @@
 
 #include "pathstream/device/motion_device.hpp"
 #include "pathstream/machine/device_setup.hpp"
-#include "pathstream/sim/device_io.hpp"
-#include "pathstream/sim/machine_switches.hpp"
+#include "pathstream/linux_device/device_io.hpp"
 #include "pathstream/units.hpp"
 
-namespace pathstream::sim {
+namespace pathstream::linux_device {
 
 /// One tick the device executed, as recorded.
 struct DeviceTick {
@@ -23,11 +22,22 @@ struct DeviceTick {
     std::uint8_t outputs = 0;  ///< discrete outputs (pen) after the tick
 };
 
+/// Something outside the device that follows its axes after every tick: a simulated machine's
+/// switches (sim/), a recorder. Task context, the thread that ticks the device.
+class TickObserver {
+public:
+    virtual ~TickObserver() = default;
+    /// `position`: the setpoints the tick output (device coordinates, `axes` of them);
+    /// `positions_set`: the device's count of applied position settings (a change means the
+    /// coordinates jumped while the axes stood still).
+    virtual void after_tick(const Lsb* position, unsigned axes, std::uint32_t positions_set) = 0;
+};
+
 /// A MotionDevice type-erased over the axis count. Not thread-safe: one thread serves and
 /// ticks it.
-class SimulatedMotionDevice {
+class AnyMotionDevice {
 public:
-    virtual ~SimulatedMotionDevice() = default;
+    virtual ~AnyMotionDevice() = default;
 
     /// One device tick (with the I/O's inputs before and outputs after it, when attached);
     /// when recording and the tick was a path tick (supplied by an accepted span, not a
@@ -56,9 +66,9 @@ public:
     /// it and drives the outputs after it. The lines must outlive the device. Init context.
     virtual DeviceIo& attach_io(const MachineWiring& wiring) = 0;
 
-    /// The machine's switches, played by the axes after every tick (none until placed; a
-    /// switch's line is whatever its MachineSwitches::Line drives). Place them at init.
-    MachineSwitches& switches() { return switches_; }
+    /// Calls `observer` after every tick from now on (nullptr: none). The observer must outlive
+    /// the device or be removed first. Init context.
+    void observe_ticks(TickObserver* observer) { observer_ = observer; }
 
     /// Records every path tick from now on: setpoints[k * axes + axis] is path tick k's.
     void record(bool on) { recording_ = on; }
@@ -75,7 +85,7 @@ public:
     std::uint64_t unchanged_ticks() const { return unchanged_ticks_; }
 
 protected:
-    MachineSwitches switches_;
+    TickObserver* observer_ = nullptr;
     bool recording_ = false;
     bool recording_every_tick_ = false;
     std::vector<Lsb> setpoints_;
@@ -85,7 +95,7 @@ protected:
     std::uint64_t unchanged_ticks_ = 0;
 };
 
-/// The shared half of a simulated device class: `Interface` (a SimulatedMotionDevice) with
+/// The shared half of a bus device class: `Interface` (a AnyMotionDevice) with
 /// its MotionDevice<Axes, Capacity> and the common functions implemented.
 template <unsigned Axes, std::uint32_t Capacity, typename Interface>
 class MotionDeviceBase : public Interface {
@@ -105,7 +115,7 @@ public:
         now.tick_count = now.tick_check = 0;
         this->unchanged_ticks_ = std::memcmp(&now, &last_status_, sizeof now) == 0 ? this->unchanged_ticks_ + 1 : 0;
         last_status_ = now;
-        if (this->switches_.size() != 0) this->switches_.after_tick(out, Axes, device_.status().position_applied);
+        if (this->observer_ != nullptr) this->observer_->after_tick(out, Axes, device_.status().position_applied);
         ++this->ticks_run_;
         if (this->recording_every_tick_) this->every_tick_.insert(this->every_tick_.end(), out, out + Axes);
         if (this->recording_ && device_.ticks_executed() != before) {  // a path tick
@@ -153,4 +163,4 @@ protected:
     device::DeviceStatus<Axes> last_status_{};
 };
 
-}  // namespace pathstream::sim
+}  // namespace pathstream::linux_device

@@ -1,4 +1,4 @@
-#include "pathstream/sim/can_device.hpp"
+#include "pathstream/linux_device/can_motion_device.hpp"
 
 #include <deque>
 #include <stdexcept>
@@ -7,7 +7,7 @@
 #include "pathstream/device/motion_device.hpp"
 #include "pathstream/machine/core_span_conversion.hpp"
 
-namespace pathstream::sim {
+namespace pathstream::linux_device {
 namespace {
 
 namespace pc = device::can;
@@ -21,17 +21,17 @@ hal::CanFrame to_hal(const pc::Frame& f) {
 }
 
 template <unsigned Axes>
-class Device final : public MotionDeviceBase<Axes, kCanDeviceCapacity, SimulatedCanDevice> {
+class Device final : public MotionDeviceBase<Axes, kCanDeviceCapacity, CanMotionDevice> {
 public:
     Device(const Lsb (&start)[Axes], std::uint8_t node)
-        : MotionDeviceBase<Axes, kCanDeviceCapacity, SimulatedCanDevice>(start), node_(this->device_, node) {}
+        : MotionDeviceBase<Axes, kCanDeviceCapacity, CanMotionDevice>(start), node_(this->device_, node) {}
 
     // The task's share of every loop turn comes first: a jog in progress is fed.
     void connect_homing(const device::HomingPort& port) override { node_.operator_commands().set_homing(port); }
 
     void tick() override {
         node_.service();
-        MotionDeviceBase<Axes, kCanDeviceCapacity, SimulatedCanDevice>::tick();
+        MotionDeviceBase<Axes, kCanDeviceCapacity, CanMotionDevice>::tick();
     }
 
     void serve(hal::CanBus& bus, std::chrono::microseconds wait) override {
@@ -79,11 +79,11 @@ private:
 
 }  // namespace
 
-std::unique_ptr<SimulatedCanDevice> SimulatedCanDevice::create(const std::vector<Lsb>& start, std::uint8_t node) {
+std::unique_ptr<CanMotionDevice> CanMotionDevice::create(const std::vector<Lsb>& start, std::uint8_t node) {
     if (node < pc::kMinNode || node > pc::kMaxNode) {
         throw std::invalid_argument("CAN node id " + std::to_string(node) + " is outside 1..127");
     }
-    return host::with_axes(start.size(), [&](auto axes) -> std::unique_ptr<SimulatedCanDevice> {
+    return host::with_axes(start.size(), [&](auto axes) -> std::unique_ptr<CanMotionDevice> {
         constexpr unsigned A = decltype(axes)::value;
         Lsb s[A];
         for (unsigned a = 0; a < A; ++a) s[a] = start[a];
@@ -91,10 +91,10 @@ std::unique_ptr<SimulatedCanDevice> SimulatedCanDevice::create(const std::vector
     });
 }
 
-std::uint64_t run_can_device_loop(SimulatedCanDevice& device, hal::CanBus& bus, const DeviceLoopOptions& options,
+std::uint64_t run_can_device_loop(CanMotionDevice& device, hal::CanBus& bus, const DeviceLoopOptions& options,
                                   const std::atomic<bool>& stop) {
     return run_paced_loop([&] { device.tick(); }, [&] { return device.tick_hz(); },
                           [&](std::chrono::microseconds wait) { device.serve(bus, wait); }, options, stop);
 }
 
-}  // namespace pathstream::sim
+}  // namespace pathstream::linux_device

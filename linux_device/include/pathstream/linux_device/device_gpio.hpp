@@ -10,7 +10,7 @@
 #include "pathstream/device/motion_device.hpp"
 #include "pathstream/hal/gpio.hpp"
 
-namespace pathstream::sim {
+namespace pathstream::linux_device {
 
 /// Which line does what; a null pointer means "not fitted".
 template <unsigned Axes>
@@ -111,4 +111,4 @@ private:
     std::uint64_t last_estop_edge_ns_ = 0;
 };
 
-}  // namespace pathstream::sim
+}  // namespace pathstream::linux_device

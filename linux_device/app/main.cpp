@@ -1,0 +1,32 @@
+// pathstream-device: the device runtime alone, as a machine's controller runs it. The same
+// command as `pathstream device`, built without the host's planner, readers and plots.
+#include <CLI/CLI.hpp>
+#include <exception>
+#include <iostream>
+
+#include "device_command.hpp"
+#include "pathstream/machine/exit_codes.hpp"
+
+int main(int argc, char** argv) {
+    CLI::App app{"pathstream-device: the device runtime (docs/cli.md, \"device\")"};
+    app.set_version_flag("--version", "pathstream-device 0.1.0");
+    pathstream::device_cli::DeviceCommandOptions options;
+    pathstream::device_cli::add_device_command(app, options);
+    app.require_subcommand(1);
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::CallForHelp& e) {
+        return app.exit(e);
+    } catch (const CLI::CallForVersion& e) {
+        return app.exit(e);
+    } catch (const CLI::ParseError& e) {
+        app.exit(e);
+        return pathstream::host::kExitUsage;
+    }
+    try {
+        return pathstream::device_cli::run_device(options);
+    } catch (const std::exception& e) {
+        std::cerr << "pathstream-device: internal error: " << e.what() << '\n';
+        return pathstream::host::kExitInternal;
+    }
+}
