@@ -23,6 +23,14 @@ const char* command_verb(device::Command c) {
             return "stop";
         case device::Command::kReset:
             return "reset";
+        case device::Command::kJog:
+            return "jog";
+        case device::Command::kSetPosition:
+            return "position";
+        case device::Command::kHome:
+            return "home";
+        case device::Command::kPen:
+            return "pen";
     }
     return "unknown";
 }

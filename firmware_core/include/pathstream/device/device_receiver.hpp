@@ -209,6 +209,11 @@ private:
                     return Status::kWrongState;
                 }
                 break;
+            case Command::kJog:
+            case Command::kSetPosition:
+            case Command::kHome:
+            case Command::kPen:
+                return Status::kUnknownCommand;  // operator commands carry arguments
         }
         post(value | modifier);
         return Status::kOk;

@@ -5,6 +5,7 @@
 
 #include <cstdint>
 
+#include "pathstream/device/command.hpp"
 #include "pathstream/units.hpp"
 
 namespace pathstream::device {
@@ -18,22 +19,6 @@ enum class DeviceState : std::uint8_t {
     kFault = 4,     ///< stopped at once by a fault; reset leaves it
     kEstop = 5,     ///< stopped at once by the e-stop; reset (input released) leaves it
 };
-
-/// Commands, as written to the command register. Any other value is refused
-/// (Status::kUnknownCommand) before it reaches the tick.
-enum class Command : std::uint16_t {
-    kStart = 1,   ///< idle with spans queued: run them
-    kHold = 2,    ///< running: controlled stop at the next span boundary, keep the queue
-    kResume = 3,  ///< holding: move back onto the path and continue
-    kStop = 4,    ///< controlled stop, then drop the queue (idle: drop the queue at once)
-    kReset = 5,   ///< leaves fault or e-stop for idle
-};
-
-/// True for the five Command values. Constant, any context.
-constexpr bool is_command(std::uint32_t value) {
-    return value >= static_cast<std::uint32_t>(Command::kStart) &&
-           value <= static_cast<std::uint32_t>(Command::kReset);
-}
 
 /// Fault codes (the status block's fault register). 0x01xx: axis limit switch, low byte =
 /// axis * 2 + side (0 negative, 1 positive); reported by the GPIO layer.

@@ -7,15 +7,11 @@
 
 #include <cstdint>
 
-#include "pathstream/device/homing.hpp"
+#include "pathstream/device/axis_move.hpp"
+#include "pathstream/device/command.hpp"
 #include "pathstream/device/motion_device.hpp"
 
 namespace pathstream::device {
-
-/// Command values beyond the mailbox's 1..5: they carry arguments, so a plain command write
-/// of them is kUnknownCommand.
-inline constexpr std::uint8_t kCommandJog = 6;
-inline constexpr std::uint8_t kCommandSetPosition = 7;
 
 /// Feed of a jog: per mille of the axis's configured max velocity (1..1000; 0 means 1000).
 inline constexpr std::uint16_t kJogFeedFull = 1000;

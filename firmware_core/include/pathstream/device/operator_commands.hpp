@@ -7,14 +7,11 @@
 #include <cstdint>
 
 #include "pathstream/device/homing.hpp"
+#include "pathstream/device/command.hpp"
 #include "pathstream/device/jog.hpp"
 #include "pathstream/device/motion_device.hpp"
 
 namespace pathstream::device {
-
-/// Command values 8 and 9 (6 jog and 7 set position are in jog.hpp).
-inline constexpr std::uint8_t kCommandHome = 8;
-inline constexpr std::uint8_t kCommandPen = 9;
 
 /// A command with its arguments as both buses carry it.
 struct OperatorCommand {
