@@ -4,6 +4,7 @@
 #include <random>
 #include <stdexcept>
 
+#include "pathstream/host/job_request.hpp"
 #include "pathstream/host/csv_path.hpp"
 #include "pathstream/host/gcode_path.hpp"
 #include "pathstream/host/json_path.hpp"
@@ -26,10 +27,6 @@ Path one_subpath(Subpath s) {
     return p;
 }
 
-bool ends_with(const std::string& text, const std::string& end) {
-    return text.size() >= end.size() &&
-           text.compare(text.size() - end.size(), end.size(), end) == 0;
-}
 }  // namespace
 
 host::MachineProfile bench_pen_plotter() {
@@ -110,22 +107,12 @@ Path random_polyline(std::size_t n, double min_turn, double max_turn, unsigned s
 }
 
 Path read_example(const std::string& file, const host::MachineProfile& machine) {
-    Path path;
-    if (ends_with(file, ".json")) {
-        path = host::load_json_path(file);
-    } else if (ends_with(file, ".svg")) {
-        path = host::load_svg_path(file);
-    } else if (ends_with(file, ".csv")) {
-        path = host::load_csv_path(file, PathBasis::kPolyline, true);
-    } else if (ends_with(file, ".ngc") || ends_with(file, ".gcode")) {
-        path = host::load_gcode_path(file);
-    } else {
-        throw std::invalid_argument(file + ": not a drawing bench_plan reads");
-    }
-    path = host::group_by_layer(host::select_layers(path, {}));
-    host::pause_between_layers(path, host::LayerPause::kPenChange);
-    host::apply_layer_feeds(path, machine);
-    return host::order_sections(path, host::OrderOptions{});
+    host::JobRequest request;  // what `pathstream plan FILE` reads with default options
+    request.file = file;
+    request.csv_basis = "polyline";  // the repository's CSV drawings are closed polylines
+    request.csv_closed = true;
+    request.order = true;  // G-code too: the benches have always timed ordered drawings
+    return host::load_path(request, &machine);
 }
 
 }  // namespace pathstream::bench

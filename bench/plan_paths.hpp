@@ -29,10 +29,11 @@ host::Path spiral_path(std::size_t n);
 /// seeded uniform angle of min_turn..max_turn radians (either side).
 host::Path random_polyline(std::size_t n, double min_turn, double max_turn, unsigned seed);
 
-/// A repository drawing read as `pathstream plan FILE` reads it with default options: by
-/// extension (.json, .svg, .csv as a closed polyline as its header asks, .ngc/.gcode with the
-/// default pen mode), grouped by layer with a pause between pens, layer feeds from `machine`,
-/// subpaths ordered (merge tolerance 0.01 mm, from the origin). Throws the readers' errors.
+/// A repository drawing read as `pathstream plan FILE --order` reads it (a JobRequest with
+/// default options: by extension, .csv as a closed polyline as its header asks, .ngc/.gcode
+/// with the default pen mode), grouped by layer with a pause between pens, layer feeds from
+/// `machine`, subpaths ordered (merge tolerance 0.01 mm, from the origin). Throws the readers'
+/// errors.
 host::Path read_example(const std::string& file, const host::MachineProfile& machine);
 
 }  // namespace pathstream::bench

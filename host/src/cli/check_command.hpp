@@ -8,7 +8,7 @@
 namespace pathstream::host {
 
 struct CheckOptions {
-    PathOptions path;
+    JobRequest path;
     bool json = false;  ///< --json: one JSON document on standard output instead of text
     std::string machine;  ///< optional profile: its work area serves --fit area
 };

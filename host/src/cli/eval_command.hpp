@@ -10,7 +10,7 @@
 namespace pathstream::host {
 
 struct EvalOptions {
-    PathOptions path;
+    JobRequest path;
     std::string output;
     std::uint32_t samples_per_span = 8;
     double mm_per_lsb = 0.001;

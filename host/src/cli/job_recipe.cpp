@@ -23,7 +23,7 @@ std::string file_content_hash(const std::string& file) {
     return content_hash(whole.str());
 }
 
-JobRecipe save_job_recipe(PathOptions& path, const std::string& machine_file,
+JobRecipe save_job_recipe(JobRequest& path, const std::string& machine_file,
                           const std::optional<std::vector<double>>& lead_in_from,
                           const std::string& copy) {
     std::string format;
@@ -47,7 +47,7 @@ JobRecipe save_job_recipe(PathOptions& path, const std::string& machine_file,
 }
 
 std::string job_recipe_json(const JobRecipe& r) {
-    const PathOptions& p = r.path;
+    const JobRequest& p = r.path;
     nlohmann::json d;
     d["input"] = p.file;
     d["input_hash"] = r.input_hash;
@@ -84,7 +84,7 @@ JobRecipe parse_job_recipe(const std::string& json, const std::string& journal) 
     const nlohmann::json d = nlohmann::json::parse(json, nullptr, false);
     if (!d.is_object()) throw InputError(journal, {}, "\"replan\" is not an object");
     JobRecipe r;
-    PathOptions& p = r.path;
+    JobRequest& p = r.path;
     const auto get = [&](const char* key, auto& out) {
         if (!d.contains(key))
             throw InputError(journal, {}, std::string("\"replan\" has no \"") + key + "\"");

@@ -13,7 +13,7 @@ namespace pathstream::host {
 
 /// What the journal's "replan" object holds.
 struct JobRecipe {
-    PathOptions path;  ///< file: the drawing's copy; format: the format it was read as
+    JobRequest path;  ///< file: the drawing's copy; format: the format it was read as
     std::optional<std::vector<double>> lead_in_from;  ///< mm per axis: --lead-in's start
     std::string input_hash;                           ///< content_hash of the copy
     std::string machine_hash;  ///< content_hash of the machine profile's file
@@ -28,7 +28,7 @@ const char* planner_identity();
 /// hashes of the copy and of `machine_file`. When `path.file` is "-", `path` itself is pointed
 /// at the copy (standard input can be read once). Throws InputError for an unreadable drawing
 /// or profile, std::runtime_error when the copy cannot be written.
-JobRecipe save_job_recipe(PathOptions& path, const std::string& machine_file,
+JobRecipe save_job_recipe(JobRequest& path, const std::string& machine_file,
                           const std::optional<std::vector<double>>& lead_in_from,
                           const std::string& copy);
 

@@ -11,7 +11,7 @@
 namespace pathstream::host {
 
 struct SetpointsOptions {
-    PathOptions path;
+    JobRequest path;
     std::string machine;  ///< -m: mm_per_lsb and ticks_per_span from the profile
     std::string output;
     std::optional<std::uint32_t> ticks_per_span;  ///< default: the profile's, else 32

@@ -9,7 +9,7 @@
 namespace pathstream::host {
 
 struct SimCommandOptions {
-    PathOptions path;
+    JobRequest path;
     std::string machine;
     std::string plot_dir;
     bool realtime = false;

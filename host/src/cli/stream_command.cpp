@@ -1004,7 +1004,7 @@ int run_stream(const StreamCommandOptions& o) {
     std::vector<double> rest_mm;
     // The path order starts where the device rests (its first subpath is the one nearest to
     // it), so the drawing begins where the pen is, and the lead-in goes from there to it.
-    PathOptions path = o.path;
+    JobRequest path = o.path;
     const bool cia402 =
         url.rfind("can://", 0) == 0 && url.find("protocol=cia402") != std::string::npos;
     if (cia402 && o.lead_in) {

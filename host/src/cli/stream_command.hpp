@@ -11,7 +11,7 @@
 namespace pathstream::host {
 
 struct StreamCommandOptions {
-    PathOptions path;
+    JobRequest path;
     std::string machine;
     StreamOptions stream;
     /// A pen-up move from where the device rests to the drawing's start is planned by default

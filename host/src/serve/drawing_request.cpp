@@ -6,13 +6,10 @@
 #include <set>
 #include <stdexcept>
 
+#include "pathstream/host/path_formats.hpp"
+
 namespace pathstream::host::serve {
 namespace {
-
-std::string lower(std::string s) {
-    std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-    return s;
-}
 
 const std::string& text_value(const nlohmann::json& v, const std::string& key, const std::set<std::string>& allowed) {
     if (!v.is_string()) throw std::invalid_argument(key + ": want a string");
@@ -45,9 +42,8 @@ std::string upload_file_name(const std::string& name) {
     for (std::size_t i = 0; i < base.size() && base[i] == '-'; ++i) base[i] = '_';
     if (base.size() > 100) base = base.substr(base.size() - 100);
     const std::size_t dot = base.rfind('.');
-    static const std::set<std::string> extensions = {"json", "csv", "svg", "gcode", "ngc", "nc", "gc"};
-    if (dot == std::string::npos || dot == 0 || extensions.count(lower(base.substr(dot + 1))) == 0) {
-        throw std::invalid_argument("'" + name + "': the name must end in .svg, .json, .csv, .gcode, .ngc, .nc or .gc");
+    if (dot == std::string::npos || dot == 0 || format_of_file_name(base).empty()) {
+        throw std::invalid_argument("'" + name + "': the name must end in " + path_extension_list());
     }
     return base;
 }

@@ -1,0 +1,44 @@
+// The job pipeline's stages after the request: prepare (load both files, check they agree, make
+// the segments and the lead-in) and plan (plan, check every tick). A straight line from a
+// JobRequest to a checked plan that a streamer or the simulator takes.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "pathstream/host/geometry.hpp"
+#include "pathstream/host/job_request.hpp"
+#include "pathstream/host/plan.hpp"
+#include "pathstream/machine/machine.hpp"
+
+namespace pathstream::host {
+
+/// A job on its way: the path, the machine, the geometry, the plan and its check. What `plan`,
+/// `sim`, `stream` and the web server's preview share.
+struct PlannedJob {
+    Path path;
+    MachineProfile machine;
+    std::vector<BezierSegment> segments;
+    Plan plan;  ///< empty when the plan was streamed (run_plan): the counts below hold
+    PlanCheck check;
+    double planning_seconds = 0;
+    std::size_t span_count = 0, pen_count = 0, pause_count = 0;
+};
+
+/// Loads both files, checks they agree (axis count) and makes the segments, the lead-in's
+/// included: a job ready to plan (its plan empty). Throws InputError for bad files.
+PlannedJob prepare_job(const JobRequest& request, const std::string& machine_file,
+                       const std::vector<double>* lead_in_from = nullptr);
+
+/// Loads both files, checks they agree (axis count), plans with a progress bar and checks
+/// every tick. Throws InputError for bad files, PlanError when planning fails.
+/// `lead_in_from` (mm per axis, optional): the machine's position; when it is not the path's
+/// first point, a straight pen-up move from it to there is planned first.
+PlannedJob plan_job(const JobRequest& request, const std::string& machine_file,
+                    const std::vector<double>* lead_in_from = nullptr);
+
+/// Throws PlanError when the job's estimated motion time passes `max_motion_s` (> 0), naming
+/// both; before any planning.
+void refuse_long_motion(const PlannedJob& job, double max_motion_s);
+
+}  // namespace pathstream::host
