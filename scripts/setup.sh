@@ -8,6 +8,8 @@ packages=(
   build-essential cmake ninja-build pkg-config catch2
   # fuzz targets: clang with its libFuzzer runtime (scripts/test.sh preset fuzz)
   clang libclang-rt-14-dev
+  # the format check in the tests (scripts/check_format.sh) and the tidy preset (.clang-tidy)
+  clang-format clang-tidy
   # host libraries (CLI, data, math baseline for the bench)
   libcli11-dev nlohmann-json3-dev libeigen3-dev libpugixml-dev
   # Cortex-M proof: cross toolchain, C++ headers, emulator with TCG plugin support

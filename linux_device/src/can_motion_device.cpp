@@ -24,10 +24,13 @@ template <unsigned Axes>
 class Device final : public MotionDeviceBase<Axes, kCanDeviceCapacity, CanMotionDevice> {
 public:
     Device(const Lsb (&start)[Axes], std::uint8_t node)
-        : MotionDeviceBase<Axes, kCanDeviceCapacity, CanMotionDevice>(start), node_(this->device_, node) {}
+        : MotionDeviceBase<Axes, kCanDeviceCapacity, CanMotionDevice>(start),
+          node_(this->device_, node) {}
 
     // The task's share of every loop turn comes first: a jog in progress is fed.
-    void connect_homing(const device::HomingPort& port) override { node_.operator_commands().set_homing(port); }
+    void connect_homing(const device::HomingPort& port) override {
+        node_.operator_commands().set_homing(port);
+    }
 
     void tick() override {
         node_.service();
@@ -37,7 +40,8 @@ public:
     void serve(hal::CanBus& bus, std::chrono::microseconds wait) override {
         flush(bus);
         const hal::CanBusState s = bus.state();
-        if (s >= hal::CanBusState::kErrorPassive && last_state_ < hal::CanBusState::kErrorPassive) node_.link_lost();
+        if (s >= hal::CanBusState::kErrorPassive && last_state_ < hal::CanBusState::kErrorPassive)
+            node_.link_lost();
         last_state_ = s;
         hal::CanFrame in;
         auto send = [&](const pc::Frame& f) { pending_.push_back(to_hal(f)); };
@@ -79,7 +83,8 @@ private:
 
 }  // namespace
 
-std::unique_ptr<CanMotionDevice> CanMotionDevice::create(const std::vector<Lsb>& start, std::uint8_t node) {
+std::unique_ptr<CanMotionDevice> CanMotionDevice::create(const std::vector<Lsb>& start,
+                                                         std::uint8_t node) {
     if (node < pc::kMinNode || node > pc::kMaxNode) {
         throw std::invalid_argument("CAN node id " + std::to_string(node) + " is outside 1..127");
     }
@@ -91,10 +96,11 @@ std::unique_ptr<CanMotionDevice> CanMotionDevice::create(const std::vector<Lsb>&
     });
 }
 
-std::uint64_t run_can_device_loop(CanMotionDevice& device, hal::CanBus& bus, const DeviceLoopOptions& options,
-                                  const std::atomic<bool>& stop) {
+std::uint64_t run_can_device_loop(CanMotionDevice& device, hal::CanBus& bus,
+                                  const DeviceLoopOptions& options, const std::atomic<bool>& stop) {
     return run_paced_loop([&] { device.tick(); }, [&] { return device.tick_hz(); },
-                          [&](std::chrono::microseconds wait) { device.serve(bus, wait); }, options, stop);
+                          [&](std::chrono::microseconds wait) { device.serve(bus, wait); }, options,
+                          stop);
 }
 
 }  // namespace pathstream::linux_device

@@ -5,7 +5,8 @@
 
 namespace pathstream::linux_device {
 
-void DeviceLog::operator()(const char* event, const std::string& text, const host::EventJson& fields) const {
+void DeviceLog::operator()(const char* event, const std::string& text,
+                           const host::EventJson& fields) const {
     const std::string time = host::iso8601_utc(std::chrono::system_clock::now());
     if (!json_) {
         std::cout << time << " pathstream device: " << text << std::endl;

@@ -40,12 +40,12 @@ void write_record(const AnyMotionDevice& d, const std::string& path) {
     f.commit();
 }
 
-
 // Homes in real time (times --time-scale), before any bus is served: a host cannot start a
 // job on a half-homed machine. `stop` ends homing at the next tick (HomingFailed); the lines
 // are then released with enable and pen inactive (MachineLines).
-void home(AnyMotionDevice& device, DeviceIo& io, const host::MachineProfile& profile, double time_scale,
-          const DeviceLog& log, DeviceWatch& watch, const std::atomic<bool>& stop) {
+void home(AnyMotionDevice& device, DeviceIo& io, const host::MachineProfile& profile,
+          double time_scale, const DeviceLog& log, DeviceWatch& watch,
+          const std::atomic<bool>& stop) {
     DeviceLoopOptions loop;
     loop.time_scale = time_scale;
     const auto run_until = [&](const std::function<bool()>& done) {
@@ -56,14 +56,13 @@ void home(AnyMotionDevice& device, DeviceIo& io, const host::MachineProfile& pro
                 watch.after_tick(device);
                 if (done() || stop.load()) finished.store(true);
             },
-            [&] { return device.tick_hz(); }, [](std::chrono::microseconds w) { std::this_thread::sleep_for(w); },
-            loop, finished);
+            [&] { return device.tick_hz(); },
+            [](std::chrono::microseconds w) { std::this_thread::sleep_for(w); }, loop, finished);
         return done();
     };
     const auto phase = [&log](const std::string& line) { log("homing", line); };
     (void)home_axes(device, io, host::homing_setups(profile), profile.mm_per_lsb, run_until, phase);
 }
-
 
 // Configuration, GPIO and homing from the profile, shared by every transport.
 struct Machine {
@@ -74,19 +73,22 @@ struct Machine {
 
     // After every tick while serving: the log's lines of a homing run.
     void after_tick(const DeviceLog& log) {
-        if (homing_log) homing_log->after_tick([&log](const std::string& line) { log("homing", line); });
+        if (homing_log)
+            homing_log->after_tick([&log](const std::string& line) { log("homing", line); });
     }
 };
 
 Machine prepare_machine(AnyMotionDevice& device, const DeviceRunOptions& o,
-                        const std::optional<host::MachineProfile>& profile, const AttachMachine& attach,
-                        const DeviceLog& log, DeviceWatch& watch, const std::atomic<bool>& stop) {
+                        const std::optional<host::MachineProfile>& profile,
+                        const AttachMachine& attach, const DeviceLog& log, DeviceWatch& watch,
+                        const std::atomic<bool>& stop) {
     Machine m;
     if (!profile) return m;
     m.profile = profile;
     const host::DeviceLimitsLsb limits = host::device_limits(*profile);
     if (Status s = device.configure(limits); s != Status::kOk) {
-        throw std::invalid_argument(profile->source + ": the device refused the profile's limits: " + status_name(s));
+        throw std::invalid_argument(profile->source +
+                                    ": the device refused the profile's limits: " + status_name(s));
     }
     std::string text =
         "configured from " + profile->source + ": " + std::to_string(limits.tick_hz) + " Hz ticks";
@@ -94,7 +96,8 @@ Machine prepare_machine(AnyMotionDevice& device, const DeviceRunOptions& o,
         text += ", " + profile->axes[a].name + " " + std::to_string(limits.max_velocity[a]) +
                 " LSB/s " + std::to_string(limits.max_acceleration[a]) + " LSB/s^2";
         if (limits.max_jerk[a] != 0) {
-            text += " " + std::to_string(std::uint64_t{limits.max_jerk[a]} * device::kJerkUnitLsb) + " LSB/s^3";
+            text += " " + std::to_string(std::uint64_t{limits.max_jerk[a]} * device::kJerkUnitLsb) +
+                    " LSB/s^3";
         }
     }
     log("configured", text, {{"tick_hz", limits.tick_hz}});
@@ -112,9 +115,11 @@ Machine prepare_machine(AnyMotionDevice& device, const DeviceRunOptions& o,
     if (attach) attach(device, log);
     if (o.home) {
         if (m.io == nullptr) {
-            throw std::invalid_argument(profile->source + ": no \"gpio\" object: --home has no switches to home against");
+            throw std::invalid_argument(
+                profile->source + ": no \"gpio\" object: --home has no switches to home against");
         }
-        if (profile->gpio.home.empty()) throw std::invalid_argument(profile->source + ": --home: gpio.home is empty");
+        if (profile->gpio.home.empty())
+            throw std::invalid_argument(profile->source + ": --home: gpio.home is empty");
         home(device, *m.io, *profile, o.time_scale, log, watch, stop);
     }
     if (m.io != nullptr && !profile->gpio.home.empty()) {
@@ -131,7 +136,8 @@ DeviceLoopOptions loop_options(const DeviceRunOptions& o, const AnyMotionDevice&
     loop.time_scale = o.time_scale;
     loop.run_for = std::chrono::milliseconds(static_cast<long>(o.exit_after * 1000));
     loop.at_rest = [&device] {
-        return device.state() == static_cast<std::uint8_t>(device::DeviceState::kIdle) && device.unchanged_ticks() >= 1000;
+        return device.state() == static_cast<std::uint8_t>(device::DeviceState::kIdle) &&
+               device.unchanged_ticks() >= 1000;
     };
     return loop;
 }
@@ -158,7 +164,8 @@ int run_can_device(const DeviceRunOptions& o, const std::vector<Lsb>& start,
             machine.after_tick(log);
         },
         [&] { return device->tick_hz(); },
-        [&](std::chrono::microseconds w) { device->serve(bus, w); }, loop_options(o, *device), stop);
+        [&](std::chrono::microseconds w) { device->serve(bus, w); }, loop_options(o, *device),
+        stop);
     const hal::SocketCanCounters& c = bus.counters();
     log("stopped",
         "stopped after " + std::to_string(device->ticks_run()) + " ticks, " +
@@ -172,8 +179,8 @@ int run_can_device(const DeviceRunOptions& o, const std::vector<Lsb>& start,
 }
 
 int run_modbus_device(const DeviceRunOptions& o, const std::vector<Lsb>& start,
-                   const std::optional<host::MachineProfile>& profile, const AttachMachine& attach,
-                   const std::atomic<bool>& stop) {
+                      const std::optional<host::MachineProfile>& profile,
+                      const AttachMachine& attach, const std::atomic<bool>& stop) {
     auto device = ModbusMotionDevice::create(start);
     device->record(!o.record.empty());
     const DeviceLog log(o.log_json);
@@ -184,23 +191,27 @@ int run_modbus_device(const DeviceRunOptions& o, const std::vector<Lsb>& start,
     std::string url;
     auto server = [&]() -> hal::ModbusServer {
         if (o.rtu_pty || !o.rtu_device.empty()) {
-            hal::ModbusServer s = o.rtu_pty ? hal::ModbusServer::rtu_pty(device->handler(), server_options)
-                                            : hal::ModbusServer::rtu(device->handler(),
-                                                                     {o.rtu_device, o.baud, o.parity[0], 8, 1},
-                                                                     server_options);
-            url = "modbus-rtu://" + s.client_device() + "?baud=" + std::to_string(o.baud) + "&parity=" + o.parity +
-                  "&unit=" + std::to_string(o.unit);
+            hal::ModbusServer s =
+                o.rtu_pty ? hal::ModbusServer::rtu_pty(device->handler(), server_options)
+                          : hal::ModbusServer::rtu(device->handler(),
+                                                   {o.rtu_device, o.baud, o.parity[0], 8, 1},
+                                                   server_options);
+            url = "modbus-rtu://" + s.client_device() + "?baud=" + std::to_string(o.baud) +
+                  "&parity=" + o.parity + "&unit=" + std::to_string(o.unit);
             return s;
         }
         const auto colon = o.tcp.rfind(':');
-        if (colon == std::string::npos) throw std::invalid_argument("--tcp wants HOST:PORT, not '" + o.tcp + "'");
+        if (colon == std::string::npos)
+            throw std::invalid_argument("--tcp wants HOST:PORT, not '" + o.tcp + "'");
         hal::ModbusTcpEndpoint endpoint;
         endpoint.host = o.tcp.substr(0, colon);
         const int port = std::stoi(o.tcp.substr(colon + 1));
-        if (port < 0 || port > 65535) throw std::invalid_argument("--tcp port out of range: " + o.tcp);
+        if (port < 0 || port > 65535)
+            throw std::invalid_argument("--tcp port out of range: " + o.tcp);
         endpoint.port = static_cast<std::uint16_t>(port);
         hal::ModbusServer s = hal::ModbusServer::tcp(device->handler(), endpoint, server_options);
-        url = "modbus-tcp://" + endpoint.host + ":" + std::to_string(s.port()) + "?unit=" + std::to_string(o.unit);
+        url = "modbus-tcp://" + endpoint.host + ":" + std::to_string(s.port()) +
+              "?unit=" + std::to_string(o.unit);
         return s;
     }();
     log("serving", std::to_string(device->axes()) + " axes, serving " + url,
@@ -230,9 +241,10 @@ int run_modbus_device(const DeviceRunOptions& o, const std::vector<Lsb>& start,
 }  // namespace
 
 int run_device_runtime(const DeviceRunOptions& options, const std::vector<Lsb>& start,
-                       const std::optional<host::MachineProfile>& profile, const AttachMachine& attach,
-                       const std::atomic<bool>& stop) {
-    if (!options.can_interface.empty()) return run_can_device(options, start, profile, attach, stop);
+                       const std::optional<host::MachineProfile>& profile,
+                       const AttachMachine& attach, const std::atomic<bool>& stop) {
+    if (!options.can_interface.empty())
+        return run_can_device(options, start, profile, attach, stop);
     return run_modbus_device(options, start, profile, attach, stop);
 }
 

@@ -25,7 +25,10 @@ struct DeviceView {
 
 // A reader of `d`'s status as the log follows it.
 inline std::function<DeviceView()> status_reader(const AnyMotionDevice& d) {
-    return [&d] { return DeviceView{d.state(), d.fault_code(), d.job(), d.finished_job(), d.finished_job_ticks()}; };
+    return [&d] {
+        return DeviceView{d.state(), d.fault_code(), d.job(), d.finished_job(),
+                          d.finished_job_ticks()};
+    };
 }
 
 // Logs what an operator follows: client connections, jobs starting and finishing, every state
@@ -59,10 +62,12 @@ public:
         if (now - window_start_ >= kConnectionWindow || last) {
             if (quiet_accepted_ + quiet_closed_ > 0) {
                 log_("connections",
-                     std::to_string(quiet_accepted_) + " more clients connected and " + std::to_string(quiet_closed_) +
-                         " disconnected in " + std::to_string(kConnectionWindow.count()) + " s (" +
+                     std::to_string(quiet_accepted_) + " more clients connected and " +
+                         std::to_string(quiet_closed_) + " disconnected in " +
+                         std::to_string(kConnectionWindow.count()) + " s (" +
                          std::to_string(open_after(accepted, closed)) + " open)",
-                     {{"connected", quiet_accepted_}, {"disconnected", quiet_closed_},
+                     {{"connected", quiet_accepted_},
+                      {"disconnected", quiet_closed_},
                       {"open", open_after(accepted, closed)}});
             }
             window_start_ = now;
@@ -72,7 +77,8 @@ public:
             ++accepted_;
             if (window_lines_ < kConnectionLines) {
                 ++window_lines_;
-                log_("connect", "client connected (" + std::to_string(open()) + " open)", {{"open", open()}});
+                log_("connect", "client connected (" + std::to_string(open()) + " open)",
+                     {{"open", open()}});
             } else {
                 ++quiet_accepted_;
             }
@@ -81,7 +87,8 @@ public:
             ++closed_;
             if (window_lines_ < kConnectionLines) {
                 ++window_lines_;
-                log_("disconnect", "client disconnected (" + std::to_string(open()) + " open)", {{"open", open()}});
+                log_("disconnect", "client disconnected (" + std::to_string(open()) + " open)",
+                     {{"open", open()}});
             } else {
                 ++quiet_closed_;
             }
@@ -118,9 +125,9 @@ private:
 
     void state_change(const DeviceView& v, std::uint64_t tick) {
         host::EventJson fields = {{"state", host::device_state_name(v.state)},
-                            {"code", v.state},
-                            {"was", host::device_state_name(last_.state)},
-                            {"tick", tick}};
+                                  {"code", v.state},
+                                  {"was", host::device_state_name(last_.state)},
+                                  {"tick", tick}};
         const std::string at = " at tick " + std::to_string(tick);
         std::string text;
         if (v.state == kEstop) {
@@ -129,7 +136,8 @@ private:
         } else if (v.state == kFault) {
             fields["fault"] = host::fault_text(v.fault_code);
             fields["fault_code"] = v.fault_code;
-            text = "FAULT" + at + ": " + host::fault_text(v.fault_code) + "; drives disabled until reset";
+            text = "FAULT" + at + ": " + host::fault_text(v.fault_code) +
+                   "; drives disabled until reset";
         } else if (v.state == kIdle && (last_.state == kEstop || last_.state == kFault)) {
             text = "reset: idle" + at;
         } else {

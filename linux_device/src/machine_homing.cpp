@@ -17,26 +17,36 @@ std::string mm(double lsb, double mm_per_lsb) {
 
 const char* phase_text(device::HomingPhase p) {
     switch (p) {
-        case device::HomingPhase::kSearch: return "searching";
-        case device::HomingPhase::kSearchStop: return "switch seen, stopping";
-        case device::HomingPhase::kBackoff: return "backing off";
-        case device::HomingPhase::kLatch: return "approaching slowly";
-        case device::HomingPhase::kSetZero: return "setting zero";
-        case device::HomingPhase::kPullOff: return "pulling off the switch";
-        default: return nullptr;
+        case device::HomingPhase::kSearch:
+            return "searching";
+        case device::HomingPhase::kSearchStop:
+            return "switch seen, stopping";
+        case device::HomingPhase::kBackoff:
+            return "backing off";
+        case device::HomingPhase::kLatch:
+            return "approaching slowly";
+        case device::HomingPhase::kSetZero:
+            return "setting zero";
+        case device::HomingPhase::kPullOff:
+            return "pulling off the switch";
+        default:
+            return nullptr;
     }
 }
 
-std::string failure(const linux_device::AnyMotionDevice& d, const linux_device::DeviceIo& io, const host::HomingSetup& s, double q) {
+std::string failure(const linux_device::AnyMotionDevice& d, const linux_device::DeviceIo& io,
+                    const host::HomingSetup& s, double q) {
     const device::HomingConfig& c = s.config;
     std::string why;
     switch (io.homing_error()) {
         case device::HomingError::kSwitchNotFound:
-            why = "switch " + s.switch_name + " not found within " + mm(c.max_travel, q) + " (max_travel)";
+            why = "switch " + s.switch_name + " not found within " + mm(c.max_travel, q) +
+                  " (max_travel)";
             break;
         case device::HomingError::kSwitchStuck:
-            why = "switch " + s.switch_name + " still active after moving off it (backoff " + mm(c.backoff, q) +
-                  ", pull_off " + mm(c.pull_off, q) + "): check its wiring and active_low";
+            why = "switch " + s.switch_name + " still active after moving off it (backoff " +
+                  mm(c.backoff, q) + ", pull_off " + mm(c.pull_off, q) +
+                  "): check its wiring and active_low";
             break;
         case device::HomingError::kLatchNotFound:
             why = "the slow approach did not find switch " + s.switch_name + " again";
@@ -49,19 +59,25 @@ std::string failure(const linux_device::AnyMotionDevice& d, const linux_device::
                       : std::string("interrupted by a fault: ") + name;
             break;
         }
-        case device::HomingError::kBadConfig: why = "a homing velocity or distance is out of range"; break;
-        case device::HomingError::kDeviceRefused:
-            why = std::string("the device refused a homing step: ") + status_name(io.homing_error_status());
+        case device::HomingError::kBadConfig:
+            why = "a homing velocity or distance is out of range";
             break;
-        case device::HomingError::kNone: why = "stopped"; break;
+        case device::HomingError::kDeviceRefused:
+            why = std::string("the device refused a homing step: ") +
+                  status_name(io.homing_error_status());
+            break;
+        case device::HomingError::kNone:
+            why = "stopped";
+            break;
     }
     return "homing " + s.axis_name + ": " + why;
 }
 
 }  // namespace
 
-HomingRunLog::HomingRunLog(const linux_device::AnyMotionDevice& device, const linux_device::DeviceIo& io,
-                           std::vector<host::HomingSetup> setups, double mm_per_lsb)
+HomingRunLog::HomingRunLog(const linux_device::AnyMotionDevice& device,
+                           const linux_device::DeviceIo& io, std::vector<host::HomingSetup> setups,
+                           double mm_per_lsb)
     : device_(device), io_(io), setups_(std::move(setups)), mm_per_lsb_(mm_per_lsb) {}
 
 void HomingRunLog::after_tick(const HomingLog& log) {
@@ -79,7 +95,8 @@ void HomingRunLog::after_tick(const HomingLog& log) {
     if (sequencer_busy_ && (!sequencer_busy || axis != axis_)) {
         if (const host::HomingSetup* s = setup_of(axis_)) {
             if (io_.homing_report(axis_).state == device::AxisHoming::kHomed) {
-                log("  " + s->axis_name + ": homed: switch point = " + mm(s->config.home_position, mm_per_lsb_) +
+                log("  " + s->axis_name +
+                    ": homed: switch point = " + mm(s->config.home_position, mm_per_lsb_) +
                     ", now at " + mm(device_.position(axis_), mm_per_lsb_));
             } else {
                 log(failure(device_, io_, *s, mm_per_lsb_));
@@ -106,22 +123,24 @@ void set_homing_plan(linux_device::DeviceIo& io, const std::vector<host::HomingS
         device::HomingAxis one{s.config, s.side};
         if (io.set_homing_plan(&one, 1) != Status::kOk) {
             (void)io.set_homing_plan(nullptr, 0);
-            throw HomingFailed("homing " + s.axis_name + ": switch " + s.switch_name + " is not wired");
+            throw HomingFailed("homing " + s.axis_name + ": switch " + s.switch_name +
+                               " is not wired");
         }
     }
     (void)io.set_homing_plan(nullptr, 0);
     throw HomingFailed("gpio.home: an axis is homed twice, or beyond the device's axes");
 }
 
-std::vector<HomedAxis> home_axes(linux_device::AnyMotionDevice& device, linux_device::DeviceIo& io, const std::vector<host::HomingSetup>& setups,
-                                 double mm_per_lsb, const RunTicksUntil& run_until, const HomingLog& log) {
+std::vector<HomedAxis> home_axes(linux_device::AnyMotionDevice& device, linux_device::DeviceIo& io,
+                                 const std::vector<host::HomingSetup>& setups, double mm_per_lsb,
+                                 const RunTicksUntil& run_until, const HomingLog& log) {
     set_homing_plan(io, setups);
     std::vector<HomedAxis> homed;
     for (const host::HomingSetup& s : setups) {
         const device::HomingConfig& c = s.config;
         log("homing " + s.axis_name + " toward switch " + s.switch_name + ": search at " +
-            mm(c.search_velocity, mm_per_lsb) + "/s for at most " + mm(c.max_travel, mm_per_lsb) + ", latch at " +
-            mm(c.latch_velocity, mm_per_lsb) + "/s");
+            mm(c.search_velocity, mm_per_lsb) + "/s for at most " + mm(c.max_travel, mm_per_lsb) +
+            ", latch at " + mm(c.latch_velocity, mm_per_lsb) + "/s");
         if (Status st = io.start_homing_run(1u << c.axis); st != Status::kOk) {
             throw HomingFailed(failure(device, io, s, mm_per_lsb));
         }
@@ -136,16 +155,18 @@ std::vector<HomedAxis> home_axes(linux_device::AnyMotionDevice& device, linux_de
             return !io.homing_run_busy();
         });
         if (!finished) throw HomingFailed("homing " + s.axis_name + ": interrupted");
-        if (io.homing_phase() != device::HomingPhase::kDone) throw HomingFailed(failure(device, io, s, mm_per_lsb));
+        if (io.homing_phase() != device::HomingPhase::kDone)
+            throw HomingFailed(failure(device, io, s, mm_per_lsb));
         HomedAxis h;
         h.axis_name = s.axis_name;
         h.latch = io.latch_position();
         h.overshoot = io.search_overshoot();
         h.rest = device.position(c.axis);
         h.ticks = device.ticks_run() - t0;
-        log("  " + s.axis_name + ": homed: switch point = " + mm(c.home_position, mm_per_lsb) + ", now at " +
-            mm(h.rest, mm_per_lsb) + " (search overshoot " + mm(static_cast<double>(h.overshoot), mm_per_lsb) + ", " +
-            std::to_string(h.ticks) + " ticks)");
+        log("  " + s.axis_name + ": homed: switch point = " + mm(c.home_position, mm_per_lsb) +
+            ", now at " + mm(h.rest, mm_per_lsb) + " (search overshoot " +
+            mm(static_cast<double>(h.overshoot), mm_per_lsb) + ", " + std::to_string(h.ticks) +
+            " ticks)");
         homed.push_back(h);
     }
     return homed;

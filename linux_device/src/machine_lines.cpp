@@ -30,19 +30,23 @@ MachineLines::~MachineLines() {
 
 MachineLines MachineLines::open(const host::MachineProfile& profile) {
     const host::GpioConfig& g = profile.gpio;
-    if (!g.present) throw std::invalid_argument(profile.source + ": the machine profile has no \"gpio\" object");
+    if (!g.present)
+        throw std::invalid_argument(profile.source +
+                                    ": the machine profile has no \"gpio\" object");
     MachineLines m;
     m.summary_ = "chip " + g.chip + ":";
     auto note = [&](const std::string& function, const host::GpioLineConfig& c) {
         m.summary_ += " " + function + "=" + c.line + (c.active_low ? " (active low)" : "");
     };
     if (g.has_enable) {
-        m.outputs_.push_back(hal::open_gpiod_output(line_spec(g.chip, g.enable), "pathstream-enable", false));
+        m.outputs_.push_back(
+            hal::open_gpiod_output(line_spec(g.chip, g.enable), "pathstream-enable", false));
         m.wiring_.enable = m.outputs_.back().get();
         note("enable", g.enable);
     }
     if (g.has_pen) {
-        m.outputs_.push_back(hal::open_gpiod_output(line_spec(g.chip, g.pen), "pathstream-pen", false));
+        m.outputs_.push_back(
+            hal::open_gpiod_output(line_spec(g.chip, g.pen), "pathstream-pen", false));
         m.wiring_.pen = m.outputs_.back().get();
         note("pen", g.pen);
     }
@@ -55,7 +59,8 @@ MachineLines MachineLines::open(const host::MachineProfile& profile) {
         // The profile reader allows only "<axis name><side>" keys.
         const unsigned axis = host::axis_index(profile, name.substr(0, name.size() - 1));
         const unsigned side = name.back() == '+' ? 1u : 0u;
-        m.inputs_.push_back(hal::open_gpiod_input(line_spec(g.chip, line), "pathstream-limit-" + name));
+        m.inputs_.push_back(
+            hal::open_gpiod_input(line_spec(g.chip, line), "pathstream-limit-" + name));
         m.wiring_.limit[axis][side] = m.inputs_.back().get();
         note(name, line);
     }

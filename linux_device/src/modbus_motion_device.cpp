@@ -28,11 +28,11 @@ public:
                                                  const std::uint16_t* values) override {
         return convert(map_.write_holding_registers(address, count, values));
     }
-    hal::ModbusException write_read_holding_registers(std::uint16_t write_address, std::uint16_t write_count,
-                                                      const std::uint16_t* values, std::uint16_t read_address,
-                                                      std::uint16_t read_count, std::uint16_t* out) override {
-        return convert(
-            map_.write_read_holding_registers(write_address, write_count, values, read_address, read_count, out));
+    hal::ModbusException write_read_holding_registers(
+        std::uint16_t write_address, std::uint16_t write_count, const std::uint16_t* values,
+        std::uint16_t read_address, std::uint16_t read_count, std::uint16_t* out) override {
+        return convert(map_.write_read_holding_registers(write_address, write_count, values,
+                                                         read_address, read_count, out));
     }
 
 private:
@@ -46,12 +46,16 @@ template <unsigned Axes>
 class Device final : public MotionDeviceBase<Axes, kModbusDeviceCapacity, ModbusMotionDevice> {
 public:
     explicit Device(const Lsb (&start)[Axes])
-        : MotionDeviceBase<Axes, kModbusDeviceCapacity, ModbusMotionDevice>(start), map_(this->device_), handler_(map_) {}
+        : MotionDeviceBase<Axes, kModbusDeviceCapacity, ModbusMotionDevice>(start),
+          map_(this->device_),
+          handler_(map_) {}
 
     hal::ModbusRegisterHandler& handler() override { return handler_; }
 
     // The task's share of every loop turn comes first: a jog in progress is fed.
-    void connect_homing(const device::HomingPort& port) override { map_.operator_commands().set_homing(port); }
+    void connect_homing(const device::HomingPort& port) override {
+        map_.operator_commands().set_homing(port);
+    }
 
     void tick() override {
         map_.service();
@@ -77,8 +81,7 @@ std::unique_ptr<ModbusMotionDevice> ModbusMotionDevice::create(const std::vector
 std::uint64_t run_device_loop(ModbusMotionDevice& device,
                               const std::function<void(std::chrono::microseconds)>& server_poll,
                               const DeviceLoopOptions& options, const std::atomic<bool>& stop) {
-    return run_paced_loop([&] { device.tick(); }, [&] { return device.tick_hz(); },
-                          server_poll,
+    return run_paced_loop([&] { device.tick(); }, [&] { return device.tick_hz(); }, server_poll,
                           options, stop);
 }
 

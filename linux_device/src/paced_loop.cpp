@@ -5,7 +5,8 @@
 
 namespace pathstream::linux_device {
 
-std::uint64_t run_paced_loop(const std::function<void()>& tick, const std::function<std::uint32_t()>& tick_hz,
+std::uint64_t run_paced_loop(const std::function<void()>& tick,
+                             const std::function<std::uint32_t()>& tick_hz,
                              const std::function<void(std::chrono::microseconds)>& serve,
                              const DeviceLoopOptions& options, const std::atomic<bool>& stop) {
     using clock = std::chrono::steady_clock;

@@ -63,12 +63,17 @@ public:
 
     FlatSax(json& root, FlatNumberArrays& flat) : dom_(root), flat_(flat) {
         for (const std::string& where : flat.where) {
-            max_depth_ = std::max(max_depth_, static_cast<std::size_t>(std::count(where.begin(), where.end(), '/')));
+            max_depth_ = std::max(
+                max_depth_, static_cast<std::size_t>(std::count(where.begin(), where.end(), '/')));
         }
     }
 
-    bool null() { return other_value([&] { return dom_.null(); }); }
-    bool boolean(bool v) { return other_value([&] { return dom_.boolean(v); }); }
+    bool null() {
+        return other_value([&] { return dom_.null(); });
+    }
+    bool boolean(bool v) {
+        return other_value([&] { return dom_.boolean(v); });
+    }
     bool number_integer(json::number_integer_t v) {
         return number(static_cast<double>(v), [&] { return dom_.number_integer(v); });
     }
@@ -78,8 +83,12 @@ public:
     bool number_float(json::number_float_t v, const json::string_t& s) {
         return number(v, [&] { return dom_.number_float(v, s); });
     }
-    bool string(json::string_t& v) { return other_value([&] { return dom_.string(v); }); }
-    bool binary(json::binary_t& v) { return other_value([&] { return dom_.binary(v); }); }
+    bool string(json::string_t& v) {
+        return other_value([&] { return dom_.string(v); });
+    }
+    bool binary(json::binary_t& v) {
+        return other_value([&] { return dom_.binary(v); });
+    }
 
     bool start_object(std::size_t n) {
         if (capturing_) give_up();
@@ -188,8 +197,11 @@ private:
             while (same && i < where.size() && j < at.size()) {  // both at a '/'
                 const std::size_t wi = std::min(where.find('/', i + 1), where.size());
                 const std::size_t aj = std::min(at.find('/', j + 1), at.size());
-                const std::string_view w(where.data() + i + 1, wi - i - 1), a(at.data() + j + 1, aj - j - 1);
-                const bool index = !a.empty() && std::all_of(a.begin(), a.end(), [](char c) { return c >= '0' && c <= '9'; });
+                const std::string_view w(where.data() + i + 1, wi - i - 1),
+                    a(at.data() + j + 1, aj - j - 1);
+                const bool index = !a.empty() && std::all_of(a.begin(), a.end(), [](char c) {
+                    return c >= '0' && c <= '9';
+                });
                 same = w == a || (w == "*" && index);
                 i = wi;
                 j = aj;
@@ -234,7 +246,8 @@ private:
 
 }  // namespace
 
-nlohmann::json parse_json_document(const std::string& text, const std::string& file, FlatNumberArrays* flat) {
+nlohmann::json parse_json_document(const std::string& text, const std::string& file,
+                                   FlatNumberArrays* flat) {
     using nlohmann::json;
     check_depth(text, file);
     json document;
@@ -261,7 +274,8 @@ nlohmann::json parse_json_document(const std::string& text, const std::string& f
             const std::string token = message.substr(open + 1, close - open - 1);
             const auto at = text.find(token);
             throw InputError(
-                file, at == std::string::npos ? SourceLocation{} : JsonIndex(text, 0).location_of(at),
+                file,
+                at == std::string::npos ? SourceLocation{} : JsonIndex(text, 0).location_of(at),
                 "number " + token + " is out of range (not finite as a double)");
         }
         throw InputError(file, {}, "invalid JSON: " + message);
@@ -271,8 +285,8 @@ nlohmann::json parse_json_document(const std::string& text, const std::string& f
 }
 
 SourceLocation JsonChecker::locate(const std::string& pointer) const {
-    if (shallow_depth_ &&
-        static_cast<std::size_t>(std::count(pointer.begin(), pointer.end(), '/')) <= *shallow_depth_) {
+    if (shallow_depth_ && static_cast<std::size_t>(
+                              std::count(pointer.begin(), pointer.end(), '/')) <= *shallow_depth_) {
         if (!shallow_) shallow_.emplace(text_, *shallow_depth_);
         return shallow_->locate(pointer);
     }

@@ -97,7 +97,8 @@ private:
         if (!open_.back().keys.insert(k).second && !index_.duplicate_key_) {
             index_.duplicate_key_ = key_at;
         }
-        if (open_.back().node != kNone) index_.nodes_[open_.back().node].keys.push_back(std::move(k));
+        if (open_.back().node != kNone)
+            index_.nodes_[open_.back().node].keys.push_back(std::move(k));
         skip_space();
         if (!at(':')) return false;
         ++pos_;

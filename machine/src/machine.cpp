@@ -20,7 +20,8 @@ namespace {
 // A JSON object key as a JSON pointer token (RFC 6901: ~ as ~0, / as ~1).
 std::string json_pointer_token(const std::string& key) {
     std::string out;
-    for (const char c : key) out += c == '~' ? std::string("~0") : c == '/' ? std::string("~1") : std::string(1, c);
+    for (const char c : key)
+        out += c == '~' ? std::string("~0") : c == '/' ? std::string("~1") : std::string(1, c);
     return out;
 }
 
@@ -31,15 +32,16 @@ public:
     using JsonChecker::JsonChecker;
 
     /// A finite number in [lo, hi] (inclusive), or exclusive of lo when lo_open.
-    double number(const json& v, const std::string& pointer, const std::string& what, double lo, double hi,
-                  bool lo_open, const char* unit) const {
+    double number(const json& v, const std::string& pointer, const std::string& what, double lo,
+                  double hi, bool lo_open, const char* unit) const {
         if (!v.is_number()) fail(pointer, what + " must be a number");
         const double x = v.get<double>();
         if (!std::isfinite(x)) fail(pointer, what + " is not finite");
         if ((lo_open ? x <= lo : x < lo) || x > hi) {
             std::ostringstream m;
-            m << what << " " << x << " " << unit << " is impossible (allowed: " << (lo_open ? "> " : ">= ") << lo
-              << " and <= " << hi << " " << unit << ")";
+            m << what << " " << x << " " << unit
+              << " is impossible (allowed: " << (lo_open ? "> " : ">= ") << lo << " and <= " << hi
+              << " " << unit << ")";
             fail(pointer, m.str());
         }
         return x;
@@ -47,37 +49,48 @@ public:
 
     MachineProfile read(const json& root) const {
         if (!root.is_object()) fail("", "a machine profile must be a JSON object");
-        only_keys(root, "", {"axes", "mm_per_lsb", "tick_hz", "ticks_per_span", "feed", "travel_feed",
-                             "pen_down_delay", "pen_up_delay", "chord_tolerance", "corner_stop_angle", "gpio", "layer_feeds"});
+        only_keys(root, "",
+                  {"axes", "mm_per_lsb", "tick_hz", "ticks_per_span", "feed", "travel_feed",
+                   "pen_down_delay", "pen_up_delay", "chord_tolerance", "corner_stop_angle", "gpio",
+                   "layer_feeds"});
         MachineProfile p;
         if (!root.contains("axes")) fail("", "machine profile has no \"axes\"");
         const json& axes = root["axes"];
-        if (!axes.is_array() || axes.empty() || axes.size() > 8) fail("/axes", "axes must be an array of 1 to 8 axis objects");
+        if (!axes.is_array() || axes.empty() || axes.size() > 8)
+            fail("/axes", "axes must be an array of 1 to 8 axis objects");
         for (std::size_t i = 0; i < axes.size(); ++i) {
             const std::string ptr = "/axes/" + std::to_string(i);
             const json& a = axes[i];
-            if (!a.is_object()) fail(ptr, "axis must be an object with name, max_velocity, max_acceleration");
+            if (!a.is_object())
+                fail(ptr, "axis must be an object with name, max_velocity, max_acceleration");
             only_keys(a, ptr, {"name", "max_velocity", "max_acceleration", "max_jerk", "travel"});
             for (const char* key : {"name", "max_velocity", "max_acceleration"}) {
                 if (!a.contains(key)) fail(ptr, std::string("axis has no \"") + key + "\"");
             }
             AxisLimits limits;
-            if (!a["name"].is_string() || a["name"].get<std::string>().empty()) fail(ptr + "/name", "axis name must be a non-empty string");
+            if (!a["name"].is_string() || a["name"].get<std::string>().empty())
+                fail(ptr + "/name", "axis name must be a non-empty string");
             limits.name = a["name"].get<std::string>();
             for (const auto& other : p.axes) {
-                if (other.name == limits.name) fail(ptr + "/name", "axis name \"" + limits.name + "\" is used twice");
+                if (other.name == limits.name)
+                    fail(ptr + "/name", "axis name \"" + limits.name + "\" is used twice");
             }
-            limits.max_velocity = number(a["max_velocity"], ptr + "/max_velocity", "max_velocity", 0, 1e5, true, "mm/s");
-            limits.max_acceleration =
-                number(a["max_acceleration"], ptr + "/max_acceleration", "max_acceleration", 0, 1e7, true, "mm/s^2");
+            limits.max_velocity = number(a["max_velocity"], ptr + "/max_velocity", "max_velocity",
+                                         0, 1e5, true, "mm/s");
+            limits.max_acceleration = number(a["max_acceleration"], ptr + "/max_acceleration",
+                                             "max_acceleration", 0, 1e7, true, "mm/s^2");
             if (a.contains("max_jerk")) {
-                limits.max_jerk = number(a["max_jerk"], ptr + "/max_jerk", "max_jerk", 0, 1e10, true, "mm/s^3");
+                limits.max_jerk =
+                    number(a["max_jerk"], ptr + "/max_jerk", "max_jerk", 0, 1e10, true, "mm/s^3");
             }
             if (a.contains("travel")) {
                 const json& t = a["travel"];
-                if (!t.is_array() || t.size() != 2) fail(ptr + "/travel", "travel must be [min, max] in mm");
-                limits.travel_min = number(t[0], ptr + "/travel/0", "travel min", -1e5, 1e5, false, "mm");
-                limits.travel_max = number(t[1], ptr + "/travel/1", "travel max", -1e5, 1e5, false, "mm");
+                if (!t.is_array() || t.size() != 2)
+                    fail(ptr + "/travel", "travel must be [min, max] in mm");
+                limits.travel_min =
+                    number(t[0], ptr + "/travel/0", "travel min", -1e5, 1e5, false, "mm");
+                limits.travel_max =
+                    number(t[1], ptr + "/travel/1", "travel max", -1e5, 1e5, false, "mm");
                 if (limits.travel_max <= limits.travel_min) {
                     fail(ptr + "/travel", "travel max must be above travel min");
                 }
@@ -85,7 +98,9 @@ public:
             }
             p.axes.push_back(limits);
         }
-        if (root.contains("mm_per_lsb")) p.mm_per_lsb = number(root["mm_per_lsb"], "/mm_per_lsb", "mm_per_lsb", 1e-6, 10, false, "mm");
+        if (root.contains("mm_per_lsb"))
+            p.mm_per_lsb =
+                number(root["mm_per_lsb"], "/mm_per_lsb", "mm_per_lsb", 1e-6, 10, false, "mm");
         if (root.contains("tick_hz")) {
             // The device's own range: a profile never asks for a rate the device refuses.
             p.tick_hz = number(root["tick_hz"], "/tick_hz", "tick_hz", device::kMinTickHz,
@@ -93,43 +108,57 @@ public:
         }
         if (root.contains("ticks_per_span")) {
             const json& v = root["ticks_per_span"];
-            if (!v.is_number_integer()) fail("/ticks_per_span", "ticks_per_span must be a whole number");
-            const double n = number(v, "/ticks_per_span", "ticks_per_span", 1, kMaxSpanTicks, false, "ticks");
+            if (!v.is_number_integer())
+                fail("/ticks_per_span", "ticks_per_span must be a whole number");
+            const double n =
+                number(v, "/ticks_per_span", "ticks_per_span", 1, kMaxSpanTicks, false, "ticks");
             p.ticks_per_span = static_cast<std::uint32_t>(n);
         }
-        if (root.contains("feed")) p.feed = number(root["feed"], "/feed", "feed", 0, 1e5, true, "mm/s");
-        if (root.contains("travel_feed")) p.travel_feed = number(root["travel_feed"], "/travel_feed", "travel_feed", 0, 1e5, true, "mm/s");
-        if (root.contains("pen_down_delay")) p.pen_down_delay = number(root["pen_down_delay"], "/pen_down_delay", "pen_down_delay", 0, 60, false, "s");
-        if (root.contains("pen_up_delay")) p.pen_up_delay = number(root["pen_up_delay"], "/pen_up_delay", "pen_up_delay", 0, 60, false, "s");
+        if (root.contains("feed"))
+            p.feed = number(root["feed"], "/feed", "feed", 0, 1e5, true, "mm/s");
+        if (root.contains("travel_feed"))
+            p.travel_feed =
+                number(root["travel_feed"], "/travel_feed", "travel_feed", 0, 1e5, true, "mm/s");
+        if (root.contains("pen_down_delay"))
+            p.pen_down_delay = number(root["pen_down_delay"], "/pen_down_delay", "pen_down_delay",
+                                      0, 60, false, "s");
+        if (root.contains("pen_up_delay"))
+            p.pen_up_delay =
+                number(root["pen_up_delay"], "/pen_up_delay", "pen_up_delay", 0, 60, false, "s");
         if (root.contains("chord_tolerance")) {
-            p.chord_tolerance = number(root["chord_tolerance"], "/chord_tolerance", "chord_tolerance", 0, 10, true, "mm");
+            p.chord_tolerance = number(root["chord_tolerance"], "/chord_tolerance",
+                                       "chord_tolerance", 0, 10, true, "mm");
         }
         if (root.contains("corner_stop_angle")) {
             // Degrees, as CAM tools give angles. Not below 1: joints of smooth curves turn by
             // rounding noise, and each would become a stop.
-            const double degrees = number(root["corner_stop_angle"], "/corner_stop_angle", "corner_stop_angle", 1,
-                                          180, false, "degrees");
+            const double degrees = number(root["corner_stop_angle"], "/corner_stop_angle",
+                                          "corner_stop_angle", 1, 180, false, "degrees");
             p.corner_stop_angle = degrees * 3.14159265358979323846 / 180;
         }
         // One LSB cannot be resolved more finely than the tolerance asks for: a tolerance below
         // half an LSB could never be met by integer setpoints.
         if (p.chord_tolerance < p.mm_per_lsb / 2) {
             std::ostringstream m;
-            m << "chord_tolerance " << p.chord_tolerance << " mm is below half an LSB (" << p.mm_per_lsb / 2
-              << " mm): integer setpoints cannot meet it";
+            m << "chord_tolerance " << p.chord_tolerance << " mm is below half an LSB ("
+              << p.mm_per_lsb / 2 << " mm): integer setpoints cannot meet it";
             fail(root.contains("chord_tolerance") ? "/chord_tolerance" : "/mm_per_lsb", m.str());
         }
         check_plannable(root, p);
         if (root.contains("gpio")) p.gpio = gpio(root["gpio"], p);
         if (root.contains("layer_feeds")) {
             const json& f = root["layer_feeds"];
-            if (!f.is_object()) fail("/layer_feeds", "layer_feeds must be an object like {\"red\": 20} (mm/s per layer)");
+            if (!f.is_object())
+                fail("/layer_feeds",
+                     "layer_feeds must be an object like {\"red\": 20} (mm/s per layer)");
             for (const auto& [name, value] : f.items()) {
                 const std::string ptr = "/layer_feeds/" + json_pointer_token(name);
-                p.layer_feeds.emplace_back(name, number(value, ptr, "layer feed", 0, 1e5, true, "mm/s"));
+                p.layer_feeds.emplace_back(name,
+                                           number(value, ptr, "layer feed", 0, 1e5, true, "mm/s"));
                 if (p.layer_feeds.back().second < min_velocity(p)) {
-                    fail(ptr, "layer feed " + format(p.layer_feeds.back().second) + " mm/s is below " +
-                                  min_velocity_reason(p) + " (allowed: >= " + format(min_velocity(p)) + " mm/s)");
+                    fail(ptr, "layer feed " + format(p.layer_feeds.back().second) +
+                                  " mm/s is below " + min_velocity_reason(p) +
+                                  " (allowed: >= " + format(min_velocity(p)) + " mm/s)");
                 }
             }
         }
@@ -145,43 +174,52 @@ private:
         const double n = p.ticks_per_span;
         const double v_min = min_velocity(p);
         const double a_min = min_acceleration(p);
-        const std::string grid = "(" + format(p.mm_per_lsb) + " mm/LSB, " + format(p.tick_hz) + " Hz, " +
-                                 format(n) + " ticks per span)";
-        const std::string floor = v_min > kSlowestVelocity ? "1 LSB per span " + grid + ": planning would crawl"
-                                                           : min_velocity_reason(p);
+        const std::string grid = "(" + format(p.mm_per_lsb) + " mm/LSB, " + format(p.tick_hz) +
+                                 " Hz, " + format(n) + " ticks per span)";
+        const std::string floor = v_min > kSlowestVelocity
+                                      ? "1 LSB per span " + grid + ": planning would crawl"
+                                      : min_velocity_reason(p);
         for (std::size_t i = 0; i < p.axes.size(); ++i) {
             const AxisLimits& a = p.axes[i];
             const std::string ptr = "/axes/" + std::to_string(i);
             if (a.max_velocity < v_min) {
                 fail(ptr + "/max_velocity",
-                     "max_velocity " + format(a.max_velocity) + " mm/s is below " + floor + " (allowed: >= " +
-                         format(v_min) + " mm/s" +
-                         (v_min > kSlowestVelocity ? "; or raise ticks_per_span, or lower tick_hz)" : ")"));
+                     "max_velocity " + format(a.max_velocity) + " mm/s is below " + floor +
+                         " (allowed: >= " + format(v_min) + " mm/s" +
+                         (v_min > kSlowestVelocity ? "; or raise ticks_per_span, or lower tick_hz)"
+                                                   : ")"));
             }
             if (a.max_acceleration < a_min) {
                 fail(ptr + "/max_acceleration",
                      "max_acceleration " + format(a.max_acceleration) +
                          " mm/s^2 cannot gain 1 LSB per span of speed within one span " + grid +
-                         " (allowed: >= " + format(a_min) + " mm/s^2; or raise ticks_per_span, or lower tick_hz)");
+                         " (allowed: >= " + format(a_min) +
+                         " mm/s^2; or raise ticks_per_span, or lower tick_hz)");
             }
             // One span at the axis's top speed must stay within its travel, or within the
             // device's position range when it has none.
-            const double extent = a.has_travel ? a.travel_max - a.travel_min
-                                               : 2.0 * static_cast<double>(kMaxPositionLsb) * p.mm_per_lsb;
+            const double extent = a.has_travel
+                                      ? a.travel_max - a.travel_min
+                                      : 2.0 * static_cast<double>(kMaxPositionLsb) * p.mm_per_lsb;
             const double span_mm = a.max_velocity * n / p.tick_hz;
             if (span_mm > extent) {
-                const double longest = std::max(1.0, std::floor(extent * p.tick_hz / a.max_velocity));
-                const std::string where = a.has_travel ? "its travel" : "the device's position range";
-                const std::string what = "a span of " + format(n) + " ticks at axis " + a.name + "'s max_velocity " +
-                                         format(a.max_velocity) + " mm/s crosses " + format(span_mm) +
-                                         " mm, more than " + where + " (" + format(extent) + " mm)";
+                const double longest =
+                    std::max(1.0, std::floor(extent * p.tick_hz / a.max_velocity));
+                const std::string where =
+                    a.has_travel ? "its travel" : "the device's position range";
+                const std::string what = "a span of " + format(n) + " ticks at axis " + a.name +
+                                         "'s max_velocity " + format(a.max_velocity) +
+                                         " mm/s crosses " + format(span_mm) + " mm, more than " +
+                                         where + " (" + format(extent) + " mm)";
                 if (root.contains("ticks_per_span")) {
-                    fail("/ticks_per_span", "ticks_per_span " + format(n) + " is too long: " + what +
-                                                " (allowed: 1 .. " + format(longest) + " ticks)");
+                    fail("/ticks_per_span", "ticks_per_span " + format(n) +
+                                                " is too long: " + what + " (allowed: 1 .. " +
+                                                format(longest) + " ticks)");
                 }
-                fail(ptr + "/max_velocity", "max_velocity " + format(a.max_velocity) + " mm/s is too fast for " +
-                                                "spans of " + format(n) + " ticks: " + what + " (allowed: <= " +
-                                                format(extent * p.tick_hz / n) + " mm/s)");
+                fail(ptr + "/max_velocity",
+                     "max_velocity " + format(a.max_velocity) + " mm/s is too fast for " +
+                         "spans of " + format(n) + " ticks: " + what +
+                         " (allowed: <= " + format(extent * p.tick_hz / n) + " mm/s)");
             }
         }
         // Without a travel, the position range bounds a span only at hundreds of metres: a span
@@ -193,24 +231,28 @@ private:
             const AxisLimits& a = p.axes[i];
             if (a.has_travel) continue;
             const double stop_ticks = a.max_velocity * p.tick_hz / a.max_acceleration;
-            const double floor_ticks = std::max(p.mm_per_lsb * p.tick_hz / a.max_velocity,
-                                                p.tick_hz * std::sqrt(p.mm_per_lsb / a.max_acceleration));
-            const double longest = std::max({std::floor(stop_ticks), static_cast<double>(MachineProfile{}.ticks_per_span),
+            const double floor_ticks =
+                std::max(p.mm_per_lsb * p.tick_hz / a.max_velocity,
+                         p.tick_hz * std::sqrt(p.mm_per_lsb / a.max_acceleration));
+            const double longest = std::max({std::floor(stop_ticks),
+                                             static_cast<double>(MachineProfile{}.ticks_per_span),
                                              std::ceil(floor_ticks)});
             if (n <= longest) continue;
             fail(root.contains("ticks_per_span") ? "/ticks_per_span" : "",
-                 "ticks_per_span " + format(n) + " is too long: a span of " + format(n) + " ticks (" +
-                     format(n / p.tick_hz) + " s) outlasts axis " + a.name + "'s stop from its max_velocity " +
-                     format(a.max_velocity) + " mm/s at its max_acceleration " + format(a.max_acceleration) +
-                     " mm/s^2 (" + format(stop_ticks / p.tick_hz) + " s), and the axis has no travel to bound it " +
-                     "(allowed: 1 .. " + format(longest) + " ticks)");
+                 "ticks_per_span " + format(n) + " is too long: a span of " + format(n) +
+                     " ticks (" + format(n / p.tick_hz) + " s) outlasts axis " + a.name +
+                     "'s stop from its max_velocity " + format(a.max_velocity) +
+                     " mm/s at its max_acceleration " + format(a.max_acceleration) + " mm/s^2 (" +
+                     format(stop_ticks / p.tick_hz) +
+                     " s), and the axis has no travel to bound it " + "(allowed: 1 .. " +
+                     format(longest) + " ticks)");
         }
         const auto check_feed = [&](const char* key, double feed) {
             if (feed >= v_min) return;
             const bool given = root.contains(key);
             fail(given ? std::string("/") + key : std::string(),
-                 std::string(key) + (given ? " " : " (default) ") + format(feed) + " mm/s is below " + floor +
-                     " (allowed: >= " + format(v_min) + " mm/s)");
+                 std::string(key) + (given ? " " : " (default) ") + format(feed) +
+                     " mm/s is below " + floor + " (allowed: >= " + format(v_min) + " mm/s)");
         };
         check_feed("feed", p.feed);
         check_feed("travel_feed", p.travel_feed);
@@ -230,7 +272,8 @@ private:
         GpioLineConfig c;
         const json& l = v["line"];
         if (l.is_number_integer()) {
-            if (l.get<long long>() < 0 || l.get<long long>() > 65535) fail(ptr + "/line", "line offset must be 0..65535");
+            if (l.get<long long>() < 0 || l.get<long long>() > 65535)
+                fail(ptr + "/line", "line offset must be 0..65535");
             c.line = std::to_string(l.get<long long>());
         } else if (l.is_string() && !l.get<std::string>().empty()) {
             c.line = l.get<std::string>();
@@ -238,7 +281,8 @@ private:
             fail(ptr + "/line", "line must be an offset (whole number) or a line name (string)");
         }
         if (v.contains("active_low")) {
-            if (!v["active_low"].is_boolean()) fail(ptr + "/active_low", "active_low must be true or false");
+            if (!v["active_low"].is_boolean())
+                fail(ptr + "/active_low", "active_low must be true or false");
             c.active_low = v["active_low"].get<bool>();
         }
         if (v.contains("bias")) {
@@ -259,11 +303,14 @@ private:
         c.present = true;
         if (!g.contains("chip")) fail("/gpio", "gpio has no \"chip\"");
         if (!g["chip"].is_string() || g["chip"].get<std::string>().empty()) {
-            fail("/gpio/chip", "chip must be a chip name, path, number or label (non-empty string)");
+            fail("/gpio/chip",
+                 "chip must be a chip name, path, number or label (non-empty string)");
         }
         c.chip = g["chip"].get<std::string>();
-        if (g.contains("enable")) c.enable = line(g["enable"], "/gpio/enable", "enable"), c.has_enable = true;
-        if (g.contains("estop")) c.estop = line(g["estop"], "/gpio/estop", "estop"), c.has_estop = true;
+        if (g.contains("enable"))
+            c.enable = line(g["enable"], "/gpio/enable", "enable"), c.has_enable = true;
+        if (g.contains("estop"))
+            c.estop = line(g["estop"], "/gpio/estop", "estop"), c.has_estop = true;
         if (g.contains("pen")) c.pen = line(g["pen"], "/gpio/pen", "pen"), c.has_pen = true;
         std::set<std::string> switch_names;
         for (const auto& a : p.axes) {
@@ -272,24 +319,34 @@ private:
         }
         if (g.contains("limits")) {
             const json& lim = g["limits"];
-            if (!lim.is_object()) fail("/gpio/limits", "limits must be an object like {\"x-\": {\"line\": 3}}");
+            if (!lim.is_object())
+                fail("/gpio/limits", "limits must be an object like {\"x-\": {\"line\": 3}}");
             only_keys(lim, "/gpio/limits", switch_names);
             for (auto it = lim.begin(); it != lim.end(); ++it) {
-                c.limits.emplace_back(it.key(), line(it.value(), "/gpio/limits/" + it.key(), "limit switch"));
+                c.limits.emplace_back(it.key(),
+                                      line(it.value(), "/gpio/limits/" + it.key(), "limit switch"));
             }
         }
         if (g.contains("home")) {
             const json& home = g["home"];
-            if (!home.is_object()) fail("/gpio/home", "home must be an object like {\"x\": {\"switch\": \"x-\", ...}}");
+            if (!home.is_object())
+                fail("/gpio/home",
+                     "home must be an object like {\"x\": {\"switch\": \"x-\", ...}}");
             std::set<std::string> axis_names;
             for (const auto& a : p.axes) axis_names.insert(a.name);
             only_keys(home, "/gpio/home", axis_names);
             for (auto it = home.begin(); it != home.end(); ++it) {
                 const std::string ptr = "/gpio/home/" + it.key();
                 const json& h = it.value();
-                if (!h.is_object()) fail(ptr, "homing must be an object with switch, search_velocity, latch_velocity, backoff, max_travel");
-                only_keys(h, ptr, {"switch", "search_velocity", "latch_velocity", "backoff", "max_travel", "position", "pull_off"});
-                for (const char* key : {"switch", "search_velocity", "latch_velocity", "backoff", "max_travel"}) {
+                if (!h.is_object())
+                    fail(ptr,
+                         "homing must be an object with switch, search_velocity, latch_velocity, "
+                         "backoff, max_travel");
+                only_keys(h, ptr,
+                          {"switch", "search_velocity", "latch_velocity", "backoff", "max_travel",
+                           "position", "pull_off"});
+                for (const char* key :
+                     {"switch", "search_velocity", "latch_velocity", "backoff", "max_travel"}) {
                     if (!h.contains(key)) fail(ptr, std::string("homing has no \"") + key + "\"");
                 }
                 HomingAxisConfig hc;
@@ -299,23 +356,30 @@ private:
                     if (a.name == hc.axis) axis = &a;
                 }
                 const json& sw = h["switch"];
-                if (!sw.is_string() || (sw.get<std::string>() != hc.axis + "-" && sw.get<std::string>() != hc.axis + "+")) {
-                    fail(ptr + "/switch", "switch must be \"" + hc.axis + "-\" or \"" + hc.axis + "+\"");
+                if (!sw.is_string() || (sw.get<std::string>() != hc.axis + "-" &&
+                                        sw.get<std::string>() != hc.axis + "+")) {
+                    fail(ptr + "/switch",
+                         "switch must be \"" + hc.axis + "-\" or \"" + hc.axis + "+\"");
                 }
                 hc.switch_name = sw.get<std::string>();
                 bool fitted = false;
                 for (const auto& l : c.limits) fitted = fitted || l.first == hc.switch_name;
-                if (!fitted) fail(ptr + "/switch", "switch \"" + hc.switch_name + "\" is not in gpio.limits");
-                hc.search_velocity = number(h["search_velocity"], ptr + "/search_velocity", "search_velocity", 0,
-                                            axis->max_velocity, true, "mm/s");
-                hc.latch_velocity = number(h["latch_velocity"], ptr + "/latch_velocity", "latch_velocity", 0,
-                                           hc.search_velocity, true, "mm/s");
+                if (!fitted)
+                    fail(ptr + "/switch",
+                         "switch \"" + hc.switch_name + "\" is not in gpio.limits");
+                hc.search_velocity = number(h["search_velocity"], ptr + "/search_velocity",
+                                            "search_velocity", 0, axis->max_velocity, true, "mm/s");
+                hc.latch_velocity = number(h["latch_velocity"], ptr + "/latch_velocity",
+                                           "latch_velocity", 0, hc.search_velocity, true, "mm/s");
                 hc.backoff = number(h["backoff"], ptr + "/backoff", "backoff", 0, 1e4, true, "mm");
-                hc.max_travel = number(h["max_travel"], ptr + "/max_travel", "max_travel", 0, 1e5, true, "mm");
-                hc.pull_off = h.contains("pull_off")
-                                  ? number(h["pull_off"], ptr + "/pull_off", "pull_off", 0, 1e4, false, "mm")
-                                  : hc.backoff;
-                if (h.contains("position")) hc.position = number(h["position"], ptr + "/position", "position", -1e5, 1e5, false, "mm");
+                hc.max_travel =
+                    number(h["max_travel"], ptr + "/max_travel", "max_travel", 0, 1e5, true, "mm");
+                hc.pull_off = h.contains("pull_off") ? number(h["pull_off"], ptr + "/pull_off",
+                                                              "pull_off", 0, 1e4, false, "mm")
+                                                     : hc.backoff;
+                if (h.contains("position"))
+                    hc.position = number(h["position"], ptr + "/position", "position", -1e5, 1e5,
+                                         false, "mm");
                 c.home.push_back(hc);
             }
         }
@@ -327,11 +391,15 @@ private:
 
 namespace {
 
-double grid_velocity(const MachineProfile& p) { return p.mm_per_lsb * p.tick_hz / p.ticks_per_span; }
+double grid_velocity(const MachineProfile& p) {
+    return p.mm_per_lsb * p.tick_hz / p.ticks_per_span;
+}
 
 }  // namespace
 
-double min_velocity(const MachineProfile& p) { return std::max(grid_velocity(p), kSlowestVelocity); }
+double min_velocity(const MachineProfile& p) {
+    return std::max(grid_velocity(p), kSlowestVelocity);
+}
 
 std::string min_velocity_reason(const MachineProfile& p) {
     if (grid_velocity(p) >= kSlowestVelocity) return "1 LSB per span: planning would crawl";

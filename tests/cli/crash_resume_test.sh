@@ -115,14 +115,21 @@ RANDOM=$seed
 incomplete=0
 for run in $(seq "$kills"); do
   start_device || exit 1
-  # Half the kills while planning runs (the first second: planning takes less here), the rest
-  # anywhere in a whole stream's time.
+  # Half the kills while planning runs (within half the planning time, at most 0.5 s, after the
+  # journal appears), the rest anywhere in a whole stream's time from its start.
   span=$whole
-  if [ $((run % 2)) -eq 1 ]; then span=$(awk -v p="$planning" 'BEGIN { print (p < 1 ? p : 1) }'); fi
+  if [ $((run % 2)) -eq 1 ]; then span=$(awk -v p="$planning" 'BEGIN { print (p < 1 ? p / 2 : 0.5) }'); fi
   delay=$(awk -v r=$RANDOM -v s=$span 'BEGIN { printf "%.3f", s * r / 32767 }')
   "$bin" stream walk.json -m "$machine" -t "$target" --journal j.json > stream1.log 2>&1 &
   stream_pid=$!
-  sleep "$delay"
+  if [ $((run % 2)) -eq 1 ]; then
+    # Counted from the journal's first appearance (the first batch is on its way), not from the
+    # start: on a loaded machine the start can take longer than the whole delay, and a kill
+    # before any journal would test nothing. Planning is then still running.
+    for _ in $(seq 600); do [ -f j.json ] && break; kill -0 "$stream_pid" 2>/dev/null || break; sleep 0.01; done
+    delay="$delay after the journal appeared"
+  fi
+  sleep "${delay%% *}"
   kill -KILL "$stream_pid" 2>/dev/null
   wait "$stream_pid" 2>/dev/null; rc=$?
   name="run $run, SIGKILL after $delay s"

@@ -10,11 +10,11 @@
 
 #include "pathstream/device/gpio_logic.hpp"
 #include "pathstream/device/motion_device.hpp"
+#include "pathstream/linux_device/can_motion_device.hpp"
+#include "pathstream/linux_device/machine_homing.hpp"
+#include "pathstream/linux_device/modbus_motion_device.hpp"
 #include "pathstream/machine/device_setup.hpp"
 #include "pathstream/machine/machine.hpp"
-#include "pathstream/linux_device/machine_homing.hpp"
-#include "pathstream/linux_device/can_motion_device.hpp"
-#include "pathstream/linux_device/modbus_motion_device.hpp"
 #include "pathstream/sim/simulated_input.hpp"
 #include "pathstream/sim/simulated_output.hpp"
 #include "pathstream/sim/virtual_clock.hpp"
@@ -90,7 +90,9 @@ struct Machine {
     Lsb offset[2] = {0, 0};
 };
 
-host::MachineProfile profile() { return host::parse_machine_profile(kProfile, "m.json"); }
+host::MachineProfile profile() {
+    return host::parse_machine_profile(kProfile, "m.json");
+}
 
 std::unique_ptr<linux_device::AnyMotionDevice> modbus_device(Lsb x, Lsb y) {
     return linux_device::ModbusMotionDevice::create({x, y});
@@ -123,10 +125,13 @@ TEST_CASE("device setup: limits and homing in LSB from the profile", "[host][gpi
     CHECK_THROWS_WITH(host::device_limits(huge), Catch::Contains("axis x max_velocity"));
 }
 
-TEST_CASE("device io: the configured device is the one a host would configure, e-stop and limits act per tick",
-          "[host][gpio]") {
+TEST_CASE(
+    "device io: the configured device is the one a host would configure, e-stop and limits act per "
+    "tick",
+    "[host][gpio]") {
     for (bool can : {false, true}) {
-        Machine m(can ? std::unique_ptr<linux_device::AnyMotionDevice>(linux_device::CanMotionDevice::create({20000, 0}, 1))
+        Machine m(can ? std::unique_ptr<linux_device::AnyMotionDevice>(
+                            linux_device::CanMotionDevice::create({20000, 0}, 1))
                       : modbus_device(20000, 0));
         REQUIRE(m.dev->configure(host::device_limits(profile())) == Status::kOk);
         CHECK(m.dev->tick_hz() == 1000);
@@ -139,7 +144,8 @@ TEST_CASE("device io: the configured device is the one a host would configure, e
         m.tick();
         CHECK(m.io->limit_trips() == 1);
         CHECK(m.dev->state() == static_cast<std::uint8_t>(DeviceState::kFault));
-        CHECK(m.dev->fault_code() == static_cast<std::uint16_t>(device::limit_fault(0, LimitSide::kNegative)));
+        CHECK(m.dev->fault_code() ==
+              static_cast<std::uint16_t>(device::limit_fault(0, LimitSide::kNegative)));
         // The e-stop overrides the fault: the next tick enters e-stop.
         m.estop.drive(true);
         m.tick();
@@ -149,9 +155,11 @@ TEST_CASE("device io: the configured device is the one a host would configure, e
     }
 }
 
-TEST_CASE("device io: homing x then y from the profile, pulled off the switches", "[host][gpio][homing]") {
+TEST_CASE("device io: homing x then y from the profile, pulled off the switches",
+          "[host][gpio][homing]") {
     for (bool can : {false, true}) {
-        Machine m(can ? std::unique_ptr<linux_device::AnyMotionDevice>(linux_device::CanMotionDevice::create({25000, 30000}, 1))
+        Machine m(can ? std::unique_ptr<linux_device::AnyMotionDevice>(
+                            linux_device::CanMotionDevice::create({25000, 30000}, 1))
                       : modbus_device(25000, 30000));
         const host::MachineProfile p = profile();
         REQUIRE(m.dev->configure(host::device_limits(p)) == Status::kOk);
@@ -159,14 +167,15 @@ TEST_CASE("device io: homing x then y from the profile, pulled off the switches"
         std::vector<std::string> log;
         bool enable_seen = false;
         auto run = m.run_until(400000);
-        const auto homed = linux_device::home_axes(*m.dev, *m.io, host::homing_setups(p), p.mm_per_lsb,
-                                          [&](const std::function<bool()>& done) {
-                                              return run([&] {
-                                                  enable_seen = enable_seen || m.enable.state();
-                                                  return done();
-                                              });
-                                          },
-                                          [&](const std::string& line) { log.push_back(line); });
+        const auto homed = linux_device::home_axes(
+            *m.dev, *m.io, host::homing_setups(p), p.mm_per_lsb,
+            [&](const std::function<bool()>& done) {
+                return run([&] {
+                    enable_seen = enable_seen || m.enable.state();
+                    return done();
+                });
+            },
+            [&](const std::string& line) { log.push_back(line); });
         REQUIRE(homed.size() == 2);
         CHECK(enable_seen);
         CHECK_FALSE(m.enable.state());
@@ -185,20 +194,24 @@ TEST_CASE("device io: homing x then y from the profile, pulled off the switches"
         CHECK(m.dev->position(1) - m.offset[1] < m.y_switch);
         CHECK(m.dev->position(1) < 200000);
         CHECK(m.dev->position(1) > 200000 - 600);
-        CHECK(log.front().find("homing x toward switch x-: search at 20.000 mm/s for at most 40.000 mm") == 0);
+        CHECK(log.front().find(
+                  "homing x toward switch x-: search at 20.000 mm/s for at most 40.000 mm") == 0);
         bool latch_logged = false;
-        for (const auto& l : log) latch_logged = latch_logged || l.find("y: approaching slowly") != std::string::npos;
+        for (const auto& l : log)
+            latch_logged = latch_logged || l.find("y: approaching slowly") != std::string::npos;
         CHECK(latch_logged);
         // The homing switch is armed again: the machine on it (here: the switch moved under it)
         // faults, naming it.
         m.x_switch = m.dev->position(0) - m.offset[0] + 5;
         m.tick();
         m.tick();
-        CHECK(m.dev->fault_code() == static_cast<std::uint16_t>(device::limit_fault(0, LimitSide::kNegative)));
+        CHECK(m.dev->fault_code() ==
+              static_cast<std::uint16_t>(device::limit_fault(0, LimitSide::kNegative)));
     }
 }
 
-TEST_CASE("device io: homing errors name the axis, the switch and the reason", "[host][gpio][homing]") {
+TEST_CASE("device io: homing errors name the axis, the switch and the reason",
+          "[host][gpio][homing]") {
     const host::MachineProfile p = profile();
     auto start = [&](Machine& m) {
         REQUIRE(m.dev->configure(host::device_limits(p)) == Status::kOk);
@@ -209,7 +222,8 @@ TEST_CASE("device io: homing errors name the axis, the switch and the reason", "
         Machine m(modbus_device(25000, 0));
         start(m);
         m.x_switch = -100000;
-        CHECK_THROWS_WITH(linux_device::home_axes(*m.dev, *m.io, host::homing_setups(p), p.mm_per_lsb, m.run_until(400000), quiet),
+        CHECK_THROWS_WITH(linux_device::home_axes(*m.dev, *m.io, host::homing_setups(p),
+                                                  p.mm_per_lsb, m.run_until(400000), quiet),
                           "homing x: switch x- not found within 40.000 mm (max_travel)");
         CHECK(m.dev->state() == static_cast<std::uint8_t>(DeviceState::kIdle));
         CHECK(m.dev->position(0) == 25000 - 40000);
@@ -218,22 +232,25 @@ TEST_CASE("device io: homing errors name the axis, the switch and the reason", "
         Machine m(modbus_device(25000, 0));
         start(m);
         m.x_switch = 1000000;
-        CHECK_THROWS_WITH(linux_device::home_axes(*m.dev, *m.io, host::homing_setups(p), p.mm_per_lsb, m.run_until(400000), quiet),
-                          Catch::StartsWith("homing x: switch x- still active after moving off it"));
+        CHECK_THROWS_WITH(
+            linux_device::home_axes(*m.dev, *m.io, host::homing_setups(p), p.mm_per_lsb,
+                                    m.run_until(400000), quiet),
+            Catch::StartsWith("homing x: switch x- still active after moving off it"));
     }
     SECTION("the e-stop during homing") {
         Machine m(modbus_device(25000, 0));
         start(m);
         std::uint64_t ticks = 0;
         auto run = m.run_until(400000);
-        CHECK_THROWS_WITH(linux_device::home_axes(*m.dev, *m.io, host::homing_setups(p), p.mm_per_lsb,
-                                         [&](const std::function<bool()>& done) {
-                                             return run([&] {
-                                                 if (++ticks == 200) m.estop.drive(true);
-                                                 return done();
-                                             });
-                                         },
-                                         quiet),
+        CHECK_THROWS_WITH(linux_device::home_axes(
+                              *m.dev, *m.io, host::homing_setups(p), p.mm_per_lsb,
+                              [&](const std::function<bool()>& done) {
+                                  return run([&] {
+                                      if (++ticks == 200) m.estop.drive(true);
+                                      return done();
+                                  });
+                              },
+                              quiet),
                           "homing x: interrupted by the e-stop");
         CHECK(m.dev->state() == static_cast<std::uint8_t>(DeviceState::kEstop));
     }
@@ -241,13 +258,16 @@ TEST_CASE("device io: homing errors name the axis, the switch and the reason", "
         Machine m(modbus_device(25000, 0));
         m.wiring.limit[0][0] = nullptr;
         start(m);
-        CHECK_THROWS_WITH(linux_device::home_axes(*m.dev, *m.io, host::homing_setups(p), p.mm_per_lsb, m.run_until(1000), quiet),
+        CHECK_THROWS_WITH(linux_device::home_axes(*m.dev, *m.io, host::homing_setups(p),
+                                                  p.mm_per_lsb, m.run_until(1000), quiet),
                           "homing x: switch x- is not wired");
     }
     SECTION("an unconfigured device") {
         Machine m(modbus_device(25000, 0));
         m.io = &m.dev->attach_io(m.wiring);
-        CHECK_THROWS_WITH(linux_device::home_axes(*m.dev, *m.io, host::homing_setups(p), p.mm_per_lsb, m.run_until(1000), quiet),
-                          "homing x: the device refused a homing step: device limits not configured");
+        CHECK_THROWS_WITH(
+            linux_device::home_axes(*m.dev, *m.io, host::homing_setups(p), p.mm_per_lsb,
+                                    m.run_until(1000), quiet),
+            "homing x: the device refused a homing step: device limits not configured");
     }
 }

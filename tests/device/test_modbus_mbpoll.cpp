@@ -1,11 +1,10 @@
 // Interoperability of the simulated device's register map with an independent master: Debian's
 // mbpoll (libmodbus-based) reads the status block and drives the command register over TCP and
 // RTU (a pty), as a user checking a device by hand would. mbpoll numbers references from 1.
-#include <catch2/catch.hpp>
-
 #include <unistd.h>
 
 #include <atomic>
+#include <catch2/catch.hpp>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -72,7 +71,8 @@ struct DeviceThread {
     std::thread thread;
     void run() {
         thread = std::thread([this] {
-            linux_device::run_device_loop(*device, [&](std::chrono::microseconds w) { server->poll_once(w); }, {}, stop);
+            linux_device::run_device_loop(
+                *device, [&](std::chrono::microseconds w) { server->poll_once(w); }, {}, stop);
         });
     }
     void halt() {
@@ -94,8 +94,9 @@ struct HaltBeforeServer {
 std::string config_values() {
     std::ostringstream v;
     v << "0 1000 2 0 0 0 0 0 0 0";
-    for (int a = 0; a < 2; ++a) v << ' ' << (250000 >> 16) << ' ' << (250000 & 0xFFFF) << ' ' << (3000000 >> 16) << ' '
-                                  << (3000000 & 0xFFFF);
+    for (int a = 0; a < 2; ++a)
+        v << ' ' << (250000 >> 16) << ' ' << (250000 & 0xFFFF) << ' ' << (3000000 >> 16) << ' '
+          << (3000000 & 0xFFFF);
     v << " 0 0 0 0 0 0 0 0";  // travel of both axes: 0, 0 = no soft limits
     v << " 0 0 0 0";          // max jerk of both axes: 0 = no jerk limit
     return v.str();
@@ -107,7 +108,8 @@ long wait_state(const std::string& program, const std::string& link, long want) 
     long state = -1;
     const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(2);
     do {
-        const auto v = values(mbpoll(program, link + " -r " + std::to_string(st::kState + 1) + " -c 1 -t 3 -1"));
+        const auto v = values(
+            mbpoll(program, link + " -r " + std::to_string(st::kState + 1) + " -c 1 -t 3 -1"));
         state = v.count(st::kState + 1) != 0 ? v.at(st::kState + 1) : -1;
         if (state == want) break;
         std::this_thread::sleep_for(std::chrono::milliseconds(20));
@@ -131,29 +133,34 @@ void check_device(const std::string& program, const std::string& link) {
     CHECK(v.at(st::kCapacity + 1) == linux_device::kModbusDeviceCapacity);
 
     // Positions as 32-bit integers, big-endian word order: the start the device was made with.
-    const std::string pos = mbpoll(program, link + " -r " + std::to_string(st::kPositions + 1) + " -c 2 -t 3:int -B -1");
+    const std::string pos = mbpoll(
+        program, link + " -r " + std::to_string(st::kPositions + 1) + " -c 2 -t 3:int -B -1");
     INFO("mbpoll output:\n" << pos);
     const auto p = values(pos);
     REQUIRE(p.size() == 2);
     CHECK(p.at(st::kPositions + 1) == 1234);
     CHECK(p.at(st::kPositions + 3) == -70000);
-    const auto axes = values(mbpoll(program, link + " -r " + std::to_string(st::kAxes + 1) + " -c 1 -t 3 -1"));
+    const auto axes =
+        values(mbpoll(program, link + " -r " + std::to_string(st::kAxes + 1) + " -c 1 -t 3 -1"));
     CHECK(axes.at(st::kAxes + 1) == 2);
 
     // FC6 start while unconfigured: refused with server device failure, state unchanged.
-    const std::string refused = mbpoll(program, link + " -r " + std::to_string(mb::kCommand + 1) + " -t 4 -1 1");
+    const std::string refused =
+        mbpoll(program, link + " -r " + std::to_string(mb::kCommand + 1) + " -t 4 -1 1");
     INFO("mbpoll output:\n" << refused);
     CHECK_THAT(refused, Contains("failure"));
     CHECK(wait_state(program, link, 0) == 0);
 
     // FC16 configuration, read back with FC3; the configured flag is set.
-    const std::string written =
-        mbpoll(program, link + " -r " + std::to_string(mb::kConfig + 1) + " -t 4 -1 " + config_values());
+    const std::string written = mbpoll(
+        program, link + " -r " + std::to_string(mb::kConfig + 1) + " -t 4 -1 " + config_values());
     INFO("mbpoll output:\n" << written);
     CHECK_THAT(written, Contains("Written 30 references"));
-    const auto hz = values(mbpoll(program, link + " -r " + std::to_string(mb::kConfig + 1) + " -c 2 -t 4:int -B -1"));
+    const auto hz = values(
+        mbpoll(program, link + " -r " + std::to_string(mb::kConfig + 1) + " -c 2 -t 4:int -B -1"));
     CHECK(hz.at(mb::kConfig + 1) == 1000);
-    const auto flags = values(mbpoll(program, link + " -r " + std::to_string(st::kFlags + 1) + " -c 1 -t 3 -1"));
+    const auto flags =
+        values(mbpoll(program, link + " -r " + std::to_string(st::kFlags + 1) + " -c 1 -t 3 -1"));
     CHECK(flags.at(st::kFlags + 1) == 1);
 
     // FC6 start with nothing queued: refused (nothing would move), the device stays idle and
@@ -169,27 +176,33 @@ void check_device(const std::string& program, const std::string& link) {
                Contains("Written 1 references"));
     CHECK(wait_state(program, link, 0) == 0);
     // The command register reads back the last command accepted.
-    const auto cmd = values(mbpoll(program, link + " -r " + std::to_string(mb::kCommand + 1) + " -c 1 -t 4 -1"));
+    const auto cmd =
+        values(mbpoll(program, link + " -r " + std::to_string(mb::kCommand + 1) + " -c 1 -t 4 -1"));
     CHECK(cmd.at(mb::kCommand + 1) == 4);
 }
 
 }  // namespace
 
-TEST_CASE("mbpoll reads the simulated device's status block and drives its commands over TCP and RTU",
-          "[modbus][mbpoll][threads]") {
+TEST_CASE(
+    "mbpoll reads the simulated device's status block and drives its commands over TCP and RTU",
+    "[modbus][mbpoll][threads]") {
     const std::string program = find_mbpoll();
     if (program.empty()) {
-        WARN("mbpoll not found on PATH: the interoperability test is skipped (scripts/setup.sh installs it)");
+        WARN(
+            "mbpoll not found on PATH: the interoperability test is skipped (scripts/setup.sh "
+            "installs it)");
         return;
     }
     SECTION("TCP, ephemeral port") {
         DeviceThread dt;
         dt.device = linux_device::ModbusMotionDevice::create({1234, -70000});
-        hal::ModbusServer server = hal::ModbusServer::tcp(dt.device->handler(), {"127.0.0.1", 0, 4});
+        hal::ModbusServer server =
+            hal::ModbusServer::tcp(dt.device->handler(), {"127.0.0.1", 0, 4});
         dt.server = &server;
         const HaltBeforeServer guard{dt};
         dt.run();
-        check_device(program, "-m tcp -a 1 -o 2 -p " + std::to_string(server.port()) + " 127.0.0.1");
+        check_device(program,
+                     "-m tcp -a 1 -o 2 -p " + std::to_string(server.port()) + " 127.0.0.1");
     }
     SECTION("RTU on a pty, 115200 8N1") {
         DeviceThread dt;

@@ -22,11 +22,11 @@ TEST_CASE("paced loop: at rest, ticks at most at the rest rate however fast the 
     o.at_rest = [] { return true; };
     o.rest_tick_hz = 1000;
     const std::uint64_t ran = linux_device::run_paced_loop([&] { ++ticks; }, [] { return 1000u; },
-                                                  [&](std::chrono::microseconds w) {
-                                                      ++serves;
-                                                      std::this_thread::sleep_for(w);
-                                                  },
-                                                  o, stop);
+                                                           [&](std::chrono::microseconds w) {
+                                                               ++serves;
+                                                               std::this_thread::sleep_for(w);
+                                                           },
+                                                           o, stop);
     CHECK(ran == ticks);
     // 200 ms at 1,000 a second, with room for the first tick and the clock's rounding.
     CHECK(ticks <= 202);

@@ -2,7 +2,6 @@
 // generator's output byte for byte (regenerate: pathstream_can_dbc 1 > docs/pathstream.dbc),
 // and the declaration itself must be consistent (signals inside their frames, no overlaps).
 #include <catch2/catch.hpp>
-
 #include <fstream>
 #include <set>
 #include <sstream>
@@ -35,7 +34,8 @@ TEST_CASE("the CAN protocol declaration is consistent", "[can][dbc]") {
             const pc::Signal& s = m.signals[i];
             INFO(s.name);
             REQUIRE(s.byte + s.bytes <= m.length + (m.base == pc::kSpanDataBase ? 0 : 0));
-            if (s.mux >= 0 && s.mux != 0) continue;  // multiplexed values share bytes 2..5 with TickRate (m0)
+            if (s.mux >= 0 && s.mux != 0)
+                continue;  // multiplexed values share bytes 2..5 with TickRate (m0)
             for (unsigned b = s.byte; b < s.byte + s.bytes; ++b) {
                 CHECK_FALSE(used[b]);
                 used[b] = true;
@@ -53,7 +53,8 @@ TEST_CASE("encoders and decoders agree with the declared layout", "[can][dbc]") 
     CHECK(f.data[2] == 0x04);  // little-endian, as the DBC says (@1)
     pc::Ack b;
     REQUIRE(pc::decode_ack(f, b));
-    CHECK((b.kind == a.kind && b.result == a.result && b.sequence == a.sequence && b.free_slots == 9 && b.state == 1));
+    CHECK((b.kind == a.kind && b.result == a.result && b.sequence == a.sequence &&
+           b.free_slots == 9 && b.state == 1));
     pc::Status3 s;
     s.state = 2;
     s.fault_code = 0x0103;
@@ -69,8 +70,8 @@ TEST_CASE("encoders and decoders agree with the declared layout", "[can][dbc]") 
     CHECK(out[3].id == 0x505u);
     pc::Status3 t;
     for (const auto& o : out) REQUIRE(pc::decode_status_part(o, t));
-    CHECK((t.state == 2 && t.fault_code == 0x0103 && t.last_accepted == 77 && t.last_completed == 70 &&
-           t.ticks_executed == 123456 && t.axes == 4 && t.version == 1));
+    CHECK((t.state == 2 && t.fault_code == 0x0103 && t.last_accepted == 77 &&
+           t.last_completed == 70 && t.ticks_executed == 123456 && t.axes == 4 && t.version == 1));
     CHECK((t.finished_job == 31 && t.finished_job_ticks == 0x01020304u));
     // Status E: a negative position and the epoch's low 16 bits survive the trip.
     const pc::Frame e = pc::encode_status_axis(5, 3, -123456789, 0x12345u);

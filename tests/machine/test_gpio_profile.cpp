@@ -13,7 +13,9 @@ const char* kAxes = R"("axes": [{"name": "x", "max_velocity": 100, "max_accelera
                                 {"name": "y", "max_velocity": 100, "max_acceleration": 1000}])";
 
 // Line 3 of the document starts with `"gpio": ` (8 columns) before the object.
-std::string with_gpio(const std::string& gpio) { return std::string("{") + kAxes + ",\n\"gpio\": " + gpio + "}"; }
+std::string with_gpio(const std::string& gpio) {
+    return std::string("{") + kAxes + ",\n\"gpio\": " + gpio + "}";
+}
 
 std::string error_of(const std::string& text) {
     try {
@@ -67,16 +69,20 @@ TEST_CASE("gpio profile: every field", "[host][gpio][machine]") {
     CHECK(g.home[0].position == -5);
 }
 
-TEST_CASE("gpio profile: bad values are refused with the place and the reason", "[host][gpio][machine]") {
+TEST_CASE("gpio profile: bad values are refused with the place and the reason",
+          "[host][gpio][machine]") {
     CHECK(error_of(with_gpio(R"({"enable": {"line": 1}})")) == "m.json:3:9: gpio has no \"chip\"");
     CHECK(error_of(with_gpio(R"({"chip": ""})")) ==
           "m.json:3:18: chip must be a chip name, path, number or label (non-empty string)");
     CHECK(error_of(with_gpio(R"({"chip": "c", "beeper": {"line": 1}})")) ==
-          "m.json:3:33: unknown key \"beeper\" (expected one of: chip, enable, estop, home, limits, pen)");
-    CHECK(error_of(with_gpio(R"({"chip": "c", "enable": {"line": -1}})")) == "m.json:3:42: line offset must be 0..65535");
+          "m.json:3:33: unknown key \"beeper\" (expected one of: chip, enable, estop, home, "
+          "limits, pen)");
+    CHECK(error_of(with_gpio(R"({"chip": "c", "enable": {"line": -1}})")) ==
+          "m.json:3:42: line offset must be 0..65535");
     CHECK(error_of(with_gpio(R"({"chip": "c", "enable": {"line": 1.5}})")) ==
           "m.json:3:42: line must be an offset (whole number) or a line name (string)");
-    CHECK(error_of(with_gpio(R"({"chip": "c", "enable": {}})")) == "m.json:3:33: enable has no \"line\"");
+    CHECK(error_of(with_gpio(R"({"chip": "c", "enable": {}})")) ==
+          "m.json:3:33: enable has no \"line\"");
     CHECK(error_of(with_gpio(R"({"chip": "c", "estop": {"line": 2, "bias": "up"}})")) ==
           "m.json:3:52: bias must be one of: as-is, disable, pull-up, pull-down");
     CHECK(error_of(with_gpio(R"({"chip": "c", "estop": {"line": 2, "active_low": 1}})")) ==

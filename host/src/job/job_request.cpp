@@ -21,8 +21,10 @@ std::vector<double> parse_numbers(const std::string& text, const std::string& op
         const std::string item = text.substr(at, comma - at);
         double v = 0;
         const auto [end, error] = std::from_chars(item.data(), item.data() + item.size(), v);
-        if (item.empty() || error != std::errc() || end != item.data() + item.size() || !std::isfinite(v)) {
-            throw std::invalid_argument(option + ": \"" + text + "\" is not a comma-separated list of numbers (mm)");
+        if (item.empty() || error != std::errc() || end != item.data() + item.size() ||
+            !std::isfinite(v)) {
+            throw std::invalid_argument(option + ": \"" + text +
+                                        "\" is not a comma-separated list of numbers (mm)");
         }
         values.push_back(v);
         at = comma + 1;
@@ -32,15 +34,19 @@ std::vector<double> parse_numbers(const std::string& text, const std::string& op
 
 }  // namespace
 
-LoadedPath load_path_report(const JobRequest& o, const MachineProfile* machine, const std::vector<double>* start) {
+LoadedPath load_path_report(const JobRequest& o, const MachineProfile* machine,
+                            const std::vector<double>* start) {
     LoadedPath loaded;
     std::string format;
     Path path = read_request_path(o, loaded.gcode_pen, format);
     PlacementOptions placement = o.placement;
-    if (machine != nullptr) placement.edge_clearance = machine->chord_tolerance + machine->mm_per_lsb;
+    if (machine != nullptr)
+        placement.edge_clearance = machine->chord_tolerance + machine->mm_per_lsb;
     if (!o.translate.empty()) {
         const std::vector<double> xy = parse_numbers(o.translate, "--translate");
-        if (xy.size() != 2) throw std::invalid_argument("--translate: give X,Y (2 numbers), got \"" + o.translate + "\"");
+        if (xy.size() != 2)
+            throw std::invalid_argument("--translate: give X,Y (2 numbers), got \"" + o.translate +
+                                        "\"");
         placement.translate = std::make_pair(xy[0], xy[1]);
     }
     loaded.placed = placement.active();
@@ -67,7 +73,8 @@ LoadedPath load_path_report(const JobRequest& o, const MachineProfile* machine, 
             order.start = parse_numbers(o.order_start, "--order-start");
             if (order.start.size() != path.axes) {
                 throw std::invalid_argument("--order-start: give " + std::to_string(path.axes) +
-                                            " coordinates (one per axis of the path), got \"" + o.order_start + "\"");
+                                            " coordinates (one per axis of the path), got \"" +
+                                            o.order_start + "\"");
             }
         } else if (start != nullptr && start->size() == path.axes) {
             order.start = *start;
@@ -79,7 +86,8 @@ LoadedPath load_path_report(const JobRequest& o, const MachineProfile* machine, 
     return loaded;
 }
 
-Path load_path(const JobRequest& o, const MachineProfile* machine, const std::vector<double>* start) {
+Path load_path(const JobRequest& o, const MachineProfile* machine,
+               const std::vector<double>* start) {
     return load_path_report(o, machine, start).path;
 }
 

@@ -28,7 +28,7 @@ PathBasis basis_from_name(const std::string& name) {
 /// The G-code reader's options from the command line's.
 GcodeOptions gcode_options(const JobRequest& o) {
     GcodeOptions g;
-    g.pen = o.gcode_pen == "spindle" ? PenControl::kSpindle
+    g.pen = o.gcode_pen == "spindle"  ? PenControl::kSpindle
             : o.gcode_pen == "motion" ? PenControl::kMotion
             : o.gcode_pen == "auto"   ? PenControl::kAuto
                                       : PenControl::kZ;
@@ -39,15 +39,18 @@ GcodeOptions gcode_options(const JobRequest& o) {
 }
 
 /// A G-code program's path: its warnings printed, its pen mode noted in `gcode_pen`.
-Path read_gcode(const std::string& text, const std::string& name, const JobRequest& o, std::string& gcode_pen) {
+Path read_gcode(const std::string& text, const std::string& name, const JobRequest& o,
+                std::string& gcode_pen) {
     GcodeReadInfo info;
     Path path = parse_gcode_path(text, name, gcode_options(o), &info);
-    for (const std::string& warning : info.warnings) std::cerr << "pathstream: warning: " << warning << '\n';
+    for (const std::string& warning : info.warnings)
+        std::cerr << "pathstream: warning: " << warning << '\n';
     gcode_pen = std::string(pen_control_name(info.pen)) + " (" + info.pen_reason + ")";
     return path;
 }
 
-Path read_json(const std::string& text, const std::string& name, const JobRequest& o, std::string&) {
+Path read_json(const std::string& text, const std::string& name, const JobRequest& o,
+               std::string&) {
     return parse_json_path(text, name, o.tolerance);
 }
 
@@ -56,7 +59,8 @@ Path read_json(const std::string& text, const std::string& name, const JobReques
 Path read_svg(const std::string& text, const std::string& name, const JobRequest& o, std::string&) {
     svg::SvgReadInfo info;
     Path path = parse_svg_path(text, name, o.tolerance, &info);
-    for (const std::string& warning : info.warnings) std::cerr << "pathstream: warning: " << warning << '\n';
+    for (const std::string& warning : info.warnings)
+        std::cerr << "pathstream: warning: " << warning << '\n';
     return path;
 }
 
@@ -70,7 +74,8 @@ std::string read_all(std::istream& in, std::size_t size_hint) {
     std::string text;
     text.reserve(size_hint);
     char block[1 << 16];
-    while (in.read(block, sizeof block) || in.gcount() > 0) text.append(block, static_cast<std::size_t>(in.gcount()));
+    while (in.read(block, sizeof block) || in.gcount() > 0)
+        text.append(block, static_cast<std::size_t>(in.gcount()));
     return text;
 }
 
@@ -90,7 +95,8 @@ std::string format_of_file_name(const std::string& name) {
     const std::size_t dot = name.find_last_of('.');
     if (dot == std::string::npos || name.find('/', dot) != std::string::npos) return "";
     std::string ext = name.substr(dot + 1);
-    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+    std::transform(ext.begin(), ext.end(), ext.begin(),
+                   [](unsigned char c) { return std::tolower(c); });
     for (const PathFormat& f : path_formats()) {
         for (const std::string& e : f.extensions) {
             if (e == ext) return f.name;
@@ -105,7 +111,8 @@ std::string path_extension_list() {
         for (const std::string& e : f.extensions) all.push_back("." + e);
     }
     std::string text;
-    for (std::size_t i = 0; i < all.size(); ++i) text += (i == 0 ? "" : i + 1 == all.size() ? " or " : ", ") + all[i];
+    for (std::size_t i = 0; i < all.size(); ++i)
+        text += (i == 0 ? "" : i + 1 == all.size() ? " or " : ", ") + all[i];
     return text;
 }
 
@@ -128,7 +135,8 @@ std::string read_path_text(const std::string& file) {
     if (!in) throw InputError(file, {}, "cannot open file");
     std::error_code error;
     const std::uintmax_t size = std::filesystem::file_size(file, error);
-    std::string text = read_all(in, !error && size < (std::uintmax_t{1} << 40) ? static_cast<std::size_t>(size) : 0);
+    std::string text = read_all(
+        in, !error && size < (std::uintmax_t{1} << 40) ? static_cast<std::size_t>(size) : 0);
     if (in.bad()) throw InputError(file, {}, "cannot read file");
     return text;
 }
@@ -138,10 +146,12 @@ std::string request_format(const JobRequest& o) {
     if (!o.format.empty() || o.file == "-") return o.format;
     const std::size_t dot = o.file.find_last_of('.');
     std::string ext = o.file.substr(dot == std::string::npos ? o.file.size() : dot);
-    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+    std::transform(ext.begin(), ext.end(), ext.begin(),
+                   [](unsigned char c) { return std::tolower(c); });
     const std::string format = format_of_file_name(o.file);
     if (!format.empty()) return format;
-    throw InputError(o.file, {}, "unknown file type \"" + ext + "\" (expected " + path_extension_list() + ")");
+    throw InputError(o.file, {},
+                     "unknown file type \"" + ext + "\" (expected " + path_extension_list() + ")");
 }
 
 Path read_request_path(const JobRequest& o, std::string& gcode_pen, std::string& format) {

@@ -15,8 +15,9 @@ void refuse_long_motion(const PlannedJob& job, double max_motion_s) {
     if (max_motion_s <= 0 || job.segments.empty()) return;
     const double estimate = JobEstimate(job.segments, job.machine).model_seconds();
     if (estimate > max_motion_s) {
-        throw PlanError("the job moves for about " + duration_text(estimate) + " (estimated before planning), longer than " +
-                        duration_text(max_motion_s) + " (--max-motion)");
+        throw PlanError("the job moves for about " + duration_text(estimate) +
+                        " (estimated before planning), longer than " + duration_text(max_motion_s) +
+                        " (--max-motion)");
     }
 }
 

@@ -3,15 +3,15 @@
 // (DeviceIo). The bus side differs; this part is written once.
 #pragma once
 
-#include <cstring>
-#include <type_traits>
 #include <cstdint>
+#include <cstring>
 #include <memory>
+#include <type_traits>
 #include <vector>
 
 #include "pathstream/device/motion_device.hpp"
-#include "pathstream/machine/device_setup.hpp"
 #include "pathstream/linux_device/device_io.hpp"
+#include "pathstream/machine/device_setup.hpp"
 #include "pathstream/units.hpp"
 
 namespace pathstream::linux_device {
@@ -110,30 +110,41 @@ public:
         if (io_) io_->after_tick();
         // The status but its tick count (the words after tick_count and before tick_check,
         // then every word after it), against the last tick's.
-        static_assert(std::has_unique_object_representations_v<device::DeviceStatus<Axes>>, "compared bytewise");
+        static_assert(std::has_unique_object_representations_v<device::DeviceStatus<Axes>>,
+                      "compared bytewise");
         device::DeviceStatus<Axes> now = device_.status();
         now.tick_count = now.tick_check = 0;
-        this->unchanged_ticks_ = std::memcmp(&now, &last_status_, sizeof now) == 0 ? this->unchanged_ticks_ + 1 : 0;
+        this->unchanged_ticks_ =
+            std::memcmp(&now, &last_status_, sizeof now) == 0 ? this->unchanged_ticks_ + 1 : 0;
         last_status_ = now;
-        if (this->observer_ != nullptr) this->observer_->after_tick(out, Axes, device_.status().position_applied);
+        if (this->observer_ != nullptr)
+            this->observer_->after_tick(out, Axes, device_.status().position_applied);
         ++this->ticks_run_;
-        if (this->recording_every_tick_) this->every_tick_.insert(this->every_tick_.end(), out, out + Axes);
+        if (this->recording_every_tick_)
+            this->every_tick_.insert(this->every_tick_.end(), out, out + Axes);
         if (this->recording_ && device_.ticks_executed() != before) {  // a path tick
             this->setpoints_.insert(this->setpoints_.end(), out, out + Axes);
             this->ticks_.push_back({static_cast<std::uint8_t>(device_.state()), device_.outputs()});
         }
     }
     unsigned axes() const override { return Axes; }
-    std::uint32_t tick_hz() const override { return device_.configured() ? device_.limits().tick_hz : 0; }
+    std::uint32_t tick_hz() const override {
+        return device_.configured() ? device_.limits().tick_hz : 0;
+    }
     std::uint8_t state() const override { return static_cast<std::uint8_t>(device_.state()); }
-    std::uint16_t fault_code() const override { return static_cast<std::uint16_t>(device_.fault_code()); }
+    std::uint16_t fault_code() const override {
+        return static_cast<std::uint16_t>(device_.fault_code());
+    }
     Lsb position(unsigned axis) const override { return device_.position(axis); }
     std::uint32_t job() const override { return device_.status().job; }
     std::uint32_t finished_job() const override { return device_.status().finished_job; }
-    std::uint32_t finished_job_ticks() const override { return device_.status().finished_job_ticks; }
+    std::uint32_t finished_job_ticks() const override {
+        return device_.status().finished_job_ticks;
+    }
     void raise_fault() override { device_.raise_fault(device::FaultCode::kExternal); }
     Status configure(const host::DeviceLimitsLsb& l) override {
-        if (l.max_velocity.size() != Axes || l.max_acceleration.size() != Axes) return Status::kBadLimits;
+        if (l.max_velocity.size() != Axes || l.max_acceleration.size() != Axes)
+            return Status::kBadLimits;
         device::MotionLimits<Axes> m;
         m.tick_hz = l.tick_hz;
         for (unsigned a = 0; a < Axes; ++a) {

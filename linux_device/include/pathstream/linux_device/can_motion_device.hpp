@@ -25,7 +25,8 @@ class CanMotionDevice : public AnyMotionDevice {
 public:
     /// `start`: initial position (LSB), its size is the axis count (1..8); `node` 1..127.
     /// Throws std::invalid_argument otherwise.
-    static std::unique_ptr<CanMotionDevice> create(const std::vector<Lsb>& start, std::uint8_t node);
+    static std::unique_ptr<CanMotionDevice> create(const std::vector<Lsb>& start,
+                                                   std::uint8_t node);
 
     /// Handles the frames `bus` delivers within `wait` (at least one wait for the first,
     /// then whatever is already there) and sends the answers; answers the bus refuses
@@ -43,7 +44,7 @@ public:
 
 /// Serves `bus` and ticks `device` on the steady clock (options.time_scale times real time)
 /// until `stop` or options.run_for. Returns the ticks run.
-std::uint64_t run_can_device_loop(CanMotionDevice& device, hal::CanBus& bus, const DeviceLoopOptions& options,
-                                  const std::atomic<bool>& stop);
+std::uint64_t run_can_device_loop(CanMotionDevice& device, hal::CanBus& bus,
+                                  const DeviceLoopOptions& options, const std::atomic<bool>& stop);
 
 }  // namespace pathstream::linux_device

@@ -30,7 +30,8 @@ public:
 
     /// `device` and every line in `wiring` must outlive this object. Drives the outputs to
     /// the device's current state at once (enable off for an idle device).
-    DeviceGpio(Device& device, const DeviceWiring<Axes>& wiring) : device_(device), wiring_(wiring) {
+    DeviceGpio(Device& device, const DeviceWiring<Axes>& wiring)
+        : device_(device), wiring_(wiring) {
         update_outputs();
     }
 
@@ -54,7 +55,8 @@ public:
             }
             const bool level = wiring_.estop->active();
             if (activated || level) estop_held_ = true;
-            if (estop_held_ && !level && !activated && device_.state() == device::DeviceState::kEstop) {
+            if (estop_held_ && !level && !activated &&
+                device_.state() == device::DeviceState::kEstop) {
                 estop_held_ = false;
             }
             device_.set_estop_input(estop_held_);
@@ -70,7 +72,8 @@ public:
                 if (first_poll_ && level) tripped = true;
                 limit_level_[a][side] = level || tripped;
                 if (tripped && !masked_[a][side]) {
-                    device_.raise_fault(device::limit_fault(a, static_cast<device::LimitSide>(side)));
+                    device_.raise_fault(
+                        device::limit_fault(a, static_cast<device::LimitSide>(side)));
                     ++limit_trips_;
                 }
             }

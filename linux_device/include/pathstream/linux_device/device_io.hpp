@@ -9,8 +9,8 @@
 
 #include "pathstream/device/homing.hpp"
 #include "pathstream/device/homing_run.hpp"
-#include "pathstream/device/operator_commands.hpp"
 #include "pathstream/device/motion_device.hpp"
+#include "pathstream/device/operator_commands.hpp"
 #include "pathstream/linux_device/device_gpio.hpp"
 
 namespace pathstream::linux_device {
@@ -36,7 +36,8 @@ public:
     /// Starts homing `config.axis` against its `side` switch (which must be wired: else
     /// kBadLimits). The switch's fault is masked while homing and armed again when it ends.
     /// The device must be configured and idle (the sequencer's errors otherwise).
-    [[nodiscard]] virtual Status start_homing(const device::HomingConfig& config, device::LimitSide side) = 0;
+    [[nodiscard]] virtual Status start_homing(const device::HomingConfig& config,
+                                              device::LimitSide side) = 0;
     /// True from start_homing() until the sequence ends (done or error).
     virtual bool homing_busy() const = 0;
     virtual device::HomingPhase homing_phase() const = 0;
@@ -50,7 +51,8 @@ public:
 
     /// The axes a bus's home command may home, in order (init: the profile's gpio.home).
     /// kBadLimits for more axes than the device has, a repeated axis, or an unwired switch.
-    [[nodiscard]] virtual Status set_homing_plan(const device::HomingAxis* axes, unsigned count) = 0;
+    [[nodiscard]] virtual Status set_homing_plan(const device::HomingAxis* axes,
+                                                 unsigned count) = 0;
     /// Starts a homing run (a bus's home command, through homing_port()): the plan's axes in
     /// `mask` (0: all), one after another; each later one starts when the one before ends
     /// homed. kWrongState unless idle with nothing queued and no homing going on; kNoHoming
@@ -66,9 +68,13 @@ public:
     device::HomingPort homing_port() {
         device::HomingPort p;
         p.context = this;
-        p.start = [](void* c, std::uint8_t mask) { return static_cast<DeviceIo*>(c)->start_homing_run(mask); };
+        p.start = [](void* c, std::uint8_t mask) {
+            return static_cast<DeviceIo*>(c)->start_homing_run(mask);
+        };
         p.busy = [](const void* c) { return static_cast<const DeviceIo*>(c)->homing_run_busy(); };
-        p.report = [](const void* c, unsigned axis) { return static_cast<const DeviceIo*>(c)->homing_report(axis); };
+        p.report = [](const void* c, unsigned axis) {
+            return static_cast<const DeviceIo*>(c)->homing_report(axis);
+        };
         return p;
     }
 
@@ -91,7 +97,8 @@ public:
         if (homing_.busy()) return;
         glue_.mask_limit(homing_axis_, homing_side_, false);
         if (!run_.busy()) return;
-        run_.finished(homing_.phase() == device::HomingPhase::kDone ? device::HomingError::kNone : homing_.error());
+        run_.finished(homing_.phase() == device::HomingPhase::kDone ? device::HomingError::kNone
+                                                                    : homing_.error());
         (void)start_next_axis();
     }
 
@@ -123,14 +130,16 @@ public:
         if (next == nullptr) return Status::kOk;
         const Status s = start_homing(next->config, next->side);
         if (s != Status::kOk) {
-            run_.finished(homing_.error() != device::HomingError::kNone ? homing_.error()
-                                                                         : device::HomingError::kDeviceRefused);
+            run_.finished(homing_.error() != device::HomingError::kNone
+                              ? homing_.error()
+                              : device::HomingError::kDeviceRefused);
         }
         return s;
     }
 
     Status start_homing(const device::HomingConfig& config, device::LimitSide side) override {
-        if (config.axis >= Axes || wiring_.limit[config.axis][static_cast<unsigned>(side)] == nullptr) {
+        if (config.axis >= Axes ||
+            wiring_.limit[config.axis][static_cast<unsigned>(side)] == nullptr) {
             return Status::kBadLimits;
         }
         homing_axis_ = config.axis;

@@ -45,7 +45,7 @@ using AttachMachine = std::function<void(AnyMotionDevice& device, const DeviceLo
 /// profile the device cannot use, HomingFailed when homing fails or is stopped, hal::ModbusError,
 /// hal::GpioError or std::system_error when a bus or line cannot be opened. Main thread; blocks.
 int run_device_runtime(const DeviceRunOptions& options, const std::vector<Lsb>& start,
-                       const std::optional<host::MachineProfile>& profile, const AttachMachine& attach,
-                       const std::atomic<bool>& stop);
+                       const std::optional<host::MachineProfile>& profile,
+                       const AttachMachine& attach, const std::atomic<bool>& stop);
 
 }  // namespace pathstream::linux_device

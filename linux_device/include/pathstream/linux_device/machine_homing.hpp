@@ -8,9 +8,9 @@
 #include <string>
 #include <vector>
 
-#include "pathstream/machine/device_setup.hpp"
-#include "pathstream/linux_device/device_io.hpp"
 #include "pathstream/linux_device/any_motion_device.hpp"
+#include "pathstream/linux_device/device_io.hpp"
+#include "pathstream/machine/device_setup.hpp"
 
 namespace pathstream::linux_device {
 
@@ -24,10 +24,10 @@ public:
 /// One homed axis.
 struct HomedAxis {
     std::string axis_name;
-    Lsb latch = 0;              ///< where the slow approach saw the switch (old coordinates)
-    std::int64_t overshoot = 0; ///< how far the search stop ran past the switch (LSB)
-    Lsb rest = 0;               ///< the axis's position afterwards (new coordinates)
-    std::uint64_t ticks = 0;    ///< ticks the axis's homing took
+    Lsb latch = 0;               ///< where the slow approach saw the switch (old coordinates)
+    std::int64_t overshoot = 0;  ///< how far the search stop ran past the switch (LSB)
+    Lsb rest = 0;                ///< the axis's position afterwards (new coordinates)
+    std::uint64_t ticks = 0;     ///< ticks the axis's homing took
 };
 
 /// Ticks the device until `done()` is true; false if it gave up (interrupted by the user).
@@ -61,9 +61,10 @@ private:
 void set_homing_plan(linux_device::DeviceIo& io, const std::vector<host::HomingSetup>& setups);
 
 /// Homes `setups` in order, each as a homing run of one axis (so the bus status reports it).
-/// Sets the plan (set_homing_plan) first. `device` must be configured and idle, `io` attached to it.
-/// Throws HomingFailed (with the device stopped: idle, or in fault/e-stop if that ended it).
-std::vector<HomedAxis> home_axes(linux_device::AnyMotionDevice& device, linux_device::DeviceIo& io, const std::vector<host::HomingSetup>& setups,
-                                 double mm_per_lsb, const RunTicksUntil& run_until, const HomingLog& log);
+/// Sets the plan (set_homing_plan) first. `device` must be configured and idle, `io` attached to
+/// it. Throws HomingFailed (with the device stopped: idle, or in fault/e-stop if that ended it).
+std::vector<HomedAxis> home_axes(linux_device::AnyMotionDevice& device, linux_device::DeviceIo& io,
+                                 const std::vector<host::HomingSetup>& setups, double mm_per_lsb,
+                                 const RunTicksUntil& run_until, const HomingLog& log);
 
 }  // namespace pathstream::linux_device

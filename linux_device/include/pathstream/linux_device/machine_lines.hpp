@@ -9,8 +9,8 @@
 #include "pathstream/hal/digital_output.hpp"
 #include "pathstream/hal/gpio.hpp"
 #include "pathstream/hal/gpio_gpiod.hpp"
-#include "pathstream/machine/machine.hpp"
 #include "pathstream/linux_device/device_io.hpp"
+#include "pathstream/machine/machine.hpp"
 
 namespace pathstream::linux_device {
 

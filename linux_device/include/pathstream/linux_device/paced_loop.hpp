@@ -29,7 +29,8 @@ struct DeviceLoopOptions {
 /// true or options.run_for passes. Ticks that fall due while `serve` runs are run right after
 /// it, so the count never drifts (except at rest, see DeviceLoopOptions::at_rest). Returns the
 /// ticks run. Throws std::invalid_argument for a time scale <= 0.
-std::uint64_t run_paced_loop(const std::function<void()>& tick, const std::function<std::uint32_t()>& tick_hz,
+std::uint64_t run_paced_loop(const std::function<void()>& tick,
+                             const std::function<std::uint32_t()>& tick_hz,
                              const std::function<void(std::chrono::microseconds)>& serve,
                              const DeviceLoopOptions& options, const std::atomic<bool>& stop);
 

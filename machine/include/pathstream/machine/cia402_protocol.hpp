@@ -39,10 +39,12 @@ enum class NmtState : std::uint8_t {
 };
 
 // SDO command bytes (expedited transfers only: every object pathstream uses fits 4 bytes).
-inline constexpr std::uint8_t kSdoDownloadRequest = 0x20;   ///< | (4 - n) << 2 | 0x03 (expedited, size)
+inline constexpr std::uint8_t kSdoDownloadRequest =
+    0x20;  ///< | (4 - n) << 2 | 0x03 (expedited, size)
 inline constexpr std::uint8_t kSdoDownloadResponse = 0x60;
 inline constexpr std::uint8_t kSdoUploadRequest = 0x40;
-inline constexpr std::uint8_t kSdoUploadResponse = 0x40;    ///< | (4 - n) << 2 | 0x03, or 0x42 (no size)
+inline constexpr std::uint8_t kSdoUploadResponse =
+    0x40;  ///< | (4 - n) << 2 | 0x03, or 0x42 (no size)
 inline constexpr std::uint8_t kSdoAbort = 0x80;
 
 // SDO abort codes (CiA 301 table 22) the drive raises and the master explains.
@@ -64,26 +66,27 @@ inline constexpr std::uint32_t kAbortDeviceState = 0x08000022;
 std::string sdo_abort_text(std::uint32_t code);
 
 // Object dictionary entries (index; sub-index in the comment where it matters).
-inline constexpr std::uint16_t kDeviceType = 0x1000;           ///< u32, low 16 bits 402 for a drive
-inline constexpr std::uint16_t kErrorRegister = 0x1001;        ///< u8
-inline constexpr std::uint16_t kHeartbeatProducer = 0x1017;    ///< u16 ms, 0 = off
-inline constexpr std::uint16_t kRpdo1Communication = 0x1400;   ///< sub 1 COB-ID u32, sub 2 type u8
-inline constexpr std::uint16_t kRpdo1Mapping = 0x1600;         ///< sub 0 count u8, sub 1..8 u32
+inline constexpr std::uint16_t kDeviceType = 0x1000;          ///< u32, low 16 bits 402 for a drive
+inline constexpr std::uint16_t kErrorRegister = 0x1001;       ///< u8
+inline constexpr std::uint16_t kHeartbeatProducer = 0x1017;   ///< u16 ms, 0 = off
+inline constexpr std::uint16_t kRpdo1Communication = 0x1400;  ///< sub 1 COB-ID u32, sub 2 type u8
+inline constexpr std::uint16_t kRpdo1Mapping = 0x1600;        ///< sub 0 count u8, sub 1..8 u32
 inline constexpr std::uint16_t kTpdo1Communication = 0x1800;
 inline constexpr std::uint16_t kTpdo2Communication = 0x1801;
 inline constexpr std::uint16_t kTpdo1Mapping = 0x1A00;
 inline constexpr std::uint16_t kTpdo2Mapping = 0x1A01;
-inline constexpr std::uint16_t kErrorCode = 0x603F;            ///< u16, last EMCY code
-inline constexpr std::uint16_t kControlword = 0x6040;          ///< u16
-inline constexpr std::uint16_t kStatusword = 0x6041;           ///< u16
-inline constexpr std::uint16_t kModesOfOperation = 0x6060;     ///< i8
-inline constexpr std::uint16_t kModesDisplay = 0x6061;         ///< i8
-inline constexpr std::uint16_t kPositionDemand = 0x6062;       ///< i32, what the drive applies
-inline constexpr std::uint16_t kPositionActual = 0x6064;       ///< i32
-inline constexpr std::uint16_t kFollowingErrorWindow = 0x6065; ///< u32 (inc)
-inline constexpr std::uint16_t kTargetPosition = 0x607A;       ///< i32
-inline constexpr std::uint16_t kQuickStopDeceleration = 0x6085;///< u32 (inc/s^2)
-inline constexpr std::uint16_t kInterpolationPeriod = 0x60C2;  ///< sub 1 u8 value, sub 2 i8 index (10^index s)
+inline constexpr std::uint16_t kErrorCode = 0x603F;              ///< u16, last EMCY code
+inline constexpr std::uint16_t kControlword = 0x6040;            ///< u16
+inline constexpr std::uint16_t kStatusword = 0x6041;             ///< u16
+inline constexpr std::uint16_t kModesOfOperation = 0x6060;       ///< i8
+inline constexpr std::uint16_t kModesDisplay = 0x6061;           ///< i8
+inline constexpr std::uint16_t kPositionDemand = 0x6062;         ///< i32, what the drive applies
+inline constexpr std::uint16_t kPositionActual = 0x6064;         ///< i32
+inline constexpr std::uint16_t kFollowingErrorWindow = 0x6065;   ///< u32 (inc)
+inline constexpr std::uint16_t kTargetPosition = 0x607A;         ///< i32
+inline constexpr std::uint16_t kQuickStopDeceleration = 0x6085;  ///< u32 (inc/s^2)
+inline constexpr std::uint16_t kInterpolationPeriod =
+    0x60C2;  ///< sub 1 u8 value, sub 2 i8 index (10^index s)
 
 inline constexpr std::uint32_t kDeviceProfile402 = 402;
 inline constexpr std::int8_t kModeCsp = 8;
@@ -98,9 +101,9 @@ constexpr std::uint32_t pdo_mapping(std::uint16_t index, std::uint8_t sub, std::
 inline constexpr std::uint16_t kCwDisableVoltage = 0x0000;
 inline constexpr std::uint16_t kCwQuickStop = 0x0002;
 inline constexpr std::uint16_t kCwShutdown = 0x0006;
-inline constexpr std::uint16_t kCwSwitchOn = 0x0007;   ///< also "disable operation"
+inline constexpr std::uint16_t kCwSwitchOn = 0x0007;  ///< also "disable operation"
 inline constexpr std::uint16_t kCwEnableOperation = 0x000F;
-inline constexpr std::uint16_t kCwFaultReset = 0x0080; ///< acts on the rising edge of bit 7
+inline constexpr std::uint16_t kCwFaultReset = 0x0080;  ///< acts on the rising edge of bit 7
 
 /// The drive's power state machine states (CiA 402 figure 5).
 enum class DriveState : std::uint8_t {

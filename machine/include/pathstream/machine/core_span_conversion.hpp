@@ -47,14 +47,22 @@ CoreSpan from_core_span(const Span<Axes>& in, std::size_t subpath, bool pen_down
 template <typename F>
 decltype(auto) with_axes(std::size_t axes, F&& f) {
     switch (axes) {
-        case 1: return f(std::integral_constant<unsigned, 1>{});
-        case 2: return f(std::integral_constant<unsigned, 2>{});
-        case 3: return f(std::integral_constant<unsigned, 3>{});
-        case 4: return f(std::integral_constant<unsigned, 4>{});
-        case 5: return f(std::integral_constant<unsigned, 5>{});
-        case 6: return f(std::integral_constant<unsigned, 6>{});
-        case 7: return f(std::integral_constant<unsigned, 7>{});
-        case 8: return f(std::integral_constant<unsigned, 8>{});
+        case 1:
+            return f(std::integral_constant<unsigned, 1>{});
+        case 2:
+            return f(std::integral_constant<unsigned, 2>{});
+        case 3:
+            return f(std::integral_constant<unsigned, 3>{});
+        case 4:
+            return f(std::integral_constant<unsigned, 4>{});
+        case 5:
+            return f(std::integral_constant<unsigned, 5>{});
+        case 6:
+            return f(std::integral_constant<unsigned, 6>{});
+        case 7:
+            return f(std::integral_constant<unsigned, 7>{});
+        case 8:
+            return f(std::integral_constant<unsigned, 8>{});
     }
     throw std::invalid_argument("1 to 8 axes, not " + std::to_string(axes));
 }

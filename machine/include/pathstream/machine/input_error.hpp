@@ -22,8 +22,8 @@ public:
 private:
     static std::string bounded(const std::string& m) {
         if (m.size() <= kMaxMessage) return m;
-        return m.substr(0, 600) + " ... (" + std::to_string(m.size() - 800) + " bytes left out) ... " +
-               m.substr(m.size() - 200);
+        return m.substr(0, 600) + " ... (" + std::to_string(m.size() - 800) +
+               " bytes left out) ... " + m.substr(m.size() - 200);
     }
     static std::string format(const std::string& file, SourceLocation at, const std::string& m) {
         if (at.line == 0) return file + ": " + m;

@@ -10,9 +10,9 @@ namespace pathstream::host {
 
 /// Limits of one axis, in millimetres and seconds.
 struct AxisLimits {
-    std::string name;                  ///< "x", "y", ...
-    double max_velocity = 0;           ///< mm/s, > 0
-    double max_acceleration = 0;       ///< mm/s^2, > 0
+    std::string name;             ///< "x", "y", ...
+    double max_velocity = 0;      ///< mm/s, > 0
+    double max_acceleration = 0;  ///< mm/s^2, > 0
     /// The work area along this axis ("travel": [min, max] in mm, min < max): a job whose path
     /// leaves it is refused, and the device checks every span against it. Absent: no limit.
     bool has_travel = false;
@@ -24,20 +24,20 @@ struct AxisLimits {
 
 /// One GPIO line of the profile's "gpio" object (docs/formats.md, docs/gpio.md).
 struct GpioLineConfig {
-    std::string line;              ///< offset ("3") or line name ("estop")
-    bool active_low = false;       ///< active = electrically low
-    std::string bias = "as-is";    ///< "as-is", "disable", "pull-up" or "pull-down"
+    std::string line;            ///< offset ("3") or line name ("estop")
+    bool active_low = false;     ///< active = electrically low
+    std::string bias = "as-is";  ///< "as-is", "disable", "pull-up" or "pull-down"
 };
 
 /// Homing of one axis against one of its limit switches, in mm and mm/s.
 struct HomingAxisConfig {
-    std::string axis;              ///< axis name
-    std::string switch_name;       ///< a key of GpioConfig::limits for this axis ("x-")
-    double search_velocity = 0;    ///< > 0, <= the axis's max_velocity
-    double latch_velocity = 0;     ///< > 0, <= search_velocity
-    double backoff = 0;            ///< > 0
-    double max_travel = 0;         ///< > 0
-    double position = 0;           ///< coordinate of the switch point after homing
+    std::string axis;            ///< axis name
+    std::string switch_name;     ///< a key of GpioConfig::limits for this axis ("x-")
+    double search_velocity = 0;  ///< > 0, <= the axis's max_velocity
+    double latch_velocity = 0;   ///< > 0, <= search_velocity
+    double backoff = 0;          ///< > 0
+    double max_travel = 0;       ///< > 0
+    double position = 0;         ///< coordinate of the switch point after homing
     /// Distance moved off the switch after zero is set (>= 0; default: backoff), so the
     /// machine ends homing off its switch.
     double pull_off = 0;
@@ -46,11 +46,11 @@ struct HomingAxisConfig {
 /// Which chip lines do what. Absent from the profile: present == false.
 struct GpioConfig {
     bool present = false;
-    std::string chip;              ///< "gpiochip0", "/dev/gpiochip0", a number or a chip label
+    std::string chip;  ///< "gpiochip0", "/dev/gpiochip0", a number or a chip label
     bool has_enable = false, has_estop = false, has_pen = false;
-    GpioLineConfig enable;         ///< drive enable output
-    GpioLineConfig estop;          ///< e-stop input
-    GpioLineConfig pen;            ///< pen-lift output (active = pen down)
+    GpioLineConfig enable;  ///< drive enable output
+    GpioLineConfig estop;   ///< e-stop input
+    GpioLineConfig pen;     ///< pen-lift output (active = pen down)
     /// Limit switch inputs by "<axis><side>": "x-", "x+", "y-", ... (side "-" or "+").
     std::vector<std::pair<std::string, GpioLineConfig>> limits;
     std::vector<HomingAxisConfig> home;  ///< in profile order
@@ -70,11 +70,11 @@ struct MachineProfile {
     /// Optional "corner_stop_angle" (1..180 degrees in the file, radians here): a joint turning
     /// by more stops exactly; absent (< 0): the planner's PlanOptions::corner_stop_angle.
     double corner_stop_angle = -1;
-    GpioConfig gpio;                   ///< optional "gpio" object
+    GpioConfig gpio;  ///< optional "gpio" object
     /// Optional "layer_feeds": pen-down speed (mm/s) per layer name (an Inkscape layer's label,
     /// a stroke colour such as "#ff0000"), for subpaths that set no feed of their own.
     std::vector<std::pair<std::string, double>> layer_feeds;
-    std::string source;                ///< file it came from, for messages
+    std::string source;  ///< file it came from, for messages
 
     double tick_seconds() const { return 1.0 / tick_hz; }
 };
