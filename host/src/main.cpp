@@ -13,6 +13,7 @@
 #include "cli/check_command.hpp"
 #include "cli/ctl_command.hpp"
 #include "device_command.hpp"
+#include "failure_exit.hpp"
 #include "cli/drive_command.hpp"
 #include "cli/eval_command.hpp"
 #include "cli/plan_command.hpp"
@@ -73,33 +74,14 @@ int main(int argc, char** argv) {
         if (app.got_subcommand("drive")) return pathstream::host::run_drive(drive);
         if (app.got_subcommand("ctl")) return pathstream::host::run_ctl(ctl);
         if (app.got_subcommand("serve")) return pathstream::host::run_serve(serve);
-    } catch (const pathstream::host::InputError& e) {
-        std::cerr << e.what() << '\n';
-        return kExitInput;
     } catch (const pathstream::host::PlanError& e) {
         std::cerr << "pathstream: planning failed: " << e.what() << '\n';
         return kExitPlanning;
     } catch (const pathstream::host::StreamError& e) {
         std::cerr << "pathstream: device: " << e.what() << '\n';
         return kExitDevice;
-    } catch (const pathstream::hal::ModbusError& e) {
-        std::cerr << "pathstream: device: " << e.what() << '\n';
-        return kExitDevice;
-    } catch (const pathstream::hal::GpioError& e) {
-        std::cerr << "pathstream: " << e.what() << '\n';
-        return kExitDevice;
-    } catch (const std::invalid_argument& e) {
-        std::cerr << "pathstream: " << e.what() << '\n';
-        return kExitUsage;
-    } catch (const std::system_error& e) {
-        std::cerr << "pathstream: " << e.what() << '\n';
-        return kExitDevice;
-    } catch (const std::runtime_error& e) {
-        std::cerr << "pathstream: " << e.what() << '\n';
-        return kExitOutput;
-    } catch (const std::exception& e) {
-        std::cerr << "pathstream: internal error: " << e.what() << '\n';
-        return kExitInternal;
+    } catch (...) {
+        return pathstream::device_cli::failure_exit(std::current_exception());
     }
     return kExitInternal;
 }

@@ -11,6 +11,7 @@
 #include <stdexcept>
 #include <system_error>
 
+#include "failure_exit.hpp"
 #include "pathstream/device/gpio_logic.hpp"
 #include "pathstream/hal/gpio_gpiod.hpp"
 #include "pathstream/hal/modbus_error.hpp"
@@ -246,27 +247,11 @@ int run_device(const DeviceCommandOptions& o) {
         std::signal(SIGINT, on_signal);
         std::signal(SIGTERM, on_signal);
         return linux_device::run_device_runtime(o.run, start, profile, attach, g_stop);
-    } catch (const InputError& e) {
-        std::cerr << e.what() << '\n';
-        return kExitInput;
     } catch (const linux_device::HomingFailed& e) {
         std::cerr << "pathstream: device: " << e.what() << '\n';
         return kExitDevice;
-    } catch (const hal::ModbusError& e) {
-        std::cerr << "pathstream: device: " << e.what() << '\n';
-        return kExitDevice;
-    } catch (const hal::GpioError& e) {
-        std::cerr << "pathstream: " << e.what() << '\n';
-        return kExitDevice;
-    } catch (const std::invalid_argument& e) {
-        std::cerr << "pathstream: " << e.what() << '\n';
-        return kExitUsage;
-    } catch (const std::system_error& e) {
-        std::cerr << "pathstream: " << e.what() << '\n';
-        return kExitDevice;
-    } catch (const std::runtime_error& e) {
-        std::cerr << "pathstream: " << e.what() << '\n';
-        return kExitOutput;
+    } catch (...) {
+        return failure_exit(std::current_exception());
     }
 }
 

@@ -1,10 +1,9 @@
 // pathstream-device: the device runtime alone, as a machine's controller runs it. The same
 // command as `pathstream device`, built without the host's planner, readers and plots.
 #include <CLI/CLI.hpp>
-#include <exception>
-#include <iostream>
 
 #include "device_command.hpp"
+#include "failure_exit.hpp"
 #include "pathstream/machine/exit_codes.hpp"
 
 int main(int argc, char** argv) {
@@ -25,8 +24,7 @@ int main(int argc, char** argv) {
     }
     try {
         return pathstream::device_cli::run_device(options);
-    } catch (const std::exception& e) {
-        std::cerr << "pathstream-device: internal error: " << e.what() << '\n';
-        return pathstream::host::kExitInternal;
+    } catch (...) {
+        return pathstream::device_cli::failure_exit(std::current_exception());
     }
 }
