@@ -16,6 +16,7 @@
 #include <thread>
 #include <vector>
 
+#include "pathstream/machine/input_error.hpp"
 #include "pathstream/device/can_protocol.hpp"
 #include "pathstream/device/device_state.hpp"
 #include "pathstream/device/jog.hpp"
@@ -470,6 +471,11 @@ TEST_CASE("job spans and journal files: round trip, changed or damaged files ref
         bad << "{\"format\": \"pathstream job journal 1\", \"target\": 3}";
     }
     CHECK_THROWS_WITH(host::read_journal(dir + "/j2.json"), Catch::Contains("j2.json:1:"));
+    // A "format" of another type is not this format: an input error, not a JSON type error
+    // (found by fuzz_job_journal).
+    CHECK_THROWS_AS(host::parse_journal("{\"format\": 48}", "j3.json"), host::InputError);
+    CHECK_THROWS_WITH(host::parse_journal("{\"format\": 48}", "j3.json"),
+                      Catch::Contains("not a pathstream job journal"));
     // Bound to its job: an edited job id, or the spans of another job with their own hash, are
     // refused by the journal reader, before any device is asked; progress and target may change.
     const auto edited = [&](const std::string& from, const std::string& to) {

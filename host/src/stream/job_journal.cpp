@@ -462,7 +462,9 @@ JobJournal read_journal(const std::string& path) {
 JobJournal parse_journal(const std::string& text, const std::string& path) {
     const nlohmann::json d = parse_json_document(text, path);
     const JsonChecker check(text, path);
-    if (!d.is_object() || d.value("format", "") != "pathstream job journal 1") {
+    // value("format", "") throws a type error for a "format" that is not a string: compared
+    // as JSON instead, any other value is simply not this format.
+    if (!d.is_object() || !d.contains("format") || d["format"] != nlohmann::json("pathstream job journal 1")) {
         check.fail("",
                    "not a pathstream job journal (want \"format\": \"pathstream job journal 1\")");
     }
