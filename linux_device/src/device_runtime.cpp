@@ -142,6 +142,21 @@ DeviceLoopOptions loop_options(const DeviceRunOptions& o, const AnyMotionDevice&
     return loop;
 }
 
+// Ticks the device (its log and homing lines after every tick) and serves its bus in between,
+// paced by loop_options, until `stop` or the time given.
+void serve_until_stopped(AnyMotionDevice& device, DeviceWatch& watch, Machine& machine,
+                         const DeviceLog& log,
+                         const std::function<void(std::chrono::microseconds)>& serve,
+                         const DeviceRunOptions& o, const std::atomic<bool>& stop) {
+    run_paced_loop(
+        [&] {
+            device.tick();
+            watch.after_tick(device);
+            machine.after_tick(log);
+        },
+        [&] { return device.tick_hz(); }, serve, loop_options(o, device), stop);
+}
+
 int run_can_device(const DeviceRunOptions& o, const std::vector<Lsb>& start,
                    const std::optional<host::MachineProfile>& profile, const AttachMachine& attach,
                    const std::atomic<bool>& stop) {
@@ -157,15 +172,9 @@ int run_can_device(const DeviceRunOptions& o, const std::vector<Lsb>& start,
         std::to_string(device->axes()) + " axes, native CAN node " + std::to_string(o.node) +
             " on " + o.can_interface + " (" + url + ")",
         {{"url", url}, {"axes", device->axes()}});
-    run_paced_loop(
-        [&] {
-            device->tick();
-            watch.after_tick(*device);
-            machine.after_tick(log);
-        },
-        [&] { return device->tick_hz(); },
-        [&](std::chrono::microseconds w) { device->serve(bus, w); }, loop_options(o, *device),
-        stop);
+    serve_until_stopped(
+        *device, watch, machine, log, [&](std::chrono::microseconds w) { device->serve(bus, w); },
+        o, stop);
     const hal::SocketCanCounters& c = bus.counters();
     log("stopped",
         "stopped after " + std::to_string(device->ticks_run()) + " ticks, " +
@@ -216,18 +225,13 @@ int run_modbus_device(const DeviceRunOptions& o, const std::vector<Lsb>& start,
     }();
     log("serving", std::to_string(device->axes()) + " axes, serving " + url,
         {{"url", url}, {"axes", device->axes()}});
-    run_paced_loop(
-        [&] {
-            device->tick();
-            watch.after_tick(*device);
-            machine.after_tick(log);
-        },
-        [&] { return device->tick_hz(); },
+    serve_until_stopped(
+        *device, watch, machine, log,
         [&](std::chrono::microseconds w) {
             server.poll_once(w);
             watch.after_poll(server);
         },
-        loop_options(o, *device), stop);
+        o, stop);
     watch.after_poll(server, true);
     log("stopped",
         "stopped after " + std::to_string(device->ticks_run()) + " ticks, " +
