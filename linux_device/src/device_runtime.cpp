@@ -136,8 +136,7 @@ DeviceLoopOptions loop_options(const DeviceRunOptions& o, const AnyMotionDevice&
     loop.time_scale = o.time_scale;
     loop.run_for = std::chrono::milliseconds(static_cast<long>(o.exit_after * 1000));
     loop.at_rest = [&device] {
-        return device.state() == static_cast<std::uint8_t>(device::DeviceState::kIdle) &&
-               device.unchanged_ticks() >= 1000;
+        return device.state() == device::DeviceState::kIdle && device.unchanged_ticks() >= 1000;
     };
     return loop;
 }

@@ -17,7 +17,7 @@ namespace pathstream::linux_device {
 
 // What the log follows of the device's status after every tick.
 struct DeviceView {
-    unsigned state = 0;
+    device::DeviceState state = device::DeviceState::kIdle;
     std::uint16_t fault_code = 0;
     std::uint32_t job = 0;  ///< job of the span in progress or last played (0: none)
     std::uint32_t finished_job = 0, finished_job_ticks = 0;
@@ -96,10 +96,10 @@ public:
     }
 
 private:
-    static constexpr unsigned kRunning = static_cast<unsigned>(device::DeviceState::kRunning);
-    static constexpr unsigned kFault = static_cast<unsigned>(device::DeviceState::kFault);
-    static constexpr unsigned kEstop = static_cast<unsigned>(device::DeviceState::kEstop);
-    static constexpr unsigned kIdle = static_cast<unsigned>(device::DeviceState::kIdle);
+    static constexpr device::DeviceState kRunning = device::DeviceState::kRunning;
+    static constexpr device::DeviceState kFault = device::DeviceState::kFault;
+    static constexpr device::DeviceState kEstop = device::DeviceState::kEstop;
+    static constexpr device::DeviceState kIdle = device::DeviceState::kIdle;
 
     static constexpr unsigned kConnectionLines = 20;
     static constexpr std::chrono::seconds kConnectionWindow{10};
@@ -125,7 +125,7 @@ private:
 
     void state_change(const DeviceView& v, std::uint64_t tick) {
         host::EventJson fields = {{"state", host::device_state_name(v.state)},
-                                  {"code", v.state},
+                                  {"code", static_cast<unsigned>(v.state)},
                                   {"was", host::device_state_name(last_.state)},
                                   {"tick", tick}};
         const std::string at = " at tick " + std::to_string(tick);

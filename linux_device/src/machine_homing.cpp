@@ -54,7 +54,7 @@ std::string failure(const linux_device::AnyMotionDevice& d, const linux_device::
         case device::HomingError::kInterrupted: {
             char name[64];
             device::fault_name(static_cast<device::FaultCode>(d.fault_code()), name, sizeof name);
-            why = d.state() == static_cast<std::uint8_t>(device::DeviceState::kEstop)
+            why = d.state() == device::DeviceState::kEstop
                       ? std::string("interrupted by the e-stop")
                       : std::string("interrupted by a fault: ") + name;
             break;

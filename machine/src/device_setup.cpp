@@ -63,10 +63,15 @@ DeviceLimitsLsb device_limits(const MachineProfile& profile) {
     return l;
 }
 
-const char* device_state_name(unsigned state) {
+const char* device_state_name(device::DeviceState state) {
     static const char* const names[] = {"idle",     "running", "holding",
                                         "stopping", "fault",   "e-stop"};
-    return state < 6 ? names[state] : "unknown";
+    const auto n = static_cast<unsigned>(state);
+    return n < 6 ? names[n] : "unknown";
+}
+
+device::DeviceState device_state_of_wire(unsigned raw) {
+    return static_cast<device::DeviceState>(raw < 255 ? raw : 255u);
 }
 
 std::string fault_text(std::uint16_t fault_code) {
@@ -75,8 +80,8 @@ std::string fault_text(std::uint16_t fault_code) {
     return name;
 }
 
-std::string fault_suffix(unsigned state, std::uint16_t fault_code) {
-    if (state != static_cast<unsigned>(device::DeviceState::kFault)) return "";
+std::string fault_suffix(device::DeviceState state, std::uint16_t fault_code) {
+    if (state != device::DeviceState::kFault) return "";
     return " (" + fault_text(fault_code) + ")";
 }
 

@@ -59,12 +59,12 @@ struct Machine {
         x_min.drive(x <= x_switch, clock.now());
         y_max.drive(y >= y_switch, clock.now());
         const Lsb before[2] = {dev->position(0), dev->position(1)};
-        const bool idle_before = dev->state() == static_cast<std::uint8_t>(DeviceState::kIdle);
+        const bool idle_before = dev->state() == (DeviceState::kIdle);
         dev->tick();
         clock.wait_until(clock.now() + 1);
         // An idle device moves only by set_position (homing's set zero): the coordinates
         // moved, the machine did not.
-        if (idle_before && dev->state() == static_cast<std::uint8_t>(DeviceState::kIdle)) {
+        if (idle_before && dev->state() == (DeviceState::kIdle)) {
             offset[0] += dev->position(0) - before[0];
             offset[1] += dev->position(1) - before[1];
         }
@@ -143,13 +143,13 @@ TEST_CASE(
         m.tick();
         m.tick();
         CHECK(m.io->limit_trips() == 1);
-        CHECK(m.dev->state() == static_cast<std::uint8_t>(DeviceState::kFault));
+        CHECK(m.dev->state() == (DeviceState::kFault));
         CHECK(m.dev->fault_code() ==
               static_cast<std::uint16_t>(device::limit_fault(0, LimitSide::kNegative)));
         // The e-stop overrides the fault: the next tick enters e-stop.
         m.estop.drive(true);
         m.tick();
-        CHECK(m.dev->state() == static_cast<std::uint8_t>(DeviceState::kEstop));
+        CHECK(m.dev->state() == (DeviceState::kEstop));
         CHECK(m.io->estop_edges() == 1);
         CHECK_FALSE(m.enable.state());
     }
@@ -179,7 +179,7 @@ TEST_CASE("device io: homing x then y from the profile, pulled off the switches"
         REQUIRE(homed.size() == 2);
         CHECK(enable_seen);
         CHECK_FALSE(m.enable.state());
-        CHECK(m.dev->state() == static_cast<std::uint8_t>(DeviceState::kIdle));
+        CHECK(m.dev->state() == (DeviceState::kIdle));
         CHECK(m.io->limit_trips() == 0);  // the homing switch was masked, the other never hit
         // The latch saw each switch within one tick at latch velocity (1 LSB/tick + the poll).
         CHECK(homed[0].latch <= 10000);
@@ -225,7 +225,7 @@ TEST_CASE("device io: homing errors name the axis, the switch and the reason",
         CHECK_THROWS_WITH(linux_device::home_axes(*m.dev, *m.io, host::homing_setups(p),
                                                   p.mm_per_lsb, m.run_until(400000), quiet),
                           "homing x: switch x- not found within 40.000 mm (max_travel)");
-        CHECK(m.dev->state() == static_cast<std::uint8_t>(DeviceState::kIdle));
+        CHECK(m.dev->state() == (DeviceState::kIdle));
         CHECK(m.dev->position(0) == 25000 - 40000);
     }
     SECTION("a switch that never releases") {
@@ -252,7 +252,7 @@ TEST_CASE("device io: homing errors name the axis, the switch and the reason",
                               },
                               quiet),
                           "homing x: interrupted by the e-stop");
-        CHECK(m.dev->state() == static_cast<std::uint8_t>(DeviceState::kEstop));
+        CHECK(m.dev->state() == (DeviceState::kEstop));
     }
     SECTION("a homing switch that is not wired") {
         Machine m(modbus_device(25000, 0));

@@ -226,7 +226,7 @@ TEST_CASE("home over Modbus: every axis in plan order, zero at its switch, withi
     s = poll_until(*link, [](const host::DeviceSnapshot& x) { return !x.homing_runs(); });
     CHECK((s.homing[0].state == AxisHoming::kHomed && s.homing[0].error == HomingError::kNone));
     CHECK(s.homing[1].state == AxisHoming::kHomed);
-    CHECK(s.state == 0);
+    CHECK(s.state == device::DeviceState::kIdle);
     // Both pulled 1000 LSB off where the latch stop came to rest (a few LSB past the switch
     // point, which is now 0: the stop from latch velocity overshoots by some 20 LSB).
     const Lsb homed_x = s.position[0];
@@ -239,7 +239,7 @@ TEST_CASE("home over Modbus: every axis in plan order, zero at its switch, withi
     CHECK(link->command_with_arguments(device::kCommandPen, 0, 2, 0) == Status::kControlValueOutOfRange);
     REQUIRE(link->command_with_arguments(device::kCommandJog, 0, 5000, 0) == Status::kOk);
     const std::uint32_t jog = s.last_accepted + 1;
-    s = poll_until(*link, [&](const host::DeviceSnapshot& x) { return x.state == 0 && x.finished_job == jog; });
+    s = poll_until(*link, [&](const host::DeviceSnapshot& x) { return x.state == device::DeviceState::kIdle && x.finished_job == jog; });
     CHECK((s.position[0] == homed_x + 5000 && s.pen_down()));
     const std::size_t jog_ticks = s.finished_job_ticks;
     REQUIRE(link->command_with_arguments(device::kCommandPen, 0, 0, 0) == Status::kOk);
@@ -277,7 +277,7 @@ TEST_CASE("home over Modbus: an axis whose switch never closes fails by name, th
         poll_until(*link, [](const host::DeviceSnapshot& x) { return !x.homing_runs(); });
     CHECK((s.homing[1].state == AxisHoming::kFailed && s.homing[1].error == HomingError::kSwitchNotFound));
     CHECK(s.homing[0].state == AxisHoming::kNotHomed);  // after y failed, x never started
-    CHECK(s.state == 0);
+    CHECK(s.state == device::DeviceState::kIdle);
     CHECK(s.position[1] == 15000 - 20000);  // the whole max_travel searched, then stopped
     // x alone (mask bit 0) homes.
     REQUIRE(link->command_with_arguments(device::kCommandHome, 1, 0, 0) == Status::kOk);

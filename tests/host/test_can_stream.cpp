@@ -130,12 +130,15 @@ TEST_CASE("two drawings in a row natively over CAN, each ending idle at rest, no
     o.ack_timeout_ms = 30;
     const host::CanStreamReport r1 = host::stream_can(first.plan, first.machine, host_bus, o);
     CHECK(r1.ticks_executed == first.plan.total_ticks);
-    CHECK(dt.device->state() == 0);  // idle
+    CHECK(dt.device->state() == device::DeviceState::kIdle);
     for (unsigned a = 0; a < 2; ++a) CHECK(dt.device->position(a) == end_of(first.plan)[a]);
     const host::CanStreamReport r2 = host::stream_can(second.plan, second.machine, host_bus, o);
     CHECK(r2.ticks_executed == second.plan.total_ticks);
-    CHECK(r2.last_completed == second.plan.spans.size());
-    CHECK(dt.device->state() == 0);
+    // Sequence numbers run on across jobs, on both buses: the second job's last span is the
+    // device's sequence number first + second.
+    CHECK(r2.last_completed == first.plan.spans.size() + second.plan.spans.size());
+    CHECK(r2.job == first.plan.spans.size() + 1);
+    CHECK(dt.device->state() == device::DeviceState::kIdle);
     for (unsigned a = 0; a < 2; ++a) CHECK(dt.device->position(a) == end_of(second.plan)[a]);
     dt.join();
     check_recorded(first.plan, *dt.device, 0);
@@ -233,9 +236,9 @@ TEST_CASE("bus-off at the device: the host stops with a clear error and the devi
     REQUIRE(cut.load());
     CHECK_THAT(message, Catch::Contains("can://loop?node=5: no answer from node 5"));
     // The device saw its bus go off and held (a controlled stop), rather than run on blind.
-    for (int i = 0; i < 200 && dt.device->state() != 2; ++i)
+    for (int i = 0; i < 200 && dt.device->state() != device::DeviceState::kHolding; ++i)
         std::this_thread::sleep_for(std::chrono::milliseconds(10));
-    CHECK(dt.device->state() == 2);  // holding
+    CHECK(dt.device->state() == device::DeviceState::kHolding);  // holding
     dt.join();
 }
 

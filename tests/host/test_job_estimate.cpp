@@ -114,14 +114,14 @@ TEST_CASE("the bar's pen is the device's output: up at a pause inside a pen-down
     events.add_span(span);
     events.add_span(span);
     JobSample s;
-    s.state = 1;  // running
+    s.state = device::DeviceState::kRunning;  // running
     s.started = true;
     s.next_span = 1;
     s.ticks = 150;
     s.pen_output = true;
     events.sample(s);
     CHECK(events.status_text().find("pen down") != std::string::npos);
-    s.state = 2;  // holding at a programmed pause: the device raised the pen
+    s.state = device::DeviceState::kHolding;  // holding at a programmed pause: the device raised the pen
     s.pen_output = false;
     events.sample(s);
     CHECK(events.status_text().find("pen up") != std::string::npos);

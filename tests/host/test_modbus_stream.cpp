@@ -167,7 +167,7 @@ static void two_drawings_in_a_row(DeviceThread& dt, const std::string& target,
     CHECK(r2.ticks_executed == second.plan.total_ticks);
     CHECK(r2.last_completed == first.plan.spans.size() + second.plan.spans.size());
     CHECK(host::modbus_rest_position(second.machine, o) == end_of(second.plan));
-    CHECK(dt.device->state() == 0);  // idle
+    CHECK(dt.device->state() == device::DeviceState::kIdle);  // idle
     dt.stop = true;
     dt.thread.join();
     check_recorded(first.plan, *dt.device, 0);

@@ -97,12 +97,12 @@ host::StreamOptions options_for(const std::string& target) {
 host::DeviceSnapshot wait_for(host::DeviceLink& link, DeviceState state) {
     const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
     host::DeviceSnapshot s = link.status();
-    while (s.state != static_cast<unsigned>(state) && std::chrono::steady_clock::now() < deadline) {
+    while (s.state != state && std::chrono::steady_clock::now() < deadline) {
         std::this_thread::sleep_for(std::chrono::milliseconds(2));
         s = link.status();
     }
     REQUIRE(std::string(host::device_state_name(s.state)) ==
-            host::device_state_name(static_cast<unsigned>(state)));
+            host::device_state_name(state));
     return s;
 }
 
@@ -201,7 +201,7 @@ void hold_then_resume(const Job& job, unsigned seed, bool rtu) {
     const host::StreamReport first = host::stream_modbus(job.plan, job.machine, o);
     INFO("interrupted at path tick " << seen_ticks << " (asked at " << at << ")");
     REQUIRE(first.interrupted == 1);
-    CHECK(first.final_status.state == static_cast<unsigned>(DeviceState::kHolding));
+    CHECK(first.final_status.state == DeviceState::kHolding);
     CHECK((first.final_status.flags & 8u) == 0);  // at rest
     CHECK(first.final_status.outputs == 0);       // pen up
     const host::HeldJob held{job_id, first.final_status.last_accepted};
@@ -316,11 +316,11 @@ TEST_CASE("resume: a stop or a fault at a seeded moment, then a re-entry from wh
                 if (r.interrupted == 1) {
                     // The hold came to rest before the stream's next look sent the stop (a short
                     // hold: the request came near a stop of the plan): stop it now.
-                    CHECK(s.state == static_cast<unsigned>(DeviceState::kHolding));
+                    CHECK(s.state == DeviceState::kHolding);
                     CHECK(link->command(Command::kStop) == Status::kOk);
                     s = wait_for(*link, DeviceState::kIdle);
                 }
-                CHECK(s.state == static_cast<unsigned>(DeviceState::kIdle));
+                CHECK(s.state == DeviceState::kIdle);
             }
             // The interrupted run's drawing ticks end with its last completed span; a fault
             // froze the axes inside the next one, whose ticks the resume draws again.
@@ -505,7 +505,7 @@ TEST_CASE("ctl's link: status and every command over Modbus TCP, refusals by nam
     ModbusDeviceThread dt(start_of(job.plan), 1.0, &limits);
     const std::unique_ptr<host::DeviceLink> link = host::open_device_link(dt.target(), {});
     host::DeviceSnapshot s = link->status();
-    CHECK((s.magic == 0x5053 && s.version == 5 && s.axes == 2 && s.state == 0));
+    CHECK((s.magic == 0x5053 && s.version == 5 && s.axes == 2 && s.state == DeviceState::kIdle));
     CHECK((s.position[0] == start_of(job.plan)[0] && s.position[1] == start_of(job.plan)[1]));
     CHECK(link->command(Command::kHold) == Status::kWrongState);  // idle: nothing to hold
     CHECK(link->command(Command::kResume) == Status::kWrongState);
@@ -526,7 +526,7 @@ TEST_CASE("ctl's link: status and every command over Modbus TCP, refusals by nam
     // A jog and a set position through the link.
     REQUIRE(link->command_with_arguments(device::kCommandJog, 1, -4321, 500) == Status::kOk);
     const std::uint32_t jog_job = s.last_accepted + 1;
-    for (int i = 0; i < 5000 && !(s.state == 0 && s.finished_job == jog_job); ++i) {
+    for (int i = 0; i < 5000 && !(s.state == DeviceState::kIdle && s.finished_job == jog_job); ++i) {
         std::this_thread::sleep_for(std::chrono::milliseconds(2));
         s = link->status();
     }
@@ -560,7 +560,7 @@ TEST_CASE("ctl's link over native CAN: status, commands, a hold of a running str
     c.name = "can://loop?node=5";
     const std::unique_ptr<host::DeviceLink> link = host::open_can_link(ctl_bus, c);
     host::DeviceSnapshot s = link->status();
-    CHECK((s.version == 4 && s.axes == 2 && s.state == 0));
+    CHECK((s.version == 4 && s.axes == 2 && s.state == DeviceState::kIdle));
     CHECK((s.position[0] == start_of(job.plan)[0] && s.position[1] == start_of(job.plan)[1]));
     CHECK(link->command(Command::kHold) == Status::kWrongState);
     CHECK(link->command_with_arguments(device::kCommandSetPosition, 2, 0, 0) ==
@@ -610,7 +610,7 @@ TEST_CASE("pause: a two-layer drawing holds pen up between its layers, resumed f
         if (!t.status.paused()) return;
         held_at_ticks = t.status.ticks_executed;
         pen_down_while_paused = pen_down_while_paused || t.status.pen_down();
-        CHECK(t.status.state == static_cast<unsigned>(DeviceState::kHolding));
+        CHECK(t.status.state == DeviceState::kHolding);
     };
     const host::StreamReport r = host::stream_modbus(job.plan, job.machine, o);
     CHECK(r.interrupted == 0);
@@ -648,7 +648,7 @@ TEST_CASE("a stop from another client while streaming ends the stream as a stop,
             CHECK(sent);
             CHECK(r.interrupted == 2);
             CHECK(r.stopped_elsewhere);
-            CHECK(r.final_status.state == static_cast<unsigned>(DeviceState::kIdle));
+            CHECK(r.final_status.state == DeviceState::kIdle);
             dt.join();
             check_steps_within_limits(*dt.device, job.machine);
         }

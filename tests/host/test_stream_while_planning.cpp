@@ -112,7 +112,7 @@ TEST_CASE("a planning error while the device runs: a controlled stop, then the p
     bool ran = false;
     bool hold_sent = false;
     o.observer = [&](const host::StreamTrace& t) {
-        ran = ran || t.status.state == 1;  // running
+        ran = ran || t.status.state == device::DeviceState::kRunning;  // running
         hold_sent = hold_sent || t.hold_requested;
     };
     CHECK_THROWS_WITH(host::stream_modbus(planning, machine, o), "span 6000: refused by the test");

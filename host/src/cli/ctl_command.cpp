@@ -266,7 +266,8 @@ unsigned axis_argument(const std::string& text, const Units& u, unsigned axes) {
 DeviceSnapshot wait_for_job(DeviceLink& link, std::uint32_t job, double seconds) {
     const auto deadline = Clock::now() + std::chrono::duration<double>(seconds);
     DeviceSnapshot s = link.status();
-    while (!(s.state == 0 && s.finished_job == job) && s.state != 4 && s.state != 5 &&
+    while (!(s.state == device::DeviceState::kIdle && s.finished_job == job) &&
+           s.state != device::DeviceState::kFault && s.state != device::DeviceState::kEstop &&
            Clock::now() < deadline) {
         std::this_thread::sleep_for(std::chrono::milliseconds(10));
         s = link.status();
@@ -306,7 +307,7 @@ int run_jog(DeviceLink& link, const CtlCommandOptions& o, const Units& u) {
                           fault_suffix(before.state, before.fault_code) + ": " + status_name(r));
     }
     const DeviceSnapshot s = wait_for_job(link, before.last_accepted + 1, wait_seconds(o, 5));
-    const bool done = s.state == 0 && s.finished_job == before.last_accepted + 1;
+    const bool done = s.state == device::DeviceState::kIdle && s.finished_job == before.last_accepted + 1;
     if (o.json) {
         nlohmann::json j;
         j["command"] = "jog";

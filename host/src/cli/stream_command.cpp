@@ -404,8 +404,8 @@ void print_interrupted(const StreamEnd& end, std::optional<SpanPlace> next,
                        const std::string& journal, bool resumable) {
     const DeviceSnapshot& s = end.status;
     std::printf("interrupted   the device %s at",
-                end.interrupted == 1 && s.state == 2 ? "holds at rest (the rest of the job queued)"
-                : s.state == 0                       ? "stopped and is idle (queue dropped)"
+                end.interrupted == 1 && s.state == device::DeviceState::kHolding ? "holds at rest (the rest of the job queued)"
+                : s.state == device::DeviceState::kIdle                       ? "stopped and is idle (queue dropped)"
                                                      : device_state_name(s.state));
     for (std::size_t a = 0; a < machine.axes.size(); ++a) {
         std::printf(" %s %.4f mm", machine.axes[a].name.c_str(),
@@ -801,7 +801,7 @@ int run_resume(StreamCommandOptions o, const EventChannel& channel) {
         // A host that died mid-stream leaves the device running out what it had queued: it
         // then holds (underrun) or, with the whole job queued, ends it. Wait for either (at
         // most the queue's length in time, bounded by the link timeout per quiet read).
-        if (s.state == static_cast<unsigned>(device::DeviceState::kRunning) && ours_now()) {
+        if (s.state == device::DeviceState::kRunning && ours_now()) {
             std::printf(
                 "resume        the device still runs job %u from its queue: waiting until it holds "
                 "or ends\n",
@@ -809,15 +809,15 @@ int run_resume(StreamCommandOptions o, const EventChannel& channel) {
             std::fflush(stdout);
             const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(600);
             bool held_at_rest = false;
-            while ((s.state == static_cast<unsigned>(device::DeviceState::kRunning) ||
-                    (s.state == static_cast<unsigned>(device::DeviceState::kHolding) &&
+            while ((s.state == device::DeviceState::kRunning ||
+                    (s.state == device::DeviceState::kHolding &&
                      s.own_move())) &&
                    std::chrono::steady_clock::now() < deadline) {
                 // Everything it accepted has run and it still runs: it waits at rest for more
                 // (the host died just after a span that ends at rest, a pen change's dwell or an
                 // exact stop), where no underrun comes. Hold it there, as an underrun would have.
                 if (!held_at_rest &&
-                    s.state == static_cast<unsigned>(device::DeviceState::kRunning) &&
+                    s.state == device::DeviceState::kRunning &&
                     s.last_completed == s.last_accepted) {
                     held_at_rest = link->command(device::Command::kHold) == Status::kOk;
                     if (held_at_rest) {
@@ -837,7 +837,7 @@ int run_resume(StreamCommandOptions o, const EventChannel& channel) {
                           " axes, the profile " + std::to_string(machine.axes.size()));
     }
     const bool ours = ours_now();
-    if (s.state == static_cast<unsigned>(device::DeviceState::kIdle) && journal.job != 0 &&
+    if (s.state == device::DeviceState::kIdle && journal.job != 0 &&
         s.finished_job == journal.job && s.epoch == journal.epoch &&
         s.last_completed + 1 - journal.job == spans) {
         // Everything was queued before the host died, and the device ran it to its end.
@@ -853,7 +853,7 @@ int run_resume(StreamCommandOptions o, const EventChannel& channel) {
             journal.job);
         return 0;
     }
-    if (s.state == static_cast<unsigned>(device::DeviceState::kHolding) && ours &&
+    if (s.state == device::DeviceState::kHolding && ours &&
         s.epoch == journal.epoch && (s.flags & 1u) != 0) {
         std::printf(
             "resume        the device holds job %u at span %u of %zu: streaming the rest, then "
@@ -864,10 +864,10 @@ int run_resume(StreamCommandOptions o, const EventChannel& channel) {
         return stream_job({supply, &job, nullptr, nullptr, nullptr, job.subpaths, {}}, machine, o,
                           journal, o.resume, &held, channel);
     }
-    if (s.state != static_cast<unsigned>(device::DeviceState::kIdle)) {
+    if (s.state != device::DeviceState::kIdle) {
         throw StreamError(o.stream.target + ": device is " + device_state_name(s.state) +
                           fault_suffix(s.state, s.fault_code) +
-                          (s.state == static_cast<unsigned>(device::DeviceState::kHolding)
+                          (s.state == device::DeviceState::kHolding
                                ? " another job: stop it first (pathstream ctl TARGET stop)"
                                : ": reset it first (pathstream ctl TARGET reset)") +
                           ", then resume");

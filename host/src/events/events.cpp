@@ -18,8 +18,8 @@
 namespace pathstream::host {
 namespace {
 
-constexpr unsigned kRunning = static_cast<unsigned>(device::DeviceState::kRunning);
-constexpr unsigned kFault = static_cast<unsigned>(device::DeviceState::kFault);
+constexpr device::DeviceState kRunning = device::DeviceState::kRunning;
+constexpr device::DeviceState kFault = device::DeviceState::kFault;
 
 // Times and lengths to a fixed resolution, so lines stay short and compare as printed.
 double rounded(double value, double per_unit) {
@@ -171,7 +171,7 @@ void JobEvents::on_state(const JobSample& s) {
     if (state_ == s.state && !new_fault) return;
     EventJson e = event("state");
     e["state"] = device_state_name(*s.state);
-    e["code"] = *s.state;
+    e["code"] = static_cast<unsigned>(*s.state);
     e["was"] = state_ ? EventJson(device_state_name(*state_)) : EventJson(nullptr);
     if (fault) e["fault"] = fault_text(s.fault_code);
     emit(e);

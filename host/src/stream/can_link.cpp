@@ -25,7 +25,7 @@ DeviceSnapshot snapshot_of(const pc::Status3& s) {
     DeviceSnapshot d;
     d.version = s.version;
     d.axes = s.axes;
-    d.state = s.state;
+    d.state = device_state_of_wire(s.state);
     d.fault_code = s.fault_code;
     d.free_slots = s.free_slots;
     d.queued = s.queued;

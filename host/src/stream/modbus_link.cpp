@@ -62,7 +62,7 @@ DeviceSnapshot parse_modbus_status(const std::uint16_t* r, std::size_t count) {
     DeviceSnapshot s;
     s.magic = r[st::kMagic];
     s.version = r[st::kVersion];
-    s.state = r[st::kState];
+    s.state = device_state_of_wire(r[st::kState]);
     s.fault_code = r[st::kFaultCode];
     s.free_slots = r[st::kFreeSlots];
     s.capacity = r[st::kCapacity];

@@ -71,6 +71,7 @@ public:
     void mark_alive() { last_ok_ = Clock::now(); }
 
     hal::ModbusClient& client() { return client_; }
+    const hal::ModbusClient& client() const { return client_; }
     const StreamOptions& options() const { return options_; }
     std::uint64_t status_reads() const { return status_reads_; }
 

@@ -9,7 +9,7 @@
 
 #include "pathstream/device/device_state.hpp"
 #include "pathstream/host/device_link.hpp"
-#include "pathstream/host/modbus_stream.hpp"
+#include "pathstream/host/stream_types.hpp"
 
 namespace pathstream::host {
 
@@ -23,7 +23,8 @@ public:
     /// instead when the device was never started: it drops what is queued and nothing moved),
     /// a stop at the second request or when the hold has not come to rest in time.
     Action next_action(bool started) {
-        const int request = std::max(options_.request != nullptr ? options_.request->load() : 0, forced_);
+        const int request =
+            std::max(options_.request != nullptr ? options_.request->load() : 0, forced_);
         if (request >= 1 && !hold_sent_ && !stop_sent_) {
             if (!started) {
                 stop_sent_ = true;
@@ -55,7 +56,7 @@ public:
     /// late and the job ended, idle); after a stop, it is idle. Fault and e-stop end it too.
     bool settled(const DeviceSnapshot& s) const {
         using device::DeviceState;
-        const auto state = static_cast<DeviceState>(s.state);
+        const DeviceState state = s.state;
         if (state == DeviceState::kIdle || state == DeviceState::kFault ||
             state == DeviceState::kEstop)
             return true;
@@ -84,7 +85,7 @@ public:
     /// After each status read. `plan_ticks`: path ticks of the plan executed so far. True when
     /// the resume should be sent now.
     bool observe(const DeviceSnapshot& s, std::uint64_t plan_ticks) {
-        const bool paused = s.paused() && s.state == static_cast<unsigned>(device::DeviceState::kHolding);
+        const bool paused = s.paused() && s.state == device::DeviceState::kHolding;
         if (paused && !was_paused_) {
             resume_sent_ = false;
             if (options_.on_pause) options_.on_pause(index_at(plan_ticks));
@@ -99,8 +100,9 @@ private:
     // The pause the device rests at: the first one at or after the ticks executed (a pause's
     // tick is the end of the span it follows).
     std::size_t index_at(std::uint64_t plan_ticks) const {
-        const auto it = std::lower_bound(pauses_.begin(), pauses_.end(), plan_ticks,
-                                         [](const PlanPause& p, std::uint64_t t) { return p.tick < t; });
+        const auto it =
+            std::lower_bound(pauses_.begin(), pauses_.end(), plan_ticks,
+                             [](const PlanPause& p, std::uint64_t t) { return p.tick < t; });
         if (it == pauses_.end()) return pauses_.empty() ? 0 : pauses_.size() - 1;
         return static_cast<std::size_t>(it - pauses_.begin());
     }

@@ -6,16 +6,17 @@
 #include <string>
 
 #include "pathstream/hal/can_bus.hpp"
-#include "pathstream/machine/machine.hpp"
-#include "pathstream/host/modbus_stream.hpp"  // StreamError, StreamProgress
 #include "pathstream/host/plan.hpp"
+#include "pathstream/host/span_supply.hpp"
+#include "pathstream/host/stream_types.hpp"
+#include "pathstream/machine/machine.hpp"
 
 namespace pathstream::host {
 
 /// A parsed `can://IFACE?node=N&protocol=native|cia402` target.
 struct CanTarget {
     std::string interface_name;
-    std::uint8_t node = 0;        ///< 1..127
+    std::uint8_t node = 0;  ///< 1..127
     std::string protocol = "native";
 };
 
@@ -24,56 +25,45 @@ struct CanTarget {
 CanTarget parse_can_target(const std::string& url);
 
 struct CanStreamOptions {
-    std::uint8_t node = 1;             ///< the device's node id, 1..127
-    std::string name = "can";          ///< how messages name the target (e.g. the URL)
-    double lead_seconds = 0.25;        ///< keep this much motion queued ahead of the device
-    unsigned ack_timeout_ms = 100;     ///< resend a batch, configuration or status request after this
-    double link_timeout_seconds = 2;   ///< give up after this long without a frame from the device
-    unsigned poll_interval_ms = 10;    ///< status requests (4 frames) while the queue is full enough
-    InterruptOptions interrupt;        ///< Ctrl-C handling
-    StreamObserver observer;           ///< called after every status read (may be empty)
-    const HeldJob* held = nullptr;     ///< continue a held job instead of starting one
+    std::uint8_t node = 1;          ///< the device's node id, 1..127
+    std::string name = "can";       ///< how messages name the target (e.g. the URL)
+    double lead_seconds = 0.25;     ///< keep this much motion queued ahead of the device
+    unsigned ack_timeout_ms = 100;  ///< resend a batch, configuration or status request after this
+    double link_timeout_seconds = 2;  ///< give up after this long without a frame from the device
+    unsigned poll_interval_ms = 10;   ///< status requests (4 frames) while the queue is full enough
+    InterruptOptions interrupt;       ///< Ctrl-C handling
+    StreamObserver observer;          ///< called after every status read (may be empty)
+    const HeldJob* held = nullptr;    ///< continue a held job instead of starting one
 };
 
 /// What the device executed and what the bus carried.
-struct CanStreamReport {
-    std::uint64_t spans_sent = 0;         ///< spans acknowledged (each once)
-    std::uint64_t batches = 0;            ///< batches acknowledged
-    std::uint64_t retransmissions = 0;    ///< batches sent again (timeout or incomplete)
-    std::uint64_t timeouts = 0;           ///< waits for an answer that ran out
-    std::uint64_t incomplete = 0;         ///< batches the device reported a lost data frame of
+struct CanStreamReport : StreamOutcome {
+    std::uint64_t retransmissions = 0;  ///< batches sent again (timeout or incomplete)
+    std::uint64_t timeouts = 0;         ///< waits for an answer that ran out
+    std::uint64_t incomplete = 0;       ///< batches the device reported a lost data frame of
     std::uint64_t status_requests = 0;
-    std::uint64_t ticks_executed = 0;     ///< path ticks the device executed for this plan
-    std::uint32_t last_completed = 0;     ///< sequence number of the last span executed
-    std::uint32_t job = 0;                ///< the job's id (its first span's sequence number), finished
-    std::uint32_t duplicates = 0;         ///< batches the device acknowledged as retries
-    std::uint32_t underruns = 0;
     std::uint64_t frames_sent = 0;
-    std::uint64_t frames_received = 0;    ///< frames from this node
-    std::uint64_t bits_sent = 0;          ///< worst-case stuffed bits (can::frame_bits_worst_case)
+    std::uint64_t frames_received = 0;  ///< frames from this node
+    std::uint64_t bits_sent = 0;        ///< worst-case stuffed bits (can::frame_bits_worst_case)
     std::uint64_t bits_received = 0;
-    double wall_seconds = 0;
-    std::int32_t final_position[8] = {};  ///< the plan's end point, which the device reached
-    int interrupted = 0;                  ///< as StreamReport::interrupted
-    bool stopped_elsewhere = false;       ///< as StreamReport::stopped_elsewhere
-    DeviceSnapshot final_status;          ///< the last status read
 };
 
-/// Streams `plan` to node options.node on `bus` (native protocol): checks the device's
-/// identity (protocol version, axis count, idle) and that it rests at the plan's start, configures its tick rate and limits from
-/// `profile` (rounded up to whole LSB/s and LSB/s^2), sends batches of spans with sequence
-/// numbers keeping options.lead_seconds queued and never more spans than the device has free
-/// slots, starts it, resumes it after an underrun, resends batches lost on the bus (timeouts,
-/// incomplete-transfer nacks), and returns when the last span has executed.
-/// Throws StreamError (device refused a batch, restarted, faulted, the host's controller went
-/// bus-off, or nothing came from the device for link_timeout_seconds) and
-/// std::invalid_argument (plan not streamable).
 /// Where the device at options.node rests (LSB per axis, from status frame E), after checking
 /// its identity (protocol version, axis count = the profile's) and that it is idle: what
 /// `stream --lead-in` plans its pen-up move from. Throws StreamError like stream_can.
 std::vector<Lsb> can_rest_position(const MachineProfile& profile, hal::CanBus& bus,
                                    const CanStreamOptions& options);
 
+/// Streams `plan` to node options.node on `bus` (native protocol): checks the device's
+/// identity (protocol version, axis count, idle) and that it rests at the plan's start,
+/// configures its tick rate and limits from `profile` (rounded up to whole LSB/s and
+/// LSB/s^2), sends batches of spans with sequence numbers keeping options.lead_seconds queued
+/// and never more spans than the device has free slots, starts it, resumes it after an
+/// underrun, resends batches lost on the bus (timeouts, incomplete-transfer nacks), and
+/// returns when the last span has executed. Throws StreamError (device refused a batch,
+/// restarted, faulted, the host's controller went bus-off, or nothing came from the device
+/// for link_timeout_seconds) and std::invalid_argument (plan not streamable). The loop is
+/// SpanStreamer's, shared with stream_modbus.
 CanStreamReport stream_can(const Plan& plan, const MachineProfile& profile, hal::CanBus& bus,
                            const CanStreamOptions& options, const StreamProgress& progress = {});
 

@@ -14,7 +14,7 @@
 #include "pathstream/hal/clock.hpp"
 #include "pathstream/machine/cia402_protocol.hpp"
 #include "pathstream/machine/machine.hpp"
-#include "pathstream/host/modbus_stream.hpp"
+#include "pathstream/host/stream_types.hpp"
 #include "pathstream/host/plan.hpp"
 
 namespace pathstream::host {

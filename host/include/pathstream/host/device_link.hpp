@@ -30,7 +30,8 @@ struct CanStreamOptions;
 /// tick (docs/device.md, "What the status says"). Fields a bus does not carry are 0 and named.
 struct DeviceSnapshot {
     unsigned magic = 0;  ///< Modbus only: 0x5053 ("PS")
-    unsigned version = 0, axes = 0, state = 0;
+    unsigned version = 0, axes = 0;
+    device::DeviceState state = device::DeviceState::kIdle;
     std::uint16_t fault_code = 0;
     unsigned free_slots = 0, queued = 0;
     unsigned capacity = 0;  ///< Modbus only (0 over CAN)

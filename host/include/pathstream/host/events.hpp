@@ -14,9 +14,10 @@
 #include <string>
 #include <vector>
 
+#include "pathstream/device/device_state.hpp"
 #include "pathstream/machine/event_json.hpp"
 #include "pathstream/machine/machine.hpp"
-#include "pathstream/host/modbus_stream.hpp"
+#include "pathstream/host/stream_types.hpp"
 #include "pathstream/host/plan.hpp"
 #include "pathstream/units.hpp"
 
@@ -63,7 +64,7 @@ struct JobInfo {
 /// One look at a job executing: a status read of a device, or a simulated tick.
 struct JobSample {
     std::optional<double> sim_seconds;  ///< sim: simulated time (progress is paced by it)
-    std::optional<unsigned> state;      ///< device state (a DeviceState number); sim: none
+    std::optional<device::DeviceState> state;  ///< device state; sim: none
     std::uint16_t fault_code = 0;
     bool started = false;                  ///< the device has begun executing the job
     std::size_t next_span = 0;             ///< the span executing or next to; spans(): all executed
@@ -170,7 +171,7 @@ private:
     // The last sample's view.
     bool first_sample_ = true;
     bool running_seen_ = false;
-    std::optional<unsigned> state_;
+    std::optional<device::DeviceState> state_;
     std::uint16_t fault_code_ = 0;
     bool hold_ = false, stop_ = false;
     unsigned underruns_base_ = 0, underruns_ = 0;

@@ -47,7 +47,7 @@ public:
     /// Tick rate the device is configured for (0 before configuration).
     virtual std::uint32_t tick_hz() const = 0;
     /// Device state (device::DeviceState as a number).
-    virtual std::uint8_t state() const = 0;
+    virtual device::DeviceState state() const = 0;
     /// Fault code (device::FaultCode as a number; 0 = none).
     virtual std::uint16_t fault_code() const = 0;
     /// Setpoint of the last tick.
@@ -131,7 +131,7 @@ public:
     std::uint32_t tick_hz() const override {
         return device_.configured() ? device_.limits().tick_hz : 0;
     }
-    std::uint8_t state() const override { return static_cast<std::uint8_t>(device_.state()); }
+    device::DeviceState state() const override { return device_.state(); }
     std::uint16_t fault_code() const override {
         return static_cast<std::uint16_t>(device_.fault_code());
     }

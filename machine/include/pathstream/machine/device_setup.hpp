@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "pathstream/device/device_state.hpp"
 #include "pathstream/device/gpio_logic.hpp"
 #include "pathstream/device/homing.hpp"
 #include "pathstream/machine/machine.hpp"
@@ -40,15 +41,19 @@ DeviceLimitsLsb device_limits(const MachineProfile& profile);
 /// Index of the axis called `name` in the profile. Throws std::invalid_argument if none.
 unsigned axis_index(const MachineProfile& profile, const std::string& name);
 
-/// "idle", "running", "holding", "stopping", "fault", "e-stop" (a DeviceState number), else
-/// "unknown".
-const char* device_state_name(unsigned state);
+/// "idle", "running", "holding", "stopping", "fault", "e-stop", else "unknown".
+const char* device_state_name(device::DeviceState state);
+
+/// A state as a bus carries it (a Modbus register, a CAN byte), typed. A number no state has
+/// stays what it is (up to 255, larger ones become 255): device_state_name calls it
+/// "unknown" and no comparison with a known state holds.
+device::DeviceState device_state_of_wire(unsigned raw);
 
 /// A device's fault code as its name: "limit switch x- (axis 0, negative side)",
 /// "external fault", "fault 0x1234" (device::fault_name).
 std::string fault_text(std::uint16_t fault_code);
-/// " (<fault_text>)" for the fault state, "" for any other state (a DeviceState number).
-std::string fault_suffix(unsigned state, std::uint16_t fault_code);
+/// " (<fault_text>)" for the fault state, "" for any other state.
+std::string fault_suffix(device::DeviceState state, std::uint16_t fault_code);
 
 /// A device position as the operator reads it: "x 12.3450 y 0.0000 mm (12345 0 LSB)", each
 /// axis by its profile name; `count` values of `lsb` (at most the profile's axes).
