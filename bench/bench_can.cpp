@@ -23,9 +23,9 @@
 #include "pathstream/host/can_stream.hpp"
 #include "pathstream/host/geometry.hpp"
 #include "pathstream/host/json_path.hpp"
-#include "pathstream/machine/machine.hpp"
 #include "pathstream/host/planner.hpp"
 #include "pathstream/linux_device/can_motion_device.hpp"
+#include "pathstream/machine/machine.hpp"
 #include "pathstream/sim/can_loopback.hpp"
 
 using namespace pathstream;
@@ -72,7 +72,8 @@ double cia402_percent(unsigned axes, double cycle_s) {
     return bits / cycle_s / 1e6 * 100;
 }
 
-Row measure(const host::Plan& plan2, const host::MachineProfile& m2, unsigned axes, double time_scale) {
+Row measure(const host::Plan& plan2, const host::MachineProfile& m2, unsigned axes,
+            double time_scale) {
     const host::Plan plan = widen(plan2, axes);
     host::MachineProfile m = m2;
     m.axes.resize(axes);
@@ -112,8 +113,9 @@ Row measure(const host::Plan& plan2, const host::MachineProfile& m2, unsigned ax
     }
     const double motion = static_cast<double>(r.ticks_executed) / m.tick_hz;
     const auto c = loop.counters();
-    return {axes, static_cast<double>(c.bits_worst_case) / motion / 1e6 * 100, static_cast<double>(c.frames) / motion,
-            cia402_percent(axes, 0.001), cia402_percent(axes, 0.002)};
+    return {axes, static_cast<double>(c.bits_worst_case) / motion / 1e6 * 100,
+            static_cast<double>(c.frames) / motion, cia402_percent(axes, 0.001),
+            cia402_percent(axes, 0.002)};
 }
 
 }  // namespace
@@ -156,19 +158,24 @@ int main(int argc, char** argv) {
         return kExitRunFailed;
     }
     if (markdown) {
-        std::printf("| axes | native, 1 kHz tick (%% of 1 Mbit/s) | frames/s | CiA 402 CSP 1 ms | CiA 402 CSP 2 ms |\n");
+        std::printf(
+            "| axes | native, 1 kHz tick (%% of 1 Mbit/s) | frames/s | CiA 402 CSP 1 ms | CiA 402 "
+            "CSP 2 ms |\n");
         std::printf("|---:|---:|---:|---:|---:|\n");
         for (const Row& r : rows) {
-            std::printf("| %u | %.1f %% | %.0f | %.1f %% | %.1f %% |\n", r.axes, r.native_percent, r.frames_per_second,
-                        r.cia402_1ms, r.cia402_2ms);
+            std::printf("| %u | %.1f %% | %.0f | %.1f %% | %.1f %% |\n", r.axes, r.native_percent,
+                        r.frames_per_second, r.cia402_1ms, r.cia402_2ms);
         }
     } else {
-        std::printf("bus load, worst-case stuffing, %% of 1 Mbit/s (wave.json, %u-tick spans, 1 kHz tick%s)\n",
-                    machine.ticks_per_span, quick ? ", device at 10x" : "");
-        std::printf("%5s %12s %10s %14s %14s\n", "axes", "native", "frames/s", "CiA402 1 ms", "CiA402 2 ms");
+        std::printf(
+            "bus load, worst-case stuffing, %% of 1 Mbit/s (wave.json, %u-tick spans, 1 kHz "
+            "tick%s)\n",
+            machine.ticks_per_span, quick ? ", device at 10x" : "");
+        std::printf("%5s %12s %10s %14s %14s\n", "axes", "native", "frames/s", "CiA402 1 ms",
+                    "CiA402 2 ms");
         for (const Row& r : rows) {
-            std::printf("%5u %11.1f%% %10.0f %13.1f%% %13.1f%%\n", r.axes, r.native_percent, r.frames_per_second,
-                        r.cia402_1ms, r.cia402_2ms);
+            std::printf("%5u %11.1f%% %10.0f %13.1f%% %13.1f%%\n", r.axes, r.native_percent,
+                        r.frames_per_second, r.cia402_1ms, r.cia402_2ms);
         }
     }
     // The one target: computed from the frames sent, so it judges the code, not the machine.

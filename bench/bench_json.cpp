@@ -15,9 +15,9 @@
 #include <cstdlib>
 #include <string>
 
+#include "pathstream/host/json_path.hpp"
 #include "pathstream/machine/input_error.hpp"
 #include "pathstream/machine/json_locate.hpp"
-#include "pathstream/host/json_path.hpp"
 
 using namespace pathstream::host;
 

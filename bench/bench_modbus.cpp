@@ -21,10 +21,10 @@
 // use under 50 % of a 115200-baud line. Wall-time figures (TCP spans/s) are printed only.
 // Exit status (also printed by --help): 0 target met, 1 target missed, 2 usage error, 3 a stream
 // failed or a drawing did not execute completely (no figures to judge).
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cmath>
-#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -38,17 +38,17 @@
 #include "pathstream/hal/modbus_server.hpp"
 #include "pathstream/host/geometry.hpp"
 #include "pathstream/host/json_path.hpp"
-#include "pathstream/machine/machine.hpp"
 #include "pathstream/host/modbus_stream.hpp"
 #include "pathstream/host/planner.hpp"
 #include "pathstream/linux_device/modbus_motion_device.hpp"
+#include "pathstream/machine/machine.hpp"
 
 using namespace pathstream;
 
 namespace {
 
 constexpr double kBaud = 115200;
-constexpr double kBitsPerChar = 10;     // 8N1
+constexpr double kBitsPerChar = 10;      // 8N1
 constexpr double kT35Seconds = 1.75e-3;  // fixed above 19200 baud (Modbus over serial line spec)
 constexpr double kDefaultTargetPercent = 50;  // 2 axes at 1 kHz on 115200 8N1
 
@@ -104,11 +104,12 @@ Job four_axis_job() {
     path << R"({"units": "mm", "basis": "catmull-rom", "points": [)";
     for (int i = 0; i <= 48; ++i) {
         const double t = i * 0.3;
-        path << (i ? ", " : "") << '[' << 40 * std::cos(t) << ", " << 40 * std::sin(t) << ", " << 2.0 * t << ", "
-             << 10 * std::sin(0.5 * t) << ']';
+        path << (i ? ", " : "") << '[' << 40 * std::cos(t) << ", " << 40 * std::sin(t) << ", "
+             << 2.0 * t << ", " << 10 * std::sin(0.5 * t) << ']';
     }
     path << "]}";
-    return plan_job("4 axes, helix (made in the bench)", host::parse_json_path(path.str(), "<bench 4-axis path>"),
+    return plan_job("4 axes, helix (made in the bench)",
+                    host::parse_json_path(path.str(), "<bench 4-axis path>"),
                     host::parse_machine_profile(profile, "<bench 4-axis profile>"));
 }
 
@@ -127,15 +128,16 @@ std::vector<Lsb> start_of(const host::Plan& plan) {
 // Streams `job` to a fresh simulated device behind `make_server`'s server, ticking at
 // `time_scale`; returns the report. Throws on a stream failure.
 template <typename MakeServer, typename Target>
-host::StreamReport stream_once(const Job& job, double time_scale, const host::StreamOptions& base, MakeServer make_server,
-                               Target target_of) {
+host::StreamReport stream_once(const Job& job, double time_scale, const host::StreamOptions& base,
+                               MakeServer make_server, Target target_of) {
     const auto device = linux_device::ModbusMotionDevice::create(start_of(job.plan));
     hal::ModbusServer server = make_server(device->handler());
     std::atomic<bool> stop{false};
     std::thread loop([&] {
         linux_device::DeviceLoopOptions o;
         o.time_scale = time_scale;
-        linux_device::run_device_loop(*device, [&](std::chrono::microseconds w) { server.poll_once(w); }, o, stop);
+        linux_device::run_device_loop(
+            *device, [&](std::chrono::microseconds w) { server.poll_once(w); }, o, stop);
     });
     host::StreamOptions o = base;
     o.target = target_of(server);
@@ -159,11 +161,11 @@ bool complete(const Job& job, const host::StreamReport& r) {
 struct RtuFigures {
     std::string name;
     double motion_seconds = 0;
-    double bytes_per_second = 0;       // ADU bytes, both directions, per second of motion
+    double bytes_per_second = 0;  // ADU bytes, both directions, per second of motion
     double frames_per_second = 0;
-    double utilisation = 0;            // share of a 115200 8N1 line
-    double poll_utilisation = 0;       // of which status polls (FC4)
-    double baseline_utilisation = 0;   // one setpoint per FC16 transaction
+    double utilisation = 0;           // share of a 115200 8N1 line
+    double poll_utilisation = 0;      // of which status polls (FC4)
+    double baseline_utilisation = 0;  // one setpoint per FC16 transaction
     double ratio = 0;
     double underruns = 0;
     double batches = 0;
@@ -182,16 +184,19 @@ RtuFigures rtu_figures(const Job& job, const host::StreamReport& r) {
     const double wire = bytes * kBitsPerChar / kBaud + frames * kT35Seconds;
     f.utilisation = wire / f.motion_seconds;
     using hal::ModbusFraming;
-    const double poll_bytes =
-        static_cast<double>(hal::modbus_adu_bytes(ModbusFraming::kRtu, hal::modbus_read_request_pdu_bytes()) +
-                            hal::modbus_adu_bytes(ModbusFraming::kRtu, hal::modbus_read_response_pdu_bytes(36)));
-    f.poll_utilisation =
-        static_cast<double>(r.status_reads) * (poll_bytes * kBitsPerChar / kBaud + 2 * kT35Seconds) / f.motion_seconds;
+    const double poll_bytes = static_cast<double>(
+        hal::modbus_adu_bytes(ModbusFraming::kRtu, hal::modbus_read_request_pdu_bytes()) +
+        hal::modbus_adu_bytes(ModbusFraming::kRtu, hal::modbus_read_response_pdu_bytes(36)));
+    f.poll_utilisation = static_cast<double>(r.status_reads) *
+                         (poll_bytes * kBitsPerChar / kBaud + 2 * kT35Seconds) / f.motion_seconds;
     // Baseline: each tick's setpoint (2 registers per axis) in its own FC16 request + response.
     const double per_tick_bytes = static_cast<double>(
-        hal::modbus_adu_bytes(ModbusFraming::kRtu, hal::modbus_write_multiple_request_pdu_bytes(2 * job.axes)) +
-        hal::modbus_adu_bytes(ModbusFraming::kRtu, hal::modbus_write_multiple_response_pdu_bytes()));
-    f.baseline_utilisation = job.machine.tick_hz * (per_tick_bytes * kBitsPerChar / kBaud + 2 * kT35Seconds);
+        hal::modbus_adu_bytes(ModbusFraming::kRtu,
+                              hal::modbus_write_multiple_request_pdu_bytes(2 * job.axes)) +
+        hal::modbus_adu_bytes(ModbusFraming::kRtu,
+                              hal::modbus_write_multiple_response_pdu_bytes()));
+    f.baseline_utilisation =
+        job.machine.tick_hz * (per_tick_bytes * kBitsPerChar / kBaud + 2 * kT35Seconds);
     f.ratio = f.baseline_utilisation / f.utilisation;
     f.underruns = r.underruns;
     f.batches = static_cast<double>(r.batches);
@@ -240,8 +245,12 @@ int main(int argc, char** argv) {
         const double tcp_scale = 200;
         const host::StreamReport t = stream_once(
             two, tcp_scale, tcp,
-            [](hal::ModbusRegisterHandler& h) { return hal::ModbusServer::tcp(h, {"127.0.0.1", 0, 4}); },
-            [](const hal::ModbusServer& s) { return "modbus-tcp://127.0.0.1:" + std::to_string(s.port()) + "?unit=1"; });
+            [](hal::ModbusRegisterHandler& h) {
+                return hal::ModbusServer::tcp(h, {"127.0.0.1", 0, 4});
+            },
+            [](const hal::ModbusServer& s) {
+                return "modbus-tcp://127.0.0.1:" + std::to_string(s.port()) + "?unit=1";
+            });
         if (!complete(two, t)) {
             std::fprintf(stderr, "bench_modbus: TCP: the drawing did not complete\n");
             return kExitRunFailed;
@@ -255,8 +264,11 @@ int main(int argc, char** argv) {
         std::vector<RtuFigures> rows;
         for (const Job* job : {&two, &four}) {
             const host::StreamReport r = stream_once(
-                *job, rtu_scale, rtu, [](hal::ModbusRegisterHandler& h) { return hal::ModbusServer::rtu_pty(h); },
-                [](const hal::ModbusServer& s) { return "modbus-rtu://" + s.client_device() + "?baud=115200&parity=N&unit=1"; });
+                *job, rtu_scale, rtu,
+                [](hal::ModbusRegisterHandler& h) { return hal::ModbusServer::rtu_pty(h); },
+                [](const hal::ModbusServer& s) {
+                    return "modbus-rtu://" + s.client_device() + "?baud=115200&parity=N&unit=1";
+                });
             if (!complete(*job, r)) {
                 std::fprintf(stderr, "bench_modbus: RTU %s: the drawing did not complete\n",
                              job->name.c_str());
@@ -267,38 +279,55 @@ int main(int argc, char** argv) {
 
         if (markdown) {
             std::printf("| link | drawing | figure | value |\n|---|---|---|---:|\n");
-            std::printf("| TCP loopback, device at %.0fx | %s | spans/s sustained | %.0f |\n", tcp_scale, two.name.c_str(),
-                        spans_per_s);
+            std::printf("| TCP loopback, device at %.0fx | %s | spans/s sustained | %.0f |\n",
+                        tcp_scale, two.name.c_str(), spans_per_s);
             std::printf("| | | transactions/s | %.0f |\n", tx_per_s);
             std::printf("| | | setpoints (ticks) delivered/s | %.0f |\n", ticks_per_s);
-            std::printf("\n| RTU 115200 8N1, 1 kHz tick | bytes/s of motion | frames/s | line use | of which status polls "
-                        "| one setpoint per FC16 | ratio | underruns |\n|---|---:|---:|---:|---:|---:|---:|---:|\n");
+            std::printf(
+                "\n| RTU 115200 8N1, 1 kHz tick | bytes/s of motion | frames/s | line use | of "
+                "which status polls "
+                "| one setpoint per FC16 | ratio | underruns "
+                "|\n|---|---:|---:|---:|---:|---:|---:|---:|\n");
             for (const auto& f : rows) {
-                std::printf("| %s | %.0f | %.1f | %.1f %% | %.1f %% | %.0f %% | %.1fx | %.0f |\n", f.name.c_str(),
-                            f.bytes_per_second, f.frames_per_second, 100 * f.utilisation, 100 * f.poll_utilisation,
+                std::printf("| %s | %.0f | %.1f | %.1f %% | %.1f %% | %.0f %% | %.1fx | %.0f |\n",
+                            f.name.c_str(), f.bytes_per_second, f.frames_per_second,
+                            100 * f.utilisation, 100 * f.poll_utilisation,
                             100 * f.baseline_utilisation, f.ratio, f.underruns);
             }
         } else {
-            std::printf("bench_modbus: plan streamed to the simulated device (firmware core behind hal::ModbusServer)\n\n");
-            std::printf("(a) Modbus TCP on loopback, device at %.0fx real time (link-bound), %s\n", tcp_scale,
-                        two.name.c_str());
-            std::printf("    %llu spans in %llu batches, %llu transactions (%llu status polls), %.3f s wall\n",
-                        static_cast<unsigned long long>(t.spans_sent), static_cast<unsigned long long>(t.batches),
-                        static_cast<unsigned long long>(t.transactions),
-                        static_cast<unsigned long long>(t.status_reads), t.wall_seconds);
-            std::printf("    spans/s %.0f | transactions/s %.0f | ticks delivered/s %.0f (%.1f setpoints per transaction; "
-                        "one setpoint per transaction would deliver %.0f/s: ratio %.1fx) | underruns %u\n\n",
-                        spans_per_s, tx_per_s, ticks_per_s, ticks_per_s / tx_per_s, tx_per_s, ticks_per_s / tx_per_s,
-                        t.underruns);
-            std::printf("(b) Modbus RTU on a pty, device at %gx real time, 1 kHz tick; wire time computed for 115200 8N1 "
-                        "(10 bits/byte) + t3.5 = 1.75 ms per frame\n",
-                        rtu_scale);
+            std::printf(
+                "bench_modbus: plan streamed to the simulated device (firmware core behind "
+                "hal::ModbusServer)\n\n");
+            std::printf("(a) Modbus TCP on loopback, device at %.0fx real time (link-bound), %s\n",
+                        tcp_scale, two.name.c_str());
+            std::printf(
+                "    %llu spans in %llu batches, %llu transactions (%llu status polls), %.3f s "
+                "wall\n",
+                static_cast<unsigned long long>(t.spans_sent),
+                static_cast<unsigned long long>(t.batches),
+                static_cast<unsigned long long>(t.transactions),
+                static_cast<unsigned long long>(t.status_reads), t.wall_seconds);
+            std::printf(
+                "    spans/s %.0f | transactions/s %.0f | ticks delivered/s %.0f (%.1f setpoints "
+                "per transaction; "
+                "one setpoint per transaction would deliver %.0f/s: ratio %.1fx) | underruns "
+                "%u\n\n",
+                spans_per_s, tx_per_s, ticks_per_s, ticks_per_s / tx_per_s, tx_per_s,
+                ticks_per_s / tx_per_s, t.underruns);
+            std::printf(
+                "(b) Modbus RTU on a pty, device at %gx real time, 1 kHz tick; wire time computed "
+                "for 115200 8N1 "
+                "(10 bits/byte) + t3.5 = 1.75 ms per frame\n",
+                rtu_scale);
             for (const auto& f : rows) {
-                std::printf("    %-36s %6.1f s motion | %6.0f bytes/s | %5.1f frames/s | line %5.1f %% (polls %5.1f %%) | "
-                            "one setpoint per FC16: %4.0f %% | ratio %4.1fx | batches %.0f | underruns %.0f\n",
-                            f.name.c_str(), f.motion_seconds, f.bytes_per_second, f.frames_per_second,
-                            100 * f.utilisation, 100 * f.poll_utilisation, 100 * f.baseline_utilisation, f.ratio,
-                            f.batches, f.underruns);
+                std::printf(
+                    "    %-36s %6.1f s motion | %6.0f bytes/s | %5.1f frames/s | line %5.1f %% "
+                    "(polls %5.1f %%) | "
+                    "one setpoint per FC16: %4.0f %% | ratio %4.1fx | batches %.0f | underruns "
+                    "%.0f\n",
+                    f.name.c_str(), f.motion_seconds, f.bytes_per_second, f.frames_per_second,
+                    100 * f.utilisation, 100 * f.poll_utilisation, 100 * f.baseline_utilisation,
+                    f.ratio, f.batches, f.underruns);
             }
         }
         // The one target: computed from bytes and frames, so it judges the code, not the machine.

@@ -73,11 +73,16 @@ MachineProfile pen_plotter() {
 /// n straight strokes at seeded random places.
 Path random_segments(std::size_t n) {
     std::mt19937_64 rng(20240611);
-    std::uniform_real_distribution<double> x(0, 300), y(0, 200), angle(0, 6.283185307179586), length(2, 12);
+    std::uniform_real_distribution<double> x(0, 300), y(0, 200), angle(0, 6.283185307179586),
+        length(2, 12);
     Path p;
     for (std::size_t i = 0; i < n; ++i) {
         const double x0 = x(rng), y0 = y(rng), a = angle(rng), l = length(rng);
-        p.subpaths.push_back({PathBasis::kPolyline, false, {{x0, y0}, {x0 + l * std::cos(a), y0 + l * std::sin(a)}}, 0, {}});
+        p.subpaths.push_back({PathBasis::kPolyline,
+                              false,
+                              {{x0, y0}, {x0 + l * std::cos(a), y0 + l * std::sin(a)}},
+                              0,
+                              {}});
     }
     return p;
 }
@@ -90,9 +95,10 @@ double motion_seconds(const Path& path) {
 }
 
 void usage(FILE* out) {
-    std::fprintf(out,
-                 "usage: bench_order [--quick] [--no-plan] [--segments N] [--markdown] [--help]\n"
-                 "exit: 0 ok, 1 an order lost to document order or greedy, 2 usage, 3 unreadable drawing\n");
+    std::fprintf(
+        out,
+        "usage: bench_order [--quick] [--no-plan] [--segments N] [--markdown] [--help]\n"
+        "exit: 0 ok, 1 an order lost to document order or greedy, 2 usage, 3 unreadable drawing\n");
 }
 
 }  // namespace
@@ -128,15 +134,19 @@ int main(int argc, char** argv) {
         drawings.push_back({"landscape.svg", load_svg_path(kSource + "/examples/landscape.svg")});
         drawings.push_back({"rose.json", load_json_path(kSource + "/examples/rose.json")});
         drawings.push_back({"leaf.ngc", load_gcode_path(kSource + "/examples/leaf.ngc")});
-        drawings.push_back({"star.csv", load_csv_path(kSource + "/examples/star.csv", PathBasis::kPolyline, true)});
+        drawings.push_back({"star.csv", load_csv_path(kSource + "/examples/star.csv",
+                                                      PathBasis::kPolyline, true)});
     } catch (const std::exception& e) {
         std::fprintf(stderr, "bench_order: %s\n", e.what());
         return 3;
     }
     drawings.push_back({"random " + std::to_string(segments), random_segments(segments)});
 
-    const char* head = markdown ? "| drawing | subpaths | document mm | greedy mm | improved mm | saved | order ms | motion s |\n|---|---|---|---|---|---|---|---|\n"
-                                : "drawing           subpaths     document mm  greedy mm  improved mm  saved  order ms  motion s\n";
+    const char* head = markdown
+                           ? "| drawing | subpaths | document mm | greedy mm | improved mm | saved "
+                             "| order ms | motion s |\n|---|---|---|---|---|---|---|---|\n"
+                           : "drawing           subpaths     document mm  greedy mm  improved mm  "
+                             "saved  order ms  motion s\n";
     std::fputs(head, stdout);
     int status = 0;
     for (const Drawing& d : drawings) {
@@ -146,25 +156,31 @@ int main(int argc, char** argv) {
         (void)order_path(d.path, greedy_only, &g);
         const auto t0 = std::chrono::steady_clock::now();
         const Path ordered = order_path(d.path, {}, &r);
-        const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-        if (r.travel_after > r.travel_before + 1e-9 || r.travel_after > g.travel_after + 1e-9) status = 1;
+        const double ms =
+            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
+                .count();
+        if (r.travel_after > r.travel_before + 1e-9 || r.travel_after > g.travel_after + 1e-9)
+            status = 1;
         std::string motion = "-";
         if (plan && !(quick && d.path.subpaths.size() > 500)) {
             try {
                 char text[64];
-                std::snprintf(text, sizeof text, "%.2f -> %.2f", motion_seconds(d.path), motion_seconds(ordered));
+                std::snprintf(text, sizeof text, "%.2f -> %.2f", motion_seconds(d.path),
+                              motion_seconds(ordered));
                 motion = text;
             } catch (const std::exception& e) {
                 std::fprintf(stderr, "bench_order: %s: %s\n", d.name.c_str(), e.what());
                 return 3;
             }
         }
-        const double saved = r.travel_before > 0 ? 100 * (r.travel_before - r.travel_after) / r.travel_before : 0;
-        const std::string counts = std::to_string(r.subpaths_before) + " -> " + std::to_string(r.subpaths_after);
+        const double saved =
+            r.travel_before > 0 ? 100 * (r.travel_before - r.travel_after) / r.travel_before : 0;
+        const std::string counts =
+            std::to_string(r.subpaths_before) + " -> " + std::to_string(r.subpaths_after);
         std::printf(markdown ? "| %s | %s | %.1f | %.1f | %.1f | %.0f %% | %.1f | %s |\n"
                              : "%-17s %-12s %11.1f %10.1f %12.1f %5.0f%% %9.1f  %s\n",
-                    d.name.c_str(), counts.c_str(), r.travel_before, g.travel_after, r.travel_after, saved, ms,
-                    motion.c_str());
+                    d.name.c_str(), counts.c_str(), r.travel_before, g.travel_after, r.travel_after,
+                    saved, ms, motion.c_str());
     }
     return status;
 }

@@ -77,7 +77,6 @@ double ms_since(std::chrono::steady_clock::time_point t0) {
     return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
 
-
 /// The load averages, as /proc/loadavg has them ("0.54 1.22 1.70").
 std::string load_text() {
     std::ifstream in("/proc/loadavg");
@@ -87,11 +86,13 @@ std::string load_text() {
 }
 
 /// The grid table: plan, fine grid and optimum for three drawings. False if a plan failed.
-bool run_grid_table(std::size_t segments, double density, int runs, bool markdown, const MachineProfile& profile) {
+bool run_grid_table(std::size_t segments, double density, int runs, bool markdown,
+                    const MachineProfile& profile) {
     const PlanOptions options;
     PlanOptions fine = options;
     fine.grid_step /= density;
-    fine.min_nodes_per_segment = static_cast<std::size_t>(std::ceil(options.min_nodes_per_segment * density));
+    fine.min_nodes_per_segment =
+        static_cast<std::size_t>(std::ceil(options.min_nodes_per_segment * density));
     fine.max_turn /= 4;
     const double quantisation = 1.5 * std::sqrt(2.0) * profile.mm_per_lsb;
 
@@ -99,7 +100,9 @@ bool run_grid_table(std::size_t segments, double density, int runs, bool markdow
         const char* name;
         Path path;
     };
-    const Named paths[] = {{"rose", rose_path(segments)}, {"wander", wander_path(segments)}, {"spiral", spiral_path(segments)}};
+    const Named paths[] = {{"rose", rose_path(segments)},
+                           {"wander", wander_path(segments)},
+                           {"spiral", spiral_path(segments)}};
     std::vector<Row> rows;
     bool ok = true;
     for (const Named& np : paths) {
@@ -132,12 +135,13 @@ bool run_grid_table(std::size_t segments, double density, int runs, bool markdow
             row.fine = static_cast<double>(fine_stats.motion_ticks) / profile.tick_hz;
             row.optimum = fine_stats.reference_motion_time;
             row.max_deviation = check.max_deviation;
-            row.v_fraction_exact = std::max(check.max_velocity_fraction_exact, check.max_span_velocity_fraction);
-            row.a_fraction_exact =
-                std::max(check.max_acceleration_fraction_exact, check.max_span_acceleration_fraction);
+            row.v_fraction_exact =
+                std::max(check.max_velocity_fraction_exact, check.max_span_velocity_fraction);
+            row.a_fraction_exact = std::max(check.max_acceleration_fraction_exact,
+                                            check.max_span_acceleration_fraction);
             if (!check.within_limits) {
-                std::fprintf(stderr, "%s: over the limits (v %.6f, a %.6f of the limit exactly)\n", np.name,
-                             row.v_fraction_exact, row.a_fraction_exact);
+                std::fprintf(stderr, "%s: over the limits (v %.6f, a %.6f of the limit exactly)\n",
+                             np.name, row.v_fraction_exact, row.a_fraction_exact);
                 ok = false;
             }
             if (check.drawing_while_pen_moves) {
@@ -145,8 +149,9 @@ bool run_grid_table(std::size_t segments, double density, int runs, bool markdow
                 ok = false;
             }
             if (check.max_deviation > profile.chord_tolerance + quantisation) {
-                std::fprintf(stderr, "%s: deviation %.6f mm at tick %llu exceeds %.6f mm\n", np.name,
-                             check.max_deviation, static_cast<unsigned long long>(check.worst_deviation_tick),
+                std::fprintf(stderr, "%s: deviation %.6f mm at tick %llu exceeds %.6f mm\n",
+                             np.name, check.max_deviation,
+                             static_cast<unsigned long long>(check.worst_deviation_tick),
                              profile.chord_tolerance + quantisation);
                 ok = false;
             }
@@ -157,38 +162,53 @@ bool run_grid_table(std::size_t segments, double density, int runs, bool markdow
         rows.push_back(row);
     }
 
-    std::printf("bench_plan: %zu segments per path, pen plotter profile (%g mm/s, %g mm/s^2, %g Hz, %u ticks/span)\n",
-                segments, profile.axes[0].max_velocity, profile.axes[0].max_acceleration, profile.tick_hz,
-                profile.ticks_per_span);
-    std::printf("fine = same planner, %gx denser lookahead grid; optimum = continuous TOPP-RA on that grid\n\n",
-                density);
+    std::printf(
+        "bench_plan: %zu segments per path, pen plotter profile (%g mm/s, %g mm/s^2, %g Hz, %u "
+        "ticks/span)\n",
+        segments, profile.axes[0].max_velocity, profile.axes[0].max_acceleration, profile.tick_hz,
+        profile.ticks_per_span);
+    std::printf(
+        "fine = same planner, %gx denser lookahead grid; optimum = continuous TOPP-RA on that "
+        "grid\n\n",
+        density);
     if (markdown) {
-        std::printf("| path | segments | grid nodes | spans | plan ms | check ms | motion s | fine s | optimum s | "
-                    "%% above fine | %% above optimum | retries | replans | max dev um | v %% exact | a %% exact |\n");
-        std::printf("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+        std::printf(
+            "| path | segments | grid nodes | spans | plan ms | check ms | motion s | fine s | "
+            "optimum s | "
+            "%% above fine | %% above optimum | retries | replans | max dev um | v %% exact | a %% "
+            "exact |\n");
+        std::printf(
+            "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
     } else {
-        std::printf("%-7s %8s %9s %7s %9s %9s %9s %9s %9s %8s %8s %7s %7s %8s %8s %8s\n", "path", "segments", "nodes",
-                    "spans", "plan ms", "check ms", "motion s", "fine s", "optim s", "%>fine", "%>optim", "retries",
-                    "replans", "dev um", "v % ex", "a % ex");
+        std::printf("%-7s %8s %9s %7s %9s %9s %9s %9s %9s %8s %8s %7s %7s %8s %8s %8s\n", "path",
+                    "segments", "nodes", "spans", "plan ms", "check ms", "motion s", "fine s",
+                    "optim s", "%>fine", "%>optim", "retries", "replans", "dev um", "v % ex",
+                    "a % ex");
     }
     for (const Row& r : rows) {
         const double above_fine = r.fine > 0 ? 100 * (r.motion / r.fine - 1) : 0;
         const double above_opt = r.optimum > 0 ? 100 * (r.motion / r.optimum - 1) : 0;
         if (markdown) {
-            std::printf("| %s | %zu | %zu | %zu | %.1f | %.1f | %.3f | %.3f | %.3f | %+.2f | %+.2f | %zu | %d | %.2f | %.2f | %.2f |\n",
-                        r.name.c_str(), r.segments, r.nodes, r.spans, r.plan_ms, r.check_ms, r.motion, r.fine,
-                        r.optimum, above_fine, above_opt, r.retries, r.replans, 1000 * r.max_deviation,
-                        100 * r.v_fraction_exact, 100 * r.a_fraction_exact);
+            std::printf(
+                "| %s | %zu | %zu | %zu | %.1f | %.1f | %.3f | %.3f | %.3f | %+.2f | %+.2f | %zu | "
+                "%d | %.2f | %.2f | %.2f |\n",
+                r.name.c_str(), r.segments, r.nodes, r.spans, r.plan_ms, r.check_ms, r.motion,
+                r.fine, r.optimum, above_fine, above_opt, r.retries, r.replans,
+                1000 * r.max_deviation, 100 * r.v_fraction_exact, 100 * r.a_fraction_exact);
         } else {
-            std::printf("%-7s %8zu %9zu %7zu %9.1f %9.1f %9.3f %9.3f %9.3f %+8.2f %+8.2f %7zu %7d %8.2f %8.2f %8.2f\n",
-                        r.name.c_str(), r.segments, r.nodes, r.spans, r.plan_ms, r.check_ms, r.motion, r.fine,
-                        r.optimum, above_fine, above_opt, r.retries, r.replans, 1000 * r.max_deviation,
-                        100 * r.v_fraction_exact, 100 * r.a_fraction_exact);
+            std::printf(
+                "%-7s %8zu %9zu %7zu %9.1f %9.1f %9.3f %9.3f %9.3f %+8.2f %+8.2f %7zu %7d %8.2f "
+                "%8.2f %8.2f\n",
+                r.name.c_str(), r.segments, r.nodes, r.spans, r.plan_ms, r.check_ms, r.motion,
+                r.fine, r.optimum, above_fine, above_opt, r.retries, r.replans,
+                1000 * r.max_deviation, 100 * r.v_fraction_exact, 100 * r.a_fraction_exact);
         }
     }
-    std::printf("\ncheck (exact cubic and every tick within limits, no motion in pen dwells, deviation <= tolerance + "
-                "%.2f um): %s\n",
-                1000 * quantisation, ok ? "passed" : "FAILED");
+    std::printf(
+        "\ncheck (exact cubic and every tick within limits, no motion in pen dwells, deviation <= "
+        "tolerance + "
+        "%.2f um): %s\n",
+        1000 * quantisation, ok ? "passed" : "FAILED");
     return ok;
 }
 
@@ -200,7 +220,9 @@ bool run_peer_table(bool quick, bool markdown, const MachineProfile& profile) {
         std::string name;
         Path path;
     };
-    const auto sized = [&](const char* kind, std::size_t n) { return std::string(kind) + " " + std::to_string(n / scale); };
+    const auto sized = [&](const char* kind, std::size_t n) {
+        return std::string(kind) + " " + std::to_string(n / scale);
+    };
     std::vector<Named> paths = {
         {sized("spiral", 1000), spiral_path(1000 / scale)},
         {sized("spiral", 10000), spiral_path(10000 / scale)},
@@ -219,9 +241,11 @@ bool run_peer_table(bool quick, bool markdown, const MachineProfile& profile) {
         std::fprintf(stderr, "bench_plan: %s\n", e.what());
         return false;
     }
-    for (const char* file : {"landscape.svg", "rose.json", "leaf.ngc", "star.csv", "two_pens.svg", "wave.json"}) {
+    for (const char* file :
+         {"landscape.svg", "rose.json", "leaf.ngc", "star.csv", "two_pens.svg", "wave.json"}) {
         try {
-            rows.push_back(compare_with_peers(file, read_example(kSource + "/examples/" + file, plotter), plotter));
+            rows.push_back(compare_with_peers(
+                file, read_example(kSource + "/examples/" + file, plotter), plotter));
         } catch (const std::exception& e) {
             PeerRow failed;
             failed.name = file;
@@ -240,7 +264,6 @@ bool run_peer_table(bool quick, bool markdown, const MachineProfile& profile) {
     return ok;
 }
 
-
 /// Worst jerk figures of a plan from its integer control values (docs/planner.md §12), as
 /// fractions of the limit: inside the spans and at the joins (rest at both ends).
 double jerk_fraction(const Plan& plan, const MachineProfile& p) {
@@ -255,7 +278,9 @@ double jerk_fraction(const Plan& plan, const MachineProfile& p) {
             const long double dp = static_cast<long double>(c[1]) - c[0];
             const long double third = 6 * (-2 * dp + c[2] + c[3]) / (n * n * n);
             const long double start = (6 * dp - 4 * c[2] - 2 * c[3]) / (n * n);
-            worst = std::max(worst, static_cast<double>(std::max(std::fabs(third), std::fabs(start - a_end[i])) / j));
+            worst = std::max(
+                worst,
+                static_cast<double>(std::max(std::fabs(third), std::fabs(start - a_end[i])) / j));
             a_end[i] = (-6 * dp + 2 * c[2] + 4 * c[3]) / (n * n);
         }
     }
@@ -276,15 +301,20 @@ bool run_jerk_table(std::size_t segments, bool markdown, const MachineProfile& p
     std::vector<Named> paths = {{"rose " + std::to_string(segments), rose_path(segments)},
                                 {"wander " + std::to_string(segments), wander_path(segments)},
                                 {"spiral " + std::to_string(segments), spiral_path(segments)}};
-    for (const char* f : {"rose.json", "wave.json", "landscape.svg", "leaf.ngc", "star.csv", "two_pens.svg"}) {
+    for (const char* f :
+         {"rose.json", "wave.json", "landscape.svg", "leaf.ngc", "star.csv", "two_pens.svg"}) {
         paths.push_back({f, read_example(kSource + "/examples/" + f, profile)});
     }
     const double jerks[] = {1e5, 1e6};
-    std::printf("\n%s", markdown ? "| path | segments | motion s | plan ms | motion s, j 1e5 | % | plan ms | j % | replans | "
-                                   "motion s, j 1e6 | % | plan ms | j % | replans |\n"
-                                   "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n"
-                                 : "path               segments  motion s   plan ms  | j=1e5: motion s        %   plan ms     j %  r "
-                                   "| j=1e6: motion s        %   plan ms     j %  r\n");
+    std::printf("\n%s",
+                markdown
+                    ? "| path | segments | motion s | plan ms | motion s, j 1e5 | % | plan ms | j "
+                      "% | replans | "
+                      "motion s, j 1e6 | % | plan ms | j % | replans |\n"
+                      "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n"
+                    : "path               segments  motion s   plan ms  | j=1e5: motion s        % "
+                      "  plan ms     j %  r "
+                      "| j=1e6: motion s        %   plan ms     j %  r\n");
     bool ok = true;
     for (const Named& np : paths) {
         const std::vector<BezierSegment> segs = to_bezier_segments(np.path);
@@ -301,15 +331,20 @@ bool run_jerk_table(std::size_t segments, bool markdown, const MachineProfile& p
                 const double ms = ms_since(t0);
                 const double motion = static_cast<double>(st.motion_ticks) / p.tick_hz;
                 const PlanCheck check = check_plan(plan, segs, p);
-                const bool passed = check.within_limits && !check.drawing_while_pen_moves &&
-                                    check.max_deviation <= p.chord_tolerance + 1.5 * std::sqrt(2.0) * p.mm_per_lsb;
+                const bool passed =
+                    check.within_limits && !check.drawing_while_pen_moves &&
+                    check.max_deviation <= p.chord_tolerance + 1.5 * std::sqrt(2.0) * p.mm_per_lsb;
                 if (k < 0) {
                     base = motion;
-                    std::snprintf(cell, sizeof cell, markdown ? "| %s | %zu | %.3f | %.1f " : "%-18s %8zu %9.3f %9.1f ",
-                                  np.name.c_str(), segs.size(), motion, ms);
+                    std::snprintf(
+                        cell, sizeof cell,
+                        markdown ? "| %s | %zu | %.3f | %.1f " : "%-18s %8zu %9.3f %9.1f ",
+                        np.name.c_str(), segs.size(), motion, ms);
                 } else {
                     const double jf = jerk_fraction(plan, p);
-                    std::snprintf(cell, sizeof cell, markdown ? "| %.3f | %+.2f | %.1f | %.1f | %d " : "| %15.3f %+8.2f %9.1f %7.1f %2d ",
+                    std::snprintf(cell, sizeof cell,
+                                  markdown ? "| %.3f | %+.2f | %.1f | %.1f | %d "
+                                           : "| %15.3f %+8.2f %9.1f %7.1f %2d ",
                                   motion, 100 * (motion / base - 1), ms, 100 * jf, st.replans);
                     if (jf > 1) ok = false;
                 }
@@ -318,8 +353,10 @@ bool run_jerk_table(std::size_t segments, bool markdown, const MachineProfile& p
                 if (!passed) {
                     char why[160];
                     std::snprintf(why, sizeof why, "(check FAILED: v %.3f a %.3f dev %.4f mm) ",
-                                  std::max(check.max_velocity_fraction_exact, check.max_span_velocity_fraction),
-                                  std::max(check.max_acceleration_fraction_exact, check.max_span_acceleration_fraction),
+                                  std::max(check.max_velocity_fraction_exact,
+                                           check.max_span_velocity_fraction),
+                                  std::max(check.max_acceleration_fraction_exact,
+                                           check.max_span_acceleration_fraction),
                                   check.max_deviation);
                     line += why;
                 }
@@ -335,11 +372,13 @@ bool run_jerk_table(std::size_t segments, bool markdown, const MachineProfile& p
 }  // namespace
 
 constexpr const char* kUsageText =
-    "usage: bench_plan [--quick] [--segments N] [--density D] [--runs R] [--no-peers] [--markdown]\n"
+    "usage: bench_plan [--quick] [--segments N] [--density D] [--runs R] [--no-peers] "
+    "[--markdown]\n"
     "       bench_plan --scaling [--max-segments N] [--timeout S] [--markdown]\n"
     "       bench_plan --jerk [--segments N] [--markdown]\n"
     "       bench_plan --self-test\n"
-    "  Plans three 2-axis drawings (rose, wander, spiral) of N segments (default 10000) for the pen\n"
+    "  Plans three 2-axis drawings (rose, wander, spiral) of N segments (default 10000) for the "
+    "pen\n"
     "  plotter and prints planning time, motion time against the same planner on a D times denser\n"
     "  grid (default 16) and the continuous optimum, and the check of every executed tick; then\n"
     "  the peer table: pathstream's motion time against grbl-style and Klipper-style reference\n"
@@ -356,12 +395,15 @@ constexpr const char* kUsageText =
     "  --max-segments N largest scaling size (default 1000000)\n"
     "  --timeout S      wall seconds a scaling size may take (default 300)\n"
     "  --jerk           the cost of a jerk limit: motion and planning time with max_jerk 1e5 and\n"
-    "                   1e6 mm/s^3 against none, on the grid table's drawings (N segments, default\n"
+    "                   1e6 mm/s^3 against none, on the grid table's drawings (N segments, "
+    "default\n"
     "                   1000 here) and the examples, each plan checked (this table only)\n"
     "  --self-test      the reference planners against closed-form answers\n"
     "targets (independent of the machine's speed): every plan within the limits for its exact\n"
-    "cubic and every tick, no motion during a pen dwell, deviation within the chord tolerance plus\n"
-    "1.5 sqrt(2) LSB; the peers' results self-consistent. Times and ratios are printed, never judged.\n"
+    "cubic and every tick, no motion during a pen dwell, deviation within the chord tolerance "
+    "plus\n"
+    "1.5 sqrt(2) LSB; the peers' results self-consistent. Times and ratios are printed, never "
+    "judged.\n"
     "exit status: 0 every plan passed; 1 a plan failed its check or could not be made, a peer's\n"
     "result is inconsistent, a scaling size failed to plan, or a self-test check failed; 2 usage\n"
     "error.\n";
@@ -370,7 +412,8 @@ int main(int argc, char** argv) {
     std::size_t segments = 10000;
     double density = 16;
     int runs = 3;
-    bool markdown = false, quick = false, peers = true, scaling = false, self_test = false, jerk = false;
+    bool markdown = false, quick = false, peers = true, scaling = false, self_test = false,
+         jerk = false;
     bool segments_given = false;
     ScalingOptions scaling_options;
     for (int i = 1; i < argc; ++i) {
@@ -392,9 +435,11 @@ int main(int argc, char** argv) {
             segments = static_cast<std::size_t>(std::strtoul(argv[++i], nullptr, 10));
             segments_given = true;
         } else if (a == "--max-segments" && has_value) {
-            scaling_options.max_segments = static_cast<std::size_t>(std::strtoul(argv[++i], nullptr, 10));
+            scaling_options.max_segments =
+                static_cast<std::size_t>(std::strtoul(argv[++i], nullptr, 10));
         } else if (a == "--timeout" && has_value) {
-            scaling_options.timeout_seconds = static_cast<unsigned>(std::strtoul(argv[++i], nullptr, 10));
+            scaling_options.timeout_seconds =
+                static_cast<unsigned>(std::strtoul(argv[++i], nullptr, 10));
         } else if (a == "--density" && has_value) {
             density = std::strtod(argv[++i], nullptr);
         } else if (a == "--runs" && has_value) {
@@ -413,8 +458,10 @@ int main(int argc, char** argv) {
     }
     if (segments < 10 || density < 1 || runs < 1 || scaling_options.max_segments < 1000 ||
         scaling_options.timeout_seconds < 1) {
-        std::fprintf(stderr, "bench_plan: --segments >= 10, --density >= 1, --runs >= 1, --max-segments >= 1000, "
-                             "--timeout >= 1\n");
+        std::fprintf(
+            stderr,
+            "bench_plan: --segments >= 10, --density >= 1, --runs >= 1, --max-segments >= 1000, "
+            "--timeout >= 1\n");
         return 2;
     }
     if (self_test) return run_reference_self_test() == 0 ? 0 : 1;
@@ -432,6 +479,7 @@ int main(int argc, char** argv) {
         ok = run_grid_table(segments, density, runs, markdown, profile);
         if (peers) ok = run_peer_table(quick, markdown, profile) && ok;
     }
-    std::printf("\nbench_plan: machine load at end: %s; %s\n", load_text().c_str(), ok ? "passed" : "FAILED");
+    std::printf("\nbench_plan: machine load at end: %s; %s\n", load_text().c_str(),
+                ok ? "passed" : "FAILED");
     return ok ? 0 : 1;
 }

@@ -21,8 +21,8 @@
 #include <string>
 #include <vector>
 
-#include "pathstream/machine/input_error.hpp"
 #include "pathstream/host/svg_path.hpp"
+#include "pathstream/machine/input_error.hpp"
 
 using namespace pathstream::host;
 
@@ -40,14 +40,16 @@ std::string lines_document(std::size_t n, std::size_t pad) {
     std::uniform_real_distribution<double> u(0, 400);
     char buf[160];
     for (std::size_t i = 0; i < n; ++i) {
-        std::snprintf(buf, sizeof buf,
-                      "  <line x1=\"%.3f\" y1=\"%.3f\" x2=\"%.3f\" y2=\"%.3f\" stroke=\"black\"/>\n",
-                      u(rng), u(rng), u(rng), u(rng));
+        std::snprintf(
+            buf, sizeof buf,
+            "  <line x1=\"%.3f\" y1=\"%.3f\" x2=\"%.3f\" y2=\"%.3f\" stroke=\"black\"/>\n", u(rng),
+            u(rng), u(rng), u(rng));
         s += buf;
         std::size_t left = pad;
         while (left > 0) {
-            const std::string chunk = "  <!-- padding padding padding padding padding -->\n"
-                                      "                                                  \n";
+            const std::string chunk =
+                "  <!-- padding padding padding padding padding -->\n"
+                "                                                  \n";
             const std::size_t take = std::min(left, chunk.size());
             s.append(chunk, 0, take);
             left -= take;
@@ -163,14 +165,16 @@ int main(int argc, char** argv) {
         results.push_back(r);
         const bool ok = r.scanned <= 2 * c.text.size();
         met = met && ok;
-        std::printf("%-20s %10zu %10zu %12.1f %14zu%s\n", c.name.c_str(), c.text.size(),
-                    r.subpaths, r.ms, r.scanned, ok ? "" : "  (over 2 bytes per byte: MISSED)");
+        std::printf("%-20s %10zu %10zu %12.1f %14zu%s\n", c.name.c_str(), c.text.size(), r.subpaths,
+                    r.ms, r.scanned, ok ? "" : "  (over 2 bytes per byte: MISSED)");
     }
-    std::printf("time ratio lines 8000 / 2000: %.2fx (linear: 4x)\n", results[2].ms / results[0].ms);
-    std::printf("time ratio lines 4000 / 2000: %.2fx (linear: 2x)\n", results[1].ms / results[0].ms);
-    std::printf("time ratio padded 2 MB / lines 2000: %.2fx (same elements, %.0fx the bytes)\n",
-                results[3].ms / results[0].ms,
-                static_cast<double>(cases[3].text.size()) /
-                    static_cast<double>(cases[0].text.size()));
+    std::printf("time ratio lines 8000 / 2000: %.2fx (linear: 4x)\n",
+                results[2].ms / results[0].ms);
+    std::printf("time ratio lines 4000 / 2000: %.2fx (linear: 2x)\n",
+                results[1].ms / results[0].ms);
+    std::printf(
+        "time ratio padded 2 MB / lines 2000: %.2fx (same elements, %.0fx the bytes)\n",
+        results[3].ms / results[0].ms,
+        static_cast<double>(cases[3].text.size()) / static_cast<double>(cases[0].text.size()));
     return met ? 0 : 1;
 }

@@ -7,8 +7,8 @@
 #include <string>
 #include <vector>
 
-#include "pathstream/machine/machine.hpp"
 #include "pathstream/host/path.hpp"
+#include "pathstream/machine/machine.hpp"
 #include "reference_planners/tick_sampling.hpp"
 
 namespace pathstream::bench {

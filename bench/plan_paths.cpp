@@ -4,9 +4,9 @@
 #include <random>
 #include <stdexcept>
 
-#include "pathstream/host/job_request.hpp"
 #include "pathstream/host/csv_path.hpp"
 #include "pathstream/host/gcode_path.hpp"
+#include "pathstream/host/job_request.hpp"
 #include "pathstream/host/json_path.hpp"
 #include "pathstream/host/layers.hpp"
 #include "pathstream/host/path_order.hpp"

@@ -5,8 +5,8 @@
 #include <cstddef>
 #include <string>
 
-#include "pathstream/machine/machine.hpp"
 #include "pathstream/host/path.hpp"
+#include "pathstream/machine/machine.hpp"
 
 namespace pathstream::bench {
 

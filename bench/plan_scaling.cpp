@@ -4,6 +4,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <array>
 #include <cerrno>
 #include <chrono>
 #include <cmath>
@@ -15,11 +16,10 @@
 #include <limits>
 #include <new>
 #include <random>
-#include <utility>
-#include <vector>
-#include <array>
 #include <sstream>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "pathstream/host/geometry.hpp"
 #include "pathstream/host/planner.hpp"
@@ -99,10 +99,12 @@ public:
         if (emitted_ + 1 >= points_) return false;
         while (window_.size() < 4) window_.push_back(point(window_index_++));
         const auto& q = window_;
-        out.p = {host::PathPoint{(q[0][0] + 4 * q[1][0] + q[2][0]) / 6, (q[0][1] + 4 * q[1][1] + q[2][1]) / 6},
+        out.p = {host::PathPoint{(q[0][0] + 4 * q[1][0] + q[2][0]) / 6,
+                                 (q[0][1] + 4 * q[1][1] + q[2][1]) / 6},
                  host::PathPoint{(4 * q[1][0] + 2 * q[2][0]) / 6, (4 * q[1][1] + 2 * q[2][1]) / 6},
                  host::PathPoint{(2 * q[1][0] + 4 * q[2][0]) / 6, (2 * q[1][1] + 4 * q[2][1]) / 6},
-                 host::PathPoint{(q[1][0] + 4 * q[2][0] + q[3][0]) / 6, (q[1][1] + 4 * q[2][1] + q[3][1]) / 6}};
+                 host::PathPoint{(q[1][0] + 4 * q[2][0] + q[3][0]) / 6,
+                                 (q[1][1] + 4 * q[2][1] + q[3][1]) / 6}};
         if (emitted_ > 0) out.p[0] = last_end_;  // joints shared exactly
         last_end_ = out.p[3];
         out.pen_down = true;
@@ -130,7 +132,8 @@ private:
             return {2 * p0[0] - p1[0], 2 * p0[1] - p1[1]};
         }
         if (i >= n) {
-            const auto a = walk(static_cast<std::size_t>(n - 1)), b = walk(static_cast<std::size_t>(n - 2));
+            const auto a = walk(static_cast<std::size_t>(n - 1)),
+                       b = walk(static_cast<std::size_t>(n - 2));
             return {2 * a[0] - b[0], 2 * a[1] - b[1]};
         }
         return walk(static_cast<std::size_t>(i));
@@ -144,7 +147,8 @@ private:
             heading_ += turn_(rng_);
             x_ += 1.5 * std::cos(heading_);
             y_ += 1.5 * std::sin(heading_);
-            if (std::fabs(x_) > 100 || std::fabs(y_) > 100) heading_ = std::atan2(-y_, -x_) + turn_(rng_);
+            if (std::fabs(x_) > 100 || std::fabs(y_) > 100)
+                heading_ = std::atan2(-y_, -x_) + turn_(rng_);
         }
         for (const auto& [k, p] : made_) {
             if (k == i) return p;
@@ -170,7 +174,8 @@ public:
     void span(const host::CoreSpan& s) override {
         ++spans;
         if (!last.empty()) {
-            for (std::size_t a = 0; a < s.control.size(); ++a) continuous = continuous && s.control[a][0] == last[a];
+            for (std::size_t a = 0; a < s.control.size(); ++a)
+                continuous = continuous && s.control[a][0] == last[a];
         }
         last.resize(s.control.size());
         for (std::size_t a = 0; a < s.control.size(); ++a) last[a] = s.control[a][1];
@@ -384,7 +389,8 @@ void print_scaling(const std::vector<ScalingRow>& rows, const ScalingOptions& op
             std::snprintf(input, sizeof input, "%.1f", r.input_mb);
             std::snprintf(plan_mb, sizeof plan_mb, "%.1f", r.plan_peak_mb);
         }
-        if (r.checked) std::snprintf(check, sizeof check, "%s", r.check_seconds > 0 ? "?" : "in plan");
+        if (r.checked)
+            std::snprintf(check, sizeof check, "%s", r.check_seconds > 0 ? "?" : "in plan");
         const std::string segments = r.planned ? std::to_string(r.segments) : "-";
         const std::string spans = r.planned ? std::to_string(r.spans) : "-";
         if (markdown) {

@@ -5,8 +5,8 @@
 #include <string>
 
 #include "fuzz_support.hpp"
-#include "pathstream/machine/input_error.hpp"
 #include "pathstream/host/job_journal.hpp"
+#include "pathstream/machine/input_error.hpp"
 
 namespace {
 

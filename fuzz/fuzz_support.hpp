@@ -9,8 +9,8 @@
 #include <exception>
 #include <string>
 
-#include "pathstream/machine/input_error.hpp"
 #include "pathstream/host/path.hpp"
+#include "pathstream/machine/input_error.hpp"
 
 namespace pathstream::fuzz {
 

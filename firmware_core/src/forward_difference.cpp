@@ -21,11 +21,11 @@ Status start_differences(const TickCubic& cubic, const SpanTiming& timing, std::
     const Int128 bn = Int128::from(cubic.b) * n;
     const Int128 a3 = Int128::from(3 * cubic.a);
     const Int128 a6 = Int128::from(6 * cubic.a);
-    const Int128 delta1 = (a3 * k + a3 + bn + bn) * k + Int128::from(cubic.a) + bn +
-                          Int128::from(cubic.c) * (n * n);
+    const Int128 delta1 =
+        (a3 * k + a3 + bn + bn) * k + Int128::from(cubic.a) + bn + Int128::from(cubic.c) * (n * n);
     const Int128 delta2 = a6 * k + a6 + bn + bn;
-    const Int128 level[4] = {tick_numerator(cubic, timing, k0) + Int128{den / 2, 0}, delta1,
-                             delta2, a6};
+    const Int128 level[4] = {tick_numerator(cubic, timing, k0) + Int128{den / 2, 0}, delta1, delta2,
+                             a6};
     const Word level_bias[4] = {bias, 0, bias, 0};
 
     DifferenceState<Word> s{};
@@ -46,9 +46,9 @@ Status start_differences(const TickCubic& cubic, const SpanTiming& timing, std::
     return Status::kOk;
 }
 
-template Status start_differences<std::uint32_t>(const TickCubic&, const SpanTiming&,
-                                                 std::uint32_t, NarrowDifferences&);
-template Status start_differences<std::uint64_t>(const TickCubic&, const SpanTiming&,
-                                                 std::uint32_t, WideDifferences&);
+template Status start_differences<std::uint32_t>(const TickCubic&, const SpanTiming&, std::uint32_t,
+                                                 NarrowDifferences&);
+template Status start_differences<std::uint64_t>(const TickCubic&, const SpanTiming&, std::uint32_t,
+                                                 WideDifferences&);
 
 }  // namespace pathstream

@@ -3,7 +3,9 @@
 namespace pathstream {
 namespace {
 
-constexpr std::int64_t cube(std::int64_t n) { return n * n * n; }
+constexpr std::int64_t cube(std::int64_t n) {
+    return n * n * n;
+}
 
 /// |v| <= limit * D, with v exact: the bound proofs compare numerators, never divide.
 bool within(Int128 v, std::int64_t limit, std::uint64_t denominator) {
@@ -103,7 +105,8 @@ Int128 tick_numerator(const TickCubic& cubic, const SpanTiming& timing, std::uin
 Status evaluate_at(const TickCubic& cubic, const SpanTiming& timing, std::uint32_t k, Lsb& out) {
     if (k > timing.ticks) return Status::kTickOutsideSpan;
     const Int128 half = Int128{timing.denominator / 2, 0};
-    const FloorDivision q = floor_divide(tick_numerator(cubic, timing, k) + half, timing.denominator);
+    const FloorDivision q =
+        floor_divide(tick_numerator(cubic, timing, k) + half, timing.denominator);
     out = static_cast<Lsb>(static_cast<std::int64_t>(q.quotient.lo));
     return Status::kOk;
 }

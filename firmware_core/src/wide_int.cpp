@@ -5,7 +5,8 @@ namespace pathstream {
 Int128 multiply_portable(Int128 a, std::int64_t b) {
     const bool negate = a.negative() != (b < 0);
     const Int128 m = magnitude(a);
-    const std::uint64_t bm = b < 0 ? 0 - static_cast<std::uint64_t>(b) : static_cast<std::uint64_t>(b);
+    const std::uint64_t bm =
+        b < 0 ? 0 - static_cast<std::uint64_t>(b) : static_cast<std::uint64_t>(b);
     Int128 p = multiply_unsigned(m.lo, bm);
     p.hi += m.hi * bm;
     return negate ? -p : p;
@@ -41,8 +42,10 @@ FloorDivision floor_divide(Int128 a, std::uint64_t d) {
             r = (r << 1) | ((word >> (bit & 63)) & 1u);
             if (carry || r >= d) {
                 r -= d;
-                if (bit >= 64) q.hi |= std::uint64_t{1} << (bit - 64);
-                else q.lo |= std::uint64_t{1} << bit;
+                if (bit >= 64)
+                    q.hi |= std::uint64_t{1} << (bit - 64);
+                else
+                    q.lo |= std::uint64_t{1} << bit;
             }
         }
     }

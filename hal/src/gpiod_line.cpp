@@ -13,10 +13,13 @@
 namespace pathstream::hal {
 namespace {
 
-std::string describe(const GpioLineSpec& spec) { return "gpio " + spec.chip + " line \"" + spec.line + "\""; }
+std::string describe(const GpioLineSpec& spec) {
+    return "gpio " + spec.chip + " line \"" + spec.line + "\"";
+}
 
 [[noreturn]] void fail(const GpioLineSpec& spec, const std::string& what, int error) {
-    throw GpioError(describe(spec) + ": " + what + (error != 0 ? std::string(": ") + std::strerror(error) : ""));
+    throw GpioError(describe(spec) + ": " + what +
+                    (error != 0 ? std::string(": ") + std::strerror(error) : ""));
 }
 
 bool all_digits(const std::string& s) {
@@ -63,7 +66,10 @@ gpiod_line* find_line(gpiod_chip* chip, const GpioLineSpec& spec) {
     if (all_digits(spec.line)) {
         const unsigned long offset = std::stoul(spec.line);
         if (offset >= gpiod_chip_num_lines(chip)) {
-            fail(spec, "offset out of range (the chip has " + std::to_string(gpiod_chip_num_lines(chip)) + " lines)", 0);
+            fail(spec,
+                 "offset out of range (the chip has " + std::to_string(gpiod_chip_num_lines(chip)) +
+                     " lines)",
+                 0);
         }
         gpiod_line* line = gpiod_chip_get_line(chip, static_cast<unsigned>(offset));
         if (line == nullptr) fail(spec, "cannot get the line", errno);
@@ -76,11 +82,15 @@ gpiod_line* find_line(gpiod_chip* chip, const GpioLineSpec& spec) {
 
 int bias_flags(Bias bias) {
     switch (bias) {
-        case Bias::kDisable: return GPIOD_LINE_REQUEST_FLAG_BIAS_DISABLE;
-        case Bias::kPullUp: return GPIOD_LINE_REQUEST_FLAG_BIAS_PULL_UP;
-        case Bias::kPullDown: return GPIOD_LINE_REQUEST_FLAG_BIAS_PULL_DOWN;
+        case Bias::kDisable:
+            return GPIOD_LINE_REQUEST_FLAG_BIAS_DISABLE;
+        case Bias::kPullUp:
+            return GPIOD_LINE_REQUEST_FLAG_BIAS_PULL_UP;
+        case Bias::kPullDown:
+            return GPIOD_LINE_REQUEST_FLAG_BIAS_PULL_DOWN;
         case Bias::kAsIs:
-        default: return 0;
+        default:
+            return 0;
     }
 }
 
@@ -105,8 +115,9 @@ public:
             const int e = errno;
             const char* holder = gpiod_line_consumer(line_);
             std::string what = type == GPIOD_LINE_REQUEST_EVENT_BOTH_EDGES ? "request edge events"
-                                                                              : "request as output";
-            if (e == EBUSY && holder != nullptr) what += " (in use by \"" + std::string(holder) + "\")";
+                                                                           : "request as output";
+            if (e == EBUSY && holder != nullptr)
+                what += " (in use by \"" + std::string(holder) + "\")";
             fail(spec_, what, e);
         }
     }
@@ -139,7 +150,8 @@ public:
         if (gpiod_line_event_read_fd(fd_, &ev) != 0) fail(line_.spec_, "read an edge event", errno);
         const bool high = ev.event_type == GPIOD_LINE_EVENT_RISING_EDGE;
         edge.active = high != line_.spec_.active_low;
-        edge.timestamp_ns = static_cast<std::uint64_t>(ev.ts.tv_sec) * 1000000000u + static_cast<std::uint64_t>(ev.ts.tv_nsec);
+        edge.timestamp_ns = static_cast<std::uint64_t>(ev.ts.tv_sec) * 1000000000u +
+                            static_cast<std::uint64_t>(ev.ts.tv_nsec);
         return true;
     }
 
@@ -152,14 +164,16 @@ private:
 
 class GpiodOutput final : public DigitalOutput {
 public:
-    GpiodOutput(const GpioLineSpec& spec, const std::string& consumer, bool initially_active) : line_(spec) {
+    GpiodOutput(const GpioLineSpec& spec, const std::string& consumer, bool initially_active)
+        : line_(spec) {
         line_.request(GPIOD_LINE_REQUEST_DIRECTION_OUTPUT, consumer, level(initially_active));
         state_ = initially_active;
     }
 
     void set(bool active) override {
         if (active == state_) return;  // one ioctl per change, none per tick
-        if (gpiod_line_set_value(line_.line_, level(active)) != 0) fail(line_.spec_, "drive the output", errno);
+        if (gpiod_line_set_value(line_.line_, level(active)) != 0)
+            fail(line_.spec_, "drive the output", errno);
         state_ = active;
     }
 
@@ -172,11 +186,13 @@ private:
 
 }  // namespace
 
-std::unique_ptr<DigitalInput> open_gpiod_input(const GpioLineSpec& spec, const std::string& consumer) {
+std::unique_ptr<DigitalInput> open_gpiod_input(const GpioLineSpec& spec,
+                                               const std::string& consumer) {
     return std::make_unique<GpiodInput>(spec, consumer);
 }
 
-std::unique_ptr<DigitalOutput> open_gpiod_output(const GpioLineSpec& spec, const std::string& consumer,
+std::unique_ptr<DigitalOutput> open_gpiod_output(const GpioLineSpec& spec,
+                                                 const std::string& consumer,
                                                  bool initially_active) {
     return std::make_unique<GpiodOutput>(spec, consumer, initially_active);
 }

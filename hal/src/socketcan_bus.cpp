@@ -23,10 +23,12 @@ namespace {
 
 }  // namespace
 
-SocketCanBus::SocketCanBus(const std::string& name, const std::vector<CanFilter>& filters) : name_(name) {
+SocketCanBus::SocketCanBus(const std::string& name, const std::vector<CanFilter>& filters)
+    : name_(name) {
     if (name.empty() || name.size() >= IFNAMSIZ) fail(name, "bad interface name", EINVAL);
     const unsigned index = if_nametoindex(name.c_str());
-    if (index == 0) fail(name, "no such interface (for a virtual one: ip link add dev NAME type vcan)", errno);
+    if (index == 0)
+        fail(name, "no such interface (for a virtual one: ip link add dev NAME type vcan)", errno);
     fd_ = ::socket(PF_CAN, SOCK_RAW | SOCK_NONBLOCK | SOCK_CLOEXEC, CAN_RAW);
     if (fd_ < 0) fail(name, "cannot open a raw CAN socket (is the can-raw module loaded?)", errno);
     try {
@@ -57,7 +59,8 @@ void SocketCanBus::set_filters(const std::vector<CanFilter>& filters) {
         can_filter k{};
         k.can_id = c.extended ? (c.id & CAN_EFF_MASK) | CAN_EFF_FLAG : c.id & CAN_SFF_MASK;
         // The EFF flag is part of the match, so a standard filter never passes extended frames.
-        k.can_mask = (c.extended ? c.mask & CAN_EFF_MASK : c.mask & CAN_SFF_MASK) | CAN_EFF_FLAG | CAN_RTR_FLAG;
+        k.can_mask = (c.extended ? c.mask & CAN_EFF_MASK : c.mask & CAN_SFF_MASK) | CAN_EFF_FLAG |
+                     CAN_RTR_FLAG;
         f.push_back(k);
     }
     const void* data = f.empty() ? nullptr : f.data();
@@ -70,12 +73,14 @@ void SocketCanBus::set_filters(const std::vector<CanFilter>& filters) {
         }
         return;
     }
-    if (::setsockopt(fd_, SOL_CAN_RAW, CAN_RAW_FILTER, data, size) != 0) fail(name_, "cannot set receive filters", errno);
+    if (::setsockopt(fd_, SOL_CAN_RAW, CAN_RAW_FILTER, data, size) != 0)
+        fail(name_, "cannot set receive filters", errno);
 }
 
 CanSendResult SocketCanBus::send(const CanFrame& frame) {
     if (state_ == CanBusState::kBusOff) return CanSendResult::kBusOff;
-    if (frame.length > 8 || (!frame.extended && frame.id > CAN_SFF_MASK) || frame.id > CAN_EFF_MASK) {
+    if (frame.length > 8 || (!frame.extended && frame.id > CAN_SFF_MASK) ||
+        frame.id > CAN_EFF_MASK) {
         return CanSendResult::kError;
     }
     can_frame f{};
@@ -117,7 +122,8 @@ bool SocketCanBus::receive(CanFrame& out, std::uint32_t timeout_us) {
             return true;
         }
         if (n < 0 && errno != EAGAIN && errno != EWOULDBLOCK && errno != EINTR) return false;
-        const auto left = std::chrono::duration_cast<std::chrono::microseconds>(deadline - clock::now()).count();
+        const auto left =
+            std::chrono::duration_cast<std::chrono::microseconds>(deadline - clock::now()).count();
         if (left <= 0) return false;
         pollfd p{fd_, POLLIN, 0};
         const int ms = static_cast<int>((left + 999) / 1000);

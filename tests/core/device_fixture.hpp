@@ -25,12 +25,14 @@ device::MotionLimits<Axes> test_limits() {
 /// with a trapezoidal speed profile, as Hermite wire spans of `ticks` ticks each from rest to
 /// rest, starting at `start`. Speed and acceleration stay within 75 % of test_limits.
 template <unsigned Axes>
-std::vector<device::WireSpan> trapezoid_move(const Lsb (&start)[Axes], double distance, std::uint32_t ticks) {
+std::vector<device::WireSpan> trapezoid_move(const Lsb (&start)[Axes], double distance,
+                                             std::uint32_t ticks) {
     // Phases last whole spans, so each span is one quadratic piece that its Hermite form
     // reproduces exactly (a phase change inside a span would bend it past the limits).
     const double span = ticks;
     const double ramp = std::ceil(100.0 / span) * span;  // 150 LSB/tick reached at 1.5 LSB/tick^2
-    const double cruise = std::max(0.0, std::ceil((std::fabs(distance) / 150.0 - ramp) / span) * span);
+    const double cruise =
+        std::max(0.0, std::ceil((std::fabs(distance) / 150.0 - ramp) / span) * span);
     const double peak = distance / (ramp + cruise);
     const double acc = peak / ramp;
     const double total = 2 * ramp + cruise;
@@ -72,7 +74,8 @@ std::vector<device::WireSpan> trapezoid_move(const Lsb (&start)[Axes], double di
 
 /// Wire bytes of spans [first, first + count).
 template <unsigned Axes>
-std::vector<std::uint8_t> batch_bytes(const std::vector<device::WireSpan>& spans, std::size_t first, std::size_t count) {
+std::vector<std::uint8_t> batch_bytes(const std::vector<device::WireSpan>& spans, std::size_t first,
+                                      std::size_t count) {
     std::vector<std::uint8_t> bytes;
     for (std::size_t i = first; i < first + count; ++i) {
         std::uint8_t buffer[4 + 12 * kMaxAxes];

@@ -97,10 +97,18 @@ public:
             const std::int64_t limit = tangent ? kMaxTangentLsb : kMaxPositionLsb;
             std::int64_t v = 0;
             switch (style) {
-                case 0: v = uniform(-limit, limit); break;                       // anywhere
-                case 1: v = (rng_() % 2 ? limit : -limit) - uniform(-3, 3); break;  // at limits
-                case 2: v = uniform(-1000, 1000); break;                         // tiny
-                default: v = center + uniform(-50000, 50000); break;             // gentle
+                case 0:
+                    v = uniform(-limit, limit);
+                    break;  // anywhere
+                case 1:
+                    v = (rng_() % 2 ? limit : -limit) - uniform(-3, 3);
+                    break;  // at limits
+                case 2:
+                    v = uniform(-1000, 1000);
+                    break;  // tiny
+                default:
+                    v = center + uniform(-50000, 50000);
+                    break;  // gentle
             }
             if (tangent && style == 3) v = uniform(-200000, 200000);
             if (v > limit) v = limit;

@@ -2,7 +2,6 @@
 // span-data frames, a lost data frame refused as incomplete, a resent batch acknowledged as a
 // duplicate, configuration sets, commands and status.
 #include <catch2/catch.hpp>
-
 #include <vector>
 
 #include "pathstream/device/can_node.hpp"
@@ -53,8 +52,10 @@ struct Fixture {
         }
         return p;
     }
-    void send_batch(std::uint32_t first, unsigned count, const std::vector<std::uint8_t>& p, int skip = -1) {
-        feed(pc::encode_span_start(5, {first, static_cast<std::uint8_t>(count), static_cast<std::uint16_t>(p.size())}));
+    void send_batch(std::uint32_t first, unsigned count, const std::vector<std::uint8_t>& p,
+                    int skip = -1) {
+        feed(pc::encode_span_start(
+            5, {first, static_cast<std::uint8_t>(count), static_cast<std::uint16_t>(p.size())}));
         for (std::size_t i = 0; i < pc::data_frames(p.size()); ++i) {
             if (static_cast<int>(i) == skip) continue;
             feed(pc::encode_span_data(5, static_cast<std::uint8_t>(i), p.data(), p.size()));
@@ -80,7 +81,8 @@ TEST_CASE("CAN node: a batch over frames is accepted whole, a resend is a duplic
     CHECK(f.node.refused_batches() == 0);
 }
 
-TEST_CASE("CAN node: a lost data frame refuses the batch as incomplete, changing nothing", "[can]") {
+TEST_CASE("CAN node: a lost data frame refuses the batch as incomplete, changing nothing",
+          "[can]") {
     Fixture f;
     f.configure();
     const auto p = f.batch(3, 0);  // 3 x 28 bytes: 12 data frames
@@ -94,7 +96,8 @@ TEST_CASE("CAN node: a lost data frame refuses the batch as incomplete, changing
     CHECK(f.dev.queued_spans() == 3);
 }
 
-TEST_CASE("CAN node: a lost last data frame leaves no answer, data without a start is ignored", "[can]") {
+TEST_CASE("CAN node: a lost last data frame leaves no answer, data without a start is ignored",
+          "[can]") {
     Fixture f;
     f.configure();
     const auto p = f.batch(2, 0);  // 2 x 28 bytes: 8 data frames
@@ -102,7 +105,8 @@ TEST_CASE("CAN node: a lost last data frame leaves no answer, data without a sta
     const std::size_t before = f.out.size();
     f.send_batch(1, 2, p, last);
     CHECK(f.out.size() == before);
-    f.feed(pc::encode_span_data(5, 0, p.data(), p.size()));  // transfer still waits for the last index
+    f.feed(
+        pc::encode_span_data(5, 0, p.data(), p.size()));  // transfer still waits for the last index
     CHECK(f.last_ack().result == pc::kResultIncomplete);
     const std::size_t after = f.out.size();
     f.feed(pc::encode_span_data(5, 0, p.data(), p.size()));  // no transfer: ignored
@@ -134,7 +138,7 @@ TEST_CASE("CAN node: configuration needs every item, commands and status answer"
     CHECK(f.last_ack().result == static_cast<std::uint8_t>(Status::kNotConfigured));
     f.configure();
     CHECK(f.dev.limits().pen_down_ticks == 40);  // the pen-down delay item reached the device
-    f.feed(pc::encode_command(5, 1));  // start with nothing queued: nothing would move
+    f.feed(pc::encode_command(5, 1));            // start with nothing queued: nothing would move
     CHECK((f.last_ack().kind == pc::kAckCommand && f.last_ack().sequence == 1 &&
            f.last_ack().result == static_cast<std::uint8_t>(Status::kNothingToResume)));
     f.feed(pc::encode_command(5, 4));  // stop while idle: drops nothing, accepted

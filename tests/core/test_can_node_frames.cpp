@@ -105,7 +105,8 @@ TEST_CASE("CAN node refuses a resend with other bytes under the same sequence", 
     other[7] ^= 1;  // the first span's end moves by one LSB
     const auto send = [&](const std::vector<std::uint8_t>& payload, std::uint32_t first = 1,
                           std::uint8_t count = 2) {
-        n.feed(pc::encode_span_start(5, {first, count, static_cast<std::uint16_t>(payload.size())}));
+        n.feed(
+            pc::encode_span_start(5, {first, count, static_cast<std::uint16_t>(payload.size())}));
         for (std::size_t i = 0; i < pc::data_frames(payload.size()); ++i) {
             n.feed(pc::encode_span_data(5, static_cast<std::uint8_t>(i), payload.data(),
                                         payload.size()));

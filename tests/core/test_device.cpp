@@ -2,7 +2,6 @@
 // limits on every tick of what the axes were given (integer setpoints, with the rounding
 // allowance of one LSB per tick in velocity and two in acceleration).
 #include <catch2/catch.hpp>
-
 #include <cstdint>
 #include <cstdlib>
 #include <vector>
@@ -37,9 +36,11 @@ struct Recorder {
     // Largest |first| and |second| difference per axis over every recorded tick, LSB/tick^k.
     void check_limits(const MotionLimits<kAxes>& limits) const {
         for (unsigned a = 0; a < kAxes; ++a) {
-            const double v_max = static_cast<double>(limits.axis[a].max_velocity) / limits.tick_hz + 1;
-            const double a_max =
-                static_cast<double>(limits.axis[a].max_acceleration) / limits.tick_hz / limits.tick_hz + 2;
+            const double v_max =
+                static_cast<double>(limits.axis[a].max_velocity) / limits.tick_hz + 1;
+            const double a_max = static_cast<double>(limits.axis[a].max_acceleration) /
+                                     limits.tick_hz / limits.tick_hz +
+                                 2;
             for (std::size_t k = 1; k < ticks.size(); ++k) {
                 const double v = ticks[k][a] - ticks[k - 1][a];
                 INFO("axis " << a << " tick " << k);
@@ -53,14 +54,15 @@ struct Recorder {
     }
 };
 
-Status send(Device& d, std::uint32_t sequence, const std::vector<WireSpan>& spans, std::size_t first,
-            std::size_t count) {
+Status send(Device& d, std::uint32_t sequence, const std::vector<WireSpan>& spans,
+            std::size_t first, std::size_t count) {
     const auto bytes = batch_bytes<kAxes>(spans, first, count);
     return d.accept_batch(sequence, static_cast<std::uint16_t>(count), bytes.data(), bytes.size());
 }
 
 // The same spans through a bare SetpointStream: what the device must reproduce tick for tick.
-std::vector<std::array<Lsb, kAxes>> reference_ticks(const Lsb (&start)[kAxes], const std::vector<WireSpan>& spans) {
+std::vector<std::array<Lsb, kAxes>> reference_ticks(const Lsb (&start)[kAxes],
+                                                    const std::vector<WireSpan>& spans) {
     SetpointStream<kAxes, 1024> stream(start);
     Lsb from[kAxes] = {start[0], start[1]};
     std::int32_t tangent[kAxes] = {0, 0};
@@ -70,7 +72,8 @@ std::vector<std::array<Lsb, kAxes>> reference_ticks(const Lsb (&start)[kAxes], c
         if ((w.flags & kWireContinueTangent) != 0) {
             for (unsigned a = 0; a < kAxes; ++a) w.start_tangent[a] = tangent[a];
         }
-        REQUIRE(stream.push(to_core_span<kAxes>(w, from, static_cast<std::uint32_t>(i + 1))) == Status::kOk);
+        REQUIRE(stream.push(to_core_span<kAxes>(w, from, static_cast<std::uint32_t>(i + 1))) ==
+                Status::kOk);
         for (unsigned a = 0; a < kAxes; ++a) {
             from[a] = w.end[a];
             tangent[a] = w.end_tangent[a];
@@ -104,7 +107,8 @@ TEST_CASE("device executes accepted batches tick for tick like the bare stream",
     while (sent < spans.size() || d.queued_spans() > 0) {
         const std::size_t room = std::min<std::size_t>(d.free_slots(), spans.size() - sent);
         if (room >= 4 || (room > 0 && sent + room == spans.size())) {
-            REQUIRE(send(d, static_cast<std::uint32_t>(sent + 1), spans, sent, room) == Status::kOk);
+            REQUIRE(send(d, static_cast<std::uint32_t>(sent + 1), spans, sent, room) ==
+                    Status::kOk);
             sent += room;
         }
         r.run(d, 5);
@@ -129,7 +133,9 @@ TEST_CASE("batches are all or nothing", "[device]") {
     Device d(start);
     const auto spans = trapezoid_move<kAxes>(start, 20000, 8);
 
-    SECTION("unconfigured") { CHECK(send(d, 1, spans, 0, 3) == Status::kNotConfigured); }
+    SECTION("unconfigured") {
+        CHECK(send(d, 1, spans, 0, 3) == Status::kNotConfigured);
+    }
 
     REQUIRE(d.configure(test_limits<kAxes>()) == Status::kOk);
     SECTION("a span over the acceleration limit in the middle refuses the whole batch") {
@@ -143,16 +149,16 @@ TEST_CASE("batches are all or nothing", "[device]") {
     }
     SECTION("velocity over the limit") {
         auto bad = spans;
-        bad[0].end[1] = 2000;                   // 2000 LSB in 8 ticks from rest
-        bad[0].end_tangent[1] = 2 * 8 * 250;    // ends at 500 LSB/tick
+        bad[0].end[1] = 2000;                 // 2000 LSB in 8 ticks from rest
+        bad[0].end_tangent[1] = 2 * 8 * 250;  // ends at 500 LSB/tick
         CHECK(send(d, 1, bad, 0, 1) != Status::kOk);
         CHECK(d.queued_spans() == 0);
     }
     SECTION("sequence numbers") {
         REQUIRE(send(d, 1, spans, 0, 3) == Status::kOk);
-        CHECK(send(d, 5, spans, 3, 2) == Status::kBadSequence);   // gap
-        CHECK(send(d, 3, spans, 2, 2) == Status::kBadSequence);   // partial overlap
-        CHECK(send(d, 1, spans, 0, 3) == Status::kOk);            // retry of the last batch
+        CHECK(send(d, 5, spans, 3, 2) == Status::kBadSequence);  // gap
+        CHECK(send(d, 3, spans, 2, 2) == Status::kBadSequence);  // partial overlap
+        CHECK(send(d, 1, spans, 0, 3) == Status::kOk);           // retry of the last batch
         CHECK(d.duplicates() == 1);
         CHECK(d.queued_spans() == 3);
         CHECK(send(d, 4, spans, 3, 2) == Status::kOk);
@@ -333,7 +339,8 @@ TEST_CASE("faults stop at once and keep the first code", "[device]") {
     CHECK(d.fault_code() == FaultCode::kNone);
 }
 
-TEST_CASE("a request the tick has not taken yet is replaced by the next one, a stop is not", "[device]") {
+TEST_CASE("a request the tick has not taken yet is replaced by the next one, a stop is not",
+          "[device]") {
     // Each section runs on its own device (Catch2 runs the case again per section): 16 spans
     // of a move queued and started.
     const Lsb start[kAxes] = {0, 0};

@@ -1,7 +1,6 @@
 // The exact limit check against an independent double-precision scan of the same cubic, and
 // the wire span encoding round trip.
 #include <catch2/catch.hpp>
-
 #include <cmath>
 #include <cstdint>
 #include <random>
@@ -32,7 +31,8 @@ Extremes scan_hermite(double p0, double p1, double t0, double t1, double n, doub
         const double dh01 = -6 * u * u + 6 * u, dh11 = 3 * u * u - 2 * u;
         const double velocity = (dh00 * p0 + dh10 * t0 + dh01 * p1 + dh11 * t1) * hz / n;
         const double ddh00 = 12 * u - 6, ddh10 = 6 * u - 4, ddh01 = -12 * u + 6, ddh11 = 6 * u - 2;
-        const double accel = (ddh00 * p0 + ddh10 * t0 + ddh01 * p1 + ddh11 * t1) * hz * hz / (n * n);
+        const double accel =
+            (ddh00 * p0 + ddh10 * t0 + ddh01 * p1 + ddh11 * t1) * hz * hz / (n * n);
         e.velocity = std::max(e.velocity, std::fabs(velocity));
         e.acceleration = std::max(e.acceleration, std::fabs(accel));
     }
@@ -60,13 +60,15 @@ TEST_CASE("limit check agrees with a dense scan of the Hermite curve", "[device]
         std::uniform_real_distribution<double> factor(0.9, 1.1);
         AxisLimits limits;
         limits.max_velocity = static_cast<std::uint32_t>(std::max(1.0, e.velocity * factor(rng)));
-        limits.max_acceleration = static_cast<std::uint32_t>(std::max(1.0, e.acceleration * factor(rng)));
+        limits.max_acceleration =
+            static_cast<std::uint32_t>(std::max(1.0, e.acceleration * factor(rng)));
         const Status s = check_axis_limits(cubic, timing, limits, hz);
         const bool velocity_ok = e.velocity <= limits.max_velocity;
         const bool accel_ok = e.acceleration <= limits.max_acceleration;
         // The scan can miss the true maximum by a hair; only judge clear cases.
         const bool clear_v = std::fabs(e.velocity - limits.max_velocity) > 1e-6 * e.velocity + 1e-3;
-        const bool clear_a = std::fabs(e.acceleration - limits.max_acceleration) > 1e-6 * e.acceleration + 1e-3;
+        const bool clear_a =
+            std::fabs(e.acceleration - limits.max_acceleration) > 1e-6 * e.acceleration + 1e-3;
         if (!clear_v || !clear_a) {
             ++near_misses;
             continue;

@@ -1,9 +1,9 @@
 // The device under stress: a task side sending random valid and invalid batches (some ending
 // in a programmed pause, kWirePause, that a later resume leaves; some pausing while moving,
-// refused), commands, faults, e-stops and resets at random moments, and a tick side checked on every tick (steps
-// and second differences within the limits, generated moves included; no motion in idle,
-// fault or e-stop; no span of an older epoch executed; the pen up on every tick that is not a
-// path tick; the status never torn). Two ways:
+// refused), commands, faults, e-stops and resets at random moments, and a tick side checked on
+// every tick (steps and second differences within the limits, generated moves included; no motion
+// in idle, fault or e-stop; no span of an older epoch executed; the pen up on every tick that is
+// not a path tick; the status never torn). Two ways:
 //   - two threads, the tick as fast as it can (tag [threads]: the ThreadSanitizer preset
 //     runs it too);
 //   - one thread, the tick run at seeded points between and inside the task side's calls

@@ -2,7 +2,6 @@
 // accepted batch is acknowledged only when its bytes carry the same CRC-32, whichever
 // transport delivered it, and nothing but the last batch counts as a resend.
 #include <catch2/catch.hpp>
-
 #include <cstdint>
 #include <vector>
 
@@ -21,7 +20,8 @@ namespace {
 constexpr unsigned kAxes = 2;
 using Device = MotionDevice<kAxes, 16>;
 
-Status send(Device& d, std::uint32_t sequence, const std::vector<std::uint8_t>& bytes, std::size_t count) {
+Status send(Device& d, std::uint32_t sequence, const std::vector<std::uint8_t>& bytes,
+            std::size_t count) {
     return d.accept_batch(sequence, static_cast<std::uint16_t>(count), bytes.data(), bytes.size());
 }
 

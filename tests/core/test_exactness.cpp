@@ -1,8 +1,7 @@
 // Exactness: forward differencing == Horner == the independent __int128 reference, at every
 // tick checked, for random spans of every basis. Size: --spans N per basis (default 100000).
-#include <catch2/catch.hpp>
-
 #include <algorithm>
+#include <catch2/catch.hpp>
 #include <cstdio>
 
 #include "core/property_settings.hpp"
@@ -11,17 +10,21 @@
 #include "pathstream/tick_cubic.hpp"
 
 using namespace pathstream;
-using pathstream::test::SpanGenerator;
 using pathstream::test::reference_setpoint;
+using pathstream::test::SpanGenerator;
 
 namespace {
 
 const char* basis_name(Basis b) {
     switch (b) {
-        case Basis::kUniformBSpline: return "bspline";
-        case Basis::kCatmullRom: return "catmull-rom";
-        case Basis::kBezier: return "bezier";
-        case Basis::kHermite: return "hermite";
+        case Basis::kUniformBSpline:
+            return "bspline";
+        case Basis::kCatmullRom:
+            return "catmull-rom";
+        case Basis::kBezier:
+            return "bezier";
+        case Basis::kHermite:
+            return "hermite";
     }
     return "?";
 }
@@ -51,10 +54,9 @@ std::uint64_t walk(Basis basis, const std::int32_t (&p)[4], const TickCubic& cub
             ok = ok && horner == expected;
         }
         if (!ok && bad++ < 3) {
-            UNSCOPED_INFO(basis_name(basis) << " n=" << timing.ticks << " k=" << k << " P={"
-                                            << p[0] << "," << p[1] << "," << p[2] << ","
-                                            << p[3] << "} fd=" << state.position()
-                                            << " expected=" << expected);
+            UNSCOPED_INFO(basis_name(basis) << " n=" << timing.ticks << " k=" << k << " P={" << p[0]
+                                            << "," << p[1] << "," << p[2] << "," << p[3] << "} fd="
+                                            << state.position() << " expected=" << expected);
         }
         if (i + 1 < count) state.step(bias);
     }
@@ -65,17 +67,19 @@ std::uint64_t walk_any(Basis basis, const std::int32_t (&p)[4], const TickCubic&
                        const SpanTiming& timing, std::uint32_t k0, std::uint32_t count,
                        std::uint32_t horner_stride, Tally& tally) {
     tally.ticks += count;
-    if (is_narrow(timing)) return walk<std::uint32_t>(basis, p, cubic, timing, k0, count, horner_stride);
+    if (is_narrow(timing))
+        return walk<std::uint32_t>(basis, p, cubic, timing, k0, count, horner_stride);
     ++tally.wide_spans;
     return walk<std::uint64_t>(basis, p, cubic, timing, k0, count, horner_stride);
 }
 
 void report(const char* what, Basis basis, std::uint64_t seed, const Tally& t) {
-    std::printf("%s %-11s seed=%llu spans=%llu rejected=%llu wide=%llu ticks=%llu mismatches=%llu\n",
-                what, basis_name(basis), static_cast<unsigned long long>(seed),
-                static_cast<unsigned long long>(t.spans), static_cast<unsigned long long>(t.rejected),
-                static_cast<unsigned long long>(t.wide_spans), static_cast<unsigned long long>(t.ticks),
-                static_cast<unsigned long long>(t.mismatches));
+    std::printf(
+        "%s %-11s seed=%llu spans=%llu rejected=%llu wide=%llu ticks=%llu mismatches=%llu\n", what,
+        basis_name(basis), static_cast<unsigned long long>(seed),
+        static_cast<unsigned long long>(t.spans), static_cast<unsigned long long>(t.rejected),
+        static_cast<unsigned long long>(t.wide_spans), static_cast<unsigned long long>(t.ticks),
+        static_cast<unsigned long long>(t.mismatches));
 }
 
 }  // namespace
@@ -114,12 +118,12 @@ TEST_CASE("forward differencing, Horner and the reference agree from any start t
     }
 }
 
-TEST_CASE("forward differencing stays exact over whole spans, end point included",
-          "[exactness]") {
+TEST_CASE("forward differencing stays exact over whole spans, end point included", "[exactness]") {
     const std::uint64_t seed = pathstream::test::property_seed();
     // Whole spans average ~6000 ticks: a hundredth of the window test's count keeps the
     // default run short while every span length from 1 to 65536 gets walked end to end.
-    const std::uint64_t spans = std::max<std::uint64_t>(pathstream::test::g_spans_per_basis / 100, 8);
+    const std::uint64_t spans =
+        std::max<std::uint64_t>(pathstream::test::g_spans_per_basis / 100, 8);
     INFO("seed " << seed);
     for (std::uint8_t b = 0; b < kBasisCount; ++b) {
         const auto basis = static_cast<Basis>(b);

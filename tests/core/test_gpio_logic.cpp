@@ -42,9 +42,12 @@ TEST_CASE("fault names say which switch, on which axis and side", "[device][gpio
     CHECK(name_of(FaultCode::kNone) == "none");
     CHECK(name_of(FaultCode::kExternal) == "external fault");
     CHECK(name_of(FaultCode::kStopFailed) == "no controlled stop fits in one span");
-    CHECK(name_of(limit_fault(0, LimitSide::kNegative)) == "limit switch x- (axis 0, negative side)");
-    CHECK(name_of(limit_fault(1, LimitSide::kPositive)) == "limit switch y+ (axis 1, positive side)");
-    CHECK(name_of(limit_fault(7, LimitSide::kPositive)) == "limit switch v+ (axis 7, positive side)");
+    CHECK(name_of(limit_fault(0, LimitSide::kNegative)) ==
+          "limit switch x- (axis 0, negative side)");
+    CHECK(name_of(limit_fault(1, LimitSide::kPositive)) ==
+          "limit switch y+ (axis 1, positive side)");
+    CHECK(name_of(limit_fault(7, LimitSide::kPositive)) ==
+          "limit switch v+ (axis 7, positive side)");
     CHECK(name_of(static_cast<FaultCode>(0x1234)) == "fault 0x1234");
     // Bounded: truncated, always terminated; nothing written for capacity 0.
     char small[8];
@@ -55,7 +58,8 @@ TEST_CASE("fault names say which switch, on which axis and side", "[device][gpio
     CHECK(untouched == 'z');
 }
 
-TEST_CASE("enables are asserted only while the device may move, the pen then or by the operator", "[device][gpio]") {
+TEST_CASE("enables are asserted only while the device may move, the pen then or by the operator",
+          "[device][gpio]") {
     CHECK_FALSE(enable_asserted(DeviceState::kIdle));
     CHECK(enable_asserted(DeviceState::kRunning));
     CHECK(enable_asserted(DeviceState::kHolding));
@@ -73,7 +77,8 @@ TEST_CASE("enables are asserted only while the device may move, the pen then or 
     }
 }
 
-TEST_CASE("set_position redefines the rest point while idle and hands it to the producer", "[device][gpio]") {
+TEST_CASE("set_position redefines the rest point while idle and hands it to the producer",
+          "[device][gpio]") {
     const Lsb start[2] = {5000, -3000};
     MotionDevice<2, 32> d(start);
     REQUIRE(d.configure(test::test_limits<2>()) == Status::kOk);
@@ -95,11 +100,14 @@ TEST_CASE("set_position redefines the rest point while idle and hands it to the 
     // The next batch must start at the new position: a move from there is accepted and runs.
     const auto spans = test::trapezoid_move<2>(zero, 1000, 8);
     const auto bytes = test::batch_bytes<2>(spans, 0, spans.size());
-    REQUIRE(d.accept_batch(1, static_cast<std::uint16_t>(spans.size()), bytes.data(), bytes.size()) == Status::kOk);
+    REQUIRE(d.accept_batch(1, static_cast<std::uint16_t>(spans.size()), bytes.data(),
+                           bytes.size()) == Status::kOk);
     // Refused with spans queued and while running.
     CHECK(d.set_position(zero) == Status::kWrongState);
     REQUIRE(d.command(Command::kStart) == Status::kOk);
-    for (int i = 0; i < 2000 && d.queued_spans() + (d.last_completed_sequence() != spans.size()) > 0; ++i) d.tick(out);
+    for (int i = 0;
+         i < 2000 && d.queued_spans() + (d.last_completed_sequence() != spans.size()) > 0; ++i)
+        d.tick(out);
     CHECK(out[0] == spans.back().end[0]);
     CHECK(d.set_position(zero) == Status::kWrongState);  // running (at rest): not idle
 }

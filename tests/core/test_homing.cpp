@@ -26,14 +26,15 @@ struct Result {
 // at or above it (positive side). `during` is called before every tick (to inject events).
 // `checked` ticks are checked against the limits (an e-stop stops at once, beyond them).
 template <typename During>
-Result run_homing(Device& d, HomingSequencer<kAxes, 32>& h, Lsb trigger, bool positive, std::uint32_t max_ticks,
-                  During during, std::size_t checked = 1u << 30) {
+Result run_homing(Device& d, HomingSequencer<kAxes, 32>& h, Lsb trigger, bool positive,
+                  std::uint32_t max_ticks, During during, std::size_t checked = 1u << 30) {
     Result r;
     Lsb out[kAxes];
     for (std::uint32_t k = 0; k < max_ticks; ++k) {
         // The switch sits at a physical place: after set zero (the machine rests on that tick)
         // the coordinates moved by the difference between the two ticks.
-        const Lsb shift = r.set_at != 0 && r.x.size() > r.set_at ? r.x[r.set_at] - r.x[r.set_at - 1] : 0;
+        const Lsb shift =
+            r.set_at != 0 && r.x.size() > r.set_at ? r.x[r.set_at] - r.x[r.set_at - 1] : 0;
         const Lsb p = d.position(0) - shift;
         const bool active = positive ? p >= trigger : p <= trigger;
         h.poll(active);
@@ -71,7 +72,8 @@ HomingConfig config(bool positive = false) {
 
 }  // namespace
 
-TEST_CASE("AxisMove: every span passes the exact limit check and the move ends exactly", "[device][homing]") {
+TEST_CASE("AxisMove: every span passes the exact limit check and the move ends exactly",
+          "[device][homing]") {
     const MotionLimits<2> limits = test::test_limits<2>();
     for (std::int64_t distance : {1, 2, 7, 100, 999, 5000, 12345, -12345, 60001, -3}) {
         for (std::uint32_t velocity : {1000u, 50000u, 200000u, 400000u}) {
@@ -107,7 +109,8 @@ TEST_CASE("AxisMove: every span passes the exact limit check and the move ends e
     }
 }
 
-TEST_CASE("homing finds the switch, backs off, latches slowly and sets zero there", "[device][homing]") {
+TEST_CASE("homing finds the switch, backs off, latches slowly and sets zero there",
+          "[device][homing]") {
     for (bool positive : {false, true}) {
         const Lsb start[kAxes] = {5000, 777};
         const Lsb trigger = positive ? 20000 : 1000;
@@ -143,7 +146,8 @@ TEST_CASE("homing finds the switch, backs off, latches slowly and sets zero ther
         const Lsb here[kAxes] = {d.position(0), d.position(1)};
         const auto spans = test::trapezoid_move<kAxes>(here, 500, 8);
         const auto bytes = test::batch_bytes<kAxes>(spans, 0, spans.size());
-        CHECK(d.accept_batch(d.last_accepted_sequence() + 1, static_cast<std::uint16_t>(spans.size()), bytes.data(),
+        CHECK(d.accept_batch(d.last_accepted_sequence() + 1,
+                             static_cast<std::uint16_t>(spans.size()), bytes.data(),
                              bytes.size()) == Status::kOk);
     }
 }
@@ -196,7 +200,8 @@ TEST_CASE("homing: a pull-off that does not clear the switch is an error", "[dev
     CHECK(d.state() == DeviceState::kIdle);
 }
 
-TEST_CASE("homing errors: switch never found, switch stuck, e-stop, bad config, wrong state", "[device][homing]") {
+TEST_CASE("homing errors: switch never found, switch stuck, e-stop, bad config, wrong state",
+          "[device][homing]") {
     const Lsb start[kAxes] = {0, 0};
     SECTION("no switch within max_travel: stops after at most max_travel") {
         Device d(start);
@@ -226,13 +231,17 @@ TEST_CASE("homing errors: switch never found, switch stuck, e-stop, bad config, 
         REQUIRE(d.configure(test::test_limits<kAxes>()) == Status::kOk);
         HomingSequencer<kAxes, 32> h(d);
         REQUIRE(h.start(config()) == Status::kOk);
-        const Result r = run_homing(d, h, -20000, false, 100000, [&](std::uint32_t k) {
-            if (k == 300) d.set_estop_input(true);
-        }, 300);
+        const Result r = run_homing(
+            d, h, -20000, false, 100000,
+            [&](std::uint32_t k) {
+                if (k == 300) d.set_estop_input(true);
+            },
+            300);
         REQUIRE(r.finished);
         CHECK(h.error() == HomingError::kInterrupted);
         CHECK(d.state() == DeviceState::kEstop);
-        CHECK(r.x.size() == 301);  // the tick with the e-stop repeated the last setpoint; then homing ended
+        CHECK(r.x.size() ==
+              301);  // the tick with the e-stop repeated the last setpoint; then homing ended
         CHECK(r.x[300] == r.x[299]);
     }
     SECTION("bad configuration and wrong state") {

@@ -1,7 +1,6 @@
 // The jerk limit travels like the other limits: appended to the Modbus configuration block and
 // as optional CAN configuration items, and reaches the device's checks either way.
 #include <catch2/catch.hpp>
-
 #include <cstdint>
 #include <vector>
 
@@ -35,7 +34,8 @@ std::vector<std::uint16_t> config_block(const std::uint32_t (&jerk)[kAxes]) {
 
 }  // namespace
 
-TEST_CASE("Modbus: the jerk limits are appended to the configuration block", "[device][jerk][modbus]") {
+TEST_CASE("Modbus: the jerk limits are appended to the configuration block",
+          "[device][jerk][modbus]") {
     // Existing addresses stay: travel of axis 1 at +10 + 8 + 4, the jerk after all travel.
     CHECK(modbus::config_travel_register(kAxes, 1) == 22);
     CHECK(modbus::config_jerk_register(kAxes, 0) == 26);
@@ -48,13 +48,13 @@ TEST_CASE("Modbus: the jerk limits are appended to the configuration block", "[d
     ModbusRegisterMap<kAxes, 16> map(dev);
     const std::uint32_t jerk[kAxes] = {0xFFFFFFFFu, 937500};
     const std::vector<std::uint16_t> r = config_block(jerk);
-    REQUIRE(map.write_holding_registers(modbus::kConfig, static_cast<std::uint16_t>(r.size()), r.data()) ==
-            modbus::Exception::kNone);
+    REQUIRE(map.write_holding_registers(modbus::kConfig, static_cast<std::uint16_t>(r.size()),
+                                        r.data()) == modbus::Exception::kNone);
     CHECK(dev.limits().axis[0].max_jerk == 0xFFFFFFFFu);
     CHECK(dev.limits().axis[1].max_jerk == 937500);
     std::vector<std::uint16_t> back(r.size(), 0xAAAA);
-    REQUIRE(map.read_holding_registers(modbus::kConfig, static_cast<std::uint16_t>(back.size()), back.data()) ==
-            modbus::Exception::kNone);
+    REQUIRE(map.read_holding_registers(modbus::kConfig, static_cast<std::uint16_t>(back.size()),
+                                       back.data()) == modbus::Exception::kNone);
     // (Travel 0, 0 reads back as the whole position range it means.)
     for (unsigned a = 0; a < kAxes; ++a) {
         const std::uint16_t j = modbus::config_jerk_register(kAxes, a);
@@ -65,13 +65,13 @@ TEST_CASE("Modbus: the jerk limits are appended to the configuration block", "[d
     // Zeros there (what a profile without max_jerk writes): no jerk limit.
     const std::uint32_t none[kAxes] = {0, 0};
     const std::vector<std::uint16_t> zero = config_block(none);
-    REQUIRE(map.write_holding_registers(modbus::kConfig, static_cast<std::uint16_t>(zero.size()), zero.data()) ==
-            modbus::Exception::kNone);
+    REQUIRE(map.write_holding_registers(modbus::kConfig, static_cast<std::uint16_t>(zero.size()),
+                                        zero.data()) == modbus::Exception::kNone);
     CHECK(dev.limits().axis[0].max_jerk == 0);
     CHECK(dev.limits().axis[1].max_jerk == 0);
     // The old, shorter block is a partial write now.
-    CHECK(map.write_holding_registers(modbus::kConfig, static_cast<std::uint16_t>(zero.size() - 4), zero.data()) ==
-          modbus::Exception::kIllegalDataAddress);
+    CHECK(map.write_holding_registers(modbus::kConfig, static_cast<std::uint16_t>(zero.size() - 4),
+                                      zero.data()) == modbus::Exception::kIllegalDataAddress);
 }
 
 TEST_CASE("CAN: jerk items configure the jerk limit, and are optional", "[device][jerk][can]") {
@@ -79,7 +79,9 @@ TEST_CASE("CAN: jerk items configure the jerk limit, and are optional", "[device
     MotionDevice<kAxes, 16> dev(start);
     pc::CanNode<kAxes, 16> node{dev, 5};
     std::vector<pc::Frame> out;
-    auto feed = [&](const pc::Frame& f) { node.handle(f, [&](const pc::Frame& o) { out.push_back(o); }); };
+    auto feed = [&](const pc::Frame& f) {
+        node.handle(f, [&](const pc::Frame& o) { out.push_back(o); });
+    };
     auto configure = [&](bool with_jerk) {
         feed(pc::encode_config(5, 0, kAxes, 1000));
         for (unsigned a = 0; a < kAxes; ++a) {

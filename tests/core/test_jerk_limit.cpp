@@ -1,7 +1,6 @@
 // The exact jerk limit: a span's constant jerk, and the acceleration step at every join
 // (rest included), at their boundaries, on their own and through the device's receiver.
 #include <catch2/catch.hpp>
-
 #include <cstdint>
 #include <vector>
 
@@ -38,10 +37,10 @@ AxisLimits with_jerk(std::uint32_t max_jerk) {
     return l;
 }
 
-// A straight move (both axes alike) built from constant-jerk phases of whole 8-tick spans with jerk j = 3/256 LSB/tick^3:
-// `rise` spans of +j, `hold` spans of constant acceleration, `rise` spans of -j, `cruise`
-// spans, then the mirror image down to rest. Every boundary has integer position and tangent,
-// so every span is its phase exactly: jerk 0 or +-j inside, no acceleration step anywhere.
+// A straight move (both axes alike) built from constant-jerk phases of whole 8-tick spans with jerk
+// j = 3/256 LSB/tick^3: `rise` spans of +j, `hold` spans of constant acceleration, `rise` spans of
+// -j, `cruise` spans, then the mirror image down to rest. Every boundary has integer position and
+// tangent, so every span is its phase exactly: jerk 0 or +-j inside, no acceleration step anywhere.
 std::vector<WireSpan> s_curve(unsigned rise, unsigned hold, unsigned cruise) {
     std::vector<int> jerk;  // in units of j per span
     for (unsigned i = 0; i < rise; ++i) jerk.push_back(1);
@@ -56,7 +55,8 @@ std::vector<WireSpan> s_curve(unsigned rise, unsigned hold, unsigned cruise) {
     std::int64_t p = 0, tangent = 0, a32 = 0;
     std::vector<WireSpan> out;
     for (std::size_t i = 0; i < jerk.size(); ++i) {
-        // Over 8 ticks: dp = 8v + 32a + 512 J / 6 = T + a32 + sign; dT = 8 (8a + 32 J) = 2 a32 + 3 sign.
+        // Over 8 ticks: dp = 8v + 32a + 512 J / 6 = T + a32 + sign; dT = 8 (8a + 32 J) = 2 a32 + 3
+        // sign.
         const int sign = jerk[i];
         const std::int64_t dp = tangent + a32 + sign;
         const std::int64_t dt = 2 * a32 + 3 * sign;
@@ -96,7 +96,8 @@ Status send(MotionDevice<2, 256>& d, const std::vector<WireSpan>& spans) {
 
 }  // namespace
 
-TEST_CASE("jerk inside a span: exactly at the limit passes, one LSB more is refused", "[device][jerk]") {
+TEST_CASE("jerk inside a span: exactly at the limit passes, one LSB more is refused",
+          "[device][jerk]") {
     // Hermite, n = 10 at 1 kHz: jerk 6(2P0 - 2P1 + T0 + T1)/n^3 LSB/tick^3 = 6e6 (..) LSB/s^3;
     // T1 = 5 gives 3e7 LSB/s^3 = 300,000 units.
     const Cubic five = cubic_of(Basis::kHermite, 0, 0, 0, 5, 10);
@@ -112,7 +113,8 @@ TEST_CASE("jerk inside a span: exactly at the limit passes, one LSB more is refu
     // Any basis: a uniform B-spline's jerk is (-P0 + 3P1 - 3P2 + P3) / n^3 (scale 6).
     const Cubic bspline = cubic_of(Basis::kUniformBSpline, 0, 0, 0, 3, 10);
     CHECK(check_axis_jerk(bspline.cubic, bspline.timing, with_jerk(30000), 1000) == Status::kOk);
-    CHECK(check_axis_jerk(bspline.cubic, bspline.timing, with_jerk(29999), 1000) == Status::kJerkLimit);
+    CHECK(check_axis_jerk(bspline.cubic, bspline.timing, with_jerk(29999), 1000) ==
+          Status::kJerkLimit);
     // No jerk limit: no check.
     CHECK(check_axis_jerk(six.cubic, six.timing, with_jerk(0), 1000) == Status::kOk);
 }
@@ -211,7 +213,8 @@ TEST_CASE("device: a trapezoid's acceleration steps are refused under a jerk lim
     }
 }
 
-TEST_CASE("device: a job end or a pause must end within one tick of jerk of rest", "[device][jerk]") {
+TEST_CASE("device: a job end or a pause must end within one tick of jerk of rest",
+          "[device][jerk]") {
     // Span 1 from rest with a = 0: P 0 -> 1, T 0 -> 3 (jerk 6/512, a_end 6/64). Span 2 joins
     // it without a step: P 1 -> 4, T 3 -> 0 (a_start (18 - 12)/64 = 6/64, jerk -18/512), and
     // ends at v = 0 but a = -12/64. Jerk 18/512 LSB/tick^3 at 2 kHz is 2,812,500 units.

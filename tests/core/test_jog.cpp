@@ -128,7 +128,7 @@ TEST_CASE("jog and set position refusals leave the device as it was", "[device][
     CHECK(write(jog_registers(0, 100, 1001)) ==
           Ex::kIllegalDataValue);  // feed above 1000 per mille
     CHECK(write(jog_registers(0, kMaxPositionLsb + 1, 0)) ==
-          Ex::kIllegalDataValue);                                        // end off the range
+          Ex::kIllegalDataValue);                                         // end off the range
     CHECK(write(jog_registers(0, 100, 0, 10)) == Ex::kIllegalDataValue);  // no such command
     CHECK(refusal() == Status::kUnknownCommand);
     const std::uint16_t plain_jog = kCommandJog;  // a jog without its arguments
@@ -220,7 +220,8 @@ TEST_CASE("a jog under a jerk limit passes the device's jerk rules and ends on i
         // The same move planned without the jerk limit: refused where its acceleration steps.
         MotionLimits<kAxes> no_jerk = l;
         for (auto& a : no_jerk.axis) a.max_jerk = 0;
-        if (static_cast<std::uint64_t>(max_jerk) * kJerkUnitLsb / l.tick_hz >= l.axis[1].max_acceleration) {
+        if (static_cast<std::uint64_t>(max_jerk) * kJerkUnitLsb / l.tick_hz >=
+            l.axis[1].max_acceleration) {
             continue;  // one tick of jerk reaches the full acceleration: nothing to refuse
         }
         const Lsb start[kAxes] = {0, 0};

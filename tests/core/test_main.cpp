@@ -10,7 +10,7 @@
 namespace pathstream::test {
 std::uint64_t g_spans_per_basis = 100000;
 std::uint64_t g_stress_ticks = 1000000;
-}
+}  // namespace pathstream::test
 
 int main(int argc, char* argv[]) {
     Catch::Session session;

@@ -1,7 +1,6 @@
 // The Modbus register map over a device, without a transport: status block, configuration,
 // commands and span batches, and that every refused write leaves the device unchanged.
 #include <catch2/catch.hpp>
-
 #include <cstdint>
 #include <vector>
 
@@ -32,12 +31,13 @@ std::vector<std::uint16_t> config_block(std::uint32_t hz, std::uint32_t v, std::
     return r;
 }
 
-std::vector<std::uint16_t> window(std::uint32_t first, const std::vector<WireSpan>& spans, std::size_t from,
-                                  std::size_t count) {
+std::vector<std::uint16_t> window(std::uint32_t first, const std::vector<WireSpan>& spans,
+                                  std::size_t from, std::size_t count) {
     const auto bytes = test::batch_bytes<kAxes>(spans, from, count);
-    std::vector<std::uint16_t> r = {static_cast<std::uint16_t>(first >> 16), static_cast<std::uint16_t>(first),
-                                    static_cast<std::uint16_t>(count), static_cast<std::uint16_t>(bytes.size()),
-                                    crc16_modbus(bytes.data(), bytes.size())};
+    std::vector<std::uint16_t> r = {
+        static_cast<std::uint16_t>(first >> 16), static_cast<std::uint16_t>(first),
+        static_cast<std::uint16_t>(count), static_cast<std::uint16_t>(bytes.size()),
+        crc16_modbus(bytes.data(), bytes.size())};
     for (std::size_t i = 0; i < bytes.size(); i += 2) {
         const std::uint16_t low = i + 1 < bytes.size() ? bytes[i + 1] : 0;
         r.push_back(static_cast<std::uint16_t>((bytes[i] << 8) | low));
@@ -83,22 +83,25 @@ TEST_CASE("configuration, commands and batches through registers", "[device][mod
     const auto spans = test::trapezoid_move<kAxes>(start, 20000, 8);
     auto batch = window(1, spans, 0, 6);
 
-    CHECK(m.write_holding_registers(modbus::kSpanWindow, static_cast<std::uint16_t>(batch.size()), batch.data()) ==
+    CHECK(m.write_holding_registers(modbus::kSpanWindow, static_cast<std::uint16_t>(batch.size()),
+                                    batch.data()) ==
           Ex::kServerDeviceFailure);  // not configured yet
-    CHECK(status(m)[modbus::status::kLastRefusal] == static_cast<std::uint16_t>(Status::kNotConfigured));
+    CHECK(status(m)[modbus::status::kLastRefusal] ==
+          static_cast<std::uint16_t>(Status::kNotConfigured));
 
     auto config = config_block(1000, 200000, 2000000);
-    CHECK(m.write_holding_registers(modbus::kConfig, 5, config.data()) == Ex::kIllegalDataAddress);  // partial
+    CHECK(m.write_holding_registers(modbus::kConfig, 5, config.data()) ==
+          Ex::kIllegalDataAddress);  // partial
     auto bad = config;
     bad[2] = 3;  // wrong axis count
-    CHECK(m.write_holding_registers(modbus::kConfig, static_cast<std::uint16_t>(bad.size()), bad.data()) ==
-          Ex::kIllegalDataValue);
+    CHECK(m.write_holding_registers(modbus::kConfig, static_cast<std::uint16_t>(bad.size()),
+                                    bad.data()) == Ex::kIllegalDataValue);
     CHECK_FALSE(d.configured());
-    REQUIRE(m.write_holding_registers(modbus::kConfig, static_cast<std::uint16_t>(config.size()), config.data()) ==
-            Ex::kNone);
+    REQUIRE(m.write_holding_registers(modbus::kConfig, static_cast<std::uint16_t>(config.size()),
+                                      config.data()) == Ex::kNone);
     std::vector<std::uint16_t> back(config.size());
-    REQUIRE(m.read_holding_registers(modbus::kConfig, static_cast<std::uint16_t>(back.size()), back.data()) ==
-            Ex::kNone);
+    REQUIRE(m.read_holding_registers(modbus::kConfig, static_cast<std::uint16_t>(back.size()),
+                                     back.data()) == Ex::kNone);
     // Travel written as zeros (no soft limits) reads back as the whole position range.
     auto expected = config;
     for (unsigned a = 0; a < kAxes; ++a) {
@@ -114,23 +117,25 @@ TEST_CASE("configuration, commands and batches through registers", "[device][mod
 
     auto corrupt = batch;
     corrupt[7] ^= 0x0100;  // one payload bit: the check value no longer matches
-    CHECK(m.write_holding_registers(modbus::kSpanWindow, static_cast<std::uint16_t>(corrupt.size()), corrupt.data()) ==
-          Ex::kIllegalDataValue);
+    CHECK(m.write_holding_registers(modbus::kSpanWindow, static_cast<std::uint16_t>(corrupt.size()),
+                                    corrupt.data()) == Ex::kIllegalDataValue);
     CHECK(status(m)[modbus::status::kLastRefusal] == static_cast<std::uint16_t>(Status::kBadBatch));
     auto wrong_sequence = window(7, spans, 0, 6);
-    CHECK(m.write_holding_registers(modbus::kSpanWindow, static_cast<std::uint16_t>(wrong_sequence.size()),
+    CHECK(m.write_holding_registers(modbus::kSpanWindow,
+                                    static_cast<std::uint16_t>(wrong_sequence.size()),
                                     wrong_sequence.data()) == Ex::kIllegalDataValue);
     CHECK(d.queued_spans() == 0);
 
     // FC23: write the batch and read the status in one transaction.
     std::vector<std::uint16_t> s(modbus::status::kCount);
-    REQUIRE(m.write_read_holding_registers(modbus::kSpanWindow, static_cast<std::uint16_t>(batch.size()), batch.data(),
+    REQUIRE(m.write_read_holding_registers(modbus::kSpanWindow,
+                                           static_cast<std::uint16_t>(batch.size()), batch.data(),
                                            0, modbus::status::kCount, s.data()) == Ex::kNone);
     CHECK(s[modbus::status::kLastAcceptedSequence + 1] == 6);
     CHECK(s[modbus::status::kFreeSlots] == 10);
     // A retry of the same batch (its reply lost) is acknowledged and not queued twice.
-    REQUIRE(m.write_holding_registers(modbus::kSpanWindow, static_cast<std::uint16_t>(batch.size()), batch.data()) ==
-            Ex::kNone);
+    REQUIRE(m.write_holding_registers(modbus::kSpanWindow, static_cast<std::uint16_t>(batch.size()),
+                                      batch.data()) == Ex::kNone);
     CHECK(d.queued_spans() == 6);
     CHECK(status(m)[modbus::status::kDuplicates] == 1);
 
@@ -144,12 +149,12 @@ TEST_CASE("configuration, commands and batches through registers", "[device][mod
     d.tick(out);
     CHECK(status(m)[modbus::status::kState] == 1);
     // Configuration is refused while running.
-    CHECK(m.write_holding_registers(modbus::kConfig, static_cast<std::uint16_t>(config.size()), config.data()) ==
-          Ex::kServerDeviceFailure);
+    CHECK(m.write_holding_registers(modbus::kConfig, static_cast<std::uint16_t>(config.size()),
+                                    config.data()) == Ex::kServerDeviceFailure);
     // Queue full answers busy.
     auto more = window(7, spans, 6, 12);
-    CHECK(m.write_holding_registers(modbus::kSpanWindow, static_cast<std::uint16_t>(more.size()), more.data()) ==
-          Ex::kServerDeviceBusy);
+    CHECK(m.write_holding_registers(modbus::kSpanWindow, static_cast<std::uint16_t>(more.size()),
+                                    more.data()) == Ex::kServerDeviceBusy);
     CHECK(status(m)[modbus::status::kRefusals] >= 5);
 }
 
@@ -158,28 +163,30 @@ TEST_CASE("a resend with other bytes under the same sequence is refused", "[devi
     Device d(start);
     Map m(d);
     auto config = config_block(1000, 200000, 2000000);
-    REQUIRE(m.write_holding_registers(modbus::kConfig, static_cast<std::uint16_t>(config.size()), config.data()) ==
-            Ex::kNone);
+    REQUIRE(m.write_holding_registers(modbus::kConfig, static_cast<std::uint16_t>(config.size()),
+                                      config.data()) == Ex::kNone);
     const auto batch = window(1, test::trapezoid_move<kAxes>(start, 20000, 8), 0, 6);
     const auto other = window(1, test::trapezoid_move<kAxes>(start, 10000, 8), 0, 6);
     REQUIRE(batch != other);
-    REQUIRE(m.write_holding_registers(modbus::kSpanWindow, static_cast<std::uint16_t>(batch.size()), batch.data()) ==
-            Ex::kNone);
-    CHECK(m.write_holding_registers(modbus::kSpanWindow, static_cast<std::uint16_t>(other.size()), other.data()) ==
-          Ex::kIllegalDataValue);
-    CHECK(status(m)[modbus::status::kLastRefusal] == static_cast<std::uint16_t>(Status::kBadSequence));
+    REQUIRE(m.write_holding_registers(modbus::kSpanWindow, static_cast<std::uint16_t>(batch.size()),
+                                      batch.data()) == Ex::kNone);
+    CHECK(m.write_holding_registers(modbus::kSpanWindow, static_cast<std::uint16_t>(other.size()),
+                                    other.data()) == Ex::kIllegalDataValue);
+    CHECK(status(m)[modbus::status::kLastRefusal] ==
+          static_cast<std::uint16_t>(Status::kBadSequence));
     CHECK(status(m)[modbus::status::kDuplicates] == 0);
     CHECK(d.queued_spans() == 6);
     // The true resend is still acknowledged as a duplicate.
-    CHECK(m.write_holding_registers(modbus::kSpanWindow, static_cast<std::uint16_t>(batch.size()), batch.data()) ==
-          Ex::kNone);
+    CHECK(m.write_holding_registers(modbus::kSpanWindow, static_cast<std::uint16_t>(batch.size()),
+                                    batch.data()) == Ex::kNone);
     CHECK(status(m)[modbus::status::kDuplicates] == 1);
     CHECK(d.queued_spans() == 6);
     // The tail of the last batch under its numbers, with other bytes: not a resend either.
     const auto tail = window(4, test::trapezoid_move<kAxes>(start, 10000, 8), 3, 3);
-    CHECK(m.write_holding_registers(modbus::kSpanWindow, static_cast<std::uint16_t>(tail.size()), tail.data()) ==
-          Ex::kIllegalDataValue);
-    CHECK(status(m)[modbus::status::kLastRefusal] == static_cast<std::uint16_t>(Status::kBadSequence));
+    CHECK(m.write_holding_registers(modbus::kSpanWindow, static_cast<std::uint16_t>(tail.size()),
+                                    tail.data()) == Ex::kIllegalDataValue);
+    CHECK(status(m)[modbus::status::kLastRefusal] ==
+          static_cast<std::uint16_t>(Status::kBadSequence));
     CHECK(status(m)[modbus::status::kDuplicates] == 1);
     CHECK(d.queued_spans() == 6);
 }
@@ -189,14 +196,14 @@ TEST_CASE("tick rates below the profile's range are refused", "[device][modbus]"
     Device d(start);
     Map m(d);
     auto slow = config_block(kMinTickHz - 1, 200000, 2000000);
-    CHECK(m.write_holding_registers(modbus::kConfig, static_cast<std::uint16_t>(slow.size()), slow.data()) ==
-          Ex::kIllegalDataValue);
+    CHECK(m.write_holding_registers(modbus::kConfig, static_cast<std::uint16_t>(slow.size()),
+                                    slow.data()) == Ex::kIllegalDataValue);
     auto five = config_block(5, 200000, 2000000);
-    CHECK(m.write_holding_registers(modbus::kConfig, static_cast<std::uint16_t>(five.size()), five.data()) ==
-          Ex::kIllegalDataValue);
+    CHECK(m.write_holding_registers(modbus::kConfig, static_cast<std::uint16_t>(five.size()),
+                                    five.data()) == Ex::kIllegalDataValue);
     CHECK_FALSE(d.configured());
     auto lowest = config_block(kMinTickHz, 200000, 2000000);
-    CHECK(m.write_holding_registers(modbus::kConfig, static_cast<std::uint16_t>(lowest.size()), lowest.data()) ==
-          Ex::kNone);
+    CHECK(m.write_holding_registers(modbus::kConfig, static_cast<std::uint16_t>(lowest.size()),
+                                    lowest.data()) == Ex::kNone);
     CHECK(d.configured());
 }

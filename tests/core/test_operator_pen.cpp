@@ -67,7 +67,8 @@ OperatorCommand jog(unsigned axis, std::int32_t distance) {
 
 }  // namespace
 
-TEST_CASE("operator's pen: down at rest while idle, carried by a jog, raised by a stop", "[device][pen]") {
+TEST_CASE("operator's pen: down at rest while idle, carried by a jog, raised by a stop",
+          "[device][pen]") {
     const Lsb start[kAxes] = {1000, 2000};
     Device d(start);
     REQUIRE(d.configure(limits()) == Status::kOk);
@@ -149,7 +150,8 @@ TEST_CASE("operator's pen: a job's start, a fault and the e-stop raise it", "[de
     CHECK(d.outputs() == 0);
 }
 
-TEST_CASE("home without a homing port is refused by name, bad arguments by value", "[device][homing]") {
+TEST_CASE("home without a homing port is refused by name, bad arguments by value",
+          "[device][homing]") {
     const Lsb start[kAxes] = {0, 0};
     Device d(start);
     REQUIRE(d.configure(limits()) == Status::kOk);
@@ -169,14 +171,15 @@ TEST_CASE("home without a homing port is refused by name, bad arguments by value
     CHECK(c.execute(unknown) == Status::kUnknownCommand);
 }
 
-TEST_CASE("homing run: plan order, a mask, a failure keeps the waiting axes as they were", "[device][homing]") {
+TEST_CASE("homing run: plan order, a mask, a failure keeps the waiting axes as they were",
+          "[device][homing]") {
     HomingRun<3> run;
     HomingAxis plan[3];
     plan[0].config.axis = 2;
     plan[1].config.axis = 0;
     plan[2].config.axis = 0;
     CHECK(run.set_plan(plan, 3) == Status::kBadLimits);  // axis 0 twice
-    CHECK(run.begin(0) == Status::kNoHoming);             // nothing planned after the refusal
+    CHECK(run.begin(0) == Status::kNoHoming);            // nothing planned after the refusal
     plan[2].config.axis = 1;
     REQUIRE(run.set_plan(plan, 3) == Status::kOk);
     CHECK(run.plannable() == 7u);
@@ -195,7 +198,8 @@ TEST_CASE("homing run: plan order, a mask, a failure keeps the waiting axes as t
     CHECK(next->config.axis == 0);
     run.finished(HomingError::kSwitchNotFound);  // x fails: y never starts
     CHECK_FALSE(run.busy());
-    CHECK((run.report(0).state == AxisHoming::kFailed && run.report(0).error == HomingError::kSwitchNotFound));
+    CHECK((run.report(0).state == AxisHoming::kFailed &&
+           run.report(0).error == HomingError::kSwitchNotFound));
     CHECK(run.report(1).state == AxisHoming::kNotHomed);  // as before the run
     CHECK(run.report(2).state == AxisHoming::kHomed);
     // y alone (mask bit 1); an axis outside the plan is kNoHoming.

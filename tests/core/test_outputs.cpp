@@ -5,7 +5,8 @@
 
 using namespace pathstream;
 
-TEST_CASE("outputs change at the first tick of their span and persist while idle", "[stream][outputs]") {
+TEST_CASE("outputs change at the first tick of their span and persist while idle",
+          "[stream][outputs]") {
     const Lsb start[1] = {100};
     SetpointStream<1, 4> stream{start};
     Lsb out[1];

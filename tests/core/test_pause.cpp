@@ -49,7 +49,8 @@ void tick_until_paused(Device& d) {
 
 }  // namespace
 
-TEST_CASE("pause: the device holds at the marked span's end, pen up, until resumed", "[device][pause]") {
+TEST_CASE("pause: the device holds at the marked span's end, pen up, until resumed",
+          "[device][pause]") {
     const Lsb start[kAxes] = {1000, 2000};
     Device d(start);
     REQUIRE(d.configure(test_limits<kAxes>()) == Status::kOk);
@@ -114,13 +115,15 @@ TEST_CASE("pause: a span marked for a pause must end at rest", "[device][pause]"
     Device d(start);
     REQUIRE(d.configure(test_limits<kAxes>()) == Status::kOk);
     std::vector<WireSpan> spans = trapezoid_move<kAxes>(start, 3000, 8);
-    spans[spans.size() / 2].flags = static_cast<std::uint8_t>(spans[spans.size() / 2].flags | kWirePause);
+    spans[spans.size() / 2].flags =
+        static_cast<std::uint8_t>(spans[spans.size() / 2].flags | kWirePause);
     CHECK(send_all(d, spans) == Status::kPauseMoving);
     CHECK(d.queued_spans() == 0);
     CHECK(d.last_accepted_sequence() == 0);
 }
 
-TEST_CASE("pause: the paused flag on Modbus (register 35 bit 6) and CAN (status A bit 6)", "[device][pause]") {
+TEST_CASE("pause: the paused flag on Modbus (register 35 bit 6) and CAN (status A bit 6)",
+          "[device][pause]") {
     const Lsb start[kAxes] = {0, 0};
     Device d(start);
     REQUIRE(d.configure(test_limits<kAxes>()) == Status::kOk);
@@ -128,9 +131,11 @@ TEST_CASE("pause: the paused flag on Modbus (register 35 bit 6) and CAN (status 
     can::CanNode<kAxes, 64> node{d, 5};
     const auto flags = [&] {
         std::uint16_t modbus_flags = 0;
-        REQUIRE(map.read_input_registers(modbus::status::kFlags, 1, &modbus_flags) == modbus::Exception::kNone);
+        REQUIRE(map.read_input_registers(modbus::status::kFlags, 1, &modbus_flags) ==
+                modbus::Exception::kNone);
         std::vector<can::Frame> out;
-        node.handle(can::encode_command(5, can::kCommandStatusRequest), [&](const can::Frame& f) { out.push_back(f); });
+        node.handle(can::encode_command(5, can::kCommandStatusRequest),
+                    [&](const can::Frame& f) { out.push_back(f); });
         can::Status3 s;
         for (const can::Frame& f : out) REQUIRE(can::decode_status_part(f, s));
         return std::make_pair(modbus_flags & modbus::flags::kPaused, s.flags & can::kFlagPaused);

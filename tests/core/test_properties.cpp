@@ -9,16 +9,14 @@
 //
 // Per-span work is a handful of evaluate_at / start_differences calls (never every tick of a
 // long span), so the default CI size (--spans 100000 under ASan) stays within a few seconds.
-#include <catch2/catch.hpp>
-
-#include <utility>
-
 #include <algorithm>
 #include <array>
+#include <catch2/catch.hpp>
 #include <cmath>
 #include <cstdint>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "core/property_settings.hpp"
@@ -51,7 +49,8 @@ namespace {
 std::string str(i128 v) {
     if (v == 0) return "0";
     const bool negative = v < 0;
-    unsigned __int128 m = negative ? -static_cast<unsigned __int128>(v) : static_cast<unsigned __int128>(v);
+    unsigned __int128 m =
+        negative ? -static_cast<unsigned __int128>(v) : static_cast<unsigned __int128>(v);
     std::string s;
     while (m != 0) {
         s.insert(s.begin(), static_cast<char>('0' + static_cast<int>(m % 10)));
@@ -60,14 +59,20 @@ std::string str(i128 v) {
     return negative ? "-" + s : s;
 }
 
-std::string name(Status s) { return pathstream::status_name(s); }
+std::string name(Status s) {
+    return pathstream::status_name(s);
+}
 
 const char* basis_name(Basis b) {
     switch (b) {
-        case Basis::kUniformBSpline: return "B-spline";
-        case Basis::kCatmullRom: return "Catmull-Rom";
-        case Basis::kBezier: return "Bezier";
-        case Basis::kHermite: return "Hermite";
+        case Basis::kUniformBSpline:
+            return "B-spline";
+        case Basis::kCatmullRom:
+            return "Catmull-Rom";
+        case Basis::kBezier:
+            return "Bezier";
+        case Basis::kHermite:
+            return "Hermite";
     }
     return "?";
 }
@@ -83,9 +88,9 @@ std::string describe(Basis b, const std::int32_t (&p)[N], std::int64_t n) {
 
 /// Fails the test with `context` (evaluated only on failure) when `cond` is false. Keeps
 /// Catch's per-assertion cost out of the hot loops.
-#define EXPECT(cond, context)                                          \
-    do {                                                               \
-        if (!(cond)) FAIL(#cond << "  [" << (context) << "]");         \
+#define EXPECT(cond, context)                                  \
+    do {                                                       \
+        if (!(cond)) FAIL(#cond << "  [" << (context) << "]"); \
     } while (0)
 
 /// One axis of a span as the core builds it.
@@ -105,7 +110,8 @@ Status build(Basis basis, const std::int32_t (&p)[4], std::uint32_t n, Axis& out
 std::int64_t core_at(const Axis& a, std::uint32_t k) {
     Lsb v = 0;
     const Status s = pathstream::evaluate_at(a.cubic, a.timing, k, v);
-    if (s != Status::kOk) FAIL("evaluate_at(" << k << ") of n=" << a.timing.ticks << ": " << name(s));
+    if (s != Status::kOk)
+        FAIL("evaluate_at(" << k << ") of n=" << a.timing.ticks << ": " << name(s));
     return v;
 }
 
@@ -116,7 +122,8 @@ template <unsigned Axes>
 Status core_start(const Span<Axes>& span, Lsb (&start)[Axes]) {
     for (unsigned a = 0; a < Axes; ++a) {
         Axis axis;
-        if (const Status s = build(span.basis, span.control[a], span.ticks, axis); s != Status::kOk) {
+        if (const Status s = build(span.basis, span.control[a], span.ticks, axis);
+            s != Status::kOk) {
             return s;
         }
         start[a] = static_cast<Lsb>(core_at(axis, 0));
@@ -156,7 +163,9 @@ bool same_value(const Rational& x, const Rational& y) {
     }
     return x.numerator * (y.denominator / a) == y.numerator * (x.denominator / a);
 }
-std::string str(const Rational& r) { return str(r.numerator) + "/" + str(r.denominator); }
+std::string str(const Rational& r) {
+    return str(r.numerator) + "/" + str(r.denominator);
+}
 
 /// Exact first and second derivative in u (u = k/n) of a span's curve at tick k0, from the
 /// reference alone: Newton forward differences of the cubic at k0..k0+3 (the closed form is
@@ -203,10 +212,18 @@ void random_points(SpanGenerator& g, std::int32_t* p, int count,
     for (int i = 0; i < count; ++i) {
         std::int64_t v = 0;
         switch (style) {
-            case 0: v = g.uniform(-limit, limit); break;
-            case 1: v = (g.uniform(0, 1) ? limit : -limit) - g.uniform(-3, 3); break;
-            case 2: v = g.uniform(-1000, 1000); break;
-            default: v = center + g.uniform(-50000, 50000); break;
+            case 0:
+                v = g.uniform(-limit, limit);
+                break;
+            case 1:
+                v = (g.uniform(0, 1) ? limit : -limit) - g.uniform(-3, 3);
+                break;
+            case 2:
+                v = g.uniform(-1000, 1000);
+                break;
+            default:
+                v = center + g.uniform(-50000, 50000);
+                break;
         }
         p[i] = static_cast<std::int32_t>(std::clamp(v, -limit, limit));
     }
@@ -217,7 +234,8 @@ void random_points(SpanGenerator& g, std::int32_t* p, int count,
 /// rounding of the root cannot miss the integer extremum).
 std::vector<std::uint32_t> extreme_ticks(Basis b, const std::int32_t (&p)[4], std::int64_t n) {
     long double v[4];
-    for (int j = 0; j < 4; ++j) v[j] = static_cast<long double>(reference_value(b, p, n, j).numerator);
+    for (int j = 0; j < 4; ++j)
+        v[j] = static_cast<long double>(reference_value(b, p, n, j).numerator);
     const long double f1 = v[1] - v[0], f2 = v[2] - 2 * v[1] + v[0],
                       f3 = v[3] - 3 * v[2] + 3 * v[1] - v[0];
     // N'(k) = (f3/2) k^2 + (f2 - f3) k + (f1 - f2/2 + f3/3)
@@ -376,14 +394,12 @@ TEST_CASE("B-spline and Catmull-Rom chains play through SetpointStream without g
                     const TickState state = stream.tick(out);
                     EXPECT(state == TickState::kMoving, t);
                     for (int a = 0; a < 2; ++a) {
-                        const std::int64_t want = c[a] + std::int64_t{n} * v[a] +
-                                                  static_cast<std::int64_t>(t) * v[a];
-                        EXPECT(out[a] == want, std::string(basis_name(b)) + " n=" +
-                                                   std::to_string(n) + " tick " +
-                                                   std::to_string(t) + " axis " +
-                                                   std::to_string(a) + " got " +
-                                                   std::to_string(out[a]) + " want " +
-                                                   std::to_string(want));
+                        const std::int64_t want =
+                            c[a] + std::int64_t{n} * v[a] + static_cast<std::int64_t>(t) * v[a];
+                        EXPECT(out[a] == want,
+                               std::string(basis_name(b)) + " n=" + std::to_string(n) + " tick " +
+                                   std::to_string(t) + " axis " + std::to_string(a) + " got " +
+                                   std::to_string(out[a]) + " want " + std::to_string(want));
                     }
                 }
                 REQUIRE(stream.ticks_executed() == total);
@@ -444,12 +460,11 @@ TEST_CASE("B-spline and Catmull-Rom chains play through SetpointStream without g
                     const TickState state = stream.tick(out);
                     EXPECT(state == TickState::kMoving, k);
                     for (int a = 0; a < 2; ++a) {
-                        const std::int32_t p[4] = {pts[a][done], pts[a][done + 1],
-                                                   pts[a][done + 2], pts[a][done + 3]};
+                        const std::int32_t p[4] = {pts[a][done], pts[a][done + 1], pts[a][done + 2],
+                                                   pts[a][done + 3]};
                         const auto want = reference_setpoint(b, p, n, k);
-                        EXPECT(out[a] == want, describe(b, p, n) + " span " +
-                                                   std::to_string(done) + " tick " +
-                                                   std::to_string(k) + " got " +
+                        EXPECT(out[a] == want, describe(b, p, n) + " span " + std::to_string(done) +
+                                                   " tick " + std::to_string(k) + " got " +
                                                    std::to_string(out[a]));
                         if (k == 0 && done > 0) {
                             // Joint: the previous span's exact end is this span's exact start,
@@ -461,9 +476,8 @@ TEST_CASE("B-spline and Catmull-Rom chains play through SetpointStream without g
                                    describe(b, q, n));
                             EXPECT(out[a] == reference_setpoint(b, q, n, n), describe(b, q, n));
                             // The step into the joint is the rounded curve's own step.
-                            EXPECT(out[a] - previous[a] ==
-                                       reference_setpoint(b, p, n, 0) -
-                                           reference_setpoint(b, q, n, n - 1),
+                            EXPECT(out[a] - previous[a] == reference_setpoint(b, p, n, 0) -
+                                                               reference_setpoint(b, q, n, n - 1),
                                    describe(b, q, n));
                         }
                         previous[a] = out[a];
@@ -476,7 +490,8 @@ TEST_CASE("B-spline and Catmull-Rom chains play through SetpointStream without g
                                 static_cast<std::uint32_t>(done - 1 + 100));
                     }
                 }
-                REQUIRE(stream.ticks_executed() == std::uint64_t{n} * static_cast<std::uint64_t>(spans));
+                REQUIRE(stream.ticks_executed() ==
+                        std::uint64_t{n} * static_cast<std::uint64_t>(spans));
             }
         }
     }
@@ -561,15 +576,22 @@ void check_end_conditions(Basis b, std::uint64_t seed_offset, int end_index, Tan
 }
 
 TEST_CASE("Bezier ends at P0 and P3 with tangents 3(P1-P0) and 3(P3-P2)", "[properties]") {
-    check_end_conditions(Basis::kBezier, 3, 3, [](const std::int32_t (&p)[4]) {
-        return std::pair{Rational{3 * (i128{p[1]} - p[0]), 1}, Rational{3 * (i128{p[3]} - p[2]), 1}};
-    }, 3);
+    check_end_conditions(
+        Basis::kBezier, 3, 3,
+        [](const std::int32_t(&p)[4]) {
+            return std::pair{Rational{3 * (i128{p[1]} - p[0]), 1},
+                             Rational{3 * (i128{p[3]} - p[2]), 1}};
+        },
+        3);
 }
 
 TEST_CASE("Hermite ends at P0 and P1 with tangents T0 and T1", "[properties]") {
-    check_end_conditions(Basis::kHermite, 4, 1, [](const std::int32_t (&p)[4]) {
-        return std::pair{Rational{p[2], 1}, Rational{p[3], 1}};
-    }, 4);
+    check_end_conditions(
+        Basis::kHermite, 4, 1,
+        [](const std::int32_t(&p)[4]) {
+            return std::pair{Rational{p[2], 1}, Rational{p[3], 1}};
+        },
+        4);
 }
 
 // ---- Convex hull ------------------------------------------------------------------------
@@ -673,10 +695,18 @@ TEST_CASE("Adding an integer offset to every position shifts every setpoint by i
             // Offsets of both signs, small ones and ones that push a point to the limit.
             std::int64_t offset = 0;
             switch (gen.uniform(0, 3)) {
-                case 0: offset = gen.uniform(-3, 3); break;
-                case 1: offset = limit - hi; break;
-                case 2: offset = -limit - lo; break;
-                default: offset = gen.uniform(-limit - lo, limit - hi); break;
+                case 0:
+                    offset = gen.uniform(-3, 3);
+                    break;
+                case 1:
+                    offset = limit - hi;
+                    break;
+                case 2:
+                    offset = -limit - lo;
+                    break;
+                default:
+                    offset = gen.uniform(-limit - lo, limit - hi);
+                    break;
             }
             offset = std::clamp(offset, -limit - lo, limit - hi);  // keep positions in range
             if (offset == 0) offset = hi < limit ? 1 : -1;
@@ -696,7 +726,8 @@ TEST_CASE("Adding an integer offset to every position shifts every setpoint by i
             std::vector<std::uint32_t> ticks = {0, n, n / 3,
                                                 static_cast<std::uint32_t>(gen.uniform(0, n))};
             for (std::uint32_t k : ticks) {
-                EXPECT(core_at(t, k) == core_at(s, k) + offset, ctx() + " tick " + std::to_string(k));
+                EXPECT(core_at(t, k) == core_at(s, k) + offset,
+                       ctx() + " tick " + std::to_string(k));
             }
             // The per-tick path too: a few stepped ticks from a random start.
             const auto k0 = static_cast<std::uint32_t>(gen.uniform(0, n));
@@ -730,8 +761,8 @@ TEST_CASE("Spans just below and above the 2^32 denominator limit are exact at ev
                                    {Basis::kHermite, 1625}};
     const std::uint64_t rounds = spans_for(10000, 4);
     for (const Boundary& bd : boundaries) {
-        for (std::uint32_t n : {bd.narrow_max - 1, bd.narrow_max, bd.narrow_max + 1,
-                                bd.narrow_max + 2}) {
+        for (std::uint32_t n :
+             {bd.narrow_max - 1, bd.narrow_max, bd.narrow_max + 1, bd.narrow_max + 2}) {
             SpanTiming timing;
             const Status ts = pathstream::make_span_timing(bd.basis, n, timing);
             REQUIRE(name(ts) == name(Status::kOk));
@@ -748,7 +779,8 @@ TEST_CASE("Spans just below and above the 2^32 denominator limit are exact at ev
                 span.tag = static_cast<std::uint32_t>(r);
                 gen.control(bd.basis, span.control[0]);
                 gen.control(bd.basis, span.control[1]);
-                const auto m = static_cast<std::int32_t>(pathstream::kMaxPositionLsb - gen.uniform(0, 5));
+                const auto m =
+                    static_cast<std::int32_t>(pathstream::kMaxPositionLsb - gen.uniform(0, 5));
                 const std::int32_t extreme[4] = {-m, m, -m, m};
                 const std::int32_t odd[4] = {1, -3, 5, 7};
                 const std::int32_t* third = r % 2 ? extreme : odd;

@@ -3,9 +3,8 @@
 // span. Then the converse as a seeded property: every span the core accepts really stays
 // inside the documented bounds at every tick (checked exactly with the independent reference,
 // at the ticks where each bound is tightest), i.e. acceptance is sound.
-#include <catch2/catch.hpp>
-
 #include <algorithm>
+#include <catch2/catch.hpp>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -44,12 +43,15 @@ using pathstream::test::SpanGenerator;
 
 namespace {
 
-std::string name(Status s) { return pathstream::status_name(s); }
+std::string name(Status s) {
+    return pathstream::status_name(s);
+}
 
 std::string str(i128 v) {
     if (v == 0) return "0";
     const bool negative = v < 0;
-    unsigned __int128 m = negative ? -static_cast<unsigned __int128>(v) : static_cast<unsigned __int128>(v);
+    unsigned __int128 m =
+        negative ? -static_cast<unsigned __int128>(v) : static_cast<unsigned __int128>(v);
     std::string s;
     while (m != 0) {
         s.insert(s.begin(), static_cast<char>('0' + static_cast<int>(m % 10)));
@@ -65,9 +67,9 @@ std::string describe(Basis b, const std::int32_t (&p)[4], std::int64_t n) {
     return os.str();
 }
 
-#define EXPECT(cond, context)                                          \
-    do {                                                               \
-        if (!(cond)) FAIL(#cond << "  [" << (context) << "]");         \
+#define EXPECT(cond, context)                                  \
+    do {                                                       \
+        if (!(cond)) FAIL(#cond << "  [" << (context) << "]"); \
     } while (0)
 
 constexpr Basis kAllBases[] = {Basis::kUniformBSpline, Basis::kCatmullRom, Basis::kBezier,
@@ -121,7 +123,9 @@ struct ExactSpan {
     i128 delta3() const { return f3; }
 };
 
-i128 abs128(i128 v) { return v < 0 ? -v : v; }
+i128 abs128(i128 v) {
+    return v < 0 ? -v : v;
+}
 
 /// The core's tick-0 (`start`) and tick-n (`end`) values of a valid span, every axis: what
 /// SetpointStream::push compares with the end of the chain.
@@ -296,13 +300,10 @@ TEST_CASE("Spans whose per-tick differences would overflow are rejected", "[reje
         std::int32_t p[4];
     };
     const Case cases[] = {
-        {Basis::kUniformBSpline, {-m, m, -m, m}},
-        {Basis::kCatmullRom, {m, -m, m, -m}},
+        {Basis::kUniformBSpline, {-m, m, -m, m}}, {Basis::kCatmullRom, {m, -m, m, -m}},
         {Basis::kCatmullRom, {-m, -m, m, m}},  // -m to m in one tick
-        {Basis::kBezier, {-m, m, -m, m}},
-        {Basis::kBezier, {m, -m, m, -m}},
-        {Basis::kHermite, {-m, m, t, t}},
-        {Basis::kHermite, {m, -m, -t, -t}},
+        {Basis::kBezier, {-m, m, -m, m}},         {Basis::kBezier, {m, -m, m, -m}},
+        {Basis::kHermite, {-m, m, t, t}},         {Basis::kHermite, {m, -m, -t, -t}},
         {Basis::kHermite, {0, 1, t, -t}},  // acceleration 2^30 + 6 per tick^2
     };
     for (const Case& c : cases) {
@@ -362,10 +363,9 @@ TEST_CASE("Spans whose per-tick differences would overflow are rejected", "[reje
             INFO(c.which << " alone: " << describe(c.basis, c.p, 1));
             const ExactSpan e(c.basis, c.p, 1);
             const i128 bound = i128{kMaxDifferenceLsb} * e.den;
-            const bool over[4] = {
-                abs128(e.delta1(0)) > bound || abs128(e.delta1(1)) > bound,
-                abs128(e.delta2(0)) > bound, abs128(e.delta2(1)) > bound,
-                abs128(e.delta3()) > bound};
+            const bool over[4] = {abs128(e.delta1(0)) > bound || abs128(e.delta1(1)) > bound,
+                                  abs128(e.delta2(0)) > bound, abs128(e.delta2(1)) > bound,
+                                  abs128(e.delta3()) > bound};
             const std::string which = c.which;
             const int expected_over = which == "velocity"            ? 0
                                       : which == "acceleration at 0" ? 1
@@ -605,8 +605,7 @@ TEST_CASE("A rejected span leaves the prepared span, the tick cubic and the stre
 
 // ---- Ticks outside the span -------------------------------------------------------------
 
-TEST_CASE("evaluate_at and start_differences past the end return kTickOutsideSpan",
-          "[rejection]") {
+TEST_CASE("evaluate_at and start_differences past the end return kTickOutsideSpan", "[rejection]") {
     const std::int32_t p[4] = {10, -20, 30, -40};
     for (Basis b : kAllBases) {
         for (std::uint32_t n : {1u, 2u, 894u, 895u, 1625u, 1626u, kMaxSpanTicks}) {
@@ -659,8 +658,8 @@ TEST_CASE("Every accepted span stays within the curve and difference bounds at e
             std::int32_t p[4];
             gen.control(b, p);
             // Bias toward short spans, where the difference bounds bite.
-            const std::uint32_t n = i % 2 ? gen.ticks()
-                                          : static_cast<std::uint32_t>(gen.uniform(1, 64));
+            const std::uint32_t n =
+                i % 2 ? gen.ticks() : static_cast<std::uint32_t>(gen.uniform(1, 64));
             SpanTiming timing;
             TickCubic cubic;
             const Status s = build(b, p, n, timing, cubic);
@@ -683,7 +682,8 @@ TEST_CASE("Every accepted span stays within the curve and difference bounds at e
             ticks_near_roots(0, f3, f2 - f3 / 2, n, ticks);
             const i128 curve_bound = i128{kMaxCurveLsb} * e.den;
             const i128 diff_bound = i128{kMaxDifferenceLsb} * e.den;
-            EXPECT(abs128(e.delta3()) <= diff_bound, describe(b, p, n) + " jerk " + str(e.delta3()));
+            EXPECT(abs128(e.delta3()) <= diff_bound,
+                   describe(b, p, n) + " jerk " + str(e.delta3()));
             for (std::int64_t k : ticks) {
                 EXPECT(abs128(e.value(k)) <= curve_bound,
                        describe(b, p, n) + " curve at tick " + std::to_string(k));

@@ -72,10 +72,9 @@ TEST_CASE("AxisMove under a jerk limit: S-curves within 1.4x of the optimal S-cu
             std::uint64_t ticks = 0;
             WireSpan w;
             while (move.next(w)) ticks += w.ticks;
-            const double optimum =
-                test::s_curve_seconds(static_cast<double>(std::llabs(distance)), 100000, 3000000,
-                                      max_jerk * 100.0) *
-                1000;
+            const double optimum = test::s_curve_seconds(static_cast<double>(std::llabs(distance)),
+                                                         100000, 3000000, max_jerk * 100.0) *
+                                   1000;
             INFO("max_jerk " << max_jerk << " distance " << distance << ": " << ticks
                              << " ticks, optimum " << optimum);
             CHECK(ticks <= 1.4 * optimum);

@@ -8,11 +8,10 @@
 // stream's start position). Random spans are made continuous by translation, which is exact
 // in the core: the same integer offset is added to every position control value (Hermite:
 // P0 and P1, not the tangents), and every setpoint moves by exactly that offset.
-#include <catch2/catch.hpp>
-
 #include <algorithm>
 #include <array>
 #include <atomic>
+#include <catch2/catch.hpp>
 #include <cstdint>
 #include <sstream>
 #include <string>
@@ -37,11 +36,13 @@ using pathstream::test::SpanGenerator;
 
 namespace {
 
-std::string name(Status s) { return pathstream::status_name(s); }
+std::string name(Status s) {
+    return pathstream::status_name(s);
+}
 
-#define EXPECT(cond, context)                                          \
-    do {                                                               \
-        if (!(cond)) FAIL(#cond << "  [" << (context) << "]");         \
+#define EXPECT(cond, context)                                  \
+    do {                                                       \
+        if (!(cond)) FAIL(#cond << "  [" << (context) << "]"); \
     } while (0)
 
 template <unsigned Axes>
@@ -49,8 +50,8 @@ std::string describe(const Span<Axes>& s) {
     std::ostringstream os;
     os << "span tag " << s.tag << " basis " << static_cast<int>(s.basis) << " n=" << s.ticks;
     for (unsigned a = 0; a < Axes; ++a) {
-        os << " {" << s.control[a][0] << ", " << s.control[a][1] << ", " << s.control[a][2]
-           << ", " << s.control[a][3] << "}";
+        os << " {" << s.control[a][0] << ", " << s.control[a][1] << ", " << s.control[a][2] << ", "
+           << s.control[a][3] << "}";
     }
     return os.str();
 }
@@ -82,7 +83,9 @@ void core_ends(const Span<Axes>& span, Lsb (&start)[Axes], Lsb (&end)[Axes]) {
 
 /// Number of leading control values that are positions (Hermite: P0, P1; the tangents T0, T1
 /// do not move with a translation).
-int position_slots(Basis b) { return b == Basis::kHermite ? 2 : 4; }
+int position_slots(Basis b) {
+    return b == Basis::kHermite ? 2 : 4;
+}
 
 /// Adds `offset` to every position control value of axis `axis`; false (span unchanged) if a
 /// value would leave +/-kMaxPositionLsb.
@@ -237,8 +240,11 @@ struct StreamCounters {
     std::uint64_t ticks;
     std::uint32_t completed, tag;
     explicit StreamCounters(const SetpointStream<Axes, Capacity>& s)
-        : queued(s.queued_spans()), free(s.free_slots()), ticks(s.ticks_executed()),
-          completed(s.spans_completed()), tag(s.last_completed_tag()) {}
+        : queued(s.queued_spans()),
+          free(s.free_slots()),
+          ticks(s.ticks_executed()),
+          completed(s.spans_completed()),
+          tag(s.last_completed_tag()) {}
     bool operator==(const StreamCounters&) const = default;
 };
 
@@ -303,7 +309,8 @@ TEST_CASE("push returns kQueueFull when full and changes nothing", "[stream]") {
         s.tag = 10 + i;
         for (int a = 0; a < 2; ++a) {
             for (int j = 0; j < 4; ++j) {
-                s.control[a][j] = static_cast<std::int32_t>(1000 * i + 100 * a + 37 * j * (j % 2 ? -1 : 1));
+                s.control[a][j] =
+                    static_cast<std::int32_t>(1000 * i + 100 * a + 37 * j * (j % 2 ? -1 : 1));
             }
         }
         const Lsb at[2] = {end[0], end[1]};
@@ -374,14 +381,16 @@ TEST_CASE("A chain of random spans plays exactly the reference setpoints, tick b
                     longest.basis = Basis::kUniformBSpline;
                     longest.ticks = pathstream::kMaxSpanTicks;
                     longest.tag = 0xFFFFFFFFu;
-                    for (unsigned a = 0; a < kAxes; ++a) gen.control(longest.basis, longest.control[a]);
+                    for (unsigned a = 0; a < kAxes; ++a)
+                        gen.control(longest.basis, longest.control[a]);
                     REQUIRE(acceptable(longest));
                     return longest;
                 },
                 at, end, redraws));
             continue;
         }
-        spans.push_back(chained<kAxes>([&] { return random_span<kAxes>(gen, tag); }, at, end, redraws));
+        spans.push_back(
+            chained<kAxes>([&] { return random_span<kAxes>(gen, tag); }, at, end, redraws));
     }
     INFO("spans redrawn because they could not be moved onto the chain: " << redraws);
     SetpointStream<kAxes, 8> stream(start);
@@ -548,7 +557,8 @@ TEST_CASE("A producer thread and a ticking consumer thread agree with the refere
     std::vector<Lsb> want;
     for (const auto& s : spans) {
         for (std::uint32_t k = 0; k < s.ticks; ++k) {
-            for (unsigned a = 0; a < kAxes; ++a) want.push_back(static_cast<Lsb>(expected(s, a, k)));
+            for (unsigned a = 0; a < kAxes; ++a)
+                want.push_back(static_cast<Lsb>(expected(s, a, k)));
         }
     }
 
@@ -603,7 +613,8 @@ TEST_CASE("A producer thread and a ticking consumer thread agree with the refere
             completed = stream.spans_completed();
             if (completed <= kSpans) {
                 const auto& s = spans[completed - 1];
-                for (unsigned a = 0; a < kAxes; ++a) last_end[a] = static_cast<Lsb>(expected(s, a, s.ticks));
+                for (unsigned a = 0; a < kAxes; ++a)
+                    last_end[a] = static_cast<Lsb>(expected(s, a, s.ticks));
             }
         }
         if (mismatches > 100) break;
@@ -614,8 +625,9 @@ TEST_CASE("A producer thread and a ticking consumer thread agree with the refere
     {
         const auto refused = static_cast<Status>(refused_status.load());
         INFO("push refused span " << refused_index.load() << ": "
-                                  << (refused == Status::kOk ? std::string("-")
-                                                             : describe(spans[refused_index.load()])));
+                                  << (refused == Status::kOk
+                                          ? std::string("-")
+                                          : describe(spans[refused_index.load()])));
         REQUIRE(name(refused) == name(Status::kOk));
     }
     CHECK(mismatches == 0);
@@ -627,9 +639,10 @@ TEST_CASE("A producer thread and a ticking consumer thread agree with the refere
 
 // ---- Continuity: push() refuses a span that does not start where the chain ends -----------
 
-TEST_CASE("A span off by 1 LSB on one axis is refused with kDiscontinuousSpan and changes "
-          "nothing",
-          "[stream]") {
+TEST_CASE(
+    "A span off by 1 LSB on one axis is refused with kDiscontinuousSpan and changes "
+    "nothing",
+    "[stream]") {
     constexpr unsigned kAxes = 3;
     constexpr std::uint32_t kCapacity = 4;
     const Lsb start[kAxes] = {500, -700, 123456};
@@ -644,7 +657,8 @@ TEST_CASE("A span off by 1 LSB on one axis is refused with kDiscontinuousSpan an
     // before room), round 2 on a stream that has run dry.
     for (int round = 0; round < 3; ++round) {
         for (Basis b : kAllBases) {
-            Span<kAxes> next = shape<kAxes>(b, 7 + 5 * tag, tag, 40000 * static_cast<std::int32_t>(tag));
+            Span<kAxes> next =
+                shape<kAxes>(b, 7 + 5 * tag, tag, 40000 * static_cast<std::int32_t>(tag));
             ++tag;
             Lsb next_end[kAxes];
             REQUIRE(chain_after(next, end, next_end));
@@ -675,8 +689,8 @@ TEST_CASE("A span off by 1 LSB on one axis is refused with kDiscontinuousSpan an
                     for (unsigned a = 0; a < kAxes; ++a) {
                         REQUIRE(off_start[a] == end[a] + (a == axis ? delta : 0));
                     }
-                    INFO(describe(off) << " axis " << axis << " off by " << delta << ", round "
-                                       << round);
+                    INFO(describe(off)
+                         << " axis " << axis << " off by " << delta << ", round " << round);
                     const StreamCounters<kAxes, kCapacity> before(stream);
                     const Status s = stream.push(off);
                     REQUIRE(name(s) == name(Status::kDiscontinuousSpan));
@@ -702,9 +716,10 @@ TEST_CASE("A span off by 1 LSB on one axis is refused with kDiscontinuousSpan an
     for (unsigned a = 0; a < kAxes; ++a) CHECK(out[a] == end[a]);
 }
 
-TEST_CASE("The first span must start at the constructor's start position (the core's rounded "
-          "tick-0 value)",
-          "[stream]") {
+TEST_CASE(
+    "The first span must start at the constructor's start position (the core's rounded "
+    "tick-0 value)",
+    "[stream]") {
     // A B-spline span whose exact start is not an integer: axis 0 starts at
     // (0 + 4 * 100 + 3) / 6 = 67.17, rounded to 67; axis 1 exactly at -1000.
     Span<2> span;
@@ -719,9 +734,9 @@ TEST_CASE("The first span must start at the constructor's start position (the co
     REQUIRE(expected(span, 0, 0) == 67);
     REQUIRE(expected(span, 1, 0) == -1000);
 
-    for (const auto& wrong : {std::array<Lsb, 2>{68, -1000}, std::array<Lsb, 2>{66, -1000},
-                              std::array<Lsb, 2>{67, -999}, std::array<Lsb, 2>{67, -1001},
-                              std::array<Lsb, 2>{0, 0}}) {
+    for (const auto& wrong :
+         {std::array<Lsb, 2>{68, -1000}, std::array<Lsb, 2>{66, -1000},
+          std::array<Lsb, 2>{67, -999}, std::array<Lsb, 2>{67, -1001}, std::array<Lsb, 2>{0, 0}}) {
         INFO("start {" << wrong[0] << ", " << wrong[1] << "}");
         const Lsb start[2] = {wrong[0], wrong[1]};
         SetpointStream<2, 2> stream(start);
@@ -785,9 +800,10 @@ TEST_CASE("The first span must start at the constructor's start position (the co
     }
 }
 
-TEST_CASE("A full queue: an invalid span gets its validation error, a valid continuous one "
-          "kQueueFull until a tick frees a slot",
-          "[stream]") {
+TEST_CASE(
+    "A full queue: an invalid span gets its validation error, a valid continuous one "
+    "kQueueFull until a tick frees a slot",
+    "[stream]") {
     constexpr unsigned kAxes = 2;
     constexpr std::uint32_t kCapacity = 2;
     const auto m = static_cast<std::int32_t>(kMaxPositionLsb);
@@ -797,7 +813,8 @@ TEST_CASE("A full queue: an invalid span gets its validation error, a valid cont
     Lsb end[kAxes] = {start[0], start[1]};
     std::vector<Span<kAxes>> chain;
     for (std::uint32_t i = 0; i < 4; ++i) {
-        Span<kAxes> s = shape<kAxes>(kAllBases[i], 5 + i, i + 1, 1000 * static_cast<std::int32_t>(i));
+        Span<kAxes> s =
+            shape<kAxes>(kAllBases[i], 5 + i, i + 1, 1000 * static_cast<std::int32_t>(i));
         const Lsb at[kAxes] = {end[0], end[1]};
         REQUIRE(chain_after(s, at, end));
         chain.push_back(s);

@@ -1,9 +1,8 @@
 // SpanQueue: the fixed-capacity single-producer/single-consumer ring between the task that
 // prepares spans and the tick interrupt. Single-threaded contract checks, then a two-thread
 // stress run (order, no loss, no duplicate) for the sanitizer builds to watch.
-#include <catch2/catch.hpp>
-
 #include <atomic>
+#include <catch2/catch.hpp>
 #include <cstdint>
 #include <random>
 #include <thread>
@@ -23,11 +22,13 @@ struct Item {
     std::uint64_t check[3] = {0, 0, 0};
     void fill(std::uint64_t s) {
         sequence = s;
-        for (int i = 0; i < 3; ++i) check[i] = s * 0x9E3779B97F4A7C15ull + static_cast<std::uint64_t>(i);
+        for (int i = 0; i < 3; ++i)
+            check[i] = s * 0x9E3779B97F4A7C15ull + static_cast<std::uint64_t>(i);
     }
     bool consistent() const {
         for (int i = 0; i < 3; ++i) {
-            if (check[i] != sequence * 0x9E3779B97F4A7C15ull + static_cast<std::uint64_t>(i)) return false;
+            if (check[i] != sequence * 0x9E3779B97F4A7C15ull + static_cast<std::uint64_t>(i))
+                return false;
         }
         return true;
     }
@@ -193,7 +194,8 @@ TEST_CASE("Two threads: one producer, one consumer, nothing lost, duplicated or 
     }
     producer.join();
     INFO("first out-of-order sequence " << first_bad << "; producer saw full " << producer_full
-                                        << " times, consumer saw empty " << empty_polls << " times");
+                                        << " times, consumer saw empty " << empty_polls
+                                        << " times");
     CHECK_FALSE(failed.load());
     CHECK(bad_sequence == 0);
     CHECK(torn == 0);

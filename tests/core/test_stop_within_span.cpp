@@ -3,9 +3,8 @@
 // that tick, planned like a stop at a span's end; a resume re-enters there and the rest of
 // the span plays. Checked on a 65,536-tick span (which once kept "running" for its whole
 // minute after a stop) and at every tick offset of short spans.
-#include <catch2/catch.hpp>
-
 #include <array>
+#include <catch2/catch.hpp>
 #include <cstdint>
 #include <cstdlib>
 #include <random>
@@ -66,13 +65,14 @@ struct Run {
     void check_limits(const MotionLimits<kAxes>& l) const {
         for (unsigned a = 0; a < kAxes; ++a) {
             const double v = static_cast<double>(l.axis[a].max_velocity) / l.tick_hz + 1;
-            const double acc = static_cast<double>(l.axis[a].max_acceleration) / l.tick_hz / l.tick_hz + 2;
+            const double acc =
+                static_cast<double>(l.axis[a].max_acceleration) / l.tick_hz / l.tick_hz + 2;
             for (std::size_t i = 1; i < ticks.size(); ++i) {
                 INFO("axis " << a << " tick " << i);
                 REQUIRE(std::llabs(std::int64_t{ticks[i][a]} - ticks[i - 1][a]) <= v);
                 if (i >= 2) {
-                    REQUIRE(std::llabs(std::int64_t{ticks[i][a]} - 2 * std::int64_t{ticks[i - 1][a]} +
-                                       ticks[i - 2][a]) <= acc);
+                    REQUIRE(std::llabs(std::int64_t{ticks[i][a]} -
+                                       2 * std::int64_t{ticks[i - 1][a]} + ticks[i - 2][a]) <= acc);
                 }
             }
         }
@@ -93,8 +93,8 @@ WireSpan long_span(const Lsb (&start)[kAxes], std::int32_t distance, std::uint32
 
 Status send(Device& d, const std::vector<WireSpan>& spans, std::size_t first, std::size_t count) {
     const auto bytes = batch_bytes<kAxes>(spans, first, count);
-    return d.accept_batch(d.last_accepted_sequence() + 1, static_cast<std::uint16_t>(count), bytes.data(),
-                          bytes.size());
+    return d.accept_batch(d.last_accepted_sequence() + 1, static_cast<std::uint16_t>(count),
+                          bytes.data(), bytes.size());
 }
 
 // 0.2 LSB/tick^2: a stop from ~40 LSB/tick needs ~200 ticks, more than the shortest base.
@@ -104,14 +104,17 @@ MotionLimits<kAxes> gentle_limits() {
     return l;
 }
 
-bool own_move(const Device& d) { return (d.status().flags & kStatusOwnMove) != 0; }
+bool own_move(const Device& d) {
+    return (d.status().flags & kStatusOwnMove) != 0;
+}
 
 constexpr std::uint32_t kLongTicks = 65536;
 constexpr std::size_t kStopAt = 20000;  // the command's tick: 0.31 of the span, ~39 LSB/tick
 
 }  // namespace
 
-TEST_CASE("velocity_within_span is the span's velocity at the tick, rounded on the base", "[device][stop]") {
+TEST_CASE("velocity_within_span is the span's velocity at the tick, rounded on the base",
+          "[device][stop]") {
     std::mt19937_64 rng(20261126);
     const auto pick = [&](std::int64_t lo, std::int64_t hi) {
         return std::uniform_int_distribution<std::int64_t>(lo, hi)(rng);
@@ -119,7 +122,8 @@ TEST_CASE("velocity_within_span is the span's velocity at the tick, rounded on t
     MotionLimits<1> limits;
     limits.tick_hz = 1000;
     for (int trial = 0; trial < 20000; ++trial) {
-        const auto n = static_cast<std::uint32_t>(trial % 3 == 0 ? pick(1, 16) : pick(1, kMaxSpanTicks));
+        const auto n =
+            static_cast<std::uint32_t>(trial % 3 == 0 ? pick(1, 16) : pick(1, kMaxSpanTicks));
         const auto k = static_cast<std::uint32_t>(pick(0, n));
         const std::int32_t chord[1] = {static_cast<std::int32_t>(pick(-(1 << 28), 1 << 28))};
         const std::int32_t t0[1] = {static_cast<std::int32_t>(pick(-(1 << 29), 1 << 29))};
@@ -133,7 +137,8 @@ TEST_CASE("velocity_within_span is the span's velocity at the tick, rounded on t
         const __int128 m = 6 * kk * (nn - kk) * chord[0] + (nn - kk) * (nn - 3 * kk) * t0[0] +
                            kk * (3 * kk - 2 * nn) * t1[0];
         const __int128 cube = nn * nn * nn;
-        INFO("n " << n << " k " << k << " chord " << chord[0] << " t0 " << t0[0] << " t1 " << t1[0]);
+        INFO("n " << n << " k " << k << " chord " << chord[0] << " t0 " << t0[0] << " t1 "
+                  << t1[0]);
         if (s != Status::kOk) {
             // Only a tangent beyond the range refuses.
             REQUIRE(s == Status::kStopTooLong);
@@ -181,13 +186,15 @@ TEST_CASE("a hold inside a 65,536-tick span stops from the tick that takes it, a
     // 0.2 LSB/tick^2 from ~39 LSB/tick), not the span's remaining 45,536.
     const double v = static_cast<double>(whole.ticks[kStopAt + 1][0] - whole.ticks[kStopAt][0]);
     const double fewest = v / (limits.axis[0].max_acceleration / 1e6);
-    const std::size_t to_rest = r.run_until(d, [&] { return !own_move(d); }, kLongTicks);
+    const std::size_t to_rest = r.run_until(
+        d, [&] { return !own_move(d); }, kLongTicks);
     CHECK(to_rest + 1 >= static_cast<std::size_t>(fewest));
     CHECK(to_rest <= 2 * static_cast<std::size_t>(fewest + 1));
     CHECK(d.state() == DeviceState::kHolding);
     // The first step of the stop continues the span's velocity (within the rounding).
     for (unsigned a = 0; a < kAxes; ++a) {
-        const std::int64_t path_step = std::int64_t{whole.ticks[kStopAt + 1][a]} - whole.ticks[kStopAt][a];
+        const std::int64_t path_step =
+            std::int64_t{whole.ticks[kStopAt + 1][a]} - whole.ticks[kStopAt][a];
         const std::int64_t stop_step = std::int64_t{r.ticks[kStopAt + 1][a]} - r.ticks[kStopAt][a];
         CHECK(std::llabs(stop_step - path_step) <= 1);
     }
@@ -195,7 +202,8 @@ TEST_CASE("a hold inside a 65,536-tick span stops from the tick that takes it, a
     CHECK(r.ticks.back() == r.ticks[r.ticks.size() - 101]);  // holding still
 
     REQUIRE(d.command(Command::kResume) == Status::kOk);
-    r.run_until(d, [&] { return d.state() == DeviceState::kIdle; }, 2 * kLongTicks);
+    r.run_until(
+        d, [&] { return d.state() == DeviceState::kIdle; }, 2 * kLongTicks);
     REQUIRE(d.state() == DeviceState::kIdle);
     CHECK(d.finished_job() == 1);
     // Every tick of the span was supplied exactly once, the same setpoints as without the hold.
@@ -205,7 +213,8 @@ TEST_CASE("a hold inside a 65,536-tick span stops from the tick that takes it, a
     r.check_limits(limits);
 }
 
-TEST_CASE("a stop inside a 65,536-tick span ends within the stopping distance, not the span", "[device][stop]") {
+TEST_CASE("a stop inside a 65,536-tick span ends within the stopping distance, not the span",
+          "[device][stop]") {
     const Lsb start[kAxes] = {0, 0};
     const auto limits = gentle_limits();
     const std::vector<WireSpan> spans = {long_span(start, 2000000, kLongTicks)};
@@ -219,8 +228,8 @@ TEST_CASE("a stop inside a 65,536-tick span ends within the stopping distance, n
     r.tick(d);
     CHECK(d.state() == DeviceState::kStopping);
     CHECK_FALSE(r.path.back());
-    const std::size_t to_idle =
-        r.run_until(d, [&] { return d.state() == DeviceState::kIdle; }, kLongTicks);
+    const std::size_t to_idle = r.run_until(
+        d, [&] { return d.state() == DeviceState::kIdle; }, kLongTicks);
     CHECK(to_idle <= 2 * 200);  // ~195 ticks needed from ~39 LSB/tick at 0.2 LSB/tick^2
     CHECK(d.queued_spans() == 0);
     CHECK(d.finished_job() == 0);  // the job was stopped, not finished
@@ -234,7 +243,8 @@ TEST_CASE("a stop inside a 65,536-tick span ends within the stopping distance, n
     CHECK(send(d, again, 0, 1) == Status::kOk);
 }
 
-TEST_CASE("a hold at any tick of a span leaves the path in the tick that takes it", "[device][stop]") {
+TEST_CASE("a hold at any tick of a span leaves the path in the tick that takes it",
+          "[device][stop]") {
     const Lsb start[kAxes] = {0, 0};
     const auto limits = test_limits<kAxes>();
     auto spans = trapezoid_move<kAxes>(start, 20000, 8);
@@ -263,7 +273,8 @@ TEST_CASE("a hold at any tick of a span leaves the path in the tick that takes i
         CHECK(r.ticks.back() == whole.ticks[at]);
         r.run(d, 200);
         REQUIRE(d.command(Command::kResume) == Status::kOk);
-        r.run_until(d, [&] { return d.state() == DeviceState::kIdle; }, 2000);
+        r.run_until(
+            d, [&] { return d.state() == DeviceState::kIdle; }, 2000);
         CHECK(d.finished_job() == 1);
         CHECK(d.ticks_executed() == total);
         CHECK(r.path_ticks() == whole.path_ticks());
@@ -297,7 +308,8 @@ TEST_CASE("an underrun after a long moving span stops within the stopping distan
     REQUIRE(send(twin, spans, 0, 2) == Status::kOk);
     REQUIRE(twin.command(Command::kStart) == Status::kOk);
     Run whole, r;
-    whole.run_until(twin, [&] { return twin.state() == DeviceState::kIdle; }, 4 * kTicks);
+    whole.run_until(
+        twin, [&] { return twin.state() == DeviceState::kIdle; }, 4 * kTicks);
     REQUIRE(twin.finished_job() == 1);
     REQUIRE(twin.underruns() == 0);
 
@@ -305,8 +317,8 @@ TEST_CASE("an underrun after a long moving span stops within the stopping distan
     REQUIRE(d.command(Command::kStart) == Status::kOk);
     r.run(d, kTicks);
     REQUIRE(d.ticks_executed() == kTicks);
-    const std::size_t to_rest = r.run_until(d, [&] { return !own_move(d) && d.state() == DeviceState::kHolding; },
-                                            4 * kTicks);
+    const std::size_t to_rest = r.run_until(
+        d, [&] { return !own_move(d) && d.state() == DeviceState::kHolding; }, 4 * kTicks);
     CHECK(d.underruns() == 1);
     CHECK(d.held_by_underrun());
     const double v = static_cast<double>(whole.ticks[kTicks][0] - whole.ticks[kTicks - 1][0]);
@@ -317,7 +329,8 @@ TEST_CASE("an underrun after a long moving span stops within the stopping distan
     // (within the rounding).
     CHECK(r.ticks[kTicks] == whole.ticks[kTicks]);
     for (unsigned a = 0; a < kAxes; ++a) {
-        const std::int64_t path_step = std::int64_t{whole.ticks[kTicks + 1][a]} - whole.ticks[kTicks][a];
+        const std::int64_t path_step =
+            std::int64_t{whole.ticks[kTicks + 1][a]} - whole.ticks[kTicks][a];
         const std::int64_t stop_step = std::int64_t{r.ticks[kTicks + 1][a]} - r.ticks[kTicks][a];
         CHECK(std::llabs(stop_step - path_step) <= 1);
     }
@@ -327,7 +340,8 @@ TEST_CASE("an underrun after a long moving span stops within the stopping distan
     // The next span arrives: resume re-enters at the boundary and the rest plays as queued.
     REQUIRE(send(d, spans, 1, 1) == Status::kOk);
     REQUIRE(d.command(Command::kResume) == Status::kOk);
-    r.run_until(d, [&] { return d.state() == DeviceState::kIdle; }, 4 * kTicks);
+    r.run_until(
+        d, [&] { return d.state() == DeviceState::kIdle; }, 4 * kTicks);
     REQUIRE(d.state() == DeviceState::kIdle);
     CHECK(d.finished_job() == 1);
     CHECK(d.ticks_executed() == 2 * kTicks);

@@ -1,8 +1,8 @@
 // The travel (soft limits) of each axis: the exact proof that a span stays inside, the
 // device refusing a batch that could leave it, jogs that must end inside it (and may come back
 // from outside), and the configuration over Modbus (zeros: no limits).
-#include <catch2/catch.hpp>
 #include <algorithm>
+#include <catch2/catch.hpp>
 #include <cmath>
 #include <cstdint>
 #include <random>
@@ -70,7 +70,8 @@ void run_to_idle(Device& d, OperatorCommands<kAxes, 16>* c = nullptr) {
 
 }  // namespace
 
-TEST_CASE("travel proof: never passes a span whose curve leaves, exact at the edge", "[device][travel]") {
+TEST_CASE("travel proof: never passes a span whose curve leaves, exact at the edge",
+          "[device][travel]") {
     std::mt19937_64 rng(20261125);
     std::uniform_int_distribution<std::int32_t> position(-1000000, 1000000);
     std::uniform_int_distribution<std::int32_t> tangent(-400000, 400000);
@@ -130,7 +131,8 @@ TEST_CASE("travel proof: never passes a span whose curve leaves, exact at the ed
 
 TEST_CASE("travel: bad limits refused, a batch leaving it refused whole", "[device][travel]") {
     CHECK(check_limits(limits(5, 5)) == Status::kBadLimits);
-    CHECK(check_limits(limits(-static_cast<std::int32_t>(kMaxPositionLsb) - 1, 0)) == Status::kBadLimits);
+    CHECK(check_limits(limits(-static_cast<std::int32_t>(kMaxPositionLsb) - 1, 0)) ==
+          Status::kBadLimits);
     const Lsb start[kAxes] = {46000, 1000};
     Device d(start);
     REQUIRE(d.configure(limits(0, 50000)) == Status::kOk);
@@ -163,7 +165,8 @@ TEST_CASE("travel: a jog must end inside, from outside it may come back in", "[d
     CHECK(d.position(0) == 50000);
 }
 
-TEST_CASE("travel over Modbus: written with the limits, read back, zeros mean none", "[device][travel]") {
+TEST_CASE("travel over Modbus: written with the limits, read back, zeros mean none",
+          "[device][travel]") {
     const Lsb start[kAxes] = {0, 0};
     Device d(start);
     ModbusRegisterMap<kAxes, 16> m(d);

@@ -1,6 +1,5 @@
 // Int128 (the core's portable two-word integer) against the compiler's __int128.
 #include <catch2/catch.hpp>
-
 #include <random>
 
 #include "core/property_settings.hpp"
@@ -50,8 +49,8 @@ TEST_CASE("Int128 multiply agrees with __int128 when the product fits", "[int128
         const int a_bits = 1 + static_cast<int>(rng() % 62);
         const int b_bits = 1 + static_cast<int>(rng() % 62);
         const i128 a = random_value(rng) % (static_cast<i128>(1) << a_bits);
-        const auto b = static_cast<std::int64_t>(rng() % (std::uint64_t{1} << b_bits)) *
-                       (rng() % 2 ? 1 : -1);
+        const auto b =
+            static_cast<std::int64_t>(rng() % (std::uint64_t{1} << b_bits)) * (rng() % 2 ? 1 : -1);
         REQUIRE(native(portable(a) * b) == a * b);
         REQUIRE(native(pathstream::multiply_portable(portable(a), b)) == a * b);
         // Beyond 2^127 both keep the product modulo 2^128, alike.
@@ -64,8 +63,7 @@ TEST_CASE("Int128 multiply agrees with __int128 when the product fits", "[int128
     }
 }
 
-TEST_CASE("Int128 floor division agrees with __int128 for both signs and all sizes",
-          "[int128]") {
+TEST_CASE("Int128 floor division agrees with __int128 for both signs and all sizes", "[int128]") {
     std::mt19937_64 rng(pathstream::test::property_seed());
     for (int i = 0; i < 200000; ++i) {
         const i128 a = random_value(rng);

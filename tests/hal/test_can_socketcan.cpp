@@ -2,7 +2,6 @@
 // whose kernel has no CAN) a non-CAN one, both named in a std::system_error. Sending and
 // receiving on a real kernel: can.native_stream.vm (sim/can/vm/native_stream.sh).
 #include <catch2/catch.hpp>
-
 #include <system_error>
 
 #include "pathstream/hal/socketcan_bus.hpp"
@@ -14,7 +13,8 @@ TEST_CASE("SocketCanBus names a missing interface", "[can]") {
         hal::SocketCanBus bus("nosuchcan7");
         FAIL("opened a missing interface");
     } catch (const std::system_error& e) {
-        CHECK_THAT(e.what(), Catch::Contains("CAN interface nosuchcan7") && Catch::Contains("no such interface"));
+        CHECK_THAT(e.what(), Catch::Contains("CAN interface nosuchcan7") &&
+                                 Catch::Contains("no such interface"));
     }
 }
 

@@ -28,7 +28,8 @@ TEST_CASE("gpiod backend: a missing chip is named with its line", "[gpio][gpiod]
     const std::string by_name = error_of({"gpiochip97", "3", true, Bias::kPullUp}, true);
     CHECK(by_name.rfind("gpio gpiochip97 line \"3\": cannot open the GPIO chip: ", 0) == 0);
     const std::string by_path = error_of({"/dev/gpiochip98", "enable", false, Bias::kAsIs}, true);
-    CHECK(by_path.rfind("gpio /dev/gpiochip98 line \"enable\": cannot open the GPIO chip: ", 0) == 0);
+    CHECK(by_path.rfind("gpio /dev/gpiochip98 line \"enable\": cannot open the GPIO chip: ", 0) ==
+          0);
     const std::string by_number = error_of({"99", "1", false, Bias::kAsIs}, false);
     CHECK(by_number.rfind("gpio 99 line \"1\": cannot open the GPIO chip: ", 0) == 0);
     CHECK(error_of({"", "1", false, Bias::kAsIs}, false) == "gpio  line \"1\": no chip given");

@@ -100,7 +100,8 @@ TEST_CASE("RTU through a line dropping 1 % of the bytes", "[modbus][rtu][faults]
     faulty_line_case(faults, 40);
 }
 
-TEST_CASE("the fault proxy forwards both ways and its faults follow the seed", "[modbus][faults][threads]") {
+TEST_CASE("the fault proxy forwards both ways and its faults follow the seed",
+          "[modbus][faults][threads]") {
     const auto corrupted_after = [](std::uint64_t seed) {
         PtyFaultOptions faults;
         faults.corrupt_rate = 0.05;

@@ -100,7 +100,8 @@ TEST_CASE("RTU: FC3, FC4, FC6, FC16 and FC23 round trips on a pty", "[modbus][rt
               modbus_adu_bytes(ModbusFraming::kRtu, 5));            // final FC3
 }
 
-TEST_CASE("RTU: requests for another unit id are ignored, as on a shared bus", "[modbus][rtu][threads]") {
+TEST_CASE("RTU: requests for another unit id are ignored, as on a shared bus",
+          "[modbus][rtu][threads]") {
     RegisterArray registers;
     ModbusServer server = ModbusServer::rtu_pty(registers, unit(1));
     ServingThread serving(server);

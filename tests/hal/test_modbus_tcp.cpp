@@ -204,7 +204,8 @@ TEST_CASE("TCP: unsupported and malformed requests get exceptions, the stream st
     CHECK(registers.writes_applied == 0);
 }
 
-TEST_CASE("TCP: a half-sent request or a vanished client never stops the server", "[modbus][tcp][threads]") {
+TEST_CASE("TCP: a half-sent request or a vanished client never stops the server",
+          "[modbus][tcp][threads]") {
     RegisterArray registers;
     ModbusServer server = ModbusServer::tcp(registers, {});
     ServingThread serving(server);

@@ -39,7 +39,8 @@ std::uint64_t queue_move(Bench& b, unsigned axis, std::int64_t distance) {
         w.outputs = kOutputPenDown;
         std::uint8_t bytes[4 + 12 * kAxes];
         const std::size_t n = encode_wire_span(w, kAxes, bytes, sizeof bytes);
-        REQUIRE(b.device.accept_batch(b.device.last_accepted_sequence() + 1, 1, bytes, n) == Status::kOk);
+        REQUIRE(b.device.accept_batch(b.device.last_accepted_sequence() + 1, 1, bytes, n) ==
+                Status::kOk);
         ticks += w.ticks;
     }
     return ticks;
@@ -53,7 +54,8 @@ std::string fault_text(FaultCode c) {
 
 }  // namespace
 
-TEST_CASE("gpio glue: enable follows the state: up while running, down when idle again", "[gpio][glue]") {
+TEST_CASE("gpio glue: enable follows the state: up while running, down when idle again",
+          "[gpio][glue]") {
     const Lsb start[kAxes] = {0, 0};
     Bench b(start, limits());
     CHECK_FALSE(b.enable.state());
@@ -66,7 +68,7 @@ TEST_CASE("gpio glue: enable follows the state: up while running, down when idle
     CHECK(b.enable.state());
     REQUIRE(b.enable.switch_ticks().size() == 1);
     CHECK(b.enable.switch_ticks()[0] == 2);  // asserted right after the tick that started
-    CHECK(b.pen.state());                      // the span's pen-down output
+    CHECK(b.pen.state());                    // the span's pen-down output
     for (std::uint64_t i = 0; i < ticks; ++i) b.step();
     REQUIRE(b.device.command(Command::kStop) == Status::kOk);
     b.step();
@@ -78,14 +80,16 @@ TEST_CASE("gpio glue: enable follows the state: up while running, down when idle
     REQUIRE(b.device.command(Command::kStart) == Status::kOk);
     for (int i = 0; i < 100; ++i) b.step();
     REQUIRE(b.device.command(Command::kHold) == Status::kOk);
-    REQUIRE(b.run_until([&] { return b.device.state() == DeviceState::kHolding && b.ticks.size() > 400; }, 2000));
+    REQUIRE(b.run_until(
+        [&] { return b.device.state() == DeviceState::kHolding && b.ticks.size() > 400; }, 2000));
     CHECK(b.enable.state());
     REQUIRE(b.device.command(Command::kStop) == Status::kOk);
     REQUIRE(b.run_until([&] { return b.device.state() == DeviceState::kIdle; }, 2000));
     CHECK_FALSE(b.enable.state());
 }
 
-TEST_CASE("gpio glue: the e-stop stops motion within one tick, drops enable, resets only released", "[gpio][glue]") {
+TEST_CASE("gpio glue: the e-stop stops motion within one tick, drops enable, resets only released",
+          "[gpio][glue]") {
     const Lsb start[kAxes] = {0, 0};
     Bench b(start, limits());
     queue_move(b, 0, 30000);
@@ -93,7 +97,7 @@ TEST_CASE("gpio glue: the e-stop stops motion within one tick, drops enable, res
     for (int i = 0; i < 150; ++i) b.step();
     REQUIRE(b.device.state() == DeviceState::kRunning);
     REQUIRE(b.ticks[149][0] != b.ticks[148][0]);  // moving
-    const std::size_t edge_at = b.ticks.size();    // the edge comes between tick 150 and 151
+    const std::size_t edge_at = b.ticks.size();   // the edge comes between tick 150 and 151
     b.estop.drive(true, 123);
     b.step();
     // Reaction: the very next tick repeats the last setpoint, the state is e-stop and enable
@@ -145,10 +149,12 @@ TEST_CASE("gpio glue: a limit switch faults at once, naming axis and side", "[gp
         CHECK(b.ticks[k] == b.ticks[k - 1]);       // stopped at once
         const Lsb seen = b.ticks[k - 1][1];
         CHECK((positive ? seen >= 10000 : seen <= -10000));
-        CHECK((positive ? b.ticks[k - 2][1] < 10000 : b.ticks[k - 2][1] > -10000));  // the tick before: not yet
+        CHECK((positive ? b.ticks[k - 2][1] < 10000
+                        : b.ticks[k - 2][1] > -10000));  // the tick before: not yet
         CHECK(b.device.fault_code() == limit_fault(1, side));
         CHECK(fault_text(b.device.fault_code()) ==
-              (positive ? "limit switch y+ (axis 1, positive side)" : "limit switch y- (axis 1, negative side)"));
+              (positive ? "limit switch y+ (axis 1, positive side)"
+                        : "limit switch y- (axis 1, negative side)"));
         CHECK_FALSE(b.enable.state());
         CHECK(b.glue.limit_trips() == 1);
         // Reset while still on the switch is allowed (the machine must move off it) and does
@@ -161,7 +167,8 @@ TEST_CASE("gpio glue: a limit switch faults at once, naming axis and side", "[gp
     }
 }
 
-TEST_CASE("gpio glue: homing on the simulated plotter, its switch masked, the other armed", "[gpio][glue][homing]") {
+TEST_CASE("gpio glue: homing on the simulated plotter, its switch masked, the other armed",
+          "[gpio][glue][homing]") {
     const Lsb start[kAxes] = {8000, 0};
     Bench b(start, limits());
     b.place_switch(0, LimitSide::kNegative, 2500);
@@ -198,7 +205,9 @@ TEST_CASE("gpio glue: homing on the simulated plotter, its switch masked, the ot
     CHECK(b.glue.limit_active(0, LimitSide::kNegative));
     queue_move(b, 0, 1000 - b.device.position(0));
     REQUIRE(b.device.command(Command::kStart) == Status::kOk);
-    REQUIRE(b.run_until([&] { return b.device.last_completed_sequence() == b.device.last_accepted_sequence(); }, 5000));
+    REQUIRE(b.run_until(
+        [&] { return b.device.last_completed_sequence() == b.device.last_accepted_sequence(); },
+        5000));
     CHECK_FALSE(b.glue.limit_active(0, LimitSide::kNegative));
     CHECK(b.device.state() == DeviceState::kRunning);
     queue_move(b, 0, -1100);

@@ -11,12 +11,12 @@
 #include "pathstream/host/core_spans.hpp"
 #include "pathstream/host/plan.hpp"
 #include "pathstream/sim/device.hpp"
-#include "sim_plots.hpp"
 #include "pathstream/sim/plant.hpp"
 #include "pathstream/sim/simulated_output.hpp"
 #include "pathstream/sim/virtual_clock.hpp"
 #include "pathstream/status.hpp"
 #include "pathstream/tick_cubic.hpp"
+#include "sim_plots.hpp"
 
 using namespace pathstream;
 using host::CoreSpan;
@@ -318,7 +318,8 @@ TEST_CASE("a plan the device refuses stops the simulation with the core's status
     }
     SECTION("axis counts") {
         const Plan plan = make_plan({line({0, 0}, {100, 0}, 4, true)});
-        CHECK_THROWS_AS(sim::simulate(plan.spans, profile_for(3), SimOptions{}), std::invalid_argument);
+        CHECK_THROWS_AS(sim::simulate(plan.spans, profile_for(3), SimOptions{}),
+                        std::invalid_argument);
         CHECK_THROWS_AS(sim::simulate({}, profile, SimOptions{}), std::invalid_argument);
     }
 }
@@ -348,7 +349,8 @@ TEST_CASE("pacing waits for every tick on the clock, in order, and counts late t
     const Plan plan = drawing_plan();
     SECTION("on time") {
         ScriptedClock clock(0);
-        const SimulationResult r = sim::simulate_paced(plan.spans, profile_for(2), SimOptions{}, clock);
+        const SimulationResult r =
+            sim::simulate_paced(plan.spans, profile_for(2), SimOptions{}, clock);
         REQUIRE(clock.waits.size() == r.ticks);
         for (std::uint64_t k = 0; k < r.ticks; ++k) REQUIRE(clock.waits[k] == k);
         CHECK(r.paced);
@@ -358,7 +360,8 @@ TEST_CASE("pacing waits for every tick on the clock, in order, and counts late t
     }
     SECTION("behind") {
         ScriptedClock clock(2);
-        const SimulationResult r = sim::simulate_paced(plan.spans, profile_for(2), SimOptions{}, clock);
+        const SimulationResult r =
+            sim::simulate_paced(plan.spans, profile_for(2), SimOptions{}, clock);
         CHECK(r.late_ticks == r.ticks);
         CHECK(r.pen_switch_ticks ==
               std::vector<std::uint64_t>{10, 43});  // lateness does not move them

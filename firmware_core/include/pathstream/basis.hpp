@@ -40,6 +40,8 @@ constexpr BasisMatrix basis_matrix(Basis b) {
 }
 
 /// True for the four defined enumerators; used to validate ids read from a wire.
-constexpr bool is_valid_basis(std::uint8_t id) { return id < kBasisCount; }
+constexpr bool is_valid_basis(std::uint8_t id) {
+    return id < kBasisCount;
+}
 
 }  // namespace pathstream

@@ -57,10 +57,10 @@ namespace pathstream {
 /// Thumb-2 one LDMIA loads a narrow state and one STMDB stores the changed part back.
 template <typename Word>
 struct DifferenceState {
-    Word jerk_remainder;        ///< level 3 remainder (bias 0), constant in a span
+    Word jerk_remainder;          ///< level 3 remainder (bias 0), constant in a span
     std::uint32_t jerk_quotient;  ///< level 3 quotient, constant in a span
-    Word remainder[3];          ///< levels 0..2, biased by K, 0, K
-    std::uint32_t quotient[3];  ///< levels 0..2 as two's complement int32
+    Word remainder[3];            ///< levels 0..2, biased by K, 0, K
+    std::uint32_t quotient[3];    ///< levels 0..2 as two's complement int32
 
     /// Current setpoint: the exact curve at the current tick, rounded once.
     constexpr Lsb position() const { return static_cast<Lsb>(quotient[0]); }

@@ -155,7 +155,8 @@ public:
     /// curve at its tick k, rounded once), without supplying it. Precondition: a span is in
     /// progress. O(1). Consumer context.
     Lsb next_setpoint(unsigned axis) const {
-        return active_->wide ? active_->wide_state[axis].position() : active_->narrow[axis].position();
+        return active_->wide ? active_->wide_state[axis].position()
+                             : active_->narrow[axis].position();
     }
     /// Where the axes rest between spans (the last span's end point, or the start). Consumer.
     Lsb resting_position(unsigned axis) const { return hold_[axis]; }
@@ -226,8 +227,8 @@ private:
     [[gnu::noinline]] void finish_span() {
         // The state has stepped once past the last tick: it now holds the end point.
         for (unsigned a = 0; a < Axes; ++a) {
-            hold_[a] = active_->wide ? active_->wide_state[a].position()
-                                     : active_->narrow[a].position();
+            hold_[a] =
+                active_->wide ? active_->wide_state[a].position() : active_->narrow[a].position();
         }
         narrow_active_ = binary_active_ = nullptr;
         last_completed_tag_ = active_->tag;

@@ -19,10 +19,10 @@ template <unsigned Axes>
 struct Span {
     static_assert(Axes >= 1 && Axes <= kMaxAxes, "1 to 8 axes");
     Basis basis = Basis::kUniformBSpline;
-    std::uint32_t ticks = 1;               ///< n, 1..kMaxSpanTicks
-    std::uint32_t tag = 0;                 ///< caller's label (e.g. a sequence number), kept
-    std::uint8_t outputs = 0;              ///< discrete outputs while it plays (kOutputPenDown...)
-    std::int32_t control[Axes][4] = {};    ///< per axis: P0..P3 (Hermite: P0, P1, T0, T1)
+    std::uint32_t ticks = 1;             ///< n, 1..kMaxSpanTicks
+    std::uint32_t tag = 0;               ///< caller's label (e.g. a sequence number), kept
+    std::uint8_t outputs = 0;            ///< discrete outputs while it plays (kOutputPenDown...)
+    std::int32_t control[Axes][4] = {};  ///< per axis: P0..P3 (Hermite: P0, P1, T0, T1)
 };
 
 /// Bits of Span::outputs. The device applies a span's outputs at its first tick, so a pen
@@ -98,8 +98,9 @@ template <unsigned Axes>
 void prepare_validated(const ValidatedSpan<Axes>& v, PreparedSpan<Axes>& out) {
     const bool narrow = is_narrow(v.timing);
     for (unsigned axis = 0; axis < Axes; ++axis) {
-        const Status s = narrow ? start_differences(v.cubic[axis], v.timing, 0, out.narrow[axis])
-                                : start_differences(v.cubic[axis], v.timing, 0, out.wide_state[axis]);
+        const Status s = narrow
+                             ? start_differences(v.cubic[axis], v.timing, 0, out.narrow[axis])
+                             : start_differences(v.cubic[axis], v.timing, 0, out.wide_state[axis]);
         (void)s;  // cannot fail: tick 0 is inside every span, and the bounds are proven
     }
     out.ticks = v.timing.ticks;

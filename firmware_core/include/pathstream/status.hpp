@@ -39,23 +39,40 @@ enum class [[nodiscard]] Status : std::uint8_t{
 /// Short stable name of a status, for logs and host messages. Never null.
 constexpr const char* status_name(Status s) {
     switch (s) {
-        case Status::kOk: return "ok";
-        case Status::kTickCountOutOfRange: return "tick count out of range";
-        case Status::kControlValueOutOfRange: return "control value out of range";
-        case Status::kCurveOutOfRange: return "curve leaves the position range";
-        case Status::kDifferenceOutOfRange: return "per-tick difference out of range";
-        case Status::kUnknownBasis: return "unknown basis";
-        case Status::kTickOutsideSpan: return "tick outside span";
-        case Status::kQueueFull: return "span queue full";
-        case Status::kDiscontinuousSpan: return "span does not start where the previous one ends";
-        case Status::kVelocityLimit: return "span exceeds an axis velocity limit";
-        case Status::kAccelerationLimit: return "span exceeds an axis acceleration limit";
-        case Status::kBadLimits: return "limit zero or out of range";
-        case Status::kNotConfigured: return "device limits not configured";
-        case Status::kBadSequence: return "batch sequence number is not the next expected";
-        case Status::kBadBatch: return "batch length, span count or check value is wrong";
-        case Status::kWrongState: return "command not allowed in this state";
-        case Status::kStopTooLong: return "no controlled stop fits in one span";
+        case Status::kOk:
+            return "ok";
+        case Status::kTickCountOutOfRange:
+            return "tick count out of range";
+        case Status::kControlValueOutOfRange:
+            return "control value out of range";
+        case Status::kCurveOutOfRange:
+            return "curve leaves the position range";
+        case Status::kDifferenceOutOfRange:
+            return "per-tick difference out of range";
+        case Status::kUnknownBasis:
+            return "unknown basis";
+        case Status::kTickOutsideSpan:
+            return "tick outside span";
+        case Status::kQueueFull:
+            return "span queue full";
+        case Status::kDiscontinuousSpan:
+            return "span does not start where the previous one ends";
+        case Status::kVelocityLimit:
+            return "span exceeds an axis velocity limit";
+        case Status::kAccelerationLimit:
+            return "span exceeds an axis acceleration limit";
+        case Status::kBadLimits:
+            return "limit zero or out of range";
+        case Status::kNotConfigured:
+            return "device limits not configured";
+        case Status::kBadSequence:
+            return "batch sequence number is not the next expected";
+        case Status::kBadBatch:
+            return "batch length, span count or check value is wrong";
+        case Status::kWrongState:
+            return "command not allowed in this state";
+        case Status::kStopTooLong:
+            return "no controlled stop fits in one span";
         case Status::kNothingToResume:
             return "nothing queued to start or resume";
         case Status::kVelocityStep:

@@ -50,7 +50,7 @@ Int128 tick_numerator(const TickCubic& cubic, const SpanTiming& timing, std::uin
 /// The setpoint at tick k: round(Q(k) / D), halves rounded toward +infinity.
 /// Returns kTickOutsideSpan for k > ticks (k == ticks gives the span's end point).
 /// Cost: Horner plus one 128/64 division (~hundreds of instructions on Cortex-M). Any context.
-[[nodiscard]] Status evaluate_at(const TickCubic& cubic, const SpanTiming& timing,
-                                 std::uint32_t k, Lsb& out);
+[[nodiscard]] Status evaluate_at(const TickCubic& cubic, const SpanTiming& timing, std::uint32_t k,
+                                 Lsb& out);
 
 }  // namespace pathstream

@@ -35,20 +35,30 @@ constexpr Int128 operator-(Int128 a) {
     return Int128{lo, ~a.hi + (lo == 0 ? 1u : 0u)};
 }
 
-constexpr Int128 operator-(Int128 a, Int128 b) { return a + (-b); }
+constexpr Int128 operator-(Int128 a, Int128 b) {
+    return a + (-b);
+}
 
 constexpr bool operator<(Int128 a, Int128 b) {
     const std::int64_t ah = static_cast<std::int64_t>(a.hi);
     const std::int64_t bh = static_cast<std::int64_t>(b.hi);
     return ah != bh ? ah < bh : a.lo < b.lo;
 }
-constexpr bool operator>(Int128 a, Int128 b) { return b < a; }
-constexpr bool operator<=(Int128 a, Int128 b) { return !(b < a); }
-constexpr bool operator>=(Int128 a, Int128 b) { return !(a < b); }
+constexpr bool operator>(Int128 a, Int128 b) {
+    return b < a;
+}
+constexpr bool operator<=(Int128 a, Int128 b) {
+    return !(b < a);
+}
+constexpr bool operator>=(Int128 a, Int128 b) {
+    return !(a < b);
+}
 
 /// |a| as an unsigned two-word magnitude. |INT128_MIN| wraps to itself, which callers never
 /// reach: every value the core builds is bounded far below 2^126 at span setup.
-constexpr Int128 magnitude(Int128 a) { return a.negative() ? -a : a; }
+constexpr Int128 magnitude(Int128 a) {
+    return a.negative() ? -a : a;
+}
 
 /// Full 64x64 -> 128-bit unsigned product, from four 32x32 partial products.
 constexpr Int128 multiply_unsigned(std::uint64_t a, std::uint64_t b) {
@@ -56,7 +66,8 @@ constexpr Int128 multiply_unsigned(std::uint64_t a, std::uint64_t b) {
     const std::uint64_t b_lo = b & 0xFFFFFFFFu, b_hi = b >> 32;
     const std::uint64_t ll = a_lo * b_lo, lh = a_lo * b_hi, hl = a_hi * b_lo, hh = a_hi * b_hi;
     const std::uint64_t middle = (ll >> 32) + (lh & 0xFFFFFFFFu) + (hl & 0xFFFFFFFFu);
-    return Int128{(middle << 32) | (ll & 0xFFFFFFFFu), hh + (lh >> 32) + (hl >> 32) + (middle >> 32)};
+    return Int128{(middle << 32) | (ll & 0xFFFFFFFFu),
+                  hh + (lh >> 32) + (hl >> 32) + (middle >> 32)};
 }
 
 /// Signed 128 x signed 64 product, truncated to 128 bits. Exact whenever |a| * |b| < 2^127;

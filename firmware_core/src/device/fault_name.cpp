@@ -24,7 +24,8 @@ public:
     }
     void put_hex4(unsigned v) {
         const char* hex = "0123456789abcdef";
-        for (int shift = 12; shift >= 0; shift -= 4) put(hex[(v >> static_cast<unsigned>(shift)) & 0xFu]);
+        for (int shift = 12; shift >= 0; shift -= 4)
+            put(hex[(v >> static_cast<unsigned>(shift)) & 0xFu]);
     }
     std::size_t finish() {
         if (capacity_ != 0) out_[length_] = '\0';

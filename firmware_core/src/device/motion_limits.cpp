@@ -68,10 +68,9 @@ Status check_axis_travel(const TickCubic& cubic, const SpanTiming& timing,
     const std::int64_t scale = static_cast<std::int64_t>(timing.denominator / (n * n * n));
     const Int128 d3 = Int128::from(cubic.d) * 3;
     const Int128 c = Int128::from(cubic.c);
-    const Int128 hull[4] = {d3, d3 + c, d3 + c * 2 + Int128::from(cubic.b),
-                            (Int128::from(cubic.a) + Int128::from(cubic.b) + c +
-                             Int128::from(cubic.d)) *
-                                3};
+    const Int128 hull[4] = {
+        d3, d3 + c, d3 + c * 2 + Int128::from(cubic.b),
+        (Int128::from(cubic.a) + Int128::from(cubic.b) + c + Int128::from(cubic.d)) * 3};
     const Int128 low = Int128::from(limits.min_position) * (3 * scale);
     const Int128 high = Int128::from(limits.max_position) * (3 * scale);
     for (const Int128& h : hull) {
@@ -109,9 +108,9 @@ TickAcceleration hermite_end_acceleration(std::int32_t chord, std::int32_t start
                                           std::int32_t end_tangent, std::uint32_t n) {
     // |6C| <= 1.5 2^30, |2 T0 + 4 T1| <= 6 2^29: the numerator < 2^33.
     const std::int64_t nn = n;
-    return TickAcceleration{-6 * std::int64_t{chord} + 2 * std::int64_t{start_tangent} +
-                                4 * std::int64_t{end_tangent},
-                            static_cast<std::uint64_t>(nn * nn)};
+    return TickAcceleration{
+        -6 * std::int64_t{chord} + 2 * std::int64_t{start_tangent} + 4 * std::int64_t{end_tangent},
+        static_cast<std::uint64_t>(nn * nn)};
 }
 
 Status check_axis_jerk(const TickCubic& cubic, const SpanTiming& timing, const AxisLimits& limits,

@@ -24,17 +24,17 @@ std::int32_t get_i32(const std::uint8_t*& p) {
     const std::uint32_t high = get_u16(p);
     const std::uint32_t u = (high << 16) | get_u16(p);
     // Two's complement back to signed without implementation-defined conversion.
-    return u <= 0x7FFFFFFFu ? static_cast<std::int32_t>(u)
-                            : -static_cast<std::int32_t>(~u) - 1;
+    return u <= 0x7FFFFFFFu ? static_cast<std::int32_t>(u) : -static_cast<std::int32_t>(~u) - 1;
 }
 
 }  // namespace
 
-std::size_t encode_wire_span(const WireSpan& span, unsigned axes, std::uint8_t* out, std::size_t capacity) {
+std::size_t encode_wire_span(const WireSpan& span, unsigned axes, std::uint8_t* out,
+                             std::size_t capacity) {
     const bool continues = (span.flags & kWireContinueTangent) != 0;
     const std::size_t size = wire_span_bytes(axes, continues);
-    if (axes < 1 || axes > kMaxAxes || capacity < size || span.ticks < 1 || span.ticks > kMaxSpanTicks ||
-        (span.flags & ~kWireKnownFlags) != 0) {
+    if (axes < 1 || axes > kMaxAxes || capacity < size || span.ticks < 1 ||
+        span.ticks > kMaxSpanTicks || (span.flags & ~kWireKnownFlags) != 0) {
         return 0;
     }
     std::uint8_t* p = out;
@@ -49,8 +49,8 @@ std::size_t encode_wire_span(const WireSpan& span, unsigned axes, std::uint8_t* 
     return size;
 }
 
-Status decode_wire_span(const std::uint8_t* bytes, std::size_t available, unsigned axes, WireSpan& out,
-                        std::size_t& consumed) {
+Status decode_wire_span(const std::uint8_t* bytes, std::size_t available, unsigned axes,
+                        WireSpan& out, std::size_t& consumed) {
     if (axes < 1 || axes > kMaxAxes || available < 4) return Status::kBadBatch;
     const std::uint8_t* p = bytes;
     const std::uint32_t ticks = get_u16(p) + 1;

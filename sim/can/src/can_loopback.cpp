@@ -9,8 +9,12 @@ namespace pathstream::sim {
 class CanLoopback::Endpoint final : public hal::CanBus {
 public:
     Endpoint(CanLoopback& bus, std::size_t index) : bus_(bus), index_(index) {}
-    hal::CanSendResult send(const hal::CanFrame& frame) override { return bus_.send_from(*this, frame); }
-    bool receive(hal::CanFrame& out, std::uint32_t timeout_us) override { return bus_.receive_at(*this, out, timeout_us); }
+    hal::CanSendResult send(const hal::CanFrame& frame) override {
+        return bus_.send_from(*this, frame);
+    }
+    bool receive(hal::CanFrame& out, std::uint32_t timeout_us) override {
+        return bus_.receive_at(*this, out, timeout_us);
+    }
     hal::CanBusState state() const override {
         std::lock_guard<std::mutex> lock(bus_.mutex_);
         return bus_off_ ? hal::CanBusState::kBusOff : hal::CanBusState::kErrorActive;
@@ -52,16 +56,20 @@ std::uint64_t CanLoopback::frames_sent_by(std::size_t index) const {
 hal::CanSendResult CanLoopback::send_from(Endpoint& from, const hal::CanFrame& frame) {
     std::lock_guard<std::mutex> lock(mutex_);
     if (from.bus_off_) return hal::CanSendResult::kBusOff;
-    if (frame.length > 8 || frame.id > (frame.extended ? 0x1FFFFFFFu : 0x7FFu)) return hal::CanSendResult::kError;
-    if (faults_.tx_budget != 0 && from.sent_since_receive_ >= faults_.tx_budget) return hal::CanSendResult::kQueueFull;
+    if (frame.length > 8 || frame.id > (frame.extended ? 0x1FFFFFFFu : 0x7FFu))
+        return hal::CanSendResult::kError;
+    if (faults_.tx_budget != 0 && from.sent_since_receive_ >= faults_.tx_budget)
+        return hal::CanSendResult::kQueueFull;
     ++from.sent_since_receive_;
     ++from.sent_;
     ++counters_.frames;
     counters_.data_bytes += frame.length;
-    counters_.bits_worst_case += device::can::frame_bits_worst_case(frame.remote ? 0u : frame.length);
+    counters_.bits_worst_case +=
+        device::can::frame_bits_worst_case(frame.remote ? 0u : frame.length);
     // One decision per frame, in send order: the same seed loses the same frames of a run
     // whose send order is the same.
-    if (faults_.drop_fraction > 0 && std::uniform_real_distribution<double>(0, 1)(random_) < faults_.drop_fraction) {
+    if (faults_.drop_fraction > 0 &&
+        std::uniform_real_distribution<double>(0, 1)(random_) < faults_.drop_fraction) {
         ++counters_.dropped;
         return hal::CanSendResult::kQueued;
     }
@@ -77,7 +85,8 @@ bool CanLoopback::receive_at(Endpoint& at, hal::CanFrame& out, std::uint32_t tim
     at.sent_since_receive_ = 0;
     const auto deadline = std::chrono::steady_clock::now() + std::chrono::microseconds(timeout_us);
     while (at.queue_.empty()) {
-        if (arrived_.wait_until(lock, deadline) == std::cv_status::timeout && at.queue_.empty()) return false;
+        if (arrived_.wait_until(lock, deadline) == std::cv_status::timeout && at.queue_.empty())
+            return false;
     }
     out = at.queue_.front();
     at.queue_.pop_front();

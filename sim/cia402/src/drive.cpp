@@ -33,7 +33,8 @@ std::uint32_t get(const hal::CanFrame& f, unsigned at, unsigned bytes) {
 
 SimulatedCia402Drive::SimulatedCia402Drive(hal::CanBus& bus, const Cia402DriveOptions& options)
     : s_(std::make_unique<State>(bus, options)) {
-    if (options.node < 1 || options.node > 127) throw std::invalid_argument("CiA 402 drive: node outside 1..127");
+    if (options.node < 1 || options.node > 127)
+        throw std::invalid_argument("CiA 402 drive: node outside 1..127");
     s_->fe_window = options.following_error_window;
     s_->qs_decel = options.quick_stop_deceleration;
     s_->position = s_->demand = options.start_position;
@@ -62,11 +63,14 @@ double SimulatedCia402Drive::State::period_seconds() const {
     return ip_value * std::pow(10.0, ip_index);
 }
 
-std::int32_t SimulatedCia402Drive::State::actual() const { return static_cast<std::int32_t>(std::llround(position)); }
+std::int32_t SimulatedCia402Drive::State::actual() const {
+    return static_cast<std::int32_t>(std::llround(position));
+}
 
 std::uint16_t SimulatedCia402Drive::State::statusword() const {
     std::uint16_t sw = statusword_bits(ds) | 0x0200;  // bit 9 remote: the bus is in control
-    if (ds == DriveState::kOperationEnabled && mode == kModeCsp) sw |= 0x1000;  // bit 12: follows the target
+    if (ds == DriveState::kOperationEnabled && mode == kModeCsp)
+        sw |= 0x1000;  // bit 12: follows the target
     return sw;
 }
 
@@ -111,7 +115,8 @@ void SimulatedCia402Drive::poll(std::uint64_t now_us) {
 
 std::uint64_t SimulatedCia402Drive::next_event_us() const {
     if (s_->boot_pending) return s_->now;
-    if (s_->heartbeat_ms == 0 || !s_->heartbeat_enabled) return std::numeric_limits<std::uint64_t>::max();
+    if (s_->heartbeat_ms == 0 || !s_->heartbeat_enabled)
+        return std::numeric_limits<std::uint64_t>::max();
     return s_->next_heartbeat;
 }
 
@@ -137,9 +142,15 @@ void SimulatedCia402Drive::State::handle(const hal::CanFrame& f) {
 
 void SimulatedCia402Drive::State::on_nmt(std::uint8_t command) {
     switch (static_cast<NmtCommand>(command)) {
-        case NmtCommand::kStart: nmt = NmtState::kOperational; break;
-        case NmtCommand::kStop: nmt = NmtState::kStopped; break;
-        case NmtCommand::kEnterPreOperational: nmt = NmtState::kPreOperational; break;
+        case NmtCommand::kStart:
+            nmt = NmtState::kOperational;
+            break;
+        case NmtCommand::kStop:
+            nmt = NmtState::kStopped;
+            break;
+        case NmtCommand::kEnterPreOperational:
+            nmt = NmtState::kPreOperational;
+            break;
         case NmtCommand::kResetNode:
             ds = error_code != 0 ? DriveState::kFault : DriveState::kSwitchOnDisabled;
             mode = 0;
@@ -149,8 +160,11 @@ void SimulatedCia402Drive::State::on_nmt(std::uint8_t command) {
             qs_decel = options.quick_stop_deceleration;
             reset_communication();
             break;
-        case NmtCommand::kResetCommunication: reset_communication(); break;
-        default: break;
+        case NmtCommand::kResetCommunication:
+            reset_communication();
+            break;
+        default:
+            break;
     }
     // Leaving operational while enabled: a drive loses its master's commands, so it stops.
     if (nmt != NmtState::kOperational && ds == DriveState::kOperationEnabled) {
@@ -219,7 +233,9 @@ void SimulatedCia402Drive::State::on_sync() {
             if (step == 0) ds = DriveState::kSwitchOnDisabled;
             break;
         }
-        default: demand = position; break;  // power stage off: the demand tracks the axis
+        default:
+            demand = position;
+            break;  // power stage off: the demand tracks the axis
     }
     last_step = demand - before;
     const bool powered = ds == DriveState::kOperationEnabled || ds == DriveState::kQuickStopActive;
@@ -240,8 +256,10 @@ void SimulatedCia402Drive::State::on_sync() {
         if (fe > max_fe) max_fe = fe;
         if (fe > fe_window) fault(kEmcyFollowingError);
     }
-    if (tpdo1.valid() && tpdo1.type >= 1 && tpdo1.type <= 240 && sync_count % tpdo1.type == 0) send_tpdo(tpdo1);
-    if (tpdo2.valid() && tpdo2.type >= 1 && tpdo2.type <= 240 && sync_count % tpdo2.type == 0) send_tpdo(tpdo2);
+    if (tpdo1.valid() && tpdo1.type >= 1 && tpdo1.type <= 240 && sync_count % tpdo1.type == 0)
+        send_tpdo(tpdo1);
+    if (tpdo2.valid() && tpdo2.type >= 1 && tpdo2.type <= 240 && sync_count % tpdo2.type == 0)
+        send_tpdo(tpdo2);
 }
 
 void SimulatedCia402Drive::State::send_tpdo(const DrivePdo& p) {
@@ -253,30 +271,61 @@ void SimulatedCia402Drive::State::send_tpdo(const DrivePdo& p) {
         std::uint32_t v = 0;
         if (index == kStatusword) v = statusword();
         if (index == kPositionActual) v = static_cast<std::uint32_t>(actual());
-        if (index == kPositionDemand) v = static_cast<std::uint32_t>(static_cast<std::int32_t>(std::llround(demand)));
+        if (index == kPositionDemand)
+            v = static_cast<std::uint32_t>(static_cast<std::int32_t>(std::llround(demand)));
         put(f, at, bytes, v);
         at += bytes;
     }
     send(f);
 }
 
-void SimulatedCia402Drive::inject_fault(std::uint16_t code) { s_->fault(code); }
-void SimulatedCia402Drive::jam(bool jammed) { s_->jammed = jammed; }
-void SimulatedCia402Drive::set_heartbeat_enabled(bool enabled) { s_->heartbeat_enabled = enabled; }
-NmtState SimulatedCia402Drive::nmt_state() const { return s_->nmt; }
-DriveState SimulatedCia402Drive::state() const { return s_->ds; }
-std::uint16_t SimulatedCia402Drive::statusword() const { return s_->statusword(); }
-std::int32_t SimulatedCia402Drive::position_actual() const { return s_->actual(); }
-std::int32_t SimulatedCia402Drive::position_demand() const { return static_cast<std::int32_t>(std::llround(s_->demand)); }
-std::int8_t SimulatedCia402Drive::mode() const { return s_->mode; }
+void SimulatedCia402Drive::inject_fault(std::uint16_t code) {
+    s_->fault(code);
+}
+void SimulatedCia402Drive::jam(bool jammed) {
+    s_->jammed = jammed;
+}
+void SimulatedCia402Drive::set_heartbeat_enabled(bool enabled) {
+    s_->heartbeat_enabled = enabled;
+}
+NmtState SimulatedCia402Drive::nmt_state() const {
+    return s_->nmt;
+}
+DriveState SimulatedCia402Drive::state() const {
+    return s_->ds;
+}
+std::uint16_t SimulatedCia402Drive::statusword() const {
+    return s_->statusword();
+}
+std::int32_t SimulatedCia402Drive::position_actual() const {
+    return s_->actual();
+}
+std::int32_t SimulatedCia402Drive::position_demand() const {
+    return static_cast<std::int32_t>(std::llround(s_->demand));
+}
+std::int8_t SimulatedCia402Drive::mode() const {
+    return s_->mode;
+}
 std::uint32_t SimulatedCia402Drive::interpolation_period_ms() const {
     return static_cast<std::uint32_t>(std::llround(s_->period_seconds() * 1000));
 }
-const std::vector<std::int32_t>& SimulatedCia402Drive::applied_targets() const { return s_->applied; }
-double SimulatedCia402Drive::max_following_error() const { return s_->max_fe; }
-std::uint64_t SimulatedCia402Drive::syncs() const { return s_->syncs; }
-std::uint64_t SimulatedCia402Drive::stale_syncs() const { return s_->stale; }
-std::uint64_t SimulatedCia402Drive::rpdos() const { return s_->rpdos; }
-std::uint16_t SimulatedCia402Drive::last_emcy() const { return s_->last_emcy; }
+const std::vector<std::int32_t>& SimulatedCia402Drive::applied_targets() const {
+    return s_->applied;
+}
+double SimulatedCia402Drive::max_following_error() const {
+    return s_->max_fe;
+}
+std::uint64_t SimulatedCia402Drive::syncs() const {
+    return s_->syncs;
+}
+std::uint64_t SimulatedCia402Drive::stale_syncs() const {
+    return s_->stale;
+}
+std::uint64_t SimulatedCia402Drive::rpdos() const {
+    return s_->rpdos;
+}
+std::uint16_t SimulatedCia402Drive::last_emcy() const {
+    return s_->last_emcy;
+}
 
 }  // namespace pathstream::sim

@@ -52,7 +52,7 @@ struct SimulatedCia402Drive::State {
     std::int32_t target = 0;
     std::uint16_t pending_cw = 0;
     std::int32_t pending_target = 0;
-    bool pending = false;    // an RPDO arrived since the last SYNC
+    bool pending = false;  // an RPDO arrived since the last SYNC
     bool have_pending_cw = false;
     bool have_pending_target = false;
     std::uint32_t fe_window;
@@ -89,8 +89,10 @@ struct SimulatedCia402Drive::State {
     std::int32_t actual() const;
     // object_dictionary.cpp
     void on_sdo(const hal::CanFrame& f);
-    std::uint32_t od_read(std::uint16_t index, std::uint8_t sub, std::uint32_t& value, std::uint8_t& size) const;
-    std::uint32_t od_write(std::uint16_t index, std::uint8_t sub, std::uint32_t value, std::uint8_t size);
+    std::uint32_t od_read(std::uint16_t index, std::uint8_t sub, std::uint32_t& value,
+                          std::uint8_t& size) const;
+    std::uint32_t od_write(std::uint16_t index, std::uint8_t sub, std::uint32_t value,
+                           std::uint8_t size);
     // state_machine.cpp
     void apply_controlword(std::uint16_t cw);
 };

@@ -12,10 +12,12 @@ namespace {
 
 // Objects a PDO may carry, with their length in bits.
 bool rpdo_mappable(std::uint32_t entry) {
-    return entry == pdo_mapping(kControlword, 0, 16) || entry == pdo_mapping(kTargetPosition, 0, 32);
+    return entry == pdo_mapping(kControlword, 0, 16) ||
+           entry == pdo_mapping(kTargetPosition, 0, 32);
 }
 bool tpdo_mappable(std::uint32_t entry) {
-    return entry == pdo_mapping(kStatusword, 0, 16) || entry == pdo_mapping(kPositionActual, 0, 32) ||
+    return entry == pdo_mapping(kStatusword, 0, 16) ||
+           entry == pdo_mapping(kPositionActual, 0, 32) ||
            entry == pdo_mapping(kPositionDemand, 0, 32);
 }
 
@@ -38,9 +40,11 @@ void SimulatedCia402Drive::State::on_sdo(const hal::CanFrame& f) {
         if ((f.data[0] & 0x02) == 0) {
             abort = kAbortCommand;  // segmented download: not supported
         } else {
-            const std::uint8_t size = (f.data[0] & 0x01) != 0 ? static_cast<std::uint8_t>(4 - ((f.data[0] >> 2) & 3)) : 0;
+            const std::uint8_t size =
+                (f.data[0] & 0x01) != 0 ? static_cast<std::uint8_t>(4 - ((f.data[0] >> 2) & 3)) : 0;
             std::uint32_t v = 0;
-            for (unsigned i = 0; i < 4; ++i) v |= static_cast<std::uint32_t>(f.data[4 + i]) << (8 * i);
+            for (unsigned i = 0; i < 4; ++i)
+                v |= static_cast<std::uint32_t>(f.data[4 + i]) << (8 * i);
             abort = od_write(index, sub, v, size);
             if (abort == 0) r.data[0] = kSdoDownloadResponse;
         }
@@ -50,20 +54,22 @@ void SimulatedCia402Drive::State::on_sdo(const hal::CanFrame& f) {
         abort = od_read(index, sub, v, size);
         if (abort == 0) {
             r.data[0] = static_cast<std::uint8_t>(kSdoUploadResponse | (4 - size) << 2 | 0x03);
-            for (unsigned i = 0; i < size; ++i) r.data[4 + i] = static_cast<std::uint8_t>(v >> (8 * i));
+            for (unsigned i = 0; i < size; ++i)
+                r.data[4 + i] = static_cast<std::uint8_t>(v >> (8 * i));
         }
     } else {
         abort = kAbortCommand;
     }
     if (abort != 0) {
         r.data[0] = kSdoAbort;
-        for (unsigned i = 0; i < 4; ++i) r.data[4 + i] = static_cast<std::uint8_t>(abort >> (8 * i));
+        for (unsigned i = 0; i < 4; ++i)
+            r.data[4 + i] = static_cast<std::uint8_t>(abort >> (8 * i));
     }
     send(r);
 }
 
-std::uint32_t SimulatedCia402Drive::State::od_read(std::uint16_t index, std::uint8_t sub, std::uint32_t& v,
-                                                   std::uint8_t& size) const {
+std::uint32_t SimulatedCia402Drive::State::od_read(std::uint16_t index, std::uint8_t sub,
+                                                   std::uint32_t& v, std::uint8_t& size) const {
     auto one = [&](std::uint32_t value, std::uint8_t bytes) -> std::uint32_t {
         if (sub != 0) return kAbortNoSubindex;
         v = value;
@@ -72,10 +78,20 @@ std::uint32_t SimulatedCia402Drive::State::od_read(std::uint16_t index, std::uin
     };
     auto pdo_comm = [&](const DrivePdo& p) -> std::uint32_t {
         switch (sub) {
-            case 0: v = 2; size = 1; return 0;
-            case 1: v = p.cob_id; size = 4; return 0;
-            case 2: v = p.type; size = 1; return 0;
-            default: return kAbortNoSubindex;
+            case 0:
+                v = 2;
+                size = 1;
+                return 0;
+            case 1:
+                v = p.cob_id;
+                size = 4;
+                return 0;
+            case 2:
+                v = p.type;
+                size = 1;
+                return 0;
+            default:
+                return kAbortNoSubindex;
         }
     };
     auto pdo_map = [&](const DrivePdo& p) -> std::uint32_t {
@@ -90,38 +106,69 @@ std::uint32_t SimulatedCia402Drive::State::od_read(std::uint16_t index, std::uin
         return 0;
     };
     switch (index) {
-        case kDeviceType: return one(0x00020000u | kDeviceProfile402, 4);  // servo drive, CiA 402
-        case kErrorRegister: return one(error_code != 0 ? 1u : 0u, 1);
-        case kHeartbeatProducer: return one(heartbeat_ms, 2);
-        case kRpdo1Communication: return pdo_comm(rpdo1);
-        case kTpdo1Communication: return pdo_comm(tpdo1);
-        case kTpdo2Communication: return pdo_comm(tpdo2);
-        case kRpdo1Mapping: return pdo_map(rpdo1);
-        case kTpdo1Mapping: return pdo_map(tpdo1);
-        case kTpdo2Mapping: return pdo_map(tpdo2);
-        case kErrorCode: return one(error_code, 2);
-        case kControlword: return one(controlword, 2);
-        case kStatusword: return one(statusword(), 2);
-        case kModesOfOperation: return one(static_cast<std::uint8_t>(mode), 1);
-        case kModesDisplay: return one(static_cast<std::uint8_t>(mode), 1);
-        case kPositionDemand: return one(static_cast<std::uint32_t>(static_cast<std::int32_t>(std::llround(demand))), 4);
-        case kPositionActual: return one(static_cast<std::uint32_t>(actual()), 4);
-        case kFollowingErrorWindow: return one(fe_window, 4);
-        case kTargetPosition: return one(static_cast<std::uint32_t>(target), 4);
-        case kQuickStopDeceleration: return one(qs_decel, 4);
+        case kDeviceType:
+            return one(0x00020000u | kDeviceProfile402, 4);  // servo drive, CiA 402
+        case kErrorRegister:
+            return one(error_code != 0 ? 1u : 0u, 1);
+        case kHeartbeatProducer:
+            return one(heartbeat_ms, 2);
+        case kRpdo1Communication:
+            return pdo_comm(rpdo1);
+        case kTpdo1Communication:
+            return pdo_comm(tpdo1);
+        case kTpdo2Communication:
+            return pdo_comm(tpdo2);
+        case kRpdo1Mapping:
+            return pdo_map(rpdo1);
+        case kTpdo1Mapping:
+            return pdo_map(tpdo1);
+        case kTpdo2Mapping:
+            return pdo_map(tpdo2);
+        case kErrorCode:
+            return one(error_code, 2);
+        case kControlword:
+            return one(controlword, 2);
+        case kStatusword:
+            return one(statusword(), 2);
+        case kModesOfOperation:
+            return one(static_cast<std::uint8_t>(mode), 1);
+        case kModesDisplay:
+            return one(static_cast<std::uint8_t>(mode), 1);
+        case kPositionDemand:
+            return one(static_cast<std::uint32_t>(static_cast<std::int32_t>(std::llround(demand))),
+                       4);
+        case kPositionActual:
+            return one(static_cast<std::uint32_t>(actual()), 4);
+        case kFollowingErrorWindow:
+            return one(fe_window, 4);
+        case kTargetPosition:
+            return one(static_cast<std::uint32_t>(target), 4);
+        case kQuickStopDeceleration:
+            return one(qs_decel, 4);
         case kInterpolationPeriod:
             switch (sub) {
-                case 0: v = 2; size = 1; return 0;
-                case 1: v = ip_value; size = 1; return 0;
-                case 2: v = static_cast<std::uint8_t>(ip_index); size = 1; return 0;
-                default: return kAbortNoSubindex;
+                case 0:
+                    v = 2;
+                    size = 1;
+                    return 0;
+                case 1:
+                    v = ip_value;
+                    size = 1;
+                    return 0;
+                case 2:
+                    v = static_cast<std::uint8_t>(ip_index);
+                    size = 1;
+                    return 0;
+                default:
+                    return kAbortNoSubindex;
             }
-        default: return kAbortNoObject;
+        default:
+            return kAbortNoObject;
     }
 }
 
-std::uint32_t SimulatedCia402Drive::State::od_write(std::uint16_t index, std::uint8_t sub, std::uint32_t v,
-                                                    std::uint8_t size) {
+std::uint32_t SimulatedCia402Drive::State::od_write(std::uint16_t index, std::uint8_t sub,
+                                                    std::uint32_t v, std::uint8_t size) {
     // Size and existence first, from the read side's view of the object.
     std::uint32_t current = 0;
     std::uint8_t object_size = 0;
@@ -132,7 +179,8 @@ std::uint32_t SimulatedCia402Drive::State::od_write(std::uint16_t index, std::ui
         if (sub == 0) return kAbortReadOnly;
         if (sub == 1) {
             // Only bit 31 (valid) may change while the PDO exists; the id needs it disabled.
-            if (p.valid() && (v & kPdoInvalid) == 0 && (v & 0x7FF) != (p.cob_id & 0x7FF)) return kAbortValueRange;
+            if (p.valid() && (v & kPdoInvalid) == 0 && (v & 0x7FF) != (p.cob_id & 0x7FF))
+                return kAbortValueRange;
             if ((v & 0x7FF) == 0 || (v & 0x3FFFF800u) != 0) return kAbortValueRange;
             p.cob_id = v;
             return 0;
@@ -162,13 +210,21 @@ std::uint32_t SimulatedCia402Drive::State::od_write(std::uint16_t index, std::ui
             heartbeat_ms = static_cast<std::uint16_t>(v);
             next_heartbeat = now;  // the first one at once
             return 0;
-        case kRpdo1Communication: return pdo_comm(rpdo1);
-        case kTpdo1Communication: return pdo_comm(tpdo1);
-        case kTpdo2Communication: return pdo_comm(tpdo2);
-        case kRpdo1Mapping: return pdo_map(rpdo1, true);
-        case kTpdo1Mapping: return pdo_map(tpdo1, false);
-        case kTpdo2Mapping: return pdo_map(tpdo2, false);
-        case kControlword: apply_controlword(static_cast<std::uint16_t>(v)); return 0;
+        case kRpdo1Communication:
+            return pdo_comm(rpdo1);
+        case kTpdo1Communication:
+            return pdo_comm(tpdo1);
+        case kTpdo2Communication:
+            return pdo_comm(tpdo2);
+        case kRpdo1Mapping:
+            return pdo_map(rpdo1, true);
+        case kTpdo1Mapping:
+            return pdo_map(tpdo1, false);
+        case kTpdo2Mapping:
+            return pdo_map(tpdo2, false);
+        case kControlword:
+            apply_controlword(static_cast<std::uint16_t>(v));
+            return 0;
         case kModesOfOperation: {
             const auto m = static_cast<std::int8_t>(v);
             if (m != 0 && m != kModeCsp) return kAbortValueRange;  // CSP is the only mode here
@@ -176,8 +232,12 @@ std::uint32_t SimulatedCia402Drive::State::od_write(std::uint16_t index, std::ui
             mode = m;
             return 0;
         }
-        case kFollowingErrorWindow: fe_window = v; return 0;
-        case kTargetPosition: target = static_cast<std::int32_t>(v); return 0;
+        case kFollowingErrorWindow:
+            fe_window = v;
+            return 0;
+        case kTargetPosition:
+            target = static_cast<std::int32_t>(v);
+            return 0;
         case kQuickStopDeceleration:
             if (v == 0) return kAbortValueRange;
             qs_decel = v;
@@ -195,7 +255,8 @@ std::uint32_t SimulatedCia402Drive::State::od_write(std::uint16_t index, std::ui
             ip_index = i;
             return 0;
         }
-        default: return kAbortReadOnly;  // it exists (read succeeded) but is not writable
+        default:
+            return kAbortReadOnly;  // it exists (read succeeded) but is not writable
     }
 }
 

@@ -46,7 +46,8 @@ void SimulatedCia402Drive::State::apply_controlword(std::uint16_t cw) {
         return;
     }
     if (!enable_operation) {  // switch on (3) or disable operation (5)
-        if (ds == DriveState::kReadyToSwitchOn || ds == DriveState::kOperationEnabled) ds = DriveState::kSwitchedOn;
+        if (ds == DriveState::kReadyToSwitchOn || ds == DriveState::kOperationEnabled)
+            ds = DriveState::kSwitchedOn;
         return;
     }
     // enable operation (4); a quick stop active drive stays there until disabled (option 2)

@@ -24,6 +24,9 @@
 // image runs three phases, (n, S spans), (2n, S), (n, 2S); differences between them cancel
 // whatever does not scale with the ticks.
 // Exit status: 0 if every asserted figure holds and the counting self-check passes.
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -36,8 +39,6 @@
 #include <regex>
 #include <sstream>
 #include <string>
-#include <sys/wait.h>
-#include <unistd.h>
 #include <vector>
 
 namespace {
@@ -66,8 +67,10 @@ struct Options {
 std::string shell_quote(const std::string& s) {
     std::string out = "'";
     for (char c : s) {
-        if (c == '\'') out += "'\\''";
-        else out += c;
+        if (c == '\'')
+            out += "'\\''";
+        else
+            out += c;
     }
     return out + "'";
 }
@@ -94,7 +97,7 @@ std::vector<std::string> lines_of(const std::string& text) {
 struct Symbol {
     std::uint64_t address = 0;  // Thumb bit cleared
     std::uint64_t size = 0;
-    std::string name;           // demangled
+    std::string name;  // demangled
 };
 
 /// `nm -S -C` of the image: sized text symbols only.
@@ -175,17 +178,28 @@ Options parse_options(int argc, char** argv) {
             if (i + 1 >= argc) die("missing value after " + arg);
             return argv[++i];
         };
-        if (arg == "--qemu") o.qemu = value();
-        else if (arg == "--plugin") o.plugin = value();
-        else if (arg == "--nm") o.nm = value();
-        else if (arg == "--board") o.board = value();
-        else if (arg == "--label") o.label = value();
-        else if (arg == "--image") o.image = value();
-        else if (arg == "--keep") o.keep_dir = value();
-        else if (arg == "--budget") o.budget = std::stod(value());
-        else if (arg == "--timeout") o.timeout = std::stoi(value());
-        else if (arg == "--assert-marginal") o.assert_marginal = true;
-        else if (arg == "--no-legend") o.legend = false;
+        if (arg == "--qemu")
+            o.qemu = value();
+        else if (arg == "--plugin")
+            o.plugin = value();
+        else if (arg == "--nm")
+            o.nm = value();
+        else if (arg == "--board")
+            o.board = value();
+        else if (arg == "--label")
+            o.label = value();
+        else if (arg == "--image")
+            o.image = value();
+        else if (arg == "--keep")
+            o.keep_dir = value();
+        else if (arg == "--budget")
+            o.budget = std::stod(value());
+        else if (arg == "--timeout")
+            o.timeout = std::stoi(value());
+        else if (arg == "--assert-marginal")
+            o.assert_marginal = true;
+        else if (arg == "--no-legend")
+            o.legend = false;
         else if (arg == "--assert") {
             const std::string spec = value();
             const auto colon = spec.find(':');
@@ -204,10 +218,12 @@ Options parse_options(int argc, char** argv) {
             for (std::string item; std::getline(in, item, ',');) {
                 const auto eq = item.find('=');
                 const std::string kind = eq == std::string::npos ? "" : item.substr(0, eq);
-                if (kind != "plain" && kind != "jerk") die("--assert-stop wants plain=MAX,jerk=MAX: " + spec);
+                if (kind != "plain" && kind != "jerk")
+                    die("--assert-stop wants plain=MAX,jerk=MAX: " + spec);
                 o.stop_limits[kind + "_stop"] = std::stod(item.substr(eq + 1));
             }
-        } else die("unknown argument " + arg);
+        } else
+            die("unknown argument " + arg);
     }
     if (o.plugin.empty() || o.image.empty()) die("--plugin and --image are required");
     return o;
@@ -223,12 +239,13 @@ int main(int argc, char** argv) {
     std::vector<Range> ranges;
     std::optional<std::uint64_t> mark;
     const std::regex tick_re(R"(^budget_tick_(\d+)(\..*| .*)?$)");
-    const std::regex member_re(
-        R"(SetpointStream<(\d+)u?l?, 16u?l?>::(tick_slow|finish_span)\()");
+    const std::regex member_re(R"(SetpointStream<(\d+)u?l?, 16u?l?>::(tick_slow|finish_span)\()");
     for (const Symbol& s : symbols) {
         std::smatch m;
-        if (s.name == "budget_mark") mark = s.address;
-        else if (s.name == "budget_calibrate") ranges.push_back({s, Role::kCalibrate, 0});
+        if (s.name == "budget_mark")
+            mark = s.address;
+        else if (s.name == "budget_calibrate")
+            ranges.push_back({s, Role::kCalibrate, 0});
         else if (std::regex_match(s.name, m, tick_re)) {
             ranges.push_back({s, Role::kTick, static_cast<unsigned>(std::stoul(m[1]))});
         } else if (std::regex_search(s.name, m, member_re)) {
@@ -267,7 +284,8 @@ int main(int argc, char** argv) {
         "timeout " + std::to_string(o.timeout) + " " + shell_quote(o.qemu) + " -M " +
         shell_quote(o.board) +
         " -semihosting-config enable=on,target=native -nographic -monitor none -serial none"
-        " -kernel " + shell_quote(o.image) + " -plugin " + shell_quote(plugin_arg) + " 2>&1";
+        " -kernel " +
+        shell_quote(o.image) + " -plugin " + shell_quote(plugin_arg) + " 2>&1";
     const auto [output, status] = run(command);
     if (!o.keep_dir.empty()) {
         std::ofstream(dir + "/qemu_output.txt") << command << "\n" << output;
@@ -306,14 +324,16 @@ int main(int argc, char** argv) {
         std::cout << "FAIL: " << why << "\n";
         failed = true;
     };
-    if (output.find("budget done") == std::string::npos || output.find("FAILED") != std::string::npos) {
+    if (output.find("budget done") == std::string::npos ||
+        output.find("FAILED") != std::string::npos) {
         fail("the image reported a failed phase");
     }
     if (marks.size() != 2 * phases.size()) fail("marks do not match phases");
 
     // Counts of a phase: total, and the sum over ranges selected by a predicate.
     auto delta = [&](const Phase& p, std::size_t column) {
-        return static_cast<double>(marks.at(2 * p.id + 1).at(column) - marks.at(2 * p.id).at(column));
+        return static_cast<double>(marks.at(2 * p.id + 1).at(column) -
+                                   marks.at(2 * p.id).at(column));
     };
     auto range_sum = [&](const Phase& p, auto predicate) {
         double sum = 0;
@@ -329,7 +349,8 @@ int main(int argc, char** argv) {
     // Self-check of the counting method: the calibration loop's exact count.
     for (const Phase& p : phases) {
         if (p.kind != "calibrate") continue;
-        const double counted = range_sum(p, [](const Range& r) { return r.role == Role::kCalibrate; });
+        const double counted =
+            range_sum(p, [](const Range& r) { return r.role == Role::kCalibrate; });
         const double expected = 2.0 * static_cast<double>(p.n) + 1.0;
         std::cout << "Counting self-check: budget_calibrate(" << p.n << ") executed "
                   << fmt(counted, 0) << " instructions, expected " << fmt(expected, 0) << " ("
@@ -354,7 +375,8 @@ int main(int argc, char** argv) {
             if (!p.ok) fail("phase " + std::to_string(p.id) + " (" + p.kind + ") not ok");
         }
         for (const auto& [axes, ps] : by_axes) {
-            if (ps.size() != 3 || push_of.count(axes) == 0) die("expected three phases and a push phase per axis count");
+            if (ps.size() != 3 || push_of.count(axes) == 0)
+                die("expected three phases and a push phase per axis count");
             const Phase &p1 = ps[0], &p2 = ps[1], &p3 = ps[2];  // (n,S) (2n,S) (n,2S)
             const unsigned a = axes;
             auto in_tick = [a](const Range& r) {
@@ -366,7 +388,8 @@ int main(int argc, char** argv) {
             bool have_tick = false;
             for (const Range& r : ranges) have_tick |= r.axes == a && r.role == Role::kTick;
             if (!have_tick) die("no budget_tick_" + std::to_string(a) + " symbol");
-            if (p2.spans != p1.spans || p2.n != 2 * p1.n || p3.n != p1.n || p3.spans != 2 * p1.spans) {
+            if (p2.spans != p1.spans || p2.n != 2 * p1.n || p3.n != p1.n ||
+                p3.spans != 2 * p1.spans) {
                 die("unexpected phase layout for " + kind);
             }
             Row row;
@@ -380,10 +403,9 @@ int main(int argc, char** argv) {
             row.whole = (delta(p3, 0) - delta(p1, 0)) / static_cast<double>(p3.ticks - p1.ticks);
             // (n, 2S) has S more spans and S n more ticks than (n, S): what it executes beyond
             // those ticks' steady cost is the span switches, whatever functions they live in.
-            row.switch_per_span =
-                (range_sum(p3, in_consumer) - range_sum(p1, in_consumer) -
-                 row.steady * static_cast<double>(p3.ticks - p1.ticks)) /
-                static_cast<double>(p3.spans - p1.spans);
+            row.switch_per_span = (range_sum(p3, in_consumer) - range_sum(p1, in_consumer) -
+                                   row.steady * static_cast<double>(p3.ticks - p1.ticks)) /
+                                  static_cast<double>(p3.spans - p1.spans);
             const Phase& push = push_of.at(a);
             row.push_per_span = delta(push, 0) / static_cast<double>(push.calls);
             rows.push_back(row);
@@ -409,10 +431,11 @@ int main(int argc, char** argv) {
     }
 
     const std::string budget_text = o.budget ? fmt(*o.budget, 0) : "-";
-    std::cout << "| spans | axes A | tick() per tick | per axis per setpoint | marginal per extra axis"
-                 " | amortized tick() incl. span switches, per axis | whole run incl. push(), per axis"
-                 " | span switch per span | push() per span | <= "
-              << budget_text << " per axis |\n";
+    std::cout
+        << "| spans | axes A | tick() per tick | per axis per setpoint | marginal per extra axis"
+           " | amortized tick() incl. span switches, per axis | whole run incl. push(), per axis"
+           " | span switch per span | push() per span | <= "
+        << budget_text << " per axis |\n";
     std::cout << "|---|---|---|---|---|---|---|---|---|---|\n";
     for (std::size_t i = 0; i < rows.size(); ++i) {
         const Row& r = rows[i];
@@ -473,9 +496,10 @@ int main(int argc, char** argv) {
             ++count;
         }
         if (count == 0) continue;
-        std::cout << (std::string(kind) == "jerk_stop" ? "plan_jerk_stop" : "plan_stop") << "<" << axes
-                  << ">, the controlled stop planned in the tick that takes a hold (" << count
-                  << " seeded states): " << fmt(sum / static_cast<double>(count), 0) << " instructions per call on"
+        std::cout << (std::string(kind) == "jerk_stop" ? "plan_jerk_stop" : "plan_stop") << "<"
+                  << axes << ">, the controlled stop planned in the tick that takes a hold ("
+                  << count << " seeded states): " << fmt(sum / static_cast<double>(count), 0)
+                  << " instructions per call on"
                   << " average, " << fmt(most, 0) << " at most";
         if (const auto limit = o.stop_limits.find(kind); limit != o.stop_limits.end()) {
             std::cout << " (asserted <= " << fmt(limit->second, 0) << ")";
@@ -502,26 +526,29 @@ int main(int argc, char** argv) {
         const double per_tick = (delta(list[1], 0) - delta(list[0], 0)) /
                                 static_cast<double>(list[0].spans * list[0].n);
         const double whole = delta(list[0], 0) / static_cast<double>(list[0].ticks);
-        std::cout << "MotionDevice<" << axes << ", 16>::tick in steady state, narrow spans n = "
-                  << list[0].n << ": " << fmt(per_tick) << " instructions per tick ("
-                  << fmt(per_tick / axes) << " per axis; the status publication, the mailbox"
+        std::cout << "MotionDevice<" << axes
+                  << ", 16>::tick in steady state, narrow spans n = " << list[0].n << ": "
+                  << fmt(per_tick) << " instructions per tick (" << fmt(per_tick / axes)
+                  << " per axis; the status publication, the mailbox"
                      " reads and SetpointStream::tick included); whole run with batches decoded"
                      " and checked: "
                   << fmt(whole) << " per tick\n";
     }
-    if (o.legend) std::cout << "\nColumns (docs/cortex-m.md):\n"
-                 "- tick() per tick: steady state, instructions executed inside tick() (and"
-                 " tick_slow for wide spans) per tick, from two runs with the same spans and n vs"
-                 " 2n ticks each; the setpoint output (exact, rounded) included.\n"
-                 "- spans: narrow, 32-bit remainders and D not a power of two (the step with"
-                 " its correction by K); binary, D a power of two (no correction); wide, 64-bit"
-                 " remainders.\n"
-                 "- per axis per setpoint: that divided by A; the budget applies to it.\n"
-                 "- marginal: extra instructions per tick for each added axis.\n"
-                 "- amortized: everything tick() executes (tick_slow, finish_span"
-                 " included) over a run of spans of n ticks, per tick, per axis.\n"
-                 "- whole run: difference of runs with S and 2S spans of n ticks: the driver"
-                 " loop, push() (validation, prepare_span) and tick(), per tick, per axis.\n";
+    if (o.legend)
+        std::cout
+            << "\nColumns (docs/cortex-m.md):\n"
+               "- tick() per tick: steady state, instructions executed inside tick() (and"
+               " tick_slow for wide spans) per tick, from two runs with the same spans and n vs"
+               " 2n ticks each; the setpoint output (exact, rounded) included.\n"
+               "- spans: narrow, 32-bit remainders and D not a power of two (the step with"
+               " its correction by K); binary, D a power of two (no correction); wide, 64-bit"
+               " remainders.\n"
+               "- per axis per setpoint: that divided by A; the budget applies to it.\n"
+               "- marginal: extra instructions per tick for each added axis.\n"
+               "- amortized: everything tick() executes (tick_slow, finish_span"
+               " included) over a run of spans of n ticks, per tick, per axis.\n"
+               "- whole run: difference of runs with S and 2S spans of n ticks: the driver"
+               " loop, push() (validation, prepare_span) and tick(), per tick, per axis.\n";
     for (const auto& [kind, limits] : o.limits) {
         std::cout << "Asserted: " << kind << " per axis per setpoint <=";
         bool first = true;

@@ -16,8 +16,8 @@
 // snapshots its counters there. tick() is measured through budget_tick_<A>, an out-of-line
 // function whose body is exactly SetpointStream::tick inlined (same arguments: the stream and
 // the output array), so its address range is tick()'s code.
-// It ends with Horner phases (evaluate_at per call, n = 64 and n = 65536) and a calibration loop whose exact
-// instruction count is known, which checks the counting method itself.
+// It ends with Horner phases (evaluate_at per call, n = 64 and n = 65536) and a calibration loop
+// whose exact instruction count is known, which checks the counting method itself.
 #include <cstdint>
 #include <new>
 
@@ -43,8 +43,8 @@ template <unsigned A>
 using Device = pathstream::device::MotionDevice<A, kCapacity>;
 
 // One stream or device at a time lives here (the micro:bit has 16 KiB of RAM).
-constexpr std::size_t kArenaBytes =
-    sizeof(Stream<8>) > sizeof(Device<2>) ? sizeof(Stream<8>) : sizeof(Device<2>);
+constexpr std::size_t kArenaBytes = sizeof(Stream<8>) > sizeof(Device<2>) ? sizeof(Stream<8>)
+                                                                          : sizeof(Device<2>);
 alignas(8) unsigned char g_arena[kArenaBytes];
 Lsb g_out[8];
 bool g_failed = false;
@@ -68,10 +68,10 @@ extern "C" [[gnu::naked, gnu::noinline, gnu::used]] void budget_calibrate(std::u
 }
 
 // tick() as an out-of-line function per axis count: budget_tick_<A>.
-#define PATHSTREAM_BUDGET_TICK(A)                                                           \
-    extern "C" [[gnu::noinline, gnu::used]] TickState budget_tick_##A(Stream<A>& s,         \
-                                                                      Lsb(&out)[A]) {       \
-        return s.tick(out);                                                                 \
+#define PATHSTREAM_BUDGET_TICK(A)                                                            \
+    extern "C"                                                                               \
+        [[gnu::noinline, gnu::used]] TickState budget_tick_##A(Stream<A>& s, Lsb(&out)[A]) { \
+        return s.tick(out);                                                                  \
     }
 PATHSTREAM_BUDGET_TICK(1)
 PATHSTREAM_BUDGET_TICK(2)
@@ -83,11 +83,26 @@ namespace {
 
 template <unsigned A>
 TickState tick_of(Stream<A>& s, Lsb (&out)[A]);
-template <> TickState tick_of<1>(Stream<1>& s, Lsb (&out)[1]) { return budget_tick_1(s, out); }
-template <> TickState tick_of<2>(Stream<2>& s, Lsb (&out)[2]) { return budget_tick_2(s, out); }
-template <> TickState tick_of<3>(Stream<3>& s, Lsb (&out)[3]) { return budget_tick_3(s, out); }
-template <> TickState tick_of<4>(Stream<4>& s, Lsb (&out)[4]) { return budget_tick_4(s, out); }
-template <> TickState tick_of<8>(Stream<8>& s, Lsb (&out)[8]) { return budget_tick_8(s, out); }
+template <>
+TickState tick_of<1>(Stream<1>& s, Lsb (&out)[1]) {
+    return budget_tick_1(s, out);
+}
+template <>
+TickState tick_of<2>(Stream<2>& s, Lsb (&out)[2]) {
+    return budget_tick_2(s, out);
+}
+template <>
+TickState tick_of<3>(Stream<3>& s, Lsb (&out)[3]) {
+    return budget_tick_3(s, out);
+}
+template <>
+TickState tick_of<4>(Stream<4>& s, Lsb (&out)[4]) {
+    return budget_tick_4(s, out);
+}
+template <>
+TickState tick_of<8>(Stream<8>& s, Lsb (&out)[8]) {
+    return budget_tick_8(s, out);
+}
 
 constexpr int kPoolSize = 4;
 using Bases = pathstream::Basis[kPoolSize];
@@ -150,9 +165,23 @@ std::uint32_t g_phase = 0;
 void report_phase(const char* kind, unsigned axes, std::uint32_t n, std::uint32_t spans,
                   std::uint64_t ticks, std::uint64_t calls, bool ok) {
     cortex_m::Line line;
-    line.text("phase id=").dec(g_phase).text(" kind=").text(kind).text(" axes=").dec(axes)
-        .text(" n=").dec(n).text(" spans=").dec(spans).text(" ticks=").dec(ticks)
-        .text(" calls=").dec(calls).text(" ok=").dec(ok ? 1 : 0).end();
+    line.text("phase id=")
+        .dec(g_phase)
+        .text(" kind=")
+        .text(kind)
+        .text(" axes=")
+        .dec(axes)
+        .text(" n=")
+        .dec(n)
+        .text(" spans=")
+        .dec(spans)
+        .text(" ticks=")
+        .dec(ticks)
+        .text(" calls=")
+        .dec(calls)
+        .text(" ok=")
+        .dec(ok ? 1 : 0)
+        .end();
     if (!ok) g_failed = true;
     ++g_phase;
 }
@@ -235,14 +264,14 @@ void stream_phases(pathstream::workload::SplitMix64& rng) {
     pathstream::TickCubic cubic;
     std::int32_t control[4];
     for (int j = 0; j < 4; ++j) control[j] = rng.between(-50000000, 50000000);
-    bool ok = pathstream::make_span_timing(pathstream::Basis::kUniformBSpline, n, timing) ==
-              Status::kOk;
-    ok &= pathstream::make_tick_cubic(pathstream::Basis::kUniformBSpline, control, timing,
-                                      cubic) == Status::kOk;
+    bool ok =
+        pathstream::make_span_timing(pathstream::Basis::kUniformBSpline, n, timing) == Status::kOk;
+    ok &= pathstream::make_tick_cubic(pathstream::Basis::kUniformBSpline, control, timing, cubic) ==
+          Status::kOk;
     budget_mark(2 * g_phase);
     for (std::uint32_t i = 0; i < calls; ++i) {
-        ok &= pathstream::evaluate_at(cubic, timing, (i * 7919u) % (n + 1), g_out[0]) ==
-              Status::kOk;
+        ok &=
+            pathstream::evaluate_at(cubic, timing, (i * 7919u) % (n + 1), g_out[0]) == Status::kOk;
     }
     budget_mark(2 * g_phase + 1);
     report_phase("horner", 1, n, 1, 0, calls, ok);
@@ -325,14 +354,17 @@ template <unsigned A>
         position[a] = rng.between(-1000000, 1000000);
         tangent[a] = rng.between(-200 * kTicks, 200 * kTicks);
         const std::int64_t against = tangent[a] > 0 ? -1 : 1;
-        acceleration[a] = dev::TickAcceleration{against * rng.between(0, kQ), static_cast<std::uint64_t>(kQ)};
+        acceleration[a] =
+            dev::TickAcceleration{against * rng.between(0, kQ), static_cast<std::uint64_t>(kQ)};
     }
     dev::JerkMove<A> move;
     budget_mark(2 * g_phase);
-    const Status s = jerk ? dev::plan_jerk_stop(position, tangent, kTicks, acceleration, limits, move)
-                          : dev::plan_stop(position, tangent, kTicks, limits, move.span[0]);
+    const Status s =
+        jerk ? dev::plan_jerk_stop(position, tangent, kTicks, acceleration, limits, move)
+             : dev::plan_stop(position, tangent, kTicks, limits, move.span[0]);
     budget_mark(2 * g_phase + 1);
-    report_phase(jerk ? "jerk_stop" : "plain_stop", A, kTicks, jerk ? move.count : 1, 0, 1, s == Status::kOk);
+    report_phase(jerk ? "jerk_stop" : "plain_stop", A, kTicks, jerk ? move.count : 1, 0, 1,
+                 s == Status::kOk);
 }
 
 [[gnu::noinline]] void calibration_phase(std::uint32_t iterations) {
@@ -353,8 +385,8 @@ int main() {
     stream_phases<3>(rng);
     stream_phases<4>(rng);
     stream_phases<8>(rng);
-    horner_phase(rng, 64, 64);      // |Q| < 2^64: one 64-bit division
-    horner_phase(rng, 65536, 64);   // |Q| >= 2^64: the bit-serial 128/64 division
+    horner_phase(rng, 64, 64);     // |Q| < 2^64: one 64-bit division
+    horner_phase(rng, 65536, 64);  // |Q| >= 2^64: the bit-serial 128/64 division
     device_phase<2>(60, 32);
     device_phase<2>(120, 32);
     for (int i = 0; i < 8; ++i) stop_phase<2>(rng, true);

@@ -9,8 +9,8 @@
 namespace {
 
 bool word_aligned(const void* a, const void* b, std::size_t n) {
-    return ((reinterpret_cast<std::uintptr_t>(a) | reinterpret_cast<std::uintptr_t>(b) | n) &
-            3u) == 0;
+    return ((reinterpret_cast<std::uintptr_t>(a) | reinterpret_cast<std::uintptr_t>(b) | n) & 3u) ==
+           0;
 }
 
 }  // namespace

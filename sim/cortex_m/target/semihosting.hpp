@@ -27,12 +27,15 @@ inline std::uint32_t semihost(std::uint32_t op, const void* arg) {
 }
 
 /// Writes a NUL-terminated string to the host's stderr.
-inline void write(const char* s) { (void)semihost(kSysWrite0, s); }
+inline void write(const char* s) {
+    (void)semihost(kSysWrite0, s);
+}
 
 /// Ends the emulation: status 0 for success, 1 for anything else (the 32-bit SYS_EXIT cannot
 /// carry a status code, only "application exit" or an error reason).
 [[noreturn]] inline void exit(bool success) {
-    const std::uint32_t reason = success ? kAdpStoppedApplicationExit : kAdpStoppedRunTimeErrorUnknown;
+    const std::uint32_t reason =
+        success ? kAdpStoppedApplicationExit : kAdpStoppedRunTimeErrorUnknown;
     register std::uint32_t r0 asm("r0") = kSysExit;
     register std::uint32_t r1 asm("r1") = reason;
     asm volatile("bkpt 0xab" : "+r"(r0) : "r"(r1) : "memory");

@@ -66,10 +66,13 @@ extern "C" [[gnu::section(".vectors"), gnu::used]] const Vector g_vector_table[1
     fault_handler,                          // 4: MemManage (v7-M)
     fault_handler,                          // 5: BusFault (v7-M)
     fault_handler,                          // 6: UsageFault (v7-M)
-    nullptr, nullptr, nullptr, nullptr,     // 7-10: reserved
-    fault_handler,                          // 11: SVCall
-    fault_handler,                          // 12: DebugMonitor (v7-M)
-    nullptr,                                // 13: reserved
-    fault_handler,                          // 14: PendSV
-    fault_handler,                          // 15: SysTick
+    nullptr,
+    nullptr,
+    nullptr,
+    nullptr,        // 7-10: reserved
+    fault_handler,  // 11: SVCall
+    fault_handler,  // 12: DebugMonitor (v7-M)
+    nullptr,        // 13: reserved
+    fault_handler,  // 14: PendSV
+    fault_handler,  // 15: SysTick
 };

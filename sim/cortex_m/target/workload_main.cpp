@@ -16,7 +16,7 @@ struct StartupProbe {
     StartupProbe() : value(g_ctor_source) {}  // a volatile read: cannot be constant-folded
 };
 
-StartupProbe g_probe;                        // dynamic initialisation via .init_array
+StartupProbe g_probe;                              // dynamic initialisation via .init_array
 volatile std::uint32_t g_data_word = 0x12345678u;  // .data (volatile: not folded to a constant)
 volatile std::uint32_t g_bss_words[4];             // .bss
 
@@ -25,8 +25,13 @@ bool startup_ok() {
     const bool data = g_data_word == 0x12345678u;
     const bool bss = (g_bss_words[0] | g_bss_words[1] | g_bss_words[2] | g_bss_words[3]) == 0;
     const bool ctors = g_probe.value == 0x600dc70u;
-    line.text("startup data=").text(data ? "ok" : "BAD").text(" bss=").text(bss ? "ok" : "BAD")
-        .text(" ctors=").text(ctors ? "ok" : "BAD").end();
+    line.text("startup data=")
+        .text(data ? "ok" : "BAD")
+        .text(" bss=")
+        .text(bss ? "ok" : "BAD")
+        .text(" ctors=")
+        .text(ctors ? "ok" : "BAD")
+        .end();
     return data && bss && ctors;
 }
 
@@ -36,9 +41,17 @@ int main() {
     if (!startup_ok()) return 1;
     const pathstream::workload::Summary s = pathstream::workload::run();
     cortex_m::Line line;
-    line.text("workload ticks=").dec(s.ticks).text(" accepted=").dec(s.spans_accepted)
-        .text(" rejected=").dec(s.spans_rejected).text(" horner=").dec(s.horner_evaluations)
-        .text(" mismatches=").dec(s.mismatches).end();
+    line.text("workload ticks=")
+        .dec(s.ticks)
+        .text(" accepted=")
+        .dec(s.spans_accepted)
+        .text(" rejected=")
+        .dec(s.spans_rejected)
+        .text(" horner=")
+        .dec(s.horner_evaluations)
+        .text(" mismatches=")
+        .dec(s.mismatches)
+        .end();
     line.text("checksum=").hex(s.checksum).end();
     return s.mismatches == 0 ? 0 : 1;
 }

@@ -76,10 +76,12 @@ private:
         r[2] = Axes;
         for (unsigned a = 0; a < Axes; ++a) {
             r[device::modbus::kConfigAxisBase + 4 * a + 1] = 60000;  // 60,000 LSB/s
-            r[device::modbus::kConfigAxisBase + 4 * a + 2] = 4;      // 4 * 65536 + 37856 = 300,000 LSB/s^2
+            r[device::modbus::kConfigAxisBase + 4 * a + 2] =
+                4;  // 4 * 65536 + 37856 = 300,000 LSB/s^2
             r[device::modbus::kConfigAxisBase + 4 * a + 3] = 37856;
         }
-        check(map_.write_holding_registers(device::modbus::kConfig, device::modbus::config_registers(Axes), r),
+        check(map_.write_holding_registers(device::modbus::kConfig,
+                                           device::modbus::config_registers(Axes), r),
               Ex::kNone);
     }
 
@@ -152,10 +154,12 @@ private:
         std::uint16_t r[123] = {};
         std::uint16_t n = window(next_sequence_, 2, r);
         r[4] ^= 1u;  // wrong check value
-        check(map_.write_holding_registers(device::modbus::kSpanWindow, n, r), Ex::kIllegalDataValue);
+        check(map_.write_holding_registers(device::modbus::kSpanWindow, n, r),
+              Ex::kIllegalDataValue);
         restore(keep_p, keep_v);
         n = window(next_sequence_ + 5, 2, r);  // sequence gap
-        check(map_.write_holding_registers(device::modbus::kSpanWindow, n, r), Ex::kIllegalDataValue);
+        check(map_.write_holding_registers(device::modbus::kSpanWindow, n, r),
+              Ex::kIllegalDataValue);
         restore(keep_p, keep_v);
         // A span far over the acceleration limit: end tangent jumps by 400 LSB/tick.
         device::WireSpan w = next_span();
@@ -168,9 +172,11 @@ private:
         r[3] = static_cast<std::uint16_t>(length);
         r[4] = device::crc16_modbus(bytes, length);
         for (std::size_t i = 0; i < (length + 1) / 2; ++i) {
-            r[5 + i] = static_cast<std::uint16_t>((bytes[2 * i] << 8) | (2 * i + 1 < length ? bytes[2 * i + 1] : 0));
+            r[5 + i] = static_cast<std::uint16_t>((bytes[2 * i] << 8) |
+                                                  (2 * i + 1 < length ? bytes[2 * i + 1] : 0));
         }
-        check(map_.write_holding_registers(device::modbus::kSpanWindow, static_cast<std::uint16_t>(5 + (length + 1) / 2), r),
+        check(map_.write_holding_registers(device::modbus::kSpanWindow,
+                                           static_cast<std::uint16_t>(5 + (length + 1) / 2), r),
               Ex::kIllegalDataValue);
         restore(keep_p, keep_v);
         std::uint16_t after[device::modbus::status::kCount];
@@ -206,7 +212,8 @@ private:
                 if (step > 61 || step < -61) ++ctx_.summary.mismatches;
                 last_[a] = out[a];
             }
-            ctx_.hash.u32(static_cast<std::uint32_t>(device_.state()) | (static_cast<std::uint32_t>(device_.outputs()) << 8));
+            ctx_.hash.u32(static_cast<std::uint32_t>(device_.state()) |
+                          (static_cast<std::uint32_t>(device_.outputs()) << 8));
         }
     }
 

@@ -111,10 +111,17 @@ inline void draw_control(SplitMix64& rng, Basis basis, std::int32_t (&p)[4]) {
         const std::int64_t limit = tangent ? kMaxTangentLsb : kMaxPositionLsb;
         std::int64_t v = 0;
         switch (style) {
-            case 0: v = rng.between(-limit, limit); break;
-            case 1: v = (rng.below(2) != 0 ? limit : -limit) - rng.between(-3, 3); break;
-            case 2: v = rng.between(-1000, 1000); break;
-            default: v = tangent ? rng.between(-200000, 200000) : center + rng.between(-50000, 50000);
+            case 0:
+                v = rng.between(-limit, limit);
+                break;
+            case 1:
+                v = (rng.below(2) != 0 ? limit : -limit) - rng.between(-3, 3);
+                break;
+            case 2:
+                v = rng.between(-1000, 1000);
+                break;
+            default:
+                v = tangent ? rng.between(-200000, 200000) : center + rng.between(-50000, 50000);
         }
         if (v > limit) v = limit;
         if (v < -limit) v = -limit;
@@ -209,9 +216,15 @@ template <unsigned Axes>
 bool maybe_break(SplitMix64& rng, Span<Axes>& span) {
     if (rng.below(14) != 0) return false;
     switch (rng.below(4)) {
-        case 0: span.ticks = 0; break;
-        case 1: span.ticks = kMaxSpanTicks + 1; break;
-        case 2: span.basis = static_cast<Basis>(4 + rng.below(250)); break;
+        case 0:
+            span.ticks = 0;
+            break;
+        case 1:
+            span.ticks = kMaxSpanTicks + 1;
+            break;
+        case 2:
+            span.basis = static_cast<Basis>(4 + rng.below(250));
+            break;
         default:
             span.control[rng.below(Axes)][rng.below(2)] =
                 static_cast<std::int32_t>(kMaxTangentLsb + 1 + rng.below(1000));

@@ -89,7 +89,8 @@ SimulationResult run(const std::vector<CoreSpan>& spans, const host::MachineProf
         std::uint32_t pushed = 0;
         while (next < span_count &&
                (options.max_pushes_per_run == 0 || pushed < options.max_pushes_per_run)) {
-            const Status s = stream->push(host::to_core_span<Axes>(spans[next], static_cast<std::uint32_t>(next + 1)));
+            const Status s = stream->push(
+                host::to_core_span<Axes>(spans[next], static_cast<std::uint32_t>(next + 1)));
             if (s == Status::kQueueFull) {
                 ++r.stream.queue_full;
                 break;
@@ -169,8 +170,7 @@ SimulationResult run(const std::vector<CoreSpan>& spans, const host::MachineProf
 
 SimulationResult dispatch(const std::vector<CoreSpan>& spans, const host::MachineProfile& profile,
                           const SimOptions& options, hal::Clock* pacing, const Progress& progress) {
-    if (spans.empty())
-        throw std::invalid_argument("no spans: nothing to simulate");
+    if (spans.empty()) throw std::invalid_argument("no spans: nothing to simulate");
     const std::size_t axes = spans.front().control.size();
     if (axes < 1 || axes > kMaxAxes) {
         throw std::invalid_argument("the plan has " + std::to_string(axes) +
@@ -206,9 +206,9 @@ SimulationResult simulate(const std::vector<CoreSpan>& spans, const host::Machin
     return dispatch(spans, profile, options, &clock, progress);
 }
 
-SimulationResult simulate_paced(const std::vector<CoreSpan>& spans, const host::MachineProfile& profile,
-                                const SimOptions& options, hal::Clock& pacing,
-                                const Progress& progress) {
+SimulationResult simulate_paced(const std::vector<CoreSpan>& spans,
+                                const host::MachineProfile& profile, const SimOptions& options,
+                                hal::Clock& pacing, const Progress& progress) {
     return dispatch(spans, profile, options, &pacing, progress);
 }
 

@@ -31,10 +31,10 @@
 #include "pathstream/device/homing.hpp"
 #include "pathstream/device/motion_device.hpp"
 #include "pathstream/hal/gpio_gpiod.hpp"
+#include "pathstream/linux_device/device_gpio.hpp"
+#include "pathstream/linux_device/machine_lines.hpp"
 #include "pathstream/machine/input_error.hpp"
 #include "pathstream/machine/machine.hpp"
-#include "pathstream/linux_device/machine_lines.hpp"
-#include "pathstream/linux_device/device_gpio.hpp"
 #include "pathstream/sim/gpio_sim_pull.hpp"
 #include "pathstream/sim/machine_switches.hpp"
 
@@ -47,7 +47,8 @@ using Glue = linux_device::DeviceGpio<2, 64>;
 std::uint64_t now_ns() {
     timespec ts{};
     clock_gettime(CLOCK_MONOTONIC, &ts);
-    return static_cast<std::uint64_t>(ts.tv_sec) * 1000000000u + static_cast<std::uint64_t>(ts.tv_nsec);
+    return static_cast<std::uint64_t>(ts.tv_sec) * 1000000000u +
+           static_cast<std::uint64_t>(ts.tv_nsec);
 }
 
 void sleep_until_ns(std::uint64_t t) {
@@ -55,7 +56,9 @@ void sleep_until_ns(std::uint64_t t) {
     clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr);
 }
 
-hal::GpioLineSpec spec(const std::string& chip, const host::GpioLineConfig& c) { return linux_device::line_spec(chip, c); }
+hal::GpioLineSpec spec(const std::string& chip, const host::GpioLineConfig& c) {
+    return linux_device::line_spec(chip, c);
+}
 
 // The plotter: device, lines, glue, and a feeder that keeps it moving back and forth.
 struct Plotter {
@@ -63,7 +66,8 @@ struct Plotter {
         const host::GpioConfig& g = p.gpio;
         if (!g.present) throw hal::GpioError("the profile has no gpio object");
         if (g.has_estop) estop = hal::open_gpiod_input(spec(g.chip, g.estop), "pathstream-estop");
-        if (g.has_enable) enable = hal::open_gpiod_output(spec(g.chip, g.enable), "pathstream-enable");
+        if (g.has_enable)
+            enable = hal::open_gpiod_output(spec(g.chip, g.enable), "pathstream-enable");
         if (g.has_pen) pen = hal::open_gpiod_output(spec(g.chip, g.pen), "pathstream-pen");
         linux_device::DeviceWiring<2> w;
         w.estop = estop.get();
@@ -90,7 +94,9 @@ struct Plotter {
     // Keeps spans queued: x and y in turn, 20 mm out and back, pen down.
     void feed() {
         const device::DeviceState s = device.state();
-        if (s == device::DeviceState::kFault || s == device::DeviceState::kEstop || s == device::DeviceState::kStopping) return;
+        if (s == device::DeviceState::kFault || s == device::DeviceState::kEstop ||
+            s == device::DeviceState::kStopping)
+            return;
         while (device.free_slots() > 8) {
             if (!move.pending()) {
                 Lsb from[2] = {end[0], end[1]};
@@ -106,7 +112,9 @@ struct Plotter {
             w.outputs = kOutputPenDown;
             std::uint8_t bytes[4 + 12 * 2];
             const std::size_t n = device::encode_wire_span(w, 2, bytes, sizeof bytes);
-            if (device.accept_batch(device.last_accepted_sequence() + 1, 1, bytes, n) != Status::kOk) return;
+            if (device.accept_batch(device.last_accepted_sequence() + 1, 1, bytes, n) !=
+                Status::kOk)
+                return;
         }
     }
 
@@ -135,17 +143,19 @@ struct Plotter {
         const auto it = std::find_if(p.gpio.limits.begin(), p.gpio.limits.end(),
                                      [&name](const auto& l) { return l.first == name; });
         if (eq == std::string::npos || it == p.gpio.limits.end()) {
-            throw hal::GpioError("switch " + arg + ": want NAME=MM with NAME a limit switch of the profile");
+            throw hal::GpioError("switch " + arg +
+                                 ": want NAME=MM with NAME a limit switch of the profile");
         }
         sim::SwitchPlacement sp;
         sp.axis = name[0] == 'x' ? 0u : 1u;
         sp.side = name.back() == '+' ? device::LimitSide::kPositive : device::LimitSide::kNegative;
         sp.trigger = static_cast<Lsb>(std::llround(std::stod(arg.substr(eq + 1)) / p.mm_per_lsb));
         const hal::GpioLineLocation where = hal::locate_gpiod_line(spec(p.gpio.chip, it->second));
-        auto pull = std::make_shared<sim::GpioSimPull>(where.chip_name, where.offset, it->second.active_low);
+        auto pull = std::make_shared<sim::GpioSimPull>(where.chip_name, where.offset,
+                                                       it->second.active_low);
         switches.place(sp, [pull](bool closed) { pull->set(closed); });
-        std::printf("driver: switch %s at %s mm played by axis %u on %s\n", name.c_str(), arg.substr(eq + 1).c_str(),
-                    sp.axis, pull->path().c_str());
+        std::printf("driver: switch %s at %s mm played by axis %u on %s\n", name.c_str(),
+                    arg.substr(eq + 1).c_str(), sp.axis, pull->path().c_str());
     }
 
     Device device;
@@ -160,9 +170,13 @@ struct Plotter {
     std::uint64_t ticks = 0;
 };
 
-void touch(const std::string& path) { std::ofstream(path) << "1\n"; }
+void touch(const std::string& path) {
+    std::ofstream(path) << "1\n";
+}
 
-bool exists(const std::string& path) { return std::ifstream(path).good(); }
+bool exists(const std::string& path) {
+    return std::ifstream(path).good();
+}
 
 bool write_attr(const std::string& path, const char* value) {
     std::ofstream out(path);
@@ -173,12 +187,18 @@ bool write_attr(const std::string& path, const char* value) {
 
 const char* state_name(device::DeviceState s) {
     switch (s) {
-        case device::DeviceState::kIdle: return "idle";
-        case device::DeviceState::kRunning: return "running";
-        case device::DeviceState::kHolding: return "holding";
-        case device::DeviceState::kStopping: return "stopping";
-        case device::DeviceState::kFault: return "fault";
-        case device::DeviceState::kEstop: return "estop";
+        case device::DeviceState::kIdle:
+            return "idle";
+        case device::DeviceState::kRunning:
+            return "running";
+        case device::DeviceState::kHolding:
+            return "holding";
+        case device::DeviceState::kStopping:
+            return "stopping";
+        case device::DeviceState::kFault:
+            return "fault";
+        case device::DeviceState::kEstop:
+            return "estop";
     }
     return "?";
 }
@@ -208,7 +228,8 @@ int run(const host::MachineProfile& profile, const std::string& dir, std::uint64
     Plotter p(profile);
     for (const std::string& sw : switches) p.place_switch(profile, sw);
     p.feed();
-    if (p.device.command(device::Command::kStart) != Status::kOk) return std::fprintf(stderr, "start refused\n"), 1;
+    if (p.device.command(device::Command::kStart) != Status::kOk)
+        return std::fprintf(stderr, "start refused\n"), 1;
     const std::uint64_t period = 1000000;  // 1 kHz
     std::uint64_t deadline = now_ns();
     device::DeviceState last = p.device.state();
@@ -225,19 +246,24 @@ int run(const host::MachineProfile& profile, const std::string& dir, std::uint64
         p.feed();
         const device::DeviceState s = p.device.state();
         if (s != last) {
-            std::printf("driver: tick %llu: %s -> %s\n", static_cast<unsigned long long>(p.ticks), state_name(last), state_name(s));
+            std::printf("driver: tick %llu: %s -> %s\n", static_cast<unsigned long long>(p.ticks),
+                        state_name(last), state_name(s));
             if (s == device::DeviceState::kEstop) {
                 estop_tick = p.ticks;
                 frozen[0] = p.device.position(0);
                 frozen[1] = p.device.position(1);
                 const bool same = frozen[0] == before[0] && frozen[1] == before[1];
                 const std::uint64_t edge = p.glue->last_estop_edge_ns();
-                std::printf("driver: estop: reaction %s tick (edge seen by the poll before tick %llu, state estop "
-                            "and enable dropped after it); setpoint repeated: %s; kernel edge timestamp -> enable "
-                            "dropped: %llu us\n",
-                            p.glue->estop_edges() > edges_before ? "1" : "<=1",
-                            static_cast<unsigned long long>(p.ticks), same ? "yes" : "NO",
-                            static_cast<unsigned long long>(edge != 0 && after_ns > edge ? (after_ns - edge) / 1000 : 0));
+                std::printf(
+                    "driver: estop: reaction %s tick (edge seen by the poll before tick %llu, "
+                    "state estop "
+                    "and enable dropped after it); setpoint repeated: %s; kernel edge timestamp -> "
+                    "enable "
+                    "dropped: %llu us\n",
+                    p.glue->estop_edges() > edges_before ? "1" : "<=1",
+                    static_cast<unsigned long long>(p.ticks), same ? "yes" : "NO",
+                    static_cast<unsigned long long>(
+                        edge != 0 && after_ns > edge ? (after_ns - edge) / 1000 : 0));
                 std::fflush(stdout);
                 if (!same) return 1;
                 touch(dir + "/estop");
@@ -249,7 +275,8 @@ int run(const host::MachineProfile& profile, const std::string& dir, std::uint64
                 return hold_until_done(p, dir, deadline);
             }
             if (s == device::DeviceState::kIdle && estop_tick != 0) {
-                std::printf("driver: reset after e-stop: idle, enable %s\n", device::enable_asserted(s) ? "high" : "low");
+                std::printf("driver: reset after e-stop: idle, enable %s\n",
+                            device::enable_asserted(s) ? "high" : "low");
                 touch(dir + "/reset");
                 return hold_until_done(p, dir, deadline);
             }
@@ -267,7 +294,8 @@ int run(const host::MachineProfile& profile, const std::string& dir, std::uint64
             if (!p.estop->active()) (void)p.device.command(device::Command::kReset);
         }
     }
-    std::printf("driver: FAIL: nothing happened within %llu ms\n", static_cast<unsigned long long>(max_ms));
+    std::printf("driver: FAIL: nothing happened within %llu ms\n",
+                static_cast<unsigned long long>(max_ms));
     return 1;
 }
 
@@ -280,7 +308,8 @@ int measure(const host::MachineProfile& profile, const std::string& pull, int ro
     for (int r = 0; r < rounds; ++r) {
         p.restart_moves();
         p.feed();
-        if (p.device.command(device::Command::kStart) != Status::kOk) return std::fprintf(stderr, "start refused\n"), 1;
+        if (p.device.command(device::Command::kStart) != Status::kOk)
+            return std::fprintf(stderr, "start refused\n"), 1;
         // Run 100 ticks, then make the edge and time it.
         for (int i = 0; i < 100; ++i) {
             deadline += period;
@@ -288,10 +317,12 @@ int measure(const host::MachineProfile& profile, const std::string& pull, int ro
             p.tick();
             p.feed();
         }
-        if (p.device.state() != device::DeviceState::kRunning) return std::fprintf(stderr, "not running\n"), 1;
+        if (p.device.state() != device::DeviceState::kRunning)
+            return std::fprintf(stderr, "not running\n"), 1;
         const std::uint64_t t0 = now_ns();
         const std::uint64_t tick0 = p.ticks;
-        if (!write_attr(pull, "pull-up")) return std::fprintf(stderr, "cannot write %s\n", pull.c_str()), 1;
+        if (!write_attr(pull, "pull-up"))
+            return std::fprintf(stderr, "cannot write %s\n", pull.c_str()), 1;
         bool dropped = false;
         for (int i = 0; i < 1000 && !dropped; ++i) {
             deadline = std::max(deadline + period, now_ns());  // the write took time: no burst
@@ -310,14 +341,18 @@ int measure(const host::MachineProfile& profile, const std::string& pull, int ro
             if (!p.estop->active()) (void)p.device.command(device::Command::kReset);
             p.tick();
         }
-        if (p.device.state() != device::DeviceState::kIdle) return std::fprintf(stderr, "no reset\n"), 1;
+        if (p.device.state() != device::DeviceState::kIdle)
+            return std::fprintf(stderr, "no reset\n"), 1;
     }
     std::vector<double> sorted = us;
     std::sort(sorted.begin(), sorted.end());
     const std::uint64_t max_ticks = *std::max_element(tick_counts.begin(), tick_counts.end());
-    std::printf("driver: measure: %d e-stops, sysfs pull write -> enable line low: min %.0f us, median %.0f us, "
-                "max %.0f us; ticks from the write to the e-stop state: max %llu\n",
-                rounds, sorted.front(), sorted[sorted.size() / 2], sorted.back(), static_cast<unsigned long long>(max_ticks));
+    std::printf(
+        "driver: measure: %d e-stops, sysfs pull write -> enable line low: min %.0f us, median "
+        "%.0f us, "
+        "max %.0f us; ticks from the write to the e-stop state: max %llu\n",
+        rounds, sorted.front(), sorted[sorted.size() / 2], sorted.back(),
+        static_cast<unsigned long long>(max_ticks));
     return 0;
 }
 
@@ -348,7 +383,9 @@ int errors(const std::string& chip) {
     // A line held by another request: busy, and the holder is named.
     const hal::GpioLineSpec estop{chip, "estop", false, hal::Bias::kAsIs};
     auto held = hal::open_gpiod_input(estop, "pathstream-holder");
-    expect(estop, false, "gpio " + chip + " line \"estop\": request edge events (in use by \"pathstream-holder\")");
+    expect(
+        estop, false,
+        "gpio " + chip + " line \"estop\": request edge events (in use by \"pathstream-holder\")");
     expect(estop, true, "request as output (in use by \"pathstream-holder\")");
     return failures == 0 ? 0 : 1;
 }
@@ -377,7 +414,8 @@ int main(int argc, char** argv) {
     try {
         const host::MachineProfile profile = host::load_machine_profile(argv[2]);
         if (mode == "run") {
-            return run(profile, argv[3], std::strtoull(argv[4], nullptr, 10), std::vector<std::string>(argv + 5, argv + argc));
+            return run(profile, argv[3], std::strtoull(argv[4], nullptr, 10),
+                       std::vector<std::string>(argv + 5, argv + argc));
         }
         if (argc != 5) return usage();
         if (mode == "measure") return measure(profile, argv[3], std::atoi(argv[4]));

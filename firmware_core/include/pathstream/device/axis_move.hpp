@@ -33,8 +33,8 @@ public:
     /// span fits the limits at no length: every span is settled here, so next() cannot fail
     /// half-way through a move (a jog refused after some of its spans were queued would leave
     /// the device changed by a refused command).
-    [[nodiscard]] Status plan(const Lsb (&start)[Axes], unsigned axis, std::int64_t distance, std::uint32_t velocity,
-                              const MotionLimits<Axes>& limits) {
+    [[nodiscard]] Status plan(const Lsb (&start)[Axes], unsigned axis, std::int64_t distance,
+                              std::uint32_t velocity, const MotionLimits<Axes>& limits) {
         for (unsigned a = 0; a < Axes; ++a) at_[a] = start[a];
         axis_ = axis;
         sign_ = distance < 0 ? -1 : 1;
@@ -46,7 +46,8 @@ public:
         s_curve_ = false;
         if (limits.axis[axis].max_jerk != 0) {
             cap_by_jerk(limits);
-            if (const Status st = plan_s_curve(start, velocity, limits); st != Status::kBadLimits) return st;
+            if (const Status st = plan_s_curve(start, velocity, limits); st != Status::kBadLimits)
+                return st;
             // No S-curve span length fits these limits: the constant-acceleration ramps below,
             // on limits_ as capped.
         }
@@ -62,12 +63,15 @@ public:
         step_ = even_floor(static_cast<std::uint64_t>(l.max_acceleration) * n_ * n_ / (hz * hz));
         cruise_ = even_floor(static_cast<std::uint64_t>(velocity) * n_ / hz);
         if (cruise_ < 2) cruise_ = 2;
-        while (static_cast<std::uint64_t>(cruise_) * hz > static_cast<std::uint64_t>(l.max_velocity) * n_ && cruise_ > 2) {
+        while (static_cast<std::uint64_t>(cruise_) * hz >
+                   static_cast<std::uint64_t>(l.max_velocity) * n_ &&
+               cruise_ > 2) {
             cruise_ -= 2;
         }
         // Even the slowest cruise (2 LSB per span) is over the velocity limit: the device would
         // refuse every span, so the move is refused here.
-        if (static_cast<std::uint64_t>(cruise_) * hz > static_cast<std::uint64_t>(l.max_velocity) * n_) {
+        if (static_cast<std::uint64_t>(cruise_) * hz >
+            static_cast<std::uint64_t>(l.max_velocity) * n_) {
             return Status::kBadLimits;
         }
         // Shrink the cruise tangent until both ramps fit in the distance. A ramp of R spans
@@ -85,7 +89,8 @@ public:
                 continue;
             }
             ramp_distance_ = 0;
-            for (std::uint32_t i = 0; i < ramp_spans_; ++i) ramp_distance_ += (ramp_tangent(i) + ramp_tangent(i + 1)) / 2;
+            for (std::uint32_t i = 0; i < ramp_spans_; ++i)
+                ramp_distance_ += (ramp_tangent(i) + ramp_tangent(i + 1)) / 2;
             if (2 * ramp_distance_ <= remaining_ || cruise_ <= 2) break;
             cruise_ = even_floor(static_cast<std::uint64_t>(cruise_) / 2);
             if (cruise_ < 2) cruise_ = 2;
@@ -178,7 +183,9 @@ public:
     std::uint32_t span_ticks() const { return n_; }
 
 private:
-    static std::int64_t even_floor(std::uint64_t v) { return static_cast<std::int64_t>(v & ~std::uint64_t{1}); }
+    static std::int64_t even_floor(std::uint64_t v) {
+        return static_cast<std::int64_t>(v & ~std::uint64_t{1});
+    }
 
     // Tangent after i ramp spans: i/ramp_spans of the cruise tangent, rounded to even.
     std::int64_t ramp_tangent(std::uint32_t i) const {
@@ -186,7 +193,9 @@ private:
         return even_floor(static_cast<std::uint64_t>(cruise_) * i / ramp_spans_);
     }
 
-    std::int64_t total_spans() const { return 2 * static_cast<std::int64_t>(ramp_spans_) + cruise_spans_ + (creep_ != 0 ? 1 : 0); }
+    std::int64_t total_spans() const {
+        return 2 * static_cast<std::int64_t>(ramp_spans_) + cruise_spans_ + (creep_ != 0 ? 1 : 0);
+    }
 
     // The cruise between the S-curve ramps: `spans` spans of tangent `cruise` covering `middle`
     // LSB, the first 3 * dips of them dipping (knots 0, -x, x, 0 of A: the tangent falls by
@@ -227,7 +236,8 @@ private:
     // more spans than kMaxRampSpans or the move's distance (its chords average at least 1).
     std::int64_t ramp_distance(std::int64_t cruise, SCurveRamp& ramp) const {
         ramp.plan(cruise);
-        if (ramp.spans > kMaxRampSpans || static_cast<std::int64_t>(ramp.spans) > remaining_) return -1;
+        if (ramp.spans > kMaxRampSpans || static_cast<std::int64_t>(ramp.spans) > remaining_)
+            return -1;
         std::int64_t t = 0, distance = 0;
         for (std::uint32_t k = 0; k < ramp.spans; ++k) {
             const std::int64_t a0 = ramp.at(k), a1 = ramp.at(k + 1);
@@ -244,8 +254,9 @@ private:
         if (rest == 0) return 0;
         const std::uint64_t hz = limits.tick_hz;
         // 12 rest hz^3 (< 2^35 2^51) over J (>= 100).
-        const FloorDivision q = floor_divide(multiply_unsigned(12 * rest, hz * hz * hz),
-                                             std::uint64_t{limits.axis[axis_].max_jerk} * kJerkUnitLsb);
+        const FloorDivision q =
+            floor_divide(multiply_unsigned(12 * rest, hz * hz * hz),
+                         std::uint64_t{limits.axis[axis_].max_jerk} * kJerkUnitLsb);
         if (q.quotient.hi != 0) return std::uint64_t{1} << 32;
         std::uint64_t x = q.quotient.lo, root = 0, bit = std::uint64_t{1} << 62;
         while (bit > x) bit >>= 2;
@@ -265,8 +276,8 @@ private:
     // S-curve, every constant-acceleration span: ramp to ramp, rest to ramp, ramp up to ramp
     // down), so that every step is at most one tick of jerk and the spans carry no jerk.
     void cap_by_jerk(const MotionLimits<Axes>& limits) {
-        const std::uint64_t by_jerk =
-            static_cast<std::uint64_t>(limits.axis[axis_].max_jerk) * kJerkUnitLsb / (2 * std::uint64_t{limits.tick_hz});
+        const std::uint64_t by_jerk = static_cast<std::uint64_t>(limits.axis[axis_].max_jerk) *
+                                      kJerkUnitLsb / (2 * std::uint64_t{limits.tick_hz});
         if (by_jerk < limits_.axis[axis_].max_acceleration) {
             limits_.axis[axis_].max_acceleration = static_cast<std::uint32_t>(by_jerk);
         }
@@ -278,7 +289,8 @@ private:
     // of 6 at most the requested velocity (n longer where that needs it), as fast as the
     // distance allows (else the creep span alone). kBadLimits (and the constant-acceleration
     // move is planned instead) when no span length fits, or the creep span fits at no length.
-    Status plan_s_curve(const Lsb (&start)[Axes], std::uint32_t velocity, const MotionLimits<Axes>& limits) {
+    Status plan_s_curve(const Lsb (&start)[Axes], std::uint32_t velocity,
+                        const MotionLimits<Axes>& limits) {
         const AxisLimits& l = limits.axis[axis_];
         const std::uint64_t hz = limits.tick_hz;
         if (velocity > l.max_velocity) velocity = l.max_velocity;
@@ -286,13 +298,18 @@ private:
         std::int64_t step = 0, peak = 0;
         for (;; n *= 2) {
             if (n > kMaxSpanTicks / 2) return Status::kBadLimits;
-            // J n^3 = max_jerk 100 n^3 / hz^3 (< 2^39 2^45 over > 2^0); A n^2 = max_acceleration n^2 / hz^2.
+            // J n^3 = max_jerk 100 n^3 / hz^3 (< 2^39 2^45 over > 2^0); A n^2 = max_acceleration
+            // n^2 / hz^2.
             const std::uint64_t n3 = std::uint64_t{n} * n * n;
-            const FloorDivision j = floor_divide(multiply_unsigned(std::uint64_t{l.max_jerk} * kJerkUnitLsb, n3), 6 * hz * hz * hz);
-            const FloorDivision a = floor_divide(multiply_unsigned(l.max_acceleration, std::uint64_t{n} * n), 6 * hz * hz);
+            const FloorDivision j = floor_divide(
+                multiply_unsigned(std::uint64_t{l.max_jerk} * kJerkUnitLsb, n3), 6 * hz * hz * hz);
+            const FloorDivision a = floor_divide(
+                multiply_unsigned(l.max_acceleration, std::uint64_t{n} * n), 6 * hz * hz);
             constexpr std::uint64_t kLarge = std::uint64_t{1} << 40;  // beyond any tangent's reach
-            const std::uint64_t js = j.quotient.hi != 0 || j.quotient.lo > kLarge ? kLarge : j.quotient.lo;
-            const std::uint64_t as = a.quotient.hi != 0 || a.quotient.lo > kLarge ? kLarge : a.quotient.lo;
+            const std::uint64_t js =
+                j.quotient.hi != 0 || j.quotient.lo > kLarge ? kLarge : j.quotient.lo;
+            const std::uint64_t as =
+                a.quotient.hi != 0 || a.quotient.lo > kLarge ? kLarge : a.quotient.lo;
             // The cruise tangent, a multiple of 6, must not exceed the requested velocity (a
             // homing latch defines zero at its speed): spans long enough for 6 LSB at it.
             if (js >= 1 && as >= 1 && std::uint64_t{velocity} * n >= 6 * hz) {
@@ -308,7 +325,8 @@ private:
         n_ = n;
         ramp_.step = step;
         ramp_.peak = peak;
-        std::int64_t cruise = static_cast<std::int64_t>(std::uint64_t{velocity} * n / hz / 6 * 6);  // >= 6
+        std::int64_t cruise =
+            static_cast<std::int64_t>(std::uint64_t{velocity} * n / hz / 6 * 6);  // >= 6
         // The fastest cruise whose two ramps fit the distance (a ramp's distance grows with its
         // cruise: bisection over the multiples of 6), then, within 1/8 of it, the one whose move
         // takes the fewest ticks with the creep span's estimated (at most 16 tries): the creep
@@ -335,13 +353,14 @@ private:
                 }
             }
             std::uint64_t best = ~std::uint64_t{0};
-            for (std::int64_t units = top, tries = 0; units >= 1 && units >= top - top / 8 && tries < 16;
-                 --units, ++tries) {
+            for (std::int64_t units = top, tries = 0;
+                 units >= 1 && units >= top - top / 8 && tries < 16; --units, ++tries) {
                 const std::int64_t d = fitting(units, ramp);
                 if (d < 0) continue;
                 const Middle m = plan_middle(remaining_ - 2 * d, 6 * units, ramp.step);
-                const std::uint64_t ticks = (2 * std::uint64_t{ramp.spans} + static_cast<std::uint64_t>(m.spans)) * n_ +
-                                            creep_estimate(static_cast<std::uint64_t>(m.creep), limits);
+                const std::uint64_t ticks =
+                    (2 * std::uint64_t{ramp.spans} + static_cast<std::uint64_t>(m.spans)) * n_ +
+                    creep_estimate(static_cast<std::uint64_t>(m.creep), limits);
                 if (ticks < best) {
                     best = ticks;
                     cruise = 6 * units;
@@ -374,7 +393,8 @@ private:
         walk_ = 0;
         if (creep_ != 0) {
             const std::int64_t creep_from = start[axis_] + sign_ * (remaining_ - creep_);
-            if (creep_from > kMaxPositionLsb || creep_from < -kMaxPositionLsb) return Status::kBadLimits;
+            if (creep_from > kMaxPositionLsb || creep_from < -kMaxPositionLsb)
+                return Status::kBadLimits;
             creep_ticks_ = creep_length(static_cast<Lsb>(creep_from),
                                         creep_estimate(static_cast<std::uint64_t>(creep_), limits));
             if (creep_ticks_ == 0) return Status::kBadLimits;
@@ -404,7 +424,8 @@ private:
         s.control[axis_][1] = static_cast<Lsb>(from + sign_ * creep_);
         std::uint64_t step = 0;
         for (std::uint64_t ticks = first != 0 ? first : n_; ticks <= kMaxSpanTicks;
-             first != 0 ? (ticks += step == 0 ? 1 : step, step = step == 0 ? 1 : 2 * step) : ticks *= 2) {
+             first != 0 ? (ticks += step == 0 ? 1 : step, step = step == 0 ? 1 : 2 * step)
+                        : ticks *= 2) {
             s.ticks = static_cast<std::uint32_t>(ticks);
             ValidatedSpan<Axes> v;
             if (validate_span(s, v) != Status::kOk) continue;
@@ -433,7 +454,7 @@ private:
     std::int64_t creep_ = 0;
     std::uint32_t creep_ticks_ = 0;  // length of the creep span, settled by plan()
     std::int64_t index_ = 0;
-    bool s_curve_ = false;   // the ramps are ramp_'s S-curves (a jerk limit on the axis)
+    bool s_curve_ = false;        // the ramps are ramp_'s S-curves (a jerk limit on the axis)
     std::int64_t dips_ = 0;       // S-curve: dips at the cruise's start (plan_middle)
     std::int64_t dip_total_ = 0;  // what they take off the plain cruise, LSB
     SCurveRamp ramp_;

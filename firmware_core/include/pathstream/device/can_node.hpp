@@ -9,8 +9,8 @@
 #include <cstdint>
 
 #include "pathstream/device/can_protocol.hpp"
-#include "pathstream/device/operator_commands.hpp"
 #include "pathstream/device/motion_device.hpp"
+#include "pathstream/device/operator_commands.hpp"
 #include "pathstream/status.hpp"
 
 namespace pathstream::device::can {
@@ -40,21 +40,33 @@ public:
                f == kCommandArgsBase;
     }
 
-    /// Handles one received frame; calls `send(const Frame&)` for each answer (a status request is answered by 4 + Axes frames; anything else by 0 or 1).
-    /// Frames for other nodes or functions are ignored; a frame claiming more than 8 data bytes
-    /// is refused (kResultBadFrame, and a transfer in progress is dropped) whatever the driver
-    /// filled in. Cost: a batch's accept_batch when its last data frame arrives, O(1) otherwise.
+    /// Handles one received frame; calls `send(const Frame&)` for each answer (a status request is
+    /// answered by 4 + Axes frames; anything else by 0 or 1). Frames for other nodes or functions
+    /// are ignored; a frame claiming more than 8 data bytes is refused (kResultBadFrame, and a
+    /// transfer in progress is dropped) whatever the driver filled in. Cost: a batch's accept_batch
+    /// when its last data frame arrives, O(1) otherwise.
     template <typename Send>
     void handle(const Frame& f, Send&& send) {
         if (!addressed(f.id)) return;
         if (f.length > sizeof f.data) return refuse_oversized(f, send);
         switch (function_of(f.id)) {
-            case kCommandBase: on_command(f, send); break;
-            case kCommandArgsBase: on_command_args(f, send); break;
-            case kConfigBase: on_config(f, send); break;
-            case kSpanStartBase: on_span_start(f, send); break;
-            case kSpanDataBase: on_span_data(f, send); break;
-            default: break;
+            case kCommandBase:
+                on_command(f, send);
+                break;
+            case kCommandArgsBase:
+                on_command_args(f, send);
+                break;
+            case kConfigBase:
+                on_config(f, send);
+                break;
+            case kSpanStartBase:
+                on_span_start(f, send);
+                break;
+            case kSpanDataBase:
+                on_span_data(f, send);
+                break;
+            default:
+                break;
         }
     }
 
@@ -65,13 +77,12 @@ public:
         const DeviceStatus<Axes> d = device_.status();
         Status3 s;
         s.state = static_cast<std::uint8_t>(d.state);
-        s.flags = static_cast<std::uint8_t>((device_.configured() ? kFlagConfigured : 0) |
-                                            (d.held_by_underrun() ? kFlagHeldByUnderrun : 0) |
-                                            (d.own_move() ? kFlagOwnMove : 0) |
-                                            (d.paused() ? kFlagPaused : 0) |
-                                            (operator_.homing() ? kFlagHoming : 0) |
-                                            ((d.outputs & kOutputPenDown) != 0 ? kFlagPenDown : 0) |
-                                            (bus_problem_ ? kFlagBusProblem : 0));
+        s.flags = static_cast<std::uint8_t>(
+            (device_.configured() ? kFlagConfigured : 0) |
+            (d.held_by_underrun() ? kFlagHeldByUnderrun : 0) | (d.own_move() ? kFlagOwnMove : 0) |
+            (d.paused() ? kFlagPaused : 0) | (operator_.homing() ? kFlagHoming : 0) |
+            ((d.outputs & kOutputPenDown) != 0 ? kFlagPenDown : 0) |
+            (bus_problem_ ? kFlagBusProblem : 0));
         s.free_slots = saturate8(device_.free_slots());
         s.queued = saturate8(device_.queued_spans());
         s.fault_code = static_cast<std::uint16_t>(d.fault_code);
@@ -91,7 +102,8 @@ public:
             const HomingReport h = operator_.homing_report(a);
             const auto homing = static_cast<std::uint8_t>(static_cast<unsigned>(h.state) |
                                                           (static_cast<unsigned>(h.error) << 4));
-            send(encode_status_axis(node_, static_cast<std::uint8_t>(a), d.position[a], d.epoch, homing));
+            send(encode_status_axis(node_, static_cast<std::uint8_t>(a), d.position[a], d.epoch,
+                                    homing));
         }
     }
 
@@ -108,7 +120,9 @@ public:
     std::uint32_t refused_batches() const { return refused_; }
 
 private:
-    static std::uint8_t saturate8(std::uint32_t v) { return static_cast<std::uint8_t>(v > 255 ? 255 : v); }
+    static std::uint8_t saturate8(std::uint32_t v) {
+        return static_cast<std::uint8_t>(v > 255 ? 255 : v);
+    }
 
     template <typename Send>
     void ack(std::uint8_t kind, std::uint8_t result, std::uint32_t sequence, Send& send) const {
@@ -126,7 +140,9 @@ private:
     template <typename Send>
     void refuse_oversized(const Frame& f, Send& send) {
         switch (function_of(f.id)) {
-            case kConfigBase: config_seen_ = 0; return ack(kAckConfig, kResultBadFrame, 0, send);
+            case kConfigBase:
+                config_seen_ = 0;
+                return ack(kAckConfig, kResultBadFrame, 0, send);
             case kSpanStartBase:
             case kSpanDataBase: {
                 const std::uint32_t sequence = active_ ? transfer_.first_sequence : 0;
@@ -134,7 +150,8 @@ private:
                 active_ = false;
                 return ack(kAckSpans, kResultBadFrame, sequence, send);
             }
-            default: return ack(kAckCommand, kResultBadFrame, 0, send);
+            default:
+                return ack(kAckCommand, kResultBadFrame, 0, send);
         }
     }
 
@@ -174,8 +191,10 @@ private:
         const std::uint8_t item = static_cast<std::uint8_t>(get(f, kConfigSignals[0]));
         const std::uint8_t axes = static_cast<std::uint8_t>(get(f, kConfigSignals[1]));
         const std::uint32_t value = get(f, kConfigSignals[2]);
-        if (axes != Axes) return ack(kAckConfig, static_cast<std::uint8_t>(Status::kBadLimits), item, send);
-        const bool travel_item = item >= config_item_min_position(0) && item < config_item_min_position(Axes);
+        if (axes != Axes)
+            return ack(kAckConfig, static_cast<std::uint8_t>(Status::kBadLimits), item, send);
+        const bool travel_item =
+            item >= config_item_min_position(0) && item < config_item_min_position(Axes);
         const bool jerk_item = item >= config_item_jerk(0) && item < config_item_jerk(Axes);
         if (item > 2 * Axes && item != kConfigItemPenDown && !travel_item && !jerk_item) {
             return ack(kAckConfig, kResultBadFrame, item, send);
@@ -203,8 +222,8 @@ private:
         config_seen_ |= std::uint64_t{1} << item;
         // Items before the last (the pen-down delay) are not acknowledged: one ack per set.
         if (item != kConfigItemPenDown) return;
-        const std::uint64_t all = ((std::uint64_t{1} << (2 * Axes + 1)) - 1u) |
-                                  (std::uint64_t{1} << kConfigItemPenDown);
+        const std::uint64_t all =
+            ((std::uint64_t{1} << (2 * Axes + 1)) - 1u) | (std::uint64_t{1} << kConfigItemPenDown);
         const std::uint8_t result = (config_seen_ & all) == all
                                         ? static_cast<std::uint8_t>(device_.configure(pending_))
                                         : kResultIncomplete;
@@ -217,9 +236,11 @@ private:
         SpanStart s;
         active_ = false;
         if (!decode_span_start(f, s)) return ack(kAckSpans, kResultBadFrame, 0, send);
-        if (s.length > kMaxTransferBytes) return ack(kAckSpans, kResultTooLong, s.first_sequence, send);
+        if (s.length > kMaxTransferBytes)
+            return ack(kAckSpans, kResultTooLong, s.first_sequence, send);
         if (s.length == 0 || s.count == 0) {
-            return ack(kAckSpans, static_cast<std::uint8_t>(Status::kBadBatch), s.first_sequence, send);
+            return ack(kAckSpans, static_cast<std::uint8_t>(Status::kBadBatch), s.first_sequence,
+                       send);
         }
         transfer_ = s;
         received_ = 0;
@@ -229,10 +250,12 @@ private:
 
     template <typename Send>
     void on_span_data(const Frame& f, Send& send) {
-        if (!active_ || f.length < 2) return;  // no transfer (its start was lost): the host times out
+        if (!active_ || f.length < 2)
+            return;  // no transfer (its start was lost): the host times out
         const std::uint8_t index = f.data[0];
         const std::size_t n = static_cast<std::size_t>(f.length) - 1;
-        if (n > sizeof f.data - 1) return refuse_oversized(f, send);  // handle() checks too: keep local
+        if (n > sizeof f.data - 1)
+            return refuse_oversized(f, send);  // handle() checks too: keep local
         if (index != next_index_ || received_ + n > transfer_.length) {
             // A frame was lost: refuse now rather than let the host wait for its timeout.
             active_ = false;
@@ -244,7 +267,8 @@ private:
         ++next_index_;
         if (received_ < transfer_.length) return;
         active_ = false;
-        const Status st = device_.accept_batch(transfer_.first_sequence, transfer_.count, buffer_, received_);
+        const Status st =
+            device_.accept_batch(transfer_.first_sequence, transfer_.count, buffer_, received_);
         if (st != Status::kOk) ++refused_;
         ack(kAckSpans, static_cast<std::uint8_t>(st), transfer_.first_sequence, send);
     }

@@ -41,13 +41,17 @@ inline constexpr std::uint32_t kStatusEBase = 0x580;
 inline constexpr std::uint32_t kCommandArgsBase = 0x600;
 
 /// Identifier of function `base` for node `node`. Constant, any context.
-constexpr std::uint32_t can_id(std::uint32_t base, std::uint8_t node) { return base + node; }
+constexpr std::uint32_t can_id(std::uint32_t base, std::uint8_t node) {
+    return base + node;
+}
 /// Function base of identifier `id` (0 when `id` is not one of ours). Constant.
 constexpr std::uint32_t function_of(std::uint32_t id) {
     const std::uint32_t base = id & ~0x7Fu;
     return (base >= kCommandBase && base <= kCommandArgsBase && (id & 0x7Fu) != 0) ? base : 0;
 }
-constexpr std::uint8_t node_of(std::uint32_t id) { return static_cast<std::uint8_t>(id & 0x7Fu); }
+constexpr std::uint8_t node_of(std::uint32_t id) {
+    return static_cast<std::uint8_t>(id & 0x7Fu);
+}
 
 /// Command frame values: device::Command (1..5) plus a status request. Any other value is
 /// passed to the device, which refuses it (ack result kUnknownCommand).
@@ -59,10 +63,11 @@ inline constexpr std::uint8_t kAckCommand = 2;
 inline constexpr std::uint8_t kAckConfig = 3;
 
 /// Ack results: a core Status value (status.hpp, 0 = kOk), or one of these protocol codes.
-inline constexpr std::uint8_t kResultIncomplete = 0x80;   ///< a span data frame was lost: send the batch again
+inline constexpr std::uint8_t kResultIncomplete =
+    0x80;  ///< a span data frame was lost: send the batch again
 inline constexpr std::uint8_t kResultBadFrame =
     0x81;  ///< wrong length or unknown configuration item
-inline constexpr std::uint8_t kResultTooLong = 0x82;      ///< batch payload over kMaxTransferBytes
+inline constexpr std::uint8_t kResultTooLong = 0x82;  ///< batch payload over kMaxTransferBytes
 
 /// Span transfer: one span-start frame, then ceil(length / 7) data frames indexed 0, 1, ...
 inline constexpr std::size_t kDataBytesPerFrame = 7;
@@ -72,8 +77,10 @@ inline constexpr std::size_t kMaxTransferBytes = kDataBytesPerFrame * kMaxDataFr
 /// Status A flags.
 inline constexpr std::uint8_t kFlagConfigured = 1u << 0;
 inline constexpr std::uint8_t kFlagHeldByUnderrun = 1u << 1;
-inline constexpr std::uint8_t kFlagBusProblem = 1u << 2;  ///< the device saw error-passive or bus-off
-/// The last tick was a tick of the device's own stop or re-entry move (holding without it: at rest).
+inline constexpr std::uint8_t kFlagBusProblem = 1u
+                                                << 2;  ///< the device saw error-passive or bus-off
+/// The last tick was a tick of the device's own stop or re-entry move (holding without it: at
+/// rest).
 inline constexpr std::uint8_t kFlagOwnMove = 1u << 3;
 /// A homing run goes on (the device's own moves, axis by axis).
 inline constexpr std::uint8_t kFlagHoming = 1u << 4;
@@ -88,13 +95,23 @@ inline constexpr std::uint8_t kFlagPaused = 1u << 6;
 /// pen-down delay in ticks. The pen-down delay is sent last: the device applies the set when
 /// it arrives after all the others (item 0 starts a set).
 inline constexpr std::uint8_t kConfigItemPenDown = 17;
-constexpr std::uint8_t config_item_velocity(unsigned axis) { return static_cast<std::uint8_t>(1 + 2 * axis); }
-constexpr std::uint8_t config_item_acceleration(unsigned axis) { return static_cast<std::uint8_t>(2 + 2 * axis); }
-constexpr std::uint8_t config_item_min_position(unsigned axis) { return static_cast<std::uint8_t>(18 + 2 * axis); }
-constexpr std::uint8_t config_item_max_position(unsigned axis) { return static_cast<std::uint8_t>(19 + 2 * axis); }
+constexpr std::uint8_t config_item_velocity(unsigned axis) {
+    return static_cast<std::uint8_t>(1 + 2 * axis);
+}
+constexpr std::uint8_t config_item_acceleration(unsigned axis) {
+    return static_cast<std::uint8_t>(2 + 2 * axis);
+}
+constexpr std::uint8_t config_item_min_position(unsigned axis) {
+    return static_cast<std::uint8_t>(18 + 2 * axis);
+}
+constexpr std::uint8_t config_item_max_position(unsigned axis) {
+    return static_cast<std::uint8_t>(19 + 2 * axis);
+}
 /// Item 34 + a: axis a's max jerk (units of 100 LSB/s^3; optional: without it, or 0, no jerk
 /// limit).
-constexpr std::uint8_t config_item_jerk(unsigned axis) { return static_cast<std::uint8_t>(34 + axis); }
+constexpr std::uint8_t config_item_jerk(unsigned axis) {
+    return static_cast<std::uint8_t>(34 + axis);
+}
 
 /// A frame as the protocol sees it (the HAL's CanFrame without the flags it never uses).
 struct Frame {
@@ -108,12 +125,13 @@ struct Frame {
 /// One byte-aligned little-endian signal.
 struct Signal {
     const char* name;
-    std::uint8_t byte;      ///< first byte
-    std::uint8_t bytes;     ///< 1, 2, 4 or 7 (the raw data payload)
+    std::uint8_t byte;   ///< first byte
+    std::uint8_t bytes;  ///< 1, 2, 4 or 7 (the raw data payload)
     bool is_signed;
     const char* unit;
     const char* comment;
-    std::int16_t mux = -1;  ///< multiplexed: present when the message's multiplexor equals this; -2: the multiplexor
+    std::int16_t mux = -1;  ///< multiplexed: present when the message's multiplexor equals this;
+                            ///< -2: the multiplexor
     /// DBC value table (`VAL_`): "0 \"idle\" 1 \"running\"", or nullptr. Host side only.
     const char* values = nullptr;
 };
@@ -125,10 +143,13 @@ inline constexpr const char* kStateValues =
     "0 \"idle\" 1 \"running\" 2 \"holding\" 3 \"stopping\" 4 \"fault\" 5 \"e-stop\"";
 inline constexpr const char* kAckKindValues = "1 \"span batch\" 2 \"command\" 3 \"configuration\"";
 inline constexpr const char* kResultValues =
-    "0 \"ok\" 1 \"tick count out of range\" 2 \"control value out of range\" 3 \"curve leaves the position range\" "
-    "4 \"per-tick difference out of range\" 5 \"unknown basis\" 6 \"tick outside span\" 7 \"span queue full\" "
+    "0 \"ok\" 1 \"tick count out of range\" 2 \"control value out of range\" 3 \"curve leaves the "
+    "position range\" "
+    "4 \"per-tick difference out of range\" 5 \"unknown basis\" 6 \"tick outside span\" 7 \"span "
+    "queue full\" "
     "8 \"discontinuous span\" 9 \"velocity limit\" 10 \"acceleration limit\" 11 \"bad limits\" "
-    "12 \"not configured\" 13 \"bad sequence\" 14 \"bad batch\" 15 \"wrong state\" 16 \"stop too long\" "
+    "12 \"not configured\" 13 \"bad sequence\" 14 \"bad batch\" 15 \"wrong state\" 16 \"stop too "
+    "long\" "
     "17 \"nothing to resume\" 18 \"velocity step\" 19 \"job end moving\" 20 \"unknown command\" "
     "21 \"no homing switch\" 22 \"outside travel\" 23 \"pause moving\" 24 \"jerk limit\" "
     "25 \"acceleration step\" "
@@ -153,7 +174,7 @@ inline constexpr const char* kCommandArgsValues =
 struct Message {
     const char* name;
     std::uint32_t base;
-    std::uint8_t length;     ///< DLC (data frames: up to; the last one may be shorter)
+    std::uint8_t length;  ///< DLC (data frames: up to; the last one may be shorter)
     bool from_device;
     const char* comment;
     const Signal* signals;
@@ -162,26 +183,31 @@ struct Message {
 
 // Signal indices below are used by the encoders: keep each table's order.
 inline constexpr Signal kCommandSignals[] = {
-    {"Command", 0, 1, false, "", "1 start, 2 hold, 3 resume, 4 stop, 5 reset, 16 status request", -1,
-     kCommandValues},
+    {"Command", 0, 1, false, "", "1 start, 2 hold, 3 resume, 4 stop, 5 reset, 16 status request",
+     -1, kCommandValues},
 };
 inline constexpr Signal kAckSignals[] = {
     {"Kind", 0, 1, false, "", "1 span batch, 2 command, 3 configuration", -1, kAckKindValues},
-    {"Result", 1, 1, false, "", "core Status (0 ok, 7 queue full, 13 bad sequence, ...), 128 incomplete transfer, 129 bad frame, 130 too long",
+    {"Result", 1, 1, false, "",
+     "core Status (0 ok, 7 queue full, 13 bad sequence, ...), 128 incomplete transfer, 129 bad "
+     "frame, 130 too long",
      -1, kResultValues},
     {"Sequence", 2, 4, false, "", "span batch: its first sequence number; command: the command"},
     {"FreeSlots", 6, 1, false, "span", "free span slots after this"},
-    {"State", 7, 1, false, "", "0 idle, 1 running, 2 holding, 3 stopping, 4 fault, 5 e-stop", -1, kStateValues},
+    {"State", 7, 1, false, "", "0 idle, 1 running, 2 holding, 3 stopping, 4 fault, 5 e-stop", -1,
+     kStateValues},
 };
 inline constexpr Signal kStatusASignals[] = {
-    {"State", 0, 1, false, "", "0 idle, 1 running, 2 holding, 3 stopping, 4 fault, 5 e-stop", -1, kStateValues},
+    {"State", 0, 1, false, "", "0 idle, 1 running, 2 holding, 3 stopping, 4 fault, 5 e-stop", -1,
+     kStateValues},
     {"Flags", 1, 1, false, "",
-     "bit 0 configured, bit 1 held by underrun, bit 2 bus problem seen, bit 3 own stop or re-entry move, bit 4 homing, "
+     "bit 0 configured, bit 1 held by underrun, bit 2 bus problem seen, bit 3 own stop or re-entry "
+     "move, bit 4 homing, "
      "bit 5 pen down, bit 6 paused at a programmed pause"},
     {"FreeSlots", 2, 1, false, "span", "free span slots"},
     {"Queued", 3, 1, false, "span", "spans queued"},
-    {"FaultCode", 4, 2, false, "", "0 none, 1 external, 2 stop failed, 3 re-entry failed, 0x01xx limit switch", -1,
-     kFaultValues},
+    {"FaultCode", 4, 2, false, "",
+     "0 none, 1 external, 2 stop failed, 3 re-entry failed, 0x01xx limit switch", -1, kFaultValues},
     {"Underruns", 6, 2, false, "", "controlled stops because the queue ran dry"},
 };
 inline constexpr Signal kStatusBSignals[] = {
@@ -203,11 +229,13 @@ inline constexpr Signal kStatusESignals[] = {
     {"Axis", 0, 1, false, "", "axis index, 0 .. axes - 1"},
     {"Position", 1, 4, true, "LSB", "setpoint the last tick output on that axis"},
     {"Epoch", 5, 2, false, "", "queue epoch (low 16 bits): advanced by every queue drop"},
-    {"Homing", 7, 1, false, "", "low nibble: 0 not homed, 1 homing, 2 homed, 3 failed; high nibble: why it failed"},
+    {"Homing", 7, 1, false, "",
+     "low nibble: 0 not homed, 1 homing, 2 homed, 3 failed; high nibble: why it failed"},
 };
 inline constexpr Signal kConfigSignals[] = {
     {"Item", 0, 1, false, "",
-     "0 tick rate, 1+2a axis a max velocity, 2+2a axis a max acceleration, 18+2a / 19+2a axis a travel min / max, "
+     "0 tick rate, 1+2a axis a max velocity, 2+2a axis a max acceleration, 18+2a / 19+2a axis a "
+     "travel min / max, "
      "34+a axis a max jerk, 17 pen-down delay (last)",
      -2},
     {"Axes", 1, 1, false, "", "axis count (must match the device)"},
@@ -257,10 +285,13 @@ inline constexpr Signal kConfigSignals[] = {
 };
 inline constexpr Signal kCommandArgsSignals[] = {
     {"Command", 0, 1, false, "", "6 jog, 7 set position, 8 home, 9 pen", -1, kCommandArgsValues},
-    {"Axis", 1, 1, false, "", "jog, set position: axis index, 0 .. axes - 1; home: axis bit mask (0: all); pen: 0"},
+    {"Axis", 1, 1, false, "",
+     "jog, set position: axis index, 0 .. axes - 1; home: axis bit mask (0: all); pen: 0"},
     {"Value", 2, 4, true, "LSB",
-     "jog: distance (signed, not 0); set position: the axis's new coordinate; pen: 1 down, 0 up; home: 0"},
-    {"Feed", 6, 2, false, "per mille", "jog: share of the axis's max velocity, 1..1000 (0: 1000); others: 0"},
+     "jog: distance (signed, not 0); set position: the axis's new coordinate; pen: 1 down, 0 up; "
+     "home: 0"},
+    {"Feed", 6, 2, false, "per mille",
+     "jog: share of the axis's max velocity, 1..1000 (0: 1000); others: 0"},
 };
 inline constexpr Signal kSpanStartSignals[] = {
     {"FirstSequence", 0, 4, false, "", "sequence number of the batch's first span"},
@@ -283,17 +314,19 @@ inline constexpr Message kMessages[] = {
     {"StatusB", kStatusBBase, 8, true, "device -> host: span sequence numbers", kStatusBSignals, 2},
     {"StatusC", kStatusCBase, 8, true, "device -> host: progress and identity", kStatusCSignals, 4},
     {"Config", kConfigBase, 6, false,
-     "host -> device: tick rate, per-axis limits and travel, and pen-down delay, one item per frame",
+     "host -> device: tick rate, per-axis limits and travel, and pen-down delay, one item per "
+     "frame",
      kConfigSignals, 44},
     {"SpanStart", kSpanStartBase, 8, false, "host -> device: starts a span batch transfer",
      kSpanStartSignals, 4},
     {"SpanData", kSpanDataBase, 8, false, "host -> device: 7 bytes of the batch's wire spans",
      kSpanDataSignals, 2},
     {"StatusD", kStatusDBase, 8, true, "device -> host: jobs", kStatusDSignals, 2},
-    {"StatusE", kStatusEBase, 8, true, "device -> host: one axis's position and homing, and the queue epoch",
-     kStatusESignals, 4},
+    {"StatusE", kStatusEBase, 8, true,
+     "device -> host: one axis's position and homing, and the queue epoch", kStatusESignals, 4},
     {"CommandArgs", kCommandArgsBase, 8, false,
-     "host -> device: a command with arguments (jog, set position, home, pen), answered by a command ack",
+     "host -> device: a command with arguments (jog, set position, home, pen), answered by a "
+     "command ack",
      kCommandArgsSignals, 4},
 };
 inline constexpr std::size_t kMessageCount = sizeof(kMessages) / sizeof(kMessages[0]);
@@ -309,7 +342,8 @@ constexpr void put(Frame& f, const Signal& s, std::uint32_t value) {
 /// Reads signal `s` (up to 4 bytes) little-endian. Any context.
 constexpr std::uint32_t get(const Frame& f, const Signal& s) {
     std::uint32_t v = 0;
-    for (unsigned i = 0; i < s.bytes && i < 4; ++i) v |= static_cast<std::uint32_t>(f.data[s.byte + i]) << (8 * i);
+    for (unsigned i = 0; i < s.bytes && i < 4; ++i)
+        v |= static_cast<std::uint32_t>(f.data[s.byte + i]) << (8 * i);
     return v;
 }
 
@@ -471,7 +505,8 @@ constexpr bool decode_status_part(const Frame& f, Status3& s) {
 }
 
 /// Configuration item `item` (0: tick rate; config_item_velocity/acceleration) = `value`.
-constexpr Frame encode_config(std::uint8_t node, std::uint8_t item, std::uint8_t axes, std::uint32_t value) {
+constexpr Frame encode_config(std::uint8_t node, std::uint8_t item, std::uint8_t axes,
+                              std::uint32_t value) {
     Frame f{can_id(kConfigBase, node), 6, {}};
     put(f, kConfigSignals[0], item);
     put(f, kConfigSignals[1], axes);
@@ -513,6 +548,8 @@ constexpr std::size_t data_frames(std::size_t length) {
 
 /// Bits of a CAN 2.0A data frame with `n` data bytes on the wire: 47 + 8n without stuffing,
 /// plus the worst-case stuff bits (one per 4 bits after the first of the 34 + 8n stuffed bits).
-constexpr std::uint32_t frame_bits_worst_case(std::uint32_t n) { return 47 + 8 * n + (34 + 8 * n - 1) / 4; }
+constexpr std::uint32_t frame_bits_worst_case(std::uint32_t n) {
+    return 47 + 8 * n + (34 + 8 * n - 1) / 4;
+}
 
 }  // namespace pathstream::device::can

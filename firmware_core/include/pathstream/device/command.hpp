@@ -30,12 +30,14 @@ constexpr bool is_command(std::uint32_t value) {
 
 /// True for the operator commands (kJog..kPen). Constant, any context.
 constexpr bool is_operator_command(std::uint32_t value) {
-    return value >= static_cast<std::uint32_t>(Command::kJog) && value <= static_cast<std::uint32_t>(Command::kPen);
+    return value >= static_cast<std::uint32_t>(Command::kJog) &&
+           value <= static_cast<std::uint32_t>(Command::kPen);
 }
 
 /// The operator commands as OperatorCommand::command holds them (one byte on both buses).
 inline constexpr std::uint8_t kCommandJog = static_cast<std::uint8_t>(Command::kJog);
-inline constexpr std::uint8_t kCommandSetPosition = static_cast<std::uint8_t>(Command::kSetPosition);
+inline constexpr std::uint8_t kCommandSetPosition =
+    static_cast<std::uint8_t>(Command::kSetPosition);
 inline constexpr std::uint8_t kCommandHome = static_cast<std::uint8_t>(Command::kHome);
 inline constexpr std::uint8_t kCommandPen = static_cast<std::uint8_t>(Command::kPen);
 

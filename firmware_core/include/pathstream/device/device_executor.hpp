@@ -367,14 +367,15 @@ private:
         for (unsigned a = 0; a < Axes; ++a) boundary_acceleration_[a] = TickAcceleration{};
         if (moving) {
             const std::int32_t none[Axes] = {};
-            if (velocity_within_span(none, none, current_.tangent, current_.ticks, current_.ticks, limits(),
-                                     boundary_tangent_, boundary_ticks_) != Status::kOk) {
+            if (velocity_within_span(none, none, current_.tangent, current_.ticks, current_.ticks,
+                                     limits(), boundary_tangent_, boundary_ticks_) != Status::kOk) {
                 fault(FaultCode::kStopFailed);
                 return false;
             }
             for (unsigned a = 0; a < Axes; ++a) {
-                boundary_acceleration_[a] = hermite_end_acceleration(current_.chord[a], current_.start_tangent[a],
-                                                                     current_.tangent[a], current_.ticks);
+                boundary_acceleration_[a] =
+                    hermite_end_acceleration(current_.chord[a], current_.start_tangent[a],
+                                             current_.tangent[a], current_.ticks);
             }
         }
         begin_stop(stopping, moving);
@@ -397,13 +398,14 @@ private:
         // Under a jerk limit the two or three spans of plan_jerk_stop; where none fit, the one
         // span of plan_stop (stopping matters more than the jerk limit).
         JerkMove<Axes> jerk_stop;
-        const bool smooth = has_jerk_limit(limits()) &&
-                            plan_jerk_stop(boundary_, boundary_tangent_, boundary_ticks_, boundary_acceleration_,
-                                           limits(), jerk_stop) == Status::kOk;
+        const bool smooth =
+            has_jerk_limit(limits()) &&
+            plan_jerk_stop(boundary_, boundary_tangent_, boundary_ticks_, boundary_acceleration_,
+                           limits(), jerk_stop) == Status::kOk;
         if (!smooth) {
             jerk_stop.count = 1;
-            if (plan_stop(boundary_, boundary_tangent_, boundary_ticks_, limits(), jerk_stop.span[0]) !=
-                Status::kOk) {
+            if (plan_stop(boundary_, boundary_tangent_, boundary_ticks_, limits(),
+                          jerk_stop.span[0]) != Status::kOk) {
                 fault(FaultCode::kStopFailed);
                 return;
             }
@@ -435,10 +437,9 @@ private:
             return true;
         }
         for (unsigned a = 0; a < Axes; ++a) {
-            boundary_acceleration_[a] =
-                acceleration_within_span(span->stamp.chord[a], span->stamp.start_tangent[a],
-                                         span->stamp.end_tangent[a], span->ticks, queue.ticks_into_span(),
-                                         boundary_ticks_);
+            boundary_acceleration_[a] = acceleration_within_span(
+                span->stamp.chord[a], span->stamp.start_tangent[a], span->stamp.end_tangent[a],
+                span->ticks, queue.ticks_into_span(), boundary_ticks_);
         }
         bool moving = false;
         for (unsigned a = 0; a < Axes; ++a) moving = moving || boundary_tangent_[a] != 0;
@@ -473,11 +474,12 @@ private:
                                  ? boundary_acceleration_[a]
                                  : start_acceleration_of(into->stamp, into->ticks, a);
             }
-            planned = plan_jerk_reentry(rest_, boundary_, boundary_tangent_, boundary_ticks_, arrival, limits(),
-                                        reentry);
+            planned = plan_jerk_reentry(rest_, boundary_, boundary_tangent_, boundary_ticks_,
+                                        arrival, limits(), reentry);
         } else {
             reentry.count = 1;
-            planned = plan_reentry(rest_, boundary_, boundary_tangent_, boundary_ticks_, limits(), reentry.span[0]);
+            planned = plan_reentry(rest_, boundary_, boundary_tangent_, boundary_ticks_, limits(),
+                                   reentry.span[0]);
         }
         if (planned != Status::kOk || !start_generated(reentry)) {
             // No move back onto the path fits: a fault the master sees (rather than a hold
@@ -498,8 +500,10 @@ private:
     }
 
     // The acceleration at the start of a queued Hermite span (its stamp): (6C - 4T0 - 2T1) / n^2.
-    static TickAcceleration start_acceleration_of(const SpanStamp<Axes>& stamp, std::uint32_t n, unsigned a) {
-        const std::int64_t c = stamp.chord[a], t0 = stamp.start_tangent[a], t1 = stamp.end_tangent[a];
+    static TickAcceleration start_acceleration_of(const SpanStamp<Axes>& stamp, std::uint32_t n,
+                                                  unsigned a) {
+        const std::int64_t c = stamp.chord[a], t0 = stamp.start_tangent[a],
+                           t1 = stamp.end_tangent[a];
         return TickAcceleration{6 * c - 4 * t0 - 2 * t1, static_cast<std::uint64_t>(n) * n};
     }
 
@@ -564,7 +568,7 @@ private:
     std::int32_t boundary_tangent_[Axes] = {};
     std::uint32_t boundary_ticks_ = 1;
     TickAcceleration boundary_acceleration_[Axes] = {};  // the path's acceleration at boundary_
-    SetpointStream<Axes, 4> generated_;  // the device's own stop and re-entry spans
+    SetpointStream<Axes, 4> generated_;                  // the device's own stop and re-entry spans
 };
 
 }  // namespace pathstream::device

@@ -139,7 +139,9 @@ public:
 
     /// A start that keeps the operator's pen (set_pen) down: the device's own jog, whose
     /// spans carry that pen. Otherwise as command(Command::kStart).
-    [[nodiscard]] Status start_keeping_pen() { return post_command(Command::kStart, kMailboxKeepPen); }
+    [[nodiscard]] Status start_keeping_pen() {
+        return post_command(Command::kStart, kMailboxKeepPen);
+    }
 
     /// The operator's pen: lowered (`down`) or raised at rest. Idle with nothing queued only
     /// (kWrongState otherwise). The tick keeps it until a plain start, a stop, a fault or the
@@ -171,7 +173,8 @@ private:
         const std::uint32_t pending = channel_.mailbox.command.load(std::memory_order_relaxed);
         const bool settled = pending == s.command_applied;
         // A stop not yet taken is not undone by a later request: the device is stopping.
-        if (!settled && (pending & kMailboxValueMask) == static_cast<std::uint32_t>(Command::kStop) &&
+        if (!settled &&
+            (pending & kMailboxValueMask) == static_cast<std::uint32_t>(Command::kStop) &&
             c != Command::kReset) {
             return c == Command::kStop ? Status::kOk : Status::kWrongState;
         }
@@ -179,16 +182,19 @@ private:
             case Command::kStart:
                 if (!configured_) return Status::kNotConfigured;
                 if (state == DeviceState::kRunning && settled) return Status::kOk;
-                if (state != DeviceState::kIdle && state != DeviceState::kRunning) return Status::kWrongState;
+                if (state != DeviceState::kIdle && state != DeviceState::kRunning)
+                    return Status::kWrongState;
                 if (state == DeviceState::kIdle && !queued) return Status::kNothingToResume;
                 break;
             case Command::kHold:
                 if (state == DeviceState::kHolding && settled) return Status::kOk;
-                if (state != DeviceState::kRunning && state != DeviceState::kHolding) return Status::kWrongState;
+                if (state != DeviceState::kRunning && state != DeviceState::kHolding)
+                    return Status::kWrongState;
                 break;
             case Command::kResume:
                 if (state == DeviceState::kRunning && settled) return Status::kOk;
-                if (state != DeviceState::kHolding && state != DeviceState::kRunning) return Status::kWrongState;
+                if (state != DeviceState::kHolding && state != DeviceState::kRunning)
+                    return Status::kWrongState;
                 if (state == DeviceState::kHolding && s.held_by_underrun() && !queued) {
                     return Status::kNothingToResume;
                 }
@@ -227,7 +233,6 @@ private:
     }
 
 public:
-
     /// Any context (a GPIO edge interrupt too): raises a fault; the next tick freezes every
     /// axis where it is, drops the queue and enters kFault. The first fault's code is kept
     /// (loads and stores only: two raisers in the same instant may keep either code, never
@@ -367,8 +372,8 @@ private:
     // The core's validation, the exact limit checks (velocity, acceleration, jerk, travel), the
     // join with the previous span (velocity, and acceleration under a jerk limit), and a job
     // end or a pause at rest (velocity, and acceleration under a jerk limit).
-    Status check_span(const Span<Axes>& span, const WireSpan& w, const Chain& chain,
-                      bool job_end, bool pause) const {
+    Status check_span(const Span<Axes>& span, const WireSpan& w, const Chain& chain, bool job_end,
+                      bool pause) const {
         ValidatedSpan<Axes> v;
         if (Status st = validate_span(span, v); st != Status::kOk) return st;
         for (unsigned a = 0; a < Axes; ++a) {

@@ -39,7 +39,8 @@ constexpr bool limit_fault_switch(FaultCode code, unsigned& axis, LimitSide& sid
 /// a stop), fault and e-stop drop them: a drive without enable cannot move whatever the
 /// setpoints say, which is what makes the e-stop independent of the motion code.
 constexpr bool enable_asserted(DeviceState state) {
-    return state == DeviceState::kRunning || state == DeviceState::kHolding || state == DeviceState::kStopping;
+    return state == DeviceState::kRunning || state == DeviceState::kHolding ||
+           state == DeviceState::kStopping;
 }
 
 /// The pen-lift output: `outputs` are those the device's last tick drove (MotionDevice::

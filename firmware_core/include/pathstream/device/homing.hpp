@@ -1,11 +1,11 @@
 // Homing one axis against a switch: search toward it, back off, approach slowly, set zero.
 //
 // The sequencer is a producer like a bus master: it feeds its own moves to a MotionDevice as
-// wire spans (accept_batch, checked like a host's), each move one job (its last span marks the job end, so the
-// device idles at the move's end by itself), stops the device with a command when the switch
-// is seen, and finally redefines the position with set_position. Every move is a rest-to-rest
-// trapezoid of constant-acceleration Hermite spans (cubic term exactly zero), or under a jerk
-// limit an S-curve of exact cubics (s_curve_ramp.hpp), so the device's exact limit check
+// wire spans (accept_batch, checked like a host's), each move one job (its last span marks the job
+// end, so the device idles at the move's end by itself), stops the device with a command when the
+// switch is seen, and finally redefines the position with set_position. Every move is a
+// rest-to-rest trapezoid of constant-acceleration Hermite spans (cubic term exactly zero), or under
+// a jerk limit an S-curve of exact cubics (s_curve_ramp.hpp), so the device's exact limit check
 // passes them like any planned span; integer math only (docs/gpio.md).
 #pragma once
 
@@ -20,7 +20,7 @@ namespace pathstream::device {
 /// What to home and how. Velocities in LSB/s, distances in LSB.
 struct HomingConfig {
     unsigned axis = 0;
-    bool toward_positive = false;      ///< the switch is at the positive end ("x+")
+    bool toward_positive = false;       ///< the switch is at the positive end ("x+")
     std::uint32_t search_velocity = 0;  ///< fast approach; >= 1
     std::uint32_t latch_velocity = 0;   ///< slow approach that defines zero; >= 1
     std::uint32_t backoff = 0;          ///< distance moved off the switch after the search; >= 1
@@ -39,10 +39,10 @@ enum class HomingPhase : std::uint8_t {
     kSearchStop,  ///< switch seen: controlled stop
     kBackoff,     ///< moving off the switch
     kBackoffStop,
-    kLatch,       ///< approaching at latch velocity
-    kLatchStop,   ///< switch seen again: controlled stop
-    kSetZero,     ///< set_position requested
-    kPullOff,     ///< moving off the switch in the new coordinates
+    kLatch,      ///< approaching at latch velocity
+    kLatchStop,  ///< switch seen again: controlled stop
+    kSetZero,    ///< set_position requested
+    kPullOff,    ///< moving off the switch in the new coordinates
     kPullOffStop,
     kDone,
     kError,
@@ -87,13 +87,15 @@ public:
         config_ = config;
         error_ = HomingError::kNone;
         error_status_ = Status::kOk;
-        if (config.axis >= Axes || config.search_velocity == 0 || config.latch_velocity == 0 || config.backoff == 0 ||
-            config.max_travel == 0 || config.max_travel > kMaxPositionLsb || config.backoff > kMaxPositionLsb ||
-            config.pull_off > kMaxPositionLsb) {
+        if (config.axis >= Axes || config.search_velocity == 0 || config.latch_velocity == 0 ||
+            config.backoff == 0 || config.max_travel == 0 || config.max_travel > kMaxPositionLsb ||
+            config.backoff > kMaxPositionLsb || config.pull_off > kMaxPositionLsb) {
             return finish_error(HomingError::kBadConfig, Status::kBadLimits);
         }
-        if (!device_.configured()) return finish_error(HomingError::kDeviceRefused, Status::kNotConfigured);
-        if (device_.state() != DeviceState::kIdle) return finish_error(HomingError::kDeviceRefused, Status::kWrongState);
+        if (!device_.configured())
+            return finish_error(HomingError::kDeviceRefused, Status::kNotConfigured);
+        if (device_.state() != DeviceState::kIdle)
+            return finish_error(HomingError::kDeviceRefused, Status::kWrongState);
         // The first move is chosen by the first poll, which knows the switch: a machine
         // already standing on it backs off first.
         phase_ = HomingPhase::kStarting;
@@ -112,7 +114,9 @@ private:
     // One step of the sequence (poll's body).
     void advance(bool switch_active) {
         const DeviceState s = device_.state();
-        if (phase_ == HomingPhase::kIdle || phase_ == HomingPhase::kDone || phase_ == HomingPhase::kError) return;
+        if (phase_ == HomingPhase::kIdle || phase_ == HomingPhase::kDone ||
+            phase_ == HomingPhase::kError)
+            return;
         if (s == DeviceState::kFault || s == DeviceState::kEstop) {
             (void)finish_error(HomingError::kInterrupted, Status::kWrongState);
             return;
@@ -127,10 +131,12 @@ private:
                 if (switch_active) {
                     trigger_ = device_.position(config_.axis);
                     overshoot_ = 0;
-                    if (begin_move(-toward(config_.backoff), config_.search_velocity) == Status::kOk) {
+                    if (begin_move(-toward(config_.backoff), config_.search_velocity) ==
+                        Status::kOk) {
                         phase_ = HomingPhase::kBackoff;
                     }
-                } else if (begin_move(toward(config_.max_travel), config_.search_velocity) == Status::kOk) {
+                } else if (begin_move(toward(config_.max_travel), config_.search_velocity) ==
+                           Status::kOk) {
                     phase_ = HomingPhase::kSearch;
                 }
                 break;
@@ -147,7 +153,8 @@ private:
                 if (idle(s)) {
                     const Lsb here = device_.position(config_.axis);
                     overshoot_ = here > trigger_ ? here - trigger_ : trigger_ - here;
-                    if (begin_move(-toward(config_.backoff), config_.search_velocity) == Status::kOk) {
+                    if (begin_move(-toward(config_.backoff), config_.search_velocity) ==
+                        Status::kOk) {
                         phase_ = HomingPhase::kBackoff;
                     }
                 }
@@ -164,8 +171,10 @@ private:
                 break;
             case HomingPhase::kBackoffStop:
                 if (idle(s)) {
-                    const std::int64_t travel = 2 * static_cast<std::int64_t>(config_.backoff) + overshoot_;
-                    if (begin_move(toward(travel), config_.latch_velocity) == Status::kOk) phase_ = HomingPhase::kLatch;
+                    const std::int64_t travel =
+                        2 * static_cast<std::int64_t>(config_.backoff) + overshoot_;
+                    if (begin_move(toward(travel), config_.latch_velocity) == Status::kOk)
+                        phase_ = HomingPhase::kLatch;
                 }
                 break;
             case HomingPhase::kLatch:
@@ -193,7 +202,8 @@ private:
                 if (device_.position_pending()) break;
                 if (config_.pull_off == 0) {
                     phase_ = HomingPhase::kDone;
-                } else if (begin_move(-toward(config_.pull_off), config_.search_velocity) == Status::kOk) {
+                } else if (begin_move(-toward(config_.pull_off), config_.search_velocity) ==
+                           Status::kOk) {
                     phase_ = HomingPhase::kPullOff;
                 }
                 break;
@@ -220,7 +230,10 @@ public:
     HomingError error() const { return error_; }
     /// The device's Status behind kDeviceRefused (or kOk).
     Status error_status() const { return error_status_; }
-    bool busy() const { return phase_ != HomingPhase::kIdle && phase_ != HomingPhase::kDone && phase_ != HomingPhase::kError; }
+    bool busy() const {
+        return phase_ != HomingPhase::kIdle && phase_ != HomingPhase::kDone &&
+               phase_ != HomingPhase::kError;
+    }
     /// Position at which the latch approach saw the switch, before set zero (LSB).
     Lsb latch_position() const { return trigger_; }
     /// How far the search stop ran past the point where the switch was seen (LSB).
@@ -229,7 +242,9 @@ public:
 private:
     static constexpr unsigned kFeedSpans = 8;  // spans per accept_batch: a small stack buffer
 
-    std::int64_t toward(std::int64_t distance) const { return config_.toward_positive ? distance : -distance; }
+    std::int64_t toward(std::int64_t distance) const {
+        return config_.toward_positive ? distance : -distance;
+    }
 
     Status finish_error(HomingError e, Status s) {
         error_ = e;
@@ -241,14 +256,16 @@ private:
     Status begin_move(std::int64_t distance, std::uint32_t velocity) {
         Lsb from[Axes];
         for (unsigned a = 0; a < Axes; ++a) from[a] = device_.position(a);
-        if (Status s = move_.plan(from, config_.axis, distance, velocity, device_.limits()); s != Status::kOk) {
+        if (Status s = move_.plan(from, config_.axis, distance, velocity, device_.limits());
+            s != Status::kOk) {
             return finish_error(HomingError::kDeviceRefused, s);
         }
         stop_requested_for_ = HomingPhase::kIdle;
         fed_all_ = false;
         move_job_ = device_.last_accepted_sequence() + 1u;  // a job's id: its first span's sequence
         if (!feed()) return error_status_;
-        if (Status s = device_.command(Command::kStart); s != Status::kOk) return finish_error(HomingError::kDeviceRefused, s);
+        if (Status s = device_.command(Command::kStart); s != Status::kOk)
+            return finish_error(HomingError::kDeviceRefused, s);
         return Status::kOk;
     }
 
@@ -271,7 +288,8 @@ private:
                 length += encode_wire_span(w, Axes, bytes + length, sizeof bytes - length);
                 ++count;
             }
-            const Status s = device_.accept_batch(device_.last_accepted_sequence() + 1u, count, bytes, length);
+            const Status s =
+                device_.accept_batch(device_.last_accepted_sequence() + 1u, count, bytes, length);
             if (s != Status::kOk) {
                 (void)finish_error(HomingError::kDeviceRefused, s);
                 return false;

@@ -84,7 +84,8 @@ public:
     void finished(HomingError error) {
         if (current_ < 0) return;
         const unsigned a = plan_[current_].config.axis;
-        report_[a] = {error == HomingError::kNone ? AxisHoming::kHomed : AxisHoming::kFailed, error};
+        report_[a] = {error == HomingError::kNone ? AxisHoming::kHomed : AxisHoming::kFailed,
+                      error};
         current_ = -1;
         if (error == HomingError::kNone) return;
         for (unsigned b = 0; b < Axes; ++b) {
@@ -97,7 +98,9 @@ public:
     bool busy() const { return current_ >= 0 || pending_ != 0; }
 
     /// Axis `axis`'s homing state (kNotHomed for an axis >= Axes).
-    HomingReport report(unsigned axis) const { return axis < Axes ? report_[axis] : HomingReport{}; }
+    HomingReport report(unsigned axis) const {
+        return axis < Axes ? report_[axis] : HomingReport{};
+    }
 
 private:
     HomingAxis plan_[Axes] = {};

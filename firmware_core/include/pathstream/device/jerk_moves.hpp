@@ -47,17 +47,19 @@ constexpr bool has_jerk_limit(const MotionLimits<Axes>& limits) {
 /// the stop from there is planned on (1..n). Cost: two 128-bit products and a division. Tick
 /// interrupt context (a one-off).
 inline TickAcceleration acceleration_within_span(std::int32_t chord, std::int32_t start_tangent,
-                                                 std::int32_t end_tangent, std::uint32_t n, std::uint32_t k,
-                                                 std::uint32_t base) {
+                                                 std::int32_t end_tangent, std::uint32_t n,
+                                                 std::uint32_t k, std::uint32_t base) {
     // |6C| <= 1.5 2^30, |4T0 + 2T1| <= 6 2^29: each end's numerator < 2^33, times n <= 2^16.
     const std::int64_t c = chord, t0 = start_tangent, t1 = end_tangent, nn = n, kk = k;
-    const std::int64_t at_k = (6 * c - 4 * t0 - 2 * t1) * (nn - kk) + (-6 * c + 2 * t0 + 4 * t1) * kk;
+    const std::int64_t at_k =
+        (6 * c - 4 * t0 - 2 * t1) * (nn - kk) + (-6 * c + 2 * t0 + 4 * t1) * kk;
     const std::uint64_t base2 = static_cast<std::uint64_t>(base) * base;
     const std::uint64_t cube = static_cast<std::uint64_t>(n) * n * n;  // < 2^49
     // round(|at_k| base^2 / n^3) = floor((2 |at_k| base^2 + n^3) / (2 n^3)); < 2^34 since
     // base <= n.
     const Int128 twice = multiply_unsigned(stop_detail::magnitude64(at_k), 2 * base2);
-    const FloorDivision r = floor_divide(twice + Int128::from(static_cast<std::int64_t>(cube)), 2 * cube);
+    const FloorDivision r =
+        floor_divide(twice + Int128::from(static_cast<std::int64_t>(cube)), 2 * cube);
     const auto magnitude = static_cast<std::int64_t>(r.quotient.lo);
     return TickAcceleration{at_k < 0 ? -magnitude : magnitude, base2};
 }
@@ -67,7 +69,8 @@ namespace jerk_detail {
 /// round(num / den) for den >= 1, halves away from zero; false when |result| > limit.
 inline bool round_quotient(Int128 num, std::uint64_t den, std::int64_t limit, std::int64_t& out) {
     const Int128 m = magnitude(num);
-    const FloorDivision q = floor_divide(m + m + Int128::from(static_cast<std::int64_t>(den)), 2 * den);
+    const FloorDivision q =
+        floor_divide(m + m + Int128::from(static_cast<std::int64_t>(den)), 2 * den);
     if (q.quotient.hi != 0 || q.quotient.lo > static_cast<std::uint64_t>(limit)) return false;
     const auto v = static_cast<std::int64_t>(q.quotient.lo);
     out = num.negative() ? -v : v;
@@ -89,10 +92,14 @@ void reset(JerkMove<Axes>& move, unsigned count, std::uint32_t ticks) {
 /// Hermite span from p0 over `chord` with tangents t0, t1 on one axis; false when a value
 /// leaves the span's ranges.
 template <unsigned Axes>
-bool set_axis(Span<Axes>& s, unsigned axis, std::int64_t p0, std::int64_t chord, std::int64_t t0, std::int64_t t1) {
+bool set_axis(Span<Axes>& s, unsigned axis, std::int64_t p0, std::int64_t chord, std::int64_t t0,
+              std::int64_t t1) {
     const std::int64_t p1 = p0 + chord;
-    if (p0 > kMaxPositionLsb || p0 < -kMaxPositionLsb || p1 > kMaxPositionLsb || p1 < -kMaxPositionLsb) return false;
-    if (t0 > kMaxTangentLsb || t0 < -kMaxTangentLsb || t1 > kMaxTangentLsb || t1 < -kMaxTangentLsb) return false;
+    if (p0 > kMaxPositionLsb || p0 < -kMaxPositionLsb || p1 > kMaxPositionLsb ||
+        p1 < -kMaxPositionLsb)
+        return false;
+    if (t0 > kMaxTangentLsb || t0 < -kMaxTangentLsb || t1 > kMaxTangentLsb || t1 < -kMaxTangentLsb)
+        return false;
     s.control[axis][0] = static_cast<std::int32_t>(p0);
     s.control[axis][1] = static_cast<std::int32_t>(p1);
     s.control[axis][2] = static_cast<std::int32_t>(t0);
@@ -106,8 +113,8 @@ bool set_axis(Span<Axes>& s, unsigned axis, std::int64_t p0, std::int64_t chord,
 /// condition of check_move at a fraction of its cost (a few 128-bit products per span and
 /// axis, no span validation), so the searches reject most lengths without validating.
 template <unsigned Axes>
-Status check_move_ends(const JerkMove<Axes>& move, const TickAcceleration (&start)[Axes], const TickAcceleration* end,
-                       const MotionLimits<Axes>& limits) {
+Status check_move_ends(const JerkMove<Axes>& move, const TickAcceleration (&start)[Axes],
+                       const TickAcceleration* end, const MotionLimits<Axes>& limits) {
     const std::uint64_t hz = limits.tick_hz;
     TickAcceleration previous[Axes];
     for (unsigned a = 0; a < Axes; ++a) previous[a] = start[a];
@@ -133,18 +140,23 @@ Status check_move_ends(const JerkMove<Axes>& move, const TickAcceleration (&star
             if (l.max_jerk != 0 &&
                 multiply_unsigned(static_cast<std::uint64_t>(l.max_jerk) * kJerkUnitLsb, n2) *
                         static_cast<std::int64_t>(n) <
-                    multiply_unsigned(stop_detail::magnitude64(at_end.numerator - at_start.numerator), hz * hz * hz)) {
+                    multiply_unsigned(
+                        stop_detail::magnitude64(at_end.numerator - at_start.numerator),
+                        hz * hz * hz)) {
                 return Status::kJerkLimit;
             }
-            if (Status st = check_acceleration_step(at_start, previous[a], l, limits.tick_hz); st != Status::kOk) {
+            if (Status st = check_acceleration_step(at_start, previous[a], l, limits.tick_hz);
+                st != Status::kOk) {
                 return st;
             }
             previous[a] = at_end;
         }
     }
     for (unsigned a = 0; a < Axes; ++a) {
-        const Status st = end == nullptr ? check_end_at_rest(previous[a], limits.axis[a], limits.tick_hz)
-                                         : check_acceleration_step(end[a], previous[a], limits.axis[a], limits.tick_hz);
+        const Status st =
+            end == nullptr
+                ? check_end_at_rest(previous[a], limits.axis[a], limits.tick_hz)
+                : check_acceleration_step(end[a], previous[a], limits.axis[a], limits.tick_hz);
         if (st != Status::kOk) return st;
     }
     return Status::kOk;
@@ -156,8 +168,8 @@ Status check_move_ends(const JerkMove<Axes>& move, const TickAcceleration (&star
 /// rules of check_move_ends first (exactly the cubic's, from the Hermite values), then each
 /// span validated and checked against the velocity and acceleration limits.
 template <unsigned Axes>
-Status check_move(const JerkMove<Axes>& move, const TickAcceleration (&start)[Axes], const TickAcceleration* end,
-                  const MotionLimits<Axes>& limits) {
+Status check_move(const JerkMove<Axes>& move, const TickAcceleration (&start)[Axes],
+                  const TickAcceleration* end, const MotionLimits<Axes>& limits) {
     if (Status s = check_move_ends(move, start, end, limits); s != Status::kOk) return s;
     for (unsigned i = 0; i < move.count; ++i) {
         if (Status s = stop_detail::check_span(move.span[i], limits); s != Status::kOk) return s;
@@ -171,15 +183,18 @@ Status check_move(const JerkMove<Axes>& move, const TickAcceleration (&start)[Ax
 template <unsigned Axes>
 void toward_zero(const TickAcceleration (&acceleration)[Axes], const MotionLimits<Axes>& limits,
                  TickAcceleration (&out)[Axes]) {
-    const std::uint64_t hz3 = static_cast<std::uint64_t>(limits.tick_hz) * limits.tick_hz * limits.tick_hz;
+    const std::uint64_t hz3 =
+        static_cast<std::uint64_t>(limits.tick_hz) * limits.tick_hz * limits.tick_hz;
     for (unsigned a = 0; a < Axes; ++a) {
         const std::uint64_t q = acceleration[a].denominator;
         // 0.9 J Q = 9 max_jerk 100 Q / (10 hz^3): below 2^32 * 2^10 * 2^35.
-        const Int128 nine = multiply_unsigned(static_cast<std::uint64_t>(limits.axis[a].max_jerk) * 900u, q);
+        const Int128 nine =
+            multiply_unsigned(static_cast<std::uint64_t>(limits.axis[a].max_jerk) * 900u, q);
         const FloorDivision step = floor_divide(nine, 10 * hz3);
         const std::int64_t n = acceleration[a].numerator;
         const std::uint64_t mag = stop_detail::magnitude64(n);
-        const std::uint64_t cut = step.quotient.hi != 0 || step.quotient.lo >= mag ? mag : step.quotient.lo;
+        const std::uint64_t cut =
+            step.quotient.hi != 0 || step.quotient.lo >= mag ? mag : step.quotient.lo;
         const auto left = static_cast<std::int64_t>(mag - cut);
         out[a] = TickAcceleration{n < 0 ? -left : left, q};
     }
@@ -197,17 +212,21 @@ inline std::int64_t ramp_end(const TickAcceleration& shape, std::int32_t tangent
     // 0.9 J r Q = 9 max_jerk 100 r Q / (10 hz^3): below 2^32 2^10 2^16 2^35; 0.9 A Q =
     // 9 max_acceleration Q / (10 hz^2): below 2^36 2^35.
     const FloorDivision ramp =
-        floor_divide(multiply_unsigned(static_cast<std::uint64_t>(limits.max_jerk) * 900u * r, q), 10 * hz * hz * hz);
+        floor_divide(multiply_unsigned(static_cast<std::uint64_t>(limits.max_jerk) * 900u * r, q),
+                     10 * hz * hz * hz);
     const FloorDivision floor =
-        floor_divide(multiply_unsigned(static_cast<std::uint64_t>(limits.max_acceleration) * 9u, q), 10 * hz * hz);
+        floor_divide(multiply_unsigned(static_cast<std::uint64_t>(limits.max_acceleration) * 9u, q),
+                     10 * hz * hz);
     // |N| < 2^36 for accelerations within any limit: a cap beyond 2^40 changes nothing.
     constexpr std::uint64_t kNoCap = std::uint64_t{1} << 40;
     const std::uint64_t mag = stop_detail::magnitude64(n);
-    const std::uint64_t cap = floor.quotient.hi != 0 || floor.quotient.lo > kNoCap ? kNoCap : floor.quotient.lo;
+    const std::uint64_t cap =
+        floor.quotient.hi != 0 || floor.quotient.lo > kNoCap ? kNoCap : floor.quotient.lo;
     // Along the velocity: mag - ramp, at least -cap.
     const bool past = ramp.quotient.hi != 0 || ramp.quotient.lo >= mag + cap;
-    const std::int64_t along = past ? -static_cast<std::int64_t>(cap)
-                                    : static_cast<std::int64_t>(mag) - static_cast<std::int64_t>(ramp.quotient.lo);
+    const std::int64_t along =
+        past ? -static_cast<std::int64_t>(cap)
+             : static_cast<std::int64_t>(mag) - static_cast<std::int64_t>(ramp.quotient.lo);
     return n > 0 ? along : -along;
 }
 
@@ -215,15 +234,17 @@ inline std::int64_t ramp_end(const TickAcceleration& shape, std::int32_t tangent
 /// `shape`: the acceleration the spans are shaped from (`acceleration` itself, or 0 where the
 /// step from it to 0 is within one tick of jerk); the joins are checked against `acceleration`.
 template <unsigned Axes>
-Status two_span_stop(const Lsb (&position)[Axes], const std::int32_t (&tangent)[Axes], std::uint32_t ticks,
-                     const TickAcceleration (&acceleration)[Axes], const TickAcceleration (&shape)[Axes],
-                     const MotionLimits<Axes>& limits, JerkMove<Axes>& out) {
+Status two_span_stop(const Lsb (&position)[Axes], const std::int32_t (&tangent)[Axes],
+                     std::uint32_t ticks, const TickAcceleration (&acceleration)[Axes],
+                     const TickAcceleration (&shape)[Axes], const MotionLimits<Axes>& limits,
+                     JerkMove<Axes>& out) {
     const auto build = [&](std::uint64_t j, JerkMove<Axes>& move) -> Status {
         const std::uint64_t m = j * ticks;
         if (m > kMaxSpanTicks) return Status::kStopTooLong;
         reset(move, 2, static_cast<std::uint32_t>(m));
         for (unsigned a = 0; a < Axes; ++a) {
-            const std::int64_t t0 = static_cast<std::int64_t>(tangent[a]) * static_cast<std::int64_t>(j);
+            const std::int64_t t0 =
+                static_cast<std::int64_t>(tangent[a]) * static_cast<std::int64_t>(j);
             const std::uint64_t q = shape[a].denominator;
             // S = (2 T0 Q + N m^2) / (4 Q): |2 T0 Q| < 2^82, |N m^2| < 2^68.
             const Int128 num = Int128::from(2 * t0) * static_cast<std::int64_t>(q) +
@@ -235,7 +256,8 @@ Status two_span_stop(const Lsb (&position)[Axes], const std::int32_t (&tangent)[
                 return Status::kStopTooLong;
             }
             const std::int64_t p0 = position[a], d1 = third + s;
-            if (!set_axis(move.span[0], a, p0, d1, t0, s) || !set_axis(move.span[1], a, p0 + d1, s_third, s, 0)) {
+            if (!set_axis(move.span[0], a, p0, d1, t0, s) ||
+                !set_axis(move.span[1], a, p0 + d1, s_third, s, 0)) {
                 return Status::kStopTooLong;
             }
         }
@@ -245,9 +267,10 @@ Status two_span_stop(const Lsb (&position)[Axes], const std::int32_t (&tangent)[
     const std::uint64_t hz2 = static_cast<std::uint64_t>(limits.tick_hz) * limits.tick_hz;
     std::uint64_t first = 1;
     for (unsigned a = 0; a < Axes; ++a) {
-        const std::uint64_t per_a = stop_detail::ceil_div(stop_detail::magnitude64(tangent[a]) * hz2,
-                                                          limits.axis[a].max_acceleration);
-        const std::uint64_t need = stop_detail::ceil_div(per_a, static_cast<std::uint64_t>(ticks) * ticks);
+        const std::uint64_t per_a = stop_detail::ceil_div(
+            stop_detail::magnitude64(tangent[a]) * hz2, limits.axis[a].max_acceleration);
+        const std::uint64_t need =
+            stop_detail::ceil_div(per_a, static_cast<std::uint64_t>(ticks) * ticks);
         if (need > first) first = need;
     }
     return stop_detail::shortest_passing(first, kMaxSpanTicks / ticks, build, out);
@@ -255,8 +278,9 @@ Status two_span_stop(const Lsb (&position)[Axes], const std::int32_t (&tangent)[
 
 /// plan_jerk_reentry's three spans onto the given acceleration (see there).
 template <unsigned Axes>
-Status three_span_reentry(const Lsb (&from)[Axes], const Lsb (&to)[Axes], const std::int32_t (&tangent)[Axes],
-                          std::uint32_t ticks, const TickAcceleration (&acceleration)[Axes],
+Status three_span_reentry(const Lsb (&from)[Axes], const Lsb (&to)[Axes],
+                          const std::int32_t (&tangent)[Axes], std::uint32_t ticks,
+                          const TickAcceleration (&acceleration)[Axes],
                           const TickAcceleration (&shape)[Axes], const MotionLimits<Axes>& limits,
                           JerkMove<Axes>& out) {
     const auto build = [&](std::uint64_t j, JerkMove<Axes>& move) -> Status {
@@ -264,7 +288,8 @@ Status three_span_reentry(const Lsb (&from)[Axes], const Lsb (&to)[Axes], const 
         if (m > kMaxSpanTicks) return Status::kStopTooLong;
         reset(move, 3, static_cast<std::uint32_t>(m));
         for (unsigned a = 0; a < Axes; ++a) {
-            const std::int64_t tb = static_cast<std::int64_t>(tangent[a]) * static_cast<std::int64_t>(j);
+            const std::int64_t tb =
+                static_cast<std::int64_t>(tangent[a]) * static_cast<std::int64_t>(j);
             const std::int64_t d = static_cast<std::int64_t>(to[a]) - from[a];
             const std::uint64_t q = shape[a].denominator;
             const Int128 nm2 = Int128::from(shape[a].numerator) * static_cast<std::int64_t>(m * m);
@@ -272,7 +297,8 @@ Status three_span_reentry(const Lsb (&from)[Axes], const Lsb (&to)[Axes], const 
             const Int128 n1 = Int128::from(3 * (d - tb)) * static_cast<std::int64_t>(q) + nm2;
             const Int128 n2 = Int128::from(2 * tb) * static_cast<std::int64_t>(q) - nm2;
             std::int64_t s1 = 0, step = 0, d1 = 0, s2_third = 0;
-            if (!round_quotient(n1, 6 * q, kMaxTangentLsb, s1) || !round_quotient(n2, 4 * q, kMaxTangentLsb, step)) {
+            if (!round_quotient(n1, 6 * q, kMaxTangentLsb, s1) ||
+                !round_quotient(n2, 4 * q, kMaxTangentLsb, step)) {
                 return Status::kStopTooLong;
             }
             const std::int64_t s2 = s1 + step;
@@ -282,7 +308,8 @@ Status three_span_reentry(const Lsb (&from)[Axes], const Lsb (&to)[Axes], const 
             }
             const std::int64_t d2 = s1 + s2_third, d3 = d - d1 - d2;
             const std::int64_t p0 = from[a];
-            if (!set_axis(move.span[0], a, p0, d1, 0, s1) || !set_axis(move.span[1], a, p0 + d1, d2, s1, s2) ||
+            if (!set_axis(move.span[0], a, p0, d1, 0, s1) ||
+                !set_axis(move.span[1], a, p0 + d1, d2, s1, s2) ||
                 !set_axis(move.span[2], a, p0 + d1 + d2, d3, s2, tb)) {
                 return Status::kStopTooLong;
             }
@@ -302,57 +329,71 @@ Status three_span_reentry(const Lsb (&from)[Axes], const Lsb (&to)[Axes], const 
 /// acceleration at its other end, exactly (the cubic's). The span within the limits and its
 /// jerk, the join at `position` within one tick of jerk.
 template <unsigned Axes>
-Status acceleration_ramp(bool forward, const Lsb (&position)[Axes], const std::int32_t (&tangent)[Axes],
-                         std::uint32_t ticks, std::uint64_t r, const TickAcceleration (&acceleration)[Axes],
-                         const TickAcceleration (&shape)[Axes], const MotionLimits<Axes>& limits, Span<Axes>& ramp,
-                         TickAcceleration (&other)[Axes], bool decelerate = false) {
+Status acceleration_ramp(bool forward, const Lsb (&position)[Axes],
+                         const std::int32_t (&tangent)[Axes], std::uint32_t ticks, std::uint64_t r,
+                         const TickAcceleration (&acceleration)[Axes],
+                         const TickAcceleration (&shape)[Axes], const MotionLimits<Axes>& limits,
+                         Span<Axes>& ramp, TickAcceleration (&other)[Axes],
+                         bool decelerate = false) {
     if (r > kMaxSpanTicks) return Status::kStopTooLong;
     ramp = Span<Axes>{};
     ramp.basis = Basis::kHermite;
     ramp.ticks = static_cast<std::uint32_t>(r);
     for (unsigned a = 0; a < Axes; ++a) {
         std::int64_t t = 0;
-        if (!round_quotient(Int128::from(tangent[a]) * static_cast<std::int64_t>(r), ticks, kMaxTangentLsb, t)) {
+        if (!round_quotient(Int128::from(tangent[a]) * static_cast<std::int64_t>(r), ticks,
+                            kMaxTangentLsb, t)) {
             return Status::kStopTooLong;
         }
         const std::uint64_t q = shape[a].denominator;
         // `decelerate`: a stop's ramp ends an axis that is speeding up decelerating instead of
         // at 0 (ramp_end): ramped only to 0, such an axis keeps speeding up for the whole ramp,
         // whose length the axis with the slowest ramp sets, and can pass its velocity limit.
-        const std::int64_t e =
-            forward && decelerate ? ramp_end(shape[a], tangent[a], r, limits.axis[a], limits.tick_hz) : 0;
+        const std::int64_t e = forward && decelerate ? ramp_end(shape[a], tangent[a], r,
+                                                                limits.axis[a], limits.tick_hz)
+                                                     : 0;
         const Int128 nr2 = Int128::from(shape[a].numerator) * static_cast<std::int64_t>(r * r);
         const Int128 er2 = Int128::from(e) * static_cast<std::int64_t>(r * r);
         // Forward: S = T + (A + E) r^2 / 2 (E the end acceleration), chord (A r^2 + 4 T + 2 S) / 6
         // (= T + (2 A + E) r^2 / 6). Backward: T0 = T - A r^2 / 2, chord (2 T0 + T) / 3.
         const Int128 tq = Int128::from(2 * t) * static_cast<std::int64_t>(q);
         std::int64_t s = 0, chord = 0;
-        if (!round_quotient(forward ? tq + nr2 + er2 : tq - nr2, 2 * q, kMaxTangentLsb, s)) return Status::kStopTooLong;
-        const Int128 chord6 = forward ? nr2 + Int128::from(4 * t + 2 * s) * static_cast<std::int64_t>(q)
-                                      : Int128::from(2 * (2 * s + t)) * static_cast<std::int64_t>(q);
+        if (!round_quotient(forward ? tq + nr2 + er2 : tq - nr2, 2 * q, kMaxTangentLsb, s))
+            return Status::kStopTooLong;
+        const Int128 chord6 = forward
+                                  ? nr2 + Int128::from(4 * t + 2 * s) * static_cast<std::int64_t>(q)
+                                  : Int128::from(2 * (2 * s + t)) * static_cast<std::int64_t>(q);
         if (!round_quotient(chord6, 6 * q, kMaxTangentLsb, chord)) return Status::kStopTooLong;
-        const bool fits = forward ? set_axis(ramp, a, position[a], chord, t, s)
-                                  : set_axis(ramp, a, static_cast<std::int64_t>(position[a]) - chord, chord, s, t);
+        const bool fits =
+            forward
+                ? set_axis(ramp, a, position[a], chord, t, s)
+                : set_axis(ramp, a, static_cast<std::int64_t>(position[a]) - chord, chord, s, t);
         if (!fits) return Status::kStopTooLong;
     }
     ValidatedSpan<Axes> v;
     if (Status st = validate_span(ramp, v); st != Status::kOk) return st;
     for (unsigned a = 0; a < Axes; ++a) {
         const AxisLimits& l = limits.axis[a];
-        if (Status st = check_axis_limits(v.cubic[a], v.timing, l, limits.tick_hz); st != Status::kOk) return st;
-        if (Status st = check_axis_jerk(v.cubic[a], v.timing, l, limits.tick_hz); st != Status::kOk) return st;
+        if (Status st = check_axis_limits(v.cubic[a], v.timing, l, limits.tick_hz);
+            st != Status::kOk)
+            return st;
+        if (Status st = check_axis_jerk(v.cubic[a], v.timing, l, limits.tick_hz); st != Status::kOk)
+            return st;
         const std::int32_t own = ramp.control[a][forward ? 2 : 3];
-        if (Status st = check_join(forward ? own : tangent[a], forward ? ramp.ticks : ticks, forward ? tangent[a] : own,
-                                   forward ? ticks : ramp.ticks, l, limits.tick_hz);
+        if (Status st = check_join(forward ? own : tangent[a], forward ? ramp.ticks : ticks,
+                                   forward ? tangent[a] : own, forward ? ticks : ramp.ticks, l,
+                                   limits.tick_hz);
             st != Status::kOk) {
             return st;
         }
-        const TickAcceleration at_position =
-            forward ? start_acceleration(v.cubic[a], v.timing) : end_acceleration(v.cubic[a], v.timing);
-        if (Status st = check_acceleration_step(at_position, acceleration[a], l, limits.tick_hz); st != Status::kOk) {
+        const TickAcceleration at_position = forward ? start_acceleration(v.cubic[a], v.timing)
+                                                     : end_acceleration(v.cubic[a], v.timing);
+        if (Status st = check_acceleration_step(at_position, acceleration[a], l, limits.tick_hz);
+            st != Status::kOk) {
             return st;
         }
-        other[a] = forward ? end_acceleration(v.cubic[a], v.timing) : start_acceleration(v.cubic[a], v.timing);
+        other[a] = forward ? end_acceleration(v.cubic[a], v.timing)
+                           : start_acceleration(v.cubic[a], v.timing);
     }
     return Status::kOk;
 }
@@ -368,14 +409,16 @@ Status with_fallbacks(bool forward, const Lsb (&point)[Axes], const std::int32_t
                       std::uint32_t ticks, const TickAcceleration (&acceleration)[Axes],
                       const MotionLimits<Axes>& limits, Sequence sequence, JerkMove<Axes>& out) {
     const Status direct = sequence(point, tangent, ticks, acceleration, acceleration, out);
-    if (direct == Status::kOk || !(stop_detail::longer_may_pass(direct) || direct == Status::kStopTooLong)) {
+    if (direct == Status::kOk ||
+        !(stop_detail::longer_may_pass(direct) || direct == Status::kStopTooLong)) {
         return direct;
     }
     // Shaped from the acceleration less one tick of jerk's step towards 0 (all of it where the
     // jerk limit ramps it faster than a whole tick can).
     TickAcceleration shaped[Axes];
     toward_zero(acceleration, limits, shaped);
-    if (sequence(point, tangent, ticks, acceleration, shaped, out) == Status::kOk) return Status::kOk;
+    if (sequence(point, tangent, ticks, acceleration, shaped, out) == Status::kOk)
+        return Status::kOk;
     JerkMove<Axes> part;
     // A stop's ramp of each length takes the acceleration to 0 first, then (where that fails)
     // takes the axes that are speeding up on to decelerating (acceleration_ramp's `decelerate`).
@@ -383,8 +426,8 @@ Status with_fallbacks(bool forward, const Lsb (&point)[Axes], const std::int32_t
         for (int variant = 0; variant < (forward ? 2 : 1); ++variant) {
             Span<Axes> ramp;
             TickAcceleration other[Axes];
-            const Status s =
-                acceleration_ramp(forward, point, tangent, ticks, r, acceleration, shaped, limits, ramp, other, variant == 1);
+            const Status s = acceleration_ramp(forward, point, tangent, ticks, r, acceleration,
+                                               shaped, limits, ramp, other, variant == 1);
             if (s != Status::kOk && variant == 0 && !stop_detail::longer_may_pass(s)) return s;
             if (s != Status::kOk) continue;
             Lsb far[Axes];
@@ -423,15 +466,17 @@ Status with_fallbacks(bool forward, const Lsb (&point)[Axes], const std::int32_t
 /// Cost: up to ~2 log2(j) checks of two spans, times log2(r) with the ramp. Tick interrupt
 /// context (a one-off).
 template <unsigned Axes>
-[[nodiscard]] Status plan_jerk_stop(const Lsb (&position)[Axes], const std::int32_t (&tangent)[Axes],
-                                    std::uint32_t ticks, const TickAcceleration (&acceleration)[Axes],
+[[nodiscard]] Status plan_jerk_stop(const Lsb (&position)[Axes],
+                                    const std::int32_t (&tangent)[Axes], std::uint32_t ticks,
+                                    const TickAcceleration (&acceleration)[Axes],
                                     const MotionLimits<Axes>& limits, JerkMove<Axes>& out) {
-    const auto two_spans = [&](const Lsb (&at)[Axes], const std::int32_t (&t)[Axes], std::uint32_t n,
-                               const TickAcceleration (&check)[Axes], const TickAcceleration (&shape)[Axes],
-                               JerkMove<Axes>& move) {
+    const auto two_spans = [&](const Lsb(&at)[Axes], const std::int32_t(&t)[Axes], std::uint32_t n,
+                               const TickAcceleration(&check)[Axes],
+                               const TickAcceleration(&shape)[Axes], JerkMove<Axes>& move) {
         return jerk_detail::two_span_stop(at, t, n, check, shape, limits, move);
     };
-    return jerk_detail::with_fallbacks(true, position, tangent, ticks, acceleration, limits, two_spans, out);
+    return jerk_detail::with_fallbacks(true, position, tangent, ticks, acceleration, limits,
+                                       two_spans, out);
 }
 
 /// The move from rest at `from` back to `to` under a jerk limit, arriving with velocity
@@ -454,12 +499,13 @@ template <unsigned Axes>
                                        const std::int32_t (&tangent)[Axes], std::uint32_t ticks,
                                        const TickAcceleration (&acceleration)[Axes],
                                        const MotionLimits<Axes>& limits, JerkMove<Axes>& out) {
-    const auto three_spans = [&](const Lsb (&at)[Axes], const std::int32_t (&t)[Axes], std::uint32_t n,
-                                 const TickAcceleration (&check)[Axes], const TickAcceleration (&shape)[Axes],
-                                 JerkMove<Axes>& move) {
+    const auto three_spans = [&](const Lsb(&at)[Axes], const std::int32_t(&t)[Axes],
+                                 std::uint32_t n, const TickAcceleration(&check)[Axes],
+                                 const TickAcceleration(&shape)[Axes], JerkMove<Axes>& move) {
         return jerk_detail::three_span_reentry(from, at, t, n, check, shape, limits, move);
     };
-    return jerk_detail::with_fallbacks(false, to, tangent, ticks, acceleration, limits, three_spans, out);
+    return jerk_detail::with_fallbacks(false, to, tangent, ticks, acceleration, limits, three_spans,
+                                       out);
 }
 
 /// A pen-down approach under a jerk limit (a host's resume): one span of r ticks, the fewest of
@@ -469,14 +515,15 @@ template <unsigned Axes>
 /// the re-entry onto it. Errors: kStopTooLong when none fits in kMaxSpanTicks. Task context.
 template <unsigned Axes>
 [[nodiscard]] Status plan_jerk_approach(const Lsb (&to)[Axes], const std::int32_t (&tangent)[Axes],
-                                        std::uint32_t ticks, const TickAcceleration (&acceleration)[Axes],
-                                        std::uint32_t min_ticks, const MotionLimits<Axes>& limits, Span<Axes>& out,
-                                        TickAcceleration (&start)[Axes]) {
+                                        std::uint32_t ticks,
+                                        const TickAcceleration (&acceleration)[Axes],
+                                        std::uint32_t min_ticks, const MotionLimits<Axes>& limits,
+                                        Span<Axes>& out, TickAcceleration (&start)[Axes]) {
     TickAcceleration shaped[Axes];
     jerk_detail::toward_zero(acceleration, limits, shaped);
     for (std::uint64_t r = min_ticks < 1 ? 1 : min_ticks; r <= kMaxSpanTicks; r *= 2) {
-        const Status s =
-            jerk_detail::acceleration_ramp(false, to, tangent, ticks, r, acceleration, shaped, limits, out, start);
+        const Status s = jerk_detail::acceleration_ramp(false, to, tangent, ticks, r, acceleration,
+                                                        shaped, limits, out, start);
         if (s == Status::kOk || !stop_detail::longer_may_pass(s)) return s;
     }
     return Status::kStopTooLong;

@@ -29,8 +29,9 @@ public:
 
     /// Jogs `axis` by `distance` LSB (signed, not 0) at up to `feed` per mille of its max
     /// velocity, with the operator's pen as it is (set_pen: a jog with the pen down draws, as a
-    /// plotter's manual walk does, and leaves it down). Refusals: kNotConfigured; kWrongState unless idle with nothing queued;
-    /// kControlValueOutOfRange for an axis >= Axes, distance 0, an end point outside
+    /// plotter's manual walk does, and leaves it down). Refusals: kNotConfigured; kWrongState
+    /// unless idle with nothing queued; kControlValueOutOfRange for an axis >= Axes, distance 0, an
+    /// end point outside
     /// +-kMaxPositionLsb or a feed above 1000; kBadLimits when the limits allow no move. On kOk
     /// the job is queued (as much as fits) and started: it takes the next sequence numbers and
     /// ends idle at the new point, reported as a finished job like any other.
@@ -132,7 +133,7 @@ private:
     AxisMove<Axes> move_;
     std::uint32_t epoch_ = 0;
     std::uint32_t job_ = 0;
-    std::uint8_t pen_ = 0;  // the operator's pen when the jog started: every span carries it
+    std::uint8_t pen_ = 0;     // the operator's pen when the jog started: every span carries it
     bool travel_off_ = false;  // this jog started outside the travel and turned its check off
     bool active_ = false;
 };

@@ -33,10 +33,10 @@ inline constexpr std::uint16_t kPositions = 10;            ///< i32 per axis, up
 inline constexpr std::uint16_t kAxes = 26;
 inline constexpr std::uint16_t kUnderruns = 27;
 inline constexpr std::uint16_t kLastCompletedSequence = 28;  ///< u32
-inline constexpr std::uint16_t kLastRefusal = 30;    ///< core Status of the last refused write
-inline constexpr std::uint16_t kRefusals = 31;       ///< refused writes (wraps)
-inline constexpr std::uint16_t kDuplicates = 32;     ///< batches acknowledged as retries (wraps)
-inline constexpr std::uint16_t kOutputs = 33;        ///< discrete outputs in force
+inline constexpr std::uint16_t kLastRefusal = 30;  ///< core Status of the last refused write
+inline constexpr std::uint16_t kRefusals = 31;     ///< refused writes (wraps)
+inline constexpr std::uint16_t kDuplicates = 32;   ///< batches acknowledged as retries (wraps)
+inline constexpr std::uint16_t kOutputs = 33;      ///< discrete outputs in force
 inline constexpr std::uint16_t kQueuedSpans = 34;
 /// bit 0: configured, bit 1: held by underrun, bit 3: the device's own stop or re-entry
 /// move, bit 4: homing runs, bit 6: paused at a programmed pause (the bits agree with CAN status A)
@@ -101,7 +101,8 @@ constexpr std::uint16_t config_jerk_register(unsigned axes, unsigned axis) {
 ///   the payload, +5.. payload (wire spans, two bytes per register, big-endian, the last
 ///   register padded with a zero byte).
 inline constexpr std::uint16_t kSpanWindow = 200;
-static_assert(kConfig + config_registers(8) <= kSpanWindow, "the configuration block ends below the span window");
+static_assert(kConfig + config_registers(8) <= kSpanWindow,
+              "the configuration block ends below the span window");
 inline constexpr std::uint16_t kSpanHeaderRegisters = 5;
 /// Largest FC16 write (123 registers) minus the header: payload registers per batch.
 inline constexpr std::uint16_t kMaxPayloadRegistersFc16 = 123 - kSpanHeaderRegisters;
@@ -114,8 +115,9 @@ enum class Exception : std::uint8_t {
     kIllegalFunction = 1,
     kIllegalDataAddress = 2,  ///< no such register, or a block written partially
     kIllegalDataValue = 3,  ///< a value refused (bad span, sequence, limits, check value, command)
-    kServerDeviceFailure = 4,  ///< refused by the state (fault, e-stop, not configured, nothing to resume)
-    kServerDeviceBusy = 6,     ///< queue full: retry the same batch later
+    kServerDeviceFailure =
+        4,  ///< refused by the state (fault, e-stop, not configured, nothing to resume)
+    kServerDeviceBusy = 6,  ///< queue full: retry the same batch later
 };
 
 }  // namespace pathstream::device::modbus

@@ -5,9 +5,9 @@
 
 #include <cstdint>
 
-#include "pathstream/device/operator_commands.hpp"
 #include "pathstream/device/modbus_map.hpp"
 #include "pathstream/device/motion_device.hpp"
+#include "pathstream/device/operator_commands.hpp"
 
 namespace pathstream::device {
 
@@ -22,7 +22,8 @@ class ModbusRegisterMap {
 public:
     using Exception = modbus::Exception;
 
-    explicit ModbusRegisterMap(MotionDevice<Axes, Capacity>& device) : device_(device), operator_(device) {}
+    explicit ModbusRegisterMap(MotionDevice<Axes, Capacity>& device)
+        : device_(device), operator_(device) {}
 
     /// Task loop: feeds a jog in progress (call at least once per span period).
     void service() { operator_.service(); }
@@ -43,7 +44,8 @@ public:
 
     /// FC3: the status mirror, the command register, the configuration block. Anything else,
     /// the span window included (a write-only mailbox): kIllegalDataAddress.
-    Exception read_holding_registers(std::uint16_t address, std::uint16_t count, std::uint16_t* out) {
+    Exception read_holding_registers(std::uint16_t address, std::uint16_t count,
+                                     std::uint16_t* out) {
         const std::uint32_t end = static_cast<std::uint32_t>(address) + count;
         if (end <= modbus::status::kCount) return read_input_registers(address, count, out);
         if (address == modbus::kCommand && count == 1) {
@@ -63,7 +65,8 @@ public:
     /// FC6/FC16: the command register (one value), the whole configuration block, or a whole
     /// batch in the span window. All or nothing. The refusal's core Status is kept in the
     /// status block (kLastRefusal) so a master can tell why.
-    Exception write_holding_registers(std::uint16_t address, std::uint16_t count, const std::uint16_t* values) {
+    Exception write_holding_registers(std::uint16_t address, std::uint16_t count,
+                                      const std::uint16_t* values) {
         Status s = Status::kOk;
         Exception e = Exception::kNone;
         if (address == modbus::kCommand && count == 1) {
@@ -108,16 +111,21 @@ public:
     /// "Validation and exceptions"). Any context; no side effects.
     static Exception exception_for(Status s) {
         switch (s) {
-            case Status::kQueueFull: return Exception::kServerDeviceBusy;
+            case Status::kQueueFull:
+                return Exception::kServerDeviceBusy;
             case Status::kNotConfigured:
             case Status::kWrongState:
-            case Status::kNothingToResume: return Exception::kServerDeviceFailure;
-            default: return Exception::kIllegalDataValue;
+            case Status::kNothingToResume:
+                return Exception::kServerDeviceFailure;
+            default:
+                return Exception::kIllegalDataValue;
         }
     }
 
 private:
-    static std::uint32_t u32(const std::uint16_t* r) { return (static_cast<std::uint32_t>(r[0]) << 16) | r[1]; }
+    static std::uint32_t u32(const std::uint16_t* r) {
+        return (static_cast<std::uint32_t>(r[0]) << 16) | r[1];
+    }
     static void put_u32(std::uint16_t* r, std::uint32_t v) {
         r[0] = static_cast<std::uint16_t>(v >> 16);
         r[1] = static_cast<std::uint16_t>(v & 0xFFFFu);
@@ -222,9 +230,11 @@ private:
         const std::uint16_t spans = v[2];
         const std::uint16_t bytes = v[3];
         const std::uint16_t check = v[4];
-        const std::uint16_t payload_registers = static_cast<std::uint16_t>(count - modbus::kSpanHeaderRegisters);
+        const std::uint16_t payload_registers =
+            static_cast<std::uint16_t>(count - modbus::kSpanHeaderRegisters);
         // The payload must fill exactly its registers (one pad byte at most).
-        if (bytes > 2u * payload_registers || bytes + 1u < 2u * payload_registers || bytes > sizeof payload_) {
+        if (bytes > 2u * payload_registers || bytes + 1u < 2u * payload_registers ||
+            bytes > sizeof payload_) {
             e = Exception::kIllegalDataValue;
             return Status::kBadBatch;
         }

@@ -6,8 +6,8 @@
 
 #include <cstdint>
 
-#include "pathstream/device/homing.hpp"
 #include "pathstream/device/command.hpp"
+#include "pathstream/device/homing.hpp"
 #include "pathstream/device/jog.hpp"
 #include "pathstream/device/motion_device.hpp"
 
@@ -41,7 +41,8 @@ struct HomingPort {
 template <unsigned Axes, std::uint32_t Capacity>
 class OperatorCommands {
 public:
-    explicit OperatorCommands(MotionDevice<Axes, Capacity>& device) : device_(device), jog_(device) {}
+    explicit OperatorCommands(MotionDevice<Axes, Capacity>& device)
+        : device_(device), jog_(device) {}
 
     /// Connects the port's homing (init, or whenever the port's switches are set up).
     void set_homing(const HomingPort& port) { homing_ = port; }
@@ -55,9 +56,11 @@ public:
     [[nodiscard]] Status execute(const OperatorCommand& c) {
         // Homing moves the device between its own idle moments: nothing else may move it or
         // redefine its position then.
-        if (c.command >= kCommandJog && c.command <= kCommandPen && homing()) return Status::kWrongState;
+        if (c.command >= kCommandJog && c.command <= kCommandPen && homing())
+            return Status::kWrongState;
         switch (c.command) {
-            case kCommandJog: return jog_.start(c.axis, c.value, c.feed);
+            case kCommandJog:
+                return jog_.start(c.axis, c.value, c.feed);
             case kCommandSetPosition:
                 if (c.feed != 0) return Status::kControlValueOutOfRange;
                 return set_axis_position(device_, c.axis, c.value);
@@ -70,7 +73,8 @@ public:
                 if (c.axis != 0 || c.feed != 0 || (c.value != 0 && c.value != 1))
                     return Status::kControlValueOutOfRange;
                 return device_.set_pen(c.value == 1);
-            default: return Status::kUnknownCommand;
+            default:
+                return Status::kUnknownCommand;
         }
     }
 

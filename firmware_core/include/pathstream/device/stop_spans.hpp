@@ -1,6 +1,6 @@
 // The device's own spans: a controlled stop from a span boundary or from inside a span, and
-// the move back onto the path when motion resumes. Both are Hermite spans checked like any other (core validation,
-// exact limit check), so a generated span never exceeds what a host span may do.
+// the move back onto the path when motion resumes. Both are Hermite spans checked like any other
+// (core validation, exact limit check), so a generated span never exceeds what a host span may do.
 #pragma once
 
 #include <cstdint>
@@ -19,7 +19,8 @@ Status check_span(const Span<Axes>& span, const MotionLimits<Axes>& limits) {
     ValidatedSpan<Axes> v;
     if (Status s = validate_span(span, v); s != Status::kOk) return s;
     for (unsigned a = 0; a < Axes; ++a) {
-        if (Status s = check_axis_limits(v.cubic[a], v.timing, limits.axis[a], limits.tick_hz); s != Status::kOk) {
+        if (Status s = check_axis_limits(v.cubic[a], v.timing, limits.axis[a], limits.tick_hz);
+            s != Status::kOk) {
             return s;
         }
     }
@@ -27,16 +28,20 @@ Status check_span(const Span<Axes>& span, const MotionLimits<Axes>& limits) {
 }
 
 constexpr std::uint64_t magnitude64(std::int64_t v) {
-    return v < 0 ? static_cast<std::uint64_t>(0) - static_cast<std::uint64_t>(v) : static_cast<std::uint64_t>(v);
+    return v < 0 ? static_cast<std::uint64_t>(0) - static_cast<std::uint64_t>(v)
+                 : static_cast<std::uint64_t>(v);
 }
 
-constexpr std::uint64_t ceil_div(std::uint64_t a, std::uint64_t b) { return a / b + (a % b != 0 ? 1u : 0u); }
+constexpr std::uint64_t ceil_div(std::uint64_t a, std::uint64_t b) {
+    return a / b + (a % b != 0 ? 1u : 0u);
+}
 
 /// A longer move may pass where this one failed: every limit eases with the length (rounding
 /// aside).
 constexpr bool longer_may_pass(Status s) {
-    return s == Status::kAccelerationLimit || s == Status::kVelocityLimit || s == Status::kJerkLimit ||
-           s == Status::kAccelerationStep || s == Status::kDifferenceOutOfRange;
+    return s == Status::kAccelerationLimit || s == Status::kVelocityLimit ||
+           s == Status::kJerkLimit || s == Status::kAccelerationStep ||
+           s == Status::kDifferenceOutOfRange;
 }
 
 /// The smallest multiple j in first..jmax for which build(j, candidate) passes, by doubling
@@ -85,15 +90,17 @@ inline constexpr unsigned kStopSearchTries = 8;
 /// Errors: kStopTooLong when no such span fits in kMaxSpanTicks ticks or the tangent range.
 /// Cost: one estimate plus one or two span validations. Tick interrupt context (a one-off).
 template <unsigned Axes>
-[[nodiscard]] Status plan_stop(const Lsb (&position)[Axes], const std::int32_t (&tangent)[Axes], std::uint32_t ticks,
-                               const MotionLimits<Axes>& limits, Span<Axes>& out) {
+[[nodiscard]] Status plan_stop(const Lsb (&position)[Axes], const std::int32_t (&tangent)[Axes],
+                               std::uint32_t ticks, const MotionLimits<Axes>& limits,
+                               Span<Axes>& out) {
     using stop_detail::ceil_div;
     using stop_detail::magnitude64;
     // Deceleration per s^2 is |tangent| hz^2 / (j ticks^2): j >= |tangent| hz^2 / (a_max ticks^2).
     const std::uint64_t hz2 = static_cast<std::uint64_t>(limits.tick_hz) * limits.tick_hz;
     std::uint64_t j = 1;
     for (unsigned a = 0; a < Axes; ++a) {
-        const std::uint64_t per_a = ceil_div(magnitude64(tangent[a]) * hz2, limits.axis[a].max_acceleration);
+        const std::uint64_t per_a =
+            ceil_div(magnitude64(tangent[a]) * hz2, limits.axis[a].max_acceleration);
         const std::uint64_t need = ceil_div(per_a, static_cast<std::uint64_t>(ticks) * ticks);
         if (need > j) j = need;
     }
@@ -104,9 +111,11 @@ template <unsigned Axes>
         out.ticks = static_cast<std::uint32_t>(j * ticks);
         bool fits = true;
         for (unsigned a = 0; a < Axes; ++a) {
-            const std::int64_t t0 = static_cast<std::int64_t>(tangent[a]) * static_cast<std::int64_t>(j);
+            const std::int64_t t0 =
+                static_cast<std::int64_t>(tangent[a]) * static_cast<std::int64_t>(j);
             const std::int64_t p1 = static_cast<std::int64_t>(position[a]) + t0 / 2;
-            if (t0 > kMaxTangentLsb || t0 < -kMaxTangentLsb || p1 > kMaxPositionLsb || p1 < -kMaxPositionLsb) {
+            if (t0 > kMaxTangentLsb || t0 < -kMaxTangentLsb || p1 > kMaxPositionLsb ||
+                p1 < -kMaxPositionLsb) {
                 fits = false;
                 break;
             }
@@ -163,7 +172,8 @@ template <unsigned Axes>
         m[a] = 6 * kk * (nn - kk) * chord[a] + (nn - kk) * (nn - 3 * kk) * start_tangent[a] +
                kk * (3 * kk - 2 * nn) * end_tangent[a];
         // ceil(|M| hz^2 / (n^3 a_max)): the deceleration |v| hz^2 / ticks within a_max.
-        const FloorDivision per_cube = floor_divide(multiply_unsigned(magnitude64(m[a]), hz2), cube);
+        const FloorDivision per_cube =
+            floor_divide(multiply_unsigned(magnitude64(m[a]), hz2), cube);
         if (per_cube.quotient.hi != 0) {
             need = kMaxSpanTicks + 1u;
             continue;
@@ -179,8 +189,10 @@ template <unsigned Axes>
     }
     for (unsigned a = 0; a < Axes; ++a) {
         // round(base M / n^3) = floor((2 base |M| + n^3) / (2 n^3)), signed like M.
-        const Int128 twice = multiply_unsigned(magnitude64(m[a]), 2u * static_cast<std::uint64_t>(base));
-        const FloorDivision r = floor_divide(twice + Int128::from(static_cast<std::int64_t>(cube)), 2 * cube);
+        const Int128 twice =
+            multiply_unsigned(magnitude64(m[a]), 2u * static_cast<std::uint64_t>(base));
+        const FloorDivision r =
+            floor_divide(twice + Int128::from(static_cast<std::int64_t>(cube)), 2 * cube);
         if (r.quotient.hi != 0 || r.quotient.lo > static_cast<std::uint64_t>(kMaxTangentLsb)) {
             return Status::kStopTooLong;
         }
@@ -198,15 +210,17 @@ template <unsigned Axes>
 /// device runs it in the tick that applies the resume; a port with a tight tick budget can
 /// lengthen that tick's deadline or plan it in a task.
 template <unsigned Axes>
-[[nodiscard]] Status plan_reentry(const Lsb (&from)[Axes], const Lsb (&to)[Axes], const std::int32_t (&tangent)[Axes],
-                                  std::uint32_t ticks, const MotionLimits<Axes>& limits, Span<Axes>& out) {
+[[nodiscard]] Status plan_reentry(const Lsb (&from)[Axes], const Lsb (&to)[Axes],
+                                  const std::int32_t (&tangent)[Axes], std::uint32_t ticks,
+                                  const MotionLimits<Axes>& limits, Span<Axes>& out) {
     auto build = [&](std::uint64_t j, Span<Axes>& s) -> Status {
         if (j * ticks > kMaxSpanTicks) return Status::kStopTooLong;
         s = Span<Axes>{};
         s.basis = Basis::kHermite;
         s.ticks = static_cast<std::uint32_t>(j * ticks);
         for (unsigned a = 0; a < Axes; ++a) {
-            const std::int64_t t1 = static_cast<std::int64_t>(tangent[a]) * static_cast<std::int64_t>(j);
+            const std::int64_t t1 =
+                static_cast<std::int64_t>(tangent[a]) * static_cast<std::int64_t>(j);
             if (t1 > kMaxTangentLsb || t1 < -kMaxTangentLsb) return Status::kStopTooLong;
             s.control[a][0] = from[a];
             s.control[a][1] = to[a];

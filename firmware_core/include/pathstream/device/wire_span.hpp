@@ -38,22 +38,23 @@ struct WireSpan {
     std::uint32_t ticks = 1;  ///< 1..kMaxSpanTicks
     std::uint8_t flags = 0;   ///< kWireContinueTangent | kWireJobEnd | kWirePause
     std::uint8_t outputs = 0;
-    std::int32_t end[kMaxAxes] = {};           ///< P1
-    std::int32_t end_tangent[kMaxAxes] = {};   ///< T1
+    std::int32_t end[kMaxAxes] = {};            ///< P1
+    std::int32_t end_tangent[kMaxAxes] = {};    ///< T1
     std::int32_t start_tangent[kMaxAxes] = {};  ///< T0 (sent only without kWireContinueTangent)
 };
 
 /// Writes `span` for `axes` axes to out[0..wire_span_bytes). Returns the bytes written, or 0
 /// when `capacity` is too small or ticks is out of range (nothing meaningful written).
 /// Cost: O(axes). Any context.
-std::size_t encode_wire_span(const WireSpan& span, unsigned axes, std::uint8_t* out, std::size_t capacity);
+std::size_t encode_wire_span(const WireSpan& span, unsigned axes, std::uint8_t* out,
+                             std::size_t capacity);
 
 /// Reads one wire span for `axes` axes from bytes[0..available) into `out` and sets
 /// `consumed`. Errors: kBadBatch (truncated, unknown flag bits), kTickCountOutOfRange never
 /// (every u16 + 1 is a valid count). `out.start_tangent` is left as is when the span continues
 /// the tangent: the caller fills it from the previous span. Cost: O(axes). Any context.
-[[nodiscard]] Status decode_wire_span(const std::uint8_t* bytes, std::size_t available, unsigned axes,
-                                      WireSpan& out, std::size_t& consumed);
+[[nodiscard]] Status decode_wire_span(const std::uint8_t* bytes, std::size_t available,
+                                      unsigned axes, WireSpan& out, std::size_t& consumed);
 
 /// The core Span of a wire span that starts at `start` (LSB per axis): Hermite P0 = start,
 /// P1 = end, T0 = start_tangent, T1 = end_tangent; tag and outputs copied. O(Axes).

@@ -9,10 +9,10 @@ namespace pathstream::hal {
 
 /// One classic CAN frame (no CAN FD).
 struct CanFrame {
-    std::uint32_t id = 0;       ///< 11-bit (0..0x7FF) or, with `extended`, 29-bit identifier
+    std::uint32_t id = 0;  ///< 11-bit (0..0x7FF) or, with `extended`, 29-bit identifier
     bool extended = false;
-    bool remote = false;        ///< RTR frame (no data)
-    std::uint8_t length = 0;    ///< data length 0..8
+    bool remote = false;      ///< RTR frame (no data)
+    std::uint8_t length = 0;  ///< data length 0..8
     std::uint8_t data[8] = {};
 };
 

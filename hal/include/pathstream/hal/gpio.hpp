@@ -39,9 +39,9 @@ public:
 
 /// Electrical bias a backend asks the line for (what the switch's wiring needs).
 enum class Bias : std::uint8_t {
-    kAsIs,      ///< leave the line's configuration alone
-    kDisable,   ///< no pull (an external resistor is fitted)
-    kPullUp,    ///< typical for an active-low switch to ground
+    kAsIs,     ///< leave the line's configuration alone
+    kDisable,  ///< no pull (an external resistor is fitted)
+    kPullUp,   ///< typical for an active-low switch to ground
     kPullDown,
 };
 

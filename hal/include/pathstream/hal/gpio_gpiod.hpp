@@ -28,13 +28,15 @@ public:
 
 /// Requests `spec` as an input with edge events on both edges. Throws GpioError: no such chip
 /// or line, line busy, bias not supported. `consumer` is the label the kernel shows (gpioinfo).
-std::unique_ptr<DigitalInput> open_gpiod_input(const GpioLineSpec& spec, const std::string& consumer);
+std::unique_ptr<DigitalInput> open_gpiod_input(const GpioLineSpec& spec,
+                                               const std::string& consumer);
 
 /// Requests `spec` as an output driven to `initially_active` at once (no glitch through the
 /// other level). Throws GpioError. set() on the returned output throws GpioError when the
 /// kernel refuses the write (the line vanished): an output that silently stops working is
 /// worse than a stopped program.
-std::unique_ptr<DigitalOutput> open_gpiod_output(const GpioLineSpec& spec, const std::string& consumer,
+std::unique_ptr<DigitalOutput> open_gpiod_output(const GpioLineSpec& spec,
+                                                 const std::string& consumer,
                                                  bool initially_active = false);
 
 /// A line's place in the kernel: the chip's name ("gpiochip3") and the line's offset on it.

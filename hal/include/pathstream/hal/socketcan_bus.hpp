@@ -27,7 +27,7 @@ struct SocketCanCounters {
     std::uint64_t tx_queue_full = 0;    ///< sends refused with ENOBUFS/EAGAIN
     std::uint64_t error_frames = 0;
     std::uint64_t bus_off_events = 0;
-    std::uint64_t restarts = 0;         ///< CAN_ERR_RESTARTED seen (controller back on the bus)
+    std::uint64_t restarts = 0;  ///< CAN_ERR_RESTARTED seen (controller back on the bus)
 };
 
 class SocketCanBus final : public CanBus {

@@ -18,14 +18,15 @@ namespace pathstream::sim {
 
 /// Faults the loopback injects.
 struct CanFaults {
-    double drop_fraction = 0;   ///< each frame is lost for every receiver with this probability
-    std::uint64_t seed = 1;     ///< of the drop decisions (deterministic sequence of decisions)
-    std::uint32_t tx_budget = 0;  ///< frames an endpoint may send between two receive() calls (0: unlimited)
+    double drop_fraction = 0;  ///< each frame is lost for every receiver with this probability
+    std::uint64_t seed = 1;    ///< of the drop decisions (deterministic sequence of decisions)
+    std::uint32_t tx_budget =
+        0;  ///< frames an endpoint may send between two receive() calls (0: unlimited)
 };
 
 /// What went over the loopback.
 struct CanLoopbackCounters {
-    std::uint64_t frames = 0;           ///< frames sent (including the dropped ones: they took bus time)
+    std::uint64_t frames = 0;  ///< frames sent (including the dropped ones: they took bus time)
     std::uint64_t dropped = 0;
     std::uint64_t bits_worst_case = 0;  ///< sum of frame_bits_worst_case over the frames sent
     std::uint64_t data_bytes = 0;

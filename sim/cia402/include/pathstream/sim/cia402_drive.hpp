@@ -15,10 +15,10 @@ namespace pathstream::sim {
 
 /// The drive's fixed parameters (everything the master configures is in the object dictionary).
 struct Cia402DriveOptions {
-    std::uint8_t node = 1;                    ///< 1..127
-    std::int32_t start_position = 0;          ///< LSB (the encoder's count at power-up)
-    ServoParameters servo{100, 1.0};          ///< the axis, in LSB (the plant is linear)
-    std::uint32_t following_error_window = 5000;   ///< 0x6065 default, LSB
+    std::uint8_t node = 1;                            ///< 1..127
+    std::int32_t start_position = 0;                  ///< LSB (the encoder's count at power-up)
+    ServoParameters servo{100, 1.0};                  ///< the axis, in LSB (the plant is linear)
+    std::uint32_t following_error_window = 5000;      ///< 0x6065 default, LSB
     std::uint32_t quick_stop_deceleration = 5000000;  ///< 0x6085 default, LSB/s^2
 };
 
@@ -59,10 +59,11 @@ public:
     const std::vector<std::int32_t>& applied_targets() const;
     /// Largest |demand - actual| while operation enabled, LSB.
     double max_following_error() const;
-    std::uint64_t syncs() const;        ///< SYNCs processed while NMT operational
-    std::uint64_t stale_syncs() const;  ///< of which, operation enabled with no new RPDO since the last
-    std::uint64_t rpdos() const;        ///< RPDO1 frames accepted
-    std::uint16_t last_emcy() const;    ///< last EMCY code sent (0 after a reset)
+    std::uint64_t syncs() const;  ///< SYNCs processed while NMT operational
+    std::uint64_t stale_syncs()
+        const;                    ///< of which, operation enabled with no new RPDO since the last
+    std::uint64_t rpdos() const;  ///< RPDO1 frames accepted
+    std::uint16_t last_emcy() const;  ///< last EMCY code sent (0 after a reset)
 
 private:
     struct State;

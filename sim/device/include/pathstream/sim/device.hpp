@@ -9,8 +9,8 @@
 #include <vector>
 
 #include "pathstream/hal/clock.hpp"
-#include "pathstream/machine/machine.hpp"
 #include "pathstream/machine/core_span.hpp"
+#include "pathstream/machine/machine.hpp"
 #include "pathstream/sim/plant.hpp"
 #include "pathstream/units.hpp"
 
@@ -98,8 +98,8 @@ struct SimulationResult {
 /// fraction done.
 using Progress = std::function<void(double fraction)>;
 
-/// Runs `spans` (a plan's) on the simulated device: a SetpointStream<axes, kQueueCapacity> (axes = the
-/// spans' axis count, 1..8) starting at the first span's start point, a producer pushing the
+/// Runs `spans` (a plan's) on the simulated device: a SetpointStream<axes, kQueueCapacity> (axes =
+/// the spans' axis count, 1..8) starting at the first span's start point, a producer pushing the
 /// spans (Span::tag = index + 1, outputs = kOutputPenDown on pen-down spans) whenever
 /// there is room, one tick() per clock tick, the pen output set from outputs() after each
 /// tick, and the plant stepped with the tick's setpoint. Virtual time (as fast as possible)
@@ -107,14 +107,15 @@ using Progress = std::function<void(double fraction)>;
 /// Throws std::invalid_argument for an empty plan, spans whose axis count differs from the
 /// profile's, or bad servo parameters; std::runtime_error ("span I (tag T): the device
 /// refused it: <status name>") when push() answers anything but kOk or kQueueFull.
-SimulationResult simulate(const std::vector<host::CoreSpan>& spans, const host::MachineProfile& profile,
-                          const SimOptions& options, const Progress& progress = {});
+SimulationResult simulate(const std::vector<host::CoreSpan>& spans,
+                          const host::MachineProfile& profile, const SimOptions& options,
+                          const Progress& progress = {});
 
 /// The same run paced by `pacing` (options.realtime is ignored): before tick k the device
 /// calls pacing.wait_until(k), and counts the tick late when pacing.now() > k afterwards.
 /// Tests inject a clock here to check the pacing without measuring wall time.
-SimulationResult simulate_paced(const std::vector<host::CoreSpan>& spans, const host::MachineProfile& profile,
-                                const SimOptions& options, hal::Clock& pacing,
-                                const Progress& progress = {});
+SimulationResult simulate_paced(const std::vector<host::CoreSpan>& spans,
+                                const host::MachineProfile& profile, const SimOptions& options,
+                                hal::Clock& pacing, const Progress& progress = {});
 
 }  // namespace pathstream::sim

@@ -84,8 +84,8 @@ public:
     SimulatedOutput pen{clock};
     linux_device::DeviceGpio<Axes, Capacity> glue;
     MachineSwitches switches;  ///< the switches placed, on the machine's coordinates
-    std::vector<std::array<Lsb, Axes>> ticks;      ///< every tick's setpoints
-    std::vector<device::DeviceState> states;       ///< the state after every tick
+    std::vector<std::array<Lsb, Axes>> ticks;  ///< every tick's setpoints
+    std::vector<device::DeviceState> states;   ///< the state after every tick
 
 private:
     linux_device::DeviceWiring<Axes> wiring() {
