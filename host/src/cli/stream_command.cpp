@@ -30,6 +30,7 @@
 #include "pathstream/host/planning_thread.hpp"
 #include "pathstream/host/progress.hpp"
 #include "pathstream/host/resume_decision.hpp"
+#include "pathstream/host/resume_path.hpp"
 #include "pathstream/host/span_supply.hpp"
 #include "pathstream/machine/device_setup.hpp"
 #include "pathstream/machine/input_error.hpp"
