@@ -1,8 +1,8 @@
 // An interrupted drawing continued: a hold asked for while streaming, a host that dies
 // mid-stream, and a fault followed by a reset, each at seeded moments; the drawing's path
 // ticks of the interrupted run and of the resumed run together are the uninterrupted plan's,
-// tick for tick, pen included (over TCP and RTU). Also `pathstream ctl`'s link: status and commands over Modbus
-// TCP and native CAN.
+// tick for tick, pen included (over TCP and RTU). Also `pathstream ctl`'s link: status and commands
+// over Modbus TCP and native CAN.
 #include <unistd.h>
 
 #include <atomic>
@@ -16,24 +16,25 @@
 #include <thread>
 #include <vector>
 
-#include "pathstream/machine/input_error.hpp"
 #include "pathstream/device/can_protocol.hpp"
 #include "pathstream/device/device_state.hpp"
 #include "pathstream/device/jog.hpp"
 #include "pathstream/hal/modbus_server.hpp"
 #include "pathstream/host/can_stream.hpp"
 #include "pathstream/host/device_link.hpp"
-#include "pathstream/machine/device_setup.hpp"
 #include "pathstream/host/job_journal.hpp"
+#include "pathstream/host/json_path.hpp"
 #include "pathstream/host/layers.hpp"
 #include "pathstream/host/modbus_stream.hpp"
 #include "pathstream/host/planner.hpp"
-#include "pathstream/host/json_path.hpp"
-#include "pathstream/machine/machine.hpp"
+#include "pathstream/host/resume_path.hpp"
 #include "pathstream/host/svg_path.hpp"
 #include "pathstream/linux_device/can_motion_device.hpp"
-#include "pathstream/sim/can_loopback.hpp"
 #include "pathstream/linux_device/modbus_motion_device.hpp"
+#include "pathstream/machine/device_setup.hpp"
+#include "pathstream/machine/input_error.hpp"
+#include "pathstream/machine/machine.hpp"
+#include "pathstream/sim/can_loopback.hpp"
 #include "stream_support.hpp"
 
 using namespace pathstream;
@@ -179,7 +180,6 @@ unsigned seeds_to_run() {
     return env != nullptr && std::atoi(env) > 0 ? static_cast<unsigned>(std::atoi(env)) : 3u;
 }
 
-
 // Holds the job at a seeded path tick, then streams the held job on; every drawing tick once.
 // The hold is asked in the first half of the drawing so that a slow bus (RTU polls take
 // longer) still sees the moment before the drawing ends.
@@ -221,15 +221,17 @@ void hold_then_resume(const Job& job, unsigned seed, bool rtu) {
 TEST_CASE("resume: a hold at a seeded moment, the held job streamed on: every drawing tick once",
           "[resume][modbus][threads]") {
     const Job job = plan_example("wave.json");
-    for (unsigned seed = 1; seed <= seeds_to_run(); ++seed)
-        DYNAMIC_SECTION("seed " << seed) { hold_then_resume(job, seed, false); }
+    for (unsigned seed = 1; seed <= seeds_to_run(); ++seed) DYNAMIC_SECTION("seed " << seed) {
+            hold_then_resume(job, seed, false);
+        }
 }
 
 TEST_CASE("resume over RTU: a hold at a seeded moment, the held job streamed on",
           "[resume][rtu][threads]") {
     const Job job = plan_example("wave.json");
-    for (unsigned seed = 31; seed < 31 + seeds_to_run(); ++seed)
-        DYNAMIC_SECTION("seed " << seed) { hold_then_resume(job, seed, true); }
+    for (unsigned seed = 31; seed < 31 + seeds_to_run(); ++seed) DYNAMIC_SECTION("seed " << seed) {
+            hold_then_resume(job, seed, true);
+        }
 }
 
 TEST_CASE("resume: the host dies at a seeded moment, the job goes on from the device's queue",
@@ -276,8 +278,8 @@ TEST_CASE("resume: a stop or a fault at a seeded moment, then a re-entry from wh
     Job job = plan_example("wave.json");
     if (jerk > 0) {
         for (auto& a : job.machine.axes) a.max_jerk = jerk;
-        job.plan = host::plan_path(host::to_bezier_segments(host::load_json_path(std::string(PATHSTREAM_SOURCE_DIR) +
-                                                                                 "/examples/wave.json")),
+        job.plan = host::plan_path(host::to_bezier_segments(host::load_json_path(
+                                       std::string(PATHSTREAM_SOURCE_DIR) + "/examples/wave.json")),
                                    job.machine);
     }
     const host::JobSpans whole = host::job_from_plan(job.plan);
@@ -380,18 +382,21 @@ TEST_CASE("resume_from: the pen-down approach along the tangent, and errors", "[
                     std::invalid_argument);
 }
 
-TEST_CASE("resume_from under a jerk limit: the re-entry and the approach keep the acceleration continuous",
-          "[resume][jerk]") {
+TEST_CASE(
+    "resume_from under a jerk limit: the re-entry and the approach keep the acceleration "
+    "continuous",
+    "[resume][jerk]") {
     // wave.json planned for the pen plotter with 1e5 mm/s^3 on both axes; resumed from spans
     // all along it (inside strokes too, where the acceleration is not 0), from a rest point
     // off the path. The whole resumed job, started at rest, is within the exact jerk rules
     // (check_plan's jerk meter: each span's jerk, every join's acceleration step, rest at both
     // ends); the same resume without the jerk limit is not (the test can fail).
     Job job;
-    job.machine = host::load_machine_profile(std::string(PATHSTREAM_SOURCE_DIR) + "/examples/machines/pen_plotter.json");
+    job.machine = host::load_machine_profile(std::string(PATHSTREAM_SOURCE_DIR) +
+                                             "/examples/machines/pen_plotter.json");
     for (auto& a : job.machine.axes) a.max_jerk = 1e5;
-    const auto segments =
-        host::to_bezier_segments(host::load_json_path(std::string(PATHSTREAM_SOURCE_DIR) + "/examples/wave.json"));
+    const auto segments = host::to_bezier_segments(
+        host::load_json_path(std::string(PATHSTREAM_SOURCE_DIR) + "/examples/wave.json"));
     job.plan = host::plan_path(segments, job.machine);
     const host::JobSpans whole = host::job_from_plan(job.plan);
     const host::DeviceLimitsLsb limits = host::device_limits(job.machine);
@@ -419,8 +424,10 @@ TEST_CASE("resume_from under a jerk limit: the re-entry and the approach keep th
         CHECK(c.max_acceleration_fraction_exact <= 1.0);
         CHECK(c.max_velocity_fraction_exact <= 1.0);
         ++resumed_count;
-        const host::PlanCheck p = host::check_plan(host::resume_from(whole, first, rest, plain).plan, segments, job.machine);
-        plain_over += p.max_jerk_fraction_exact > 1.0 || p.max_join_acceleration_step_fraction > 1.0 ? 1 : 0;
+        const host::PlanCheck p = host::check_plan(
+            host::resume_from(whole, first, rest, plain).plan, segments, job.machine);
+        plain_over +=
+            p.max_jerk_fraction_exact > 1.0 || p.max_join_acceleration_step_fraction > 1.0 ? 1 : 0;
     }
     CHECK(resumed_count > 10);
     CHECK(plain_over > 0);
@@ -490,12 +497,15 @@ TEST_CASE("job spans and journal files: round trip, changed or damaged files ref
     };
     CHECK_THROWS_WITH(host::read_journal(edited("\"job\": 7", "\"job\": 8")),
                       Catch::Contains("\"binding\" does not match"));
-    CHECK_THROWS_WITH(host::read_journal(edited("\"plan_hash\": \"" + hash, "\"plan_hash\": \"0000000000000000")),
-                      Catch::Contains("\"binding\" does not match"));
+    CHECK_THROWS_WITH(
+        host::read_journal(edited("\"plan_hash\": \"" + hash, "\"plan_hash\": \"0000000000000000")),
+        Catch::Contains("\"binding\" does not match"));
     CHECK_THROWS_WITH(host::read_journal(edited("\"plan_file\": \"", "\"plan_file\": \"/other")),
                       Catch::Contains("j3.json:"));
-    CHECK(host::read_journal(edited("\"last_completed\": 33", "\"last_completed\": 40")).last_completed == 40);
-    CHECK(host::read_journal(edited("127.0.0.1:1502", "127.0.0.1:1503")).target == "modbus-tcp://127.0.0.1:1503");
+    CHECK(host::read_journal(edited("\"last_completed\": 33", "\"last_completed\": 40"))
+              .last_completed == 40);
+    CHECK(host::read_journal(edited("127.0.0.1:1502", "127.0.0.1:1503")).target ==
+          "modbus-tcp://127.0.0.1:1503");
 }
 
 TEST_CASE("ctl's link: status and every command over Modbus TCP, refusals by name",
@@ -640,7 +650,8 @@ TEST_CASE("a stop from another client while streaming ends the stream as a stop,
             bool sent = false;
             o.observer = [&](const host::StreamTrace& t) {
                 if (sent || t.status.ticks_executed < at) return;
-                const std::unique_ptr<host::DeviceLink> other = host::open_device_link(dt.target(), {});
+                const std::unique_ptr<host::DeviceLink> other =
+                    host::open_device_link(dt.target(), {});
                 REQUIRE(other->command(Command::kStop) == Status::kOk);
                 sent = true;
             };
@@ -657,8 +668,11 @@ TEST_CASE("a stop from another client while streaming ends the stream as a stop,
 
 TEST_CASE("resume reads a journal and its spans from regular files only", "[resume]") {
     // A journal edited to name /dev/zero as its plan would be read without end.
-    CHECK_THROWS_WITH(host::read_job_spans("/dev/zero", ""),
-                      Catch::Contains("/dev/zero: not a regular file: a job's spans are a file that stream writes"));
-    CHECK_THROWS_WITH(host::read_journal("/dev/null"),
-                      Catch::Contains("/dev/null: not a regular file: a journal is a file that stream writes"));
+    CHECK_THROWS_WITH(
+        host::read_job_spans("/dev/zero", ""),
+        Catch::Contains(
+            "/dev/zero: not a regular file: a job's spans are a file that stream writes"));
+    CHECK_THROWS_WITH(
+        host::read_journal("/dev/null"),
+        Catch::Contains("/dev/null: not a regular file: a journal is a file that stream writes"));
 }

@@ -24,14 +24,16 @@
 #include "pathstream/host/can_stream.hpp"
 #include "pathstream/host/cia402_master.hpp"
 #include "pathstream/host/device_link.hpp"
-#include "pathstream/machine/device_setup.hpp"
 #include "pathstream/host/events.hpp"
-#include "pathstream/machine/input_error.hpp"
 #include "pathstream/host/job_estimate.hpp"
 #include "pathstream/host/job_journal.hpp"
 #include "pathstream/host/planning_thread.hpp"
 #include "pathstream/host/progress.hpp"
+#include "pathstream/host/resume_decision.hpp"
+#include "pathstream/host/resume_path.hpp"
 #include "pathstream/host/span_supply.hpp"
+#include "pathstream/machine/device_setup.hpp"
+#include "pathstream/machine/input_error.hpp"
 #include "plan_command.hpp"
 #include "stream_plan_tap.hpp"
 
@@ -67,8 +69,9 @@ void add_stream_command(CLI::App& app, StreamCommandOptions& o) {
                     "DRAWING.journal.json in the "
                     "current directory, DRAWING the file's name without its extension)");
     cmd->add_flag("--no-journal", o.no_journal, "write no job journal");
-    cmd->add_flag("--replace-journal", o.replace_journal,
-                  "start anew even when the journal holds a job that did not finish (it is replaced)");
+    cmd->add_flag(
+        "--replace-journal", o.replace_journal,
+        "start anew even when the journal holds a job that did not finish (it is replaced)");
     cmd->add_flag(
         "--plan-first", o.plan_first,
         "plan the whole job before sending anything (the events' totals are known from job_start; "
@@ -772,6 +775,7 @@ JobSpans replan_for_resume(JobJournal& journal, const std::string& journal_path,
 
 // --resume: the device holds the job (go on streaming, then resume), or rests idle (a
 // re-entry from where it rests to the first span not executed, then the rest of the job).
+// decide_resume says which; this reads the device, waits, prints and acts.
 int run_resume(StreamCommandOptions o, const EventChannel& channel) {
     JobJournal journal = read_journal(o.resume);
     if (o.machine.empty()) o.machine = journal.machine;
@@ -780,7 +784,12 @@ int run_resume(StreamCommandOptions o, const EventChannel& channel) {
     const JobSpans job = journal.plan_hash.empty()
                              ? replan_for_resume(journal, o.resume, o.machine)
                              : read_job_spans(journal.plan_file, journal.plan_hash);
-    if (journal.outcome == "finished") {
+    const std::size_t spans = job.plan.spans.size();
+    const std::size_t axes = machine.axes.size();
+    const ResumeJournal record{journal.job, journal.epoch, journal.last_completed,
+                               journal.outcome == "finished"};
+    ResumeDecision d = decide_resume(record, spans, axes, nullptr);
+    if (d.kind == ResumeKind::kAlreadyFinished) {
         std::printf("resume        %s: the job already ran to its end; nothing to do\n",
                     o.resume.c_str());
         return 0;
@@ -790,62 +799,47 @@ int run_resume(StreamCommandOptions o, const EventChannel& channel) {
     l.attempts = o.stream.attempts;
     l.link_timeout_seconds = o.stream.link_timeout_seconds;
     DeviceSnapshot s;
-    const std::size_t spans = job.plan.spans.size();
-    const auto ours_now = [&] {
-        return journal.job != 0 && s.last_accepted >= journal.job &&
-               s.last_accepted - journal.job < spans && s.last_completed + 1 >= journal.job;
-    };
     {
         const std::unique_ptr<DeviceLink> link = open_device_link(o.stream.target, l);
         s = link->status();
-        // A host that died mid-stream leaves the device running out what it had queued: it
-        // then holds (underrun) or, with the whole job queued, ends it. Wait for either (at
-        // most the queue's length in time, bounded by the link timeout per quiet read).
-        if (s.state == device::DeviceState::kRunning && ours_now()) {
-            std::printf(
-                "resume        the device still runs job %u from its queue: waiting until it holds "
-                "or ends\n",
-                journal.job);
-            std::fflush(stdout);
-            const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(600);
-            bool held_at_rest = false;
-            while ((s.state == device::DeviceState::kRunning ||
-                    (s.state == device::DeviceState::kHolding &&
-                     s.own_move())) &&
-                   std::chrono::steady_clock::now() < deadline) {
-                // Everything it accepted has run and it still runs: it waits at rest for more
-                // (the host died just after a span that ends at rest, a pen change's dwell or an
-                // exact stop), where no underrun comes. Hold it there, as an underrun would have.
-                if (!held_at_rest &&
-                    s.state == device::DeviceState::kRunning &&
-                    s.last_completed == s.last_accepted) {
-                    held_at_rest = link->command(device::Command::kHold) == Status::kOk;
-                    if (held_at_rest) {
-                        std::printf(
-                            "resume        the device ran out its queue at rest: holding it "
-                            "there\n");
-                        std::fflush(stdout);
-                    }
-                }
-                std::this_thread::sleep_for(std::chrono::milliseconds(20));
-                s = link->status();
+        // The wait for a device running out its queue lasts at most the queue's length in
+        // time, bounded by the link timeout per quiet read.
+        ResumeWait wait;
+        std::chrono::steady_clock::time_point deadline;
+        for (d = decide_resume(record, spans, axes, &s, wait); d.kind == ResumeKind::kWaitForQueue;
+             d = decide_resume(record, spans, axes, &s, wait)) {
+            if (!wait.waiting) {
+                std::printf(
+                    "resume        the device still runs job %u from its queue: waiting until it "
+                    "holds or ends\n",
+                    journal.job);
+                std::fflush(stdout);
+                wait.waiting = true;
+                deadline = std::chrono::steady_clock::now() + std::chrono::seconds(600);
             }
+            if (std::chrono::steady_clock::now() >= deadline) {
+                wait.timed_out = true;
+                continue;
+            }
+            if (d.hold_at_rest) {
+                wait.held_at_rest = link->command(device::Command::kHold) == Status::kOk;
+                if (wait.held_at_rest) {
+                    std::printf(
+                        "resume        the device ran out its queue at rest: holding it there\n");
+                    std::fflush(stdout);
+                }
+            }
+            std::this_thread::sleep_for(std::chrono::milliseconds(20));
+            s = link->status();
         }
     }
-    if (s.axes != machine.axes.size()) {
-        throw StreamError(o.stream.target + ": device has " + std::to_string(s.axes) +
-                          " axes, the profile " + std::to_string(machine.axes.size()));
-    }
-    const bool ours = ours_now();
-    if (s.state == device::DeviceState::kIdle && journal.job != 0 &&
-        s.finished_job == journal.job && s.epoch == journal.epoch &&
-        s.last_completed + 1 - journal.job == spans) {
-        // Everything was queued before the host died, and the device ran it to its end.
+    if (d.kind == ResumeKind::kRefuse) throw StreamError(o.stream.target + ": " + d.refusal);
+    if (d.kind == ResumeKind::kFinishedWhileAway) {
         JobJournal done = journal;
         done.outcome = "finished";
         done.last_completed = s.last_completed;
         done.state = device_state_name(s.state);
-        done.position.assign(s.position, s.position + machine.axes.size());
+        done.position.assign(s.position, s.position + axes);
         write_journal(done, o.resume);
         std::printf(
             "resume        the device ran job %u to its end after the host stopped; nothing to "
@@ -853,37 +847,25 @@ int run_resume(StreamCommandOptions o, const EventChannel& channel) {
             journal.job);
         return 0;
     }
-    if (s.state == device::DeviceState::kHolding && ours &&
-        s.epoch == journal.epoch && (s.flags & 1u) != 0) {
+    if (d.kind == ResumeKind::kContinueHeld) {
         std::printf(
             "resume        the device holds job %u at span %u of %zu: streaming the rest, then "
             "resume\n",
-            journal.job, s.last_completed + 1 - journal.job, spans);
-        const HeldJob held{journal.job, s.last_accepted};
+            journal.job, static_cast<unsigned>(d.first), spans);
         PlanSupply supply(job.plan);
         return stream_job({supply, &job, nullptr, nullptr, nullptr, job.subpaths, {}}, machine, o,
-                          journal, o.resume, &held, channel);
+                          journal, o.resume, &d.held, channel);
     }
-    if (s.state != device::DeviceState::kIdle) {
-        throw StreamError(o.stream.target + ": device is " + device_state_name(s.state) +
-                          fault_suffix(s.state, s.fault_code) +
-                          (s.state == device::DeviceState::kHolding
-                               ? " another job: stop it first (pathstream ctl TARGET stop)"
-                               : ": reset it first (pathstream ctl TARGET reset)") +
-                          ", then resume");
-    }
-    std::size_t first = 0;
-    if (ours) {
-        first = s.last_completed + 1 - journal.job;
-    } else if (journal.job != 0 && journal.last_completed + 1 >= journal.job) {
-        first = journal.last_completed + 1 - journal.job;
+    // kReenter: the only decision left once the device was read and the wait is over.
+    const std::size_t first = d.first;
+    if (d.from_journal) {
         std::printf(
             "resume        the device does not know job %u (restarted?): from the journal's last "
             "record, "
             "span %zu\n",
             journal.job, first);
     }
-    std::vector<Lsb> rest(s.position, s.position + machine.axes.size());
+    std::vector<Lsb> rest(s.position, s.position + axes);
     const JobSpans resumed = resume_from(job, first, rest, device_limits(machine));
     std::printf(
         "resume        from where the device rests, back onto the drawing at span %lld of %zu "

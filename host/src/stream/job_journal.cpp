@@ -1,20 +1,17 @@
-// Job journal: the job's spans, the progress record, and the re-entry that resumes a job.
+// Job journal: the job's spans file and the progress record, each written atomically; the move
+// back onto the drawing that a resume streams is resume_path.cpp's.
 #include "pathstream/host/job_journal.hpp"
 
 #include <algorithm>
 #include <cerrno>
-#include <cstring>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
 
-#include "pathstream/device/jerk_moves.hpp"
-#include "pathstream/device/motion_limits.hpp"
-#include "pathstream/device/stop_spans.hpp"
 #include "pathstream/machine/atomic_file.hpp"
-#include "pathstream/machine/core_span_conversion.hpp"
 #include "pathstream/machine/input_error.hpp"
 #include "pathstream/machine/json_document.hpp"
 
@@ -45,104 +42,6 @@ std::string fnv1a_hex(const std::string& text) {
     return f.hex();
 }
 
-// The device's limits as the core's functions take them.
-template <unsigned Axes>
-device::MotionLimits<Axes> motion_limits(const DeviceLimitsLsb& l) {
-    device::MotionLimits<Axes> limits;
-    limits.tick_hz = l.tick_hz;
-    limits.pen_down_ticks = l.pen_down_ticks;
-    for (unsigned a = 0; a < Axes; ++a) {
-        limits.axis[a].max_velocity = l.max_velocity[a];
-        limits.axis[a].max_acceleration = l.max_acceleration[a];
-        if (l.max_jerk.size() == Axes) limits.axis[a].max_jerk = l.max_jerk[a];
-    }
-    return limits;
-}
-
-// The core's plan_reentry for a run-time axis count; `out` keeps its subpath and pen.
-Status reentry(const std::vector<Lsb>& from, const std::vector<std::int32_t>& to,
-               const std::vector<std::int32_t>& tangent, std::uint32_t ticks,
-               const DeviceLimitsLsb& l, CoreSpan& out) {
-    return with_axes(from.size(), [&](auto tag) {
-        constexpr unsigned kAxes = decltype(tag)::value;
-        Lsb f[kAxes], t[kAxes];
-        std::int32_t g[kAxes];
-        for (unsigned a = 0; a < kAxes; ++a) {
-            f[a] = from[a];
-            t[a] = to[a];
-            g[a] = tangent[a];
-        }
-        Span<kAxes> span;
-        const Status s = device::plan_reentry(f, t, g, ticks, motion_limits<kAxes>(l), span);
-        if (s == Status::kOk) out = from_core_span(span, out.subpath, out.pen_down);
-        return s;
-    });
-}
-
-// Under a jerk limit, onto `target`'s start (its velocity and start acceleration): the
-// approach, when `approach_ticks` > 0 (a span of at least that many ticks ending there and
-// starting at about no acceleration: jerk_moves.hpp's ramp, pen down), and the re-entry from rest
-// at `from` onto it (plan_jerk_reentry, pen up). `out`: the re-entry spans, then the approach.
-Status jerk_reentry(const std::vector<Lsb>& from, const CoreSpan& target, std::uint32_t approach_ticks,
-                    const DeviceLimitsLsb& l, std::vector<CoreSpan>& out) {
-    return with_axes(from.size(), [&](auto tag) {
-        constexpr unsigned kAxes = decltype(tag)::value;
-        const device::MotionLimits<kAxes> limits = motion_limits<kAxes>(l);
-        Lsb f[kAxes], t[kAxes];
-        std::int32_t g[kAxes];
-        device::TickAcceleration acc[kAxes];
-        for (unsigned a = 0; a < kAxes; ++a) {
-            const auto& c = target.control[a];
-            f[a] = from[a];
-            t[a] = c[0];
-            g[a] = c[2];
-            // The target's start acceleration: (6 (P1 - P0) - 4 T0 - 2 T1) / n^2 LSB/tick^2.
-            acc[a] = device::TickAcceleration{6 * (static_cast<std::int64_t>(c[1]) - c[0]) -
-                                                  4 * static_cast<std::int64_t>(c[2]) - 2 * static_cast<std::int64_t>(c[3]),
-                                              static_cast<std::uint64_t>(target.ticks) * target.ticks};
-        }
-        std::uint32_t into_ticks = target.ticks;
-        Span<kAxes> ramp;
-        if (approach_ticks > 0) {
-            device::TickAcceleration start[kAxes];
-            if (const Status s =
-                    device::plan_jerk_approach(t, g, target.ticks, acc, approach_ticks, limits, ramp, start);
-                s != Status::kOk) {
-                return s;
-            }
-            for (unsigned a = 0; a < kAxes; ++a) {
-                t[a] = ramp.control[a][0];
-                g[a] = ramp.control[a][2];
-                acc[a] = start[a];
-            }
-            into_ticks = ramp.ticks;
-        }
-        device::JerkMove<kAxes> move;
-        if (const Status s = device::plan_jerk_reentry(f, t, g, into_ticks, acc, limits, move); s != Status::kOk) {
-            return s;
-        }
-        out.clear();
-        for (unsigned i = 0; i < move.count; ++i) out.push_back(from_core_span(move.span[i], target.subpath, false));
-        if (approach_ticks > 0) out.push_back(from_core_span(ramp, target.subpath, true));
-        return Status::kOk;
-    });
-}
-
-// The core's timing and exact cubics of a Hermite span built here (the re-entry, the approach),
-// as the planner's spans carry them, so a resumed job checks like a planned one.
-void complete_core_span(CoreSpan& c) {
-    if (make_span_timing(c.basis, c.ticks, c.timing) != Status::kOk) {
-        throw std::range_error("a re-entry span's tick count is out of range");
-    }
-    c.cubic.assign(c.control.size(), TickCubic{});
-    for (std::size_t a = 0; a < c.control.size(); ++a) {
-        const std::int32_t control[4] = {c.control[a][0], c.control[a][1], c.control[a][2], c.control[a][3]};
-        if (const Status s = make_tick_cubic(c.basis, control, c.timing, c.cubic[a]); s != Status::kOk) {
-            throw std::range_error(std::string("the core refuses a re-entry span: ") + status_name(s));
-        }
-    }
-}
-
 // Subpaths of the drawing: its spans name them by index.
 std::size_t count_subpaths(const Plan& plan) {
     std::size_t n = 0;
@@ -150,8 +49,9 @@ std::size_t count_subpaths(const Plan& plan) {
     return n;
 }
 
-// The plan's programmed pauses, from its spans' pause marks.
-std::vector<PlanPause> pauses_of(const std::vector<CoreSpan>& spans) {
+}  // namespace
+
+std::vector<PlanPause> pauses_from_spans(const std::vector<CoreSpan>& spans) {
     std::vector<PlanPause> out;
     std::uint64_t tick = 0;
     for (std::size_t i = 0; i < spans.size(); ++i) {
@@ -161,8 +61,6 @@ std::vector<PlanPause> pauses_of(const std::vector<CoreSpan>& spans) {
     }
     return out;
 }
-
-}  // namespace
 
 JobSpans job_from_plan(const Plan& plan) {
     JobSpans j;
@@ -179,102 +77,14 @@ JobSpans job_from_plan(const Plan& plan) {
     return j;
 }
 
-JobSpans resume_from(const JobSpans& job, std::size_t first, const std::vector<Lsb>& rest,
-                     const DeviceLimitsLsb& limits) {
-    while (first < job.origin.size() && job.origin[first] < 0) ++first;  // our own re-entry spans
-    if (first >= job.plan.spans.size())
-        throw std::invalid_argument("nothing left to draw: the job ran to its end");
-    const CoreSpan& target = job.plan.spans[first];
-    const std::size_t axes = target.control.size();
-    if (rest.size() != axes)
-        throw std::invalid_argument("the device's axis count differs from the job's");
-    std::vector<std::int32_t> entry(axes), tangent(axes);
-    for (std::size_t a = 0; a < axes; ++a) {
-        entry[a] = target.control[a][0];
-        tangent[a] = target.control[a][2];
-    }
-    JobSpans out;
-    out.drawing_spans = job.drawing_spans;
-    out.drawing_ticks = job.drawing_ticks;
-    out.subpaths = job.subpaths;
-    const auto add = [&](CoreSpan s, std::int64_t origin, std::uint64_t tick) {
-        out.plan.spans.push_back(std::move(s));
-        out.origin.push_back(origin);
-        out.drawing_tick.push_back(tick);
-    };
-    // The lead-in spans (re-entry, approach), then the job's own from `first` on.
-    const auto complete = [&](std::vector<CoreSpan> lead) {
-        const std::uint64_t tick = job.drawing_tick[first];
-        for (CoreSpan& c : lead) {
-            complete_core_span(c);
-            add(std::move(c), -1, tick);
-        }
-        for (std::size_t i = first; i < job.plan.spans.size(); ++i) {
-            if (job.origin[i] >= 0) add(job.plan.spans[i], job.origin[i], job.drawing_tick[i]);
-        }
-        std::uint64_t total = 0;
-        for (const CoreSpan& c : out.plan.spans) total += c.ticks;
-        out.plan.total_ticks = total;
-        out.plan.pauses = pauses_of(out.plan.spans);
-        return out;
-    };
-    // Under a jerk limit the re-entry and the approach keep the acceleration continuous too
-    // (jerk_reentry): the approach ends with the span's start acceleration, not none.
-    const bool jerk = std::any_of(limits.max_jerk.begin(), limits.max_jerk.end(), [](std::uint32_t j) { return j != 0; });
-    if (jerk) {
-        const std::uint32_t approach_ticks = target.pen_down ? limits.pen_down_ticks : 0;
-        std::vector<CoreSpan> lead;
-        if (const Status s = jerk_reentry(rest, target, approach_ticks, limits, lead); s != Status::kOk) {
-            throw std::range_error(std::string("no move from where the device rests back onto the drawing fits "
-                                               "the limits and the jerk limit (") +
-                                   status_name(s) + ")");
-        }
-        return complete(std::move(lead));
-    }
-    // The pen lands where the span starts: approach along its start tangent, pen down, for
-    // whole multiples of its length (k n ticks with tangent k T0: the same velocity, exactly).
-    std::vector<CoreSpan> approach;
-    if (target.pen_down && limits.pen_down_ticks > 0) {
-        const std::uint32_t k = (limits.pen_down_ticks + target.ticks - 1) / target.ticks;
-        CoreSpan a;
-        a.basis = Basis::kHermite;
-        a.ticks = k * target.ticks;
-        a.subpath = target.subpath;
-        a.pen_down = true;
-        a.control.assign(axes, {});
-        for (std::size_t i = 0; i < axes; ++i) {
-            const std::int64_t t = static_cast<std::int64_t>(tangent[i]) * k;
-            const std::int64_t start = static_cast<std::int64_t>(entry[i]) - t;
-            if (t > kMaxTangentLsb || t < -kMaxTangentLsb || start > kMaxPositionLsb ||
-                start < -kMaxPositionLsb) {
-                throw std::range_error(
-                    "the pen-down approach to the resume point leaves the position range");
-            }
-            a.control[i] = {static_cast<std::int32_t>(start), entry[i],
-                            static_cast<std::int32_t>(t), static_cast<std::int32_t>(t)};
-            entry[i] = static_cast<std::int32_t>(start);
-        }
-        approach.push_back(std::move(a));
-    }
-    CoreSpan r;
-    r.subpath = target.subpath;
-    r.pen_down = false;
-    if (const Status s = reentry(rest, entry, tangent, target.ticks, limits, r); s != Status::kOk) {
-        throw std::range_error(
-            std::string("no move from where the device rests back onto the drawing fits "
-                        "the limits in one span (") +
-            status_name(s) + ")");
-    }
-    approach.insert(approach.begin(), std::move(r));
-    return complete(std::move(approach));
-}
-
 JobSpansWriter::JobSpansWriter(std::string path, bool partial)
-    : path_(std::move(path)), body_(partial ? std::fopen(partial_spans_path(path_).c_str(), "w+") : std::tmpfile()),
+    : path_(std::move(path)),
+      body_(partial ? std::fopen(partial_spans_path(path_).c_str(), "w+") : std::tmpfile()),
       partial_(partial) {
     if (body_ == nullptr) {
-        throw std::runtime_error((partial ? partial_spans_path(path_) : path_) + ": cannot make a file for the job's spans: " +
-                                 std::strerror(errno));
+        throw std::runtime_error(
+            (partial ? partial_spans_path(path_) : path_) +
+            ": cannot make a file for the job's spans: " + std::strerror(errno));
     }
 }
 
@@ -296,24 +106,28 @@ std::string job_span_line(const CoreSpan& s, std::int64_t origin, std::uint64_t 
     return line;
 }
 
-std::string content_hash(const std::string& bytes) { return fnv1a_hex(bytes); }
+std::string content_hash(const std::string& bytes) {
+    return fnv1a_hex(bytes);
+}
 
 void JobSpansWriter::add(const CoreSpan& s, std::int64_t origin, std::uint64_t drawing_tick) {
     if (spans_ == 0) axes_ = s.control.size();
     std::string line = job_span_line(s, origin, drawing_tick);
     line += '\n';
-    if (std::fwrite(line.data(), 1, line.size(), body_) != line.size() || (partial_ && std::fflush(body_) != 0)) {
-        throw std::runtime_error((partial_ ? partial_spans_path(path_) : path_) + ": cannot write the job's spans: " +
-                                 std::strerror(errno));
+    if (std::fwrite(line.data(), 1, line.size(), body_) != line.size() ||
+        (partial_ && std::fflush(body_) != 0)) {
+        throw std::runtime_error((partial_ ? partial_spans_path(path_) : path_) +
+                                 ": cannot write the job's spans: " + std::strerror(errno));
     }
     ++spans_;
 }
 
-std::string JobSpansWriter::finish(std::size_t drawing_spans, std::uint64_t drawing_ticks, std::size_t subpaths) {
+std::string JobSpansWriter::finish(std::size_t drawing_spans, std::uint64_t drawing_ticks,
+                                   std::size_t subpaths) {
     std::ostringstream header;
     header << kSpansHeader << '\n';
-    header << "axes " << axes_ << " spans " << spans_ << " drawing_spans " << drawing_spans << " drawing_ticks "
-           << drawing_ticks << " subpaths " << subpaths << '\n';
+    header << "axes " << axes_ << " spans " << spans_ << " drawing_spans " << drawing_spans
+           << " drawing_ticks " << drawing_ticks << " subpaths " << subpaths << '\n';
     const std::string head = header.str();
     Fnv1a hash;
     hash.add(head.data(), head.size());
@@ -328,7 +142,8 @@ std::string JobSpansWriter::finish(std::size_t drawing_spans, std::uint64_t draw
         hash.add(buffer, n);
         f.stream().write(buffer, static_cast<std::streamsize>(n));
     }
-    if (std::ferror(body_)) throw std::runtime_error(path_ + ": the job's spans could not be read back");
+    if (std::ferror(body_))
+        throw std::runtime_error(path_ + ": the job's spans could not be read back");
     f.commit();
     if (partial_) std::remove(partial_spans_path(path_).c_str());
     return hash.hex();
@@ -336,7 +151,8 @@ std::string JobSpansWriter::finish(std::size_t drawing_spans, std::uint64_t draw
 
 std::string write_job_spans(const JobSpans& job, const std::string& path) {
     JobSpansWriter w(path);
-    for (std::size_t i = 0; i < job.plan.spans.size(); ++i) w.add(job.plan.spans[i], job.origin[i], job.drawing_tick[i]);
+    for (std::size_t i = 0; i < job.plan.spans.size(); ++i)
+        w.add(job.plan.spans[i], job.origin[i], job.drawing_tick[i]);
     return w.finish(job.drawing_spans, job.drawing_ticks, job.subpaths);
 }
 
@@ -344,7 +160,8 @@ JobSpans read_job_spans(const std::string& path, const std::string& expected_has
     // A journal edited to name a device or a FIFO (/dev/zero) would be read without end.
     std::error_code ec;
     if (std::filesystem::exists(path, ec) && !std::filesystem::is_regular_file(path, ec)) {
-        throw InputError(path, {}, "not a regular file: a job's spans are a file that stream writes");
+        throw InputError(path, {},
+                         "not a regular file: a job's spans are a file that stream writes");
     }
     std::ifstream in(path, std::ios::binary);
     if (!in) throw InputError(path, {}, "cannot open the job's spans");
@@ -353,7 +170,8 @@ JobSpans read_job_spans(const std::string& path, const std::string& expected_has
     return parse_job_spans(whole.str(), path, expected_hash);
 }
 
-JobSpans parse_job_spans(const std::string& contents, const std::string& path, const std::string& expected_hash) {
+JobSpans parse_job_spans(const std::string& contents, const std::string& path,
+                         const std::string& expected_hash) {
     if (!expected_hash.empty() && fnv1a_hex(contents) != expected_hash) {
         throw InputError(path, {},
                          "the job's spans changed since the journal was written (hash " +
@@ -394,8 +212,8 @@ JobSpans parse_job_spans(const std::string& contents, const std::string& path, c
         std::uint64_t tick = 0;
         int marks = 0;  // bit 0: pen down, bit 1: a pause follows
         s.basis = Basis::kHermite;
-        if (!(l >> origin >> tick >> s.subpath >> marks >> s.ticks) || s.ticks < 1 ||
-            marks < 0 || marks > 3) {
+        if (!(l >> origin >> tick >> s.subpath >> marks >> s.ticks) || s.ticks < 1 || marks < 0 ||
+            marks > 3) {
             fail("bad span line");
         }
         s.pen_down = (marks & 1) != 0;
@@ -411,16 +229,16 @@ JobSpans parse_job_spans(const std::string& contents, const std::string& path, c
         job.drawing_tick.push_back(tick);
     }
     job.plan.total_ticks = total;
-    job.plan.pauses = pauses_of(job.plan.spans);
+    job.plan.pauses = pauses_from_spans(job.plan.spans);
     return job;
 }
 
 std::string journal_binding(const JobJournal& j) {
     // The fields that say which job this is and what it draws; the progress fields and the
     // target (resume may name the device anew) change legitimately and are left out.
-    return content_hash("pathstream job binding 1\n" + j.machine + '\n' + j.drawing + '\n' + j.plan_file + '\n' +
-                        j.plan_hash + '\n' + std::to_string(j.job) + '\n' + std::to_string(j.epoch) + '\n' +
-                        j.replan);
+    return content_hash("pathstream job binding 1\n" + j.machine + '\n' + j.drawing + '\n' +
+                        j.plan_file + '\n' + j.plan_hash + '\n' + std::to_string(j.job) + '\n' +
+                        std::to_string(j.epoch) + '\n' + j.replan);
 }
 
 void write_journal(const JobJournal& j, const std::string& path) {
@@ -464,7 +282,8 @@ JobJournal parse_journal(const std::string& text, const std::string& path) {
     const JsonChecker check(text, path);
     // value("format", "") throws a type error for a "format" that is not a string: compared
     // as JSON instead, any other value is simply not this format.
-    if (!d.is_object() || !d.contains("format") || d["format"] != nlohmann::json("pathstream job journal 1")) {
+    if (!d.is_object() || !d.contains("format") ||
+        d["format"] != nlohmann::json("pathstream job journal 1")) {
         check.fail("",
                    "not a pathstream job journal (want \"format\": \"pathstream job journal 1\")");
     }
@@ -499,7 +318,8 @@ JobJournal parse_journal(const std::string& text, const std::string& path) {
     get("binding", binding);
     if (binding != journal_binding(j)) {
         check.fail("/binding",
-                   "the journal's job, plan or drawing is not the one it was written with (\"binding\" does not match): "
+                   "the journal's job, plan or drawing is not the one it was written with "
+                   "(\"binding\" does not match): "
                    "an edited or swapped journal is never resumed");
     }
     return j;

@@ -1,7 +1,8 @@
 // A stream's record on disk, so that an interrupted drawing can be continued after a hold, a
 // stop, a fault reset, a device restart or a host crash (docs/cli.md, "Interrupt and
 // resume"). Two files: the job's spans (JOURNAL.plan, written once per job) and the journal
-// itself (JSON, rewritten as the stream goes). Both are written atomically.
+// itself (JSON, rewritten as the stream goes). Both are written atomically. The move back onto
+// the drawing that a resume streams is resume_path.hpp's.
 #pragma once
 
 #include <cstdint>
@@ -9,8 +10,8 @@
 #include <string>
 #include <vector>
 
-#include "pathstream/machine/device_setup.hpp"
 #include "pathstream/host/plan.hpp"
+#include "pathstream/units.hpp"
 
 namespace pathstream::host {
 
@@ -29,19 +30,9 @@ struct JobSpans {
 /// A drawing's plan as the first job: every span its own origin.
 JobSpans job_from_plan(const Plan& plan);
 
-/// The job's spans from span `first` on (the first one not executed to its end), entered from
-/// rest at `rest`: a re-entry span (the core's plan_reentry, pen up) that arrives at span
-/// `first`'s start with its start velocity, and, when that span draws and `limits` has a
-/// pen-down delay, a straight approach along its start tangent lasting at least that delay,
-/// with the pen down, so the pen touches where the span starts. Under a jerk limit (any
-/// `limits.max_jerk`) the acceleration stays continuous within one tick of jerk as well: the
-/// re-entry is plan_jerk_reentry's three or four spans, and the approach a span of at least
-/// the delay that ends with the span's start velocity and acceleration and starts with about
-/// none (a ramp, slightly curved where that acceleration is not along the tangent). Re-entry
-/// spans of `job` itself are skipped. Throws std::invalid_argument when `first` is past the end
-/// and std::range_error when no re-entry fits the limits.
-JobSpans resume_from(const JobSpans& job, std::size_t first, const std::vector<Lsb>& rest,
-                     const DeviceLimitsLsb& limits);
+/// The programmed pauses of a plan made of `spans` (Plan::pauses), from their pause_after
+/// marks: what a spans file, which keeps only the marks, and a resumed job's spans imply.
+std::vector<PlanPause> pauses_from_spans(const std::vector<CoreSpan>& spans);
 
 /// Writes a job's spans file as the spans come, holding none of them: the span lines go to a
 /// temporary file, and finish() writes `path` atomically (the header, which needs the totals,
