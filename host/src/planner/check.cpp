@@ -11,15 +11,30 @@
 // come in coarse steps (1/3 of the limit at 3 LSB/tick^2) and stay below the exact cubic's, so
 // the check also keeps the raw integer peaks in LSB and the exact fractions for reports.
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <functional>
 #include <map>
 #include <memory>
 #include <sstream>
+#include <string>
+#include <utility>
+#include <vector>
 
-#include "internal.hpp"
+#include "check.hpp"
+#include "cubic.hpp"
 #include "jerk_meter.hpp"
+#include "pathstream/host/geometry.hpp"
+#include "pathstream/host/plan.hpp"
+#include "pathstream/host/planner.hpp"
+#include "pathstream/machine/core_span.hpp"
+#include "pathstream/machine/machine.hpp"
 #include "pathstream/setpoint_stream.hpp"
 #include "pathstream/span.hpp"
+#include "projection.hpp"
+#include "vec.hpp"
 
 namespace pathstream::host {
 namespace {

@@ -5,8 +5,14 @@
 // every axis can jump its velocity within one tick (docs/planner.md §3, §8).
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
+#include <utility>
 
-#include "internal.hpp"
+#include "corner_blend.hpp"
+#include "cubic.hpp"
+#include "pathstream/host/geometry.hpp"
+#include "pathstream/host/planner.hpp"
+#include "vec.hpp"
 
 namespace pathstream::host::planner_detail {
 namespace {

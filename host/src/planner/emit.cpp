@@ -5,14 +5,27 @@
 // (dp/du over the span). Consecutive spans share P exactly, and T whenever they have the same
 // tick count, so the core's cubic is continuous tick for tick.
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstddef>
+#include <cstdint>
 #include <cstdlib>
 #include <sstream>
+#include <string>
+#include <utility>
+#include <vector>
 
-#include "internal.hpp"
+#include "emit.hpp"
+#include "forward_pass.hpp"
+#include "grid.hpp"
+#include "lsb_rounding.hpp"
+#include "pathstream/host/planner.hpp"
+#include "pathstream/machine/core_span.hpp"
+#include "pathstream/machine/machine.hpp"
 #include "pathstream/status.hpp"
 #include "pathstream/tick_cubic.hpp"
 #include "pathstream/units.hpp"
+#include "vec.hpp"
 
 namespace pathstream::host::planner_detail {
 

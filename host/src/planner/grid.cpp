@@ -2,10 +2,20 @@
 // stops at sharp corners, cusps and pen changes; the arc length -> point lookup.
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
+#include <cstdint>
 #include <limits>
 #include <sstream>
+#include <string>
+#include <utility>
+#include <vector>
 
-#include "internal.hpp"
+#include "cubic.hpp"
+#include "grid.hpp"
+#include "pathstream/host/geometry.hpp"
+#include "pathstream/host/planner.hpp"
+#include "pathstream/machine/machine.hpp"
+#include "vec.hpp"
 
 namespace pathstream::host::planner_detail {
 namespace {

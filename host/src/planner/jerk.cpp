@@ -3,11 +3,22 @@
 // every span and every join meets the jerk limits exactly.
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
+#include <cstdint>
 #include <limits>
 #include <sstream>
+#include <vector>
 
-#include "internal.hpp"
+#include "emit.hpp"
+#include "forward_pass.hpp"
+#include "grid.hpp"
+#include "jerk.hpp"
+#include "limits.hpp"
+#include "pathstream/host/planner.hpp"
+#include "pathstream/machine/machine.hpp"
 #include "pathstream/units.hpp"
+#include "piece.hpp"
+#include "vec.hpp"
 
 namespace pathstream::host::planner_detail {
 namespace {

@@ -7,9 +7,18 @@
 // limit |q_i' dds + q_i'' x| <= a_i at both ends of the interval is linear in (x[k], x[k+1]).
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
+#include <cstdint>
 #include <limits>
+#include <vector>
 
-#include "internal.hpp"
+#include "grid.hpp"
+#include "limits.hpp"
+#include "lookahead.hpp"
+#include "lp2.hpp"
+#include "pathstream/host/planner.hpp"
+#include "pathstream/machine/machine.hpp"
+#include "vec.hpp"
 
 namespace pathstream::host::planner_detail {
 namespace {

@@ -4,8 +4,10 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstddef>
 
-#include "internal.hpp"
+#include "lp2.hpp"
+#include "vec.hpp"
 
 namespace pathstream::host::planner_detail {
 namespace {

@@ -2,9 +2,19 @@
 // local retries that lower the lookahead where the forward pass got stuck (docs/planner.md §5).
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <sstream>
+#include <string>
 
-#include "internal.hpp"
+#include "forward_pass.hpp"
+#include "grid.hpp"
+#include "jerk.hpp"
+#include "limits.hpp"
+#include "lookahead.hpp"
+#include "pathstream/host/planner.hpp"
+#include "pathstream/machine/machine.hpp"
+#include "piece.hpp"
+#include "vec.hpp"
 
 namespace pathstream::host::planner_detail {
 

@@ -6,9 +6,12 @@
 // nodes are passed, found by Newton's method.
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
 
+#include "forward_pass.hpp"
 #include "piece_timer.hpp"
+#include "vec.hpp"
 
 namespace pathstream::host::planner_detail {
 

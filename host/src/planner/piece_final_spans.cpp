@@ -6,9 +6,14 @@
 // regular spans alone would overshoot it or stop short.
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
+#include <utility>
 
+#include "forward_pass.hpp"
+#include "grid.hpp"
 #include "piece_timer.hpp"
+#include "vec.hpp"
 
 namespace pathstream::host::planner_detail {
 

@@ -5,9 +5,12 @@
 // acceleration across the rest of the bend (leave_dip).
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
 
+#include "forward_pass.hpp"
 #include "piece_timer.hpp"
+#include "vec.hpp"
 
 namespace pathstream::host::planner_detail {
 

@@ -6,10 +6,15 @@
 // only for the planned profile.
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
 #include <cstdlib>
 
+#include "forward_pass.hpp"
+#include "grid.hpp"
+#include "lsb_rounding.hpp"
 #include "piece_timer.hpp"
+#include "vec.hpp"
 
 namespace pathstream::host::planner_detail {
 

@@ -10,10 +10,18 @@
 // evaluate), which every other stage of PieceTimer (piece_timer.hpp) calls back into.
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
+#include <utility>
 #include <vector>
 
+#include "forward_pass.hpp"
+#include "grid.hpp"
+#include "limits.hpp"
+#include "pathstream/host/planner.hpp"
+#include "pathstream/machine/machine.hpp"
 #include "piece_timer.hpp"
+#include "vec.hpp"
 
 namespace pathstream::host::planner_detail {
 

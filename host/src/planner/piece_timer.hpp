@@ -14,7 +14,13 @@
 #include <cstdint>
 #include <vector>
 
-#include "internal.hpp"
+#include "forward_pass.hpp"
+#include "grid.hpp"
+#include "limits.hpp"
+#include "lsb_rounding.hpp"
+#include "pathstream/host/planner.hpp"
+#include "pathstream/machine/machine.hpp"
+#include "vec.hpp"
 
 namespace pathstream::host::planner_detail {
 

@@ -1,10 +1,25 @@
 // plan_path: plan_stream into a Plan held in memory, and the continuous optimum for PlanStats.
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <functional>
 #include <sstream>
+#include <string>
+#include <utility>
+#include <vector>
 
-#include "internal.hpp"
+#include "corner_blend.hpp"
+#include "grid.hpp"
+#include "limits.hpp"
+#include "lookahead.hpp"
+#include "pathstream/host/geometry.hpp"
+#include "pathstream/host/plan.hpp"
+#include "pathstream/host/planner.hpp"
+#include "pathstream/machine/core_span.hpp"
+#include "pathstream/machine/machine.hpp"
 #include "pathstream/units.hpp"
+#include "plan_inputs.hpp"
+#include "vec.hpp"
 
 namespace pathstream::host {
 namespace {

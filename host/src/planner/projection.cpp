@@ -1,9 +1,14 @@
 // Distance from a point to the geometric path (nearest point on the Bezier segments).
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <limits>
+#include <utility>
+#include <vector>
 
-#include "internal.hpp"
+#include "cubic.hpp"
+#include "projection.hpp"
+#include "vec.hpp"
 
 namespace pathstream::host::planner_detail {
 

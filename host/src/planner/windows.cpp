@@ -10,14 +10,34 @@
 // planned; window N goes to the sink once its check passed.
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <functional>
 #include <limits>
 #include <optional>
 #include <sstream>
+#include <string>
 #include <thread>
 #include <utility>
+#include <vector>
 
-#include "internal.hpp"
+#include "check.hpp"
+#include "corner_blend.hpp"
+#include "cubic.hpp"
+#include "emit.hpp"
+#include "forward_pass.hpp"
+#include "grid.hpp"
+#include "jerk.hpp"
+#include "limits.hpp"
+#include "lsb_rounding.hpp"
+#include "pathstream/host/geometry.hpp"
 #include "pathstream/host/handoff_worker.hpp"
+#include "pathstream/host/plan.hpp"
+#include "pathstream/host/planner.hpp"
+#include "pathstream/machine/machine.hpp"
+#include "piece.hpp"
+#include "plan_inputs.hpp"
+#include "vec.hpp"
 
 namespace pathstream::host {
 namespace {
