@@ -27,7 +27,8 @@ class PathProjector;
 class TickChecker {
 public:
     /// `segments` (optional) give the feeds and, with `deviation`, the path to measure from.
-    TickChecker(const MachineProfile& profile, const std::vector<BezierSegment>* segments, bool deviation);
+    TickChecker(const MachineProfile& profile, const std::vector<BezierSegment>* segments,
+                bool deviation);
     ~TickChecker();
     TickChecker(const TickChecker&) = delete;
     TickChecker& operator=(const TickChecker&) = delete;
@@ -43,7 +44,8 @@ public:
     PlanCheck finish();
     /// Called with every executed tick: its number, the core's setpoint (LSB per axis) and
     /// the pen output of the span playing it (the held end point last).
-    using TickObserver = std::function<void(std::uint64_t tick, const std::int64_t* setpoint, bool pen_down)>;
+    using TickObserver =
+        std::function<void(std::uint64_t tick, const std::int64_t* setpoint, bool pen_down)>;
     void observe(TickObserver observer) { observer_ = std::move(observer); }
 
 private:

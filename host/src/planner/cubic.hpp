@@ -31,7 +31,8 @@ struct Cubic {
         const double v = 1 - u;
         Vec r{};
         for (std::size_t i = 0; i < axes; ++i) {
-            r[i] = 3 * (v * v * (p[1][i] - p[0][i]) + 2 * u * v * (p[2][i] - p[1][i]) + u * u * (p[3][i] - p[2][i]));
+            r[i] = 3 * (v * v * (p[1][i] - p[0][i]) + 2 * u * v * (p[2][i] - p[1][i]) +
+                        u * u * (p[3][i] - p[2][i]));
         }
         return r;
     }
@@ -39,7 +40,8 @@ struct Cubic {
         const double v = 1 - u;
         Vec r{};
         for (std::size_t i = 0; i < axes; ++i) {
-            r[i] = 6 * (v * (p[2][i] - 2 * p[1][i] + p[0][i]) + u * (p[3][i] - 2 * p[2][i] + p[1][i]));
+            r[i] =
+                6 * (v * (p[2][i] - 2 * p[1][i] + p[0][i]) + u * (p[3][i] - 2 * p[2][i] + p[1][i]));
         }
         return r;
     }

@@ -42,8 +42,8 @@ public:
     void motion(const Knot& from, const MotionSpan& span, const Run& run);
     using LsbVec = std::array<std::int64_t, kAxesMax>;
     /// A motion span given in LSB: from the current position to `p1` with tangents t0, t1.
-    void motion_lsb(const LsbVec& p1, const LsbVec& t0, const LsbVec& t1, std::uint32_t ticks, std::size_t subpath,
-                    bool pen_down);
+    void motion_lsb(const LsbVec& p1, const LsbVec& t0, const LsbVec& t1, std::uint32_t ticks,
+                    std::size_t subpath, bool pen_down);
     /// Where the last span ended (LSB).
     const LsbVec& position() const { return pos_; }
     /// The last span's end acceleration per axis: numerator (LSB/u^2) over `last_ticks()`^2
@@ -72,13 +72,14 @@ public:
 private:
     LsbVec quantise(const Vec& mm) const;
     LsbVec tangent(const Vec& velocity, std::uint32_t ticks) const;
-    void span(const LsbVec& p1, const LsbVec& t0, const LsbVec& t1, std::uint32_t ticks, std::size_t subpath,
-              bool pen_down);
+    void span(const LsbVec& p1, const LsbVec& t0, const LsbVec& t1, std::uint32_t ticks,
+              std::size_t subpath, bool pen_down);
     void dwell(std::uint64_t ticks, std::size_t subpath, bool pen_down);
     void pen(bool down, std::size_t subpath, bool last);
     void before_pen_down(const Run& run);
     void release();
-    void verify_jerk(const LsbVec& p1, const LsbVec& t0, const LsbVec& t1, std::uint32_t ticks, std::size_t subpath);
+    void verify_jerk(const LsbVec& p1, const LsbVec& t0, const LsbVec& t1, std::uint32_t ticks,
+                     std::size_t subpath);
     [[noreturn]] static void fail(std::size_t subpath, const std::string& what);
 
     LsbVec a_end_{};
@@ -90,7 +91,7 @@ private:
     std::size_t axes_;
     std::vector<PlanEvent> events_;
     std::vector<CoreSpan> spare_;  ///< spans taken back by take(), their vectors' storage reused
-    bool held_ = false;  ///< events_.back() is a span held back
+    bool held_ = false;            ///< events_.back() is a span held back
     bool any_span_ = false, last_pen_down_ = false;
     LsbVec pos_{};
     bool pen_ = false;

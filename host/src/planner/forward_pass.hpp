@@ -44,8 +44,8 @@ struct PieceMotion {
 /// (the last resort: their tangents are rounded on a different scale).
 PieceMotion forward_pass(const PathGrid& g, const Piece& piece, const Limits& limits,
                          const std::vector<double>& caps, const std::vector<double>& beta,
-                         const MachineProfile& profile, const PlanOptions& options, const Vec& start_q,
-                         PieceMotion* resume = nullptr, double resume_lambda = 0,
-                         bool short_spans = false);
+                         const MachineProfile& profile, const PlanOptions& options,
+                         const Vec& start_q, PieceMotion* resume = nullptr,
+                         double resume_lambda = 0, bool short_spans = false);
 
 }  // namespace pathstream::host::planner_detail

@@ -42,7 +42,9 @@ public:
 
     void set_axes(std::size_t axes) { axes_ = axes; }
     void reserve(std::size_t n) { data_.reserve(n * axes_); }
-    void push_back(const Vec& v) { data_.insert(data_.end(), v.begin(), v.begin() + static_cast<std::ptrdiff_t>(axes_)); }
+    void push_back(const Vec& v) {
+        data_.insert(data_.end(), v.begin(), v.begin() + static_cast<std::ptrdiff_t>(axes_));
+    }
     std::size_t size() const { return axes_ == 0 ? 0 : data_.size() / axes_; }
     ConstRow operator[](std::size_t k) const { return {data_.data() + k * axes_, axes_}; }
     Row operator[](std::size_t k) { return {data_.data() + k * axes_, axes_}; }
@@ -114,6 +116,7 @@ struct PathAt {
 /// `precise` = false skips the arc length's refinement: the point is exactly on the path but
 /// its arc length may be off by about 1e-6 of the grid interval (enough for a distance measured
 /// across the path; four times cheaper).
-PathAt path_at(const PathGrid& g, const Piece& piece, double lambda, std::size_t& hint, bool precise = true);
+PathAt path_at(const PathGrid& g, const Piece& piece, double lambda, std::size_t& hint,
+               bool precise = true);
 
 }  // namespace pathstream::host::planner_detail

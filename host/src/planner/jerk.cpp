@@ -1,6 +1,8 @@
 // The jerk stage (docs/planner.md §12): the second-order motion of each piece, retimed by a box
 // filter of its path parameter, sampled on the LSB grid, with integer tangents chosen so that
 // every span and every join meets the jerk limits exactly.
+#include "jerk.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
@@ -12,7 +14,6 @@
 #include "emit.hpp"
 #include "forward_pass.hpp"
 #include "grid.hpp"
-#include "jerk.hpp"
 #include "limits.hpp"
 #include "pathstream/host/planner.hpp"
 #include "pathstream/machine/machine.hpp"

@@ -21,8 +21,8 @@ namespace pathstream::host::planner_detail {
 /// Span length and filter of the jerk stage for a profile (docs/planner.md §12).
 struct JerkSetup {
     bool active = false;
-    std::uint32_t span_ticks = 0;    ///< ticks of every emitted motion span
-    std::uint32_t filter_ticks = 0;  ///< M: the box filter's length
+    std::uint32_t span_ticks = 0;             ///< ticks of every emitted motion span
+    std::uint32_t filter_ticks = 0;           ///< M: the box filter's length
     std::array<double, kAxesMax> jerk_lsb{};  ///< LSB/tick^3 per axis (infinity: no limit)
 };
 /// The smallest span length >= `ticks` at which the jerk limits can be met exactly on the LSB
@@ -55,10 +55,11 @@ public:
     void piece_begin(double lambda, std::size_t subpath, bool pen_down, const SpanEmitter& emitter);
     /// The second-order span from `from` to `span.end`; `pg`, `piece`: the current window's.
     /// Emits what is final. Returns false when no exact spans exist (failure() says where).
-    bool raw_span(const Knot& from, const MotionSpan& span, const PathGrid& pg, const Piece& piece, double run_offset,
-                  SpanEmitter& emitter);
+    bool raw_span(const Knot& from, const MotionSpan& span, const PathGrid& pg, const Piece& piece,
+                  double run_offset, SpanEmitter& emitter);
     /// The piece's motion ended at rest (raw end point on the LSB grid: `end_q`); emits the rest.
-    bool piece_end(const Vec& end_q, const PathGrid& pg, const Piece& piece, double run_offset, SpanEmitter& emitter);
+    bool piece_end(const Vec& end_q, const PathGrid& pg, const Piece& piece, double run_offset,
+                   SpanEmitter& emitter);
     /// A new window: arc length of the last raw knot there is `lambda` (the grids differ).
     void rebase(double lambda);
     const JerkFailure& failure() const { return failure_; }
@@ -84,16 +85,19 @@ private:
     /// The whole tick nearest quarter i + 1 of a span (at least 1 tick apart from its ends).
     std::int64_t quarter_tick(std::size_t i) const {
         const std::int64_t n = setup_.span_ticks;
-        return std::clamp<std::int64_t>((static_cast<std::int64_t>(i + 1) * n + 2) / 4, std::min<std::int64_t>(1, n - 1), n - 1);
+        return std::clamp<std::int64_t>((static_cast<std::int64_t>(i + 1) * n + 2) / 4,
+                                        std::min<std::int64_t>(1, n - 1), n - 1);
     }
-    void check_deviation(std::size_t k, const PathGrid& pg, const Piece& piece, double run_offset) const;
+    void check_deviation(std::size_t k, const PathGrid& pg, const Piece& piece,
+                         double run_offset) const;
     double filtered(std::int64_t t) const;
     double raw_lambda(double t) const;
     /// Positions of the knots up to raw time `until` (or all, once the piece ended).
     void add_knots(const PathGrid& pg, const Piece& piece);
     void add_targets();
     /// Chooses the tangents of knots chosen_from.. (backtracking), emits the final spans.
-    bool choose_and_emit(bool end, const PathGrid& pg, const Piece& piece, double run_offset, SpanEmitter& emitter);
+    bool choose_and_emit(bool end, const PathGrid& pg, const Piece& piece, double run_offset,
+                         SpanEmitter& emitter);
     bool choose_axis(std::size_t axis, std::size_t from, std::size_t to, bool end);
     /// Whether knot k's tangent keeps the rules with the knots before it (see jerk.cpp).
     bool valid(std::size_t axis, std::size_t k, bool end) const;

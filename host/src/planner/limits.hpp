@@ -4,8 +4,6 @@
 
 #include <vector>
 
-
-
 namespace pathstream::host::planner_detail {
 
 /// Per-axis limits of one planning attempt (mm/s, mm/s^2): the profile's, possibly lowered by

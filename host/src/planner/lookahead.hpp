@@ -16,14 +16,14 @@ namespace pathstream::host::planner_detail {
 
 /// Per-node squared-speed caps: per-axis velocity, feed, chord tolerance, corner rule, with
 /// the velocity and feed margins of `options`.
-std::vector<double> speed_caps(const PathGrid& g, const Limits& limits, const MachineProfile& profile,
-                               const PlanOptions& options);
+std::vector<double> speed_caps(const PathGrid& g, const Limits& limits,
+                               const MachineProfile& profile, const PlanOptions& options);
 
 /// With jerk limits: lowers `caps` (squared speeds) for the curvature's change (kappa' s^3 and
 /// curvature steps at joints), for tangent jumps crossed inside spans, and erodes every cap over
 /// the distance the jerk stage's box filter of `filter_ticks` averages (docs/planner.md §12).
-void jerk_caps(const PathGrid& g, const Limits& limits, const MachineProfile& profile, std::uint32_t filter_ticks,
-               std::vector<double>& caps);
+void jerk_caps(const PathGrid& g, const Limits& limits, const MachineProfile& profile,
+               std::uint32_t filter_ticks, std::vector<double>& caps);
 
 /// A span that crosses a corner at speed v turns on axis i at up to 4 v |J_i| / span_time:
 /// caps the lookahead's acceleration factor within two spans' travel of every crossed corner

@@ -3,8 +3,6 @@
 
 #include <cstddef>
 
-
-
 namespace pathstream::host::planner_detail {
 
 /// Max x in [0, x_max] such that some y in [y_lo, y_hi] satisfies lo_m <= c_m x + d_m y <= hi_m

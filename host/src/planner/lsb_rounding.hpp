@@ -37,7 +37,8 @@ inline long long scaled_tangent_lsb(double velocity, double scale) {
 /// A point on the LSB grid (mm), rounded as the emitter rounds span end points.
 inline Vec on_lsb_grid(const Vec& q, double lsb, std::size_t axes) {
     Vec r{};
-    for (std::size_t i = 0; i < axes; ++i) r[i] = static_cast<double>(std::llround(q[i] / lsb)) * lsb;
+    for (std::size_t i = 0; i < axes; ++i)
+        r[i] = static_cast<double>(std::llround(q[i] / lsb)) * lsb;
     return r;
 }
 

@@ -35,8 +35,8 @@ struct WindowLookahead {
 /// of `carried`, whose spans were sent already and are kept first in the result), and the
 /// local retries. Throws PlanError naming the place when no whole-tick motion is found.
 /// `run_offset`: mm of the run before this window's grid, for that message.
-PieceMotion plan_piece(WindowLookahead& lookahead, const Piece& piece, const Vec& start_q, PieceMotion* carried,
-                       double run_offset, PlanStats& stats);
+PieceMotion plan_piece(WindowLookahead& lookahead, const Piece& piece, const Vec& start_q,
+                       PieceMotion* carried, double run_offset, PlanStats& stats);
 
 /// "subpath N, X mm along it" for a place in a piece.
 std::string where(const PathGrid& pg, const Piece& piece, double lambda, double run_offset);

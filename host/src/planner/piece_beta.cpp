@@ -16,7 +16,8 @@
 namespace pathstream::host::planner_detail {
 
 /// Largest A in [a_lo, a_hi] keeping the speed under beta, or false if even a_lo fails.
-bool PieceTimer::max_under_beta(const Knot& k, double tau, double a_lo, double a_hi, double& a) const {
+bool PieceTimer::max_under_beta(const Knot& k, double tau, double a_lo, double a_hi,
+                                double& a) const {
     if (!under_beta(k, a_lo, tau)) return false;
     if (under_beta(k, a_hi, tau)) {
         a = a_hi;
@@ -42,7 +43,8 @@ bool PieceTimer::max_under_beta(const Knot& k, double tau, double a_lo, double a
 /// grows (l1 = l0 + V0 tau + A tau^2 / 2), so A is split at the nodes; in each interval the
 /// nodes passed cap A linearly and the end's x = (V0 + A tau)^2 against beta interpolated
 /// linearly is a quadratic. The largest A in [a_lo, a_hi] meeting them (a_lo if none).
-inline double PieceTimer::solve_under_beta(const Knot& k, double tau, double a_lo, double a_hi) const {
+inline double PieceTimer::solve_under_beta(const Knot& k, double tau, double a_lo,
+                                           double a_hi) const {
     const double s = k.speed, x0 = s * s, tau2 = tau * tau;
     const auto a_at = [&](double l) { return 2 * (l - k.lambda - s * tau) / tau2; };
     const double top = std::min(a_hi, a_at(end_lambda_ + 1e-12));
@@ -50,7 +52,8 @@ inline double PieceTimer::solve_under_beta(const Knot& k, double tau, double a_l
     const std::size_t first = interval(k.lambda);
     for (std::size_t j = first; j < piece_.last; ++j) {
         const double lj = g_.lambda[j], lj1 = g_.lambda[j + 1];
-        if (j > first && lj > k.lambda) cap = std::min(cap, (beta_[j] * (1 + 1e-9) + 1e-12 - x0) / (2 * (lj - k.lambda)));
+        if (j > first && lj > k.lambda)
+            cap = std::min(cap, (beta_[j] * (1 + 1e-9) + 1e-12 - x0) / (2 * (lj - k.lambda)));
         const double seg_lo = j == first ? a_lo : a_at(lj);
         const double seg_hi = j + 1 == piece_.last ? top : a_at(lj1);
         if (seg_lo > cap) break;
@@ -82,7 +85,9 @@ inline double PieceTimer::solve_under_beta(const Knot& k, double tau, double a_l
 inline bool PieceTimer::jerk_under_beta(const Knot& k, double a, double jerk, double tau) const {
     const double a0 = a - 0.5 * jerk * tau;
     const auto speed = [&](double t) { return k.speed + a0 * t + 0.5 * jerk * t * t; };
-    const auto dist = [&](double t) { return k.speed * t + 0.5 * a0 * t * t + jerk * t * t * t / 6; };
+    const auto dist = [&](double t) {
+        return k.speed * t + 0.5 * a0 * t * t + jerk * t * t * t / 6;
+    };
     if (jerk > 0 && a0 < 0) {
         const double t_min = -a0 / jerk;
         if (t_min < tau && speed(t_min) < 0) return false;

@@ -1,9 +1,9 @@
 // The spans that end at rest exactly at the piece's end: a final span of at most
 // ticks_per_span ticks (finish, finish_ok), or that span and the one before it chosen together
 // (land) where no final span fits from the current knot, and the one rest-to-rest span of a
-// piece too short for speed caps to resolve (creep_ticks). Tried at every knot before the
-// regular span: the end must be reached at a whole tick, at rest, on the LSB grid, and the
-// regular spans alone would overshoot it or stop short.
+// piece too short for speed caps to resolve (creep_ticks). finish and land are tried at every
+// knot before the regular span: the end must be reached at a whole tick, at rest, on the LSB
+// grid, and the regular spans alone would overshoot it or stop short.
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
@@ -47,7 +47,8 @@ std::uint32_t PieceTimer::finish(const Knot& k) {
     for (std::uint32_t t = lo; t <= hi; t += stride) {
         if (!finish_ok(k, arrival_, t)) continue;
         std::uint32_t best = t;  // with a coarse stride, look for a shorter one just below
-        while (stride > 1 && best > lo && best + stride > t + 1 && finish_ok(k, arrival_, best - 1)) --best;
+        while (stride > 1 && best > lo && best + stride > t + 1 && finish_ok(k, arrival_, best - 1))
+            --best;
         return best;
     }
     return 0;
@@ -76,10 +77,12 @@ bool PieceTimer::finish_ok(const Knot& k, const Arrival& in, std::uint32_t ticks
         const double w = s / 8.0, w2 = w * w;
         double along = 0, speed2 = 0;
         for (std::size_t i = 0; i < axes_; ++i) {
-            const double x = (2 * w2 * w - 3 * w2 + 1) * k.q[i] + (w2 * w - 2 * w2 + w) * v0[i] * tau +
+            const double x = (2 * w2 * w - 3 * w2 + 1) * k.q[i] +
+                             (w2 * w - 2 * w2 + w) * v0[i] * tau +
                              (-2 * w2 * w + 3 * w2) * end_q_[i];
             const double v = ((6 * w2 - 6 * w) * k.q[i] + (3 * w2 - 4 * w + 1) * v0[i] * tau +
-                              (-6 * w2 + 6 * w) * end_q_[i]) / tau;
+                              (-6 * w2 + 6 * w) * end_q_[i]) /
+                             tau;
             along += (x - k.q[i]) * chord[i];
             speed2 += v * v;
         }
@@ -132,10 +135,8 @@ std::uint32_t PieceTimer::land(const Knot& k, Knot& mid, std::uint32_t& first_ti
             hi = std::min(hi, 2 * (d - v * tau) / (tau * tau));  // d' >= 0
             // Final span along the path: a0 = 6 d'/tf^2 - 4 V'/tf, a1 = -6 d'/tf^2 + 2 V'/tf.
             const double base = 6 * (d - v * tau) / (tf * tf);
-            const double a0c = base - 4 * v / tf,
-                         a0s = -(3 * tau * tau / (tf * tf) + 4 * tau / tf);
-            const double a1c = -base + 2 * v / tf,
-                         a1s = 3 * tau * tau / (tf * tf) + 2 * tau / tf;
+            const double a0c = base - 4 * v / tf, a0s = -(3 * tau * tau / (tf * tf) + 4 * tau / tf);
+            const double a1c = -base + 2 * v / tf, a1s = 3 * tau * tau / (tf * tf) + 2 * tau / tf;
             for (const auto& [c, sl] : {std::pair{a0c, a0s}, std::pair{a1c, a1s}}) {
                 double x = (-lim - c) / sl, y = (lim - c) / sl;
                 if (x > y) std::swap(x, y);
@@ -149,8 +150,7 @@ std::uint32_t PieceTimer::land(const Knot& k, Knot& mid, std::uint32_t& first_ti
                 Candidate c = evaluate(k, a, m);
                 // A knot on the end point: moving, the final span would leave it and come back
                 // (a stop with a wiggle of an LSB); at rest, it would only wait there.
-                if (c.f > 0 || c.end.q == end_q_ || !finish_ok(c.end, Arrival{k, m}, f))
-                    continue;
+                if (c.f > 0 || c.end.q == end_q_ || !finish_ok(c.end, Arrival{k, m}, f)) continue;
                 mid = c.end;
                 first_ticks = m;
                 return f;

@@ -26,9 +26,10 @@ std::uint32_t PieceTimer::corner_landing(const Knot& k, Knot& out) {
     const double reach = k.speed * tau_n + 0.5 * acc_norm_ * tau_n * tau_n;
     std::size_t c = 0;
     bool found = false;
-    for (std::size_t i = interval(k.lambda); i <= piece_.last && g_.lambda[i] <= k.lambda + reach; ++i) {
-        if (g_.lambda[i] > k.lambda + 1e-9 && g_.lambda[i] < end_lambda_ - 1e-9 && i + 1 <= piece_.last &&
-            g_.lambda[i + 1] == g_.lambda[i] && g_.corner[i] != 0) {
+    for (std::size_t i = interval(k.lambda); i <= piece_.last && g_.lambda[i] <= k.lambda + reach;
+         ++i) {
+        if (g_.lambda[i] > k.lambda + 1e-9 && g_.lambda[i] < end_lambda_ - 1e-9 &&
+            i + 1 <= piece_.last && g_.lambda[i + 1] == g_.lambda[i] && g_.corner[i] != 0) {
             c = i;
             found = true;
             break;
@@ -98,8 +99,7 @@ std::uint32_t PieceTimer::dip_landing(const Knot& k, Knot& out) {
                                beta_[i] < beta_[i + 1] && g_.lambda[i] > g_.lambda[i - 1] &&
                                g_.lambda[i + 1] > g_.lambda[i] &&
                                steps_between(g_.lambda[i] - reach, g_.lambda[i] + reach, i);
-        const bool step_up = curvature_jump(i) &&
-                             g_.curvature_norm[i + 1] > g_.curvature_norm[i] &&
+        const bool step_up = curvature_jump(i) && g_.curvature_norm[i + 1] > g_.curvature_norm[i] &&
                              beta_[i] < beta_[i - 1] && beta_[i] <= beta_[i + 1] &&
                              beta_[i + 1] < beta_[i + 2] && beta_[i] < caps_[i];
         if (inside && (local_min || step_up)) {
@@ -112,7 +112,8 @@ std::uint32_t PieceTimer::dip_landing(const Knot& k, Knot& out) {
     const Vec dir(g_.tangent[c]);
     Knot direct;
     const std::uint32_t direct_ticks = land_on_corner(k, c, dir, beta_[c], direct);
-    const std::uint32_t ticks = approach(k, c, dir, beta_[c], kSpansAhead, direct_ticks, direct, out);
+    const std::uint32_t ticks =
+        approach(k, c, dir, beta_[c], kSpansAhead, direct_ticks, direct, out);
     on_dip_ = ticks != 0 && out.lambda == g_.lambda[c];  // landed (an approach span ends before it)
     return ticks;
 }
@@ -136,24 +137,26 @@ std::uint32_t PieceTimer::leave_dip(const Knot& k, Knot& out) {
 /// span of m <= ticks_per_span ticks (land_on_corner; `direct`, of `direct_ticks` ticks, is
 /// the landing from k itself, 0 for none). Where j fits in one span the landing after it is
 /// checked now. Returns the ticks of the span taken (0: none).
-std::uint32_t PieceTimer::approach(const Knot& k, std::size_t c, const Vec& dir, double xc, std::uint32_t spans_ahead,
-                                   std::uint32_t direct_ticks, const Knot& direct, Knot& out) {
+std::uint32_t PieceTimer::approach(const Knot& k, std::size_t c, const Vec& dir, double xc,
+                                   std::uint32_t spans_ahead, std::uint32_t direct_ticks,
+                                   const Knot& direct, Knot& out) {
     const double d_all = g_.lambda[c] - k.lambda, vt = std::sqrt(xc);
     const Arrival saved = arrival_;
     // (spans_ahead + 1) n^2 pairs at most: the same for spans up to 128 ticks, bounded for
     // the longer spans a profile may ask for.
     std::uint32_t pairs = 0;
     constexpr std::uint32_t kMaxPairs = 65536;
-    for (std::uint32_t total = 1; total <= (spans_ahead + 1) * n_ && pairs < kMaxPairs;
-         ++total) {
+    for (std::uint32_t total = 1; total <= (spans_ahead + 1) * n_ && pairs < kMaxPairs; ++total) {
         if (total == direct_ticks) {
             out = direct;
             return total;
         }
-        for (std::uint32_t j = std::min(spans_ahead * n_, total - 1); j >= 1 && total - j <= n_; --j) {
+        for (std::uint32_t j = std::min(spans_ahead * n_, total - 1); j >= 1 && total - j <= n_;
+             --j) {
             ++pairs;
             const double tj = j * tick_, tm = (total - j) * tick_;
-            const double a = (d_all - k.speed * tj - (k.speed + vt) * tm / 2) / (tj * tj / 2 + tj * tm / 2);
+            const double a =
+                (d_all - k.speed * tj - (k.speed + vt) * tm / 2) / (tj * tj / 2 + tj * tm / 2);
             if (k.speed + a * tj < 0 || std::fabs(a) > 1.5 * acc_norm_) continue;
             const std::uint32_t now_ticks = std::min(j, n_);
             if (!under_beta(k, a, now_ticks * tick_)) continue;
@@ -182,8 +185,8 @@ std::uint32_t PieceTimer::approach(const Knot& k, std::size_t c, const Vec& dir,
 /// the fewest ticks from m_lo to m_hi (0: ticks_per_span) that work. Its speed is the
 /// constant-acceleration one, or xc where that is faster (then the cubic is not of constant
 /// path acceleration; it is checked as is).
-std::uint32_t PieceTimer::land_on_corner(const Knot& k, std::size_t c, const Vec& dir, double xc, Knot& out,
-                                         std::uint32_t m_lo, std::uint32_t m_hi) {
+std::uint32_t PieceTimer::land_on_corner(const Knot& k, std::size_t c, const Vec& dir, double xc,
+                                         Knot& out, std::uint32_t m_lo, std::uint32_t m_hi) {
     const double lc = g_.lambda[c], d = lc - k.lambda;
     for (std::uint32_t m = m_lo; m <= (m_hi == 0 ? n_ : m_hi); ++m) {
         const double tau = m * tick_;
@@ -216,8 +219,7 @@ std::uint32_t PieceTimer::land_on_corner(const Knot& k, std::size_t c, const Vec
 /// (searched from node `from`, or from l0's interval): the dips the rising spans and the
 /// landings on local minima are for. On smooth curves they cost planning time (a tenth more
 /// on a 10,000-segment random walk) for a few milliseconds of motion either way.
-bool PieceTimer::steps_between(double l0, double l1,
-                               std::size_t from) const {
+bool PieceTimer::steps_between(double l0, double l1, std::size_t from) const {
     std::size_t i = from == static_cast<std::size_t>(-1) ? interval(l0) : from;
     for (std::size_t j = i; j < piece_.last && g_.lambda[j] <= l1; ++j) {
         if (g_.lambda[j] >= l0 && curvature_jump(j)) return true;

@@ -33,7 +33,8 @@ void PieceTimer::fit_end(const Knot& k0, const Vec& v0, Knot& k1, std::uint32_t 
         const double p = std::round(k1.q[i] / lsb_);
         const double t = static_cast<double>(scaled_tangent_lsb(k1.v[i], scale));
         const auto cost = [&](double p1, double t1) {
-            const double a0 = 6 * (p1 - p0) - 4 * t0 - 2 * t1, a1 = -6 * (p1 - p0) + 2 * t0 + 4 * t1;
+            const double a0 = 6 * (p1 - p0) - 4 * t0 - 2 * t1,
+                         a1 = -6 * (p1 - p0) + 2 * t0 + 4 * t1;
             double peak = std::max(std::fabs(t0), std::fabs(t1));
             if (a0 * a1 < 0) peak = std::max(peak, std::fabs(t0 + 0.5 * a0 * a0 / (a0 - a1)));
             return std::max(std::max(std::fabs(a0), std::fabs(a1)) / lim_a, peak / lim_v);
@@ -60,13 +61,15 @@ void PieceTimer::fit_end(const Knot& k0, const Vec& v0, Knot& k1, std::uint32_t 
 /// the second difference of the exact cubic across the knot (tick before, knot, tick
 /// after) over each axis's limit. 0 where the tick count does not change (then it is a
 /// weighted mean of the two spans' accelerations, which are checked).
-inline double PieceTimer::junction(const Arrival& in, const Knot& k0, const Vec& v0, const Knot& k1, std::uint32_t m) const {
+inline double PieceTimer::junction(const Arrival& in, const Knot& k0, const Vec& v0, const Knot& k1,
+                                   std::uint32_t m) const {
     if (in.ticks == 0 || in.ticks == m) return 0;
     const double tp = in.ticks * tick_, tau = m * tick_;
     const Vec va = span_velocity(in.from.v, in.ticks);
     double worst = 0;
     for (std::size_t i = 0; i < axes_; ++i) {
-        const double before = hermite(in.from.q[i] - k0.q[i], 0, va[i] * tp, k0.v[i] * tp, 1 - 1.0 / in.ticks);
+        const double before =
+            hermite(in.from.q[i] - k0.q[i], 0, va[i] * tp, k0.v[i] * tp, 1 - 1.0 / in.ticks);
         const double after = hermite(0, k1.q[i] - k0.q[i], v0[i] * tau, k1.v[i] * tau, 1.0 / m);
         worst = std::max(worst, std::fabs(before + after) / (tick_ * tick_ * acc_[i]));
     }
@@ -100,7 +103,8 @@ double PieceTimer::violation(const Knot& k0, const Arrival& in, const Knot& k1, 
             peak = std::max(peak, std::fabs(v0[i] + 0.5 * a0 * t));
         }
         worst = std::max(worst, peak / vel_[i]);
-        for (int s = 0; s < kSamples; ++s) {  // velocity at t = w tau: v0 + a0 w tau + (a1 - a0) w^2 tau / 2
+        for (int s = 0; s < kSamples;
+             ++s) {  // velocity at t = w tau: v0 + a0 w tau + (a1 - a0) w^2 tau / 2
             at[s][i] = v0[i] + tau * (a0 * kW[s] + (a1 - a0) * kW[s] * kW[s] / 2);
         }
     }
@@ -110,12 +114,15 @@ double PieceTimer::violation(const Knot& k0, const Arrival& in, const Knot& k1, 
     for (int s = 0; s < kSamples; ++s) {
         const double t = kW[s] * tau;
         const double speed = std::max(0.0, norm(at[s]) - rounding);
-        const double cap = interpolate(caps_, std::clamp(k0.lambda + k0.speed * t + 0.5 * acc * t * t,
-                                                         k0.lambda, std::max(k0.lambda, k1.lambda)));
+        const double cap =
+            interpolate(caps_, std::clamp(k0.lambda + k0.speed * t + 0.5 * acc * t * t, k0.lambda,
+                                          std::max(k0.lambda, k1.lambda)));
         worst = std::max(worst, speed / feed_);
         if (!caps) continue;
-        if (cap > 0) worst = std::max(worst, speed / std::sqrt(cap));
-        else if (speed > 0) worst = std::max(worst, 2.0);
+        if (cap > 0)
+            worst = std::max(worst, speed / std::sqrt(cap));
+        else if (speed > 0)
+            worst = std::max(worst, 2.0);
     }
     worst = std::max(worst, junction(in, k0, v0, k1, m));
     return worst - 1;
@@ -131,7 +138,8 @@ double PieceTimer::span_deviation(const Knot& k, const Knot& end, std::uint32_t 
     const double len = end.lambda - k.lambda;
     double kappa = 0;
     bool corner = false, curvature_step = false;
-    for (std::size_t i = interval(k.lambda); i <= piece_.last && g_.lambda[i] <= end.lambda + 1e-12; ++i) {
+    for (std::size_t i = interval(k.lambda); i <= piece_.last && g_.lambda[i] <= end.lambda + 1e-12;
+         ++i) {
         kappa = std::max(kappa, g_.curvature_norm[i]);
         if (i + 1 <= piece_.last) {
             kappa = std::max(kappa, g_.curvature_norm[i + 1]);
@@ -172,7 +180,8 @@ double PieceTimer::span_deviation(const Knot& k, const Knot& end, std::uint32_t 
         corner || curvature_step ? static_cast<int>(std::min<std::uint32_t>(per_tick, 256)) : 6;
     for (int s = 1; s < samples; ++s) {
         const double w = static_cast<double>(s) / samples, w2 = w * w, w3 = w2 * w;
-        const double h00 = 2 * w3 - 3 * w2 + 1, h10 = w3 - 2 * w2 + w, h01 = -2 * w3 + 3 * w2, h11 = w3 - w2;
+        const double h00 = 2 * w3 - 3 * w2 + 1, h10 = w3 - 2 * w2 + w, h01 = -2 * w3 + 3 * w2,
+                     h11 = w3 - w2;
         Vec x{};
         for (std::size_t i = 0; i < axes_; ++i) {
             x[i] = h00 * k.q[i] + h10 * v0[i] * tau + h01 * end.q[i] + h11 * end.v[i] * tau;

@@ -7,7 +7,7 @@
 // continuous profile, so acceleration switches inside a span cannot overshoot the limits.
 //
 // This file holds the loop over knots (run) and the regular span's search (step, boundary,
-// evaluate), which every other stage of PieceTimer (piece_timer.hpp) calls back into.
+// evaluate), which the landings, the final spans and rise_across call back into.
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
@@ -28,16 +28,16 @@ namespace pathstream::host::planner_detail {
 PieceTimer::PieceTimer(const PathGrid& pg, const Piece& piece, const Limits& limits,
                        const std::vector<double>& caps, const std::vector<double>& beta,
                        const MachineProfile& profile, const PlanOptions& options)
-                : pg_(pg),
-                  g_(pg.grid),
-                  piece_(piece),
-                  caps_(caps),
-                  beta_(beta),
-                  axes_(pg.grid.axes),
-                  tick_(1.0 / profile.tick_hz),
-                  tick_hz_(profile.tick_hz),
-                  n_(profile.ticks_per_span),
-                  jerk_limited_(limits.has_jerk()) {
+    : pg_(pg),
+      g_(pg.grid),
+      piece_(piece),
+      caps_(caps),
+      beta_(beta),
+      axes_(pg.grid.axes),
+      tick_(1.0 / profile.tick_hz),
+      tick_hz_(profile.tick_hz),
+      n_(profile.ticks_per_span),
+      jerk_limited_(limits.has_jerk()) {
     // The spans are checked exactly as the device will run them (end points and tangents
     // rounded to LSB), against the limits less a hair for the double arithmetic.
     constexpr double kExact = 1 - 1e-9;
@@ -57,7 +57,8 @@ PieceTimer::PieceTimer(const PathGrid& pg, const Piece& piece, const Limits& lim
     end_q_ = grid_point(g_.q[piece.last]);
 }
 
-PieceMotion PieceTimer::run(const Vec& start_q, PieceMotion* resume, double resume_lambda, bool short_spans) {
+PieceMotion PieceTimer::run(const Vec& start_q, PieceMotion* resume, double resume_lambda,
+                            bool short_spans) {
     PieceMotion out;
     Knot k;
     k.lambda = g_.lambda[piece_.first];
@@ -75,7 +76,8 @@ PieceMotion PieceTimer::run(const Vec& start_q, PieceMotion* resume, double resu
     // Spans never go faster than the feed: the piece needs at least length / (feed tau) of
     // them; reserving a quarter more spares most of the vector's regrowth and copies.
     const double at_feed = (end_lambda_ - k.lambda) / (feed_ * n_ * tick_);
-    if (at_feed > 0 && at_feed < 1e6) out.spans.reserve(static_cast<std::size_t>(1.25 * at_feed) + 8);
+    if (at_feed > 0 && at_feed < 1e6)
+        out.spans.reserve(static_cast<std::size_t>(1.25 * at_feed) + 8);
     const auto advance = [&](const MotionSpan& s) {
         out.spans.push_back(s);
         arrival_ = Arrival{k, s.ticks};
@@ -132,7 +134,8 @@ PieceMotion PieceTimer::run(const Vec& start_q, PieceMotion* resume, double resu
         // A run of spans that leave the point on the LSB grid where it is makes no progress
         // the device could see (creeping towards a stop in ever smaller steps): stuck.
         stalled = next.q == k.q ? stalled + 1 : 0;
-        if (ticks == 0 || (!(next.lambda > k.lambda) && next.speed <= 0 && k.speed <= 0) || stalled > 256) {
+        if (ticks == 0 || (!(next.lambda > k.lambda) && next.speed <= 0 && k.speed <= 0) ||
+            stalled > 256) {
             out.ok = false;
             out.fail_lambda = k.lambda;
             out.fail_speed = k.speed;
@@ -204,7 +207,8 @@ bool PieceTimer::step(const Knot& k, std::uint32_t m, Knot& next) {
 /// The feasible end of [lo, hi] (lo within the limits, hi not): regula falsi (Illinois) on
 /// the violation, to 1e-4 of the acceleration limit (a finer one bought no measurable
 /// motion time). Spans of m ticks with the path acceleration's slope `jerk` (evaluate).
-PieceTimer::Candidate PieceTimer::boundary(const Knot& k, Candidate lo, Candidate hi, std::uint32_t m, double jerk) {
+PieceTimer::Candidate PieceTimer::boundary(const Knot& k, Candidate lo, Candidate hi,
+                                           std::uint32_t m, double jerk) {
     int side = 0;
     double flo = lo.f, fhi = hi.f;
     for (int it = 0; it < 40 && hi.a - lo.a > 1e-4 * acc_norm_; ++it) {
@@ -240,8 +244,8 @@ PieceTimer::Candidate PieceTimer::evaluate(const Knot& k, double a, std::uint32_
     Candidate c;
     c.a = a;
     c.end.speed = std::max(0.0, k.speed + a * tau);
-    const double l1 =
-        std::min(end_lambda_, k.lambda + k.speed * tau + 0.5 * a * tau * tau - jerk * tau * tau * tau / 12);
+    const double l1 = std::min(
+        end_lambda_, k.lambda + k.speed * tau + 0.5 * a * tau * tau - jerk * tau * tau * tau / 12);
     c.end.lambda = l1;
     PathAt p = path_at(pg_, piece_, l1, hint_);
     const double v1 = c.end.speed;
@@ -284,8 +288,9 @@ PieceTimer::Candidate PieceTimer::evaluate(const Knot& k, double a, std::uint32_
 
 PieceMotion forward_pass(const PathGrid& g, const Piece& piece, const Limits& limits,
                          const std::vector<double>& caps, const std::vector<double>& beta,
-                         const MachineProfile& profile, const PlanOptions& options, const Vec& start_q,
-                         PieceMotion* resume, double resume_lambda, bool short_spans) {
+                         const MachineProfile& profile, const PlanOptions& options,
+                         const Vec& start_q, PieceMotion* resume, double resume_lambda,
+                         bool short_spans) {
     PieceTimer timer(g, piece, limits, caps, beta, profile, options);
     return timer.run(start_q, resume, resume_lambda, short_spans);
 }

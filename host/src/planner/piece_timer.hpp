@@ -1,11 +1,8 @@
-// PieceTimer: the forward pass of one piece in whole ticks (forward_pass), one class whose
-// stages live in sources of their own: piece_stepping.cpp (the regular span, the loop over
-// knots), piece_span_check.cpp (what the executed span breaks), piece_beta.cpp (the speed
-// kept under the lookahead), piece_landings.cpp (knots on corners and dips), and
-// piece_final_spans.cpp (the spans that end at rest). The grid lookups and the beta test
-// every candidate span makes are defined inline at the end, so that each stage's loops still
-// inline them; a helper with one caller is declared inline and defined in that caller's
-// source, for the same reason (a call from another source fails to compile).
+// PieceTimer: the forward pass of one piece in whole ticks, one class whose stages have sources
+// of their own: piece_stepping.cpp (the loop over knots, the regular span), piece_span_check.cpp,
+// piece_beta.cpp, piece_landings.cpp and piece_final_spans.cpp. What every candidate span calls
+// is inline below, so that each stage's loops inline it; a helper with one caller is declared
+// inline and defined next to it (a call from another source does not compile).
 #pragma once
 
 #include <algorithm>
@@ -26,15 +23,15 @@ namespace pathstream::host::planner_detail {
 
 class PieceTimer {
 public:
-    /// One piece with the limits less the margins of `options`; everything given by reference
-    /// must outlive the timer.
+    /// One piece, the limits less the margins of `options`; the references must outlive it.
     PieceTimer(const PathGrid& pg, const Piece& piece, const Limits& limits,
                const std::vector<double>& caps, const std::vector<double>& beta,
                const MachineProfile& profile, const PlanOptions& options);
 
     /// The piece's spans from rest at start_q to rest at its end (ok false, with the place,
     /// where no whole-tick span is found); `resume`'s spans before resume_lambda are kept.
-    PieceMotion run(const Vec& start_q, PieceMotion* resume, double resume_lambda, bool short_spans);
+    PieceMotion run(const Vec& start_q, PieceMotion* resume, double resume_lambda,
+                    bool short_spans);
 
 private:
     /// The span that arrived at a knot: where it started and its ticks (0: none, at rest).
@@ -43,8 +40,7 @@ private:
         std::uint32_t ticks = 0;
     };
 
-    /// A span tried by evaluate: its path acceleration, its end, and its violation f (<= 0:
-    /// within the limits, the tolerance and beta).
+    /// A span tried by evaluate: path acceleration a, end, violation f (<= 0: within all).
     struct Candidate {
         double a = 0;
         Knot end;
@@ -53,11 +49,9 @@ private:
 
     // The regular span (piece_stepping.cpp).
 
-    /// The fastest span of m ticks from k within the limits and under beta (false: none); up
-    /// to about ninety evaluate calls.
+    /// The fastest span of m ticks from k within the limits and beta (false: none); ~90 evaluates.
     bool step(const Knot& k, std::uint32_t m, Knot& next);
-    /// The feasible end of a bracket [lo, hi] of path accelerations, by regula falsi on the
-    /// violation; up to forty evaluate calls.
+    /// The feasible end of a bracket [lo, hi] of accelerations (regula falsi): up to 40 evaluates.
     Candidate boundary(const Knot& k, Candidate lo, Candidate hi, std::uint32_t m, double jerk);
     /// The span of m ticks from k at path acceleration a (rising by `jerk`), its end on the LSB
     /// grid, and how far it breaks the limits, the tolerance or beta: the unit of the search,
@@ -69,10 +63,9 @@ private:
     /// Moves k1, the end of a span of m ticks from k0, onto the LSB grid as the emitter
     /// rounds it: the nearest point and tangent within the limits, else the least violating.
     void fit_end(const Knot& k0, const Vec& v0, Knot& k1, std::uint32_t m) const;
-    /// The velocity jump at k0 where the tick count changes, over the acceleration limit (0
-    /// where it does not change).
+    /// The velocity jump at k0 where the tick count changes, over the acceleration limit, or 0.
     inline double junction(const Arrival& in, const Knot& k0, const Vec& v0, const Knot& k1,
-                    std::uint32_t m) const;
+                           std::uint32_t m) const;
     /// How far the executed span k0 -> k1 of m ticks exceeds the axis limits, the feed and
     /// (with `caps`) the speed caps, and its junction with `in`: ratio - 1, <= 0 within.
     double violation(const Knot& k0, const Arrival& in, const Knot& k1, std::uint32_t m,
@@ -88,8 +81,7 @@ private:
 
     // The speed kept under the lookahead's beta (piece_beta.cpp; under_beta inline below).
 
-    /// Whether path acceleration a for tau seconds from k keeps s^2 under beta at every node
-    /// passed and at the end.
+    /// Whether path acceleration a for tau seconds from k keeps s^2 under beta (nodes, end).
     bool under_beta(const Knot& k, double a, double tau) const;
     /// The largest a in [a_lo, a_hi] under beta (false: not even a_lo): closed form, verified.
     bool max_under_beta(const Knot& k, double tau, double a_lo, double a_hi, double& a) const;
@@ -103,11 +95,9 @@ private:
 
     // Knots landed on corners and dips of beta (piece_landings.cpp).
 
-    /// A span ending on the next crossed corner where the corner's speed binds (its ticks; 0:
-    /// take a regular span).
+    /// A span ending on the next crossed corner where its speed binds (ticks; 0: a regular one).
     std::uint32_t corner_landing(const Knot& k, Knot& out);
-    /// A knot on the next dip of beta within three spans, reached as early as possible (the
-    /// ticks of the span taken now; 0: none).
+    /// A knot on the next dip of beta within three spans, soonest (ticks of this span; 0: none).
     std::uint32_t dip_landing(const Knot& k, Knot& out);
     /// The span leaving a dip: the regular one or a rising one, whichever ends faster (0: none).
     std::uint32_t leave_dip(const Knot& k, Knot& out);
@@ -118,12 +108,10 @@ private:
                            const Knot& direct, Knot& out);
     /// One span from k ending exactly on node c with its velocity along dir, the fewest ticks
     /// from m_lo to m_hi (0: ticks_per_span) that work (0: none).
-    std::uint32_t land_on_corner(const Knot& k, std::size_t c, const Vec& dir, double xc,
-                                 Knot& out, std::uint32_t m_lo = 1, std::uint32_t m_hi = 0);
-    /// Whether a joint whose curvature jumps lies between arc lengths l0 and l1 (searched from
-    /// node `from`, or from l0's interval).
-    bool steps_between(double l0, double l1,
-                       std::size_t from = static_cast<std::size_t>(-1)) const;
+    std::uint32_t land_on_corner(const Knot& k, std::size_t c, const Vec& dir, double xc, Knot& out,
+                                 std::uint32_t m_lo = 1, std::uint32_t m_hi = 0);
+    /// Whether a joint whose curvature jumps lies in [l0, l1] (searched from node `from`).
+    bool steps_between(double l0, double l1, std::size_t from = static_cast<std::size_t>(-1)) const;
 
     // The spans that end at rest at the piece's end (piece_final_spans.cpp).
 
@@ -137,8 +125,7 @@ private:
     /// `mid` before it and the first span's ticks; at most 17 first-span lengths, each with
     /// every final one.
     std::uint32_t land(const Knot& k, Knot& mid, std::uint32_t& first_ticks);
-    /// Ticks of the fewest rest-to-rest span from q to the end within the limits and the feed
-    /// (0: q is the end).
+    /// The fewest ticks of a rest-to-rest span from q to the end within limits and feed (0: at it).
     std::uint32_t creep_ticks(const Vec& q) const;
 
     // Grid lookups and roundings of every candidate span (inline, below).
@@ -193,7 +180,9 @@ private:
 // The lookups and roundings every candidate span makes: inline, because the stages whose hot
 // loops call them are in sources of their own.
 
-inline Vec PieceTimer::grid_point(const Vec& q) const { return on_lsb_grid(q, lsb_, axes_); }
+inline Vec PieceTimer::grid_point(const Vec& q) const {
+    return on_lsb_grid(q, lsb_, axes_);
+}
 
 // The tangent is dp/du = v m T / lsb, rounded with the emitter's formula and rounding.
 inline Vec PieceTimer::span_velocity(const Vec& v, std::uint32_t m) const {
@@ -212,7 +201,7 @@ inline Knot PieceTimer::end_knot() const {
 }
 
 // The lookups come in runs near each other: a short walk from the last answer first, a
-/// binary search when that does not reach.
+// binary search when that does not reach.
 inline std::size_t PieceTimer::interval(double lambda) const {
     const std::size_t top = piece_.last == piece_.first ? piece_.first : piece_.last - 1;
     std::size_t i = std::clamp(interval_hint_, piece_.first, top);
@@ -246,14 +235,17 @@ inline double PieceTimer::interpolate(const std::vector<double>& v, double lambd
 
 // beta interpolated linearly in x = s^2, as TOPP-RA's constant path acceleration between
 // nodes has it.
-inline double PieceTimer::beta_at(double l) const { return interpolate(beta_, l); }
+inline double PieceTimer::beta_at(double l) const {
+    return interpolate(beta_, l);
+}
 
 inline Vec PieceTimer::curvature_at(double l) const {
     const std::size_t i = interval(l);
     const double l0 = g_.lambda[i], l1 = g_.lambda[i + 1];
     const double w = l1 > l0 ? std::clamp((l - l0) / (l1 - l0), 0.0, 1.0) : 1.0;
     Vec r{};
-    for (std::size_t a = 0; a < kAxesMax; ++a) r[a] = (1 - w) * g_.curvature[i][a] + w * g_.curvature[i + 1][a];
+    for (std::size_t a = 0; a < kAxesMax; ++a)
+        r[a] = (1 - w) * g_.curvature[i][a] + w * g_.curvature[i + 1][a];
     return r;
 }
 
@@ -268,12 +260,14 @@ inline double PieceTimer::path_acceleration_limit(const Vec& t) const {
 // A jump by more than a factor of 2: a blend's ends, a line meeting an arc.
 inline bool PieceTimer::curvature_jump(std::size_t i) const {
     const double before = g_.curvature_norm[i], after = g_.curvature_norm[i + 1];
-    return g_.lambda[i + 1] == g_.lambda[i] && std::max(before, after) > 2 * std::min(before, after) + 1e-9;
+    return g_.lambda[i + 1] == g_.lambda[i] &&
+           std::max(before, after) > 2 * std::min(before, after) + 1e-9;
 }
 
 inline double PieceTimer::hermite(double p0, double p1, double m0, double m1, double t) {
     const double t2 = t * t, t3 = t2 * t;
-    return (2 * t3 - 3 * t2 + 1) * p0 + (t3 - 2 * t2 + t) * m0 + (-2 * t3 + 3 * t2) * p1 + (t3 - t2) * m1;
+    return (2 * t3 - 3 * t2 + 1) * p0 + (t3 - 2 * t2 + t) * m0 + (-2 * t3 + 3 * t2) * p1 +
+           (t3 - t2) * m1;
 }
 
 // x = s^2 and beta are both linear in arc length between nodes: the nodes and the end bound it.
@@ -293,7 +287,8 @@ inline bool PieceTimer::under_beta(const Knot& k, double a, double tau) const {
     return v1 * v1 <= b1 + tol(b1);
 }
 
-inline double PieceTimer::violation(const Knot& k0, const Arrival& in, const Knot& k1, std::uint32_t m, bool caps) const {
+inline double PieceTimer::violation(const Knot& k0, const Arrival& in, const Knot& k1,
+                                    std::uint32_t m, bool caps) const {
     return violation(k0, in, k1, m, span_velocity(k0.v, m), caps);
 }
 

@@ -6,8 +6,6 @@
 #include <cmath>
 #include <cstddef>
 
-
-
 namespace pathstream::host::planner_detail {
 
 inline constexpr std::size_t kAxesMax = 8;
@@ -21,7 +19,9 @@ inline double dot(const Vec& a, const Vec& b) {
     const double s45 = a[4] * b[4] + a[5] * b[5], s67 = a[6] * b[6] + a[7] * b[7];
     return (s01 + s23) + (s45 + s67);
 }
-inline double norm(const Vec& a) { return std::sqrt(dot(a, a)); }
+inline double norm(const Vec& a) {
+    return std::sqrt(dot(a, a));
+}
 inline Vec sub(const Vec& a, const Vec& b) {
     Vec r{};
     for (std::size_t i = 0; i < kAxesMax; ++i) r[i] = a[i] - b[i];
