@@ -10,16 +10,32 @@
 // |second difference| <= a T^2 / lsb + 2 (max_*_fraction subtract exactly this). Those fractions
 // come in coarse steps (1/3 of the limit at 3 LSB/tick^2) and stay below the exact cubic's, so
 // the check also keeps the raw integer peaks in LSB and the exact fractions for reports.
+#include "check.hpp"
+
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <functional>
 #include <map>
 #include <memory>
 #include <sstream>
+#include <string>
+#include <utility>
+#include <vector>
 
-#include "internal.hpp"
+#include "cubic.hpp"
 #include "jerk_meter.hpp"
+#include "pathstream/host/geometry.hpp"
+#include "pathstream/host/plan.hpp"
+#include "pathstream/host/planner.hpp"
+#include "pathstream/machine/core_span.hpp"
+#include "pathstream/machine/machine.hpp"
 #include "pathstream/setpoint_stream.hpp"
 #include "pathstream/span.hpp"
+#include "projection.hpp"
+#include "vec.hpp"
 
 namespace pathstream::host {
 namespace {
@@ -29,11 +45,13 @@ using planner_detail::kAxesMax;
 using planner_detail::PathProjector;
 using planner_detail::Vec;
 
-/// The exact value (before rounding, LSB) of every axis of one span at tick k (0..ticks): the core's cubic in double,
+/// The exact value (before rounding, LSB) of every axis of one span at tick k (0..ticks): the
+/// core's cubic in double,
 /// (((a u + b) u + c) u + d) / scale with u = k / ticks, its coefficients converted once for
 /// the per-tick check's inner loop.
 struct ExactSpan {
-    ExactSpan(const CoreSpan& s, std::size_t axes) : axes_(axes), ticks_(s.ticks), scale_(basis_matrix(s.basis).scale) {
+    ExactSpan(const CoreSpan& s, std::size_t axes)
+        : axes_(axes), ticks_(s.ticks), scale_(basis_matrix(s.basis).scale) {
         for (std::size_t a = 0; a < axes; ++a) {
             const TickCubic& c = s.cubic[a];
             k_[a] = {static_cast<double>(c.a), static_cast<double>(c.b), static_cast<double>(c.c),
@@ -63,7 +81,8 @@ struct SpanPeaks {
 SpanPeaks span_peaks(const CoreSpan& s, std::size_t axis) {
     const TickCubic& c = s.cubic[axis];
     const double n = s.ticks, scale = basis_matrix(s.basis).scale;
-    const double a = static_cast<double>(c.a), b = static_cast<double>(c.b), cc = static_cast<double>(c.c);
+    const double a = static_cast<double>(c.a), b = static_cast<double>(c.b),
+                 cc = static_cast<double>(c.c);
     const auto v = [&](double u) { return std::fabs((3 * a * u + 2 * b) * u + cc) / (scale * n); };
     SpanPeaks r;
     r.velocity = std::max(v(0), v(1));
@@ -138,20 +157,32 @@ private:
 
 static std::unique_ptr<CoreStepper> make_stepper(std::size_t axes, const CoreSpan& first) {
     switch (axes) {
-        case 1: return std::make_unique<CoreStepperOf<1>>(first);
-        case 2: return std::make_unique<CoreStepperOf<2>>(first);
-        case 3: return std::make_unique<CoreStepperOf<3>>(first);
-        case 4: return std::make_unique<CoreStepperOf<4>>(first);
-        case 5: return std::make_unique<CoreStepperOf<5>>(first);
-        case 6: return std::make_unique<CoreStepperOf<6>>(first);
-        case 7: return std::make_unique<CoreStepperOf<7>>(first);
-        case 8: return std::make_unique<CoreStepperOf<8>>(first);
-        default: throw PlanError("plan check: 1 to 8 axes");
+        case 1:
+            return std::make_unique<CoreStepperOf<1>>(first);
+        case 2:
+            return std::make_unique<CoreStepperOf<2>>(first);
+        case 3:
+            return std::make_unique<CoreStepperOf<3>>(first);
+        case 4:
+            return std::make_unique<CoreStepperOf<4>>(first);
+        case 5:
+            return std::make_unique<CoreStepperOf<5>>(first);
+        case 6:
+            return std::make_unique<CoreStepperOf<6>>(first);
+        case 7:
+            return std::make_unique<CoreStepperOf<7>>(first);
+        case 8:
+            return std::make_unique<CoreStepperOf<8>>(first);
+        default:
+            throw PlanError("plan check: 1 to 8 axes");
     }
 }
 
-TickChecker::TickChecker(const MachineProfile& profile, const std::vector<BezierSegment>* segments, bool deviation)
-    : profile_(profile), axes_(profile.axes.size()), feeds_(std::make_unique<FeedTable>(profile)),
+TickChecker::TickChecker(const MachineProfile& profile, const std::vector<BezierSegment>* segments,
+                         bool deviation)
+    : profile_(profile),
+      axes_(profile.axes.size()),
+      feeds_(std::make_unique<FeedTable>(profile)),
       do_deviation_(deviation && segments != nullptr) {
     if (axes_ == 0 || axes_ > kAxesMax) throw PlanError("plan check: 1 to 8 axes");
     const double t = 1.0 / profile.tick_hz;
@@ -165,8 +196,10 @@ TickChecker::TickChecker(const MachineProfile& profile, const std::vector<Bezier
     out_.axis_acceleration_fraction_exact.assign(axes_, 0);
     out_.axis_max_step.assign(axes_, 0);
     out_.axis_max_second_difference.assign(axes_, 0);
-    out_.axis_velocity_limit_lsb.assign(vlim_.begin(), vlim_.begin() + static_cast<std::ptrdiff_t>(axes_));
-    out_.axis_acceleration_limit_lsb.assign(alim_.begin(), alim_.begin() + static_cast<std::ptrdiff_t>(axes_));
+    out_.axis_velocity_limit_lsb.assign(vlim_.begin(),
+                                        vlim_.begin() + static_cast<std::ptrdiff_t>(axes_));
+    out_.axis_acceleration_limit_lsb.assign(alim_.begin(),
+                                            alim_.begin() + static_cast<std::ptrdiff_t>(axes_));
     if (segments != nullptr) {
         for (const BezierSegment& seg : *segments) feeds_->add(seg);
     }
@@ -179,7 +212,8 @@ TickChecker::TickChecker(const MachineProfile& profile, const std::vector<Bezier
             index.push_back(s);
         }
         // Any distance over half the tolerance is confirmed against every segment.
-        projector_ = std::make_unique<PathProjector>(std::move(down), std::move(index), 0.5 * profile.chord_tolerance);
+        projector_ = std::make_unique<PathProjector>(std::move(down), std::move(index),
+                                                     0.5 * profile.chord_tolerance);
     }
 }
 
@@ -190,15 +224,16 @@ void TickChecker::note_feed(std::size_t subpath, bool pen_down, double feed) {
 }
 
 void TickChecker::pen(const PenEvent& e) {
-    const std::uint64_t d = delay_ticks(e.down ? profile_.pen_down_delay : profile_.pen_up_delay, profile_.tick_hz);
+    const std::uint64_t d =
+        delay_ticks(e.down ? profile_.pen_down_delay : profile_.pen_up_delay, profile_.tick_hz);
     if (d > 0) windows_.emplace_back(e.tick, e.tick + d);
     pens_.push_back(e);
 }
 
 void TickChecker::span(const CoreSpan& cs) {
     if (cs.control.size() != axes_ || cs.cubic.size() != axes_) {
-        throw PlanError("plan check: a span has " + std::to_string(cs.control.size()) + " axes but the machine has " +
-                        std::to_string(axes_));
+        throw PlanError("plan check: a span has " + std::to_string(cs.control.size()) +
+                        " axes but the machine has " + std::to_string(axes_));
     }
     if (!stepper_) stepper_ = make_stepper(axes_, cs);
     for (std::size_t a = 0; a < axes_; ++a) {
@@ -207,11 +242,14 @@ void TickChecker::span(const CoreSpan& cs) {
         out_.max_span_velocity_fraction = std::max(out_.max_span_velocity_fraction, fv);
         out_.max_span_acceleration_fraction = std::max(out_.max_span_acceleration_fraction, fa);
         out_.axis_velocity_fraction_exact[a] = std::max(out_.axis_velocity_fraction_exact[a], fv);
-        out_.axis_acceleration_fraction_exact[a] = std::max(out_.axis_acceleration_fraction_exact[a], fa);
+        out_.axis_acceleration_fraction_exact[a] =
+            std::max(out_.axis_acceleration_fraction_exact[a], fa);
     }
-    if (const Status st = stepper_->push(cs, static_cast<std::uint32_t>(spans_)); st != Status::kOk) {
+    if (const Status st = stepper_->push(cs, static_cast<std::uint32_t>(spans_));
+        st != Status::kOk) {
         std::ostringstream m;
-        m << "plan check: span " << spans_ << " (subpath " << cs.subpath << ") refused by the core: " << status_name(st);
+        m << "plan check: span " << spans_ << " (subpath " << cs.subpath
+          << ") refused by the core: " << status_name(st);
         throw PlanError(m.str());
     }
     ++spans_;
@@ -233,13 +271,18 @@ void TickChecker::span(const CoreSpan& cs) {
 void TickChecker::fold_peaks() {
     for (std::size_t a = 0; a < axes_; ++a) {
         const AxisPeaks& k = peaks_[a];
-        out_.axis_velocity_fraction[a] = std::max(out_.axis_velocity_fraction[a], k.velocity_allowed / vlim_[a]);
-        out_.max_velocity_fraction_raw = std::max(out_.max_velocity_fraction_raw, k.velocity_raw / vlim_[a]);
-        out_.max_velocity_fraction_exact = std::max(out_.max_velocity_fraction_exact, k.velocity_exact / vlim_[a]);
-        out_.axis_velocity_fraction_exact[a] = std::max(out_.axis_velocity_fraction_exact[a], k.velocity_exact / vlim_[a]);
+        out_.axis_velocity_fraction[a] =
+            std::max(out_.axis_velocity_fraction[a], k.velocity_allowed / vlim_[a]);
+        out_.max_velocity_fraction_raw =
+            std::max(out_.max_velocity_fraction_raw, k.velocity_raw / vlim_[a]);
+        out_.max_velocity_fraction_exact =
+            std::max(out_.max_velocity_fraction_exact, k.velocity_exact / vlim_[a]);
+        out_.axis_velocity_fraction_exact[a] =
+            std::max(out_.axis_velocity_fraction_exact[a], k.velocity_exact / vlim_[a]);
         out_.axis_acceleration_fraction[a] =
             std::max(out_.axis_acceleration_fraction[a], k.acceleration_allowed / alim_[a]);
-        out_.max_acceleration_fraction_raw = std::max(out_.max_acceleration_fraction_raw, k.acceleration_raw / alim_[a]);
+        out_.max_acceleration_fraction_raw =
+            std::max(out_.max_acceleration_fraction_raw, k.acceleration_raw / alim_[a]);
         out_.max_acceleration_fraction_exact =
             std::max(out_.max_acceleration_fraction_exact, k.acceleration_exact / alim_[a]);
         out_.axis_acceleration_fraction_exact[a] =
@@ -250,7 +293,8 @@ void TickChecker::fold_peaks() {
 bool TickChecker::over_limits() {
     fold_peaks();
     for (std::size_t a = 0; a < axes_; ++a) {
-        if (out_.axis_velocity_fraction[a] > 1 || out_.axis_acceleration_fraction[a] > 1) return true;
+        if (out_.axis_velocity_fraction[a] > 1 || out_.axis_acceleration_fraction[a] > 1)
+            return true;
     }
     return out_.max_velocity_fraction_exact > 1 || out_.max_acceleration_fraction_exact > 1 ||
            out_.max_span_velocity_fraction > 1 || out_.max_span_acceleration_fraction > 1;
@@ -265,12 +309,13 @@ bool TickChecker::pen_down_at(std::uint64_t tick) {
 }
 
 bool TickChecker::in_window(std::uint64_t tick) {
-    while (window_index_ < windows_.size() && windows_[window_index_].second <= tick) ++window_index_;
+    while (window_index_ < windows_.size() && windows_[window_index_].second <= tick)
+        ++window_index_;
     return window_index_ < windows_.size() && windows_[window_index_].first <= tick;
 }
 
-void TickChecker::visit(const std::array<std::int64_t, kAxesMax>& p, const std::array<double, kAxesMax>& e,
-                        bool pen_output, double feed) {
+void TickChecker::visit(const std::array<std::int64_t, kAxesMax>& p,
+                        const std::array<double, kAxesMax>& e, bool pen_output, double feed) {
     const std::uint64_t k = tick_;
     if (observer_) observer_(k, p.data(), pen_output);
     if (k == 0) {  // at rest before the first tick
@@ -294,7 +339,9 @@ void TickChecker::visit(const std::array<std::int64_t, kAxesMax>& p, const std::
         const double lsb_per_tick = profile_.mm_per_lsb * profile_.tick_hz;
         // Allowance: each setpoint's rounding (< 1 LSB per axis in a difference) and the
         // rounding of the spans' end points and tangents (about as much again).
-        const double speed = std::max(0.0, std::sqrt(speed2) - 2 * std::sqrt(static_cast<double>(axes_))) * lsb_per_tick;
+        const double speed =
+            std::max(0.0, std::sqrt(speed2) - 2 * std::sqrt(static_cast<double>(axes_))) *
+            lsb_per_tick;
         out_.max_feed_fraction = std::max(out_.max_feed_fraction, speed / prev_feed_);
     }
     // Second difference centred on k - 1.
@@ -309,7 +356,8 @@ void TickChecker::visit(const std::array<std::int64_t, kAxesMax>& p, const std::
     if (do_deviation_ && down && !projector_->empty()) {
         if (k == 0 || moved || !have_distance_) {
             Vec q{};
-            for (std::size_t a = 0; a < axes_; ++a) q[a] = static_cast<double>(p[a]) * profile_.mm_per_lsb;
+            for (std::size_t a = 0; a < axes_; ++a)
+                q[a] = static_cast<double>(p[a]) * profile_.mm_per_lsb;
             std::size_t seg = 0;
             distance_ = projector_->distance(q, seg);
             have_distance_ = true;
@@ -357,17 +405,21 @@ PlanCheck TickChecker::finish() {
     for (std::size_t a = 0; a < axes_; ++a) e[a] = last_end_[a];
     visit(p, e, last_pen_down_, last_feed_);
     // The axes rest after the end: one more second difference, centred on the end point.
-    for (std::size_t a = 0; a < axes_; ++a) acceleration(a, p2_[a] - p1_[a], std::fabs(e2_[a] - e1_[a]));
+    for (std::size_t a = 0; a < axes_; ++a)
+        acceleration(a, p2_[a] - p1_[a], std::fabs(e2_[a] - e1_[a]));
     fold_peaks();
     for (std::size_t a = 0; a < axes_; ++a) {
-        out_.max_velocity_fraction = std::max(out_.max_velocity_fraction, out_.axis_velocity_fraction[a]);
-        out_.max_acceleration_fraction = std::max(out_.max_acceleration_fraction, out_.axis_acceleration_fraction[a]);
+        out_.max_velocity_fraction =
+            std::max(out_.max_velocity_fraction, out_.axis_velocity_fraction[a]);
+        out_.max_acceleration_fraction =
+            std::max(out_.max_acceleration_fraction, out_.axis_acceleration_fraction[a]);
     }
     // The exact cubic must be within the limits too (a device that validates spans refuses
     // anything over), not only the rounded setpoints with their allowance.
-    out_.within_limits = out_.max_velocity_fraction <= 1 && out_.max_acceleration_fraction <= 1 &&
-                         out_.max_velocity_fraction_exact <= 1 && out_.max_acceleration_fraction_exact <= 1 &&
-                         out_.max_span_velocity_fraction <= 1 && out_.max_span_acceleration_fraction <= 1;
+    out_.within_limits =
+        out_.max_velocity_fraction <= 1 && out_.max_acceleration_fraction <= 1 &&
+        out_.max_velocity_fraction_exact <= 1 && out_.max_acceleration_fraction_exact <= 1 &&
+        out_.max_span_velocity_fraction <= 1 && out_.max_span_acceleration_fraction <= 1;
     out_.ticks_checked = tick_;
     return out_;
 }
@@ -387,7 +439,8 @@ PlanCheck check_plan_impl(const Plan& plan, const std::vector<BezierSegment>& se
 }
 }  // namespace planner_detail
 
-PlanCheck check_plan(const Plan& plan, const std::vector<BezierSegment>& segments, const MachineProfile& profile) {
+PlanCheck check_plan(const Plan& plan, const std::vector<BezierSegment>& segments,
+                     const MachineProfile& profile) {
     return planner_detail::check_plan_impl(plan, segments, profile, true);
 }
 

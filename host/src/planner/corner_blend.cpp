@@ -3,10 +3,17 @@
 // it (or within the subpath's own smaller blend tolerance, G64 P; never in G61 or G61.1), so
 // that the motion crosses the corner at the curvature's speed instead of the speed at which
 // every axis can jump its velocity within one tick (docs/planner.md §3, §8).
+#include "corner_blend.hpp"
+
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
+#include <utility>
 
-#include "internal.hpp"
+#include "cubic.hpp"
+#include "pathstream/host/geometry.hpp"
+#include "pathstream/host/planner.hpp"
+#include "vec.hpp"
 
 namespace pathstream::host::planner_detail {
 namespace {
@@ -20,7 +27,9 @@ bool straight(const BezierSegment& s, Vec& direction, double& length) {
     if (!(length > 1e-9)) return false;
     for (int k = 1; k <= 2; ++k) {
         const Vec expected = scaled(chord, k / 3.0);
-        if (norm(sub(sub(c.p[static_cast<std::size_t>(k)], c.p[0]), expected)) > 1e-9 * (1 + length)) return false;
+        if (norm(sub(sub(c.p[static_cast<std::size_t>(k)], c.p[0]), expected)) >
+            1e-9 * (1 + length))
+            return false;
     }
     direction = scaled(chord, 1 / length);
     return true;
@@ -32,7 +41,9 @@ Vec add(const Vec& a, const Vec& b) {
     return r;
 }
 
-PathPoint to_point(const Vec& v, std::size_t axes) { return PathPoint(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(axes)); }
+PathPoint to_point(const Vec& v, std::size_t axes) {
+    return PathPoint(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(axes));
+}
 
 Vec to_vec(const PathPoint& p) {
     Vec v{};
@@ -91,8 +102,8 @@ void CornerBlender::blend(BezierSegment& b) {
     // A subpath in exact path or exact stop mode (G61, G61.1) keeps its vertices.
     const bool same_run = a.pen_down == b.pen_down && a.subpath == b.subpath && !b.pause_before &&
                           b.dwell_before == 0 && !b.stop_before && b.blend_tolerance != 0;
-    if (same_run && a.p[0].size() == b.p[0].size() && a.p[0].size() <= kAxesMax && straight(a, ta, la) &&
-        straight(b, tb, lb)) {
+    if (same_run && a.p[0].size() == b.p[0].size() && a.p[0].size() <= kAxesMax &&
+        straight(a, ta, la) && straight(b, tb, lb)) {
         if (held_original_length_ < 0) held_original_length_ = la;
         const double turn = std::acos(std::clamp(dot(ta, tb), -1.0, 1.0));
         if (turn > 1e-6 && turn <= stop_angle_) {
@@ -100,7 +111,8 @@ void CornerBlender::blend(BezierSegment& b) {
             // d sin(turn / 2) / 2 from the vertex V; each leg takes at most half a segment
             // (the first one what its earlier blend left of it).
             const double half = std::sin(0.5 * turn);
-            const double deviation = b.blend_tolerance > 0 ? std::min(deviation_, b.blend_tolerance) : deviation_;
+            const double deviation =
+                b.blend_tolerance > 0 ? std::min(deviation_, b.blend_tolerance) : deviation_;
             double d = 2 * deviation / half;
             d = std::min({d, 0.5 * held_original_length_, la, 0.5 * lb});
             if (d > 1e-6) {
@@ -114,7 +126,8 @@ void CornerBlender::blend(BezierSegment& b) {
                 corner.stop_before = false;
                 corner.p[0] = start;
                 // The quadratic's middle control point V raised to a cubic: P + 2/3 (V - P).
-                corner.p[1] = to_point(add(scaled(to_vec(start), 1.0 / 3), scaled(v, 2.0 / 3)), axes);
+                corner.p[1] =
+                    to_point(add(scaled(to_vec(start), 1.0 / 3), scaled(v, 2.0 / 3)), axes);
                 corner.p[2] = to_point(add(scaled(to_vec(end), 1.0 / 3), scaled(v, 2.0 / 3)), axes);
                 corner.p[3] = end;
                 make_straight(a, a.p[0], start);

@@ -4,15 +4,29 @@
 // with P = the knot's point rounded to LSB and T = velocity * (m / tick_hz) rounded to LSB
 // (dp/du over the span). Consecutive spans share P exactly, and T whenever they have the same
 // tick count, so the core's cubic is continuous tick for tick.
+#include "emit.hpp"
+
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstddef>
+#include <cstdint>
 #include <cstdlib>
 #include <sstream>
+#include <string>
+#include <utility>
+#include <vector>
 
-#include "internal.hpp"
+#include "forward_pass.hpp"
+#include "grid.hpp"
+#include "lsb_rounding.hpp"
+#include "pathstream/host/planner.hpp"
+#include "pathstream/machine/core_span.hpp"
+#include "pathstream/machine/machine.hpp"
 #include "pathstream/status.hpp"
 #include "pathstream/tick_cubic.hpp"
 #include "pathstream/units.hpp"
+#include "vec.hpp"
 
 namespace pathstream::host::planner_detail {
 
@@ -34,7 +48,9 @@ SpanEmitter::LsbVec SpanEmitter::tangent(const Vec& velocity, std::uint32_t tick
     return r;
 }
 
-void SpanEmitter::release() { held_ = false; }
+void SpanEmitter::release() {
+    held_ = false;
+}
 
 void SpanEmitter::span(const LsbVec& p1, const LsbVec& t0, const LsbVec& t1, std::uint32_t ticks,
                        std::size_t subpath, bool pen_down) {
@@ -51,7 +67,8 @@ void SpanEmitter::span(const LsbVec& p1, const LsbVec& t0, const LsbVec& t1, std
     s.ticks = ticks;
     s.subpath = subpath;
     s.pen_down = pen_down;
-    if (make_span_timing(s.basis, ticks, s.timing) != Status::kOk) fail(subpath, "span ticks out of range");
+    if (make_span_timing(s.basis, ticks, s.timing) != Status::kOk)
+        fail(subpath, "span ticks out of range");
     if (check_jerk_) verify_jerk(p1, t0, t1, ticks, subpath);
     const LsbVec* values[4] = {&pos_, &p1, &t0, &t1};
     s.control.reserve(axes_);
@@ -72,13 +89,16 @@ void SpanEmitter::span(const LsbVec& p1, const LsbVec& t0, const LsbVec& t1, std
         }
         const std::int32_t control[4] = {c[0], c[1], c[2], c[3]};
         TickCubic cubic;
-        if (const Status st = make_tick_cubic(s.basis, control, s.timing, cubic); st != Status::kOk) {
-            fail(subpath, std::string("axis ") + std::to_string(a) + ": the core rejects a span: " + status_name(st));
+        if (const Status st = make_tick_cubic(s.basis, control, s.timing, cubic);
+            st != Status::kOk) {
+            fail(subpath, std::string("axis ") + std::to_string(a) +
+                              ": the core rejects a span: " + status_name(st));
         }
         s.control.push_back(c);
         s.cubic.push_back(cubic);
     }
-    for (std::size_t a = 0; a < axes_; ++a) a_end_[a] = -6 * (p1[a] - pos_[a]) + 2 * t0[a] + 4 * t1[a];
+    for (std::size_t a = 0; a < axes_; ++a)
+        a_end_[a] = -6 * (p1[a] - pos_[a]) + 2 * t0[a] + 4 * t1[a];
     last_ticks_ = ticks;
     release();
     events_.push_back(std::move(ev));
@@ -91,7 +111,8 @@ void SpanEmitter::span(const LsbVec& p1, const LsbVec& t0, const LsbVec& t1, std
 
 void SpanEmitter::dwell(std::uint64_t ticks, std::size_t subpath, bool pen_down) {
     while (ticks > 0) {
-        const std::uint32_t m = static_cast<std::uint32_t>(std::min<std::uint64_t>(ticks, kMaxSpanTicks));
+        const std::uint32_t m =
+            static_cast<std::uint32_t>(std::min<std::uint64_t>(ticks, kMaxSpanTicks));
         span(pos_, LsbVec{}, LsbVec{}, m, subpath, pen_down);
         ticks -= m;
         dwell_ticks_ += m;
@@ -104,7 +125,8 @@ void SpanEmitter::pen(bool down, std::size_t subpath, bool last) {
     ev.kind = PlanEvent::Kind::kPen;
     ev.pen = {total_ticks_, down};
     events_.push_back(std::move(ev));
-    std::uint64_t d = delay_ticks(down ? profile_.pen_down_delay : profile_.pen_up_delay, profile_.tick_hz);
+    std::uint64_t d =
+        delay_ticks(down ? profile_.pen_down_delay : profile_.pen_up_delay, profile_.tick_hz);
     if (last && d == 0) d = 1;  // the final lift needs a span that carries it
     dwell(d, subpath, down);
     pen_ = down;
@@ -129,7 +151,8 @@ void SpanEmitter::before_pen_down(const Run& run) {
 }
 
 void SpanEmitter::begin_run(const Run& run) {
-    if (in_run_ && run.pen_down == run_pen_down_ && run.subpath == run_subpath_) return;  // continued
+    if (in_run_ && run.pen_down == run_pen_down_ && run.subpath == run_subpath_)
+        return;  // continued
     in_run_ = true;
     run_pen_down_ = run.pen_down;
     run_subpath_ = run.subpath;
@@ -143,18 +166,20 @@ void SpanEmitter::begin_run(const Run& run) {
 void SpanEmitter::piece_start(const Vec& start_mm, std::size_t subpath) {
     const LsbVec start = quantise(start_mm);
     for (std::size_t a = 0; a < axes_; ++a) {
-        if (std::llabs(start[a] - pos_[a]) > 1) fail(subpath, "internal: a piece does not start where the last one ended");
+        if (std::llabs(start[a] - pos_[a]) > 1)
+            fail(subpath, "internal: a piece does not start where the last one ended");
     }
 }
 
 void SpanEmitter::motion(const Knot& from, const MotionSpan& s, const Run& run) {
-    span(quantise(s.end.q), tangent(from.v, s.ticks), tangent(s.end.v, s.ticks), s.ticks, run.subpath, run.pen_down);
+    span(quantise(s.end.q), tangent(from.v, s.ticks), tangent(s.end.v, s.ticks), s.ticks,
+         run.subpath, run.pen_down);
     ++motion_spans_;
     motion_ticks_ += s.ticks;
 }
 
-void SpanEmitter::motion_lsb(const LsbVec& p1, const LsbVec& t0, const LsbVec& t1, std::uint32_t ticks,
-                             std::size_t subpath, bool pen_down) {
+void SpanEmitter::motion_lsb(const LsbVec& p1, const LsbVec& t0, const LsbVec& t1,
+                             std::uint32_t ticks, std::size_t subpath, bool pen_down) {
     span(p1, t0, t1, ticks, subpath, pen_down);
     ++motion_spans_;
     motion_ticks_ += ticks;
@@ -163,20 +188,23 @@ void SpanEmitter::motion_lsb(const LsbVec& p1, const LsbVec& t0, const LsbVec& t
 // The jerk rules of docs/planner.md §12 on the exact integer span, before it is made: its
 // third derivative 6 (2 P0 - 2 P1 + T0 + T1) / n^3 and the step from the last span's end
 // acceleration to its start acceleration (6 (P1 - P0) - 4 T0 - 2 T1) / n^2, both within J.
-void SpanEmitter::verify_jerk(const LsbVec& p1, const LsbVec& t0, const LsbVec& t1, std::uint32_t ticks,
-                              std::size_t subpath) {
+void SpanEmitter::verify_jerk(const LsbVec& p1, const LsbVec& t0, const LsbVec& t1,
+                              std::uint32_t ticks, std::size_t subpath) {
     const long double n = ticks, m = last_ticks_;
     for (std::size_t a = 0; a < axes_; ++a) {
         const long double j = jerk_lsb_[a];
         if (!std::isfinite(static_cast<double>(j))) continue;
         const std::int64_t dp = p1[a] - pos_[a];
-        const long double third = std::fabs(static_cast<long double>(6 * (-2 * dp + t0[a] + t1[a])));
+        const long double third =
+            std::fabs(static_cast<long double>(6 * (-2 * dp + t0[a] + t1[a])));
         const long double start = static_cast<long double>(6 * dp - 4 * t0[a] - 2 * t1[a]);
-        const long double step = std::fabs(start * m * m - static_cast<long double>(a_end_[a]) * n * n);
+        const long double step =
+            std::fabs(start * m * m - static_cast<long double>(a_end_[a]) * n * n);
         if (third > j * n * n * n || step > j * n * n * m * m) {
             std::ostringstream msg;
-            msg << "axis " << a << ": a span at tick " << total_ticks_ << " exceeds the jerk limit of " << j
-                << " LSB/tick^3 (" << (third > j * n * n * n ? "inside the span" : "at its join with the last one")
+            msg << "axis " << a << ": a span at tick " << total_ticks_
+                << " exceeds the jerk limit of " << j << " LSB/tick^3 ("
+                << (third > j * n * n * n ? "inside the span" : "at its join with the last one")
                 << ")";
             fail(subpath, msg.str());
         }
@@ -189,7 +217,8 @@ void SpanEmitter::finish(std::size_t last_subpath) {
         const long double n = last_ticks_;
         for (std::size_t a = 0; a < axes_; ++a) {
             if (std::fabs(static_cast<long double>(a_end_[a])) > jerk_lsb_[a] * n * n) {
-                fail(last_subpath, "axis " + std::to_string(a) + ": the last span does not end within the jerk limit");
+                fail(last_subpath, "axis " + std::to_string(a) +
+                                       ": the last span does not end within the jerk limit");
             }
         }
     }

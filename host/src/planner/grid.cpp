@@ -1,11 +1,22 @@
 // The lookahead grid: nodes along the path at known arc length, with tangent and curvature;
 // stops at sharp corners, cusps and pen changes; the arc length -> point lookup.
+#include "grid.hpp"
+
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
+#include <cstdint>
 #include <limits>
 #include <sstream>
+#include <string>
+#include <utility>
+#include <vector>
 
-#include "internal.hpp"
+#include "cubic.hpp"
+#include "pathstream/host/geometry.hpp"
+#include "pathstream/host/planner.hpp"
+#include "pathstream/machine/machine.hpp"
+#include "vec.hpp"
 
 namespace pathstream::host::planner_detail {
 namespace {
@@ -68,7 +79,8 @@ void segment_nodes(const Cubic& c, double length, const PlanOptions& o, std::vec
     const double size = c.size();
     std::size_t k = std::max<std::size_t>(o.min_nodes_per_segment, 1);
     if (o.grid_step > 0) {
-        k = std::max<std::size_t>(k, static_cast<std::size_t>(std::ceil(std::min(length / o.grid_step, 1e6))));
+        k = std::max<std::size_t>(
+            k, static_cast<std::size_t>(std::ceil(std::min(length / o.grid_step, 1e6))));
     }
     // A node's tangent on either side (they differ only where q' vanishes), computed once.
     struct Sides {
@@ -99,7 +111,8 @@ void segment_nodes(const Cubic& c, double length, const PlanOptions& o, std::vec
         if (!(n1 > 0)) return false;
         // cos(alpha + beta) against cos(max_turn), without acos (this runs for every interval);
         // an angle over 90 degrees bisects at once, so alpha + beta < pi below.
-        const double ca = std::clamp(dot(ta, h1) / n1, -1.0, 1.0), cb = std::clamp(dot(h1, tb) / n1, -1.0, 1.0);
+        const double ca = std::clamp(dot(ta, h1) / n1, -1.0, 1.0),
+                     cb = std::clamp(dot(h1, tb) / n1, -1.0, 1.0);
         if (ca < 0 || cb < 0) return true;
         return ca * cb - std::sqrt((1 - ca * ca) * (1 - cb * cb)) < cos_max_turn;
     };
@@ -135,7 +148,8 @@ void segment_nodes(const Cubic& c, double length, const PlanOptions& o, std::vec
     // tangent is taken on the interval's own side: compare the two sides at the node.
     for (std::size_t i = 1; i + 1 < out.size(); ++i) {
         if (norm(c.d1(out[i])) > 1e-9 * size) continue;
-        if (angle_between(unit_tangent(c, out[i], size, -1), unit_tangent(c, out[i], size, +1)) > 0.5 * kPi) {
+        if (angle_between(unit_tangent(c, out[i], size, -1), unit_tangent(c, out[i], size, +1)) >
+            0.5 * kPi) {
             cusps.push_back(out[i]);
         }
     }
@@ -186,9 +200,10 @@ struct Builder {
         run.dwell_pen_down = segments[first_seg].dwell_pen_down;
         run.start = out.cubics[first_seg].p[0];
         run.end = out.cubics[last_seg].p[3];
-        const double feed = run.pen_down ? (segments[first_seg].feed > 0 ? segments[first_seg].feed : profile.feed)
-                                         : (segments[first_seg].feed > 0 ? segments[first_seg].feed
-                                                                          : profile.travel_feed);
+        const double feed =
+            run.pen_down
+                ? (segments[first_seg].feed > 0 ? segments[first_seg].feed : profile.feed)
+                : (segments[first_seg].feed > 0 ? segments[first_seg].feed : profile.travel_feed);
         std::size_t piece_first = g.size();
         bool any = false;
         for (std::size_t s = first_seg; s <= last_seg; ++s) {
@@ -208,13 +223,14 @@ struct Builder {
                 if (i > 0) lam += arc_length(c, us[i - 1], us[i]);
                 const int side = i + 1 == us.size() ? -1 : +1;
                 Vec q = c.point(us[i]);
-                add_node(static_cast<std::uint32_t>(s), us[i], lam, q, unit_tangent(c, us[i], size, side),
-                         curvature(c, us[i], size, side), feed);
+                add_node(static_cast<std::uint32_t>(s), us[i], lam, q,
+                         unit_tangent(c, us[i], size, side), curvature(c, us[i], size, side), feed);
             }
             if (any) {  // the joint with the previous segment of this run
                 const std::size_t a = seg_first - 1, b = seg_first;
                 const double turn = angle_between(g.tangent[a], g.tangent[b]);
-                const bool sharp = norm(g.curvature[a]) > kappa_stop_ || norm(g.curvature[b]) > kappa_stop_;
+                const bool sharp =
+                    norm(g.curvature[a]) > kappa_stop_ || norm(g.curvature[b]) > kappa_stop_;
                 if (turn > options.corner_stop_angle || sharp || segments[s].stop_before) {
                     close_piece(run, piece_first, a, feed);
                     piece_first = b;
@@ -227,7 +243,8 @@ struct Builder {
             // at a cusp.
             for (std::size_t n = seg_first + 1; n + 1 < g.size(); ++n) {
                 const double kn = norm(g.curvature[n]);
-                if (kn > kappa_stop_ && kn >= norm(g.curvature[n - 1]) && kn >= norm(g.curvature[n + 1])) {
+                if (kn > kappa_stop_ && kn >= norm(g.curvature[n - 1]) &&
+                    kn >= norm(g.curvature[n + 1])) {
                     cusps.push_back(g.u[n]);
                 }
             }
@@ -239,8 +256,8 @@ struct Builder {
                 for (std::size_t n = seg_first; n < g.size(); ++n) {
                     if (std::fabs(g.u[n] - cu) < std::fabs(g.u[best] - cu)) best = n;
                 }
-                if (best > piece_first && best + 1 < g.size() && (out.pieces.empty() || run.pieces.empty() ||
-                                                                  out.pieces.back().last != best)) {
+                if (best > piece_first && best + 1 < g.size() &&
+                    (out.pieces.empty() || run.pieces.empty() || out.pieces.back().last != best)) {
                     g.curvature[best] = Vec{};
                     close_piece(run, piece_first, best, feed);
                     piece_first = best;
@@ -250,7 +267,8 @@ struct Builder {
             any = true;
         }
         if (!any) {  // nothing but points: a piece of zero length where the run is
-            add_node(static_cast<std::uint32_t>(first_seg), 0, lambda, run.start, Vec{}, Vec{}, feed);
+            add_node(static_cast<std::uint32_t>(first_seg), 0, lambda, run.start, Vec{}, Vec{},
+                     feed);
         }
         close_piece(run, piece_first, g.size() - 1, feed);
         out.runs.push_back(std::move(run));
@@ -276,8 +294,8 @@ double speed_at(const Cubic& c, double u) {
 }
 
 double arc_length(const Cubic& c, double u0, double u1) {
-    static constexpr double x[5] = {0.0, -0.5384693101056831, 0.5384693101056831, -0.9061798459386640,
-                                    0.9061798459386640};
+    static constexpr double x[5] = {0.0, -0.5384693101056831, 0.5384693101056831,
+                                    -0.9061798459386640, 0.9061798459386640};
     static constexpr double w[5] = {0.5688888888888889, 0.4786286704993665, 0.4786286704993665,
                                     0.2369268850561891, 0.2369268850561891};
     const double h = 0.5 * (u1 - u0), m = 0.5 * (u0 + u1);
@@ -291,7 +309,8 @@ PathGrid build_grid(const std::vector<BezierSegment>& segments, const MachinePro
     const std::size_t axes = profile.axes.size();
     Builder b{segments, profile, options, {}, 0, 0, {}, {}, {}};
     double a_min = 0;
-    for (const auto& a : profile.axes) a_min = a_min == 0 ? a.max_acceleration : std::min(a_min, a.max_acceleration);
+    for (const auto& a : profile.axes)
+        a_min = a_min == 0 ? a.max_acceleration : std::min(a_min, a.max_acceleration);
     const double tick = 1 / profile.tick_hz;
     b.kappa_stop_ = a_min > 0 ? 1 / (a_min * tick * tick) : std::numeric_limits<double>::infinity();
     // With a jerk limit (docs/planner.md §12) also where the jerk cap kappa^2 s^3 <= j / 4 is below
@@ -301,23 +320,26 @@ PathGrid build_grid(const std::vector<BezierSegment>& segments, const MachinePro
         if (a.max_jerk > 0) j_min = j_min == 0 ? a.max_jerk : std::min(j_min, a.max_jerk);
     }
     if (j_min > 0 && a_min > 0) {
-        b.kappa_stop_ = std::min(b.kappa_stop_, std::sqrt(0.25 * j_min / std::pow(a_min * tick, 3)));
+        b.kappa_stop_ =
+            std::min(b.kappa_stop_, std::sqrt(0.25 * j_min / std::pow(a_min * tick, 3)));
     }
     b.out.grid.axes = axes;
-    for (VecArray* v : {&b.out.grid.q, &b.out.grid.tangent, &b.out.grid.curvature, &b.out.grid.corner_jump}) {
+    for (VecArray* v :
+         {&b.out.grid.q, &b.out.grid.tangent, &b.out.grid.curvature, &b.out.grid.corner_jump}) {
         v->set_axes(axes);
     }
     for (std::size_t s = 0; s < segments.size(); ++s) {
         for (const auto& p : segments[s].p) {
             if (p.size() != axes) {
                 std::ostringstream m;
-                m << "segment " << first_index + s << " (subpath " << segments[s].subpath << ") has " << p.size()
-                  << " coordinates but the machine has " << axes << " axes";
+                m << "segment " << first_index + s << " (subpath " << segments[s].subpath
+                  << ") has " << p.size() << " coordinates but the machine has " << axes << " axes";
                 throw PlanError(m.str());
             }
             for (double x : p) {
                 if (!std::isfinite(x)) {
-                    throw PlanError("segment " + std::to_string(first_index + s) + " has a non-finite coordinate");
+                    throw PlanError("segment " + std::to_string(first_index + s) +
+                                    " has a non-finite coordinate");
                 }
             }
         }
@@ -331,8 +353,9 @@ PathGrid build_grid(const std::vector<BezierSegment>& segments, const MachinePro
             const double gap = norm(sub(b.out.cubics[s].p[0], b.out.cubics[s - 1].p[3]));
             if (gap > 1e-6) {
                 std::ostringstream m;
-                m << "segment " << first_index + s << " (subpath " << segments[s].subpath << ") starts " << gap
-                  << " mm away from where segment " << first_index + s - 1 << " ends: the path must be continuous";
+                m << "segment " << first_index + s << " (subpath " << segments[s].subpath
+                  << ") starts " << gap << " mm away from where segment " << first_index + s - 1
+                  << " ends: the path must be continuous";
                 throw PlanError(m.str());
             }
         }
@@ -360,7 +383,8 @@ PathGrid build_grid(const std::vector<BezierSegment>& segments, const MachinePro
     return std::move(b.out);
 }
 
-PathAt path_at(const PathGrid& pg, const Piece& piece, double lambda, std::size_t& hint, bool precise) {
+PathAt path_at(const PathGrid& pg, const Piece& piece, double lambda, std::size_t& hint,
+               bool precise) {
     const Grid& g = pg.grid;
     PathAt r;
     if (piece.first == piece.last) {
@@ -372,16 +396,18 @@ PathAt path_at(const PathGrid& pg, const Piece& piece, double lambda, std::size_
     std::size_t k = std::clamp(hint, piece.first, piece.last - 1);
     for (std::size_t steps = 0; g.lambda[k] > lambda && k > piece.first && steps < 16; ++steps) --k;
     if (g.lambda[k] > lambda) {
-        const auto it = std::upper_bound(g.lambda.begin() + static_cast<std::ptrdiff_t>(piece.first),
-                                         g.lambda.begin() + static_cast<std::ptrdiff_t>(piece.last) + 1, lambda);
+        const auto it = std::upper_bound(
+            g.lambda.begin() + static_cast<std::ptrdiff_t>(piece.first),
+            g.lambda.begin() + static_cast<std::ptrdiff_t>(piece.last) + 1, lambda);
         k = static_cast<std::size_t>(it - g.lambda.begin());
         k = k == 0 ? 0 : k - 1;
     } else {
         std::size_t steps = 0;
         while (k + 1 < piece.last && g.lambda[k + 1] <= lambda && ++steps < 64) ++k;
         if (k + 1 < piece.last && g.lambda[k + 1] <= lambda) {
-            const auto it = std::upper_bound(g.lambda.begin() + static_cast<std::ptrdiff_t>(k),
-                                             g.lambda.begin() + static_cast<std::ptrdiff_t>(piece.last) + 1, lambda);
+            const auto it = std::upper_bound(
+                g.lambda.begin() + static_cast<std::ptrdiff_t>(k),
+                g.lambda.begin() + static_cast<std::ptrdiff_t>(piece.last) + 1, lambda);
             k = static_cast<std::size_t>(it - g.lambda.begin()) - 1;
         }
     }
@@ -408,7 +434,8 @@ PathAt path_at(const PathGrid& pg, const Piece& piece, double lambda, std::size_
     double u;
     if (p0 > 0 && p1 > 0) {
         const double w2 = w * w, w3 = w2 * w;
-        u = (2 * w3 - 3 * w2 + 1) * u0 + (w3 - 2 * w2 + w) * h * p0 + (-2 * w3 + 3 * w2) * u1 + (w3 - w2) * h * p1;
+        u = (2 * w3 - 3 * w2 + 1) * u0 + (w3 - 2 * w2 + w) * h * p0 + (-2 * w3 + 3 * w2) * u1 +
+            (w3 - w2) * h * p1;
         if (!(u > u0 && u < u1)) u = u0 + (u1 - u0) * w;
     } else {
         u = u0 + (u1 - u0) * w;
@@ -417,15 +444,17 @@ PathAt path_at(const PathGrid& pg, const Piece& piece, double lambda, std::size_
     for (int it = 0; it < (precise ? 12 : 0); ++it) {
         const double f = arc_length(c, u0, u) - target;
         if (std::fabs(f) < tolerance) break;
-        if (f > 0) hi = u;
-        else lo = u;
+        if (f > 0)
+            hi = u;
+        else
+            lo = u;
         const double speed = speed_at(c, u);
         double next = speed > 0 ? u - f / speed : 0.5 * (lo + hi);
         if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);
         const double e = next - u;
         u = next;
-        if (next - lo > 0 && hi - next > 0 && speed > 0 && 0.5 * norm(c.d2(u)) * e * e < 0.1 * tolerance &&
-            std::fabs(f) < 1e-3 * h) {
+        if (next - lo > 0 && hi - next > 0 && speed > 0 &&
+            0.5 * norm(c.d2(u)) * e * e < 0.1 * tolerance && std::fabs(f) < 1e-3 * h) {
             break;
         }
     }
@@ -436,7 +465,8 @@ PathAt path_at(const PathGrid& pg, const Piece& piece, double lambda, std::size_
         r.t = scaled(d, 1 / n);
     } else {  // at a degenerate point: interpolate the node tangents
         const double wl = (lambda - l0) / (l1 - l0);
-        for (std::size_t i = 0; i < kAxesMax; ++i) r.t[i] = (1 - wl) * g.tangent[k][i] + wl * g.tangent[k + 1][i];
+        for (std::size_t i = 0; i < kAxesMax; ++i)
+            r.t[i] = (1 - wl) * g.tangent[k][i] + wl * g.tangent[k + 1][i];
         const double m = norm(r.t);
         if (m > 0) r.t = scaled(r.t, 1 / m);
     }

@@ -1,13 +1,25 @@
 // The jerk stage (docs/planner.md §12): the second-order motion of each piece, retimed by a box
 // filter of its path parameter, sampled on the LSB grid, with integer tangents chosen so that
 // every span and every join meets the jerk limits exactly.
+#include "jerk.hpp"
+
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
+#include <cstdint>
 #include <limits>
 #include <sstream>
+#include <vector>
 
-#include "internal.hpp"
+#include "emit.hpp"
+#include "forward_pass.hpp"
+#include "grid.hpp"
+#include "limits.hpp"
+#include "pathstream/host/planner.hpp"
+#include "pathstream/machine/machine.hpp"
 #include "pathstream/units.hpp"
+#include "piece.hpp"
+#include "vec.hpp"
 
 namespace pathstream::host::planner_detail {
 namespace {

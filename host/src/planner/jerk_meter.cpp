@@ -6,20 +6,28 @@
 namespace pathstream::host::planner_detail {
 
 JerkMeter::JerkMeter(const MachineProfile& profile)
-    : profile_(profile), axes_(profile.axes.size()), jerk_lsb_(axes_, 0), step_lsb_(axes_, 0),
-      limit_lsb_(axes_, 0), previous_end_(axes_) {
+    : profile_(profile),
+      axes_(profile.axes.size()),
+      jerk_lsb_(axes_, 0),
+      step_lsb_(axes_, 0),
+      limit_lsb_(axes_, 0),
+      previous_end_(axes_) {
     const double t = 1.0 / profile.tick_hz;
-    for (std::size_t a = 0; a < axes_; ++a) limit_lsb_[a] = profile.axes[a].max_jerk * t * t * t / profile.mm_per_lsb;
+    for (std::size_t a = 0; a < axes_; ++a)
+        limit_lsb_[a] = profile.axes[a].max_jerk * t * t * t / profile.mm_per_lsb;
 }
 
 // |next - previous| in LSB/tick^2, from the two fractions cross-multiplied exactly (each
 // numerator < 2^36, denominator < 2^35) and divided once.
 void JerkMeter::join(std::size_t axis, const Acceleration& next, const Acceleration& previous,
                      std::vector<double>& step) const {
-    const __int128 difference = static_cast<__int128>(next.numerator) * static_cast<__int128>(previous.denominator) -
-                                static_cast<__int128>(previous.numerator) * static_cast<__int128>(next.denominator);
-    const long double magnitude = static_cast<long double>(difference < 0 ? -difference : difference) /
-                                  (static_cast<long double>(next.denominator) * static_cast<long double>(previous.denominator));
+    const __int128 difference =
+        static_cast<__int128>(next.numerator) * static_cast<__int128>(previous.denominator) -
+        static_cast<__int128>(previous.numerator) * static_cast<__int128>(next.denominator);
+    const long double magnitude =
+        static_cast<long double>(difference < 0 ? -difference : difference) /
+        (static_cast<long double>(next.denominator) *
+         static_cast<long double>(previous.denominator));
     step[axis] = std::max(step[axis], static_cast<double>(magnitude));
 }
 
@@ -30,8 +38,9 @@ void JerkMeter::span(const CoreSpan& s) {
         const TickCubic& c = s.cubic[a];
         // p(u) = (a u^3 + b u^2 + c u + d) / s, u = k/n: jerk 6a / (s n^3) LSB/tick^3, and the
         // acceleration 2b / (s n^2) at the start, (6a + 2b) / (s n^2) at the end.
-        const long double jerk = std::fabs(static_cast<long double>(6 * c.a)) /
-                                 (static_cast<long double>(scale) * static_cast<long double>(n * n * n));
+        const long double jerk =
+            std::fabs(static_cast<long double>(6 * c.a)) /
+            (static_cast<long double>(scale) * static_cast<long double>(n * n * n));
         jerk_lsb_[a] = std::max(jerk_lsb_[a], static_cast<double>(jerk));
         const Acceleration start{2 * c.b, scale * n * n};
         join(a, start, previous_end_[a], step_lsb_);
@@ -67,11 +76,13 @@ void JerkMeter::finish(PlanCheck& out) const {
         // A join may step by one tick of jerk: J * 1 tick, in LSB/tick^2 the same number as J.
         out.axis_jerk_fraction_exact[a] = jerk_lsb_[a] / limit_lsb_[a];
         out.axis_join_acceleration_step_fraction[a] = step[a] / limit_lsb_[a];
-        out.max_jerk_fraction_exact = std::max(out.max_jerk_fraction_exact, out.axis_jerk_fraction_exact[a]);
-        out.max_join_acceleration_step_fraction =
-            std::max(out.max_join_acceleration_step_fraction, out.axis_join_acceleration_step_fraction[a]);
+        out.max_jerk_fraction_exact =
+            std::max(out.max_jerk_fraction_exact, out.axis_jerk_fraction_exact[a]);
+        out.max_join_acceleration_step_fraction = std::max(
+            out.max_join_acceleration_step_fraction, out.axis_join_acceleration_step_fraction[a]);
     }
-    if (out.max_jerk_fraction_exact > 1 || out.max_join_acceleration_step_fraction > 1) out.within_limits = false;
+    if (out.max_jerk_fraction_exact > 1 || out.max_join_acceleration_step_fraction > 1)
+        out.within_limits = false;
 }
 
 }  // namespace pathstream::host::planner_detail

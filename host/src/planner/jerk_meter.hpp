@@ -6,8 +6,8 @@
 #include <vector>
 
 #include "pathstream/host/core_spans.hpp"
-#include "pathstream/machine/machine.hpp"
 #include "pathstream/host/plan.hpp"
+#include "pathstream/machine/machine.hpp"
 
 namespace pathstream::host::planner_detail {
 

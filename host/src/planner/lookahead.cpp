@@ -5,11 +5,21 @@
 // q_i'(l) dds + q_i''(l) x (q' the unit tangent, q'' the curvature vector), and between two
 // nodes TOPP-RA takes dds constant, so x is linear in l: dds = (x[k+1] - x[k]) / (2 dl). The
 // limit |q_i' dds + q_i'' x| <= a_i at both ends of the interval is linear in (x[k], x[k+1]).
+#include "lookahead.hpp"
+
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
+#include <cstdint>
 #include <limits>
+#include <vector>
 
-#include "internal.hpp"
+#include "grid.hpp"
+#include "limits.hpp"
+#include "lp2.hpp"
+#include "pathstream/host/planner.hpp"
+#include "pathstream/machine/machine.hpp"
+#include "vec.hpp"
 
 namespace pathstream::host::planner_detail {
 namespace {
@@ -21,7 +31,8 @@ constexpr double kNoCap = 1e20;  // (mm/s)^2: effectively unlimited, still finit
 /// more acceleration than they do, while the curvature terms (the speed cap of a bend) keep
 /// the full budget.
 std::size_t interval_rows(const Grid& g, std::size_t k, double dl, const Limits& limits,
-                          const std::vector<double>& accel_factor, double tangential_margin, LpRow* rows) {
+                          const std::vector<double>& accel_factor, double tangential_margin,
+                          LpRow* rows) {
     std::size_t n = 0;
     for (std::size_t i = 0; i < g.axes; ++i) {
         const double a0 = limits.acceleration[i] * accel_factor[k];
@@ -35,7 +46,8 @@ std::size_t interval_rows(const Grid& g, std::size_t k, double dl, const Limits&
 }
 
 /// Largest x at node k for which some path acceleration keeps every axis within its limit.
-double acceleration_cap(const Grid& g, std::size_t k, const Limits& limits, double factor, double x_max) {
+double acceleration_cap(const Grid& g, std::size_t k, const Limits& limits, double factor,
+                        double x_max) {
     LpRow rows[kAxesMax];
     for (std::size_t i = 0; i < g.axes; ++i) {
         const double a = limits.acceleration[i] * factor;
@@ -46,8 +58,8 @@ double acceleration_cap(const Grid& g, std::size_t k, const Limits& limits, doub
 
 }  // namespace
 
-std::vector<double> speed_caps(const PathGrid& pg, const Limits& limits, const MachineProfile& profile,
-                               const PlanOptions& options) {
+std::vector<double> speed_caps(const PathGrid& pg, const Limits& limits,
+                               const MachineProfile& profile, const PlanOptions& options) {
     const Grid& g = pg.grid;
     const double tick = 1.0 / profile.tick_hz;
     const double span = tick * profile.ticks_per_span;
@@ -93,8 +105,8 @@ std::vector<double> speed_caps(const PathGrid& pg, const Limits& limits, const M
     return caps;
 }
 
-void jerk_caps(const PathGrid& pg, const Limits& limits, const MachineProfile& profile, std::uint32_t filter_ticks,
-               std::vector<double>& caps) {
+void jerk_caps(const PathGrid& pg, const Limits& limits, const MachineProfile& profile,
+               std::uint32_t filter_ticks, std::vector<double>& caps) {
     const Grid& g = pg.grid;
     const double span = profile.ticks_per_span / profile.tick_hz;
     const double share = limits.jerk_share;
@@ -124,7 +136,9 @@ void jerk_caps(const PathGrid& pg, const Limits& limits, const MachineProfile& p
             // Turning the velocity at curvature kappa: its derivative along the tangent, kappa^2
             // s^3 (within the quarter of the limit the filter leaves).
             const double kappa = norm(g.curvature[k]);
-            if (kappa > 0 && !stop[k]) cap(k, std::cbrt((1 - share) * j / (kappa * kappa * std::fabs(g.tangent[k][i]) + 1e-300)));
+            if (kappa > 0 && !stop[k])
+                cap(k, std::cbrt((1 - share) * j /
+                                 (kappa * kappa * std::fabs(g.tangent[k][i]) + 1e-300)));
             if (k + 1 >= g.size() || stop[k] || stop[k + 1]) continue;
             const double dk = std::fabs(g.curvature[k + 1][i] - g.curvature[k][i]);
             if (!(dk > 0)) continue;
@@ -152,7 +166,8 @@ void jerk_caps(const PathGrid& pg, const Limits& limits, const MachineProfile& p
     for (const Piece& piece : pg.pieces) {
         for (std::size_t k = piece.first; k <= piece.last; ++k) {
             const double d = reach_time * std::sqrt(std::min(before[k], kNoCap));
-            for (std::size_t i = k; i-- > piece.first && g.lambda[k] - g.lambda[i] <= d;) caps[k] = std::min(caps[k], before[i]);
+            for (std::size_t i = k; i-- > piece.first && g.lambda[k] - g.lambda[i] <= d;)
+                caps[k] = std::min(caps[k], before[i]);
             for (std::size_t i = k + 1; i <= piece.last && g.lambda[i] - g.lambda[k] <= d; ++i)
                 caps[k] = std::min(caps[k], before[i]);
         }
@@ -168,12 +183,14 @@ void reserve_for_corners(const PathGrid& pg, const Limits& limits, const std::ve
         const double v = std::sqrt(caps[k]);
         double share = 0;
         for (std::size_t i = 0; i < g.axes; ++i) {
-            share = std::max(share, 4 * v * std::fabs(g.corner_jump[k][i]) / (span_time * limits.acceleration[i]));
+            share = std::max(share, 4 * v * std::fabs(g.corner_jump[k][i]) /
+                                        (span_time * limits.acceleration[i]));
         }
         share = std::min(share, 0.5);
         // Every node within two spans' travel at the corner speed (and at least the neighbours).
         const double reach = 2 * v * span_time;
-        for (std::size_t j = k; j-- > 0 && g.lambda[k] - g.lambda[j] <= reach;) factor[j] = std::min(factor[j], 1 - share);
+        for (std::size_t j = k; j-- > 0 && g.lambda[k] - g.lambda[j] <= reach;)
+            factor[j] = std::min(factor[j], 1 - share);
         for (std::size_t j = k; j < g.size() && g.lambda[j] - g.lambda[k] <= reach; ++j) {
             factor[j] = std::min(factor[j], 1 - share);
         }
@@ -220,11 +237,13 @@ std::size_t backward_pass(const PathGrid& pg, const Piece& piece, const Limits& 
         if (!(dl > 1e-12)) {  // a joint: the speed is the same on both sides
             x = std::min(beta[k + 1], bend);
         } else {
-            const std::size_t n = interval_rows(g, k, dl, limits, accel_factor, tangential_margin, rows);
+            const std::size_t n =
+                interval_rows(g, k, dl, limits, accel_factor, tangential_margin, rows);
             x = lp_max_x(rows, n, caps[k], 0, beta[k + 1]);
         }
         if (span_time > 0) x = std::min(x, d);
-        if (k < unchanged_below && x == beta[k] && d == dip[k]) break;  // nothing below changes either
+        if (k < unchanged_below && x == beta[k] && d == dip[k])
+            break;  // nothing below changes either
         beta[k] = x;
         dip[k] = d;
         lowest = k;

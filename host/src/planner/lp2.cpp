@@ -1,11 +1,14 @@
 // The two-variable linear programs of a TOPP-RA step, solved exactly: every row bounds y by an
 // affine function of x, so the feasible x form an interval [0, x*] whose end is the smallest
 // crossing of a lower and an upper bound (O(rows^2), rows <= 4 * axes + 2).
+#include "lp2.hpp"
+
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstddef>
 
-#include "internal.hpp"
+#include "vec.hpp"
 
 namespace pathstream::host::planner_detail {
 namespace {
@@ -32,8 +35,10 @@ double lp_max_x(const LpRow* rows, std::size_t count, double x_max, double y_lo,
     for (std::size_t m = 0; m < count && nl < kMaxBounds; ++m) {
         const LpRow& row = rows[m];
         if (x_only(row)) {
-            if (row.c > 0) x = std::min(x, row.hi / row.c);
-            else if (row.c < 0) x = std::min(x, row.lo / row.c);
+            if (row.c > 0)
+                x = std::min(x, row.hi / row.c);
+            else if (row.c < 0)
+                x = std::min(x, row.lo / row.c);
             continue;
         }
         const double r = -row.c / row.d;
@@ -61,7 +66,8 @@ bool lp_max_y(const LpRow* rows, std::size_t count, double x, double y_lo, doubl
         const LpRow& row = rows[m];
         if (x_only(row)) {
             const double v = row.c * x;
-            if (v > row.hi * (1 + 1e-9) + 1e-12 || v < row.lo * (1 + 1e-9) - 1e-12) feasible = false;
+            if (v > row.hi * (1 + 1e-9) + 1e-12 || v < row.lo * (1 + 1e-9) - 1e-12)
+                feasible = false;
             continue;
         }
         const double a = (row.lo - row.c * x) / row.d, b = (row.hi - row.c * x) / row.d;

@@ -1,13 +1,20 @@
 // Distance from a point to the geometric path (nearest point on the Bezier segments).
+#include "projection.hpp"
+
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <limits>
+#include <utility>
+#include <vector>
 
-#include "internal.hpp"
+#include "cubic.hpp"
+#include "vec.hpp"
 
 namespace pathstream::host::planner_detail {
 
-PathProjector::PathProjector(std::vector<Cubic> segments, std::vector<std::size_t> index, double global_below)
+PathProjector::PathProjector(std::vector<Cubic> segments, std::vector<std::size_t> index,
+                             double global_below)
     : segs_(std::move(segments)), index_(std::move(index)), global_below_(global_below) {
     for (const Cubic& c : segs_) {
         length_.push_back(arc_length(c, 0, 0.5) + arc_length(c, 0.5, 1));
@@ -112,7 +119,8 @@ void PathProjector::search_tree(const Vec& p, double& best, Consider&& consider)
 double PathProjector::box_distance(std::size_t i, const Vec& p) const {
     double s = 0;
     for (std::size_t a = 0; a < kAxesMax; ++a) {
-        const double d = p[a] < lo_[i][a] ? lo_[i][a] - p[a] : (p[a] > hi_[i][a] ? p[a] - hi_[i][a] : 0.0);
+        const double d =
+            p[a] < lo_[i][a] ? lo_[i][a] - p[a] : (p[a] > hi_[i][a] ? p[a] - hi_[i][a] : 0.0);
         s += d * d;
     }
     return std::sqrt(s);
@@ -168,7 +176,8 @@ double flatness(const Cubic& c) {
 
 }  // namespace
 
-double PathProjector::segment_distance(std::size_t i, const Vec& p, double bound, double* at) const {
+double PathProjector::segment_distance(std::size_t i, const Vec& p, double bound,
+                                       double* at) const {
     // Branch and bound: a piece of the curve lies in the box of its control points, so a piece
     // whose box is farther than the best distance so far is dropped; nearly straight pieces
     // are projected on their chord and the parameter refined by Newton on the whole segment.
@@ -220,7 +229,8 @@ double PathProjector::segment_distance(std::size_t i, const Vec& p, double bound
             }
             continue;
         }
-        Item left{{}, it.u0, 0.5 * (it.u0 + it.u1), it.depth + 1}, right{{}, left.u1, it.u1, it.depth + 1};
+        Item left{{}, it.u0, 0.5 * (it.u0 + it.u1), it.depth + 1},
+            right{{}, left.u1, it.u1, it.depth + 1};
         split(it.c, left.c, right.c);
         // The nearer half is examined first (pushed last): it tightens the bound sooner.
         if (box_distance2(left.c, p) <= box_distance2(right.c, p)) {
@@ -242,7 +252,8 @@ double PathProjector::distance(const Vec& p, std::size_t& segment) {
     std::size_t best_i = cursor_;
     // Around the cursor, both ways, until `reach` mm of path (at least two segments each way).
     std::size_t from = cursor_;
-    for (double behind = 0; from > 0 && (from + 2 > cursor_ || behind <= reach);) behind += length_[--from];
+    for (double behind = 0; from > 0 && (from + 2 > cursor_ || behind <= reach);)
+        behind += length_[--from];
     double best_u = 0;
     const auto consider = [&](std::size_t i) {
         if (box_distance(i, p) >= best) return;
@@ -276,9 +287,10 @@ double PathProjector::distance(const Vec& p, std::size_t& segment) {
         if (i > cursor_) ahead += length_[i - 1];
         consider(i);
     }
-    if (n > 0 && segs_[run_last_[cursor_]].p[3] == segs_[run_first_[cursor_]].p[0]) {  // closed: wrap
-        for (const std::size_t i : {run_first_[cursor_], run_first_[cursor_] + 1, run_last_[cursor_],
-                                    run_last_[cursor_] - 1}) {
+    if (n > 0 &&
+        segs_[run_last_[cursor_]].p[3] == segs_[run_first_[cursor_]].p[0]) {  // closed: wrap
+        for (const std::size_t i : {run_first_[cursor_], run_first_[cursor_] + 1,
+                                    run_last_[cursor_], run_last_[cursor_] - 1}) {
             if (i >= run_first_[cursor_] && i <= run_last_[cursor_]) consider(i);
         }
     }

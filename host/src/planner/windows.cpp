@@ -10,14 +10,34 @@
 // planned; window N goes to the sink once its check passed.
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <functional>
 #include <limits>
 #include <optional>
 #include <sstream>
+#include <string>
 #include <thread>
 #include <utility>
+#include <vector>
 
-#include "internal.hpp"
+#include "check.hpp"
+#include "corner_blend.hpp"
+#include "cubic.hpp"
+#include "emit.hpp"
+#include "forward_pass.hpp"
+#include "grid.hpp"
+#include "jerk.hpp"
+#include "limits.hpp"
+#include "lsb_rounding.hpp"
+#include "pathstream/host/geometry.hpp"
 #include "pathstream/host/handoff_worker.hpp"
+#include "pathstream/host/plan.hpp"
+#include "pathstream/host/planner.hpp"
+#include "pathstream/machine/machine.hpp"
+#include "piece.hpp"
+#include "plan_inputs.hpp"
+#include "vec.hpp"
 
 namespace pathstream::host {
 namespace {
@@ -46,14 +66,14 @@ private:
 /// Where the kept motion ended: the knot it reached inside a segment (λ from that segment's
 /// start) and the knot the last span started from, or a piece start at rest.
 struct Carry {
-    bool started = false;      ///< anything planned yet
-    std::size_t segment = 0;   ///< global index of the segment holding the knot
+    bool started = false;     ///< anything planned yet
+    std::size_t segment = 0;  ///< global index of the segment holding the knot
     double lambda_in_segment = 0;
-    bool moving = false;       ///< mid-piece: continue from `last` (else a piece starts at rest)
-    Knot prev, last;           ///< the last span ran from prev to last...
-    std::uint32_t ticks = 0;   ///< ...in this many ticks
-    Vec q{};                   ///< where the motion is (mm, on the LSB grid)
-    double run_offset = 0;     ///< mm of the current run before `segment`
+    bool moving = false;      ///< mid-piece: continue from `last` (else a piece starts at rest)
+    Knot prev, last;          ///< the last span ran from prev to last...
+    std::uint32_t ticks = 0;  ///< ...in this many ticks
+    Vec q{};                  ///< where the motion is (mm, on the LSB grid)
+    double run_offset = 0;    ///< mm of the current run before `segment`
 };
 
 /// A segment's requested feed, as the per-tick check needs it for the segment's spans.
@@ -115,7 +135,8 @@ public:
             read(want);
             if (buffer_.empty()) break;  // nothing at all
             const std::size_t window_first = window_start();
-            buffer_.erase(buffer_.begin(), buffer_.begin() + static_cast<std::ptrdiff_t>(window_first - base_));
+            buffer_.erase(buffer_.begin(),
+                          buffer_.begin() + static_cast<std::ptrdiff_t>(window_first - base_));
             base_ = window_first;
             const PathGrid pg = build_grid(buffer_, profile_, options_, base_);
             const double end = pg.grid.size() > 0 ? pg.grid.lambda.back() : 0.0;
@@ -143,12 +164,15 @@ public:
             if (!deliver()) return fail(check);
             if (std::pair{carry_.segment, carry_.lambda_in_segment} == before) {
                 // No span fitted before the commit point: a longer window moves it further.
-                if (want >= kMaxWindowSegments) throw PlanError("internal: the windowed planner made no progress");
+                if (want >= kMaxWindowSegments)
+                    throw PlanError("internal: the windowed planner made no progress");
                 want *= 2;
             } else {
                 want = window_segments();
             }
-            if (total_ > 0) report_(lo_ + (hi_ - lo_) * static_cast<double>(carry_.segment) / static_cast<double>(total_));
+            if (total_ > 0)
+                report_(lo_ + (hi_ - lo_) * static_cast<double>(carry_.segment) /
+                                  static_cast<double>(total_));
         }
         if (!collect_checked()) return fail(check);
         check = checker_.finish();
@@ -173,7 +197,9 @@ public:
 
 private:
     SpanEmitter& emitter() { return *emitter_; }
-    std::size_t window_segments() const { return std::clamp<std::size_t>(options_.window_segments, 16, kMaxWindowSegments); }
+    std::size_t window_segments() const {
+        return std::clamp<std::size_t>(options_.window_segments, 16, kMaxWindowSegments);
+    }
 
     /// The check's figures after a failed window; a window still in the check (the one before
     /// a failed jerk stage) is first finished and, if it passed, sent as it would have been.
@@ -221,8 +247,9 @@ private:
         if (carry_.moving && jerk_setup_.active) {
             // The jerk stage's filtered position lags the motion by up to M ticks of travel:
             // the path there must be in this window too.
-            const double lag = (jerk_setup_.filter_ticks + 2.0 * profile_.ticks_per_span) / profile_.tick_hz *
-                                   top_speed_ + 1.0 + carry_.lambda_in_segment;
+            const double lag = (jerk_setup_.filter_ticks + 2.0 * profile_.ticks_per_span) /
+                                   profile_.tick_hz * top_speed_ +
+                               1.0 + carry_.lambda_in_segment;
             double back = 0;
             while (first > base_ && back < lag) {
                 const BezierSegment& a = buffer_[first - 1 - base_];
@@ -281,18 +308,20 @@ private:
             // Messages measure along the whole run: a run continued from the last window
             // started before this grid.
             const double run_start = g.lambda[pg.pieces[run.pieces.front()].first];
-            const double run_offset = r == 0 && carry_.moving ? carry_.run_offset - (segment_start(pg) - run_start) : 0.0;
+            const double run_offset =
+                r == 0 && carry_.moving ? carry_.run_offset - (segment_start(pg) - run_start) : 0.0;
             for (const std::size_t index : run.pieces) {
                 const Piece& piece = pg.pieces[index];
                 const double first = g.lambda[piece.first], last = g.lambda[piece.last];
                 // Done already: wholly before the carry (a piece at rest at the carry's point
                 // starts there, and zero-length pieces before it were sent).
-                if (last < carry_lambda - 1e-9 || (last <= carry_lambda + 1e-12 && first < last)) continue;
+                if (last < carry_lambda - 1e-9 || (last <= carry_lambda + 1e-12 && first < last))
+                    continue;
                 if (first < carry_lambda - 1e-9 && !carry_.moving) continue;
                 emitter().begin_run(run);
                 PieceMotion carried;
-                const bool resume = carry_.moving && !carried_used && first <= carry_lambda + 1e-9 &&
-                                    carry_lambda < last;
+                const bool resume = carry_.moving && !carried_used &&
+                                    first <= carry_lambda + 1e-9 && carry_lambda < last;
                 if (resume) {
                     carried.start.lambda = first;
                     carried.start.q = carry_.q;
@@ -305,10 +334,13 @@ private:
                     emitter().piece_start(carry_.q, run.subpath);
                 }
                 if (jerk_) {
-                    if (resume) jerk_->rebase(carry_lambda);
-                    else jerk_->piece_begin(first, run.subpath, run.pen_down, emitter());
+                    if (resume)
+                        jerk_->rebase(carry_lambda);
+                    else
+                        jerk_->piece_begin(first, run.subpath, run.pen_down, emitter());
                 }
-                PieceMotion m = plan_piece(la, piece, carry_.q, resume ? &carried : nullptr, run_offset, st_);
+                PieceMotion m =
+                    plan_piece(la, piece, carry_.q, resume ? &carried : nullptr, run_offset, st_);
                 ++st_.pieces;
                 const std::size_t skip = resume ? 2 : 0;
                 Knot from = skip > 0 ? m.spans[skip - 1].end : m.start;
@@ -334,11 +366,13 @@ private:
                 carry_.q = from.q;
                 if (stopped_inside) {
                     cut_ = true;
-                    if (ticks == 0) {  // nothing of this piece sent: it starts the next window at rest
-                        set_carry(pg, run, run_offset, piece.first, first, false, Knot{}, Knot{}, 0);
+                    if (ticks ==
+                        0) {  // nothing of this piece sent: it starts the next window at rest
+                        set_carry(pg, run, run_offset, piece.first, first, false, Knot{}, Knot{},
+                                  0);
                     } else {
-                        set_carry(pg, run, run_offset, node_at(pg, piece, from.lambda), from.lambda, true, before,
-                                  from, ticks);
+                        set_carry(pg, run, run_offset, node_at(pg, piece, from.lambda), from.lambda,
+                                  true, before, from, ticks);
                     }
                     break;
                 }
@@ -360,14 +394,16 @@ private:
     /// Arc length in this grid where the carry's segment starts.
     double segment_start(const PathGrid& pg) const {
         const std::size_t k = carry_node(pg);
-        return k < pg.grid.size() ? pg.grid.lambda[k] : (pg.grid.size() > 0 ? pg.grid.lambda.back() : 0.0);
+        return k < pg.grid.size() ? pg.grid.lambda[k]
+                                  : (pg.grid.size() > 0 ? pg.grid.lambda.back() : 0.0);
     }
 
     /// The next window continues at node `node` of this grid (moving: from knot `last`, which
     /// the span of `ticks` ticks reached from `prev`; else a piece starts there at rest).
     /// `run_offset`: mm of `run` before this grid.
-    void set_carry(const PathGrid& pg, const Run& run, double run_offset, std::size_t node, double lambda,
-                   bool moving, const Knot& prev, const Knot& last, std::uint32_t ticks) {
+    void set_carry(const PathGrid& pg, const Run& run, double run_offset, std::size_t node,
+                   double lambda, bool moving, const Knot& prev, const Knot& last,
+                   std::uint32_t ticks) {
         const Grid& g = pg.grid;
         std::size_t seg_first = node;
         while (seg_first > 0 && g.seg[seg_first - 1] == g.seg[node]) --seg_first;
@@ -393,8 +429,8 @@ private:
     static std::size_t node_at(const PathGrid& pg, const Piece& piece, double lambda) {
         const auto b = pg.grid.lambda.begin();
         std::size_t k = static_cast<std::size_t>(
-            std::upper_bound(b + static_cast<std::ptrdiff_t>(piece.first), b + static_cast<std::ptrdiff_t>(piece.last) + 1,
-                             lambda) -
+            std::upper_bound(b + static_cast<std::ptrdiff_t>(piece.first),
+                             b + static_cast<std::ptrdiff_t>(piece.last) + 1, lambda) -
             b);
         k = k == 0 ? 0 : k - 1;
         return std::clamp(k, piece.first, piece.last);
@@ -480,8 +516,9 @@ private:
 
 }  // namespace
 
-PlanTotals plan_stream(SegmentSource& source, const MachineProfile& machine_profile, const PlanOptions& requested,
-                       PlanSink& sink, PlanStats* stats, const std::function<void(double fraction)>& progress) {
+PlanTotals plan_stream(SegmentSource& source, const MachineProfile& machine_profile,
+                       const PlanOptions& requested, PlanSink& sink, PlanStats* stats,
+                       const std::function<void(double fraction)>& progress) {
     const PlanOptions options = profile_options(requested, machine_profile);
     validate_plan_inputs(machine_profile, options);
     MachineProfile profile = machine_profile;  // what is planned with: spans of regular_span_ticks
@@ -504,11 +541,13 @@ PlanTotals plan_stream(SegmentSource& source, const MachineProfile& machine_prof
     // a span: the second-order stage leaves it 3 % to 10 %.
     if (limits.has_jerk()) {
         const JerkSetup js = jerk_setup(profile, limits);
-        const double headroom = 0.97 - 0.07 * std::min(1.0, double(profile.ticks_per_span) / js.filter_ticks);
+        const double headroom =
+            0.97 - 0.07 * std::min(1.0, double(profile.ticks_per_span) / js.filter_ticks);
         for (double& a : limits.acceleration) a *= headroom;
     }
     double lo = 0.0, hi = 0.95;
-    CornerBlender blended(source, options.corner_blend * profile.chord_tolerance, options.corner_stop_angle);
+    CornerBlender blended(source, options.corner_blend * profile.chord_tolerance,
+                          options.corner_stop_angle);
     SegmentSource& input = options.corner_blend > 0 ? static_cast<SegmentSource&>(blended) : source;
     for (int attempt = 0;; ++attempt) {
         PlanCheck check;
@@ -522,46 +561,60 @@ PlanTotals plan_stream(SegmentSource& source, const MachineProfile& machine_prof
         }
         const JerkFailure jerk = planner.jerk_failure();
         if (jerk.failed && attempt >= options.max_replans) {
-            static const char* const rules[] = {"the acceleration step at a join", "the jerk inside a span",
-                                                "the end at rest", "the acceleration limit", "the velocity limit"};
-            throw PlanError("cannot meet the jerk limit of axis " + profile.axes[jerk.axis].name + " at " + jerk.where +
-                            " after " + std::to_string(attempt) +
-                            " replans with lowered limits (no integer tangents keep every span and join "
-                            "within it and the velocity and acceleration limits; most often refused: " +
-                            rules[std::clamp(jerk.rule, 0, 4)] + ")");
+            static const char* const rules[] = {"the acceleration step at a join",
+                                                "the jerk inside a span", "the end at rest",
+                                                "the acceleration limit", "the velocity limit"};
+            throw PlanError(
+                "cannot meet the jerk limit of axis " + profile.axes[jerk.axis].name + " at " +
+                jerk.where + " after " + std::to_string(attempt) +
+                " replans with lowered limits (no integer tangents keep every span and join "
+                "within it and the velocity and acceleration limits; most often refused: " +
+                rules[std::clamp(jerk.rule, 0, 4)] + ")");
         }
         if (attempt >= options.max_replans) {
             std::ostringstream m;
-            m << "cannot meet the machine's limits on every tick after " << attempt << " replans (velocity at "
-              << 100 * check.max_velocity_fraction << " %, acceleration at " << 100 * check.max_acceleration_fraction
+            m << "cannot meet the machine's limits on every tick after " << attempt
+              << " replans (velocity at " << 100 * check.max_velocity_fraction
+              << " %, acceleration at " << 100 * check.max_acceleration_fraction
               << " % of the limit after the rounding allowance; the exact cubic at "
-              << 100 * std::max(check.max_velocity_fraction_exact, check.max_span_velocity_fraction) << " % and "
-              << 100 * std::max(check.max_acceleration_fraction_exact, check.max_span_acceleration_fraction) << " %)";
+              << 100 * std::max(check.max_velocity_fraction_exact, check.max_span_velocity_fraction)
+              << " % and "
+              << 100 * std::max(check.max_acceleration_fraction_exact,
+                                check.max_span_acceleration_fraction)
+              << " %)";
             throw PlanError(m.str());
         }
         if (!input.rewind() || (planner.sent() && !sink.restart())) {
-            throw PlanError("the plan needs lowered limits (a tick over a limit after rounding) but the spans "
-                            "already sent cannot be taken back");
+            throw PlanError(
+                "the plan needs lowered limits (a tick over a limit after rounding) but the spans "
+                "already sent cannot be taken back");
         }
         if (jerk.failed && jerk.velocity) {
             // The spline through the knots overshoots a velocity limit the second-order stage
             // reached: that axis's velocity a little lower.
             limits.velocity[jerk.axis] *= 0.97;
-            st.velocity_scale = std::min(st.velocity_scale, limits.velocity[jerk.axis] / profile.axes[jerk.axis].max_velocity);
+            st.velocity_scale =
+                std::min(st.velocity_scale,
+                         limits.velocity[jerk.axis] / profile.axes[jerk.axis].max_velocity);
         }
         for (std::size_t i = 0; i < profile.axes.size() && jerk.failed && !jerk.velocity; ++i) {
             // The jerk stage failed: less acceleration, with the same filter (the filter's jerk
             // and the curvature terms 3 kappa s s'' both fall with it; docs/planner.md §12).
             limits.acceleration[i] *= 0.85;
-            st.acceleration_scale = std::min(st.acceleration_scale, limits.acceleration[i] / profile.axes[i].max_acceleration);
+            st.acceleration_scale = std::min(
+                st.acceleration_scale, limits.acceleration[i] / profile.axes[i].max_acceleration);
         }
         for (std::size_t i = 0; i < profile.axes.size() && !jerk.failed; ++i) {
-            const double fv = std::max(check.axis_velocity_fraction[i], check.axis_velocity_fraction_exact[i]);
-            const double fa = std::max(check.axis_acceleration_fraction[i], check.axis_acceleration_fraction_exact[i]);
+            const double fv =
+                std::max(check.axis_velocity_fraction[i], check.axis_velocity_fraction_exact[i]);
+            const double fa = std::max(check.axis_acceleration_fraction[i],
+                                       check.axis_acceleration_fraction_exact[i]);
             if (fv > 1) limits.velocity[i] *= 0.99 / fv;
             if (fa > 1) limits.acceleration[i] *= 0.99 / fa;
-            st.velocity_scale = std::min(st.velocity_scale, limits.velocity[i] / profile.axes[i].max_velocity);
-            st.acceleration_scale = std::min(st.acceleration_scale, limits.acceleration[i] / profile.axes[i].max_acceleration);
+            st.velocity_scale =
+                std::min(st.velocity_scale, limits.velocity[i] / profile.axes[i].max_velocity);
+            st.acceleration_scale = std::min(
+                st.acceleration_scale, limits.acceleration[i] / profile.axes[i].max_acceleration);
         }
         ++st.replans;
         lo = hi;
