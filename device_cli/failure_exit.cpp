@@ -41,4 +41,22 @@ int failure_exit(const std::exception_ptr& failure) {
     }
 }
 
+int parse_and_run(CLI::App& app, int argc, char** argv, const std::function<int()>& run) {
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::CallForHelp& e) {
+        return app.exit(e);
+    } catch (const CLI::CallForVersion& e) {
+        return app.exit(e);
+    } catch (const CLI::ParseError& e) {
+        app.exit(e);
+        return host::kExitUsage;
+    }
+    try {
+        return run();
+    } catch (...) {
+        return failure_exit(std::current_exception());
+    }
+}
+
 }  // namespace pathstream::device_cli

@@ -3,7 +3,9 @@
 // written. Both programs (pathstream, pathstream-device) end their commands with it.
 #pragma once
 
+#include <CLI/CLI.hpp>
 #include <exception>
+#include <functional>
 
 namespace pathstream::device_cli {
 
@@ -12,5 +14,10 @@ namespace pathstream::device_cli {
 /// hal::GpioError and std::system_error 6, std::invalid_argument 2, another std::runtime_error 3,
 /// anything else 4 ("internal error"). Main thread.
 int failure_exit(const std::exception_ptr& failure);
+
+/// A program's main after its options are declared on `app`: parses the command line (help
+/// and --version print and return 0; a bad command line prints CLI11's message and returns
+/// kExitUsage), then returns `run()`, whose exceptions end as failure_exit says. Main thread.
+int parse_and_run(CLI::App& app, int argc, char** argv, const std::function<int()>& run);
 
 }  // namespace pathstream::device_cli

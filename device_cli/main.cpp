@@ -4,7 +4,6 @@
 
 #include "device_command.hpp"
 #include "failure_exit.hpp"
-#include "pathstream/machine/exit_codes.hpp"
 
 int main(int argc, char** argv) {
     CLI::App app{"pathstream-device: the device runtime (docs/cli.md, \"device\")"};
@@ -12,19 +11,6 @@ int main(int argc, char** argv) {
     pathstream::device_cli::DeviceCommandOptions options;
     pathstream::device_cli::add_device_command(app, options);
     app.require_subcommand(1);
-    try {
-        app.parse(argc, argv);
-    } catch (const CLI::CallForHelp& e) {
-        return app.exit(e);
-    } catch (const CLI::CallForVersion& e) {
-        return app.exit(e);
-    } catch (const CLI::ParseError& e) {
-        app.exit(e);
-        return pathstream::host::kExitUsage;
-    }
-    try {
-        return pathstream::device_cli::run_device(options);
-    } catch (...) {
-        return pathstream::device_cli::failure_exit(std::current_exception());
-    }
+    return pathstream::device_cli::parse_and_run(
+        app, argc, argv, [&] { return pathstream::device_cli::run_device(options); });
 }

@@ -13,7 +13,7 @@ while read -r folder; do
   folder=${folder// /}
   [ -n "$folder" ] || continue
   [ -e "$folder" ] || { echo "check_format: $folder (scripts/format_enforced.txt) does not exist" >&2; exit 1; }
-  while IFS= read -r f; do files+=("$f"); done < <(find "$folder" -name '*.cpp' -o -name '*.hpp' -o -name '*.h' | sort)
+  while IFS= read -r f; do files+=("$f"); done < <(find "$folder" \( -name '*.cpp' -o -name '*.hpp' -o -name '*.h' \) -not -path '*/node_modules/*' | sort)
 done < scripts/format_enforced.txt
 if [ "${2:-}" = "--changed" ]; then
   while IFS= read -r f; do [ -f "$f" ] && files+=("$f"); done < <(git diff --name-only HEAD -- '*.cpp' '*.hpp' '*.h')

@@ -13,7 +13,8 @@ namespace pathstream::host {
 namespace {
 
 template <unsigned Axes>
-std::uint64_t play(const std::vector<CoreSpan>& spans, const std::function<void(const PlayedTick&)>& on_tick) {
+std::uint64_t play(const std::vector<CoreSpan>& spans,
+                   const std::function<void(const PlayedTick&)>& on_tick) {
     Lsb start[Axes];
     for (unsigned a = 0; a < Axes; ++a) start[a] = core_value_at(spans.front(), a, 0);
     // The host may allocate: one stream object (inline storage, tens of kB) on the heap.
@@ -24,10 +25,11 @@ std::uint64_t play(const std::vector<CoreSpan>& spans, const std::function<void(
     Lsb out[Axes];
     for (;;) {
         while (next_to_push < spans.size() && stream->free_slots() > 0) {
-            const Span<Axes> s = to_core_span<Axes>(spans[next_to_push], static_cast<std::uint32_t>(next_to_push));
+            const Span<Axes> s =
+                to_core_span<Axes>(spans[next_to_push], static_cast<std::uint32_t>(next_to_push));
             if (const Status st = stream->push(s); st != Status::kOk) {
-                throw std::runtime_error("the core refused span " + std::to_string(next_to_push) + ": " +
-                                         status_name(st));
+                throw std::runtime_error("the core refused span " + std::to_string(next_to_push) +
+                                         ": " + status_name(st));
             }
             ++next_to_push;
         }
@@ -36,11 +38,13 @@ std::uint64_t play(const std::vector<CoreSpan>& spans, const std::function<void(
         for (unsigned a = 0; a < Axes; ++a) {
             if (out[a] != core_value_at(spans[current], a, tick_in_span)) {
                 std::ostringstream m;
-                m << "forward differencing and Horner disagree at tick " << calls << " (a core bug)";
+                m << "forward differencing and Horner disagree at tick " << calls
+                  << " (a core bug)";
                 throw std::logic_error(m.str());
             }
         }
-        on_tick(PlayedTick{calls++, current, tick_in_span, out, (stream->outputs() & kOutputPenDown) != 0});
+        on_tick(PlayedTick{calls++, current, tick_in_span, out,
+                           (stream->outputs() & kOutputPenDown) != 0});
         tick_in_span = stream->spans_completed() != current ? 0 : tick_in_span + 1;
     }
     // The end point, held once the queue has run dry: the state stepped once past the last

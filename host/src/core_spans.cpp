@@ -45,7 +45,8 @@ std::vector<std::array<const LsbPoint*, 4>> windows(const std::vector<LsbPoint>&
     ext.push_back(&storage[0]);
     for (const auto& p : pts) ext.push_back(&p);
     ext.push_back(&storage[1]);
-    for (std::size_t i = 0; i + 3 < ext.size(); ++i) out.push_back({ext[i], ext[i + 1], ext[i + 2], ext[i + 3]});
+    for (std::size_t i = 0; i + 3 < ext.size(); ++i)
+        out.push_back({ext[i], ext[i + 1], ext[i + 2], ext[i + 3]});
     return out;
 }
 
@@ -61,8 +62,8 @@ Status to_core(const CoreSpan& span, std::size_t axis, SpanTiming& timing, TickC
 /// Builds the spans of one subpath, checking each against the core's ranges.
 class SubpathBuilder {
 public:
-    SubpathBuilder(const std::string& file, std::size_t axes, std::uint32_t ticks, std::size_t subpath,
-                   SourceLocation at)
+    SubpathBuilder(const std::string& file, std::size_t axes, std::uint32_t ticks,
+                   std::size_t subpath, SourceLocation at)
         : file_(file), axes_(axes), ticks_(ticks), subpath_(subpath), at_(at) {}
 
     void add(Basis basis, const LsbPoint& p0, const LsbPoint& p1, const LsbPoint& p2,
@@ -81,8 +82,9 @@ public:
                 const std::int64_t limit = tangent ? kMaxTangentLsb : kMaxPositionLsb;
                 if (v < -limit || v > limit) {
                     std::ostringstream m;
-                    m << "subpath " << subpath_ << ": axis " << a << (tangent ? " tangent " : " value ")
-                      << v << " LSB is outside the core's range +/-" << limit
+                    m << "subpath " << subpath_ << ": axis " << a
+                      << (tangent ? " tangent " : " value ") << v
+                      << " LSB is outside the core's range +/-" << limit
                       << " LSB (use a coarser --lsb or move the drawing)";
                     throw InputError(file_, at_, m.str());
                 }
@@ -129,15 +131,18 @@ std::vector<CoreSpan> subpath_spans(const Path& path, std::size_t s, const std::
     switch (sp.basis) {
         case PathBasis::kBSpline:
         case PathBasis::kCatmullRom: {
-            const Basis basis = sp.basis == PathBasis::kBSpline ? Basis::kUniformBSpline : Basis::kCatmullRom;
+            const Basis basis =
+                sp.basis == PathBasis::kBSpline ? Basis::kUniformBSpline : Basis::kCatmullRom;
             std::vector<LsbPoint> storage;
-            for (const auto& w : windows(pts, sp.closed, storage)) b.add(basis, *w[0], *w[1], *w[2], *w[3]);
+            for (const auto& w : windows(pts, sp.closed, storage))
+                b.add(basis, *w[0], *w[1], *w[2], *w[3]);
             break;
         }
         case PathBasis::kBezier: {
             const std::size_t count = sp.closed ? m / 3 : (m - 1) / 3;
             for (std::size_t i = 0; i < count; ++i) {
-                b.add(Basis::kBezier, pts[3 * i], pts[3 * i + 1], pts[3 * i + 2], pts[(3 * i + 3) % m]);
+                b.add(Basis::kBezier, pts[3 * i], pts[3 * i + 1], pts[3 * i + 2],
+                      pts[(3 * i + 3) % m]);
             }
             break;
         }

@@ -38,7 +38,8 @@ void for_each_window(const PointList& pts, bool closed, Visit&& visit) {
     const auto ext = [&](std::size_t i) {
         return i == 0 ? PointRef(before) : i == m + 1 ? PointRef(after) : pts[i - 1];
     };
-    for (std::size_t i = 0; i + 3 < m + 2; ++i) visit(Window{ext(i), ext(i + 1), ext(i + 2), ext(i + 3)});
+    for (std::size_t i = 0; i + 3 < m + 2; ++i)
+        visit(Window{ext(i), ext(i + 1), ext(i + 2), ext(i + 3)});
 }
 
 /// Weighted sum w0 Q0 + w1 Q1 + w2 Q2 + w3 Q3 of a window.
@@ -76,7 +77,8 @@ using Controls = std::array<PathPoint, 4>;
 /// subpath is never held at once.
 class JointSharer {
 public:
-    JointSharer(bool closed, const std::function<void(Controls&)>& emit) : closed_(closed), emit_(emit) {}
+    JointSharer(bool closed, const std::function<void(Controls&)>& emit)
+        : closed_(closed), emit_(emit) {}
 
     void add(Controls&& c) {
         if (held_) {
@@ -105,12 +107,14 @@ private:
     bool held_ = false;
 };
 
-void subpath_segments(const Subpath& sp, std::size_t index, const std::function<void(Controls&)>& emit) {
+void subpath_segments(const Subpath& sp, std::size_t index,
+                      const std::function<void(Controls&)>& emit) {
     const auto& pts = sp.points;
     const std::size_t m = pts.size();
     const auto too_few = [&](const char* need) {
-        throw std::invalid_argument("subpath " + std::to_string(index) + ": " + basis_name(sp.basis) +
-                                    " needs " + need + " points, got " + std::to_string(m));
+        throw std::invalid_argument("subpath " + std::to_string(index) + ": " +
+                                    basis_name(sp.basis) + " needs " + need + " points, got " +
+                                    std::to_string(m));
     };
     JointSharer out(sp.closed, emit);
     switch (sp.basis) {
@@ -119,8 +123,10 @@ void subpath_segments(const Subpath& sp, std::size_t index, const std::function<
             if (m < (sp.closed ? 3u : 2u)) too_few(sp.closed ? "at least 3" : "at least 2");
             bool first = true;
             for_each_window(pts, sp.closed, [&](const Window& w) {
-                Controls c = sp.basis == PathBasis::kBSpline ? bspline_to_bezier(w) : catmull_rom_to_bezier(w);
-                if (first && !sp.closed) c[0] = pts.front();  // the clamped start is exactly the first point
+                Controls c = sp.basis == PathBasis::kBSpline ? bspline_to_bezier(w)
+                                                             : catmull_rom_to_bezier(w);
+                if (first && !sp.closed)
+                    c[0] = pts.front();  // the clamped start is exactly the first point
                 first = false;
                 out.add(std::move(c));
             });
@@ -129,7 +135,8 @@ void subpath_segments(const Subpath& sp, std::size_t index, const std::function<
             return;
         }
         case PathBasis::kBezier: {
-            if (sp.closed ? (m < 3 || m % 3 != 0) : (m < 4 || m % 3 != 1)) too_few(sp.closed ? "3k" : "3k + 1");
+            if (sp.closed ? (m < 3 || m % 3 != 0) : (m < 4 || m % 3 != 1))
+                too_few(sp.closed ? "3k" : "3k + 1");
             const std::size_t count = sp.closed ? m / 3 : (m - 1) / 3;
             for (std::size_t i = 0; i < count; ++i) {
                 out.add({pts[3 * i], pts[3 * i + 1], pts[3 * i + 2], pts[(3 * i + 3) % m]});
@@ -148,7 +155,8 @@ void subpath_segments(const Subpath& sp, std::size_t index, const std::function<
 
 }  // namespace
 
-void for_each_bezier_segment(const Path& path, const std::function<void(const BezierSegment&)>& visit) {
+void for_each_bezier_segment(const Path& path,
+                             const std::function<void(const BezierSegment&)>& visit) {
     bool any = false;
     PathPoint last_end;
     for (std::size_t s = 0; s < path.subpaths.size(); ++s) {
@@ -226,7 +234,8 @@ PathPoint bezier_d2(const BezierSegment& s, double u) {
     const double v = 1 - u;
     PathPoint r(s.p[0].size());
     for (std::size_t i = 0; i < r.size(); ++i) {
-        r[i] = 6 * (v * (s.p[2][i] - 2 * s.p[1][i] + s.p[0][i]) + u * (s.p[3][i] - 2 * s.p[2][i] + s.p[1][i]));
+        r[i] = 6 * (v * (s.p[2][i] - 2 * s.p[1][i] + s.p[0][i]) +
+                    u * (s.p[3][i] - 2 * s.p[2][i] + s.p[1][i]));
     }
     return r;
 }
@@ -235,8 +244,8 @@ void prepend_lead_in(std::vector<BezierSegment>& segments, const PathPoint& from
     if (segments.empty()) return;
     const PathPoint to = segments.front().p[0];
     if (from.size() != to.size()) {
-        throw std::invalid_argument("lead-in: the machine has " + std::to_string(from.size()) + " axes, the path " +
-                                    std::to_string(to.size()));
+        throw std::invalid_argument("lead-in: the machine has " + std::to_string(from.size()) +
+                                    " axes, the path " + std::to_string(to.size()));
     }
     if (from == to) return;
     BezierSegment travel;
@@ -244,7 +253,8 @@ void prepend_lead_in(std::vector<BezierSegment>& segments, const PathPoint& from
     travel.subpath = 0;
     for (int k = 0; k < 4; ++k) {
         travel.p[k].resize(from.size());
-        for (std::size_t i = 0; i < from.size(); ++i) travel.p[k][i] = from[i] + (to[i] - from[i]) * k / 3.0;
+        for (std::size_t i = 0; i < from.size(); ++i)
+            travel.p[k][i] = from[i] + (to[i] - from[i]) * k / 3.0;
     }
     travel.p[0] = from;
     travel.p[3] = to;  // exactly the path's start: consecutive segments share end points

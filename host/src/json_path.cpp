@@ -4,12 +4,12 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <set>
-#include <stdexcept>
 #include <sstream>
+#include <stdexcept>
 
+#include "nurbs/nurbs.hpp"
 #include "pathstream/machine/input_error.hpp"
 #include "pathstream/machine/json_document.hpp"
-#include "nurbs/nurbs.hpp"
 
 namespace pathstream::host {
 
@@ -36,7 +36,8 @@ public:
         if (s == "nurbs") {
             fail(pointer, "basis nurbs is given per subpath, with its degree and knots");
         }
-        fail(pointer, "unknown basis \"" + s + "\" (expected bspline, catmull-rom, bezier, polyline or nurbs)");
+        fail(pointer, "unknown basis \"" + s +
+                          "\" (expected bspline, catmull-rom, bezier, polyline or nurbs)");
     }
 
     bool boolean(const json& v, const std::string& pointer, const char* what) const {
@@ -46,7 +47,8 @@ public:
 
     double coordinate(const json& v, const std::string& pointer, double scale) const {
         if (!v.is_number()) fail(pointer, "coordinate must be a number");
-        return coordinate_mm(v.get<double>(), [&] { return pointer; }, scale);
+        return coordinate_mm(
+            v.get<double>(), [&] { return pointer; }, scale);
     }
 
     /// A number's coordinate in mm; `pointer()` gives its place, only for an error.
@@ -70,7 +72,8 @@ public:
         sp.closed = default_closed;
         sp.location = locate(pointer);
         if (!v.is_object()) fail(pointer, "subpath must be an object with \"points\"");
-        if (v.contains("basis") && v["basis"] == "nurbs") return nurbs_subpath(v, pointer, sp, scale, axes);
+        if (v.contains("basis") && v["basis"] == "nurbs")
+            return nurbs_subpath(v, pointer, sp, scale, axes);
         only_keys(v, pointer, {"basis", "closed", "points"});
         if (v.contains("basis")) sp.basis = basis(v["basis"], pointer + "/basis");
         if (v.contains("closed")) sp.closed = boolean(v["closed"], pointer + "/closed", "closed");
@@ -95,7 +98,8 @@ public:
             if (!pt.is_array()) fail(p, "point must be an array of coordinates");
             if (axes == 0) {
                 if (pt.size() < 1 || pt.size() > kMaxAxes) {
-                    fail(p, "point has " + std::to_string(pt.size()) + " coordinates (1 to 8 axes)");
+                    fail(p,
+                         "point has " + std::to_string(pt.size()) + " coordinates (1 to 8 axes)");
                 }
                 axes = pt.size();
             } else if (pt.size() != axes) {
@@ -131,7 +135,8 @@ public:
             if (out.empty()) out.reserve(rows.widths.size(), width);
             double point[kMaxAxes];
             for (std::size_t a = 0; a < width; ++a) {
-                point[a] = coordinate_mm(*value++, [&] { return p() + "/" + std::to_string(a); }, scale);
+                point[a] = coordinate_mm(
+                    *value++, [&] { return p() + "/" + std::to_string(a); }, scale);
             }
             out.push_back(PointRef(point, width));
         }
@@ -144,7 +149,8 @@ public:
         std::vector<double> out;
         for (std::size_t i = 0; i < v.size(); ++i) {
             if (!v[i].is_number() || !std::isfinite(v[i].get<double>())) {
-                fail(pointer + "/" + std::to_string(i), std::string(what) + " must be finite numbers");
+                fail(pointer + "/" + std::to_string(i),
+                     std::string(what) + " must be finite numbers");
             }
             out.push_back(v[i].get<double>());
         }
@@ -170,13 +176,16 @@ public:
         }
         curve.points = points(v["points"], pointer + "/points", scale, axes).vectors();
         if (curve.points.size() < static_cast<std::size_t>(curve.degree) + 1) {
-            fail(pointer + "/points", "degree " + std::to_string(curve.degree) + " needs at least " +
-                                          std::to_string(curve.degree + 1) + " control points, got " +
+            fail(pointer + "/points", "degree " + std::to_string(curve.degree) +
+                                          " needs at least " + std::to_string(curve.degree + 1) +
+                                          " control points, got " +
                                           std::to_string(curve.points.size()));
         }
-        curve.knots = v.contains("knots") ? numbers(v["knots"], pointer + "/knots", "knots")
-                                          : nurbs::clamped_uniform_knots(curve.points.size(), curve.degree);
-        if (v.contains("weights")) curve.weights = numbers(v["weights"], pointer + "/weights", "weights");
+        curve.knots = v.contains("knots")
+                          ? numbers(v["knots"], pointer + "/knots", "knots")
+                          : nurbs::clamped_uniform_knots(curve.points.size(), curve.degree);
+        if (v.contains("weights"))
+            curve.weights = numbers(v["weights"], pointer + "/weights", "weights");
         if (const std::string problem = nurbs::nurbs_problem(curve); !problem.empty()) {
             fail(pointer, "nurbs: " + problem);
         }
@@ -192,7 +201,8 @@ public:
     }
 
     void check_count(const Subpath& sp, const std::string& pointer) const {
-        if (const std::string problem = point_count_problem(sp); !problem.empty()) fail(pointer, problem);
+        if (const std::string problem = point_count_problem(sp); !problem.empty())
+            fail(pointer, problem);
     }
 
     Path path(const json& root) const {
@@ -203,8 +213,10 @@ public:
             const json& u = root["units"];
             if (!u.is_string()) fail("/units", "units must be \"mm\" or \"in\"");
             const std::string s = u.get<std::string>();
-            if (s == "in") scale = 25.4;
-            else if (s != "mm") fail("/units", "unknown units \"" + s + "\" (expected mm or in)");
+            if (s == "in")
+                scale = 25.4;
+            else if (s != "mm")
+                fail("/units", "unknown units \"" + s + "\" (expected mm or in)");
         }
         const PathBasis default_basis =
             root.contains("basis") ? basis(root["basis"], "/basis") : PathBasis::kBSpline;
@@ -229,7 +241,8 @@ public:
             path.subpaths.push_back(std::move(sp));
         } else {
             const json& list = root["subpaths"];
-            if (!list.is_array() || list.empty()) fail("/subpaths", "subpaths must be a non-empty array");
+            if (!list.is_array() || list.empty())
+                fail("/subpaths", "subpaths must be a non-empty array");
             for (std::size_t i = 0; i < list.size(); ++i) {
                 path.subpaths.push_back(subpath(list[i], "/subpaths/" + std::to_string(i),
                                                 default_basis, default_closed, scale, axes));
@@ -252,7 +265,8 @@ private:
 
 Path parse_json_path(const std::string& text, const std::string& file, double nurbs_tolerance_mm) {
     if (!(nurbs_tolerance_mm > 0) || !std::isfinite(nurbs_tolerance_mm)) {
-        throw std::invalid_argument("parse_json_path: the NURBS tolerance must be positive and finite");
+        throw std::invalid_argument(
+            "parse_json_path: the NURBS tolerance must be positive and finite");
     }
     // The points arrays are read flat: a document tree of 10^6 points is ~100 MB.
     FlatNumberArrays flat;

@@ -4,26 +4,26 @@
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <exception>
+#include <iostream>
 #include <stdexcept>
 #include <system_error>
-#include <iostream>
 
-#include "pathstream/machine/input_error.hpp"
-#include "pathstream/host/planner.hpp"
 #include "cli/check_command.hpp"
 #include "cli/ctl_command.hpp"
-#include "device_command.hpp"
-#include "failure_exit.hpp"
 #include "cli/drive_command.hpp"
 #include "cli/eval_command.hpp"
 #include "cli/plan_command.hpp"
 #include "cli/serve_command.hpp"
 #include "cli/setpoints_command.hpp"
 #include "cli/sim_command.hpp"
-#include "pathstream/machine/exit_codes.hpp"
 #include "cli/stream_command.hpp"
+#include "device_command.hpp"
+#include "failure_exit.hpp"
 #include "pathstream/hal/gpio_gpiod.hpp"
 #include "pathstream/hal/modbus_error.hpp"
+#include "pathstream/host/planner.hpp"
+#include "pathstream/machine/exit_codes.hpp"
+#include "pathstream/machine/input_error.hpp"
 
 using namespace pathstream::host;
 
@@ -52,36 +52,25 @@ int main(int argc, char** argv) {
     pathstream::host::ServeCommandOptions serve;
     pathstream::host::add_serve_command(app, serve);
 
-    try {
-        app.parse(argc, argv);
-    } catch (const CLI::CallForHelp& e) {
-        return app.exit(e);
-    } catch (const CLI::CallForVersion& e) {
-        return app.exit(e);
-    } catch (const CLI::ParseError& e) {
-        app.exit(e);
-        return kExitUsage;
-    }
-
-    try {
-        if (app.got_subcommand("setpoints")) return pathstream::host::run_setpoints(setpoints);
-        if (app.got_subcommand("eval")) return pathstream::host::run_eval(eval);
-        if (app.got_subcommand("check")) return pathstream::host::run_check(check);
-        if (app.got_subcommand("plan")) return pathstream::host::run_plan(plan);
-        if (app.got_subcommand("sim")) return pathstream::host::run_sim(sim);
-        if (app.got_subcommand("stream")) return pathstream::host::run_stream(stream);
-        if (app.got_subcommand("device")) return pathstream::device_cli::run_device(device);
-        if (app.got_subcommand("drive")) return pathstream::host::run_drive(drive);
-        if (app.got_subcommand("ctl")) return pathstream::host::run_ctl(ctl);
-        if (app.got_subcommand("serve")) return pathstream::host::run_serve(serve);
-    } catch (const pathstream::host::PlanError& e) {
-        std::cerr << "pathstream: planning failed: " << e.what() << '\n';
-        return kExitPlanning;
-    } catch (const pathstream::host::StreamError& e) {
-        std::cerr << "pathstream: device: " << e.what() << '\n';
-        return kExitDevice;
-    } catch (...) {
-        return pathstream::device_cli::failure_exit(std::current_exception());
-    }
-    return kExitInternal;
+    return pathstream::device_cli::parse_and_run(app, argc, argv, [&]() -> int {
+        try {
+            if (app.got_subcommand("setpoints")) return pathstream::host::run_setpoints(setpoints);
+            if (app.got_subcommand("eval")) return pathstream::host::run_eval(eval);
+            if (app.got_subcommand("check")) return pathstream::host::run_check(check);
+            if (app.got_subcommand("plan")) return pathstream::host::run_plan(plan);
+            if (app.got_subcommand("sim")) return pathstream::host::run_sim(sim);
+            if (app.got_subcommand("stream")) return pathstream::host::run_stream(stream);
+            if (app.got_subcommand("device")) return pathstream::device_cli::run_device(device);
+            if (app.got_subcommand("drive")) return pathstream::host::run_drive(drive);
+            if (app.got_subcommand("ctl")) return pathstream::host::run_ctl(ctl);
+            if (app.got_subcommand("serve")) return pathstream::host::run_serve(serve);
+        } catch (const pathstream::host::PlanError& e) {
+            std::cerr << "pathstream: planning failed: " << e.what() << '\n';
+            return kExitPlanning;
+        } catch (const pathstream::host::StreamError& e) {
+            std::cerr << "pathstream: device: " << e.what() << '\n';
+            return kExitDevice;
+        }
+        return kExitInternal;
+    });
 }

@@ -4,10 +4,14 @@ namespace pathstream::host {
 
 const char* basis_name(PathBasis basis) {
     switch (basis) {
-        case PathBasis::kBSpline: return "bspline";
-        case PathBasis::kCatmullRom: return "catmull-rom";
-        case PathBasis::kBezier: return "bezier";
-        case PathBasis::kPolyline: return "polyline";
+        case PathBasis::kBSpline:
+            return "bspline";
+        case PathBasis::kCatmullRom:
+            return "catmull-rom";
+        case PathBasis::kBezier:
+            return "bezier";
+        case PathBasis::kPolyline:
+            return "polyline";
     }
     return "?";
 }
@@ -27,12 +31,13 @@ std::string point_count_problem(const Subpath& sp) {
     if (sp.basis == PathBasis::kBezier) {
         const bool ok = sp.closed ? (n >= 3 && n % 3 == 0) : (n >= 4 && n % 3 == 1);
         if (ok) return {};
-        return kind + "bezier needs " + (sp.closed ? "3k" : "3k + 1") + " points (k >= 1), got " + std::to_string(n);
+        return kind + "bezier needs " + (sp.closed ? "3k" : "3k + 1") + " points (k >= 1), got " +
+               std::to_string(n);
     }
     const std::size_t needed = sp.closed ? 3 : 2;
     if (n >= needed) return {};
-    return kind + basis_name(sp.basis) + " needs at least " + std::to_string(needed) + " points, got " +
-           std::to_string(n);
+    return kind + basis_name(sp.basis) + " needs at least " + std::to_string(needed) +
+           " points, got " + std::to_string(n);
 }
 
 }  // namespace pathstream::host

@@ -17,8 +17,8 @@
 #include "pathstream/host/core_playback.hpp"
 #include "pathstream/host/geometry.hpp"
 #include "pathstream/host/json_path.hpp"
-#include "pathstream/machine/machine.hpp"
 #include "pathstream/host/planner.hpp"
+#include "pathstream/machine/machine.hpp"
 #include "pathstream/sim/cia402_drive.hpp"
 
 namespace cia402_test {
@@ -61,7 +61,8 @@ private:
 /// lose chosen frames. `service` runs the other nodes; `step_us` is the time grain.
 class Hub {
 public:
-    explicit Hub(double loss_fraction = 0, std::uint64_t seed = 1) : loss(loss_fraction), random_(seed) {}
+    explicit Hub(double loss_fraction = 0, std::uint64_t seed = 1)
+        : loss(loss_fraction), random_(seed) {}
 
     Endpoint& add(bool serviced) {
         endpoints_.push_back(std::make_unique<Endpoint>(*this, serviced));
@@ -91,7 +92,7 @@ public:
     std::uint64_t step_us = 100;
     std::uint64_t frames = 0, lost = 0;
     bool keep_log = false;
-    double loss;  ///< fraction of frame copies lost; may change between phases
+    double loss;                     ///< fraction of frame copies lost; may change between phases
     std::vector<hal::CanFrame> log;  // every frame sent (when keep_log)
 
 private:
@@ -128,8 +129,8 @@ inline bool Endpoint::receive(hal::CanFrame& out, std::uint32_t timeout_us) {
 
 /// A master endpoint and `nodes` simulated drives (node 1..n) at `start` positions.
 struct Rig {
-    explicit Rig(std::size_t nodes, const std::vector<std::int32_t>& start, double loss = 0, std::uint64_t seed = 1,
-                 sim::Cia402DriveOptions base = {})
+    explicit Rig(std::size_t nodes, const std::vector<std::int32_t>& start, double loss = 0,
+                 std::uint64_t seed = 1, sim::Cia402DriveOptions base = {})
         : hub(loss, seed), master_bus(hub.add(true)) {
         for (std::size_t i = 0; i < nodes; ++i) {
             sim::Cia402DriveOptions o = base;
@@ -153,22 +154,26 @@ struct Job {
 
 inline Job plan_example(const std::string& name) {
     Job j;
-    j.machine = host::load_machine_profile(std::string(PATHSTREAM_SOURCE_DIR) + "/examples/machines/pen_plotter.json");
-    const host::Path path = host::load_json_path(std::string(PATHSTREAM_SOURCE_DIR) + "/examples/" + name);
+    j.machine = host::load_machine_profile(std::string(PATHSTREAM_SOURCE_DIR) +
+                                           "/examples/machines/pen_plotter.json");
+    const host::Path path =
+        host::load_json_path(std::string(PATHSTREAM_SOURCE_DIR) + "/examples/" + name);
     j.plan = host::plan_path(host::to_bezier_segments(path), j.machine);
     return j;
 }
 
 /// The core's setpoints of `plan` at ticks 0, c, 2c, ... below its length, then the end point:
 /// what a CSP master with c ticks per cycle sends. Row-major, `axes` per row.
-inline std::vector<std::int32_t> cycle_setpoints(const host::Plan& plan, std::size_t axes, std::uint32_t c) {
+inline std::vector<std::int32_t> cycle_setpoints(const host::Plan& plan, std::size_t axes,
+                                                 std::uint32_t c) {
     std::vector<std::int32_t> all;
     host::play_through_core(plan.spans, axes, [&](const host::PlayedTick& t) {
         all.insert(all.end(), t.setpoint, t.setpoint + axes);
     });
     const std::size_t ticks = all.size() / axes;  // total + 1 (the end point)
     std::vector<std::int32_t> out;
-    for (std::size_t k = 0; k + 1 < ticks; k += c) out.insert(out.end(), all.begin() + k * axes, all.begin() + (k + 1) * axes);
+    for (std::size_t k = 0; k + 1 < ticks; k += c)
+        out.insert(out.end(), all.begin() + k * axes, all.begin() + (k + 1) * axes);
     out.insert(out.end(), all.end() - static_cast<std::ptrdiff_t>(axes), all.end());
     return out;
 }

@@ -15,17 +15,21 @@ namespace pathstream::host::test {
 /// each window of four control points): nothing of the job is held in memory.
 class RandomWalkSource : public SegmentSource {
 public:
-    RandomWalkSource(std::size_t segments, std::uint64_t seed) : segments_(segments), seed_(seed) { rewind(); }
+    RandomWalkSource(std::size_t segments, std::uint64_t seed) : segments_(segments), seed_(seed) {
+        rewind();
+    }
     bool next(BezierSegment& out) override {
         if (made_ >= segments_) return false;
         q_[0] = q_[1];
         q_[1] = q_[2];
         q_[2] = q_[3];
         q_[3] = step();
-        out.p = {PathPoint{(q_[0][0] + 4 * q_[1][0] + q_[2][0]) / 6, (q_[0][1] + 4 * q_[1][1] + q_[2][1]) / 6},
+        out.p = {PathPoint{(q_[0][0] + 4 * q_[1][0] + q_[2][0]) / 6,
+                           (q_[0][1] + 4 * q_[1][1] + q_[2][1]) / 6},
                  PathPoint{(4 * q_[1][0] + 2 * q_[2][0]) / 6, (4 * q_[1][1] + 2 * q_[2][1]) / 6},
                  PathPoint{(2 * q_[1][0] + 4 * q_[2][0]) / 6, (2 * q_[1][1] + 4 * q_[2][1]) / 6},
-                 PathPoint{(q_[1][0] + 4 * q_[2][0] + q_[3][0]) / 6, (q_[1][1] + 4 * q_[2][1] + q_[3][1]) / 6}};
+                 PathPoint{(q_[1][0] + 4 * q_[2][0] + q_[3][0]) / 6,
+                           (q_[1][1] + 4 * q_[2][1] + q_[3][1]) / 6}};
         if (made_ > 0) out.p[0] = last_end_;  // joints shared exactly
         last_end_ = out.p[3];
         out.pen_down = true;

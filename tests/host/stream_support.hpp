@@ -8,9 +8,9 @@
 #include "pathstream/host/core_playback.hpp"
 #include "pathstream/host/geometry.hpp"
 #include "pathstream/host/json_path.hpp"
-#include "pathstream/machine/machine.hpp"
 #include "pathstream/host/planner.hpp"
 #include "pathstream/linux_device/any_motion_device.hpp"
+#include "pathstream/machine/machine.hpp"
 #include "pathstream/span.hpp"
 #include "pathstream/units.hpp"
 
@@ -24,8 +24,10 @@ struct Job {
 /// examples/<name> (a JSON path) planned with examples/machines/pen_plotter.json.
 inline Job plan_example(const std::string& name) {
     Job j;
-    j.machine = host::load_machine_profile(std::string(PATHSTREAM_SOURCE_DIR) + "/examples/machines/pen_plotter.json");
-    const host::Path path = host::load_json_path(std::string(PATHSTREAM_SOURCE_DIR) + "/examples/" + name);
+    j.machine = host::load_machine_profile(std::string(PATHSTREAM_SOURCE_DIR) +
+                                           "/examples/machines/pen_plotter.json");
+    const host::Path path =
+        host::load_json_path(std::string(PATHSTREAM_SOURCE_DIR) + "/examples/" + name);
     j.plan = host::plan_path(host::to_bezier_segments(path), j.machine);
     return j;
 }

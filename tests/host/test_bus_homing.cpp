@@ -17,8 +17,8 @@
 #include "pathstream/host/can_stream.hpp"
 #include "pathstream/host/device_link.hpp"
 #include "pathstream/linux_device/can_motion_device.hpp"
-#include "pathstream/sim/can_loopback.hpp"
 #include "pathstream/linux_device/modbus_motion_device.hpp"
+#include "pathstream/sim/can_loopback.hpp"
 #include "pathstream/sim/machine_switches.hpp"
 #include "pathstream/sim/simulated_input.hpp"
 
@@ -123,8 +123,10 @@ public:
         for (unsigned a = 0; a < kAxes; ++a) {
             double last_step = 0;
             for (std::size_t k = 1; k < rows_.size(); ++k) {
-                const double step = static_cast<double>(rows_[k].position[a]) - rows_[k - 1].position[a];
-                if (rows_[k].state == DeviceState::kIdle && rows_[k - 1].state == DeviceState::kIdle) {
+                const double step =
+                    static_cast<double>(rows_[k].position[a]) - rows_[k - 1].position[a];
+                if (rows_[k].state == DeviceState::kIdle &&
+                    rows_[k - 1].state == DeviceState::kIdle) {
                     last_step = 0;
                     continue;
                 }
@@ -163,12 +165,9 @@ struct ModbusRig {
         thread = std::thread([this] {
             linux_device::DeviceLoopOptions o;
             o.time_scale = 20.0;
-            linux_device::run_paced_loop(
-                [&] { rig->tick(); }, [&] { return device->tick_hz(); },
-                [&](std::chrono::microseconds w) {
-                    server->poll_once(w);
-                },
-                o, stop);
+            linux_device::run_paced_loop([&] { rig->tick(); }, [&] { return device->tick_hz(); },
+                                         [&](std::chrono::microseconds w) { server->poll_once(w); },
+                                         o, stop);
         });
     }
     std::string target() const {
@@ -202,15 +201,19 @@ TEST_CASE("home over Modbus: every axis in plan order, zero at its switch, withi
     ModbusRig m(start);
     m.rig->place_switch(0, -3000);
     m.rig->place_switch(1, -2000);
-    const device::HomingAxis plan[] = {homing_axis(1, 300000), homing_axis(0, 300000)};  // y, then x
+    const device::HomingAxis plan[] = {homing_axis(1, 300000),
+                                       homing_axis(0, 300000)};  // y, then x
     REQUIRE(m.rig->io().set_homing_plan(plan, 2) == Status::kOk);
     m.run();
     const std::unique_ptr<host::DeviceLink> link = host::open_device_link(m.target(), {});
     host::DeviceSnapshot s = link->status();
-    CHECK((s.homing[0].state == AxisHoming::kNotHomed && s.homing[1].state == AxisHoming::kNotHomed));
+    CHECK(
+        (s.homing[0].state == AxisHoming::kNotHomed && s.homing[1].state == AxisHoming::kNotHomed));
     // Axis 2 does not exist; a value or feed is no argument of home.
-    CHECK(link->command_with_arguments(device::kCommandHome, 4, 0, 0) == Status::kControlValueOutOfRange);
-    CHECK(link->command_with_arguments(device::kCommandHome, 0, 1, 0) == Status::kControlValueOutOfRange);
+    CHECK(link->command_with_arguments(device::kCommandHome, 4, 0, 0) ==
+          Status::kControlValueOutOfRange);
+    CHECK(link->command_with_arguments(device::kCommandHome, 0, 1, 0) ==
+          Status::kControlValueOutOfRange);
     REQUIRE(link->command_with_arguments(device::kCommandHome, 0, 0, 0) == Status::kOk);
     s = link->status();
     REQUIRE(s.homing_runs());
@@ -219,9 +222,12 @@ TEST_CASE("home over Modbus: every axis in plan order, zero at its switch, withi
     CHECK(link->command_with_arguments(device::kCommandHome, 0, 0, 0) == Status::kWrongState);
     CHECK(link->command_with_arguments(device::kCommandJog, 0, 100, 0) == Status::kWrongState);
     CHECK(link->command_with_arguments(device::kCommandPen, 0, 1, 0) == Status::kWrongState);
-    CHECK(link->command_with_arguments(device::kCommandSetPosition, 0, 0, 0) == Status::kWrongState);
+    CHECK(link->command_with_arguments(device::kCommandSetPosition, 0, 0, 0) ==
+          Status::kWrongState);
     // y first: x waits its turn while y moves.
-    s = poll_until(*link, [](const host::DeviceSnapshot& x) { return x.homing[1].state != AxisHoming::kHoming; });
+    s = poll_until(*link, [](const host::DeviceSnapshot& x) {
+        return x.homing[1].state != AxisHoming::kHoming;
+    });
     CHECK(s.homing[1].state == AxisHoming::kHomed);
     s = poll_until(*link, [](const host::DeviceSnapshot& x) { return !x.homing_runs(); });
     CHECK((s.homing[0].state == AxisHoming::kHomed && s.homing[0].error == HomingError::kNone));
@@ -231,15 +237,19 @@ TEST_CASE("home over Modbus: every axis in plan order, zero at its switch, withi
     // point, which is now 0: the stop from latch velocity overshoots by some 20 LSB).
     const Lsb homed_x = s.position[0];
     INFO("at " << s.position[0] << ", " << s.position[1]);
-    CHECK((s.position[0] >= 950 && s.position[0] <= 1000 && s.position[1] >= 950 && s.position[1] <= 1000));
+    CHECK((s.position[0] >= 950 && s.position[0] <= 1000 && s.position[1] >= 950 &&
+           s.position[1] <= 1000));
 
     // The pen by the operator: down at rest, carried by a jog, up again.
     REQUIRE(link->command_with_arguments(device::kCommandPen, 0, 1, 0) == Status::kOk);
     s = poll_until(*link, [](const host::DeviceSnapshot& x) { return x.pen_down(); });
-    CHECK(link->command_with_arguments(device::kCommandPen, 0, 2, 0) == Status::kControlValueOutOfRange);
+    CHECK(link->command_with_arguments(device::kCommandPen, 0, 2, 0) ==
+          Status::kControlValueOutOfRange);
     REQUIRE(link->command_with_arguments(device::kCommandJog, 0, 5000, 0) == Status::kOk);
     const std::uint32_t jog = s.last_accepted + 1;
-    s = poll_until(*link, [&](const host::DeviceSnapshot& x) { return x.state == device::DeviceState::kIdle && x.finished_job == jog; });
+    s = poll_until(*link, [&](const host::DeviceSnapshot& x) {
+        return x.state == device::DeviceState::kIdle && x.finished_job == jog;
+    });
     CHECK((s.position[0] == homed_x + 5000 && s.pen_down()));
     const std::size_t jog_ticks = s.finished_job_ticks;
     REQUIRE(link->command_with_arguments(device::kCommandPen, 0, 0, 0) == Status::kOk);
@@ -275,7 +285,8 @@ TEST_CASE("home over Modbus: an axis whose switch never closes fails by name, th
     REQUIRE(link->command_with_arguments(device::kCommandHome, 0, 0, 0) == Status::kOk);
     const host::DeviceSnapshot s =
         poll_until(*link, [](const host::DeviceSnapshot& x) { return !x.homing_runs(); });
-    CHECK((s.homing[1].state == AxisHoming::kFailed && s.homing[1].error == HomingError::kSwitchNotFound));
+    CHECK((s.homing[1].state == AxisHoming::kFailed &&
+           s.homing[1].error == HomingError::kSwitchNotFound));
     CHECK(s.homing[0].state == AxisHoming::kNotHomed);  // after y failed, x never started
     CHECK(s.state == device::DeviceState::kIdle);
     CHECK(s.position[1] == 15000 - 20000);  // the whole max_travel searched, then stopped
@@ -294,7 +305,8 @@ TEST_CASE("home and pen over native CAN: status E reports each axis, status A th
     sim::CanLoopback loop;
     hal::CanBus& device_bus = loop.add_endpoint();
     hal::CanBus& host_bus = loop.add_endpoint();
-    std::unique_ptr<linux_device::CanMotionDevice> device = linux_device::CanMotionDevice::create(start, 7);
+    std::unique_ptr<linux_device::CanMotionDevice> device =
+        linux_device::CanMotionDevice::create(start, 7);
     HomingRig rig(*device);
     rig.place_switch(0, -3000);
     const device::HomingAxis plan[] = {homing_axis(0, 300000)};
@@ -303,21 +315,23 @@ TEST_CASE("home and pen over native CAN: status E reports each axis, status A th
     std::thread t([&] {
         linux_device::DeviceLoopOptions o;
         o.time_scale = 20.0;
-        linux_device::run_paced_loop([&] { rig.tick(); }, [&] { return device->tick_hz(); },
-                            [&](std::chrono::microseconds w) { device->serve(device_bus, w); }, o, stop);
+        linux_device::run_paced_loop(
+            [&] { rig.tick(); }, [&] { return device->tick_hz(); },
+            [&](std::chrono::microseconds w) { device->serve(device_bus, w); }, o, stop);
     });
     host::CanStreamOptions c;
     c.node = 7;
     c.ack_timeout_ms = 30;
     c.name = "can://loop?node=7";
     const std::unique_ptr<host::DeviceLink> link = host::open_can_link(host_bus, c);
-    CHECK(link->command_with_arguments(device::kCommandHome, 2, 0, 0) == Status::kNoHoming);  // y: no switch
+    CHECK(link->command_with_arguments(device::kCommandHome, 2, 0, 0) ==
+          Status::kNoHoming);  // y: no switch
     REQUIRE(link->command_with_arguments(device::kCommandHome, 0, 0, 0) == Status::kOk);
     // Until x's homing has ended: a status read before the device took the command shows no
     // homing running either (a loaded machine saw that).
     host::DeviceSnapshot s = poll_until(*link, [](const host::DeviceSnapshot& x) {
-        return !x.homing_runs() &&
-               (x.homing[0].state == AxisHoming::kHomed || x.homing[0].state == AxisHoming::kFailed);
+        return !x.homing_runs() && (x.homing[0].state == AxisHoming::kHomed ||
+                                    x.homing[0].state == AxisHoming::kFailed);
     });
     CHECK((s.homing[0].state == AxisHoming::kHomed && s.homing[1].state == AxisHoming::kNotHomed));
     CHECK((s.position[0] >= 950 && s.position[0] <= 1000 && s.position[1] == 15000));

@@ -14,9 +14,9 @@
 #include "pathstream/host/core_playback.hpp"
 #include "pathstream/host/geometry.hpp"
 #include "pathstream/host/json_path.hpp"
-#include "pathstream/machine/machine.hpp"
 #include "pathstream/host/planner.hpp"
 #include "pathstream/host/plot.hpp"
+#include "pathstream/machine/machine.hpp"
 
 using namespace pathstream;
 using namespace pathstream::host;

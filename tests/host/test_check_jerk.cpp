@@ -2,13 +2,12 @@
 // the limit, and a trapezoid whose acceleration steps at its joins. The profile uses 1024 Hz
 // and 2^-10 mm per LSB so that every figure is a binary fraction and the boundaries are exact.
 #include <catch2/catch.hpp>
-
 #include <cmath>
 #include <cstdint>
 #include <vector>
 
-#include "pathstream/machine/device_setup.hpp"
 #include "pathstream/host/planner.hpp"
+#include "pathstream/machine/device_setup.hpp"
 #include "pathstream/tick_cubic.hpp"
 
 using namespace pathstream;
@@ -41,10 +40,9 @@ CoreSpan hermite(std::int64_t p0, std::int64_t p1, std::int64_t t0, std::int64_t
     s.ticks = 8;
     REQUIRE(make_span_timing(Basis::kHermite, 8, s.timing) == Status::kOk);
     for (std::int64_t share : {2, 1}) {
-        const std::array<std::int32_t, 4> c = {static_cast<std::int32_t>(p0 * share / 2),
-                                               static_cast<std::int32_t>(p1 * share / 2),
-                                               static_cast<std::int32_t>(t0 * share / 2),
-                                               static_cast<std::int32_t>(t1 * share / 2)};
+        const std::array<std::int32_t, 4> c = {
+            static_cast<std::int32_t>(p0 * share / 2), static_cast<std::int32_t>(p1 * share / 2),
+            static_cast<std::int32_t>(t0 * share / 2), static_cast<std::int32_t>(t1 * share / 2)};
         s.control.push_back(c);
         const std::int32_t control[4] = {c[0], c[1], c[2], c[3]};
         TickCubic cubic;
@@ -82,12 +80,14 @@ Plan plan_of(const std::vector<int>& steps, bool trapezoid) {
     return plan;
 }
 
-const std::vector<int> kSCurve = {1, 1, 1, 1, 0, 0, -1, -1, -1, -1, 0, 0, 0, -1, -1, -1, -1, 0, 0, 1, 1, 1, 1};
+const std::vector<int> kSCurve = {1, 1,  1,  1,  0,  0, -1, -1, -1, -1, 0, 0,
+                                  0, -1, -1, -1, -1, 0, 0,  1,  1,  1,  1};
 const std::vector<int> kTrapezoid = {1, 1, 1, 1, 0, 0, -1, -1, -1, -1};
 
 }  // namespace
 
-TEST_CASE("check_plan: an S-curve at exactly the jerk limit is within it", "[planner][check][jerk]") {
+TEST_CASE("check_plan: an S-curve at exactly the jerk limit is within it",
+          "[planner][check][jerk]") {
     // x doubles every value of plan_of: j = 2 * 3/256 LSB/tick^3 = 3/128 * 1024^3 / 1024 mm/s^3
     // = 24576 mm/s^3 exactly; y, half of it, 12288.
     const Plan plan = plan_of(kSCurve, false);
@@ -121,7 +121,8 @@ TEST_CASE("check_plan: an S-curve at exactly the jerk limit is within it", "[pla
     }
 }
 
-TEST_CASE("check_plan: a trapezoid's acceleration steps fail a jerk limit", "[planner][check][jerk]") {
+TEST_CASE("check_plan: a trapezoid's acceleration steps fail a jerk limit",
+          "[planner][check][jerk]") {
     // x: a = 2/32 = 1/16 LSB/tick^2 on the ramps; the steps at the joins (rest -> ramp, ramp ->
     // cruise, ...) are 1/16 LSB/tick^2 = 1/16 * 1024^2 / 1024 = 64 mm/s^2; no jerk inside.
     const Plan plan = plan_of(kTrapezoid, true);
@@ -155,7 +156,8 @@ TEST_CASE("check_plan: a pause joins with rest on both sides", "[planner][check]
         const CoreSpan& last = two.spans[first - 1];
         std::int64_t ends[2];
         for (std::size_t a = 0; a < 2; ++a) ends[a] = last.control[a][1];
-        CoreSpan moved = hermite(ends[0] + s.control[0][0], ends[0] + s.control[0][1], s.control[0][2], s.control[0][3]);
+        CoreSpan moved = hermite(ends[0] + s.control[0][0], ends[0] + s.control[0][1],
+                                 s.control[0][2], s.control[0][3]);
         REQUIRE(moved.control[1][0] == ends[1] + s.control[1][0]);
         two.spans.push_back(moved);
     }

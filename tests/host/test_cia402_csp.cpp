@@ -1,7 +1,6 @@
 // CiA 402 cyclic synchronous position: the enable sequence, and a planned drawing driven at
 // 1 ms and 2 ms cycles: every target the drives took is the core's setpoint for that cycle.
 #include <catch2/catch.hpp>
-
 #include <cmath>
 
 #include "cia402_support.hpp"
@@ -52,14 +51,16 @@ void drive_wave(std::uint32_t cycle_ms) {
     const std::size_t axes = job.machine.axes.size();
     const auto c = static_cast<std::uint32_t>(std::lround(cycle_ms * job.machine.tick_hz / 1000));
     const std::vector<std::int32_t> expected = cia402_test::cycle_setpoints(job.plan, axes, c);
-    std::vector<std::int32_t> start(expected.begin(), expected.begin() + static_cast<std::ptrdiff_t>(axes));
+    std::vector<std::int32_t> start(expected.begin(),
+                                    expected.begin() + static_cast<std::ptrdiff_t>(axes));
     Rig rig(axes, start);
     host::Cia402Options o;
     o.nodes = {1, 2};
     o.cycle_ms = cycle_ms;
     std::vector<double> progress;
-    const host::Cia402Report r = host::stream_cia402(job.plan, job.machine, o, rig.master_bus, rig.hub.clock,
-                                                     [&](double f) { progress.push_back(f); });
+    const host::Cia402Report r =
+        host::stream_cia402(job.plan, job.machine, o, rig.master_bus, rig.hub.clock,
+                            [&](double f) { progress.push_back(f); });
     REQUIRE(r.completed);
     CHECK(r.message.empty());
     const std::size_t rows = expected.size() / axes;
@@ -80,11 +81,13 @@ void drive_wave(std::uint32_t cycle_ms) {
             INFO("cycle " << k);
             REQUIRE(got[k] == expected[k * axes + a]);
         }
-        for (std::size_t k = rows; k < got.size(); ++k) REQUIRE(got[k] == expected[(rows - 1) * axes + a]);
+        for (std::size_t k = rows; k < got.size(); ++k)
+            REQUIRE(got[k] == expected[(rows - 1) * axes + a]);
         // Never a step larger than v_max x cycle (+1 LSB of rounding), checked independently.
         const double v_lsb = job.machine.axes[a].max_velocity / job.machine.mm_per_lsb;
         std::int64_t worst = 0;
-        for (std::size_t k = 1; k < got.size(); ++k) worst = std::max<std::int64_t>(worst, std::llabs(std::int64_t{got[k]} - got[k - 1]));
+        for (std::size_t k = 1; k < got.size(); ++k)
+            worst = std::max<std::int64_t>(worst, std::llabs(std::int64_t{got[k]} - got[k - 1]));
         CHECK(worst <= std::floor(v_lsb * cycle_s) + 1);
         CHECK(worst <= r.max_step);
         // The plant followed within its following error window, and arrived.
@@ -99,5 +102,9 @@ void drive_wave(std::uint32_t cycle_ms) {
 
 }  // namespace
 
-TEST_CASE("wave.json in CSP at a 1 ms cycle: targets are the core's setpoints", "[cia402]") { drive_wave(1); }
-TEST_CASE("wave.json in CSP at a 2 ms cycle: every second setpoint", "[cia402]") { drive_wave(2); }
+TEST_CASE("wave.json in CSP at a 1 ms cycle: targets are the core's setpoints", "[cia402]") {
+    drive_wave(1);
+}
+TEST_CASE("wave.json in CSP at a 2 ms cycle: every second setpoint", "[cia402]") {
+    drive_wave(2);
+}

@@ -1,9 +1,8 @@
 // CiA 402 faults: a drive fault mid-path (jammed axis -> following error, a commanded fault),
 // fault reset, heartbeat loss, bus-off, a target that would break the limits, and 1 % frame
 // loss (seeded).
-#include <catch2/catch.hpp>
-
 #include <algorithm>
+#include <catch2/catch.hpp>
 #include <cmath>
 
 #include "cia402_support.hpp"
@@ -28,7 +27,8 @@ struct Setup {
 };
 
 // Runs `m` with `at_cycle(k)` called at every progress report (once per motion cycle).
-host::Cia402Report run(host::Cia402Master& m, const Setup& s, const std::function<void(std::size_t)>& at_cycle) {
+host::Cia402Report run(host::Cia402Master& m, const Setup& s,
+                       const std::function<void(std::size_t)>& at_cycle) {
     std::size_t k = 0;
     return m.run(s.job.plan, s.job.machine, [&](double) { at_cycle(++k); });
 }
@@ -43,7 +43,9 @@ void check_held(const Rig& rig, std::size_t from_cycles) {
 
 }  // namespace
 
-TEST_CASE("jammed axis: following error fault mid-path, master stops and reports, fault reset works", "[cia402]") {
+TEST_CASE(
+    "jammed axis: following error fault mid-path, master stops and reports, fault reset works",
+    "[cia402]") {
     Setup s;
     Rig rig(2, s.start);
     host::Cia402Master m(rig.master_bus, rig.hub.clock, s.options());
@@ -68,7 +70,8 @@ TEST_CASE("jammed axis: following error fault mid-path, master stops and reports
     REQUIRE(m.fault_reset());
     CHECK(rig.drives[1]->state() == DriveState::kSwitchOnDisabled);
     CHECK(rig.drives[1]->last_emcy() == kEmcyNoError);
-    std::vector<std::int32_t> here{rig.drives[0]->position_actual(), rig.drives[1]->position_actual()};
+    std::vector<std::int32_t> here{rig.drives[0]->position_actual(),
+                                   rig.drives[1]->position_actual()};
     REQUIRE(m.enable(here) == host::Cia402Stop::kNone);
     CHECK(rig.drives[0]->state() == DriveState::kOperationEnabled);
     CHECK(rig.drives[1]->state() == DriveState::kOperationEnabled);
@@ -134,11 +137,13 @@ TEST_CASE("a target beyond v_max x cycle is never sent", "[cia402]") {
     m.configure();
     const host::Cia402Report r = m.run(s.job.plan, slow, {});
     CHECK(r.stop == host::Cia402Stop::kStepLimit);
-    CHECK_THAT(r.message, Catch::Contains("more than v_max x cycle") && Catch::Contains("; not sent"));
+    CHECK_THAT(r.message,
+               Catch::Contains("more than v_max x cycle") && Catch::Contains("; not sent"));
     const double limit = std::floor(slow.axes[0].max_velocity / slow.mm_per_lsb * 0.002) + 1;
     for (std::size_t a = 0; a < 2; ++a) {
         const auto& t = rig.drives[a]->applied_targets();
-        for (std::size_t k = 1; k < t.size(); ++k) REQUIRE(std::llabs(std::int64_t{t[k]} - t[k - 1]) <= limit);
+        for (std::size_t k = 1; k < t.size(); ++k)
+            REQUIRE(std::llabs(std::int64_t{t[k]} - t[k - 1]) <= limit);
     }
     CHECK(r.max_step <= limit);
 }
@@ -150,7 +155,8 @@ TEST_CASE("a drive away from the plan's start is not enabled", "[cia402]") {
     m.configure();
     const host::Cia402Report r = m.run(s.job.plan, s.job.machine, {});
     CHECK(r.stop == host::Cia402Stop::kStepLimit);
-    CHECK_THAT(r.message, Catch::Contains("node 1 (axis x) is at") && Catch::Contains("move it there first"));
+    CHECK_THAT(r.message,
+               Catch::Contains("node 1 (axis x) is at") && Catch::Contains("move it there first"));
     CHECK(rig.drives[0]->applied_targets().empty());
     CHECK(rig.drives[0]->state() != DriveState::kOperationEnabled);
 }
@@ -190,8 +196,9 @@ TEST_CASE("1 % of frames lost (seeded): lost RPDOs are seen through the demand e
     CHECK(r.demand_mismatches <= stale);
 }
 
-TEST_CASE("the first TPDO1s lost: the master waits a few SYNCs for every position before the enable",
-          "[cia402]") {
+TEST_CASE(
+    "the first TPDO1s lost: the master waits a few SYNCs for every position before the enable",
+    "[cia402]") {
     Setup s;
     Rig rig(2, s.start);
     host::Cia402Master m(rig.master_bus, rig.hub.clock, s.options());

@@ -24,12 +24,14 @@ TEST_CASE("statusword table and texts", "[cia402]") {
     CHECK(decode_statusword(0x0218) == DriveState::kFault);
     CHECK(decode_statusword(0x000F) == DriveState::kFaultReactionActive);
     CHECK(decode_statusword(0x0000) == DriveState::kNotReadyToSwitchOn);
-    for (auto s : {DriveState::kSwitchOnDisabled, DriveState::kReadyToSwitchOn, DriveState::kSwitchedOn,
-                   DriveState::kOperationEnabled, DriveState::kQuickStopActive, DriveState::kFault,
-                   DriveState::kFaultReactionActive, DriveState::kNotReadyToSwitchOn}) {
+    for (auto s :
+         {DriveState::kSwitchOnDisabled, DriveState::kReadyToSwitchOn, DriveState::kSwitchedOn,
+          DriveState::kOperationEnabled, DriveState::kQuickStopActive, DriveState::kFault,
+          DriveState::kFaultReactionActive, DriveState::kNotReadyToSwitchOn}) {
         CHECK(decode_statusword(statusword_bits(s)) == s);
     }
-    CHECK(sdo_abort_text(0x06020000) == "object does not exist in the object dictionary (0x06020000)");
+    CHECK(sdo_abort_text(0x06020000) ==
+          "object does not exist in the object dictionary (0x06020000)");
     CHECK(sdo_abort_text(0x12345678).find("unknown abort code (0x12345678)") != std::string::npos);
     CHECK(emcy_text(0x8611) == "following error too large (0x8611)");
     CHECK(emcy_text(0x4310) == "temperature (0x4310)");
@@ -40,16 +42,22 @@ TEST_CASE("cia402 target URLs", "[cia402]") {
     CHECK(t.interface == "vcan0");
     CHECK(t.options.nodes == std::vector<std::uint8_t>{3, 4});
     CHECK(t.options.cycle_ms == 2);
-    const auto u = host::parse_cia402_target("can://can1?protocol=cia402&nodes=5,9&cycle=1&heartbeat=50ms&echo=1", 2);
+    const auto u = host::parse_cia402_target(
+        "can://can1?protocol=cia402&nodes=5,9&cycle=1&heartbeat=50ms&echo=1", 2);
     CHECK(u.options.nodes == std::vector<std::uint8_t>{5, 9});
     CHECK(u.options.cycle_ms == 1);
     CHECK(u.options.heartbeat_ms == 50);
     CHECK(u.options.demand_echo);
-    CHECK_THROWS_WITH(host::parse_cia402_target("can://vcan0?node=1", 1), Catch::Contains("protocol=cia402 missing"));
-    CHECK_THROWS_WITH(host::parse_cia402_target("can://vcan0?node=0&protocol=cia402", 1), Catch::Contains("outside 1..127"));
-    CHECK_THROWS_WITH(host::parse_cia402_target("can://vcan0?nodes=1&protocol=cia402", 2), Catch::Contains("1 nodes for 2 axes"));
-    CHECK_THROWS_WITH(host::parse_cia402_target("can://vcan0?protocol=cia402&cycle=fast", 1), Catch::Contains("cycle wants a number"));
-    CHECK_THROWS_WITH(host::parse_cia402_target("can://vcan0?protocol=cia402&speed=1", 1), Catch::Contains("unknown key 'speed'"));
+    CHECK_THROWS_WITH(host::parse_cia402_target("can://vcan0?node=1", 1),
+                      Catch::Contains("protocol=cia402 missing"));
+    CHECK_THROWS_WITH(host::parse_cia402_target("can://vcan0?node=0&protocol=cia402", 1),
+                      Catch::Contains("outside 1..127"));
+    CHECK_THROWS_WITH(host::parse_cia402_target("can://vcan0?nodes=1&protocol=cia402", 2),
+                      Catch::Contains("1 nodes for 2 axes"));
+    CHECK_THROWS_WITH(host::parse_cia402_target("can://vcan0?protocol=cia402&cycle=fast", 1),
+                      Catch::Contains("cycle wants a number"));
+    CHECK_THROWS_WITH(host::parse_cia402_target("can://vcan0?protocol=cia402&speed=1", 1),
+                      Catch::Contains("unknown key 'speed'"));
 }
 
 TEST_CASE("SDO configuration round trip", "[cia402]") {
@@ -82,7 +90,8 @@ TEST_CASE("SDO configuration round trip", "[cia402]") {
         std::uint8_t size = 0;
         CHECK(m.sdo_upload(n, kInterpolationPeriod, 2, &size) == 0xFDu);  // -3: milliseconds
         CHECK(size == 1);
-        CHECK(static_cast<std::int32_t>(m.sdo_upload(n, kPositionActual, 0, &size)) == (n == 1 ? 100 : -200));
+        CHECK(static_cast<std::int32_t>(m.sdo_upload(n, kPositionActual, 0, &size)) ==
+              (n == 1 ? 100 : -200));
         CHECK(size == 4);
         CHECK((m.sdo_upload(n, kDeviceType, 0) & 0xFFFF) == 402u);
     }
@@ -114,11 +123,13 @@ TEST_CASE("SDO aborts are decoded and name node and object", "[cia402]") {
     m.configure();  // NMT operational now
 
     CHECK_THROWS_WITH(m.sdo_upload(1, 0x2000, 0),
-                      "node 1: SDO 0x2000:00 read refused: object does not exist in the object dictionary (0x06020000)");
+                      "node 1: SDO 0x2000:00 read refused: object does not exist in the object "
+                      "dictionary (0x06020000)");
     CHECK(abort_of([&] { m.sdo_upload(1, kInterpolationPeriod, 3); }) == kAbortNoSubindex);
     CHECK(abort_of([&] { m.sdo_download(1, kModesOfOperation, 0, 8, 2); }) == kAbortLength);
     CHECK(abort_of([&] { m.sdo_download(1, kStatusword, 0, 0, 2); }) == kAbortReadOnly);
-    CHECK(abort_of([&] { m.sdo_download(1, kModesOfOperation, 0, 3, 1); }) == kAbortValueRange);  // profile velocity: not here
+    CHECK(abort_of([&] { m.sdo_download(1, kModesOfOperation, 0, 3, 1); }) ==
+          kAbortValueRange);  // profile velocity: not here
     // Mapping changes in NMT operational: the wrong state.
     CHECK_THROWS_WITH(m.sdo_download(1, kRpdo1Mapping, 0, 0, 1),
                       Catch::Contains("node 1: SDO 0x1600:00 write refused") &&
@@ -128,11 +139,15 @@ TEST_CASE("SDO aborts are decoded and name node and object", "[cia402]") {
     m.nmt(NmtCommand::kEnterPreOperational, 1);
     m.sdo_download(1, kRpdo1Communication, 1, kPdoInvalid | 0x201, 4);
     m.sdo_download(1, kRpdo1Mapping, 0, 0, 1);
-    CHECK(abort_of([&] { m.sdo_download(1, kRpdo1Mapping, 1, pdo_mapping(kStatusword, 0, 16), 4); }) == kAbortNotMappable);
-    for (std::uint8_t s = 1; s <= 3; ++s) m.sdo_download(1, kRpdo1Mapping, s, pdo_mapping(kTargetPosition, 0, 32), 4);
+    CHECK(abort_of([&] {
+              m.sdo_download(1, kRpdo1Mapping, 1, pdo_mapping(kStatusword, 0, 16), 4);
+          }) == kAbortNotMappable);
+    for (std::uint8_t s = 1; s <= 3; ++s)
+        m.sdo_download(1, kRpdo1Mapping, s, pdo_mapping(kTargetPosition, 0, 32), 4);
     CHECK(abort_of([&] { m.sdo_download(1, kRpdo1Mapping, 0, 3, 1); }) == kAbortPdoLength);
     // A node that is not there: retried, then a timeout naming it.
-    CHECK_THROWS_WITH(m.sdo_upload(9, kDeviceType, 0), Catch::Contains("no response in 3 tries of 50 ms"));
+    CHECK_THROWS_WITH(m.sdo_upload(9, kDeviceType, 0),
+                      Catch::Contains("no response in 3 tries of 50 ms"));
 }
 
 TEST_CASE("configure names a missing drive", "[cia402]") {

@@ -2,17 +2,18 @@
 #include <catch2/catch.hpp>
 
 #include "pathstream/host/core_spans.hpp"
-#include "pathstream/machine/input_error.hpp"
 #include "pathstream/host/json_path.hpp"
+#include "pathstream/machine/input_error.hpp"
 
 using namespace pathstream::host;
 
 TEST_CASE("open B-spline and Catmull-Rom start and end at their first and last points",
           "[host][spans]") {
     for (const char* basis : {"bspline", "catmull-rom"}) {
-        const Path p = parse_json_path(std::string(R"({"basis": ")") + basis +
-                                           R"(", "points": [[0, 0], [10, 3], [20, -4], [30, 1.5]]})",
-                                       "t.json");
+        const Path p =
+            parse_json_path(std::string(R"({"basis": ")") + basis +
+                                R"(", "points": [[0, 0], [10, 3], [20, -4], [30, 1.5]]})",
+                            "t.json");
         const auto spans = uniform_core_spans(p, "t.json", 0.001, 16);
         REQUIRE(spans.size() == 3);
         CHECK(core_value_at(spans.front(), 0, 0) == 0);

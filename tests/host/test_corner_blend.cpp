@@ -2,7 +2,6 @@
 // motion crosses them at the curve's speed; the plan still passes the exact per-tick check and
 // stays within the tolerance of the polyline as given. Sharp vertices still stop.
 #include <catch2/catch.hpp>
-
 #include <cmath>
 
 #include "pathstream/host/geometry.hpp"
@@ -30,7 +29,8 @@ Path polygon(int n, double r) {
 
 }  // namespace
 
-TEST_CASE("shallow vertices are blended within the tolerance and crossed faster", "[planner][blend]") {
+TEST_CASE("shallow vertices are blended within the tolerance and crossed faster",
+          "[planner][blend]") {
     const MachineProfile p = pen_plotter();
     const Path path = polygon(50, 50);  // 0.126 rad at every vertex, 6.3 mm sides
     const auto segments = to_bezier_segments(path);
@@ -47,7 +47,8 @@ TEST_CASE("shallow vertices are blended within the tolerance and crossed faster"
     // one-tick velocity step of the corner rule (~24 mm/s).
     CHECK(blended_stats.motion_ticks < 0.85 * static_cast<double>(corner_stats.motion_ticks));
     // The blended path's own continuous optimum is what the motion is compared with.
-    CHECK(static_cast<double>(blended_stats.motion_ticks) / p.tick_hz >= blended_stats.reference_motion_time);
+    CHECK(static_cast<double>(blended_stats.motion_ticks) / p.tick_hz >=
+          blended_stats.reference_motion_time);
 }
 
 TEST_CASE("sharp vertices still stop, a blend never crosses a pen change", "[planner][blend]") {
@@ -62,7 +63,9 @@ TEST_CASE("sharp vertices still stop, a blend never crosses a pen change", "[pla
     for (std::size_t i = 0; i + 1 < plan.spans.size(); ++i) {
         const auto& a = plan.spans[i];
         bool at_rest = a.pen_down;
-        for (std::size_t axis = 0; axis < 2; ++axis) at_rest = at_rest && a.control[axis][3] == 0 && a.control[axis][1] != a.control[axis][0];
+        for (std::size_t axis = 0; axis < 2; ++axis)
+            at_rest =
+                at_rest && a.control[axis][3] == 0 && a.control[axis][1] != a.control[axis][0];
         if (at_rest) ++stops;
     }
     CHECK(stops >= 4);

@@ -2,7 +2,6 @@
 // independent double-precision evaluation of the same bases from the file's points: they
 // agree to half an LSB, the core's rounding, on every sample.
 #include <catch2/catch.hpp>
-
 #include <cmath>
 #include <random>
 #include <sstream>
@@ -58,26 +57,31 @@ std::vector<double> window(const Subpath& sp, std::size_t i, std::size_t axis, d
             ext.push_back(2 * q[m - 1] - q[m - 2]);
             return {ext[i], ext[i + 1], ext[i + 2], ext[i + 3]};
         }
-        case PathBasis::kBezier: return {q[3 * i], q[3 * i + 1], q[3 * i + 2], q[3 * i + 3]};
-        case PathBasis::kPolyline: return {q[i], q[i + 1], 0, 0};
+        case PathBasis::kBezier:
+            return {q[3 * i], q[3 * i + 1], q[3 * i + 2], q[3 * i + 3]};
+        case PathBasis::kPolyline:
+            return {q[i], q[i + 1], 0, 0};
     }
     return {};
 }
 
 }  // namespace
 
-TEST_CASE("eval's core values equal an independent double evaluation to half an LSB", "[host][eval]") {
+TEST_CASE("eval's core values equal an independent double evaluation to half an LSB",
+          "[host][eval]") {
     std::mt19937_64 rng(20261122);
     std::uniform_real_distribution<double> coord(-300.0, 300.0);
     const double lsb = 0.001;
     const std::uint32_t n = 16;
     for (const char* basis : {"bspline", "catmull-rom", "bezier", "polyline"}) {
         for (int trial = 0; trial < 20; ++trial) {
-            const std::size_t points = std::string(basis) == "bezier" ? 3 * (1 + rng() % 5) + 1 : 2 + rng() % 8;
+            const std::size_t points =
+                std::string(basis) == "bezier" ? 3 * (1 + rng() % 5) + 1 : 2 + rng() % 8;
             std::ostringstream doc;
             doc.precision(17);
             doc << "{\"basis\": \"" << basis << "\", \"points\": [";
-            for (std::size_t i = 0; i < points; ++i) doc << (i ? "," : "") << "[" << coord(rng) << "," << coord(rng) << "]";
+            for (std::size_t i = 0; i < points; ++i)
+                doc << (i ? "," : "") << "[" << coord(rng) << "," << coord(rng) << "]";
             doc << "]}";
             const Path path = parse_json_path(doc.str(), "t.json");
             const auto spans = uniform_core_spans(path, "t.json", lsb, n);
@@ -88,7 +92,8 @@ TEST_CASE("eval's core values equal an independent double evaluation to half an 
                     for (std::uint32_t k = 0; k <= n; ++k) {
                         double w[4] = {0, 0, 0, 0};
                         weights(sp.basis, static_cast<double>(k) / n, w);
-                        const double expected = w[0] * p[0] + w[1] * p[1] + w[2] * p[2] + w[3] * p[3];
+                        const double expected =
+                            w[0] * p[0] + w[1] * p[1] + w[2] * p[2] + w[3] * p[3];
                         const double got = core_value_at(spans[i], a, k) * lsb;
                         INFO(basis << " span " << i << " axis " << a << " k " << k);
                         REQUIRE(std::fabs(got - expected) <= lsb / 2 + 1e-9);

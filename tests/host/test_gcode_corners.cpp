@@ -2,7 +2,6 @@
 // path: every vertex crossed as programmed) and G61.1 (exact stop: rest at every block's end),
 // from the reader's subpaths through path order to the planner's stops and blends.
 #include <catch2/catch.hpp>
-
 #include <cmath>
 #include <cstdint>
 #include <sstream>
@@ -11,9 +10,9 @@
 
 #include "pathstream/host/gcode_path.hpp"
 #include "pathstream/host/geometry.hpp"
-#include "pathstream/machine/input_error.hpp"
 #include "pathstream/host/path_order.hpp"
 #include "pathstream/host/planner.hpp"
+#include "pathstream/machine/input_error.hpp"
 #include "pen_plotter_profile.hpp"
 
 using namespace pathstream::host;
@@ -63,7 +62,8 @@ Planned plan_of(const Path& path, const MachineProfile& p) {
 
 }  // namespace
 
-TEST_CASE("G-code path control: the reader keeps each mode on the subpaths it draws", "[host][gcode][corners]") {
+TEST_CASE("G-code path control: the reader keeps each mode on the subpaths it draws",
+          "[host][gcode][corners]") {
     const Path blend = gcode("G0 Z-1\nG1 X10\nG1 Y10\n");
     REQUIRE(blend.subpaths.size() == 1);
     CHECK(blend.subpaths[0].corner_mode == CornerMode::kBlend);
@@ -82,7 +82,8 @@ TEST_CASE("G-code path control: the reader keeps each mode on the subpaths it dr
 
     // G61.1: a rest at every block's end, not where an arc is split into cubics (each
     // half circle below is two of them).
-    const Path stops = gcode("G61.1\nG0 X10 Y0 Z-1\nG3 X-10 Y0 I-10 J0\nG3 X10 Y0 I10 J0\nG1 X20\nG1 X30\n");
+    const Path stops =
+        gcode("G61.1\nG0 X10 Y0 Z-1\nG3 X-10 Y0 I-10 J0\nG3 X10 Y0 I10 J0\nG1 X20\nG1 X30\n");
     REQUIRE(stops.subpaths.size() == 1);
     const Subpath& s = stops.subpaths[0];
     CHECK(s.corner_mode == CornerMode::kExactStop);
@@ -97,7 +98,8 @@ TEST_CASE("G-code path control: the reader keeps each mode on the subpaths it dr
     CHECK(lines.subpaths[0].stops == std::vector<std::uint32_t>{1, 2});
 }
 
-TEST_CASE("G-code path control: a mode change starts a new subpath where the run is", "[host][gcode][corners]") {
+TEST_CASE("G-code path control: a mode change starts a new subpath where the run is",
+          "[host][gcode][corners]") {
     const Path p = gcode("G0 Z-1\nG1 X10\nG61\nG1 Y10\nG64 P0.01\nG1 X0\nG64 P0.01\nG1 Y0\n");
     REQUIRE(p.subpaths.size() == 3);
     CHECK(p.subpaths[0].corner_mode == CornerMode::kBlend);
@@ -118,15 +120,19 @@ TEST_CASE("G-code path control: a mode change starts a new subpath where the run
 
 TEST_CASE("G-code path control: bad words get their place", "[host][gcode][corners]") {
     CHECK(error_of("G64 P-0.1\n") == "t.ngc:1:5: G64 blend tolerance P must not be negative");
-    CHECK(error_of("G64 P0.1 Q-1\n") == "t.ngc:1:10: G64 naive CAM tolerance Q must not be negative");
+    CHECK(error_of("G64 P0.1 Q-1\n") ==
+          "t.ngc:1:10: G64 naive CAM tolerance Q must not be negative");
     CHECK(error_of("G61 P0.1\n") == "t.ngc:1:5: word P is not used by any command in this block");
     CHECK(error_of("G61.1 Q1\n") == "t.ngc:1:7: word Q is not used by any command in this block");
     CHECK(error_of("G0 Z-1\nG64 G4 P1\n") ==
-          "t.ngc:2:8: word P would be used by G64 and by the block's other command: give G64 a block of its own");
-    CHECK(error_of("G61 G64\n") == "t.ngc:1:5: G61 and G64 are in the same modal group (one per block)");
+          "t.ngc:2:8: word P would be used by G64 and by the block's other command: give G64 a "
+          "block of its own");
+    CHECK(error_of("G61 G64\n") ==
+          "t.ngc:1:5: G61 and G64 are in the same modal group (one per block)");
 }
 
-TEST_CASE("G-code path control: the planner blends, crosses exactly or stops as asked", "[planner][corners]") {
+TEST_CASE("G-code path control: the planner blends, crosses exactly or stops as asked",
+          "[planner][corners]") {
     MachineProfile p = pen_plotter();
     p.chord_tolerance = 0.05;  // blends up to 25 um from the vertex by the planner's own rule
     const int n = 50;          // 0.126 rad at every vertex, 6.3 mm sides

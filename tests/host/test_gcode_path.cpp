@@ -8,10 +8,10 @@
 
 #include "pathstream/host/gcode_path.hpp"
 #include "pathstream/host/geometry.hpp"
-#include "pathstream/machine/input_error.hpp"
-#include "pathstream/machine/machine.hpp"
 #include "pathstream/host/path_order.hpp"
 #include "pathstream/host/work_area.hpp"
+#include "pathstream/machine/input_error.hpp"
+#include "pathstream/machine/machine.hpp"
 
 using namespace pathstream::host;
 
@@ -288,7 +288,8 @@ TEST_CASE("G-code: zero-length pieces are dropped and empty runs skipped", "[hos
     CHECK(p.subpaths[0].location.line == 9);
 }
 
-TEST_CASE("G-code: accepted codes change no geometry, M2 and M30 end the program", "[host][gcode]") {
+TEST_CASE("G-code: accepted codes change no geometry, M2 and M30 end the program",
+          "[host][gcode]") {
     const Path p = gcode(
         "G17 G21 G40 G49 G54 G61 G80 G90 G94 G91.1 T1 S500\nG4 P0.5\nG64 P0.01 Q0.01\nG61.1\n"
         "M3 S100\nM5\nG0 Z-1\nG1 X10\nM30\nthis is @ not G-code\n");
@@ -432,8 +433,9 @@ TEST_CASE("G-code: end radius large bound", "[host][gcode]") {
 TEST_CASE("G-code: tiny arcs rounded to 4 decimals", "[host][gcode]") {
     // A 0.01 mm arc whose end was rounded: 0.4 % off, far under 0.028 mm (the rule before
     // LinuxCNC 2.8, either bound alone, refused it).
-    const Path p = gcode("G0 X0.01 Y0 Z-1\nG3 X0.0071 Y0.0071 I-0.01 J0\nG3 X-0.0071 Y0.0071 "
-                         "I-0.0071 J-0.0071\nG2 X-0.0213 Y0.0071 I-0.0071 J0\n");
+    const Path p = gcode(
+        "G0 X0.01 Y0 Z-1\nG3 X0.0071 Y0.0071 I-0.01 J0\nG3 X-0.0071 Y0.0071 "
+        "I-0.0071 J-0.0071\nG2 X-0.0213 Y0.0071 I-0.0071 J0\n");
     REQUIRE(p.subpaths.size() == 1);
     CHECK(near(p.subpaths[0].points.back(), -0.0213, 0.0071));
 }
@@ -542,8 +544,9 @@ TEST_CASE("G-code: code and word errors", "[host][gcode]") {
           "t.ngc:1:1: unsupported M code M62 (skip it with --ignore-code M62 if it means nothing "
           "here)");
     CHECK(error_of("M3.5") == "t.ngc:1:1: unsupported M code M3.5");
-    CHECK(error_of("X10") ==
-          "t.ngc:1:1: axis word X with no motion mode (give G0, G1, G2, G3, G5, G5.1 or G5.2 first)");
+    CHECK(
+        error_of("X10") ==
+        "t.ngc:1:1: axis word X with no motion mode (give G0, G1, G2, G3, G5, G5.1 or G5.2 first)");
     CHECK(error_of("G1 X1\nG80 Y1") == "t.ngc:2:5: axis words cannot be used with G80");
     CHECK(error_of("G1 X1 I2") == "t.ngc:1:7: word I is not used by any command in this block");
     CHECK(error_of("G0 X1 R2") == "t.ngc:1:7: word R is not used by any command in this block");
@@ -633,15 +636,17 @@ TEST_CASE("G-code: spline errors", "[host][gcode]") {
 
 TEST_CASE("G-code: a program that draws nothing is an error", "[host][gcode]") {
     CHECK(error_of("G0 X10\nG1 X20\nM2\n") ==
-          "t.ngc: no pen-down moves (the pen is down during G1, G2, G3, G5, G5.1 and G5.2 moves at Z <= "
+          "t.ngc: no pen-down moves (the pen is down during G1, G2, G3, G5, G5.1 and G5.2 moves at "
+          "Z <= "
           "0 mm)");
     CHECK(error_of("") ==
-          "t.ngc: no pen-down moves (the pen is down during G1, G2, G3, G5, G5.1 and G5.2 moves at Z <= "
+          "t.ngc: no pen-down moves (the pen is down during G1, G2, G3, G5, G5.1 and G5.2 moves at "
+          "Z <= "
           "0 mm)");
-    CHECK(
-        error_of("G0 Z-1\nG1 X10\n", spindle()) ==
-        "t.ngc: no pen-down moves (the pen is down during G1, G2, G3, G5, G5.1 and G5.2 moves between M3 "
-        "or M4 and M5)");
+    CHECK(error_of("G0 Z-1\nG1 X10\n", spindle()) ==
+          "t.ngc: no pen-down moves (the pen is down during G1, G2, G3, G5, G5.1 and G5.2 moves "
+          "between M3 "
+          "or M4 and M5)");
     CHECK(error_of("M3\nG0 X10\nM2\nG1 X20\n", spindle()).rfind("t.ngc: no pen-down moves", 0) ==
           0);
 }
@@ -659,15 +664,17 @@ TEST_CASE("G-code: bad options and missing files", "[host][gcode]") {
                       "/nonexistent/p.ngc: cannot open file");
 }
 
-TEST_CASE("G-code keeps each move's line: a travel error names the move that crosses", "[gcode][workarea]") {
+TEST_CASE("G-code keeps each move's line: a travel error names the move that crosses",
+          "[gcode][workarea]") {
     MachineProfile m;
     m.tick_hz = 1000;
     m.mm_per_lsb = 0.001;
     m.axes = {{"x", 200, 2000, true, 0, 430}, {"y", 200, 2000, true, 0, 297}};
     m.source = "m.json";
-    const Path path = parse_gcode_path("G21 G90\nG0 X10 Y10\nG1 Z-1 F1000\nG1 X50 Y10\nG2 X90 Y10 I20 J0\n"
-                                       "G1 X500 Y10\nG1 X10 Y20\n",
-                                       "t.ngc");
+    const Path path = parse_gcode_path(
+        "G21 G90\nG0 X10 Y10\nG1 Z-1 F1000\nG1 X50 Y10\nG2 X90 Y10 I20 J0\n"
+        "G1 X500 Y10\nG1 X10 Y20\n",
+        "t.ngc");
     REQUIRE(path.subpaths.size() == 1);
     const Subpath& run = path.subpaths[0];
     REQUIRE(run.segment_lines.size() == chain_segments(run));

@@ -1,7 +1,6 @@
 // Path -> Bezier segments: each basis agrees with a direct evaluation of that basis, joints are
 // exact, closed subpaths close, travel joins subpaths pen-up; Bezier derivatives.
 #include <catch2/catch.hpp>
-
 #include <cmath>
 #include <random>
 
@@ -29,7 +28,8 @@ PathPoint direct(pathstream::Basis basis, const std::array<PathPoint, 4>& w, dou
     for (std::size_t a = 0; a < r.size(); ++a) {
         for (int row = 0; row < 4; ++row) {
             double s = 0;
-            for (int col = 0; col < 4; ++col) s += m.m[row][col] * w[static_cast<std::size_t>(col)][a];
+            for (int col = 0; col < 4; ++col)
+                s += m.m[row][col] * w[static_cast<std::size_t>(col)][a];
             r[a] += pw[row] * s;
         }
         r[a] /= m.scale;
@@ -55,13 +55,15 @@ std::vector<std::array<PathPoint, 4>> windows(const std::vector<PathPoint>& p, b
     const std::size_t m = p.size();
     std::vector<std::array<PathPoint, 4>> out;
     if (closed) {
-        for (std::size_t i = 0; i < m; ++i) out.push_back({p[(i + m - 1) % m], p[i], p[(i + 1) % m], p[(i + 2) % m]});
+        for (std::size_t i = 0; i < m; ++i)
+            out.push_back({p[(i + m - 1) % m], p[i], p[(i + 1) % m], p[(i + 2) % m]});
         return out;
     }
     ext.push_back(reflect(p[0], p[1]));
     ext.insert(ext.end(), p.begin(), p.end());
     ext.push_back(reflect(p[m - 1], p[m - 2]));
-    for (std::size_t i = 0; i + 3 < ext.size(); ++i) out.push_back({ext[i], ext[i + 1], ext[i + 2], ext[i + 3]});
+    for (std::size_t i = 0; i + 3 < ext.size(); ++i)
+        out.push_back({ext[i], ext[i + 1], ext[i + 2], ext[i + 3]});
     return out;
 }
 
@@ -71,7 +73,8 @@ void check_joints(const std::vector<BezierSegment>& segs) {
 
 }  // namespace
 
-TEST_CASE("B-spline and Catmull-Rom segments agree with the basis evaluated directly", "[geometry]") {
+TEST_CASE("B-spline and Catmull-Rom segments agree with the basis evaluated directly",
+          "[geometry]") {
     std::mt19937_64 rng(1234);
     for (const PathBasis basis : {PathBasis::kBSpline, PathBasis::kCatmullRom}) {
         for (const bool closed : {false, true}) {
@@ -87,13 +90,15 @@ TEST_CASE("B-spline and Catmull-Rom segments agree with the basis evaluated dire
                     const auto segs = to_bezier_segments(path);
                     const auto w = windows(sp.points.vectors(), closed);
                     REQUIRE(segs.size() == w.size());
-                    const auto core = basis == PathBasis::kBSpline ? pathstream::Basis::kUniformBSpline
-                                                                   : pathstream::Basis::kCatmullRom;
+                    const auto core = basis == PathBasis::kBSpline
+                                          ? pathstream::Basis::kUniformBSpline
+                                          : pathstream::Basis::kCatmullRom;
                     double worst = 0;
                     for (std::size_t s = 0; s < segs.size(); ++s) {
                         for (int k = 0; k <= 64; ++k) {
                             const double u = k / 64.0;
-                            worst = std::max(worst, distance(bezier_point(segs[s], u), direct(core, w[s], u)));
+                            worst = std::max(
+                                worst, distance(bezier_point(segs[s], u), direct(core, w[s], u)));
                         }
                         CHECK(segs[s].pen_down);
                         CHECK(segs[s].subpath == 0);

@@ -8,15 +8,16 @@
 #include "pathstream/device/wire_span.hpp"
 #include "pathstream/host/geometry.hpp"
 #include "pathstream/host/json_path.hpp"
-#include "pathstream/machine/machine.hpp"
 #include "pathstream/host/planner.hpp"
 #include "pathstream/host/plot.hpp"
+#include "pathstream/machine/machine.hpp"
 #include "pathstream/sim/gpio_bench.hpp"
 
 using namespace pathstream;
 using namespace pathstream::device;
 
-TEST_CASE("gpio pen: the pen line switches at the plan's pen events, never while moving", "[gpio][pen]") {
+TEST_CASE("gpio pen: the pen line switches at the plan's pen events, never while moving",
+          "[gpio][pen]") {
     const host::MachineProfile profile =
         host::load_machine_profile(PATHSTREAM_SOURCE_DIR "/examples/machines/pen_plotter.json");
     const host::Path path = host::parse_json_path(
@@ -30,7 +31,8 @@ TEST_CASE("gpio pen: the pen line switches at the plan's pen events, never while
     MotionLimits<2> limits;
     limits.tick_hz = 1000;
     for (unsigned a = 0; a < 2; ++a) {
-        limits.axis[a].max_velocity = static_cast<std::uint32_t>(profile.axes[a].max_velocity / profile.mm_per_lsb);
+        limits.axis[a].max_velocity =
+            static_cast<std::uint32_t>(profile.axes[a].max_velocity / profile.mm_per_lsb);
         limits.axis[a].max_acceleration =
             static_cast<std::uint32_t>(profile.axes[a].max_acceleration / profile.mm_per_lsb);
     }
@@ -51,7 +53,8 @@ TEST_CASE("gpio pen: the pen line switches at the plan's pen events, never while
             }
             std::uint8_t bytes[4 + 12 * 2];
             const std::size_t n = encode_wire_span(w, 2, bytes, sizeof bytes);
-            REQUIRE(b.device.accept_batch(b.device.last_accepted_sequence() + 1, 1, bytes, n) == Status::kOk);
+            REQUIRE(b.device.accept_batch(b.device.last_accepted_sequence() + 1, 1, bytes, n) ==
+                    Status::kOk);
             ++next;
         }
     };
@@ -71,18 +74,22 @@ TEST_CASE("gpio pen: the pen line switches at the plan's pen events, never while
     // from the first path tick as in the plan.
     const auto& switches = b.pen.switch_ticks();
     REQUIRE(switches.size() == plan.pen.size());
-    const std::int64_t offset = static_cast<std::int64_t>(switches[0]) - static_cast<std::int64_t>(plan.pen[0].tick);
+    const std::int64_t offset =
+        static_cast<std::int64_t>(switches[0]) - static_cast<std::int64_t>(plan.pen[0].tick);
     CHECK(offset >= 0);
     CHECK(static_cast<std::uint64_t>(offset) <= first_path_stamp);
     for (std::size_t i = 0; i < plan.pen.size(); ++i) {
-        CHECK(static_cast<std::int64_t>(switches[i]) - static_cast<std::int64_t>(plan.pen[i].tick) == offset);
+        CHECK(static_cast<std::int64_t>(switches[i]) -
+                  static_cast<std::int64_t>(plan.pen[i].tick) ==
+              offset);
         CHECK(plan.pen[i].down == (i % 2 == 0));
     }
     // No drawing while the pen moves: from each switch on, the axes hold for the pen's delay.
     for (std::size_t i = 0; i < switches.size(); ++i) {
-        const std::uint64_t delay =
-            host::delay_ticks(plan.pen[i].down ? profile.pen_down_delay : profile.pen_up_delay, profile.tick_hz);
-        const std::size_t first = static_cast<std::size_t>(switches[i]) - 1;  // the tick after which it switched
+        const std::uint64_t delay = host::delay_ticks(
+            plan.pen[i].down ? profile.pen_down_delay : profile.pen_up_delay, profile.tick_hz);
+        const std::size_t first =
+            static_cast<std::size_t>(switches[i]) - 1;  // the tick after which it switched
         INFO("pen switch " << i << " after tick " << first);
         for (std::uint64_t j = 1; j < delay && first + j < b.ticks.size(); ++j) {
             REQUIRE(b.ticks[first + j] == b.ticks[first]);

@@ -121,7 +121,8 @@ TEST_CASE("the bar's pen is the device's output: up at a pause inside a pen-down
     s.pen_output = true;
     events.sample(s);
     CHECK(events.status_text().find("pen down") != std::string::npos);
-    s.state = device::DeviceState::kHolding;  // holding at a programmed pause: the device raised the pen
+    s.state =
+        device::DeviceState::kHolding;  // holding at a programmed pause: the device raised the pen
     s.pen_output = false;
     events.sample(s);
     CHECK(events.status_text().find("pen up") != std::string::npos);

@@ -1,8 +1,8 @@
 // The JSON path reader: valid documents, and each kind of broken one with its exact message.
 #include <catch2/catch.hpp>
 
-#include "pathstream/machine/input_error.hpp"
 #include "pathstream/host/json_path.hpp"
+#include "pathstream/machine/input_error.hpp"
 
 using namespace pathstream::host;
 
@@ -44,13 +44,16 @@ TEST_CASE("broken documents name file, line, column and the problem", "[host][js
     CHECK(error_of("{\n  \"points\": [[0, 0],\n    [1, \"x\"]]\n}") ==
           "t.json:3:9: coordinate must be a number");
     CHECK(error_of("{\"points\": [[0, 0], [1, 2]], \"colour\": 1}") ==
-          "t.json:1:40: unknown key \"colour\" (expected one of: basis, closed, points, subpaths, units)");
-    CHECK(error_of("{\"points\": [[0, 0], [1, 2]]\n,}").rfind("t.json:2:2: invalid JSON: syntax error", 0) == 0);
+          "t.json:1:40: unknown key \"colour\" (expected one of: basis, closed, points, subpaths, "
+          "units)");
+    CHECK(error_of("{\"points\": [[0, 0], [1, 2]]\n,}")
+              .rfind("t.json:2:2: invalid JSON: syntax error", 0) == 0);
     CHECK(error_of("{\"points\": [[0, 0], [1e400, 2]]}") ==
           "t.json:1:22: number 1e400 is out of range (not finite as a double)");
     CHECK(error_of("{\"points\": [[0, 0], [2e6, 2]]}") ==
           "t.json:1:22: coordinate 2e+06 is out of range (|value| <= 1e+06 mm)");
-    CHECK(error_of("{\"points\": [[0, 0]]}") == "t.json:1:12: open bspline needs at least 2 points, got 1");
+    CHECK(error_of("{\"points\": [[0, 0]]}") ==
+          "t.json:1:12: open bspline needs at least 2 points, got 1");
     CHECK(error_of("{\"closed\": true, \"points\": [[0, 0], [1, 1]]}") ==
           "t.json:1:28: closed bspline needs at least 3 points, got 2");
     CHECK(error_of("{\"basis\": \"bezier\", \"points\": [[0,0],[1,1],[2,2]]}") ==
@@ -58,8 +61,10 @@ TEST_CASE("broken documents name file, line, column and the problem", "[host][js
     CHECK(error_of("{\"basis\": \"nurbs\", \"points\": [[0,0],[1,1]]}") ==
           "t.json:1:11: basis nurbs is given per subpath, with its degree and knots");
     CHECK(error_of("{\"basis\": \"spline\", \"points\": [[0,0],[1,1]]}") ==
-          "t.json:1:11: unknown basis \"spline\" (expected bspline, catmull-rom, bezier, polyline or nurbs)");
-    CHECK(error_of("{\"points\": [[0,0],[1,1,1]]}") == "t.json:1:19: point has 3 coordinates, expected 2");
+          "t.json:1:11: unknown basis \"spline\" (expected bspline, catmull-rom, bezier, polyline "
+          "or nurbs)");
+    CHECK(error_of("{\"points\": [[0,0],[1,1,1]]}") ==
+          "t.json:1:19: point has 3 coordinates, expected 2");
     CHECK(error_of("{\"points\": [[0,0],[1,1]], \"subpaths\": []}") ==
           "t.json:1:1: give either \"points\" (one subpath) or \"subpaths\", not both or neither");
     CHECK(error_of("{\"units\": \"cm\", \"points\": [[0,0],[1,1]]}") ==
@@ -68,5 +73,6 @@ TEST_CASE("broken documents name file, line, column and the problem", "[host][js
 }
 
 TEST_CASE("a missing file is an input error naming it", "[host][json]") {
-    CHECK_THROWS_WITH(load_json_path("/nonexistent/p.json"), "/nonexistent/p.json: cannot open file");
+    CHECK_THROWS_WITH(load_json_path("/nonexistent/p.json"),
+                      "/nonexistent/p.json: cannot open file");
 }

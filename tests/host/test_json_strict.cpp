@@ -2,10 +2,10 @@
 // values costs a bounded number of passes over the document, however many there are.
 #include <catch2/catch.hpp>
 
+#include "pathstream/host/json_path.hpp"
 #include "pathstream/machine/input_error.hpp"
 #include "pathstream/machine/json_document.hpp"
 #include "pathstream/machine/json_locate.hpp"
-#include "pathstream/host/json_path.hpp"
 
 using namespace pathstream::host;
 
@@ -139,7 +139,8 @@ TEST_CASE("JSON nested past the reader's limit is refused at the first bracket t
 
 TEST_CASE("an error quoting a huge token stays short", "[host][json]") {
     // A number of a million digits: the message names it, cut in the middle.
-    const std::string text = R"({"units": "mm", "points": [[0, 1)" + std::string(1'000'000, '0') + "]]}";
+    const std::string text =
+        R"({"units": "mm", "points": [[0, 1)" + std::string(1'000'000, '0') + "]]}";
     const std::string message = error_of(text);
     INFO(message.substr(0, 200));
     CHECK(message.rfind("t.json:1:", 0) == 0);

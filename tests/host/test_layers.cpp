@@ -8,10 +8,10 @@
 #include "pathstream/device/wire_span.hpp"
 #include "pathstream/host/geometry.hpp"
 #include "pathstream/host/layers.hpp"
-#include "pathstream/machine/machine.hpp"
 #include "pathstream/host/planner.hpp"
 #include "pathstream/host/svg_path.hpp"
 #include "pathstream/host/wire_plan.hpp"
+#include "pathstream/machine/machine.hpp"
 
 using namespace pathstream;
 using namespace pathstream::host;
@@ -31,7 +31,8 @@ const char* const kLayered = R"(<svg xmlns="http://www.w3.org/2000/svg"
   <g inkscape:groupmode="layer" inkscape:label="black2"><path d="M 80 10 L 90 20"/></g>
 </svg>)";
 
-const char* const kColours = R"(<svg xmlns="http://www.w3.org/2000/svg" width="100mm" height="100mm" viewBox="0 0 100 100">
+const char* const kColours =
+    R"(<svg xmlns="http://www.w3.org/2000/svg" width="100mm" height="100mm" viewBox="0 0 100 100">
   <path d="M 10 10 L 20 10" stroke="#F00"/>
   <path d="M 10 20 L 20 20" stroke="black"/>
   <path d="M 10 30 L 20 30" stroke="#ff0000"/>
@@ -50,12 +51,14 @@ std::vector<std::size_t> layer_of_each(const Path& p) {
 }
 
 MachineProfile plotter() {
-    return load_machine_profile(std::string(PATHSTREAM_SOURCE_DIR) + "/examples/machines/pen_plotter.json");
+    return load_machine_profile(std::string(PATHSTREAM_SOURCE_DIR) +
+                                "/examples/machines/pen_plotter.json");
 }
 
 }  // namespace
 
-TEST_CASE("layers: Inkscape layers by label, id, sublayers in theirs, hidden ones gone", "[layers]") {
+TEST_CASE("layers: Inkscape layers by label, id, sublayers in theirs, hidden ones gone",
+          "[layers]") {
     const Path p = parse_svg_path(kLayered, "layered.svg");
     CHECK(names(p) == std::vector<std::string>{"(outside layers)", "black", "layer7", "black2"});
     CHECK(layer_of_each(p) == std::vector<std::size_t>{0, 1, 1, 2, 2, 3});
@@ -66,18 +69,22 @@ TEST_CASE("layers: stroke colours become layers when there are no Inkscape layer
     const Path p = parse_svg_path(kColours, "colours.svg");
     CHECK(names(p) == std::vector<std::string>{"#ff0000", "#000000"});
     CHECK(layer_of_each(p) == std::vector<std::size_t>{0, 1, 0});
-    const Path one = parse_svg_path(R"(<svg xmlns="http://www.w3.org/2000/svg"><path d="M0 0 L1 1" stroke="red"/>
-        <path d="M2 2 L3 3" stroke="red"/></svg>)", "one.svg");
+    const Path one =
+        parse_svg_path(R"(<svg xmlns="http://www.w3.org/2000/svg"><path d="M0 0 L1 1" stroke="red"/>
+        <path d="M2 2 L3 3" stroke="red"/></svg>)",
+                       "one.svg");
     CHECK(one.layers.empty());
 }
 
-TEST_CASE("layers: choose by name or number, grouped in layer order, a pause between them", "[layers]") {
+TEST_CASE("layers: choose by name or number, grouped in layer order, a pause between them",
+          "[layers]") {
     const Path p = parse_svg_path(kColours, "colours.svg");
     CHECK(select_layers(p, {"#000000"}).subpaths.size() == 1);
     CHECK(select_layers(p, {"1"}).subpaths.size() == 2);
     CHECK(select_layers(p, {"1", "2"}).subpaths.size() == 3);
-    CHECK_THROWS_WITH(select_layers(p, {"green"}),
-                      "--layer green: no such layer (the drawing has 1: \"#ff0000\", 2: \"#000000\")");
+    CHECK_THROWS_WITH(
+        select_layers(p, {"green"}),
+        "--layer green: no such layer (the drawing has 1: \"#ff0000\", 2: \"#000000\")");
     CHECK_THROWS_WITH(select_layers(p, {"3"}), Catch::Contains("--layer 3: no such layer"));
     Path g = group_by_layer(p);
     CHECK(layer_of_each(g) == std::vector<std::size_t>{0, 0, 1});

@@ -30,10 +30,10 @@
 #include "pathstream/host/core_playback.hpp"
 #include "pathstream/host/geometry.hpp"
 #include "pathstream/host/json_path.hpp"
-#include "pathstream/machine/machine.hpp"
 #include "pathstream/host/modbus_stream.hpp"
 #include "pathstream/host/planner.hpp"
 #include "pathstream/linux_device/modbus_motion_device.hpp"
+#include "pathstream/machine/machine.hpp"
 #include "pathstream/span.hpp"
 #include "stream_support.hpp"
 

@@ -8,8 +8,8 @@
 #include <vector>
 
 #include "pathstream/host/gcode_path.hpp"
-#include "pathstream/machine/input_error.hpp"
 #include "pathstream/host/json_path.hpp"
+#include "pathstream/machine/input_error.hpp"
 
 using namespace pathstream::host;
 

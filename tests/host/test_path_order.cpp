@@ -44,7 +44,8 @@ double segment_gap(const BezierSegment& a, const BezierSegment& b, bool backward
     double worst = 0;
     for (std::size_t k = 0; k < 4; ++k) {
         const PathPoint& q = b.p[backwards ? 3 - k : k];
-        for (std::size_t i = 0; i < q.size(); ++i) worst = std::max(worst, std::fabs(a.p[k][i] - q[i]));
+        for (std::size_t i = 0; i < q.size(); ++i)
+            worst = std::max(worst, std::fabs(a.p[k][i] - q[i]));
     }
     return worst;
 }
@@ -55,7 +56,8 @@ Subpath random_subpath(std::mt19937_64& rng, PathBasis basis, bool closed, std::
     Subpath s;
     s.basis = basis;
     s.closed = closed;
-    if (basis == PathBasis::kBezier) n = closed ? 3 * std::max<std::size_t>(1, n / 3) : 3 * (n / 3) + 1;
+    if (basis == PathBasis::kBezier)
+        n = closed ? 3 * std::max<std::size_t>(1, n / 3) : 3 * (n / 3) + 1;
     for (std::size_t i = 0; i < n; ++i) s.points.push_back({coord(rng), coord(rng)});
     return s;
 }
@@ -64,7 +66,8 @@ Subpath random_subpath(std::mt19937_64& rng, PathBasis basis, bool closed, std::
 Path random_strokes(std::uint64_t seed, std::size_t count) {
     std::mt19937_64 rng(seed);
     std::uniform_real_distribution<double> where(0, 300), step(-8, 8);
-    const PathBasis bases[] = {PathBasis::kPolyline, PathBasis::kBezier, PathBasis::kBSpline, PathBasis::kCatmullRom};
+    const PathBasis bases[] = {PathBasis::kPolyline, PathBasis::kBezier, PathBasis::kBSpline,
+                               PathBasis::kCatmullRom};
     Path p;
     for (std::size_t i = 0; i < count; ++i) {
         Subpath s;
@@ -85,10 +88,12 @@ Path random_strokes(std::uint64_t seed, std::size_t count) {
 
 TEST_CASE("reversal draws the same curve backwards, every basis", "[order]") {
     std::mt19937_64 rng(7);
-    for (PathBasis basis : {PathBasis::kBSpline, PathBasis::kCatmullRom, PathBasis::kBezier, PathBasis::kPolyline}) {
+    for (PathBasis basis :
+         {PathBasis::kBSpline, PathBasis::kCatmullRom, PathBasis::kBezier, PathBasis::kPolyline}) {
         for (bool closed : {false, true}) {
             const Subpath s = random_subpath(rng, basis, closed, 10);
-            const std::vector<BezierSegment> a = segments_of(s), b = segments_of(reversed_subpath(s));
+            const std::vector<BezierSegment> a = segments_of(s),
+                                             b = segments_of(reversed_subpath(s));
             REQUIRE(a.size() == b.size());
             for (std::size_t i = 0; i < a.size(); ++i) {
                 CHECK(segment_gap(a[i], b[b.size() - 1 - i], true) < 1e-12);
@@ -100,11 +105,13 @@ TEST_CASE("reversal draws the same curve backwards, every basis", "[order]") {
 
 TEST_CASE("rotating a closed subpath keeps its curve", "[order]") {
     std::mt19937_64 rng(11);
-    for (PathBasis basis : {PathBasis::kBSpline, PathBasis::kCatmullRom, PathBasis::kBezier, PathBasis::kPolyline}) {
+    for (PathBasis basis :
+         {PathBasis::kBSpline, PathBasis::kCatmullRom, PathBasis::kBezier, PathBasis::kPolyline}) {
         const Subpath s = random_subpath(rng, basis, true, 12);
         const std::size_t shift = basis == PathBasis::kBezier ? 6 : 5;
         const std::size_t per = basis == PathBasis::kBezier ? 3 : 1;
-        const std::vector<BezierSegment> a = segments_of(s), b = segments_of(rotated_subpath(s, shift));
+        const std::vector<BezierSegment> a = segments_of(s),
+                                         b = segments_of(rotated_subpath(s, shift));
         REQUIRE(a.size() == b.size());
         for (std::size_t i = 0; i < a.size(); ++i) {
             CHECK(segment_gap(a[(i + shift / per) % a.size()], b[i], false) < 1e-12);
@@ -195,7 +202,8 @@ TEST_CASE("order: 2-opt and Or-opt never lose to plain greedy", "[order]") {
 TEST_CASE("order: a good document order stays (start point given)", "[order]") {
     Path p;
     for (int i = 0; i < 10; ++i) {
-        p.subpaths.push_back({PathBasis::kPolyline, false, {{10.0 * i, 0}, {10.0 * i + 5, 0}}, 0, {}});
+        p.subpaths.push_back(
+            {PathBasis::kPolyline, false, {{10.0 * i, 0}, {10.0 * i + 5, 0}}, 0, {}});
     }
     OrderOptions o;
     o.start = {0, 0};
@@ -209,10 +217,22 @@ TEST_CASE("order: a good document order stays (start point given)", "[order]") {
 }
 
 TEST_CASE("order: closed subpaths start at their nearest vertex", "[order]") {
-    Subpath square{PathBasis::kPolyline, true, {{100, 100}, {110, 100}, {110, 110}, {100, 110}}, 0, {}};
-    Subpath loop{PathBasis::kBezier, false,
-                 {{0, 50}, {0, 55}, {5, 60}, {10, 60}, {15, 60}, {20, 55}, {20, 50}, {10, 45}, {5, 45}, {0, 50.005}},
-                 0, {}};
+    Subpath square{
+        PathBasis::kPolyline, true, {{100, 100}, {110, 100}, {110, 110}, {100, 110}}, 0, {}};
+    Subpath loop{PathBasis::kBezier,
+                 false,
+                 {{0, 50},
+                  {0, 55},
+                  {5, 60},
+                  {10, 60},
+                  {15, 60},
+                  {20, 55},
+                  {20, 50},
+                  {10, 45},
+                  {5, 45},
+                  {0, 50.005}},
+                 0,
+                 {}};
     Path p;
     p.subpaths = {square, loop};
     OrderOptions o;
@@ -232,7 +252,8 @@ TEST_CASE("order: same input, same output", "[order]") {
     const Path p = random_strokes(99, 500);
     const Path a = order_path(p), b = order_path(p);
     REQUIRE(a.subpaths.size() == b.subpaths.size());
-    for (std::size_t i = 0; i < a.subpaths.size(); ++i) CHECK(a.subpaths[i].points == b.subpaths[i].points);
+    for (std::size_t i = 0; i < a.subpaths.size(); ++i)
+        CHECK(a.subpaths[i].points == b.subpaths[i].points);
 }
 
 TEST_CASE("order: a bounded work limit still gives a valid order", "[order]") {
@@ -250,10 +271,10 @@ TEST_CASE("order: landscape.svg pen-up travel at most 582 mm", "[order]") {
     const Path p = load_svg_path(source_dir() + "/examples/landscape.svg");
     OrderReport r;
     const Path q = order_path(p, {}, &r);
-    INFO("before " << r.travel_before << " mm, after " << r.travel_after << " mm, " << r.subpaths_before
-                   << " -> " << r.subpaths_after);
+    INFO("before " << r.travel_before << " mm, after " << r.travel_after << " mm, "
+                   << r.subpaths_before << " -> " << r.subpaths_after);
     CHECK(r.travel_after <= 582.0);
     CHECK(r.travel_after < r.travel_before);
-    WARN("landscape.svg: " << r.travel_before << " mm -> " << r.travel_after << " mm, " << r.subpaths_before
-                           << " -> " << r.subpaths_after << " subpaths");
+    WARN("landscape.svg: " << r.travel_before << " mm -> " << r.travel_after << " mm, "
+                           << r.subpaths_before << " -> " << r.subpaths_after << " subpaths");
 }

@@ -12,11 +12,14 @@ namespace {
 /// A 40 x 20 mm polyline rectangle at (10, 5).
 Path rectangle() {
     Path p;
-    p.subpaths.push_back({PathBasis::kPolyline, true, {{10, 5}, {50, 5}, {50, 25}, {10, 25}}, 0, {}});
+    p.subpaths.push_back(
+        {PathBasis::kPolyline, true, {{10, 5}, {50, 5}, {50, 25}, {10, 25}}, 0, {}});
     return p;
 }
 
-Box2 box_of(const Path& p) { return *drawing_box(p); }
+Box2 box_of(const Path& p) {
+    return *drawing_box(p);
+}
 
 }  // namespace
 
@@ -107,7 +110,8 @@ TEST_CASE("placement: bad values are refused with the option's name", "[placemen
     const Path p = rectangle();
     PlacementOptions o;
     o.fit = "area";
-    CHECK_THROWS_WITH(place_path(p, o, std::nullopt), Catch::Contains("--fit area needs a machine profile"));
+    CHECK_THROWS_WITH(place_path(p, o, std::nullopt),
+                      Catch::Contains("--fit area needs a machine profile"));
     o.fit = "a9";
     CHECK_THROWS_WITH(place_path(p, o, std::nullopt), Catch::Contains("--fit: \"a9\""));
     o.fit = "a4";
@@ -128,15 +132,18 @@ TEST_CASE("placement: bad values are refused with the option's name", "[placemen
     CHECK_THROWS_AS(place_path(Path{}, o, std::nullopt), std::invalid_argument);
 }
 
-TEST_CASE("placement: a paper larger than the work area names the orientation that fits", "[placement]") {
+TEST_CASE("placement: a paper larger than the work area names the orientation that fits",
+          "[placement]") {
     const std::optional<Box2> a3_landscape_area = Box2{0, 0, 430, 297};
     PlacementOptions o;
     o.fit = "a3";
-    CHECK_THROWS_WITH(place_path(rectangle(), o, a3_landscape_area),
-                      Catch::Contains("--fit a3: the paper (297 x 420 mm) does not fit the machine's work area "
-                                      "(430 x 297 mm from (0, 0) mm); --fit a3-landscape does"));
+    CHECK_THROWS_WITH(
+        place_path(rectangle(), o, a3_landscape_area),
+        Catch::Contains("--fit a3: the paper (297 x 420 mm) does not fit the machine's work area "
+                        "(430 x 297 mm from (0, 0) mm); --fit a3-landscape does"));
     o.fit = "a2";
-    CHECK_THROWS_WITH(place_path(rectangle(), o, a3_landscape_area), Catch::Contains(", in either orientation"));
+    CHECK_THROWS_WITH(place_path(rectangle(), o, a3_landscape_area),
+                      Catch::Contains(", in either orientation"));
     o.fit = "a3-landscape";
     CHECK_NOTHROW(place_path(rectangle(), o, a3_landscape_area));
     CHECK_NOTHROW(place_path(rectangle(), o, std::nullopt));  // no machine: no check
@@ -158,5 +165,6 @@ TEST_CASE("placement: a fit keeps the edge clearance from the travel's edges", "
     PlacementOptions without = o;
     without.edge_clearance = 0;
     const std::optional<Box2> big = Box2{-10, -10, 430, 297};
-    CHECK(box_of(place_path(rectangle(), o, big)).x_min == box_of(place_path(rectangle(), without, big)).x_min);
+    CHECK(box_of(place_path(rectangle(), o, big)).x_min ==
+          box_of(place_path(rectangle(), without, big)).x_min);
 }

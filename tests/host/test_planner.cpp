@@ -4,7 +4,6 @@
 //
 // Random cases: PATHSTREAM_PLAN_CASES (default 12) paths, seed PATHSTREAM_PLAN_SEED (default 1).
 #include <catch2/catch.hpp>
-
 #include <cmath>
 #include <cstdlib>
 #include <memory>
@@ -24,7 +23,8 @@ constexpr double kPi = 3.14159265358979323846;
 
 MachineProfile profile(double v = 250, double a = 3000, std::size_t axes = 2) {
     MachineProfile p;
-    for (std::size_t i = 0; i < axes; ++i) p.axes.push_back({std::string(1, static_cast<char>('x' + i)), v, a});
+    for (std::size_t i = 0; i < axes; ++i)
+        p.axes.push_back({std::string(1, static_cast<char>('x' + i)), v, a});
     p.feed = 80;
     p.travel_feed = 200;
     p.pen_down_delay = 0.08;
@@ -174,7 +174,8 @@ TEST_CASE("on a circle the speed is limited by acceleration: v = sqrt(a r)", "[p
     for (std::size_t k = 2; k + 2 < sp.size(); ++k) {
         const double x = sp[k][0] * lsb, y = sp[k][1] * lsb;
         if (std::fabs(x) > 0.2 || y < 0) continue;
-        const double dx = (sp[k + 2][0] - sp[k - 2][0]) * lsb, dy = (sp[k + 2][1] - sp[k - 2][1]) * lsb;
+        const double dx = (sp[k + 2][0] - sp[k - 2][0]) * lsb,
+                     dy = (sp[k + 2][1] - sp[k - 2][1]) * lsb;
         const double v = std::sqrt(dx * dx + dy * dy) / (4 * tick);
         CHECK(v <= expected * 1.005);
         CHECK(v >= expected * 0.96);
@@ -189,8 +190,10 @@ TEST_CASE("on a circle the speed is limited by acceleration: v = sqrt(a r)", "[p
 
 TEST_CASE("a square polyline stops exactly at every corner", "[planner]") {
     const MachineProfile p = profile();
-    const Planned r = plan_and_check(path_of({polyline({{0, 0}, {20, 0}, {20, 20}, {0, 20}}, true)}), p);
-    const std::vector<std::array<int, 2>> corners = {{0, 0}, {20000, 0}, {20000, 20000}, {0, 20000}};
+    const Planned r =
+        plan_and_check(path_of({polyline({{0, 0}, {20, 0}, {20, 20}, {0, 20}}, true)}), p);
+    const std::vector<std::array<int, 2>> corners = {
+        {0, 0}, {20000, 0}, {20000, 20000}, {0, 20000}};
     int stops = 0;
     for (std::size_t i = 0; i + 1 < r.plan.spans.size(); ++i) {
         const CoreSpan& s = r.plan.spans[i];
@@ -209,7 +212,8 @@ TEST_CASE("a square polyline stops exactly at every corner", "[planner]") {
     stream_all(r.plan);
 }
 
-TEST_CASE("a shallow polyline corner is crossed without stopping, at the corner speed", "[planner]") {
+TEST_CASE("a shallow polyline corner is crossed without stopping, at the corner speed",
+          "[planner]") {
     MachineProfile p = profile();
     p.feed = 100;
     // Turns by 0.05 rad (under corner_stop_angle): crossed at the corner rule's speed.
@@ -244,7 +248,8 @@ TEST_CASE("pen events: down after arriving, dwell, draw, up, dwell, travel", "[p
     const auto sp = stream_all(r.plan);
     const auto at = [&](std::uint64_t t) { return sp[static_cast<std::size_t>(t)]; };
     // Holding still through each pen delay, at the right place.
-    const std::array<std::array<int, 2>, 4> where = {{{0, 0}, {10000, 0}, {10000, 5000}, {0, 5000}}};
+    const std::array<std::array<int, 2>, 4> where = {
+        {{0, 0}, {10000, 0}, {10000, 5000}, {0, 5000}}};
     const std::uint64_t delay[4] = {80, 60, 80, 60};
     for (std::size_t e = 0; e < 4; ++e) {
         for (std::uint64_t t = r.plan.pen[e].tick; t <= r.plan.pen[e].tick + delay[e]; ++t) {
@@ -257,7 +262,8 @@ TEST_CASE("pen events: down after arriving, dwell, draw, up, dwell, travel", "[p
     std::size_t event = 0;
     bool down = false;
     for (const CoreSpan& s : r.plan.spans) {
-        while (event < r.plan.pen.size() && r.plan.pen[event].tick <= tick) down = r.plan.pen[event++].down;
+        while (event < r.plan.pen.size() && r.plan.pen[event].tick <= tick)
+            down = r.plan.pen[event++].down;
         CHECK(s.pen_down == down);
         tick += s.ticks;
     }
@@ -353,7 +359,8 @@ TEST_CASE("one and three axes: a line and a helix", "[planner]") {
         MachineProfile p = profile(100, 2000, 1);
         Subpath s = polyline({{0}, {30}, {10}});  // a reversal: a sharp corner, a stop
         const Planned r = plan_and_check(path_of({s}, 1), p);
-        const double optimum = (30 / 80.0 + 80 / 2000.0) + (20 / 80.0 + 80 / 2000.0);  // two trapezoids
+        const double optimum =
+            (30 / 80.0 + 80 / 2000.0) + (20 / 80.0 + 80 / 2000.0);  // two trapezoids
         CHECK(motion_time(r, p) >= optimum * 0.999);
         CHECK(motion_time(r, p) <= optimum * 1.02);
     }
@@ -388,7 +395,9 @@ TEST_CASE("seeded random paths pass the per-tick check and stream into the core"
     std::mt19937_64 rng(seed);
     std::uniform_real_distribution<double> unit(0, 1);
     const auto pick = [&](double lo, double hi) { return lo + (hi - lo) * unit(rng); };
-    const auto log_pick = [&](double lo, double hi) { return std::exp(pick(std::log(lo), std::log(hi))); };
+    const auto log_pick = [&](double lo, double hi) {
+        return std::exp(pick(std::log(lo), std::log(hi)));
+    };
     for (int c = 0; c < cases; ++c) {
         MachineProfile p = profile(log_pick(20, 500), log_pick(200, 20000));
         p.axes[1].max_velocity *= pick(0.5, 2);
@@ -408,16 +417,18 @@ TEST_CASE("seeded random paths pass the per-tick check and stream into the core"
             sp.basis = static_cast<PathBasis>(rng() % 4);
             sp.closed = rng() % 3 == 0;
             std::size_t n = 2 + rng() % 12;
-            if (sp.basis == PathBasis::kBezier) n = sp.closed ? 3 * (1 + rng() % 4) : 3 * (1 + rng() % 4) + 1;
+            if (sp.basis == PathBasis::kBezier)
+                n = sp.closed ? 3 * (1 + rng() % 4) : 3 * (1 + rng() % 4) + 1;
             if (sp.closed && n < 3) n = 3;
             const double size = log_pick(0.5, 60);
-            for (std::size_t i = 0; i < n; ++i) sp.points.push_back({pick(-size, size), pick(-size, size)});
+            for (std::size_t i = 0; i < n; ++i)
+                sp.points.push_back({pick(-size, size), pick(-size, size)});
             if (rng() % 4 == 0) sp.feed = log_pick(5, 200);
             path.subpaths.push_back(sp);
         }
         INFO("case " << c << " seed " << seed << ": tick_hz " << p.tick_hz << ", ticks_per_span "
-                     << p.ticks_per_span << ", lsb " << p.mm_per_lsb << ", v " << p.axes[0].max_velocity
-                     << ", a " << p.axes[0].max_acceleration);
+                     << p.ticks_per_span << ", lsb " << p.mm_per_lsb << ", v "
+                     << p.axes[0].max_velocity << ", a " << p.axes[0].max_acceleration);
         try {
             const Planned r = plan_and_check(path, p);
             stream_all(r.plan);
@@ -426,7 +437,8 @@ TEST_CASE("seeded random paths pass the per-tick check and stream into the core"
             // spans of up to 150 ms on millimetre-sized wiggles, where whole spans cost a lot.
             const double span = p.ticks_per_span / p.tick_hz;
             CHECK(motion_time(r, p) <= 4 * r.stats.reference_motion_time +
-                                           3 * span * static_cast<double>(r.stats.pieces + 1) + 0.1);
+                                           3 * span * static_cast<double>(r.stats.pieces + 1) +
+                                           0.1);
         } catch (const PlanError& e) {
             FAIL_CHECK("planning failed: " << e.what());
         }

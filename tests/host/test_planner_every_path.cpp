@@ -6,9 +6,8 @@
 //
 // Size: PATHSTREAM_HARD_PATH_CASES (default 200) cases from seed PATHSTREAM_HARD_PATH_SEED
 // (default 1); e.g. PATHSTREAM_HARD_PATH_CASES=5000 for a long run.
-#include <catch2/catch.hpp>
-
 #include <array>
+#include <catch2/catch.hpp>
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
@@ -18,8 +17,8 @@
 #include <vector>
 
 #include "pathstream/host/geometry.hpp"
-#include "pathstream/machine/machine.hpp"
 #include "pathstream/host/planner.hpp"
+#include "pathstream/machine/machine.hpp"
 #include "pen_plotter_profile.hpp"
 
 using namespace pathstream::host;
@@ -40,11 +39,21 @@ public:
         s.basis = basis;
         const int kind = static_cast<int>(rng_() % 5);
         switch (kind) {
-            case 0: hairpins(s.points); break;
-            case 1: repeated(s.points); break;
-            case 2: tiny_loops(s.points); break;
-            case 3: turning_walk(s.points); break;
-            default: mixed(s.points); break;
+            case 0:
+                hairpins(s.points);
+                break;
+            case 1:
+                repeated(s.points);
+                break;
+            case 2:
+                tiny_loops(s.points);
+                break;
+            case 3:
+                turning_walk(s.points);
+                break;
+            default:
+                mixed(s.points);
+                break;
         }
         if (basis == PathBasis::kBezier) {
             while (s.points.size() % 3 != 1) s.points.push_back(s.points.back());
@@ -56,7 +65,9 @@ public:
     int last_kind() const { return kind_; }
 
 private:
-    double pick(double lo, double hi) { return std::uniform_real_distribution<double>(lo, hi)(rng_); }
+    double pick(double lo, double hi) {
+        return std::uniform_real_distribution<double>(lo, hi)(rng_);
+    }
     /// A point `lsbs` LSB away from p in a random direction (0: p itself).
     PathPoint near(const PathPoint& p, double lsbs) {
         const double a = pick(0, 2 * kPi);
@@ -134,13 +145,15 @@ std::string profile_json(const MachineProfile& p) {
     m.precision(17);
     m << "{\"axes\":[";
     for (std::size_t i = 0; i < p.axes.size(); ++i) {
-        m << (i ? "," : "") << "{\"name\":\"" << p.axes[i].name << "\",\"max_velocity\":" << p.axes[i].max_velocity
+        m << (i ? "," : "") << "{\"name\":\"" << p.axes[i].name
+          << "\",\"max_velocity\":" << p.axes[i].max_velocity
           << ",\"max_acceleration\":" << p.axes[i].max_acceleration << "}";
     }
-    m << "],\"tick_hz\":" << p.tick_hz << ",\"ticks_per_span\":" << p.ticks_per_span << ",\"mm_per_lsb\":"
-      << p.mm_per_lsb << ",\"chord_tolerance\":" << p.chord_tolerance << ",\"feed\":" << p.feed
-      << ",\"travel_feed\":" << p.travel_feed << ",\"pen_down_delay\":" << p.pen_down_delay
-      << ",\"pen_up_delay\":" << p.pen_up_delay << "}\n";
+    m << "],\"tick_hz\":" << p.tick_hz << ",\"ticks_per_span\":" << p.ticks_per_span
+      << ",\"mm_per_lsb\":" << p.mm_per_lsb << ",\"chord_tolerance\":" << p.chord_tolerance
+      << ",\"feed\":" << p.feed << ",\"travel_feed\":" << p.travel_feed
+      << ",\"pen_down_delay\":" << p.pen_down_delay << ",\"pen_up_delay\":" << p.pen_up_delay
+      << "}\n";
     return m.str();
 }
 
@@ -165,8 +178,8 @@ void dump(const Path& path, const MachineProfile& p, int c) {
     f << "{\"units\":\"mm\",\"subpaths\":[";
     for (std::size_t s = 0; s < path.subpaths.size(); ++s) {
         const Subpath& sp = path.subpaths[s];
-        f << (s ? "," : "") << "{\"basis\":\"" << names[static_cast<int>(sp.basis)] << "\",\"closed\":"
-          << (sp.closed ? "true" : "false") << ",\"points\":[";
+        f << (s ? "," : "") << "{\"basis\":\"" << names[static_cast<int>(sp.basis)]
+          << "\",\"closed\":" << (sp.closed ? "true" : "false") << ",\"points\":[";
         for (std::size_t i = 0; i < sp.points.size(); ++i) {
             f << (i ? "," : "") << "[" << sp.points[i][0] << "," << sp.points[i][1] << "]";
         }
@@ -212,11 +225,13 @@ TEST_CASE("every accepted path plans: cusps, near-cusps, repeated points, tiny l
             const auto basis = static_cast<PathBasis>(rng() % 4);
             Subpath sp = shapes.next(basis);
             sp.closed = basis != PathBasis::kBezier && rng() % 4 == 0 && sp.points.size() >= 3;
-            kinds += std::to_string(static_cast<int>(basis)) + "/" + std::to_string(shapes.last_kind()) + " ";
+            kinds += std::to_string(static_cast<int>(basis)) + "/" +
+                     std::to_string(shapes.last_kind()) + " ";
             path.subpaths.push_back(std::move(sp));
         }
-        INFO("case " << c << " seed " << seed << " (basis/shape: " << kinds << "): tick_hz " << p.tick_hz
-                     << ", ticks_per_span " << p.ticks_per_span << ", lsb " << p.mm_per_lsb);
+        INFO("case " << c << " seed " << seed << " (basis/shape: " << kinds << "): tick_hz "
+                     << p.tick_hz << ", ticks_per_span " << p.ticks_per_span << ", lsb "
+                     << p.mm_per_lsb);
         try {
             const auto segs = to_bezier_segments(path);
             const Plan plan = plan_path(segs, p);
@@ -226,7 +241,8 @@ TEST_CASE("every accepted path plans: cusps, near-cusps, repeated points, tiny l
             CHECK(check.max_feed_fraction <= 1.0);
             CHECK(check.max_deviation <= p.chord_tolerance + 1.5 * std::sqrt(2.0) * p.mm_per_lsb);
             CHECK(check.ticks_checked == plan.total_ticks + 1);
-            if (!check.within_limits || check.max_deviation > p.chord_tolerance + 1.5 * std::sqrt(2.0) * p.mm_per_lsb) {
+            if (!check.within_limits ||
+                check.max_deviation > p.chord_tolerance + 1.5 * std::sqrt(2.0) * p.mm_per_lsb) {
                 if (std::getenv("PATHSTREAM_HARD_PATH_DUMP") != nullptr) dump(path, p, c);
             }
         } catch (const PlanError& e) {

@@ -6,7 +6,6 @@
 //
 // Random cases: PATHSTREAM_EXACT_CASES (default 8) paths, seed PATHSTREAM_PLAN_SEED (default 1).
 #include <catch2/catch.hpp>
-
 #include <cmath>
 #include <cstdlib>
 #include <random>
@@ -16,9 +15,9 @@
 #include "pathstream/host/gcode_path.hpp"
 #include "pathstream/host/geometry.hpp"
 #include "pathstream/host/json_path.hpp"
-#include "pathstream/machine/machine.hpp"
 #include "pathstream/host/planner.hpp"
 #include "pathstream/host/svg_path.hpp"
+#include "pathstream/machine/machine.hpp"
 #include "pathstream/tick_cubic.hpp"
 
 using namespace pathstream::host;
@@ -54,8 +53,11 @@ Worst worst_span(const Plan& plan, const MachineProfile& p) {
             const auto& c = s.control[i];
             const double dp = static_cast<double>(c[1]) - c[0], t0 = c[2], t1 = c[3];
             const double a0 = 6 * dp - 4 * t0 - 2 * t1, a1 = -6 * dp + 2 * t0 + 4 * t1;
-            w.acceleration = std::max(w.acceleration, std::max(std::fabs(a0), std::fabs(a1)) / (n * n) / a_lim);
-            const auto v = [&](double u) { return std::fabs(t0 + a0 * u + (a1 - a0) * u * u / 2) / n / v_lim; };
+            w.acceleration =
+                std::max(w.acceleration, std::max(std::fabs(a0), std::fabs(a1)) / (n * n) / a_lim);
+            const auto v = [&](double u) {
+                return std::fabs(t0 + a0 * u + (a1 - a0) * u * u / 2) / n / v_lim;
+            };
             for (int k = 0; k <= 64; ++k) w.velocity = std::max(w.velocity, v(k / 64.0));
             if (a0 * a1 < 0) w.velocity = std::max(w.velocity, v(a0 / (a0 - a1)));
         }
@@ -82,13 +84,15 @@ PlanCheck plan_exactly(const Path& path, const MachineProfile& p) {
     // The two computations of the span figures agree.
     CHECK(w.acceleration == Approx(c.max_span_acceleration_fraction).epsilon(1e-9));
     CHECK(w.velocity <= c.max_span_velocity_fraction * (1 + 1e-9));
-    CHECK(c.max_deviation <= p.chord_tolerance + 1.5 * std::sqrt(static_cast<double>(p.axes.size())) * p.mm_per_lsb);
+    CHECK(c.max_deviation <=
+          p.chord_tolerance + 1.5 * std::sqrt(static_cast<double>(p.axes.size())) * p.mm_per_lsb);
     return c;
 }
 
 MachineProfile profile(double v, double a, std::size_t axes) {
     MachineProfile p;
-    for (std::size_t i = 0; i < axes; ++i) p.axes.push_back({std::string(1, static_cast<char>('x' + i)), v, a});
+    for (std::size_t i = 0; i < axes; ++i)
+        p.axes.push_back({std::string(1, static_cast<char>('x' + i)), v, a});
     p.feed = 80;
     p.travel_feed = 200;
     return p;
@@ -96,14 +100,26 @@ MachineProfile profile(double v, double a, std::size_t axes) {
 
 }  // namespace
 
-TEST_CASE("every example plans to spans whose exact cubic is within the pen plotter's limits", "[planner]") {
-    const MachineProfile p = load_machine_profile(source_dir() + "/examples/machines/pen_plotter.json");
+TEST_CASE("every example plans to spans whose exact cubic is within the pen plotter's limits",
+          "[planner]") {
+    const MachineProfile p =
+        load_machine_profile(source_dir() + "/examples/machines/pen_plotter.json");
     const std::string ex = source_dir() + "/examples/";
-    SECTION("rose.json") { plan_exactly(load_json_path(ex + "rose.json"), p); }
-    SECTION("wave.json") { plan_exactly(load_json_path(ex + "wave.json"), p); }
-    SECTION("landscape.svg") { plan_exactly(load_svg_path(ex + "landscape.svg"), p); }
-    SECTION("leaf.ngc") { plan_exactly(load_gcode_path(ex + "leaf.ngc"), p); }
-    SECTION("star.csv") { plan_exactly(load_csv_path(ex + "star.csv", PathBasis::kBSpline, false), p); }
+    SECTION("rose.json") {
+        plan_exactly(load_json_path(ex + "rose.json"), p);
+    }
+    SECTION("wave.json") {
+        plan_exactly(load_json_path(ex + "wave.json"), p);
+    }
+    SECTION("landscape.svg") {
+        plan_exactly(load_svg_path(ex + "landscape.svg"), p);
+    }
+    SECTION("leaf.ngc") {
+        plan_exactly(load_gcode_path(ex + "leaf.ngc"), p);
+    }
+    SECTION("star.csv") {
+        plan_exactly(load_csv_path(ex + "star.csv", PathBasis::kBSpline, false), p);
+    }
     SECTION("star.csv as a closed polyline") {
         plan_exactly(load_csv_path(ex + "star.csv", PathBasis::kPolyline, true), p);
     }
@@ -141,7 +157,9 @@ void random_exact_cases(unsigned long seed, int cases) {
     std::mt19937_64 rng(seed ^ 0x5eedULL);
     std::uniform_real_distribution<double> unit(0, 1);
     const auto pick = [&](double lo, double hi) { return lo + (hi - lo) * unit(rng); };
-    const auto log_pick = [&](double lo, double hi) { return std::exp(pick(std::log(lo), std::log(hi))); };
+    const auto log_pick = [&](double lo, double hi) {
+        return std::exp(pick(std::log(lo), std::log(hi)));
+    };
     for (int c = 0; c < cases; ++c) {
         const std::size_t axes = 1 + rng() % 3;
         MachineProfile p = profile(log_pick(20, 500), log_pick(200, 20000), axes);
@@ -159,7 +177,8 @@ void random_exact_cases(unsigned long seed, int cases) {
         for (int s = 0, n = 1 + static_cast<int>(rng() % 2); s < n; ++s) {
             Subpath sp;
             sp.basis = static_cast<PathBasis>(rng() % 4);
-            std::size_t points = sp.basis == PathBasis::kBezier ? 3 * (1 + rng() % 3) + 1 : 2 + rng() % 10;
+            std::size_t points =
+                sp.basis == PathBasis::kBezier ? 3 * (1 + rng() % 3) + 1 : 2 + rng() % 10;
             const double size = log_pick(0.5, 60);
             for (std::size_t i = 0; i < points; ++i) {
                 PathPoint q;
@@ -188,17 +207,20 @@ TEST_CASE("seeded random paths: the exact cubic of every span is within the limi
     random_exact_cases(seed, cases);
 }
 
-TEST_CASE("seed 7 cases 5 and 6 (1 axis, 1 tick per span requested): no PlanError near a start", "[planner]") {
+TEST_CASE("seed 7 cases 5 and 6 (1 axis, 1 tick per span requested): no PlanError near a start",
+          "[planner]") {
     // A node capped at rest by a retry was a dip of 0 in the lookahead: beta stayed 0 over the
     // whole piece before it and planning failed a few LSB after the piece's start.
     random_exact_cases(7, 7);
 }
 
-TEST_CASE("check_plan refuses a span whose exact cubic is over the limit by a little", "[planner]") {
+TEST_CASE("check_plan refuses a span whose exact cubic is over the limit by a little",
+          "[planner]") {
     // One LSB more tangent at one knot moves the spans' end accelerations by 2 to 4 LSB/u^2:
     // 3 to 6 % of 3 LSB/tick^2 at 8 ticks, over the limit exactly but well within the check's
     // rounding allowance of 2 LSB/tick^2 on the setpoints.
-    const MachineProfile p = load_machine_profile(source_dir() + "/examples/machines/pen_plotter.json");
+    const MachineProfile p =
+        load_machine_profile(source_dir() + "/examples/machines/pen_plotter.json");
     Subpath s;
     s.basis = PathBasis::kPolyline;
     s.points = {{0, 0}, {40, 0}};
@@ -210,13 +232,17 @@ TEST_CASE("check_plan refuses a span whose exact cubic is over the limit by a li
     // The first knot inside the acceleration ramp (x accelerating at the limit): raise its
     // tangent on both spans that share it.
     std::size_t j = 0;
-    while (j + 1 < plan.spans.size() && !(plan.spans[j].control[0][3] > 0 && plan.spans[j].ticks == 8)) ++j;
+    while (j + 1 < plan.spans.size() &&
+           !(plan.spans[j].control[0][3] > 0 && plan.spans[j].ticks == 8))
+        ++j;
     REQUIRE(j + 1 < plan.spans.size());
     for (std::size_t k : {j, j + 1}) {
         CoreSpan& cs = plan.spans[k];
         cs.control[0][k == j ? 3 : 2] += 1;
-        const std::int32_t control[4] = {cs.control[0][0], cs.control[0][1], cs.control[0][2], cs.control[0][3]};
-        REQUIRE(pathstream::make_tick_cubic(cs.basis, control, cs.timing, cs.cubic[0]) == pathstream::Status::kOk);
+        const std::int32_t control[4] = {cs.control[0][0], cs.control[0][1], cs.control[0][2],
+                                         cs.control[0][3]};
+        REQUIRE(pathstream::make_tick_cubic(cs.basis, control, cs.timing, cs.cubic[0]) ==
+                pathstream::Status::kOk);
     }
     const PlanCheck c = check_plan(plan, segs, p);
     CHECK(c.max_span_acceleration_fraction > 1.0);

@@ -16,9 +16,9 @@
 #include "pathstream/host/gcode_path.hpp"
 #include "pathstream/host/geometry.hpp"
 #include "pathstream/host/json_path.hpp"
-#include "pathstream/machine/machine.hpp"
 #include "pathstream/host/planner.hpp"
 #include "pathstream/host/svg_path.hpp"
+#include "pathstream/machine/machine.hpp"
 
 using namespace pathstream::host;
 

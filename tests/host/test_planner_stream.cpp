@@ -2,12 +2,11 @@
 // the plan of one window over the whole path (within the grid's rounding), every span passes
 // the per-tick check, and a long generated job plans under a memory ceiling the whole-path
 // planner could not meet.
-#include <catch2/catch.hpp>
-
 #include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <catch2/catch.hpp>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -136,7 +135,9 @@ TEST_CASE("a long job plans under a memory ceiling the whole-path planner needs 
             RandomWalkSource walk(100000, 11);
             CountingSink sink;
             const PlanTotals totals = plan_stream(walk, pen_plotter(), PlanOptions{}, sink);
-            _exit(sink.discontinuities == 0 && totals.spans > 200000 && sink.spans == totals.spans ? 0 : 1);
+            _exit(sink.discontinuities == 0 && totals.spans > 200000 && sink.spans == totals.spans
+                      ? 0
+                      : 1);
         } catch (const std::bad_alloc&) {
             _exit(2);
         } catch (...) {
@@ -146,7 +147,9 @@ TEST_CASE("a long job plans under a memory ceiling the whole-path planner needs 
     int status = 0;
     REQUIRE(waitpid(child, &status, 0) == child);
     REQUIRE(WIFEXITED(status));
-    INFO("exit status 0: planned; 1: wrong plan; 2: out of memory; 3: setrlimit failed; 4: other error");
+    INFO(
+        "exit status 0: planned; 1: wrong plan; 2: out of memory; 3: setrlimit failed; 4: other "
+        "error");
     CHECK(WEXITSTATUS(status) == 0);
 #endif
 }
@@ -158,7 +161,8 @@ TEST_CASE("PlanChecker on a streamed plan gives check_plan's figures and the cor
     for (int c = 0; c < 3; ++c) {
         Subpath s;
         s.basis = PathBasis::kCatmullRom;
-        for (int i = 0; i < 30; ++i) s.points.push_back({20.0 * c + 8 * std::cos(i * 0.7), 8 * std::sin(i * 0.9)});
+        for (int i = 0; i < 30; ++i)
+            s.points.push_back({20.0 * c + 8 * std::cos(i * 0.7), 8 * std::sin(i * 0.9)});
         path.subpaths.push_back(s);
     }
     const auto segments = to_bezier_segments(path);

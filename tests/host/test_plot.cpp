@@ -17,9 +17,9 @@
 #include "pathstream/host/plan.hpp"
 #include "pathstream/host/plot.hpp"
 #include "pathstream/sim/device.hpp"
-#include "sim_plots.hpp"
 #include "pathstream/status.hpp"
 #include "pathstream/tick_cubic.hpp"
+#include "sim_plots.hpp"
 
 using namespace pathstream;
 using namespace pathstream::host;

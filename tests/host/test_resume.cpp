@@ -102,8 +102,7 @@ host::DeviceSnapshot wait_for(host::DeviceLink& link, DeviceState state) {
         std::this_thread::sleep_for(std::chrono::milliseconds(2));
         s = link.status();
     }
-    REQUIRE(std::string(host::device_state_name(s.state)) ==
-            host::device_state_name(state));
+    REQUIRE(std::string(host::device_state_name(s.state)) == host::device_state_name(state));
     return s;
 }
 
@@ -536,7 +535,8 @@ TEST_CASE("ctl's link: status and every command over Modbus TCP, refusals by nam
     // A jog and a set position through the link.
     REQUIRE(link->command_with_arguments(device::kCommandJog, 1, -4321, 500) == Status::kOk);
     const std::uint32_t jog_job = s.last_accepted + 1;
-    for (int i = 0; i < 5000 && !(s.state == DeviceState::kIdle && s.finished_job == jog_job); ++i) {
+    for (int i = 0; i < 5000 && !(s.state == DeviceState::kIdle && s.finished_job == jog_job);
+         ++i) {
         std::this_thread::sleep_for(std::chrono::milliseconds(2));
         s = link->status();
     }

@@ -30,7 +30,8 @@ struct Item {
 
 }  // namespace
 
-TEST_CASE("SpscRing: a producer and a consumer thread pass every item once, in order, whole", "[spsc][threads]") {
+TEST_CASE("SpscRing: a producer and a consumer thread pass every item once, in order, whole",
+          "[spsc][threads]") {
     constexpr std::uint64_t kItems = 200000;
     SpscRing<Item, 64> ring;  // small: both sides meet full and empty often
     std::thread producer([&] {
@@ -60,7 +61,8 @@ TEST_CASE("SpscRing: a producer and a consumer thread pass every item once, in o
     CHECK_FALSE(ring.try_pop(item));
 }
 
-TEST_CASE("SpscRing: a seeded interleaving of pushes and pops behaves as a bounded FIFO", "[spsc]") {
+TEST_CASE("SpscRing: a seeded interleaving of pushes and pops behaves as a bounded FIFO",
+          "[spsc]") {
     for (const std::uint64_t seed : {1u, 2u, 3u, 42u, 1234u}) {
         INFO("seed " << seed);
         std::mt19937_64 rng(seed);
@@ -98,8 +100,10 @@ TEST_CASE("SpscRing: a seeded interleaving of pushes and pops behaves as a bound
     }
 }
 
-TEST_CASE("PlanningThread: the spans cross the queue as plan_stream makes them, the totals after the last",
-          "[spsc][planner][threads]") {
+TEST_CASE(
+    "PlanningThread: the spans cross the queue as plan_stream makes them, the totals after the "
+    "last",
+    "[spsc][planner][threads]") {
     const MachineProfile machine = pen_plotter();
     // Longer than the queue: the planning thread waits on it, and cannot be finished
     // before the consumer took most of the job.
@@ -139,8 +143,10 @@ TEST_CASE("PlanningThread: the spans cross the queue as plan_stream makes them, 
     CHECK(tapped.digest.hash == reference.digest.hash);
 }
 
-TEST_CASE("PlanningThread: an error on the planning thread reaches the consumer, cancel ends a waiting planner",
-          "[spsc][planner][threads]") {
+TEST_CASE(
+    "PlanningThread: an error on the planning thread reaches the consumer, cancel ends a waiting "
+    "planner",
+    "[spsc][planner][threads]") {
     const MachineProfile machine = pen_plotter();
     class FailingTap : public PlanSink {
     public:
@@ -163,7 +169,8 @@ TEST_CASE("PlanningThread: an error on the planning thread reaches the consumer,
                 const SpanSupply::Take t = planning.take(span);
                 if (t == SpanSupply::Take::kSpan) ++taken;
                 if (t == SpanSupply::Take::kEnd) break;
-                if (t == SpanSupply::Take::kWait) std::this_thread::sleep_for(std::chrono::microseconds(100));
+                if (t == SpanSupply::Take::kWait)
+                    std::this_thread::sleep_for(std::chrono::microseconds(100));
             }
         } catch (const PlanError& e) {
             threw = true;

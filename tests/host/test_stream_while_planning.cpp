@@ -2,9 +2,8 @@
 // job reaches the simulated device (Modbus TCP) before planning has finished and executes,
 // tick for tick, what plan_path plans for it; a planning error once the device runs brings
 // it to a controlled stop and reaches the caller.
-#include <catch2/catch.hpp>
-
 #include <atomic>
+#include <catch2/catch.hpp>
 #include <optional>
 #include <thread>
 #include <vector>
@@ -30,16 +29,20 @@ struct TcpDevice {
     std::atomic<bool> stop{false};
     std::thread thread;
 
-    TcpDevice(const std::vector<Lsb>& rest, double time_scale) : device(linux_device::ModbusMotionDevice::create(rest)) {
+    TcpDevice(const std::vector<Lsb>& rest, double time_scale)
+        : device(linux_device::ModbusMotionDevice::create(rest)) {
         device->record(true);
         server.emplace(hal::ModbusServer::tcp(device->handler(), {"127.0.0.1", 0, 4}));
         thread = std::thread([this, time_scale] {
             linux_device::DeviceLoopOptions o;
             o.time_scale = time_scale;
-            linux_device::run_device_loop(*device, [&](std::chrono::microseconds w) { server->poll_once(w); }, o, stop);
+            linux_device::run_device_loop(
+                *device, [&](std::chrono::microseconds w) { server->poll_once(w); }, o, stop);
         });
     }
-    std::string target() const { return "modbus-tcp://127.0.0.1:" + std::to_string(server->port()) + "?unit=1"; }
+    std::string target() const {
+        return "modbus-tcp://127.0.0.1:" + std::to_string(server->port()) + "?unit=1";
+    }
     void join() {
         stop = true;
         if (thread.joinable()) thread.join();
@@ -59,8 +62,10 @@ std::vector<host::BezierSegment> collect(host::SegmentSource& source) {
 
 // Not [threads]: under ThreadSanitizer the reference plan alone would take minutes; the
 // planning thread's sharing is what the [threads] cases here and in test_spsc_ring.cpp run.
-TEST_CASE("a long job streams while it is planned: first batch before planning ends, ticks as plan_path's",
-          "[stream][modbus]") {
+TEST_CASE(
+    "a long job streams while it is planned: first batch before planning ends, ticks as "
+    "plan_path's",
+    "[stream][modbus]") {
     const host::MachineProfile machine = pen_plotter();
     RandomWalkSource walk(20000, 11);
     const host::Plan reference = host::plan_path(collect(walk), machine);
@@ -73,10 +78,11 @@ TEST_CASE("a long job streams while it is planned: first batch before planning e
     std::optional<bool> finished_at_first_batch;
     std::size_t traces_before_total = 0;
     o.observer = [&](const host::StreamTrace& t) {
-        if (!finished_at_first_batch && t.acknowledged >= t.job) finished_at_first_batch = planning.finished();
+        if (!finished_at_first_batch && t.acknowledged >= t.job)
+            finished_at_first_batch = planning.finished();
     };
-    const host::StreamReport report =
-        host::stream_modbus(planning, machine, o, [&](std::uint64_t, std::optional<std::uint64_t> total, double) {
+    const host::StreamReport report = host::stream_modbus(
+        planning, machine, o, [&](std::uint64_t, std::optional<std::uint64_t> total, double) {
             if (!total) ++traces_before_total;
         });
     device.join();

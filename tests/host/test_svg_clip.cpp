@@ -6,9 +6,9 @@
 #include <string>
 #include <vector>
 
-#include "pathstream/machine/input_error.hpp"
 #include "pathstream/host/svg_clip.hpp"
 #include "pathstream/host/svg_path.hpp"
+#include "pathstream/machine/input_error.hpp"
 
 using namespace pathstream::host;
 using svg::Point;

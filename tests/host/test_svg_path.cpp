@@ -7,8 +7,8 @@
 #include <string>
 #include <vector>
 
-#include "pathstream/machine/input_error.hpp"
 #include "pathstream/host/svg_path.hpp"
+#include "pathstream/machine/input_error.hpp"
 
 using namespace pathstream::host;
 using svg::Point;
@@ -663,7 +663,8 @@ TEST_CASE("svg: rect, sharp and rounded", "[svg]") {
     for (const char* radii : {R"(rx="0" ry="20")", R"(rx="20" ry="0")"}) {
         INFO(radii);
         const Subpath sq =
-            parse(std::string(R"(<rect x="20" y="20" width="160" height="160" )") + radii + "/>").subpaths.at(0);
+            parse(std::string(R"(<rect x="20" y="20" width="160" height="160" )") + radii + "/>")
+                .subpaths.at(0);
         check_points(sq, lines({{20, 20}, {180, 20}, {180, 180}, {20, 180}, {20, 20}}));
     }
 }

@@ -4,8 +4,8 @@
 #include <random>
 #include <string>
 
-#include "pathstream/machine/input_error.hpp"
 #include "pathstream/host/svg_path.hpp"
+#include "pathstream/machine/input_error.hpp"
 
 using namespace pathstream::host;
 

@@ -4,8 +4,8 @@
 #include <cmath>
 #include <string>
 
-#include "pathstream/machine/input_error.hpp"
 #include "pathstream/host/svg_path.hpp"
+#include "pathstream/machine/input_error.hpp"
 
 using namespace pathstream::host;
 
@@ -140,8 +140,9 @@ TEST_CASE("svg css: the CSS transform property", "[svg]") {
     CHECK(start_of("<style>line{transform:translate(5px, 7px)}</style>" + kLine + "/>") ==
           std::pair{15.0, 17.0});
     // The property replaces the attribute.
-    CHECK(start_of(kLine + R"~( transform="translate(50)" style="transform: translateX(1px)"/>)~") ==
-          std::pair{11.0, 10.0});
+    CHECK(
+        start_of(kLine + R"~( transform="translate(50)" style="transform: translateX(1px)"/>)~") ==
+        std::pair{11.0, 10.0});
     const auto [x, y] = start_of(kLine + R"~( style="transform: rotate(0.25turn)"/>)~");
     CHECK(x == Approx(-10));
     CHECK(y == Approx(10));
@@ -174,12 +175,13 @@ TEST_CASE("svg: transform-origin as attribute and property", "[svg]") {
     CHECK(at("bottom") == std::pair{-30.0, -80.0});
     CHECK(at("10mm 0 0") == std::pair{20.0 - 10.0 * 96 / 25.4, 20.0});
     // As a CSS property, also about a group.
-    CHECK(start_of(R"~(<style>g{transform:scale(2);transform-origin:10px 10px}</style><g>)~" + kLine +
-                   "/></g>") == std::pair{10.0, 10.0});
+    CHECK(start_of(R"~(<style>g{transform:scale(2);transform-origin:10px 10px}</style><g>)~" +
+                   kLine + "/></g>") == std::pair{10.0, 10.0});
     // No transform: the origin changes nothing.
     CHECK(start_of(kLine + " transform-origin=\"50 50\"/>") == std::pair{10.0, 10.0});
-    CHECK(error_of(kLine + " transform=\"scale(2)\" transform-origin=\"left right\"/>") ==
-          "t.svg:1:151: transform-origin: 'left right' puts both values on one axis at character 1");
+    CHECK(
+        error_of(kLine + " transform=\"scale(2)\" transform-origin=\"left right\"/>") ==
+        "t.svg:1:151: transform-origin: 'left right' puts both values on one axis at character 1");
     CHECK(error_of(kLine + " transform=\"scale(2)\" transform-origin=\"1 2 3 4\"/>") ==
           "t.svg:1:151: transform-origin: expected at most 3 values (x y z) at character 7");
     CHECK(error_of(kLine + " transform=\"scale(2)\" transform-origin=\"1 2em\"/>") ==
@@ -192,7 +194,8 @@ TEST_CASE("svg css: malformed sheets name the place", "[svg]") {
           "t.svg:2:3: style: unclosed '{' (no matching '}')");
     CHECK(error_of("<style>\n .a{} /* x</style>" + kLine + "/>") ==
           "t.svg:2:7: style: unclosed comment '/*'");
-    CHECK(error_of("<style>\n .a{} }</style>" + kLine + "/>") == "t.svg:2:7: style: unexpected '}'");
+    CHECK(error_of("<style>\n .a{} }</style>" + kLine + "/>") ==
+          "t.svg:2:7: style: unexpected '}'");
     CHECK(error_of("<style>\n  .a</style>" + kLine + "/>") ==
           "t.svg:2:3: style: expected '{' after the selector '.a'");
     // A declaration without a colon or value is dropped (CSS error recovery).
@@ -204,7 +207,7 @@ TEST_CASE("svg css: more than 10000 rules are refused", "[svg]") {
     for (int i = 0; i < 5000; ++i) sheet += ".a" + std::to_string(i) + ",.b{display:inline}";
     CHECK(drawn(sheet + "</style>" + kLine + " class=\"b\"/>") == 1);
     sheet += ".z{display:none}</style>";
-    CHECK(error_of(sheet + kLine + "/>").find(
-              "style: more than 10000 rules (each selector of a list counts)") !=
+    CHECK(error_of(sheet + kLine + "/>")
+              .find("style: more than 10000 rules (each selector of a list counts)") !=
           std::string::npos);
 }

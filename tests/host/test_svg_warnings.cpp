@@ -5,8 +5,8 @@
 #include <string>
 #include <vector>
 
-#include "pathstream/machine/input_error.hpp"
 #include "pathstream/host/svg_path.hpp"
+#include "pathstream/machine/input_error.hpp"
 
 using namespace pathstream::host;
 

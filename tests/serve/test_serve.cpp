@@ -1,9 +1,8 @@
 // `pathstream serve`'s parts that need no browser: who may use it (token, Host, Origin), what
 // the page may ask for (upload names, path options as arguments), the preview of a plan, the
 // event hub under two real threads and a seeded interleaving, and the child process runner.
-#include <catch2/catch.hpp>
-
 #include <algorithm>
+#include <catch2/catch.hpp>
 #include <random>
 #include <thread>
 
@@ -93,14 +92,16 @@ TEST_CASE("serve: beyond loopback every request carries the token", "[serve]") {
     CHECK(refusal(p, cross));
 }
 
-TEST_CASE("serve: the token cookie is the server's token, set for a right ?token= only", "[serve]") {
+TEST_CASE("serve: the token cookie is the server's token, set for a right ?token= only",
+          "[serve]") {
     AccessPolicy p;
     p.token = "s3cret";
     p.loopback = false;
     RequestFacts r;
     r.method = "GET";
     r.query_token = "s3cret";
-    CHECK(token_cookie(p, r, "pathstream_token") == "pathstream_token=s3cret; Path=/; HttpOnly; SameSite=Strict");
+    CHECK(token_cookie(p, r, "pathstream_token") ==
+          "pathstream_token=s3cret; Path=/; HttpOnly; SameSite=Strict");
     // A wrong ?token= next to a right Bearer header passes the check, but its bytes (cookie
     // attributes here) never reach Set-Cookie.
     r.authorization = "Bearer s3cret";
@@ -135,13 +136,19 @@ TEST_CASE("serve: upload names stay inside the server's directory", "[serve]") {
 }
 
 TEST_CASE("serve: the page's options become path-option arguments", "[serve]") {
-    const auto args = path_arguments(nlohmann::json{{"fit", "a4-landscape"}, {"margin", 10}, {"rotate", 90},
-                                                    {"flip_y", true}, {"keep_order", false},
-                                                    {"layers", {"2", "--machine=/etc/passwd"}}, {"pause", "none"}});
+    const auto args = path_arguments(nlohmann::json{{"fit", "a4-landscape"},
+                                                    {"margin", 10},
+                                                    {"rotate", 90},
+                                                    {"flip_y", true},
+                                                    {"keep_order", false},
+                                                    {"layers", {"2", "--machine=/etc/passwd"}},
+                                                    {"pause", "none"}});
     // The box "Order for less travel" on: --order, so that G-code is ordered too (its default
     // keeps the program's order).
-    const std::vector<std::string> want = {"--fit=a4-landscape", "--flip-y", "--layer=--machine=/etc/passwd", "--layer=2",
-                                           "--margin=10", "--order", "--pause=none", "--rotate=90"};
+    const std::vector<std::string> want = {
+        "--fit=a4-landscape", "--flip-y",    "--layer=--machine=/etc/passwd",
+        "--layer=2",          "--margin=10", "--order",
+        "--pause=none",       "--rotate=90"};
     std::vector<std::string> sorted = args;
     std::sort(sorted.begin(), sorted.end());
     CHECK(sorted == want);
@@ -201,7 +208,9 @@ TEST_CASE("serve: the preview follows the plan's spans and figures", "[serve]") 
     // The corner at (60, 50) is kept, drawn with the pen down.
     bool corner_kept = false;
     for (std::size_t i = 0; i < x.size(); ++i) {
-        if (std::abs(x[i].get<double>() - 60) < 1e-3 && std::abs(y[i].get<double>() - 50) < 1e-3 && pen[i] == 1) corner_kept = true;
+        if (std::abs(x[i].get<double>() - 60) < 1e-3 && std::abs(y[i].get<double>() - 50) < 1e-3 &&
+            pen[i] == 1)
+            corner_kept = true;
     }
     CHECK(corner_kept);
     CHECK(std::count(pen.begin(), pen.end(), 0) >= 1);  // the travel between the subpaths
@@ -210,7 +219,8 @@ TEST_CASE("serve: the preview follows the plan's spans and figures", "[serve]") 
     CHECK(*std::max_element(v.begin(), v.end()) <= 250 * std::sqrt(2.0) + 1e-6);
 }
 
-TEST_CASE("serve: a listener gets every event in order while another thread publishes", "[serve][threads]") {
+TEST_CASE("serve: a listener gets every event in order while another thread publishes",
+          "[serve][threads]") {
     EventHub hub(100000);
     constexpr std::uint64_t kEvents = 20000;
     std::vector<std::uint64_t> seen;
@@ -227,7 +237,8 @@ TEST_CASE("serve: a listener gets every event in order while another thread publ
         }
     });
     std::thread publisher([&] {
-        for (std::uint64_t i = 1; i <= kEvents; ++i) hub.publish(std::to_string(i), i % 100 == 0 ? "hundreds" : "");
+        for (std::uint64_t i = 1; i <= kEvents; ++i)
+            hub.publish(std::to_string(i), i % 100 == 0 ? "hundreds" : "");
     });
     publisher.join();
     listener.join();
@@ -241,7 +252,8 @@ TEST_CASE("serve: a listener gets every event in order while another thread publ
     CHECK(after == kEvents);
 }
 
-TEST_CASE("serve: a slow listener misses the oldest events and is told how many", "[serve][threads]") {
+TEST_CASE("serve: a slow listener misses the oldest events and is told how many",
+          "[serve][threads]") {
     EventHub hub(64);
     std::thread publisher([&] {
         for (int i = 1; i <= 5000; ++i) hub.publish(std::to_string(i));
@@ -259,7 +271,8 @@ TEST_CASE("serve: a slow listener misses the oldest events and is told how many"
     CHECK(hub.wait_after(0, std::chrono::milliseconds(1000)).empty());  // closed: at once, nothing
 }
 
-TEST_CASE("serve: seeded interleavings of publishers and listeners keep order and counts", "[serve]") {
+TEST_CASE("serve: seeded interleavings of publishers and listeners keep order and counts",
+          "[serve]") {
     std::mt19937 random(20261126);
     for (int round = 0; round < 50; ++round) {
         const std::size_t capacity = 1 + random() % 40;
@@ -284,7 +297,8 @@ TEST_CASE("serve: seeded interleavings of publishers and listeners keep order an
         }
         for (unsigned who = 0; who < 3; ++who) {
             std::uint64_t m = 0;
-            for (const HubEvent& e : hub.wait_after(cursor[who], std::chrono::milliseconds(0), &m)) {
+            for (const HubEvent& e :
+                 hub.wait_after(cursor[who], std::chrono::milliseconds(0), &m)) {
                 cursor[who] = e.sequence;
                 ++received[who];
             }
@@ -295,7 +309,8 @@ TEST_CASE("serve: seeded interleavings of publishers and listeners keep order an
 }
 
 TEST_CASE("serve: a child's output, error text and exit status", "[serve]") {
-    const ChildOutput r = run_child({"/bin/sh", "-c", "echo one; echo two; echo oops >&2; printf tail; exit 3"}, "/");
+    const ChildOutput r =
+        run_child({"/bin/sh", "-c", "echo one; echo two; echo oops >&2; printf tail; exit 3"}, "/");
     CHECK(r.exit_code == 3);
     CHECK(r.out == "one\ntwo\ntail\n");
     CHECK(r.err == "oops\n");

@@ -38,13 +38,15 @@ void Cia402Master::configure() {
             if (now >= deadline) {
                 for (const auto& d : drives_) {
                     if (!d.heartbeat_seen) {
-                        throw Cia402Error("node " + std::to_string(d.node) + ": no boot-up message within " +
-                                          std::to_string(options_.boot_timeout_ms) +
-                                          " ms of NMT reset communication (is the drive on the bus?)");
+                        throw Cia402Error(
+                            "node " + std::to_string(d.node) + ": no boot-up message within " +
+                            std::to_string(options_.boot_timeout_ms) +
+                            " ms of NMT reset communication (is the drive on the bus?)");
                     }
                 }
             }
-            if (bus_.receive(f, static_cast<std::uint32_t>(deadline > now ? deadline - now : 0))) handle(f);
+            if (bus_.receive(f, static_cast<std::uint32_t>(deadline > now ? deadline - now : 0)))
+                handle(f);
         }
     } else {
         for (const auto& d : drives_) nmt(NmtCommand::kEnterPreOperational, d.node);
@@ -61,7 +63,8 @@ void Cia402Master::configure() {
     hal::CanFrame f;
     for (;;) {
         bool all = true;
-        for (const auto& d : drives_) all = all && d.heartbeat_seen && d.nmt == NmtState::kOperational;
+        for (const auto& d : drives_)
+            all = all && d.heartbeat_seen && d.nmt == NmtState::kOperational;
         if (all) return;
         const std::uint64_t now = clock_.now();
         if (now >= deadline) {
@@ -73,7 +76,8 @@ void Cia402Master::configure() {
                 }
             }
         }
-        if (bus_.receive(f, static_cast<std::uint32_t>(deadline > now ? deadline - now : 0))) handle(f);
+        if (bus_.receive(f, static_cast<std::uint32_t>(deadline > now ? deadline - now : 0)))
+            handle(f);
     }
 }
 
@@ -86,7 +90,8 @@ void Cia402Master::configure_node(std::uint8_t n) {
     }
     sdo_download(n, kModesOfOperation, 0, static_cast<std::uint8_t>(kModeCsp), 1);
     sdo_download(n, kInterpolationPeriod, 1, options_.cycle_ms, 1);
-    sdo_download(n, kInterpolationPeriod, 2, static_cast<std::uint8_t>(std::int8_t{-3}), 1);  // 10^-3 s: ms
+    sdo_download(n, kInterpolationPeriod, 2, static_cast<std::uint8_t>(std::int8_t{-3}),
+                 1);  // 10^-3 s: ms
 
     // A PDO's mapping may change only while the PDO is disabled and its count is 0 (CiA 301).
     struct Pdo {
@@ -95,24 +100,36 @@ void Cia402Master::configure_node(std::uint8_t n) {
         std::uint32_t entries[2];
         std::uint8_t count;
     };
-    const Pdo rpdo1{kRpdo1Communication, kRpdo1Mapping, kRpdo1Base + n,
-                    {pdo_mapping(kControlword, 0, 16), pdo_mapping(kTargetPosition, 0, 32)}, 2};
-    const Pdo tpdo1{kTpdo1Communication, kTpdo1Mapping, kTpdo1Base + n,
-                    {pdo_mapping(kStatusword, 0, 16), pdo_mapping(kPositionActual, 0, 32)}, 2};
-    const Pdo tpdo2{kTpdo2Communication, kTpdo2Mapping, kTpdo2Base + n, {pdo_mapping(kPositionDemand, 0, 32), 0}, 1};
+    const Pdo rpdo1{kRpdo1Communication,
+                    kRpdo1Mapping,
+                    kRpdo1Base + n,
+                    {pdo_mapping(kControlword, 0, 16), pdo_mapping(kTargetPosition, 0, 32)},
+                    2};
+    const Pdo tpdo1{kTpdo1Communication,
+                    kTpdo1Mapping,
+                    kTpdo1Base + n,
+                    {pdo_mapping(kStatusword, 0, 16), pdo_mapping(kPositionActual, 0, 32)},
+                    2};
+    const Pdo tpdo2{kTpdo2Communication,
+                    kTpdo2Mapping,
+                    kTpdo2Base + n,
+                    {pdo_mapping(kPositionDemand, 0, 32), 0},
+                    1};
     auto map = [&](const Pdo& p) {
         sdo_download(n, p.communication, 1, kPdoInvalid | p.cob_id, 4);
         sdo_download(n, p.communication, 2, kTransmissionEverySync, 1);
         sdo_download(n, p.mapping, 0, 0, 1);
-        for (std::uint8_t i = 0; i < p.count; ++i) sdo_download(n, p.mapping, static_cast<std::uint8_t>(i + 1), p.entries[i], 4);
+        for (std::uint8_t i = 0; i < p.count; ++i)
+            sdo_download(n, p.mapping, static_cast<std::uint8_t>(i + 1), p.entries[i], 4);
         sdo_download(n, p.mapping, 0, p.count, 1);
         sdo_download(n, p.communication, 1, p.cob_id, 4);
         // Read back: a drive that accepted a write but maps something else must not move.
         for (std::uint8_t i = 0; i < p.count; ++i) {
             const std::uint32_t got = sdo_upload(n, p.mapping, static_cast<std::uint8_t>(i + 1));
             if (got != p.entries[i]) {
-                throw Cia402Error(who + "PDO mapping readback differs at 0x" + hex32(p.mapping).substr(6) + ":" +
-                                  std::to_string(i + 1) + ": wrote " + hex32(p.entries[i]) + ", read " + hex32(got));
+                throw Cia402Error(who + "PDO mapping readback differs at 0x" +
+                                  hex32(p.mapping).substr(6) + ":" + std::to_string(i + 1) +
+                                  ": wrote " + hex32(p.entries[i]) + ", read " + hex32(got));
             }
         }
     };
@@ -130,9 +147,13 @@ void Cia402Master::configure_node(std::uint8_t n) {
     }
     sdo_download(n, kHeartbeatProducer, 0, options_.heartbeat_ms, 2);
     const std::uint32_t mode = sdo_upload(n, kModesOfOperation, 0);
-    if (mode != static_cast<std::uint8_t>(kModeCsp)) throw Cia402Error(who + "mode of operation reads back " + std::to_string(mode) + ", not 8 (CSP)");
+    if (mode != static_cast<std::uint8_t>(kModeCsp))
+        throw Cia402Error(who + "mode of operation reads back " + std::to_string(mode) +
+                          ", not 8 (CSP)");
     const std::uint32_t period = sdo_upload(n, kInterpolationPeriod, 1);
-    if (period != options_.cycle_ms) throw Cia402Error(who + "interpolation period reads back " + std::to_string(period) + " ms");
+    if (period != options_.cycle_ms)
+        throw Cia402Error(who + "interpolation period reads back " + std::to_string(period) +
+                          " ms");
 }
 
 }  // namespace pathstream::host

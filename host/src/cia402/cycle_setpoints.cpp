@@ -41,9 +41,11 @@ public:
 private:
     void refill() {
         while (next_span_ < spans_.size() && stream_->free_slots() > 0) {
-            const Span<Axes> s = to_core_span<Axes>(spans_[next_span_], static_cast<std::uint32_t>(next_span_ + 1));
+            const Span<Axes> s =
+                to_core_span<Axes>(spans_[next_span_], static_cast<std::uint32_t>(next_span_ + 1));
             if (const Status st = stream_->push(s); st != Status::kOk) {
-                throw std::runtime_error("the core refused span " + std::to_string(next_span_) + ": " + status_name(st));
+                throw std::runtime_error("the core refused span " + std::to_string(next_span_) +
+                                         ": " + status_name(st));
             }
             ++next_span_;
         }
@@ -59,7 +61,8 @@ private:
 
 }  // namespace
 
-std::unique_ptr<CycleSetpoints> make_cycle_setpoints(const std::vector<CoreSpan>& spans, std::size_t axes,
+std::unique_ptr<CycleSetpoints> make_cycle_setpoints(const std::vector<CoreSpan>& spans,
+                                                     std::size_t axes,
                                                      std::uint32_t ticks_per_cycle) {
     if (spans.empty()) throw std::invalid_argument("the plan has no spans");
     if (ticks_per_cycle == 0) throw std::invalid_argument("ticks per cycle must be >= 1");

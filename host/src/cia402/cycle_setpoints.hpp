@@ -23,7 +23,8 @@ public:
 };
 
 /// `spans` (validated core spans, all of `axes` axes) decimated by `ticks_per_cycle` >= 1.
-std::unique_ptr<CycleSetpoints> make_cycle_setpoints(const std::vector<CoreSpan>& spans, std::size_t axes,
+std::unique_ptr<CycleSetpoints> make_cycle_setpoints(const std::vector<CoreSpan>& spans,
+                                                     std::size_t axes,
                                                      std::uint32_t ticks_per_cycle);
 
 }  // namespace pathstream::host::cia402

@@ -13,12 +13,17 @@ namespace {
 // The controlword that moves a drive in `state` one step towards operation enabled.
 std::uint16_t towards_enabled(DriveState state) {
     switch (state) {
-        case DriveState::kSwitchOnDisabled: return kCwShutdown;
-        case DriveState::kReadyToSwitchOn: return kCwSwitchOn;
+        case DriveState::kSwitchOnDisabled:
+            return kCwShutdown;
+        case DriveState::kReadyToSwitchOn:
+            return kCwSwitchOn;
         case DriveState::kSwitchedOn:
-        case DriveState::kOperationEnabled: return kCwEnableOperation;
-        case DriveState::kQuickStopActive: return kCwDisableVoltage;  // back to switch on disabled
-        default: return kCwShutdown;  // not ready yet (or no feedback): a harmless command
+        case DriveState::kOperationEnabled:
+            return kCwEnableOperation;
+        case DriveState::kQuickStopActive:
+            return kCwDisableVoltage;  // back to switch on disabled
+        default:
+            return kCwShutdown;  // not ready yet (or no feedback): a harmless command
     }
 }
 
@@ -41,9 +46,10 @@ Cia402Stop Cia402Master::enable(const std::vector<std::int32_t>& targets) {
             for (const auto& d : drives_) {
                 if (d.state() != DriveState::kOperationEnabled) {
                     return stop_with(Cia402Stop::kDriveLeftOperation,
-                                     "node " + std::to_string(d.node) + ": not operation enabled after " +
-                                         std::to_string(options_.enable_timeout_ms) + " ms (still " +
-                                         drive_state_name(d.state()) + ")");
+                                     "node " + std::to_string(d.node) +
+                                         ": not operation enabled after " +
+                                         std::to_string(options_.enable_timeout_ms) +
+                                         " ms (still " + drive_state_name(d.state()) + ")");
                 }
             }
         }
@@ -62,7 +68,8 @@ bool Cia402Master::fault_reset() {
         bool clear = true;
         for (const auto& d : drives_) {
             const DriveState s = d.state();
-            clear = clear && d.feedback_cycle == cycle_ && s != DriveState::kFault && s != DriveState::kFaultReactionActive;
+            clear = clear && d.feedback_cycle == cycle_ && s != DriveState::kFault &&
+                    s != DriveState::kFaultReactionActive;
         }
         if (clear) {
             for (auto& d : drives_) {

@@ -15,14 +15,22 @@ using namespace cia402;
 
 const char* cia402_stop_name(Cia402Stop stop) {
     switch (stop) {
-        case Cia402Stop::kNone: return "completed";
-        case Cia402Stop::kDriveFault: return "drive fault";
-        case Cia402Stop::kHeartbeatLost: return "heartbeat lost";
-        case Cia402Stop::kFeedbackLost: return "feedback lost";
-        case Cia402Stop::kDriveLeftOperation: return "drive left operation";
-        case Cia402Stop::kStepLimit: return "step limit";
-        case Cia402Stop::kBusOff: return "bus off";
-        case Cia402Stop::kSettleTimeout: return "settle timeout";
+        case Cia402Stop::kNone:
+            return "completed";
+        case Cia402Stop::kDriveFault:
+            return "drive fault";
+        case Cia402Stop::kHeartbeatLost:
+            return "heartbeat lost";
+        case Cia402Stop::kFeedbackLost:
+            return "feedback lost";
+        case Cia402Stop::kDriveLeftOperation:
+            return "drive left operation";
+        case Cia402Stop::kStepLimit:
+            return "step limit";
+        case Cia402Stop::kBusOff:
+            return "bus off";
+        case Cia402Stop::kSettleTimeout:
+            return "settle timeout";
     }
     return "unknown";
 }
@@ -32,14 +40,19 @@ Cia402Master::Cia402Master(hal::CanBus& bus, hal::Clock& clock_us, Cia402Options
     if (options_.nodes.empty()) throw std::invalid_argument("CiA 402: no drive nodes given");
     std::set<std::uint8_t> seen;
     for (const std::uint8_t n : options_.nodes) {
-        if (n < 1 || n > 127) throw std::invalid_argument("CiA 402: node id " + std::to_string(n) + " outside 1..127");
-        if (!seen.insert(n).second) throw std::invalid_argument("CiA 402: node " + std::to_string(n) + " given twice");
+        if (n < 1 || n > 127)
+            throw std::invalid_argument("CiA 402: node id " + std::to_string(n) +
+                                        " outside 1..127");
+        if (!seen.insert(n).second)
+            throw std::invalid_argument("CiA 402: node " + std::to_string(n) + " given twice");
         Cia402DriveView v;
         v.node = n;
         drives_.push_back(v);
     }
-    if (options_.cycle_ms == 0 || options_.cycle_ms > 255) throw std::invalid_argument("CiA 402: cycle 1..255 ms");
-    if (options_.sdo_attempts == 0) throw std::invalid_argument("CiA 402: sdo_attempts must be >= 1");
+    if (options_.cycle_ms == 0 || options_.cycle_ms > 255)
+        throw std::invalid_argument("CiA 402: cycle 1..255 ms");
+    if (options_.sdo_attempts == 0)
+        throw std::invalid_argument("CiA 402: sdo_attempts must be >= 1");
 }
 
 Cia402DriveView& Cia402Master::view(std::uint8_t node) {
@@ -55,9 +68,10 @@ void Cia402Master::send(const hal::CanFrame& frame) {
         ++report_.frames_sent;
         return;
     }
-    const std::string what = r == hal::CanSendResult::kBusOff      ? "the CAN controller is bus-off"
-                             : r == hal::CanSendResult::kQueueFull ? "the CAN transmit queue is full"
-                                                                   : "the CAN interface refused a frame";
+    const std::string what = r == hal::CanSendResult::kBusOff ? "the CAN controller is bus-off"
+                             : r == hal::CanSendResult::kQueueFull
+                                 ? "the CAN transmit queue is full"
+                                 : "the CAN interface refused a frame";
     // While cycling the loop must still stop the drives cleanly: record, let check_health act.
     if (cycling_) {
         send_failure_ = what;
@@ -78,7 +92,7 @@ void Cia402Master::handle(const hal::CanFrame& f) {
     if (f.extended || f.remote) return;
     const std::uint32_t function = f.id & 0x780;
     const auto node = static_cast<std::uint8_t>(f.id & 0x7F);
-    if (node == 0) return;  // NMT and SYNC from another master: not ours to read
+    if (node == 0) return;               // NMT and SYNC from another master: not ours to read
     if (function == kSdoResponseBase) {  // any node may be asked, configured or not
         if (node == sdo_node_ && !sdo_done_ && f.length == 8) {
             sdo_response_ = f;
@@ -124,7 +138,8 @@ void Cia402Master::handle(const hal::CanFrame& f) {
                 d->demand_cycle = cycle_;
             }
             break;
-        default: break;
+        default:
+            break;
     }
 }
 
@@ -134,11 +149,13 @@ void Cia402Master::wait_until(std::uint64_t deadline_us) {
         const std::uint64_t now = clock_.now();
         if (now >= deadline_us) return;
         const std::uint64_t left = deadline_us - now;
-        if (bus_.receive(f, static_cast<std::uint32_t>(std::min<std::uint64_t>(left, 0xFFFFFFFFu)))) handle(f);
+        if (bus_.receive(f, static_cast<std::uint32_t>(std::min<std::uint64_t>(left, 0xFFFFFFFFu))))
+            handle(f);
     }
 }
 
-void Cia402Master::exchange(const std::vector<std::uint16_t>& controlwords, const std::vector<std::int32_t>& targets) {
+void Cia402Master::exchange(const std::vector<std::uint16_t>& controlwords,
+                            const std::vector<std::int32_t>& targets) {
     cycling_ = true;
     const std::uint64_t now = clock_.now();
     const std::uint64_t period = std::uint64_t{options_.cycle_ms} * 1000;
@@ -185,26 +202,33 @@ Cia402Stop Cia402Master::check_health(bool moving) {
     for (const auto& d : drives_) {
         const std::string who = "node " + std::to_string(d.node) + ": ";
         const DriveState s = d.state();
-        if (d.emcy_pending || (d.feedback_cycle > 0 && (s == DriveState::kFault || s == DriveState::kFaultReactionActive))) {
-            return stop_with(Cia402Stop::kDriveFault,
-                             who + "drive fault: " + (d.emcy_pending ? emcy_text(d.emcy_code) : std::string("statusword fault")));
+        if (d.emcy_pending || (d.feedback_cycle > 0 && (s == DriveState::kFault ||
+                                                        s == DriveState::kFaultReactionActive))) {
+            return stop_with(
+                Cia402Stop::kDriveFault,
+                who + "drive fault: " +
+                    (d.emcy_pending ? emcy_text(d.emcy_code) : std::string("statusword fault")));
         }
-        if (options_.heartbeat_ms > 0 && d.heartbeat_seen && now - d.last_heartbeat_us > std::uint64_t{options_.heartbeat_timeout_ms} * 1000) {
-            return stop_with(Cia402Stop::kHeartbeatLost,
-                             who + "no heartbeat for " + std::to_string((now - d.last_heartbeat_us) / 1000) +
-                                 " ms (timeout " + std::to_string(options_.heartbeat_timeout_ms) + " ms)");
+        if (options_.heartbeat_ms > 0 && d.heartbeat_seen &&
+            now - d.last_heartbeat_us > std::uint64_t{options_.heartbeat_timeout_ms} * 1000) {
+            return stop_with(
+                Cia402Stop::kHeartbeatLost,
+                who + "no heartbeat for " + std::to_string((now - d.last_heartbeat_us) / 1000) +
+                    " ms (timeout " + std::to_string(options_.heartbeat_timeout_ms) + " ms)");
         }
         if (d.heartbeat_seen && d.nmt != NmtState::kOperational) {
-            return stop_with(Cia402Stop::kDriveLeftOperation, who + "left NMT operational (heartbeat state 0x" +
-                                                                  std::to_string(static_cast<int>(d.nmt)) + ")");
+            return stop_with(Cia402Stop::kDriveLeftOperation,
+                             who + "left NMT operational (heartbeat state 0x" +
+                                 std::to_string(static_cast<int>(d.nmt)) + ")");
         }
         if (d.missed_in_row >= options_.max_missed_feedback) {
             return stop_with(Cia402Stop::kFeedbackLost,
                              who + "no TPDO1 for " + std::to_string(d.missed_in_row) + " cycles");
         }
         if (moving && d.feedback_cycle == cycle_ && s != DriveState::kOperationEnabled) {
-            return stop_with(Cia402Stop::kDriveLeftOperation,
-                             who + "left operation enabled during motion (now " + drive_state_name(s) + ")");
+            return stop_with(
+                Cia402Stop::kDriveLeftOperation,
+                who + "left operation enabled during motion (now " + drive_state_name(s) + ")");
         }
     }
     return Cia402Stop::kNone;
@@ -222,7 +246,9 @@ void Cia402Master::quick_stop(const std::vector<std::int32_t>& hold) {
         for (const auto& d : drives_) {
             const DriveState s = d.state();
             const bool silent = d.missed_in_row >= options_.max_missed_feedback;
-            if (!silent && (s == DriveState::kOperationEnabled || s == DriveState::kQuickStopActive)) all_stopped = false;
+            if (!silent &&
+                (s == DriveState::kOperationEnabled || s == DriveState::kQuickStopActive))
+                all_stopped = false;
         }
         if (all_stopped) return;
     }

@@ -19,7 +19,8 @@ std::uint32_t ticks_per_cycle(const MachineProfile& profile, std::uint32_t cycle
     const double c = cycle_ms * profile.tick_hz / 1000.0;
     const double r = std::round(c);
     if (r < 1 || std::fabs(c - r) > 1e-9) {
-        throw std::invalid_argument("CiA 402: a " + std::to_string(cycle_ms) + " ms cycle is not a whole number of " +
+        throw std::invalid_argument("CiA 402: a " + std::to_string(cycle_ms) +
+                                    " ms cycle is not a whole number of " +
                                     std::to_string(profile.tick_hz) + " Hz ticks");
     }
     return static_cast<std::uint32_t>(r);
@@ -27,13 +28,15 @@ std::uint32_t ticks_per_cycle(const MachineProfile& profile, std::uint32_t cycle
 
 }  // namespace
 
-Cia402Report Cia402Master::run(const Plan& plan, const MachineProfile& profile, const Cia402Progress& progress) {
+Cia402Report Cia402Master::run(const Plan& plan, const MachineProfile& profile,
+                               const Cia402Progress& progress) {
     const std::size_t axes = profile.axes.size();
     if (plan.spans.empty()) throw std::invalid_argument("CiA 402: the plan has no spans");
-    if (plan.spans.front().control.size() != axes) throw std::invalid_argument("CiA 402: plan and profile differ in axes");
+    if (plan.spans.front().control.size() != axes)
+        throw std::invalid_argument("CiA 402: plan and profile differ in axes");
     if (drives_.size() != axes) {
-        throw std::invalid_argument("CiA 402: " + std::to_string(axes) + " axes but " + std::to_string(drives_.size()) +
-                                    " drive nodes");
+        throw std::invalid_argument("CiA 402: " + std::to_string(axes) + " axes but " +
+                                    std::to_string(drives_.size()) + " drive nodes");
     }
     const std::uint32_t c = ticks_per_cycle(profile, options_.cycle_ms);
     const double cycle_s = options_.cycle_ms / 1000.0;
@@ -82,8 +85,9 @@ Cia402Report Cia402Master::run(const Plan& plan, const MachineProfile& profile, 
         if (tries >= options_.max_missed_feedback) {
             for (const auto& d : drives_) {
                 if (d.feedback_cycle != cycle_) {
-                    stop_with(Cia402Stop::kFeedbackLost, "node " + std::to_string(d.node) + ": no TPDO1 after " +
-                                                             std::to_string(tries) + " SYNCs before the enable");
+                    stop_with(Cia402Stop::kFeedbackLost,
+                              "node " + std::to_string(d.node) + ": no TPDO1 after " +
+                                  std::to_string(tries) + " SYNCs before the enable");
                     break;
                 }
             }
@@ -93,9 +97,10 @@ Cia402Report Cia402Master::run(const Plan& plan, const MachineProfile& profile, 
     for (std::size_t a = 0; a < axes; ++a) {
         const auto& d = drives_[a];
         if (std::llabs(std::int64_t{d.position} - target[a]) > options_.start_tolerance) {
-            stop_with(Cia402Stop::kStepLimit, "node " + std::to_string(d.node) + " (axis " + profile.axes[a].name +
-                                                  ") is at " + std::to_string(d.position) + " LSB, the plan starts at " +
-                                                  std::to_string(target[a]) + ": move it there first");
+            stop_with(Cia402Stop::kStepLimit,
+                      "node " + std::to_string(d.node) + " (axis " + profile.axes[a].name +
+                          ") is at " + std::to_string(d.position) + " LSB, the plan starts at " +
+                          std::to_string(target[a]) + ": move it there first");
             return stop();
         }
     }
@@ -112,10 +117,13 @@ Cia402Report Cia402Master::run(const Plan& plan, const MachineProfile& profile, 
                 const std::int64_t lag = std::llabs(std::int64_t{target[a]} - d.position);
                 if (lag > report_.max_lag) report_.max_lag = static_cast<std::int32_t>(lag);
             }
-            if (options_.demand_echo && d.demand_cycle == cycle_ && d.demand != target[a]) ++report_.demand_mismatches;
+            if (options_.demand_echo && d.demand_cycle == cycle_ && d.demand != target[a])
+                ++report_.demand_mismatches;
         }
         if (check_health(true) != Cia402Stop::kNone) return stop();
-        if (progress) progress(static_cast<double>(report_.motion_cycles) / static_cast<double>(report_.total_motion_cycles));
+        if (progress)
+            progress(static_cast<double>(report_.motion_cycles) /
+                     static_cast<double>(report_.total_motion_cycles));
         more = source->next(next.data());
         if (!more) break;
         for (std::size_t a = 0; a < axes; ++a) {
@@ -124,16 +132,19 @@ Cia402Report Cia402Master::run(const Plan& plan, const MachineProfile& profile, 
             if (std::llabs(step) > max_step[a] || std::llabs(second) > max_second[a]) {
                 const bool v = std::llabs(step) > max_step[a];
                 stop_with(Cia402Stop::kStepLimit,
-                          "axis " + profile.axes[a].name + " (node " + std::to_string(drives_[a].node) +
-                              "): the next target would " +
-                              (v ? "step " + std::to_string(step) + " LSB in one cycle, more than v_max x cycle = " +
+                          "axis " + profile.axes[a].name + " (node " +
+                              std::to_string(drives_[a].node) + "): the next target would " +
+                              (v ? "step " + std::to_string(step) +
+                                       " LSB in one cycle, more than v_max x cycle = " +
                                        std::to_string(max_step[a]) + " LSB"
                                  : "change its step by " + std::to_string(second) +
-                                       " LSB, more than a_max x cycle^2 = " + std::to_string(max_second[a]) + " LSB") +
+                                       " LSB, more than a_max x cycle^2 = " +
+                                       std::to_string(max_second[a]) + " LSB") +
                               "; not sent");
                 return stop();
             }
-            if (std::llabs(step) > report_.max_step) report_.max_step = static_cast<std::int32_t>(std::llabs(step));
+            if (std::llabs(step) > report_.max_step)
+                report_.max_step = static_cast<std::int32_t>(std::llabs(step));
         }
         prev2 = prev;
         prev = next;
@@ -141,7 +152,8 @@ Cia402Report Cia402Master::run(const Plan& plan, const MachineProfile& profile, 
     }
 
     // Hold the end point until every axis has arrived (fresh feedback within the window).
-    const std::uint64_t settle_deadline = clock_.now() + std::uint64_t{options_.settle_timeout_ms} * 1000;
+    const std::uint64_t settle_deadline =
+        clock_.now() + std::uint64_t{options_.settle_timeout_ms} * 1000;
     for (;;) {
         bool arrived = true;
         for (std::size_t a = 0; a < axes; ++a) {
@@ -152,7 +164,8 @@ Cia402Report Cia402Master::run(const Plan& plan, const MachineProfile& profile, 
         if (arrived) break;
         if (clock_.now() >= settle_deadline) {
             stop_with(Cia402Stop::kSettleTimeout, "the axes did not reach the end point within " +
-                                                      std::to_string(options_.settle_timeout_ms) + " ms");
+                                                      std::to_string(options_.settle_timeout_ms) +
+                                                      " ms");
             return stop();
         }
         exchange(enabled, target);
@@ -169,12 +182,15 @@ Cia402Report Cia402Master::run(const Plan& plan, const MachineProfile& profile, 
     return finish(true);
 }
 
-Cia402Report stream_cia402(const Plan& plan, const MachineProfile& profile, const Cia402Options& options,
-                           hal::CanBus& bus, hal::Clock& clock_us, const Cia402Progress& progress) {
+Cia402Report stream_cia402(const Plan& plan, const MachineProfile& profile,
+                           const Cia402Options& options, hal::CanBus& bus, hal::Clock& clock_us,
+                           const Cia402Progress& progress) {
     Cia402Master master(bus, clock_us, options);
     master.configure();
     const Cia402Report r = master.run(plan, profile, progress);
-    if (!r.completed) throw Cia402Error("CiA 402 stopped (" + std::string(cia402_stop_name(r.stop)) + "): " + r.message);
+    if (!r.completed)
+        throw Cia402Error("CiA 402 stopped (" + std::string(cia402_stop_name(r.stop)) +
+                          "): " + r.message);
     return r;
 }
 

@@ -20,7 +20,8 @@ std::string object_name(std::uint8_t node, std::uint16_t index, std::uint8_t sub
 
 }  // namespace
 
-std::uint32_t Cia402Master::sdo_transfer(std::uint8_t node, const hal::CanFrame& request, std::uint8_t* size) {
+std::uint32_t Cia402Master::sdo_transfer(std::uint8_t node, const hal::CanFrame& request,
+                                         std::uint8_t* size) {
     const auto index = static_cast<std::uint16_t>(get_le(request, 1, 2));
     const std::uint8_t sub = request.data[3];
     const bool upload = request.data[0] == kSdoUploadRequest;
@@ -36,7 +37,8 @@ std::uint32_t Cia402Master::sdo_transfer(std::uint8_t node, const hal::CanFrame&
             if (now >= deadline) break;
             if (bus_.receive(f, static_cast<std::uint32_t>(deadline - now))) handle(f);
             // A response to another object (a late answer to an earlier try) is not ours.
-            if (sdo_done_ && (get_le(sdo_response_, 1, 2) != index || sdo_response_.data[3] != sub)) sdo_done_ = false;
+            if (sdo_done_ && (get_le(sdo_response_, 1, 2) != index || sdo_response_.data[3] != sub))
+                sdo_done_ = false;
         }
         sdo_node_ = 0;
         if (!sdo_done_) continue;
@@ -46,14 +48,17 @@ std::uint32_t Cia402Master::sdo_transfer(std::uint8_t node, const hal::CanFrame&
             throw SdoError(what + " refused: " + sdo_abort_text(code), code);
         }
         if (!upload) {
-            if (r.data[0] != kSdoDownloadResponse) throw SdoError(what + ": unexpected response", kAbortCommand);
+            if (r.data[0] != kSdoDownloadResponse)
+                throw SdoError(what + ": unexpected response", kAbortCommand);
             return 0;
         }
         if ((r.data[0] & 0xE0) != kSdoUploadResponse || (r.data[0] & 0x02) == 0) {
-            throw SdoError(what + ": not an expedited upload response (segmented transfers are not supported)",
-                           kAbortCommand);
+            throw SdoError(
+                what + ": not an expedited upload response (segmented transfers are not supported)",
+                kAbortCommand);
         }
-        const std::uint8_t n = (r.data[0] & 0x01) != 0 ? static_cast<std::uint8_t>(4 - ((r.data[0] >> 2) & 3)) : 4;
+        const std::uint8_t n =
+            (r.data[0] & 0x01) != 0 ? static_cast<std::uint8_t>(4 - ((r.data[0] >> 2) & 3)) : 4;
         if (size != nullptr) *size = n;
         return get_le(r, 4, n);
     }
@@ -64,15 +69,16 @@ std::uint32_t Cia402Master::sdo_transfer(std::uint8_t node, const hal::CanFrame&
     abort.data[3] = sub;
     put_le(abort, 4, 4, kAbortTimeout);
     send(abort);
-    throw SdoError(what + ": no response in " + std::to_string(options_.sdo_attempts) + " tries of " +
-                       std::to_string(options_.sdo_timeout_ms) + " ms (is node " + std::to_string(node) +
-                       " on the bus?)",
+    throw SdoError(what + ": no response in " + std::to_string(options_.sdo_attempts) +
+                       " tries of " + std::to_string(options_.sdo_timeout_ms) + " ms (is node " +
+                       std::to_string(node) + " on the bus?)",
                    kAbortTimeout);
 }
 
-void Cia402Master::sdo_download(std::uint8_t node, std::uint16_t index, std::uint8_t sub, std::uint32_t value,
-                                std::uint8_t size) {
-    if (size != 1 && size != 2 && size != 4) throw std::invalid_argument("SDO download of 1, 2 or 4 bytes");
+void Cia402Master::sdo_download(std::uint8_t node, std::uint16_t index, std::uint8_t sub,
+                                std::uint32_t value, std::uint8_t size) {
+    if (size != 1 && size != 2 && size != 4)
+        throw std::invalid_argument("SDO download of 1, 2 or 4 bytes");
     hal::CanFrame f = make_frame(kSdoRequestBase + node, 8);
     f.data[0] = static_cast<std::uint8_t>(kSdoDownloadRequest | (4 - size) << 2 | 0x03);
     put_le(f, 1, 2, index);
@@ -81,7 +87,8 @@ void Cia402Master::sdo_download(std::uint8_t node, std::uint16_t index, std::uin
     sdo_transfer(node, f, nullptr);
 }
 
-std::uint32_t Cia402Master::sdo_upload(std::uint8_t node, std::uint16_t index, std::uint8_t sub, std::uint8_t* size) {
+std::uint32_t Cia402Master::sdo_upload(std::uint8_t node, std::uint16_t index, std::uint8_t sub,
+                                       std::uint8_t* size) {
     hal::CanFrame f = make_frame(kSdoRequestBase + node, 8);
     f.data[0] = kSdoUploadRequest;
     put_le(f, 1, 2, index);

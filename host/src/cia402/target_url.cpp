@@ -15,12 +15,14 @@ unsigned long number(const std::string& text, const std::string& key, const std:
     } catch (const std::exception&) {
         used = 0;
     }
-    if (used == 0 || used != text.size()) throw std::invalid_argument(url + ": " + key + " wants a number, not '" + text + "'");
+    if (used == 0 || used != text.size())
+        throw std::invalid_argument(url + ": " + key + " wants a number, not '" + text + "'");
     return v;
 }
 
 std::uint32_t milliseconds(std::string text, const std::string& key, const std::string& url) {
-    if (text.size() > 2 && text.compare(text.size() - 2, 2, "ms") == 0) text.resize(text.size() - 2);
+    if (text.size() > 2 && text.compare(text.size() - 2, 2, "ms") == 0)
+        text.resize(text.size() - 2);
     return static_cast<std::uint32_t>(number(text, key, url));
 }
 
@@ -34,11 +36,14 @@ std::uint8_t node_id(const std::string& text, const std::string& url) {
 
 Cia402Target parse_cia402_target(const std::string& url, std::size_t axes) {
     const std::string scheme = "can://";
-    if (url.compare(0, scheme.size(), scheme) != 0) throw std::invalid_argument(url + ": a CAN target starts with can://");
+    if (url.compare(0, scheme.size(), scheme) != 0)
+        throw std::invalid_argument(url + ": a CAN target starts with can://");
     const std::size_t q = url.find('?', scheme.size());
     Cia402Target t;
-    t.interface = url.substr(scheme.size(), q == std::string::npos ? std::string::npos : q - scheme.size());
-    if (t.interface.empty()) throw std::invalid_argument(url + ": no CAN interface (can://can0?...)");
+    t.interface =
+        url.substr(scheme.size(), q == std::string::npos ? std::string::npos : q - scheme.size());
+    if (t.interface.empty())
+        throw std::invalid_argument(url + ": no CAN interface (can://can0?...)");
     bool cia402 = false;
     t.options.nodes.clear();
     std::string query = q == std::string::npos ? "" : url.substr(q + 1);
@@ -47,15 +52,19 @@ Cia402Target parse_cia402_target(const std::string& url, std::size_t axes) {
         const std::string item = query.substr(0, amp);
         query = amp == std::string::npos ? "" : query.substr(amp + 1);
         const std::size_t eq = item.find('=');
-        if (eq == std::string::npos) throw std::invalid_argument(url + ": '" + item + "' is not KEY=VALUE");
+        if (eq == std::string::npos)
+            throw std::invalid_argument(url + ": '" + item + "' is not KEY=VALUE");
         const std::string key = item.substr(0, eq), value = item.substr(eq + 1);
         if (key == "protocol") {
-            if (value != "cia402") throw std::invalid_argument(url + ": protocol '" + value + "' is not cia402");
+            if (value != "cia402")
+                throw std::invalid_argument(url + ": protocol '" + value + "' is not cia402");
             cia402 = true;
         } else if (key == "node") {
             const std::uint8_t first = node_id(value, url);
-            if (first + axes - 1 > 127) throw std::invalid_argument(url + ": nodes " + value + ".. run past 127");
-            for (std::size_t a = 0; a < axes; ++a) t.options.nodes.push_back(static_cast<std::uint8_t>(first + a));
+            if (first + axes - 1 > 127)
+                throw std::invalid_argument(url + ": nodes " + value + ".. run past 127");
+            for (std::size_t a = 0; a < axes; ++a)
+                t.options.nodes.push_back(static_cast<std::uint8_t>(first + a));
         } else if (key == "nodes") {
             std::string list = value;
             while (!list.empty()) {
@@ -65,7 +74,8 @@ Cia402Target parse_cia402_target(const std::string& url, std::size_t axes) {
             }
         } else if (key == "cycle") {
             t.options.cycle_ms = milliseconds(value, key, url);
-            if (t.options.cycle_ms < 1 || t.options.cycle_ms > 255) throw std::invalid_argument(url + ": cycle 1..255 ms");
+            if (t.options.cycle_ms < 1 || t.options.cycle_ms > 255)
+                throw std::invalid_argument(url + ": cycle 1..255 ms");
         } else if (key == "heartbeat") {
             const std::uint32_t hb = milliseconds(value, key, url);
             if (hb > 10000) throw std::invalid_argument(url + ": heartbeat at most 10000 ms");
@@ -74,16 +84,18 @@ Cia402Target parse_cia402_target(const std::string& url, std::size_t axes) {
         } else if (key == "echo") {
             t.options.demand_echo = value == "1" || value == "true";
         } else {
-            throw std::invalid_argument(url + ": unknown key '" + key + "' (node, nodes, protocol, cycle, heartbeat, echo)");
+            throw std::invalid_argument(url + ": unknown key '" + key +
+                                        "' (node, nodes, protocol, cycle, heartbeat, echo)");
         }
     }
     if (!cia402) throw std::invalid_argument(url + ": protocol=cia402 missing");
     if (t.options.nodes.empty()) {
-        for (std::size_t a = 0; a < axes; ++a) t.options.nodes.push_back(static_cast<std::uint8_t>(1 + a));
+        for (std::size_t a = 0; a < axes; ++a)
+            t.options.nodes.push_back(static_cast<std::uint8_t>(1 + a));
     }
     if (t.options.nodes.size() != axes) {
-        throw std::invalid_argument(url + ": " + std::to_string(t.options.nodes.size()) + " nodes for " +
-                                    std::to_string(axes) + " axes");
+        throw std::invalid_argument(url + ": " + std::to_string(t.options.nodes.size()) +
+                                    " nodes for " + std::to_string(axes) + " axes");
     }
     return t;
 }

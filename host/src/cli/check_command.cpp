@@ -9,18 +9,20 @@
 #include <optional>
 #include <string>
 
-#include "pathstream/host/layers.hpp"
 #include "pathstream/host/geometry.hpp"
-#include "pathstream/machine/input_error.hpp"
+#include "pathstream/host/layers.hpp"
 #include "pathstream/host/work_area.hpp"
+#include "pathstream/machine/input_error.hpp"
 
 namespace pathstream::host {
 
 void add_check_command(CLI::App& app, CheckOptions& o) {
-    CLI::App* cmd = app.add_subcommand("check", "Validate a path file and print a summary: subpaths, spans, length, bounding box");
+    CLI::App* cmd = app.add_subcommand(
+        "check", "Validate a path file and print a summary: subpaths, spans, length, bounding box");
     add_path_options(*cmd, o.path);
     cmd->add_flag("--json", o.json, "print the summary as one JSON document on standard output");
-    cmd->add_option("--machine,-m", o.machine, "machine profile (JSON): its work area serves --fit area")
+    cmd->add_option("--machine,-m", o.machine,
+                    "machine profile (JSON): its work area serves --fit area")
         ->check(CLI::ExistingFile);
 }
 
@@ -30,8 +32,10 @@ namespace {
 /// ~1e-12 relative for the smooth speed of a cubic). No allocation: check measures every
 /// segment of files with millions of points.
 double segment_length(const BezierSegment& s) {
-    static const double x[4] = {0.1834346424956498, 0.5255324099163290, 0.7966664774136267, 0.9602898564975363};
-    static const double w[4] = {0.3626837833783620, 0.3137066458778873, 0.2223810344533745, 0.1012285362903763};
+    static const double x[4] = {0.1834346424956498, 0.5255324099163290, 0.7966664774136267,
+                                0.9602898564975363};
+    static const double w[4] = {0.3626837833783620, 0.3137066458778873, 0.2223810344533745,
+                                0.1012285362903763};
     // The control point differences per axis (bezier_d1's, in its order of operations).
     constexpr std::size_t kAxesMax = 8;
     const std::size_t axes = std::min(s.p[0].size(), kAxesMax);
@@ -42,7 +46,8 @@ double segment_length(const BezierSegment& s) {
     double total = 0;
     constexpr int kPieces = 8;
     for (int piece = 0; piece < kPieces; ++piece) {
-        const double a0 = static_cast<double>(piece) / kPieces, half = 0.5 / kPieces, mid = a0 + half;
+        const double a0 = static_cast<double>(piece) / kPieces, half = 0.5 / kPieces,
+                     mid = a0 + half;
         for (int i = 0; i < 4; ++i) {
             for (const double sign : {-1.0, 1.0}) {
                 const double u = mid + sign * half * x[i], v = 1 - u;
@@ -108,8 +113,8 @@ CheckFigures measure(const Path& path) {
 std::string box_text(const std::optional<Box2>& box) {
     if (!box) return "empty";
     char text[160];
-    std::snprintf(text, sizeof text, "x %.3f .. %.3f, y %.3f .. %.3f mm", box->x_min, box->x_max, box->y_min,
-                  box->y_max);
+    std::snprintf(text, sizeof text, "x %.3f .. %.3f, y %.3f .. %.3f mm", box->x_min, box->x_max,
+                  box->y_min, box->y_max);
     return text;
 }
 
@@ -122,10 +127,13 @@ void print_load_report(const LoadedPath& loaded) {
     }
     if (loaded.ordered) {
         const OrderReport& r = loaded.order;
-        const double change = r.travel_before > 0 ? 100 * (r.travel_after - r.travel_before) / r.travel_before : 0.0;
-        std::printf("  order: pen-up travel from the start %.1f mm -> %.1f mm (%+.0f %%), %zu subpaths -> %zu "
-                    "(merged %zu)\n",
-                    r.travel_before, r.travel_after, change, r.subpaths_before, r.subpaths_after, r.merged);
+        const double change =
+            r.travel_before > 0 ? 100 * (r.travel_after - r.travel_before) / r.travel_before : 0.0;
+        std::printf(
+            "  order: pen-up travel from the start %.1f mm -> %.1f mm (%+.0f %%), %zu subpaths -> "
+            "%zu "
+            "(merged %zu)\n",
+            r.travel_before, r.travel_after, change, r.subpaths_before, r.subpaths_after, r.merged);
     } else {
         std::printf("  order: as in the file (%s)\n", loaded.kept_order_because.c_str());
     }
@@ -133,12 +141,14 @@ void print_load_report(const LoadedPath& loaded) {
 
 /// The human summary (the first 20 subpaths; the rest are counted).
 void print_text(const CheckOptions& o, const Path& path, const CheckFigures& f) {
-    std::printf("%s: valid, %zu axes, units %s\n", path_display_name(o.path.file).c_str(), path.axes, path.units.c_str());
+    std::printf("%s: valid, %zu axes, units %s\n", path_display_name(o.path.file).c_str(),
+                path.axes, path.units.c_str());
     std::printf("  subpaths: %zu\n", path.subpaths.size());
     for (std::size_t i = 0; i < path.subpaths.size() && i < 20; ++i) {
         const Subpath& sp = path.subpaths[i];
-        std::printf("    %zu: %s, %s, %zu points%s\n", i, basis_name(sp.basis), sp.closed ? "closed" : "open",
-                    sp.points.size(), sp.feed > 0 ? (", feed " + std::to_string(sp.feed) + " mm/s").c_str() : "");
+        std::printf("    %zu: %s, %s, %zu points%s\n", i, basis_name(sp.basis),
+                    sp.closed ? "closed" : "open", sp.points.size(),
+                    sp.feed > 0 ? (", feed " + std::to_string(sp.feed) + " mm/s").c_str() : "");
     }
     if (path.subpaths.size() > 20) std::printf("    ... %zu more\n", path.subpaths.size() - 20);
     std::printf("  spans: %zu drawing, %zu travel\n", f.drawing_segments, f.travel_segments);
@@ -166,11 +176,13 @@ nlohmann::ordered_json subpaths_json(const Path& path) {
 /// {"x": {"min", "max"}, "y": {...}} or null.
 nlohmann::ordered_json box_json(const std::optional<Box2>& box) {
     if (!box) return nullptr;
-    return {{"x", {{"min", box->x_min}, {"max", box->x_max}}}, {"y", {{"min", box->y_min}, {"max", box->y_max}}}};
+    return {{"x", {{"min", box->x_min}, {"max", box->x_max}}},
+            {"y", {{"min", box->y_min}, {"max", box->y_max}}}};
 }
 
 /// The summary for machines: the same figures, unrounded (an empty drawing's box is null).
-nlohmann::ordered_json summary_json(const CheckOptions& o, const LoadedPath& loaded, const CheckFigures& f) {
+nlohmann::ordered_json summary_json(const CheckOptions& o, const LoadedPath& loaded,
+                                    const CheckFigures& f) {
     const Path& path = loaded.path;
     nlohmann::ordered_json box = nlohmann::ordered_json::object();
     for (std::size_t a = 0; a < path.axes; ++a) {
@@ -188,10 +200,11 @@ nlohmann::ordered_json summary_json(const CheckOptions& o, const LoadedPath& loa
     j["drawn_length_mm"] = f.drawn;
     j["travel_length_mm"] = f.travel;
     j["bounding_box_mm"] = box;
-    j["placement"] = loaded.placed ? nlohmann::ordered_json{{"scale", loaded.placement.scale},
-                                                            {"box_before_mm", box_json(loaded.placement.before)},
-                                                            {"box_after_mm", box_json(loaded.placement.after)}}
-                                   : nlohmann::ordered_json(nullptr);
+    j["placement"] =
+        loaded.placed ? nlohmann::ordered_json{{"scale", loaded.placement.scale},
+                                               {"box_before_mm", box_json(loaded.placement.before)},
+                                               {"box_after_mm", box_json(loaded.placement.after)}}
+                      : nlohmann::ordered_json(nullptr);
     j["layers"] = layers_json(path);
     j["pauses"] = count_pauses(path);
     if (!loaded.gcode_pen.empty()) j["gcode_pen"] = loaded.gcode_pen;
@@ -209,14 +222,16 @@ nlohmann::ordered_json summary_json(const CheckOptions& o, const LoadedPath& loa
 
 int run_check(const CheckOptions& o) {
     const std::optional<MachineProfile> machine =
-        o.machine.empty() ? std::nullopt : std::optional<MachineProfile>(load_machine_profile(o.machine));
+        o.machine.empty() ? std::nullopt
+                          : std::optional<MachineProfile>(load_machine_profile(o.machine));
     const LoadedPath loaded = load_path_report(o.path, machine ? &*machine : nullptr);
     if (machine) {
         // What plan and stream would refuse first, checked here too: the axes, then the travel.
         if (machine->axes.size() != loaded.path.axes) {
-            throw InputError(o.machine, {}, "the machine has " + std::to_string(machine->axes.size()) +
-                                                " axes but " + o.path.file + " has " +
-                                                std::to_string(loaded.path.axes));
+            throw InputError(o.machine, {},
+                             "the machine has " + std::to_string(machine->axes.size()) +
+                                 " axes but " + o.path.file + " has " +
+                                 std::to_string(loaded.path.axes));
         }
         for_each_bezier_segment(loaded.path, [&](const BezierSegment& s) {
             check_segment_work_area(s, loaded.path, *machine, o.path.file);

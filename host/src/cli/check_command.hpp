@@ -9,7 +9,7 @@ namespace pathstream::host {
 
 struct CheckOptions {
     JobRequest path;
-    bool json = false;  ///< --json: one JSON document on standard output instead of text
+    bool json = false;    ///< --json: one JSON document on standard output instead of text
     std::string machine;  ///< optional profile: its work area serves --fit area
 };
 

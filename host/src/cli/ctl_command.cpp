@@ -12,9 +12,9 @@
 #include <thread>
 
 #include "pathstream/device/operator_commands.hpp"
+#include "pathstream/host/modbus_stream.hpp"
 #include "pathstream/machine/device_setup.hpp"
 #include "pathstream/machine/machine.hpp"
-#include "pathstream/host/modbus_stream.hpp"
 #include "pathstream/machine/position_argument.hpp"
 
 namespace pathstream::host {
@@ -307,7 +307,8 @@ int run_jog(DeviceLink& link, const CtlCommandOptions& o, const Units& u) {
                           fault_suffix(before.state, before.fault_code) + ": " + status_name(r));
     }
     const DeviceSnapshot s = wait_for_job(link, before.last_accepted + 1, wait_seconds(o, 5));
-    const bool done = s.state == device::DeviceState::kIdle && s.finished_job == before.last_accepted + 1;
+    const bool done =
+        s.state == device::DeviceState::kIdle && s.finished_job == before.last_accepted + 1;
     if (o.json) {
         nlohmann::json j;
         j["command"] = "jog";
@@ -393,7 +394,8 @@ int run_home(DeviceLink& link, const CtlCommandOptions& o, const Units& u) {
     std::copy(before.homing, before.homing + kMaxAxes, shown);
     const auto show_changes = [&] {
         for (unsigned a = 0; a < s.axes && a < kMaxAxes; ++a) {
-            if (s.homing[a].state == shown[a].state && s.homing[a].error == shown[a].error) continue;
+            if (s.homing[a].state == shown[a].state && s.homing[a].error == shown[a].error)
+                continue;
             shown[a] = s.homing[a];
             if (!o.json) {
                 std::printf("home          %s %s\n", u.axis_name(a).c_str(),
@@ -413,14 +415,17 @@ int run_home(DeviceLink& link, const CtlCommandOptions& o, const Units& u) {
         // The operator gave up: the homing must not go on unattended.
         const Status stop = link.command(device::Command::kStop);
         throw StreamError(link.name() + ": homing interrupted; " +
-                          (stop == Status::kOk ? std::string("stop sent")
-                                               : std::string("stop refused: ") + status_name(stop)));
+                          (stop == Status::kOk
+                               ? std::string("stop sent")
+                               : std::string("stop refused: ") + status_name(stop)));
     }
     show_changes();
     std::string failed;
     for (unsigned a = 0; a < s.axes && a < kMaxAxes; ++a) {
-        if ((mask == 0 || (mask & (1u << a)) != 0) && s.homing[a].state == device::AxisHoming::kFailed) {
-            failed += (failed.empty() ? "" : "; ") + u.axis_name(a) + ": " + homing_error_name(s.homing[a].error);
+        if ((mask == 0 || (mask & (1u << a)) != 0) &&
+            s.homing[a].state == device::AxisHoming::kFailed) {
+            failed += (failed.empty() ? "" : "; ") + u.axis_name(a) + ": " +
+                      homing_error_name(s.homing[a].error);
         }
     }
     if (o.json) {
@@ -466,7 +471,8 @@ int run_pen(DeviceLink& link, const CtlCommandOptions& o, const Units& u) {
         std::printf("pen           %s\n", s.pen_down() ? "down" : "up");
     }
     if (s.pen_down() != down)
-        throw StreamError(link.name() + ": the device did not " + (down ? "lower" : "raise") + " the pen");
+        throw StreamError(link.name() + ": the device did not " + (down ? "lower" : "raise") +
+                          " the pen");
     return 0;
 }
 
@@ -481,9 +487,10 @@ void add_ctl_command(CLI::App& app, CtlCommandOptions& o) {
                     "modbus-rtu:///dev/ttyX?baud=115200&parity=N&unit=1 "
                     "or can://IFACE?node=N")
         ->required();
-    cmd->add_option("verb", o.verb,
-                    "status, hold, resume, stop, reset, home [AXES], jog AXIS DISTANCE, pen up|down "
-                    "or position AXIS VALUE")
+    cmd->add_option(
+           "verb", o.verb,
+           "status, hold, resume, stop, reset, home [AXES], jog AXIS DISTANCE, pen up|down "
+           "or position AXIS VALUE")
         ->required()
         ->check(CLI::IsMember(
             {"status", "hold", "resume", "stop", "reset", "home", "jog", "pen", "position"}));

@@ -15,7 +15,9 @@ namespace pathstream::host {
 namespace {
 
 std::atomic<bool> g_drive_stop{false};
-extern "C" void on_drive_signal(int) { g_drive_stop.store(true); }
+extern "C" void on_drive_signal(int) {
+    g_drive_stop.store(true);
+}
 
 // The drive polls its bus without waiting; this loop waits on the socket instead and hands
 // the frame it woke up for to the drive first.
@@ -46,15 +48,22 @@ private:
 }  // namespace
 
 void add_drive_command(CLI::App& app, DriveCommandOptions& o) {
-    CLI::App* cmd = app.add_subcommand("drive", "Run a simulated CiA 402 servo drive (CSP) on a SocketCAN interface (docs/cia402.md)");
+    CLI::App* cmd = app.add_subcommand(
+        "drive",
+        "Run a simulated CiA 402 servo drive (CSP) on a SocketCAN interface (docs/cia402.md)");
     cmd->add_option("--can", o.can, "CAN interface, e.g. vcan0")->required();
-    cmd->add_option("--node", o.node, "CANopen node id")->capture_default_str()->check(CLI::Range(1u, 127u));
+    cmd->add_option("--node", o.node, "CANopen node id")
+        ->capture_default_str()
+        ->check(CLI::Range(1u, 127u));
     cmd->add_option("--position", o.position, "position at power-up, LSB")->capture_default_str();
     cmd->add_option("--bandwidth", o.bandwidth_hz, "servo plant natural frequency, Hz")
         ->capture_default_str()
         ->check(CLI::Range(1.0, 10000.0));
-    cmd->add_option("--following-window", o.following_window, "following error window (0x6065), LSB")->capture_default_str();
-    cmd->add_option("--exit-after", o.exit_after, "stop after this many seconds (default: at SIGINT/SIGTERM)")
+    cmd->add_option("--following-window", o.following_window,
+                    "following error window (0x6065), LSB")
+        ->capture_default_str();
+    cmd->add_option("--exit-after", o.exit_after,
+                    "stop after this many seconds (default: at SIGINT/SIGTERM)")
         ->check(CLI::Range(0.0, 1e6));
 }
 
@@ -70,9 +79,10 @@ int run_drive(const DriveCommandOptions& o) {
     std::signal(SIGINT, on_drive_signal);
     std::signal(SIGTERM, on_drive_signal);
     SteadyMicrosecondClock clock;
-    std::cout << "pathstream drive: CiA 402 node " << o.node << " on " << o.can << " at " << o.position << " LSB"
-              << std::endl;
-    const std::uint64_t end = o.exit_after > 0 ? static_cast<std::uint64_t>(o.exit_after * 1e6) : UINT64_MAX;
+    std::cout << "pathstream drive: CiA 402 node " << o.node << " on " << o.can << " at "
+              << o.position << " LSB" << std::endl;
+    const std::uint64_t end =
+        o.exit_after > 0 ? static_cast<std::uint64_t>(o.exit_after * 1e6) : UINT64_MAX;
     for (;;) {
         const std::uint64_t now = clock.now();
         if (g_drive_stop.load() || now >= end) break;
@@ -82,10 +92,11 @@ int run_drive(const DriveCommandOptions& o) {
         const std::uint64_t t = clock.now();
         bus.wait(static_cast<std::uint32_t>(next > t ? next - t : 0));
     }
-    std::cout << "pathstream drive: stopped in state " << cia402::drive_state_name(drive.state()) << " at "
-              << drive.position_actual() << " LSB; " << drive.syncs() << " SYNCs, " << drive.rpdos() << " RPDOs, "
-              << drive.applied_targets().size() << " targets applied, max following error "
-              << drive.max_following_error() << " LSB" << std::endl;
+    std::cout << "pathstream drive: stopped in state " << cia402::drive_state_name(drive.state())
+              << " at " << drive.position_actual() << " LSB; " << drive.syncs() << " SYNCs, "
+              << drive.rpdos() << " RPDOs, " << drive.applied_targets().size()
+              << " targets applied, max following error " << drive.max_following_error() << " LSB"
+              << std::endl;
     return 0;
 }
 

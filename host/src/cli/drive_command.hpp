@@ -8,12 +8,12 @@
 namespace pathstream::host {
 
 struct DriveCommandOptions {
-    std::string can;                   ///< interface, e.g. vcan0
-    unsigned node = 1;                 ///< 1..127
-    std::int32_t position = 0;         ///< LSB at power-up
-    double bandwidth_hz = 100;         ///< servo plant
+    std::string can;                        ///< interface, e.g. vcan0
+    unsigned node = 1;                      ///< 1..127
+    std::int32_t position = 0;              ///< LSB at power-up
+    double bandwidth_hz = 100;              ///< servo plant
     std::uint32_t following_window = 5000;  ///< LSB (0x6065 default)
-    double exit_after = 0;             ///< seconds of wall time; 0 = until SIGINT/SIGTERM
+    double exit_after = 0;                  ///< seconds of wall time; 0 = until SIGINT/SIGTERM
 };
 
 void add_drive_command(CLI::App& app, DriveCommandOptions& options);

@@ -4,9 +4,9 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "pathstream/host/job_journal.hpp"
 #include "pathstream/machine/atomic_file.hpp"
 #include "pathstream/machine/input_error.hpp"
-#include "pathstream/host/job_journal.hpp"
 
 namespace pathstream::host {
 

@@ -6,14 +6,14 @@
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 
-#include "pathstream/machine/atomic_file.hpp"
 #include "pathstream/host/core_playback.hpp"
-#include "pathstream/machine/input_error.hpp"
 #include "pathstream/host/job_estimate.hpp"
 #include "pathstream/host/layers.hpp"
 #include "pathstream/host/planner.hpp"
 #include "pathstream/host/progress.hpp"
 #include "pathstream/host/work_area.hpp"
+#include "pathstream/machine/atomic_file.hpp"
+#include "pathstream/machine/input_error.hpp"
 
 namespace pathstream::host {
 
@@ -30,9 +30,10 @@ void add_plan_command(CLI::App& app, PlanCommandOptions& o) {
                     "CSV output file, - for standard output (the summary then goes to standard "
                     "error; default: only the summary)");
     cmd->add_flag("--json", o.json, "print the summary as one JSON document on standard output");
-    cmd->add_flag("--preview", o.preview,
-                  "print planning progress as JSON lines, then the preview document of `pathstream serve` "
-                  "(the path simplified, speed bins, figures) as one JSON line");
+    cmd->add_flag(
+        "--preview", o.preview,
+        "print planning progress as JSON lines, then the preview document of `pathstream serve` "
+        "(the path simplified, speed bins, figures) as one JSON line");
     cmd->add_option("--max-motion", o.max_motion,
                     "s: refuse, before planning, a job estimated to move for longer (0: no limit)")
         ->capture_default_str()

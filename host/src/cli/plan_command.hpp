@@ -5,10 +5,10 @@
 #include <string>
 
 #include "path_options.hpp"
-#include "pathstream/host/planned_job.hpp"
 #include "pathstream/host/geometry.hpp"
-#include "pathstream/machine/machine.hpp"
 #include "pathstream/host/plan.hpp"
+#include "pathstream/host/planned_job.hpp"
+#include "pathstream/machine/machine.hpp"
 
 namespace pathstream::host {
 
@@ -16,9 +16,10 @@ struct PlanCommandOptions {
     JobRequest path;
     std::string machine;
     std::string output;
-    bool json = false;  ///< --json: one JSON document on standard output instead of text
-    bool preview = false;   ///< --preview: the web page's preview document (plan_preview.cpp)
-    double max_motion = 0;  ///< --max-motion: s; a job estimated to move longer is refused; 0: no limit
+    bool json = false;     ///< --json: one JSON document on standard output instead of text
+    bool preview = false;  ///< --preview: the web page's preview document (plan_preview.cpp)
+    double max_motion =
+        0;  ///< --max-motion: s; a job estimated to move longer is refused; 0: no limit
 };
 
 void add_plan_command(CLI::App& app, PlanCommandOptions& options);
@@ -26,7 +27,6 @@ int run_plan(const PlanCommandOptions& options);
 /// `plan --preview`: planning progress as JSON lines, then the preview document `pathstream
 /// serve` shows, one line, on standard output.
 int run_plan_preview(const PlanCommandOptions& options);
-
 
 /// The summary lines both commands print (duration, lengths, deviation, limit fractions).
 void print_plan_summary(const PlannedJob& job, std::ostream& out);

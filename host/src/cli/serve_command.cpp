@@ -24,30 +24,36 @@ namespace pathstream::host {
 namespace fs = std::filesystem;
 
 void add_serve_command(CLI::App& app, ServeCommandOptions& o) {
-    CLI::App* cmd = app.add_subcommand(
-        "serve", "Serve a web page that loads, places, previews, simulates and streams drawings to a device and "
-                 "steers it (docs/serve.md)");
+    CLI::App* cmd = app.add_subcommand("serve",
+                                       "Serve a web page that loads, places, previews, simulates "
+                                       "and streams drawings to a device and "
+                                       "steers it (docs/serve.md)");
     cmd->add_option("--machine,-m", o.machine, "machine profile (JSON, docs/formats.md)")
         ->required()
         ->check(CLI::ExistingFile);
     cmd->add_option("--target,-t", o.target,
-                    "device: modbus-tcp://HOST:PORT?unit=N, modbus-rtu:///dev/ttyX?... or can://IFACE?node=N")
+                    "device: modbus-tcp://HOST:PORT?unit=N, modbus-rtu:///dev/ttyX?... or "
+                    "can://IFACE?node=N")
         ->required();
-    cmd->add_option("--listen", o.listen,
-                    "HOST:PORT to serve on; an address other than loopback needs --token or --token-file")
+    cmd->add_option(
+           "--listen", o.listen,
+           "HOST:PORT to serve on; an address other than loopback needs --token or --token-file")
         ->capture_default_str();
-    cmd->add_option("--token", o.token, "a secret every request must carry (?token= once, then a cookie)");
+    cmd->add_option("--token", o.token,
+                    "a secret every request must carry (?token= once, then a cookie)");
     cmd->add_option("--token-file", o.token_file, "read the token from the first line of this file")
         ->check(CLI::ExistingFile);
-    cmd->add_option("--state-dir", o.state_dir,
-                    "directory for the uploaded drawing and the job journal (default: a new temporary one)");
+    cmd->add_option(
+        "--state-dir", o.state_dir,
+        "directory for the uploaded drawing and the job journal (default: a new temporary one)");
     cmd->add_option("--max-upload-mb", o.max_upload_mb, "largest drawing accepted, MB")
         ->capture_default_str()
         ->check(CLI::Range(0.001, 1024.0));
     cmd->add_option("--events-rate", o.events_rate, "progress updates per second sent to the page")
         ->capture_default_str()
         ->check(CLI::Range(1.0, 50.0));
-    cmd->add_option("--plan-timeout", o.plan_timeout, "s a preview, run or simulation may plan before it is stopped")
+    cmd->add_option("--plan-timeout", o.plan_timeout,
+                    "s a preview, run or simulation may plan before it is stopped")
         ->capture_default_str()
         ->check(CLI::Range(1.0, 86400.0));
     cmd->add_option("--max-motion-hours", o.max_motion_hours,
@@ -57,7 +63,8 @@ void add_serve_command(CLI::App& app, ServeCommandOptions& o) {
     cmd->add_option("--max-connections", o.max_connections, "open connections in total")
         ->capture_default_str()
         ->check(CLI::Range(8, 100000));
-    cmd->add_option("--max-connections-per-client", o.max_connections_per_client, "open connections per client address")
+    cmd->add_option("--max-connections-per-client", o.max_connections_per_client,
+                    "open connections per client address")
         ->capture_default_str()
         ->check(CLI::Range(4, 100000));
 }
@@ -65,20 +72,26 @@ void add_serve_command(CLI::App& app, ServeCommandOptions& o) {
 namespace {
 
 std::atomic<bool> g_stop{false};
-extern "C" void on_serve_signal(int) { g_stop.store(true); }
+extern "C" void on_serve_signal(int) {
+    g_stop.store(true);
+}
 
 std::string read_token(const ServeCommandOptions& o) {
-    if (!o.token.empty() && !o.token_file.empty()) throw std::invalid_argument("serve: --token or --token-file, not both");
+    if (!o.token.empty() && !o.token_file.empty())
+        throw std::invalid_argument("serve: --token or --token-file, not both");
     if (o.token_file.empty()) {
         if (o.token.empty()) return o.token;
-        if (const auto why = serve::token_problem(o.token)) throw std::invalid_argument("serve: --token: " + *why);
+        if (const auto why = serve::token_problem(o.token))
+            throw std::invalid_argument("serve: --token: " + *why);
         return o.token;
     }
     std::ifstream in(o.token_file);
     std::string line;
     std::getline(in, line);
     while (!line.empty() && (line.back() == '\r' || line.back() == ' ')) line.pop_back();
-    if (line.empty()) throw std::invalid_argument("serve: --token-file " + o.token_file + ": the first line is empty");
+    if (line.empty())
+        throw std::invalid_argument("serve: --token-file " + o.token_file +
+                                    ": the first line is empty");
     if (const auto why = serve::token_problem(line))
         throw std::invalid_argument("serve: --token-file " + o.token_file + ": " + *why);
     return line;
@@ -109,7 +122,8 @@ int run_serve(const ServeCommandOptions& o) {
     bool temporary = false;
     if (o.state_dir.empty()) {
         std::string pattern = (fs::temp_directory_path() / "pathstream-serve-XXXXXX").string();
-        if (::mkdtemp(pattern.data()) == nullptr) throw std::runtime_error("serve: cannot create a temporary directory");
+        if (::mkdtemp(pattern.data()) == nullptr)
+            throw std::runtime_error("serve: cannot create a temporary directory");
         c.state_dir = pattern;
         temporary = true;
     } else {
@@ -130,9 +144,10 @@ int run_serve(const ServeCommandOptions& o) {
             throw;
         }
         std::printf("pathstream serve: http://%s:%u/%s for %s (machine %s)\n",
-                    listen.host.find(':') != std::string::npos ? ("[" + listen.host + "]").c_str() : listen.host.c_str(),
-                    server.bound_port(), c.access.token.empty() ? "" : "?token=...", o.target.c_str(),
-                    o.machine.c_str());
+                    listen.host.find(':') != std::string::npos ? ("[" + listen.host + "]").c_str()
+                                                               : listen.host.c_str(),
+                    server.bound_port(), c.access.token.empty() ? "" : "?token=...",
+                    o.target.c_str(), o.machine.c_str());
         std::printf("state         %s\n", c.state_dir.c_str());
         std::fflush(stdout);
         ::signal(SIGINT, on_serve_signal);

@@ -9,16 +9,16 @@ namespace pathstream::host {
 
 /// The command line of `serve`, as parsed.
 struct ServeCommandOptions {
-    std::string machine;                 ///< --machine: the profile every job is planned for
-    std::string target;                  ///< --target: the device's URL
+    std::string machine;  ///< --machine: the profile every job is planned for
+    std::string target;   ///< --target: the device's URL
     std::string listen = "127.0.0.1:8080";
-    std::string token;                   ///< --token: required by every request (not on loopback: required)
-    std::string token_file;              ///< --token-file: the token's first line
-    std::string state_dir;               ///< --state-dir: drawing and journal ("": a new temporary directory)
+    std::string token;       ///< --token: required by every request (not on loopback: required)
+    std::string token_file;  ///< --token-file: the token's first line
+    std::string state_dir;   ///< --state-dir: drawing and journal ("": a new temporary directory)
     double max_upload_mb = 16;
-    double events_rate = 10;             ///< progress updates per second to the page
-    double plan_timeout = 60;            ///< s a preview, run or simulation may plan
-    double max_motion_hours = 24;        ///< a longer job (estimated) is refused before planning
+    double events_rate = 10;       ///< progress updates per second to the page
+    double plan_timeout = 60;      ///< s a preview, run or simulation may plan
+    double max_motion_hours = 24;  ///< a longer job (estimated) is refused before planning
     std::size_t max_connections = 512;
     std::size_t max_connections_per_client = 256;
 };

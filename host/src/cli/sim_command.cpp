@@ -5,12 +5,12 @@
 #include <iostream>
 #include <nlohmann/json.hpp>
 
-#include "pathstream/machine/exit_codes.hpp"
 #include "pathstream/host/events.hpp"
 #include "pathstream/host/layers.hpp"
 #include "pathstream/host/planner.hpp"
 #include "pathstream/host/plot.hpp"
 #include "pathstream/host/progress.hpp"
+#include "pathstream/machine/exit_codes.hpp"
 #include "pathstream/sim/device.hpp"
 #include "plan_command.hpp"
 #include "sim_plots.hpp"
@@ -19,18 +19,29 @@ namespace pathstream::host {
 
 void add_sim_command(CLI::App& app, SimCommandOptions& o) {
     CLI::App* cmd = app.add_subcommand(
-        "sim", "Plan the path and run it on the simulated plotter (the firmware core on a simulated HAL): "
-               "plots and a one-screen report");
+        "sim",
+        "Plan the path and run it on the simulated plotter (the firmware core on a simulated HAL): "
+        "plots and a one-screen report");
     add_path_options(*cmd, o.path);
-    cmd->add_option("--machine,-m", o.machine, "machine profile (JSON, docs/formats.md)")->required()->check(CLI::ExistingFile);
-    cmd->add_option("--plot", o.plot_dir, "directory for path/speed/acceleration plots (SVG, and PNG with rsvg-convert)");
-    cmd->add_flag("--realtime", o.realtime, "pace the device at its real tick rate (default: as fast as possible)");
-    cmd->add_option("--plant", o.plant, "axis model: ideal (position = setpoint) or servo (2nd order)")
+    cmd->add_option("--machine,-m", o.machine, "machine profile (JSON, docs/formats.md)")
+        ->required()
+        ->check(CLI::ExistingFile);
+    cmd->add_option("--plot", o.plot_dir,
+                    "directory for path/speed/acceleration plots (SVG, and PNG with rsvg-convert)");
+    cmd->add_flag("--realtime", o.realtime,
+                  "pace the device at its real tick rate (default: as fast as possible)");
+    cmd->add_option("--plant", o.plant,
+                    "axis model: ideal (position = setpoint) or servo (2nd order)")
         ->capture_default_str()
         ->check(CLI::IsMember({"ideal", "servo"}));
-    cmd->add_option("--bandwidth", o.bandwidth_hz, "servo bandwidth, Hz")->capture_default_str()->check(CLI::Range(0.1, 10000.0));
-    cmd->add_option("--damping", o.damping, "servo damping ratio")->capture_default_str()->check(CLI::Range(0.05, 20.0));
-    cmd->add_flag("--y-up", o.y_up, "draw path.svg with +y upwards (default: downwards, like SVG and most plotters)");
+    cmd->add_option("--bandwidth", o.bandwidth_hz, "servo bandwidth, Hz")
+        ->capture_default_str()
+        ->check(CLI::Range(0.1, 10000.0));
+    cmd->add_option("--damping", o.damping, "servo damping ratio")
+        ->capture_default_str()
+        ->check(CLI::Range(0.05, 20.0));
+    cmd->add_flag("--y-up", o.y_up,
+                  "draw path.svg with +y upwards (default: downwards, like SVG and most plotters)");
     cmd->add_flag("--json", o.json, "print the report as one JSON document on standard output");
     cmd->add_option(
         "--events", o.events,
@@ -139,9 +150,10 @@ void limits_json(const PlannedJob& job, const plot::ReportFigures& f, Json& j) {
         c.jerk_limited ? Json(c.max_join_acceleration_step_fraction) : Json(nullptr);
     Json jerk = Json::object();
     for (std::size_t a = 0; a < job.machine.axes.size() && a < c.axis_jerk.size(); ++a) {
-        jerk[job.machine.axes[a].name] = {{"jerk_mm_per_s3", c.axis_jerk[a]},
-                                          {"jerk_lsb_per_tick3", c.axis_jerk_lsb[a]},
-                                          {"join_acceleration_step_mm_per_s2", c.axis_join_acceleration_step[a]}};
+        jerk[job.machine.axes[a].name] = {
+            {"jerk_mm_per_s3", c.axis_jerk[a]},
+            {"jerk_lsb_per_tick3", c.axis_jerk_lsb[a]},
+            {"join_acceleration_step_mm_per_s2", c.axis_join_acceleration_step[a]}};
     }
     j["jerk_axes"] = jerk;
     j["executed_window_ticks"] = f.executed_half_window;
@@ -195,7 +207,8 @@ std::size_t count_subpaths(const Plan& plan) {
 
 /// One simulated tick as the events see it: the device always runs, in simulated time.
 /// `prefix`: ticks before each span of the plan (size spans + 1).
-JobSample sim_sample(const sim::TickProbe& p, const PlannedJob& job, const std::vector<std::uint64_t>& prefix) {
+JobSample sim_sample(const sim::TickProbe& p, const PlannedJob& job,
+                     const std::vector<std::uint64_t>& prefix) {
     const std::size_t spans = job.plan.spans.size();
     JobSample s;
     s.sim_seconds = static_cast<double>(p.tick + 1) / job.machine.tick_hz;
@@ -231,7 +244,8 @@ sim::SimulationResult simulate_job(const SimCommandOptions& o, const PlannedJob&
     ProgressBar bar(o.realtime ? "running (real time)" : "simulating");
     events.start(std::nullopt);
     try {
-        return sim::simulate(job.plan.spans, job.machine, options, [&](double f) { bar.update(f); });
+        return sim::simulate(job.plan.spans, job.machine, options,
+                             [&](double f) { bar.update(f); });
     } catch (const std::exception& e) {
         events.end("failed", e.what());
         throw;
@@ -292,14 +306,17 @@ int run_sim(const SimCommandOptions& o) {
         }
     }
     if (result.underruns != 0) {
-        std::cerr << "pathstream: the device ran dry " << result.underruns << " times (a streaming bug)\n";
+        std::cerr << "pathstream: the device ran dry " << result.underruns
+                  << " times (a streaming bug)\n";
         return kExitInternal;
     }
     if (failed) {
         // Name the rule the plan broke: the jerk limit is checked with the others.
         const PlanCheck& c = job.check;
-        if (c.jerk_limited && (c.max_jerk_fraction_exact > 1 || c.max_join_acceleration_step_fraction > 1)) {
-            throw PlanError("the plan exceeds the machine's max_jerk (a planner bug): see the report above");
+        if (c.jerk_limited &&
+            (c.max_jerk_fraction_exact > 1 || c.max_join_acceleration_step_fraction > 1)) {
+            throw PlanError(
+                "the plan exceeds the machine's max_jerk (a planner bug): see the report above");
         }
         throw PlanError("the plan failed its per-tick check (a planner bug): see the report above");
     }

@@ -17,7 +17,7 @@ struct SimCommandOptions {
     double bandwidth_hz = 50;
     double damping = 1.0;
     bool y_up = false;
-    bool json = false;  ///< --json: one JSON document on standard output instead of text
+    bool json = false;       ///< --json: one JSON document on standard output instead of text
     std::string events;      ///< --events: NDJSON events to this file ("-": stdout)
     double events_rate = 5;  ///< --events-rate: progress events per simulated second, at most
 };

@@ -35,6 +35,7 @@
 #include "pathstream/machine/device_setup.hpp"
 #include "pathstream/machine/input_error.hpp"
 #include "plan_command.hpp"
+#include "stream_job.hpp"
 #include "stream_plan_tap.hpp"
 
 namespace pathstream::host {
@@ -179,39 +180,6 @@ private:
     std::chrono::steady_clock::time_point last_write_{};
 };
 
-// What a stream ended with, whichever bus carried it.
-struct StreamEnd {
-    int interrupted = 0;
-    DeviceSnapshot status;
-    std::uint32_t job = 0;
-    bool stopped_elsewhere = false;  // interrupted 2 by another client's stop
-};
-
-// What comes after a programmed pause that subpath `subpath` follows: the next layer's name
-// where the layer changes, else the subpath and where it is in the file.
-std::string pause_description(const Path& path, std::size_t subpath) {
-    const Subpath& s = path.subpaths.at(subpath);
-    const bool new_layer =
-        !path.layers.empty() && (subpath == 0 || path.subpaths[subpath - 1].layer != s.layer);
-    if (new_layer) return "layer \"" + path.layers.at(s.layer).name + "\"";
-    return "subpath " + std::to_string(subpath + 1) +
-           (s.location.line > 0 ? " (line " + std::to_string(s.location.line) + ")" : "");
-}
-
-// Where a span sits in the drawing: for the report of where an interrupted job stopped.
-struct SpanPlace {
-    std::int64_t origin = 0;  // index in the drawing's plan; -1: a re-entry span
-    std::size_t subpath = 0;
-    std::uint64_t drawing_tick = 0;  // the drawing's tick at its start
-};
-
-// The whole drawing's counts, known once planning ended.
-struct DrawingTotals {
-    std::size_t spans = 0;
-    std::size_t subpaths = 0;
-    std::uint64_t ticks = 0;
-};
-
 // The job as the streamer takes it, span by span: the events learn each span, the journal
 // each pause's description (a job planned as it streams), and the spans not yet executed are
 // kept for the report of where an interrupt stopped. Streaming thread only.
@@ -273,173 +241,6 @@ private:
     std::size_t last_subpath_ = 0;
 };
 
-// The progress bar's fraction, ETA and detail: the fraction of the whole drawing and the motion
-// left (estimated while planning goes on, marked "~"), then the queue level, how far planning
-// got while it runs, and where the job is.
-struct BarView {
-    double fraction = 0;
-    ProgressEta eta;
-    std::string detail;
-};
-BarView bar_view(std::uint64_t ticks, std::optional<std::uint64_t> total, double queued,
-                 const JobEvents& events, const PlanningThread* planning, double tick_hz) {
-    char text[96];
-    BarView v;
-    if (const std::optional<JobEvents::Progress> p = events.progress(ticks)) {
-        v.fraction = p->fraction;
-        v.eta = {static_cast<double>(p->ticks_left) / tick_hz, p->estimated};
-    } else if (total) {
-        v.fraction = *total > 0 ? static_cast<double>(ticks) / static_cast<double>(*total) : 1.0;
-    }
-    if (total || planning == nullptr || planning->finished()) {
-        std::snprintf(text, sizeof text, "queue %.2f s", queued);
-    } else {
-        std::snprintf(text, sizeof text, "planning %.0f %%, queue %.2f s",
-                      100 * planning->fraction(), queued);
-    }
-    const std::string status = events.status_text();
-    v.detail = status.empty() ? std::string(text) : std::string(text) + ", " + status;
-    return v;
-}
-
-StreamEnd stream_over_can(SpanSupply& supply, const MachineProfile& machine,
-                          const StreamCommandOptions& o, const StreamObserver& observer,
-                          const HeldJob* held, const JobEvents& events,
-                          const PlanningThread* planning) {
-    const CanTarget t = parse_can_target(o.stream.target);
-    hal::SocketCanBus bus(t.interface_name);
-    CanStreamOptions c;
-    c.node = t.node;
-    c.name = o.stream.target;
-    c.lead_seconds = o.stream.lead_seconds;
-    c.ack_timeout_ms = std::min(o.stream.response_timeout_ms, 100u);
-    c.link_timeout_seconds = o.stream.link_timeout_seconds;
-    c.interrupt = o.stream.interrupt;
-    c.observer = observer;
-    c.held = held;
-    CanStreamReport r;
-    {
-        ProgressBar bar("streaming");
-        r = stream_can(supply, machine, bus, c,
-                       [&](std::uint64_t ticks, std::optional<std::uint64_t> total, double queued) {
-                           const BarView v =
-                               bar_view(ticks, total, queued, events, planning, machine.tick_hz);
-                           bar.update(v.fraction, v.detail, v.eta);
-                       });
-    }
-    if (r.interrupted != 0) return {r.interrupted, r.final_status, r.job, r.stopped_elsewhere};
-    const double motion = static_cast<double>(r.ticks_executed) / machine.tick_hz;
-    std::printf("streamed      %s (native CAN protocol, node %u)\n", o.stream.target.c_str(),
-                unsigned(t.node));
-    std::printf(
-        "executed      %llu ticks (%.3f s of motion), %llu spans in %llu batches, last span %u\n",
-        static_cast<unsigned long long>(r.ticks_executed), motion,
-        static_cast<unsigned long long>(r.spans_sent), static_cast<unsigned long long>(r.batches),
-        r.last_completed);
-    std::printf("job           %u finished: the device is idle at the drawing's end point\n",
-                r.job);
-    std::printf(
-        "bus           %llu frames sent, %llu received, %llu retransmitted batches, %llu timeouts;"
-        " %.1f kbit/s worst case (%.2f %% of 1 Mbit/s)\n",
-        static_cast<unsigned long long>(r.frames_sent),
-        static_cast<unsigned long long>(r.frames_received),
-        static_cast<unsigned long long>(r.retransmissions),
-        static_cast<unsigned long long>(r.timeouts),
-        static_cast<double>(r.bits_sent + r.bits_received) / motion / 1e3,
-        static_cast<double>(r.bits_sent + r.bits_received) / motion / 1e4);
-    std::printf("device        %u underruns, %u duplicate batches acknowledged; wall time %.2f s\n",
-                r.underruns, r.duplicates, r.wall_seconds);
-    return {0, r.final_status, r.job};
-}
-
-StreamEnd stream_over_modbus(SpanSupply& supply, const MachineProfile& machine,
-                             const StreamCommandOptions& o, const StreamObserver& observer,
-                             const HeldJob* held, const JobEvents& events,
-                             const PlanningThread* planning) {
-    StreamOptions options = o.stream;
-    options.observer = observer;
-    options.held = held;
-    StreamReport r;
-    {
-        ProgressBar bar("streaming");
-        r = stream_modbus(
-            supply, machine, options,
-            [&](std::uint64_t ticks, std::optional<std::uint64_t> total, double queued) {
-                const BarView v = bar_view(ticks, total, queued, events, planning, machine.tick_hz);
-                bar.update(v.fraction, v.detail, v.eta);
-            });
-    }
-    if (r.interrupted != 0) return {r.interrupted, r.final_status, r.job, r.stopped_elsewhere};
-    std::printf("streamed      %s\n", o.stream.target.c_str());
-    std::printf(
-        "executed      %llu ticks (%.3f s of motion), %llu spans in %llu batches, last span %u\n",
-        static_cast<unsigned long long>(r.ticks_executed),
-        static_cast<double>(r.ticks_executed) / machine.tick_hz,
-        static_cast<unsigned long long>(r.spans_sent), static_cast<unsigned long long>(r.batches),
-        r.last_completed);
-    std::printf("job           %u finished: the device is idle at the drawing's end point\n",
-                r.job);
-    std::printf("final point  ");
-    for (std::size_t a = 0; a < machine.axes.size(); ++a) {
-        std::printf(" %s %.4f mm", machine.axes[a].name.c_str(),
-                    r.final_position[a] * machine.mm_per_lsb);
-    }
-    std::printf(
-        "\nlink          %llu transactions, %llu retries, %llu reconnects, %llu bytes sent, %llu "
-        "received"
-        " (%.0f B per s of motion)\n",
-        static_cast<unsigned long long>(r.transactions), static_cast<unsigned long long>(r.retries),
-        static_cast<unsigned long long>(r.reconnects),
-        static_cast<unsigned long long>(r.bytes_sent),
-        static_cast<unsigned long long>(r.bytes_received),
-        (r.bytes_sent + r.bytes_received) /
-            (static_cast<double>(r.ticks_executed) / machine.tick_hz));
-    std::printf("device        %u underruns, %u duplicate batches acknowledged; wall time %.2f s\n",
-                r.underruns, r.duplicates, r.wall_seconds);
-    return {0, r.final_status, r.job};
-}
-
-// Where an interrupted job stopped, in the drawing's terms, and how to go on. `next`: the
-// first span of the job not executed to its end (its place, when known); `totals`: the
-// drawing's, when planning got to its end; `resumable`: the journal can resume it.
-void print_interrupted(const StreamEnd& end, std::optional<SpanPlace> next,
-                       std::optional<DrawingTotals> totals, const MachineProfile& machine,
-                       const std::string& journal, bool resumable) {
-    const DeviceSnapshot& s = end.status;
-    std::printf("interrupted   the device %s at",
-                end.interrupted == 1 && s.state == device::DeviceState::kHolding ? "holds at rest (the rest of the job queued)"
-                : s.state == device::DeviceState::kIdle                       ? "stopped and is idle (queue dropped)"
-                                                     : device_state_name(s.state));
-    for (std::size_t a = 0; a < machine.axes.size(); ++a) {
-        std::printf(" %s %.4f mm", machine.axes[a].name.c_str(),
-                    s.position[a] * machine.mm_per_lsb);
-    }
-    std::printf(", pen up\n");
-    if (next && totals) {
-        std::printf(
-            "              stopped before drawing span %lld of %zu (subpath %zu of %zu, tick %llu "
-            "of %llu)\n",
-            static_cast<long long>(next->origin) + 1, totals->spans, next->subpath + 1,
-            totals->subpaths, static_cast<unsigned long long>(next->drawing_tick),
-            static_cast<unsigned long long>(totals->ticks));
-    } else if (next) {
-        std::printf(
-            "              stopped before drawing span %lld (subpath %zu, tick %llu; planning did "
-            "not finish)\n",
-            static_cast<long long>(next->origin) + 1, next->subpath + 1,
-            static_cast<unsigned long long>(next->drawing_tick));
-    }
-    if (journal.empty()) {
-        std::printf("resume        not possible: --no-journal\n");
-    } else if (!resumable) {
-        std::printf(
-            "resume        not possible: planning did not finish, the journal has no plan to go on "
-            "from\n");
-    } else {
-        std::printf("resume with   pathstream stream --resume %s\n", journal.c_str());
-    }
-}
-
 std::string default_journal_path(const std::string& drawing) {
     if (drawing == "-") return "stdin.journal.json";
     return std::filesystem::path(drawing).stem().string() + ".journal.json";
@@ -475,28 +276,6 @@ public:
 private:
     std::string journal_;
 };
-
-// Says where the job starts: at the device's rest position, or after a pen-up lead-in from it
-// (prepare_job put one first when the two differ on the LSB grid).
-void print_lead_in(const PlannedJob& job, const std::vector<double>& rest_mm) {
-    std::string at;
-    char value[48];
-    for (std::size_t a = 0; a < rest_mm.size() && a < job.machine.axes.size(); ++a) {
-        std::snprintf(value, sizeof value, " %s %.4f mm", job.machine.axes[a].name.c_str(),
-                      rest_mm[a]);
-        at += value;
-    }
-    const bool moved = !job.segments.empty() && !job.segments.front().pen_down &&
-                       job.segments.size() > 1 &&
-                       job.segments.front().p[0] == PathPoint(rest_mm.begin(), rest_mm.end());
-    if (moved) {
-        std::printf("lead-in       pen up from where the device rests,%s, to the drawing's start\n",
-                    at.c_str());
-    } else {
-        std::printf("start         the device rests at the drawing's start,%s: no lead-in\n",
-                    at.c_str());
-    }
-}
 
 // A second stream to the same journal (the default one of a drawing streamed again from the
 // same directory, or the same --journal) would replace the journal of a job the device may
@@ -543,22 +322,6 @@ void handle_pauses(InterruptOptions& interrupt, const JournalWriter& writer, Job
     if (terminal) interrupt.resume_requested = enter_pressed;
 }
 
-// What stream_job streams: the spans and what is known of the whole job.
-struct JobToStream {
-    SpanSupply& supply;
-    // The job held in memory (a resume, --plan-first): its spans file is written before the
-    // stream, its totals known. Null: a first job planned as it streams.
-    const JobSpans* spans = nullptr;
-    // The planner feeding `supply` and its tap (the spans file), for a job planned as it
-    // streams; `path` describes its pauses.
-    PlanningThread* planning = nullptr;
-    const StreamPlanTap* tap = nullptr;
-    const Path* path = nullptr;
-    std::size_t subpaths = 0;  // of the whole drawing
-    // The job's ticks estimated while planning goes on (JobEvents::set_progress_basis).
-    std::function<std::optional<std::uint64_t>()> estimate;
-};
-
 // After a stream that ended early (an interrupt, a device error) while planning still runs:
 // planning goes on to its end, for the journal's spans file that --resume needs, unless the
 // operator interrupts again.
@@ -571,6 +334,8 @@ void finish_planning(PlanningThread& planning, bool journal) {
     const int interrupts = g_interrupts.load();
     planning.drain([interrupts] { return g_interrupts.load() == interrupts; });
 }
+
+}  // namespace
 
 // Streams `job`, keeping the journal and writing the events; returns the exit status.
 int stream_job(const JobToStream& job, const MachineProfile& machine, StreamCommandOptions o,
@@ -687,199 +452,7 @@ int stream_job(const JobToStream& job, const MachineProfile& machine, StreamComm
     return kExitInterrupted;
 }
 
-// What comes after each programmed pause of a plan in memory (pause_description of each).
-std::vector<std::string> pause_descriptions(const Path& path, const Plan& plan) {
-    std::vector<std::string> out;
-    for (const PlanPause& p : plan.pauses) out.push_back(pause_description(path, p.subpath));
-    return out;
-}
-
-// A journal whose plan was not complete when the stream ended (a host crash while planning):
-// the job planned again from the drawing's copy with the same options, proved against every
-// span the stream had handed on (the partial spans file), its spans file written and the
-// journal updated. Throws InputError when it cannot be, naming what changed.
-JobSpans replan_for_resume(JobJournal& journal, const std::string& journal_path,
-                           const std::string& machine_file) {
-    if (journal.replan.empty()) {
-        throw InputError(
-            journal_path, {},
-            "the job's plan was never complete and the journal has no \"replan\" (written by an "
-            "older "
-            "pathstream, or --plan-first): nothing to go on from; stream the drawing again");
-    }
-    const JobRecipe recipe = parse_job_recipe(journal.replan, journal_path);
-    if (const std::string h = file_content_hash(recipe.path.file); h != recipe.input_hash) {
-        throw InputError(recipe.path.file, {},
-                         "the drawing's copy changed since the job started (hash " + h +
-                             ", journal " + recipe.input_hash + "): stream the drawing again");
-    }
-    if (const std::string h = file_content_hash(machine_file); h != recipe.machine_hash) {
-        throw InputError(machine_file, {},
-                         "the machine profile changed since the job started (hash " + h +
-                             ", journal " + recipe.machine_hash +
-                             "): resume with the profile the job was planned for");
-    }
-    std::printf(
-        "resume        the plan was not complete when the stream ended: planning the job again "
-        "from %s\n",
-        recipe.path.file.c_str());
-    std::fflush(stdout);
-    const PlannedJob planned =
-        plan_job(recipe.path, machine_file, recipe.lead_in_from ? &*recipe.lead_in_from : nullptr);
-    JobSpans job = job_from_plan(planned.plan);
-    // Every span the stream handed on is in the partial file, flushed before it left the
-    // planner: the new plan must begin with exactly those lines. Planning may have ended (the
-    // spans file written, the partial one removed) just before the journal could say so: then
-    // the spans file is the proof.
-    const std::string partial = partial_spans_path(journal.plan_file);
-    std::string proof = partial;
-    std::ifstream in(partial, std::ios::binary);
-    std::size_t skip = 0;
-    if (!in) {
-        in.clear();
-        in.open(journal.plan_file, std::ios::binary);
-        proof = journal.plan_file;
-        skip = 2;  // its header lines
-    }
-    if (!in && journal.job != 0) {
-        throw InputError(journal_path, {},
-                         "spans were sent, but neither " + partial + " nor " + journal.plan_file +
-                             " is there to prove a new plan against: stream the drawing again");
-    }
-    std::string line;
-    std::size_t proved = 0;
-    std::size_t number = 0;
-    while (in && std::getline(in, line)) {
-        ++number;
-        if (in.eof()) break;  // a last line without its newline was never flushed whole
-        if (number <= skip) continue;
-        if (proved >= job.plan.spans.size() ||
-            line != job_span_line(job.plan.spans[proved], job.origin[proved],
-                                  job.drawing_tick[proved])) {
-            throw InputError(proof, {number, 1},
-                             "the job planned again differs from the one streamed at span " +
-                                 std::to_string(proved + 1) + " (planned by " + recipe.planner +
-                                 ", now " + planner_identity() + "): stream the drawing again");
-        }
-        ++proved;
-    }
-    std::printf(
-        "resume        planned again: %zu spans, the first %zu identical to the ones streamed\n",
-        job.plan.spans.size(), proved);
-    journal.plan_hash = write_job_spans(job, journal.plan_file);
-    journal.pauses = pause_descriptions(planned.path, planned.plan);
-    write_journal(journal, journal_path);
-    std::remove(partial.c_str());
-    return job;
-}
-
-// --resume: the device holds the job (go on streaming, then resume), or rests idle (a
-// re-entry from where it rests to the first span not executed, then the rest of the job).
-// decide_resume says which; this reads the device, waits, prints and acts.
-int run_resume(StreamCommandOptions o, const EventChannel& channel) {
-    JobJournal journal = read_journal(o.resume);
-    if (o.machine.empty()) o.machine = journal.machine;
-    if (o.stream.target.empty()) o.stream.target = journal.target;
-    const MachineProfile machine = load_machine_profile(o.machine);
-    const JobSpans job = journal.plan_hash.empty()
-                             ? replan_for_resume(journal, o.resume, o.machine)
-                             : read_job_spans(journal.plan_file, journal.plan_hash);
-    const std::size_t spans = job.plan.spans.size();
-    const std::size_t axes = machine.axes.size();
-    const ResumeJournal record{journal.job, journal.epoch, journal.last_completed,
-                               journal.outcome == "finished"};
-    ResumeDecision d = decide_resume(record, spans, axes, nullptr);
-    if (d.kind == ResumeKind::kAlreadyFinished) {
-        std::printf("resume        %s: the job already ran to its end; nothing to do\n",
-                    o.resume.c_str());
-        return 0;
-    }
-    LinkOptions l;
-    l.response_timeout_ms = o.stream.response_timeout_ms;
-    l.attempts = o.stream.attempts;
-    l.link_timeout_seconds = o.stream.link_timeout_seconds;
-    DeviceSnapshot s;
-    {
-        const std::unique_ptr<DeviceLink> link = open_device_link(o.stream.target, l);
-        s = link->status();
-        // The wait for a device running out its queue lasts at most the queue's length in
-        // time, bounded by the link timeout per quiet read.
-        ResumeWait wait;
-        std::chrono::steady_clock::time_point deadline;
-        for (d = decide_resume(record, spans, axes, &s, wait); d.kind == ResumeKind::kWaitForQueue;
-             d = decide_resume(record, spans, axes, &s, wait)) {
-            if (!wait.waiting) {
-                std::printf(
-                    "resume        the device still runs job %u from its queue: waiting until it "
-                    "holds or ends\n",
-                    journal.job);
-                std::fflush(stdout);
-                wait.waiting = true;
-                deadline = std::chrono::steady_clock::now() + std::chrono::seconds(600);
-            }
-            if (std::chrono::steady_clock::now() >= deadline) {
-                wait.timed_out = true;
-                continue;
-            }
-            if (d.hold_at_rest) {
-                wait.held_at_rest = link->command(device::Command::kHold) == Status::kOk;
-                if (wait.held_at_rest) {
-                    std::printf(
-                        "resume        the device ran out its queue at rest: holding it there\n");
-                    std::fflush(stdout);
-                }
-            }
-            std::this_thread::sleep_for(std::chrono::milliseconds(20));
-            s = link->status();
-        }
-    }
-    if (d.kind == ResumeKind::kRefuse) throw StreamError(o.stream.target + ": " + d.refusal);
-    if (d.kind == ResumeKind::kFinishedWhileAway) {
-        JobJournal done = journal;
-        done.outcome = "finished";
-        done.last_completed = s.last_completed;
-        done.state = device_state_name(s.state);
-        done.position.assign(s.position, s.position + axes);
-        write_journal(done, o.resume);
-        std::printf(
-            "resume        the device ran job %u to its end after the host stopped; nothing to "
-            "do\n",
-            journal.job);
-        return 0;
-    }
-    if (d.kind == ResumeKind::kContinueHeld) {
-        std::printf(
-            "resume        the device holds job %u at span %u of %zu: streaming the rest, then "
-            "resume\n",
-            journal.job, static_cast<unsigned>(d.first), spans);
-        PlanSupply supply(job.plan);
-        return stream_job({supply, &job, nullptr, nullptr, nullptr, job.subpaths, {}}, machine, o,
-                          journal, o.resume, &d.held, channel);
-    }
-    // kReenter: the only decision left once the device was read and the wait is over.
-    const std::size_t first = d.first;
-    if (d.from_journal) {
-        std::printf(
-            "resume        the device does not know job %u (restarted?): from the journal's last "
-            "record, "
-            "span %zu\n",
-            journal.job, first);
-    }
-    std::vector<Lsb> rest(s.position, s.position + axes);
-    const JobSpans resumed = resume_from(job, first, rest, device_limits(machine));
-    std::printf(
-        "resume        from where the device rests, back onto the drawing at span %lld of %zu "
-        "(tick %llu)\n",
-        static_cast<long long>(resumed.origin[resumed.origin.size() - (spans - first)]) + 1,
-        job.drawing_spans, static_cast<unsigned long long>(resumed.drawing_tick.front()));
-    JobJournal next = journal;
-    next.job = 0;
-    next.outcome = "streaming";
-    next.error.clear();
-    PlanSupply supply(resumed.plan);
-    return stream_job({supply, &resumed, nullptr, nullptr, nullptr, resumed.subpaths, {}}, machine,
-                      o, next, o.resume, nullptr, channel);
-}
+namespace {
 
 // CiA 402 drives: no device status to follow, so the events are the job's start and end.
 int stream_cia402(const PlannedJob& planned, const std::string& url, const EventChannel& channel,

@@ -4,9 +4,9 @@
 #include <CLI/CLI.hpp>
 #include <string>
 
-#include "pathstream/machine/exit_codes.hpp"
 #include "path_options.hpp"
 #include "pathstream/host/modbus_stream.hpp"
+#include "pathstream/machine/exit_codes.hpp"
 
 namespace pathstream::host {
 
@@ -19,10 +19,12 @@ struct StreamCommandOptions {
     /// --lead-in (the default) is kept for scripts; CiA 402 targets refuse it.
     bool lead_in = false;
     bool no_lead_in = false;
-    std::string journal;   ///< job journal path ("" : DRAWING-STEM.journal.json in the current directory)
+    std::string
+        journal;  ///< job journal path ("" : DRAWING-STEM.journal.json in the current directory)
     bool no_journal = false;
-    bool replace_journal = false;  ///< --replace-journal: an unfinished job's journal may be replaced
-    std::string resume;    ///< continue the job of this journal
+    bool replace_journal =
+        false;           ///< --replace-journal: an unfinished job's journal may be replaced
+    std::string resume;  ///< continue the job of this journal
     double hold_timeout_seconds = 10;  ///< Ctrl-C: a hold not at rest by then becomes a stop
     std::string events;                ///< --events: NDJSON events to this file ("-": stdout)
     double events_rate = 5;            ///< --events-rate: progress events per second, at most

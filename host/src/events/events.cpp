@@ -132,8 +132,9 @@ void JobEvents::start(std::optional<std::uint32_t> job) {
     e["target"] = info_.target;
     e["job"] = job ? EventJson(*job) : EventJson(nullptr);
     e["plan_ticks"] = total_json(total_ticks_);
-    e["duration_s"] = total_ticks_ ? EventJson(static_cast<double>(*total_ticks_) / machine_.tick_hz)
-                                   : EventJson(nullptr);
+    e["duration_s"] = total_ticks_
+                          ? EventJson(static_cast<double>(*total_ticks_) / machine_.tick_hz)
+                          : EventJson(nullptr);
     e["spans"] = total_json(total_spans_);
     e["subpaths"] = info_.subpaths;
     e["tick_hz"] = machine_.tick_hz;
@@ -244,7 +245,8 @@ void JobEvents::enter_spans(const JobSample& s) {
     }
 }
 
-void JobEvents::set_progress_basis(std::uint64_t before, std::function<std::optional<std::uint64_t>()> estimate) {
+void JobEvents::set_progress_basis(std::uint64_t before,
+                                   std::function<std::optional<std::uint64_t>()> estimate) {
     ticks_before_job_ = before;
     estimate_ = std::move(estimate);
 }
@@ -259,9 +261,10 @@ std::optional<JobEvents::Progress> JobEvents::progress(std::uint64_t ticks) cons
     // An estimate may fall short of what already ran: never past the end before the end.
     const std::uint64_t job = estimated ? std::max(*total, ticks + 1) : *total;
     const std::uint64_t whole = ticks_before_job_ + job;
-    p.fraction = whole > 0 ? std::min(1.0, static_cast<double>(ticks_before_job_ + std::min(ticks, job)) /
-                                               static_cast<double>(whole))
-                           : 1.0;
+    p.fraction = whole > 0
+                     ? std::min(1.0, static_cast<double>(ticks_before_job_ + std::min(ticks, job)) /
+                                         static_cast<double>(whole))
+                     : 1.0;
     p.ticks_left = job - std::min(ticks, job);
     return p;
 }
@@ -277,7 +280,8 @@ void JobEvents::on_progress(const JobSample& s) {
     e["fraction"] = p ? EventJson(rounded(p->fraction, 1e6)) : EventJson(nullptr);
     e["ticks"] = s.ticks;
     e["plan_ticks"] = total_json(total_ticks_);
-    e["eta_s"] = p ? EventJson(rounded(static_cast<double>(p->ticks_left) / machine_.tick_hz, 1e6)) : EventJson(nullptr);
+    e["eta_s"] = p ? EventJson(rounded(static_cast<double>(p->ticks_left) / machine_.tick_hz, 1e6))
+                   : EventJson(nullptr);
     e["estimated"] = p && p->estimated;
     e["queue_s"] = rounded(static_cast<double>(s.queued_ticks) / machine_.tick_hz, 1e6);
     e["queue_spans"] = s.queued_spans ? EventJson(*s.queued_spans) : EventJson(nullptr);

@@ -41,20 +41,20 @@ struct IgnoredCode {
 /// One block, decoded. Codes the reader accepts and ignores (G17, G40, G49, G54, G94, S, T)
 /// leave no trace here.
 struct Command {
-    SourceLocation start;                  ///< the block's first word
-    std::optional<Motion> motion;          ///< G0 G1 G2 G3 G5 G5.1 G80
-    SourceLocation motion_at;              ///< where that G word is
-    std::optional<bool> inch;              ///< G20 (true) / G21 (false)
-    std::optional<bool> incremental;       ///< G91 (true) / G90 (false)
-    std::optional<bool> arc_incremental;   ///< G91.1 (true) / G90.1 (false)
-    NonModal non_modal = NonModal::kNone;  ///< G4, G28, G30, G53, G92...
-    SourceLocation non_modal_at;           ///< where that G word is
-    bool nurbs_end = false;                ///< G5.3
+    SourceLocation start;                    ///< the block's first word
+    std::optional<Motion> motion;            ///< G0 G1 G2 G3 G5 G5.1 G80
+    SourceLocation motion_at;                ///< where that G word is
+    std::optional<bool> inch;                ///< G20 (true) / G21 (false)
+    std::optional<bool> incremental;         ///< G91 (true) / G90 (false)
+    std::optional<bool> arc_incremental;     ///< G91.1 (true) / G90.1 (false)
+    NonModal non_modal = NonModal::kNone;    ///< G4, G28, G30, G53, G92...
+    SourceLocation non_modal_at;             ///< where that G word is
+    bool nurbs_end = false;                  ///< G5.3
     std::optional<CornerMode> path_control;  ///< G61 (exact path), G61.1 (exact stop), G64 (P, Q)
-    SourceLocation path_control_at;         ///< where that G word is
-    std::optional<bool> spindle_on;        ///< M3, M4 (true) / M5 (false)
-    bool end_program = false;              ///< M2, M30
-    bool pause = false;                    ///< M0, M1
+    SourceLocation path_control_at;          ///< where that G word is
+    std::optional<bool> spindle_on;          ///< M3, M4 (true) / M5 (false)
+    bool end_program = false;                ///< M2, M30
+    bool pause = false;                      ///< M0, M1
     /// Codes skipped in this block; when `skip` the whole block is skipped (it held only
     /// skipped codes and their words).
     std::vector<IgnoredCode> ignored;

@@ -6,8 +6,8 @@
 #include <string>
 #include <string_view>
 
-#include "pathstream/machine/input_error.hpp"
 #include "pathstream/host/path.hpp"
+#include "pathstream/machine/input_error.hpp"
 
 namespace pathstream::host::gcode {
 

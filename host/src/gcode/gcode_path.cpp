@@ -112,7 +112,7 @@ Path parse_gcode_path(const std::string& text, const std::string& file, const Gc
         chosen.pen = choose_pen(evidence, options.z_down_max, out.pen_reason);
         if (chosen.pen != PenControl::kZ || path.subpaths.empty()) {
             std::vector<std::string> again;  // the warnings of the first run stand
-            path = Path{};  // not held through the second run
+            path = Path{};                   // not held through the second run
             path = run(lines, file, chosen, ignored, false, nullptr, again);
         }
     } else {

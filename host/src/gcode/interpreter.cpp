@@ -195,7 +195,9 @@ void Interpreter::check_words_used(const Command& c, Motion move, bool moving) c
     };
     if (const Word* p = c.value('P');
         p && blending && (arc || cubic || nurbs || c.non_modal == NonModal::kDwell)) {
-        fail(p->at, "word P would be used by G64 and by the block's other command: give G64 a block of its own");
+        fail(p->at,
+             "word P would be used by G64 and by the block's other command: give G64 a block of "
+             "its own");
     }
     for (const auto& u : uses) {
         if (const Word* w = c.value(u.letter); w && !u.used) {

@@ -84,7 +84,8 @@ void RunBuilder::end_block() {
 }
 
 void RunBuilder::close_run() {
-    if (open_ && !done_.back().stops.empty() && done_.back().stops.back() >= chain_segments(done_.back())) {
+    if (open_ && !done_.back().stops.empty() &&
+        done_.back().stops.back() >= chain_segments(done_.back())) {
         done_.back().stops.pop_back();
     }
     open_ = false;

@@ -24,11 +24,13 @@ std::size_t find_layer(const Path& path, const std::string& choice) {
     for (std::size_t i = 0; i < path.layers.size(); ++i)
         if (path.layers[i].name == choice) return i;
     std::size_t n = 0;
-    const bool digits = !choice.empty() && std::all_of(choice.begin(), choice.end(), [](char c) { return c >= '0' && c <= '9'; });
+    const bool digits = !choice.empty() && std::all_of(choice.begin(), choice.end(),
+                                                       [](char c) { return c >= '0' && c <= '9'; });
     if (digits && choice.size() < 6) n = std::stoul(choice);
     if (n >= 1 && n <= path.layers.size()) return n - 1;
-    throw std::invalid_argument("--layer " + choice + ": no such layer (the drawing has " +
-                                (path.layers.empty() ? std::string("no layers") : layer_list(path)) + ")");
+    throw std::invalid_argument(
+        "--layer " + choice + ": no such layer (the drawing has " +
+        (path.layers.empty() ? std::string("no layers") : layer_list(path)) + ")");
 }
 
 // Pen-down length of one subpath (mm): 32 chords per Bezier segment.
@@ -43,7 +45,8 @@ double subpath_length(const Subpath& s, std::size_t axes) {
         for (int k = 1; k <= 32; ++k) {
             const PathPoint p = bezier_point(b, k / 32.0);
             double d = 0;
-            for (std::size_t a = 0; a < p.size(); ++a) d += (p[a] - previous[a]) * (p[a] - previous[a]);
+            for (std::size_t a = 0; a < p.size(); ++a)
+                d += (p[a] - previous[a]) * (p[a] - previous[a]);
             length += std::sqrt(d);
             previous = p;
         }
@@ -66,7 +69,8 @@ Path select_layers(const Path& path, const std::vector<std::string>& chosen) {
     Path out = without_subpaths(path);
     for (const Subpath& s : path.subpaths)
         if (keep.at(s.layer)) out.subpaths.push_back(s);
-    if (out.subpaths.empty()) throw std::invalid_argument("--layer: the chosen layers have nothing to draw");
+    if (out.subpaths.empty())
+        throw std::invalid_argument("--layer: the chosen layers have nothing to draw");
     return out;
 }
 
@@ -88,7 +92,8 @@ void pause_between_layers(Path& path, LayerPause when) {
         }
         const std::string& p = path.layers[a].pen;
         const std::string& q = path.layers[b].pen;
-        if (p == "mixed" || q == "mixed" || (!p.empty() && !q.empty() && p != q)) path.subpaths[i].pause_before = true;
+        if (p == "mixed" || q == "mixed" || (!p.empty() && !q.empty() && p != q))
+            path.subpaths[i].pause_before = true;
     }
 }
 
@@ -113,8 +118,9 @@ Path order_sections(Path path, const OrderOptions& options, OrderReport* report)
         while (end < path.subpaths.size() && !starts_section(path, end)) ++end;
         Path section = without_subpaths(path);
         // Moved, not copied: each subpath goes into exactly one section.
-        section.subpaths.assign(std::make_move_iterator(path.subpaths.begin() + static_cast<std::ptrdiff_t>(first)),
-                                std::make_move_iterator(path.subpaths.begin() + static_cast<std::ptrdiff_t>(end)));
+        section.subpaths.assign(
+            std::make_move_iterator(path.subpaths.begin() + static_cast<std::ptrdiff_t>(first)),
+            std::make_move_iterator(path.subpaths.begin() + static_cast<std::ptrdiff_t>(end)));
         const bool head_pauses = section.subpaths.front().pause_before;
         const bool head_rests = section.subpaths.front().dwell_before > 0;
         if (head_rests) {
@@ -165,14 +171,15 @@ nlohmann::ordered_json layers_json(const Path& path) {
         out.push_back({{"name", layers[i].name},
                        {"subpaths", layers[i].subpaths},
                        {"drawn_length_mm", layers[i].length},
-                       {"feed_mm_s", feed > 0 ? nlohmann::ordered_json(feed) : nlohmann::ordered_json(nullptr)}});
+                       {"feed_mm_s", feed > 0 ? nlohmann::ordered_json(feed)
+                                              : nlohmann::ordered_json(nullptr)}});
     }
     return out;
 }
 
 std::size_t count_pauses(const Path& path) {
-    return static_cast<std::size_t>(
-        std::count_if(path.subpaths.begin(), path.subpaths.end(), [](const Subpath& s) { return s.pause_before; }));
+    return static_cast<std::size_t>(std::count_if(path.subpaths.begin(), path.subpaths.end(),
+                                                  [](const Subpath& s) { return s.pause_before; }));
 }
 
 std::string layers_text(const Path& path) {
@@ -185,7 +192,8 @@ std::string layers_text(const Path& path) {
         out << "layers: " << layers.size() << " (";
         for (std::size_t i = 0; i < layers.size(); ++i) {
             out << (i ? ", " : "") << '"' << layers[i].name << "\" " << layers[i].subpaths
-                << (layers[i].subpaths == 1 ? " subpath " : " subpaths ") << layers[i].length << " mm";
+                << (layers[i].subpaths == 1 ? " subpath " : " subpaths ") << layers[i].length
+                << " mm";
             if (path.layers[i].feed > 0) out << " at " << path.layers[i].feed << " mm/s";
         }
         out << "), ";

@@ -7,8 +7,8 @@
 #include <limits>
 #include <map>
 #include <stdexcept>
-#include <type_traits>
 #include <string>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -30,7 +30,9 @@ bool joinable_basis(PathBasis basis) {
 /// An open polyline or Bezier chain whose ends meet: it may start at any on-curve vertex
 /// (unless it rests at some of its vertices: those would move).
 bool is_open_loop(const Subpath& s, double tolerance) {
-    if (s.closed || !joinable_basis(s.basis) || tolerance < 0 || s.corner_mode == CornerMode::kExactStop) return false;
+    if (s.closed || !joinable_basis(s.basis) || tolerance < 0 ||
+        s.corner_mode == CornerMode::kExactStop)
+        return false;
     const std::size_t m = s.points.size();
     if (s.basis == PathBasis::kBezier ? m < 7 || (m - 1) % 3 != 0 : m < 3) return false;
     return distance(s.points.front(), s.points.back()) <= tolerance;
@@ -84,12 +86,14 @@ void rotate_points(Subpath& r, std::size_t shift) {
     if (!r.closed) throw std::invalid_argument("rotated_subpath: the subpath is open");
     if (r.points.empty()) return;
     if (r.basis == PathBasis::kBezier && shift % 3 != 0) {
-        throw std::invalid_argument("rotated_subpath: a Bezier chain starts only at on-curve points (shift " +
-                                    std::to_string(shift) + " is not a multiple of 3)");
+        throw std::invalid_argument(
+            "rotated_subpath: a Bezier chain starts only at on-curve points (shift " +
+            std::to_string(shift) + " is not a multiple of 3)");
     }
     r.segment_lines.clear();
     r.points.rotate(shift);
-    renumber_stops(r, 1, -static_cast<long long>(r.basis == PathBasis::kBezier ? shift / 3 : shift));
+    renumber_stops(r, 1,
+                   -static_cast<long long>(r.basis == PathBasis::kBezier ? shift / 3 : shift));
 }
 
 /// 2-D cell of a point for the grids: the first two axes (one-axis paths: y = 0).
@@ -100,10 +104,10 @@ std::pair<double, double> plane(PointRef p) {
 /// One thing to draw: an open subpath (two directions) or a loop (any of its start vertices).
 struct Item {
     std::size_t subpath = 0;
-    bool cyclic = false;                ///< closed, or an open loop
-    PointList starts;                   ///< cyclic: curve point at each allowed start
-    std::vector<std::size_t> shifts;    ///< cyclic: rotation giving that start
-    PathPoint first, last;              ///< open: curve ends
+    bool cyclic = false;              ///< closed, or an open loop
+    PointList starts;                 ///< cyclic: curve point at each allowed start
+    std::vector<std::size_t> shifts;  ///< cyclic: rotation giving that start
+    PathPoint first, last;            ///< open: curve ends
 };
 
 /// A place in the order: the item, and its direction (open) or start (cyclic).
@@ -173,7 +177,8 @@ public:
 
     double travel() const {
         double t = 0;
-        for (std::size_t k = 0; k < visits.size(); ++k) t += distance(before(k), start_of(visits[k]));
+        for (std::size_t k = 0; k < visits.size(); ++k)
+            t += distance(before(k), start_of(visits[k]));
         return t;
     }
     bool spent() const { return work_ >= limit_; }
@@ -278,7 +283,8 @@ private:
                 visits.erase(visits.begin() + static_cast<std::ptrdiff_t>(i),
                              visits.begin() + static_cast<std::ptrdiff_t>(j) + 1);
                 const std::size_t at = p > j ? p - len : p;
-                visits.insert(visits.begin() + static_cast<std::ptrdiff_t>(at), block.begin(), block.end());
+                visits.insert(visits.begin() + static_cast<std::ptrdiff_t>(at), block.begin(),
+                              block.end());
                 return true;
             }
         }
@@ -364,10 +370,13 @@ private:
         for (std::size_t id = 0; id < entries_.size(); ++id) {
             if (!alive_[id]) continue;
             const auto [x, y] = plane(entries_[id].point);
-            x0_ = std::min(x0_, x), x1 = std::max(x1, x), y0_ = std::min(y0_, y), y1 = std::max(y1, y);
+            x0_ = std::min(x0_, x), x1 = std::max(x1, x), y0_ = std::min(y0_, y),
+            y1 = std::max(y1, y);
         }
         built_size_ = live_;
-        g_ = std::clamp<std::size_t>(static_cast<std::size_t>(std::ceil(std::sqrt(static_cast<double>(live_) / 2.0))), 1, 1024);
+        g_ = std::clamp<std::size_t>(
+            static_cast<std::size_t>(std::ceil(std::sqrt(static_cast<double>(live_) / 2.0))), 1,
+            1024);
         w_ = std::max((x1 - x0_) / static_cast<double>(g_), 1e-9);
         h_ = std::max((y1 - y0_) / static_cast<double>(g_), 1e-9);
         if (!(w_ < std::numeric_limits<double>::infinity())) w_ = h_ = 1, x0_ = y0_ = 0;
@@ -484,7 +493,8 @@ Path build(P& path, const std::vector<Item>& items, const std::vector<Visit>& vi
 /// Orders `path` (already joined) from `start`: greedy then improvement. A non-const `path`
 /// is not needed afterwards: its subpaths may move into the result.
 template <class P>
-Path order_items(P& path, const PathPoint& start, const OrderOptions& o, bool greedy, std::size_t& work) {
+Path order_items(P& path, const PathPoint& start, const OrderOptions& o, bool greedy,
+                 std::size_t& work) {
     const std::vector<Item> items = make_items(path, o.merge_tolerance);
     Tour tour(items, start, o.work_limit);
     if (greedy) {
@@ -544,13 +554,14 @@ namespace {
 /// A subpath merge_touching may join at its ends: open, of a joinable basis, points valid, not
 /// resting at its joints (the join would lose the rest at its own ends).
 bool joinable(const Subpath& s) {
-    return !s.closed && joinable_basis(s.basis) && s.points.size() >= 2 && point_count_problem(s).empty() &&
-           s.corner_mode != CornerMode::kExactStop;
+    return !s.closed && joinable_basis(s.basis) && s.points.size() >= 2 &&
+           point_count_problem(s).empty() && s.corner_mode != CornerMode::kExactStop;
 }
 
 /// Whether two subpaths may become one: the same feed and the same corner rule.
 bool same_motion(const Subpath& a, const Subpath& b) {
-    return a.feed == b.feed && a.corner_mode == b.corner_mode && a.blend_tolerance == b.blend_tolerance;
+    return a.feed == b.feed && a.corner_mode == b.corner_mode &&
+           a.blend_tolerance == b.blend_tolerance;
 }
 
 /// The grid cell (side `cell`, mm) of an end point in the plane: ends within `cell` of each
@@ -558,7 +569,8 @@ bool same_motion(const Subpath& a, const Subpath& b) {
 using EndCell = std::pair<long long, long long>;
 EndCell end_cell(PointRef p, double cell) {
     const auto [x, y] = plane(p);
-    return EndCell{static_cast<long long>(std::floor(x / cell)), static_cast<long long>(std::floor(y / cell))};
+    return EndCell{static_cast<long long>(std::floor(x / cell)),
+                   static_cast<long long>(std::floor(y / cell))};
 }
 
 /// A polyline as the Bezier chain the planner draws of it: control points at the thirds, as
@@ -648,7 +660,8 @@ Path merge_touching(const Path& path, double tolerance, std::size_t* merged) {
                 const auto found = ends.find({k.first + dx, k.second + dy});
                 if (found == ends.end()) continue;
                 auto& list = found->second;
-                list.erase(std::remove_if(list.begin(), list.end(), [&](const auto& e) { return used[e.first]; }),
+                list.erase(std::remove_if(list.begin(), list.end(),
+                                          [&](const auto& e) { return used[e.first]; }),
                            list.end());
                 for (const auto& [i, side] : list) {
                     const Subpath& s = in[i];
@@ -686,7 +699,8 @@ Path merge_touching(const Path& path, double tolerance, std::size_t* merged) {
             same_basis(chain, prev);
             chain.points.prepend(prev.points, 0, prev.points.size() - 1);
         }
-        if (joins != joins_before) chain.segment_lines.clear();  // joined: the lines no longer match
+        if (joins != joins_before)
+            chain.segment_lines.clear();  // joined: the lines no longer match
     }
     if (merged != nullptr) *merged = joins;
     return out;
@@ -696,7 +710,8 @@ Path order_path(const Path& path, const OrderOptions& o, OrderReport* report) {
     const PathPoint start = o.start.empty() ? PathPoint(path.axes, 0.0) : o.start;
     if (start.size() != path.axes) {
         throw std::invalid_argument("order: the start point has " + std::to_string(start.size()) +
-                                    " coordinates, the path " + std::to_string(path.axes) + " axes");
+                                    " coordinates, the path " + std::to_string(path.axes) +
+                                    " axes");
     }
     OrderReport r;
     r.subpaths_before = path.subpaths.size();

@@ -18,8 +18,8 @@ struct Affine {
     double a = 1, b = 0, c = 0, d = 1, e = 0, f = 0;
     /// This map followed by `next`.
     Affine then(const Affine& n) const {
-        return {n.a * a + n.b * c, n.a * b + n.b * d, n.c * a + n.d * c, n.c * b + n.d * d,
-                n.a * e + n.b * f + n.e, n.c * e + n.d * f + n.f};
+        return {n.a * a + n.b * c, n.a * b + n.b * d,       n.c * a + n.d * c,
+                n.c * b + n.d * d, n.a * e + n.b * f + n.e, n.c * e + n.d * f + n.f};
     }
     void apply(double& x, double& y) const {
         const double nx = a * x + b * y + e, ny = c * x + d * y + f;
@@ -50,16 +50,19 @@ void extend(const BezierSegment& s, Box2& box) {
 
 /// Fraction (0 low edge, 0.5 middle, 1 high edge) of the box in x and y for an alignment.
 std::array<double, 2> anchor(const std::string& align, bool y_down) {
-    static const char* const kNames[] = {"center", "top-left", "top", "top-right", "left",
-                                         "right", "bottom-left", "bottom", "bottom-right"};
+    static const char* const kNames[] = {"center", "top-left",    "top",    "top-right",   "left",
+                                         "right",  "bottom-left", "bottom", "bottom-right"};
     bool known = false;
     for (const char* n : kNames) known = known || align == n;
     if (!known) {
-        throw std::invalid_argument("--align: \"" + align +
-                                    "\" is not one of center, top-left, top, top-right, left, right, "
-                                    "bottom-left, bottom, bottom-right");
+        throw std::invalid_argument(
+            "--align: \"" + align +
+            "\" is not one of center, top-left, top, top-right, left, right, "
+            "bottom-left, bottom, bottom-right");
     }
-    const double fx = align.find("left") != std::string::npos ? 0 : align.find("right") != std::string::npos ? 1 : 0.5;
+    const double fx = align.find("left") != std::string::npos    ? 0
+                      : align.find("right") != std::string::npos ? 1
+                                                                 : 0.5;
     double fy = 0.5;
     if (align.rfind("top", 0) == 0) fy = y_down ? 0 : 1;
     if (align.rfind("bottom", 0) == 0) fy = y_down ? 1 : 0;
@@ -80,7 +83,8 @@ std::optional<Box2> drawing_box(const Path& path) {
 }
 
 std::optional<Box2> work_area(const MachineProfile& profile) {
-    if (profile.axes.size() < 2 || !profile.axes[0].has_travel || !profile.axes[1].has_travel) return std::nullopt;
+    if (profile.axes.size() < 2 || !profile.axes[0].has_travel || !profile.axes[1].has_travel)
+        return std::nullopt;
     return Box2{profile.axes[0].travel_min, profile.axes[1].travel_min, profile.axes[0].travel_max,
                 profile.axes[1].travel_max};
 }
@@ -90,19 +94,23 @@ Box2 paper_box(const std::string& name) {
         const char* name;
         double width, height;
     };
-    static const Paper kPapers[] = {{"a0", 841, 1189},     {"a1", 594, 841},     {"a2", 420, 594},
-                                    {"a3", 297, 420},      {"a4", 210, 297},     {"a5", 148, 210},
-                                    {"a6", 105, 148},      {"letter", 215.9, 279.4},
+    static const Paper kPapers[] = {{"a0", 841, 1189},       {"a1", 594, 841},
+                                    {"a2", 420, 594},        {"a3", 297, 420},
+                                    {"a4", 210, 297},        {"a5", 148, 210},
+                                    {"a6", 105, 148},        {"letter", 215.9, 279.4},
                                     {"legal", 215.9, 355.6}, {"tabloid", 279.4, 431.8}};
     const std::string suffix = "-landscape";
-    const bool landscape = name.size() > suffix.size() && name.compare(name.size() - suffix.size(), suffix.size(), suffix) == 0;
+    const bool landscape = name.size() > suffix.size() &&
+                           name.compare(name.size() - suffix.size(), suffix.size(), suffix) == 0;
     const std::string base = landscape ? name.substr(0, name.size() - suffix.size()) : name;
     for (const Paper& p : kPapers) {
-        if (base == p.name) return landscape ? Box2{0, 0, p.height, p.width} : Box2{0, 0, p.width, p.height};
+        if (base == p.name)
+            return landscape ? Box2{0, 0, p.height, p.width} : Box2{0, 0, p.width, p.height};
     }
-    throw std::invalid_argument("--fit: \"" + name +
-                                "\" is not area or a paper: a0, a1, a2, a3, a4, a5, a6, letter, legal, "
-                                "tabloid (add -landscape for the long side along x)");
+    throw std::invalid_argument(
+        "--fit: \"" + name +
+        "\" is not area or a paper: a0, a1, a2, a3, a4, a5, a6, letter, legal, "
+        "tabloid (add -landscape for the long side along x)");
 }
 
 namespace {
@@ -136,16 +144,23 @@ Path place_path(const Path& path, const PlacementOptions& o, const std::optional
     }
     if (path.axes < 2) throw std::invalid_argument("placement needs x and y: the path has 1 axis");
     if (o.rotate != 0 && o.rotate != 90 && o.rotate != 180 && o.rotate != 270) {
-        throw std::invalid_argument("--rotate: " + std::to_string(o.rotate) + " is not 90, 180 or 270");
+        throw std::invalid_argument("--rotate: " + std::to_string(o.rotate) +
+                                    " is not 90, 180 or 270");
     }
-    if (!(o.scale >= 0) || !std::isfinite(o.scale)) throw std::invalid_argument("--scale: must be a positive number");
-    if (o.scale != 0 && !o.fit.empty()) throw std::invalid_argument("--scale and --fit exclude each other");
-    if (!(o.margin >= 0) || !std::isfinite(o.margin)) throw std::invalid_argument("--margin: must be 0 or more mm");
-    if (o.margin != 0 && o.fit.empty()) throw std::invalid_argument("--margin applies only with --fit");
+    if (!(o.scale >= 0) || !std::isfinite(o.scale))
+        throw std::invalid_argument("--scale: must be a positive number");
+    if (o.scale != 0 && !o.fit.empty())
+        throw std::invalid_argument("--scale and --fit exclude each other");
+    if (!(o.margin >= 0) || !std::isfinite(o.margin))
+        throw std::invalid_argument("--margin: must be 0 or more mm");
+    if (o.margin != 0 && o.fit.empty())
+        throw std::invalid_argument("--margin applies only with --fit");
     if (o.origin != "top-left" && o.origin != "bottom-left") {
-        throw std::invalid_argument("--origin: \"" + o.origin + "\" is not top-left or bottom-left");
+        throw std::invalid_argument("--origin: \"" + o.origin +
+                                    "\" is not top-left or bottom-left");
     }
-    if (o.translate && (!std::isfinite(o.translate->first) || !std::isfinite(o.translate->second))) {
+    if (o.translate &&
+        (!std::isfinite(o.translate->first) || !std::isfinite(o.translate->second))) {
         throw std::invalid_argument("--translate: coordinates must be finite");
     }
     r.before = drawing_box(path);
@@ -160,20 +175,24 @@ Path place_path(const Path& path, const PlacementOptions& o, const std::optional
         if (o.fit == "area") {
             if (!area) {
                 throw std::invalid_argument(
-                    "--fit area needs a machine profile (--machine) whose x and y axes have a \"travel\" range");
+                    "--fit area needs a machine profile (--machine) whose x and y axes have a "
+                    "\"travel\" range");
             }
             target = area;
         } else {
             target = paper_box(o.fit);
             if (area && !box_inside(*target, *area)) {
                 // The paper lies on the machine from its origin: name the orientation that fits.
-                const bool landscape = o.fit.size() > 10 && o.fit.compare(o.fit.size() - 10, 10, "-landscape") == 0;
-                const std::string other = landscape ? o.fit.substr(0, o.fit.size() - 10) : o.fit + "-landscape";
+                const bool landscape =
+                    o.fit.size() > 10 && o.fit.compare(o.fit.size() - 10, 10, "-landscape") == 0;
+                const std::string other =
+                    landscape ? o.fit.substr(0, o.fit.size() - 10) : o.fit + "-landscape";
                 const bool other_fits = box_inside(paper_box(other), *area);
-                throw std::invalid_argument("--fit " + o.fit + ": the paper (" + mm_size(*target) +
-                                            ") does not fit the machine's work area (" + mm_size(*area) + " from " +
-                                            mm_corner(*area) + ")" +
-                                            (other_fits ? "; --fit " + other + " does" : ", in either orientation"));
+                throw std::invalid_argument(
+                    "--fit " + o.fit + ": the paper (" + mm_size(*target) +
+                    ") does not fit the machine's work area (" + mm_size(*area) + " from " +
+                    mm_corner(*area) + ")" +
+                    (other_fits ? "; --fit " + other + " does" : ", in either orientation"));
             }
         }
         target->x_min += o.margin, target->y_min += o.margin;
@@ -187,7 +206,8 @@ Path place_path(const Path& path, const PlacementOptions& o, const std::optional
             target->y_max = std::min(target->y_max, area->y_max - o.edge_clearance);
         }
         if (target->width() <= 0 || target->height() <= 0) {
-            throw std::invalid_argument("--margin: " + std::to_string(o.margin) + " mm leaves no room in the fit box");
+            throw std::invalid_argument("--margin: " + std::to_string(o.margin) +
+                                        " mm leaves no room in the fit box");
         }
     }
     double scale = o.scale != 0 ? o.scale : 1.0;
@@ -196,8 +216,10 @@ Path place_path(const Path& path, const PlacementOptions& o, const std::optional
         const Box2 turned = m.apply(*r.before);
         if (target) {
             const double w = turned.width(), h = turned.height();
-            if (w <= 0 && h <= 0) throw std::invalid_argument("--fit: the drawing is a single point");
-            scale = std::min(w > 0 ? target->width() / w : INFINITY, h > 0 ? target->height() / h : INFINITY);
+            if (w <= 0 && h <= 0)
+                throw std::invalid_argument("--fit: the drawing is a single point");
+            scale = std::min(w > 0 ? target->width() / w : INFINITY,
+                             h > 0 ? target->height() / h : INFINITY);
         }
         m = m.then({scale, 0, 0, scale, 0, 0});
         const Box2 sized = m.apply(*r.before);

@@ -299,7 +299,8 @@ std::string layer_colour(const Options& o, std::size_t layer) {
         name.find_first_not_of("0123456789abcdefABCDEF", 1) == std::string::npos) {
         return name;
     }
-    static const char* const kPalette[] = {"#1b9e77", "#d95f02", "#7570b3", "#e7298a", "#66a61e", "#e6ab02"};
+    static const char* const kPalette[] = {"#1b9e77", "#d95f02", "#7570b3",
+                                           "#e7298a", "#66a61e", "#e6ab02"};
     return kPalette[layer % 6];
 }
 
@@ -359,8 +360,8 @@ std::string path_svg(const std::vector<BezierSegment>& path, const TickSeries& e
     std::size_t run_layer = 0;
     const bool layered = !options.layers.empty();
     const auto flush = [&] {
-        const std::string colour =
-            layered && run_down ? layer_colour(options, run_layer) : std::string(detail::kIdealColour);
+        const std::string colour = layered && run_down ? layer_colour(options, run_layer)
+                                                       : std::string(detail::kIdealColour);
         const std::string cls = !run_down ? "pen-up"
                                 : layered ? "pen-down layer-" + std::to_string(run_layer + 1)
                                           : "pen-down";

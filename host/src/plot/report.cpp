@@ -147,7 +147,8 @@ std::string text_report(const Plan& plan, const PlanCheck* check, const MachineP
         o << " (" << fmt("%.3g", run.simulated_seconds / run.wall_seconds) << "x)";
     o << (run.realtime ? ", paced" : "") << "\n";
     o << "  path       " << fmt("%.2f", plan.path_length) << " mm pen-down, "
-      << fmt("%.2f", plan.travel_length) << " mm travel, " << run.pen_switches << " pen lifts and lowers\n";
+      << fmt("%.2f", plan.travel_length) << " mm travel, " << run.pen_switches
+      << " pen lifts and lowers\n";
     {
         const double total = static_cast<double>(f.executed_ticks);
         const double down_ticks = static_cast<double>(f.pen_down_ticks);
@@ -173,10 +174,12 @@ std::string text_report(const Plan& plan, const PlanCheck* check, const MachineP
           << percent2(f.acceleration_fraction_cubic) << " %)\n";
         // Jerk next to it: against max_jerk when the profile sets one, else in mm/s^3.
         if (check->jerk_limited) {
-            o << "  jerk       cubic " << percent2(check->max_jerk_fraction_exact) << " % of max jerk, join step "
+            o << "  jerk       cubic " << percent2(check->max_jerk_fraction_exact)
+              << " % of max jerk, join step "
               << percent2(check->max_join_acceleration_step_fraction) << " % of one tick of it\n";
         } else if (!check->axis_jerk.empty()) {
-            o << "  jerk       cubic peak " << fmt("%.4g", *std::max_element(check->axis_jerk.begin(), check->axis_jerk.end()))
+            o << "  jerk       cubic peak "
+              << fmt("%.4g", *std::max_element(check->axis_jerk.begin(), check->axis_jerk.end()))
               << " mm/s^3, join step "
               << fmt("%.4g", *std::max_element(check->axis_join_acceleration_step.begin(),
                                                check->axis_join_acceleration_step.end()))

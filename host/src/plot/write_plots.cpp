@@ -11,8 +11,8 @@
 #include <cstring>
 #include <stdexcept>
 
-#include "pathstream/machine/atomic_file.hpp"
 #include "pathstream/host/plot.hpp"
+#include "pathstream/machine/atomic_file.hpp"
 
 extern char** environ;
 

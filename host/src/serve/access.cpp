@@ -33,7 +33,8 @@ bool is_loopback_host(const std::string& host) {
         const std::size_t dot = std::min(host.find('.', at), host.size());
         unsigned value = 0;
         const auto [end, error] = std::from_chars(host.data() + at, host.data() + dot, value);
-        if (dot == at || error != std::errc() || end != host.data() + dot || value > 255) return false;
+        if (dot == at || error != std::errc() || end != host.data() + dot || value > 255)
+            return false;
         ++parts;
         at = dot + 1;
     }
@@ -53,9 +54,10 @@ std::optional<std::string> refusal(const AccessPolicy& policy, const RequestFact
     if (r.method == "POST" && r.origin.empty()) return "a POST without an Origin header";
     if (!policy.token.empty()) {
         const std::string bearer = "Bearer ";
-        const std::string given = r.authorization.rfind(bearer, 0) == 0 ? r.authorization.substr(bearer.size())
-                                  : !r.query_token.empty()                ? r.query_token
-                                                                          : r.cookie_token;
+        const std::string given = r.authorization.rfind(bearer, 0) == 0
+                                      ? r.authorization.substr(bearer.size())
+                                  : !r.query_token.empty() ? r.query_token
+                                                           : r.cookie_token;
         if (!same_secret(given, policy.token)) return "missing or wrong token";
     }
     return std::nullopt;
@@ -63,7 +65,8 @@ std::optional<std::string> refusal(const AccessPolicy& policy, const RequestFact
 
 std::optional<std::string> token_cookie(const AccessPolicy& policy, const RequestFacts& request,
                                         const std::string& cookie_name) {
-    if (policy.token.empty() || !same_secret(request.query_token, policy.token)) return std::nullopt;
+    if (policy.token.empty() || !same_secret(request.query_token, policy.token))
+        return std::nullopt;
     return cookie_name + "=" + policy.token + "; Path=/; HttpOnly; SameSite=Strict";
 }
 
@@ -72,7 +75,8 @@ std::optional<std::string> token_problem(const std::string& token) {
     for (const char c : token) {
         const auto u = static_cast<unsigned char>(c);
         if (u <= 0x20 || u == 0x7F || c == '"' || c == ',' || c == ';' || c == '\\') {
-            return "the token holds a character a cookie cannot carry (controls, space, '\"', ',', ';', '\\')";
+            return "the token holds a character a cookie cannot carry (controls, space, '\"', ',', "
+                   "';', '\\')";
         }
     }
     return std::nullopt;
@@ -81,11 +85,13 @@ std::optional<std::string> token_problem(const std::string& token) {
 ListenAddress parse_listen_address(const std::string& listen) {
     const std::size_t colon = listen.rfind(':');
     if (colon == std::string::npos || colon == 0 || colon + 1 == listen.size()) {
-        throw std::invalid_argument("--listen '" + listen + "': want HOST:PORT, e.g. 127.0.0.1:8080");
+        throw std::invalid_argument("--listen '" + listen +
+                                    "': want HOST:PORT, e.g. 127.0.0.1:8080");
     }
     ListenAddress a;
     a.host = listen.substr(0, colon);
-    if (a.host.size() > 2 && a.host.front() == '[' && a.host.back() == ']') a.host = a.host.substr(1, a.host.size() - 2);
+    if (a.host.size() > 2 && a.host.front() == '[' && a.host.back() == ']')
+        a.host = a.host.substr(1, a.host.size() - 2);
     const std::string port = listen.substr(colon + 1);
     const auto [end, error] = std::from_chars(port.data(), port.data() + port.size(), a.port);
     if (error != std::errc() || end != port.data() + port.size() || a.port > 65535) {

@@ -10,9 +10,9 @@ namespace pathstream::host::serve {
 
 /// What the server was started with, for the checks below. Plain value, read-only once built.
 struct AccessPolicy {
-    std::string token;           ///< required when non-empty (always when not on loopback)
-    bool loopback = true;        ///< listening on 127.0.0.0/8 or ::1 only
-    unsigned port = 0;           ///< the port listened on (what a loopback Host header names)
+    std::string token;     ///< required when non-empty (always when not on loopback)
+    bool loopback = true;  ///< listening on 127.0.0.0/8 or ::1 only
+    unsigned port = 0;     ///< the port listened on (what a loopback Host header names)
 };
 
 /// The parts of one request the checks look at ("" for a header that is absent).
@@ -40,8 +40,8 @@ bool is_loopback_host(const std::string& host);
 /// rebinds a DNS name to 127.0.0.1 sends its own name); an Origin, when sent, is this
 /// server's (http://HOST with the request's Host); a POST carries an Origin (browsers always
 /// send one on a POST, so a missing one is not a page's); the token, when one is set, by a
-/// Bearer header, ?token= or the cookie, compared in constant time. Cost: a few string compares; any
-/// thread.
+/// Bearer header, ?token= or the cookie, compared in constant time. Cost: a few string compares;
+/// any thread.
 std::optional<std::string> refusal(const AccessPolicy& policy, const RequestFacts& request);
 
 /// The cookie that keeps the page's token: set only when this request's ?token= is the token

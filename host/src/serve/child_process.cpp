@@ -27,7 +27,8 @@ void close_fd(int& fd) {
 
 ChildProcess::ChildProcess(const std::vector<std::string>& argv, const std::string& cwd) {
     int out[2], err[2];
-    if (::pipe2(out, O_CLOEXEC) != 0) throw std::system_error(errno, std::generic_category(), "pipe");
+    if (::pipe2(out, O_CLOEXEC) != 0)
+        throw std::system_error(errno, std::generic_category(), "pipe");
     if (::pipe2(err, O_CLOEXEC) != 0) {
         ::close(out[0]);
         ::close(out[1]);
@@ -41,7 +42,8 @@ ChildProcess::ChildProcess(const std::vector<std::string>& argv, const std::stri
     posix_spawn_file_actions_addchdir_np(&actions, cwd.c_str());
     posix_spawnattr_t attributes;
     posix_spawnattr_init(&attributes);
-    posix_spawnattr_setflags(&attributes, POSIX_SPAWN_SETPGROUP | POSIX_SPAWN_SETSIGDEF | POSIX_SPAWN_SETSIGMASK);
+    posix_spawnattr_setflags(
+        &attributes, POSIX_SPAWN_SETPGROUP | POSIX_SPAWN_SETSIGDEF | POSIX_SPAWN_SETSIGMASK);
     posix_spawnattr_setpgroup(&attributes, 0);
     sigset_t defaults, none;
     sigemptyset(&defaults);
@@ -54,7 +56,8 @@ ChildProcess::ChildProcess(const std::vector<std::string>& argv, const std::stri
     std::vector<char*> args;
     for (const std::string& a : argv) args.push_back(const_cast<char*>(a.c_str()));
     args.push_back(nullptr);
-    const int r = ::posix_spawn(&pid_, argv.at(0).c_str(), &actions, &attributes, args.data(), environ);
+    const int r =
+        ::posix_spawn(&pid_, argv.at(0).c_str(), &actions, &attributes, args.data(), environ);
     posix_spawn_file_actions_destroy(&actions);
     posix_spawnattr_destroy(&attributes);
     ::close(out[1]);
@@ -82,8 +85,8 @@ ChildProcess::~ChildProcess() {
     close_fd(err_);
 }
 
-int ChildProcess::wait(const std::function<void(const std::string&)>& on_line, std::string& error_text,
-                       const std::function<bool()>& abandon) {
+int ChildProcess::wait(const std::function<void(const std::string&)>& on_line,
+                       std::string& error_text, const std::function<bool()>& abandon) {
     std::string line;
     char buffer[8192];
     bool killed = false;
@@ -111,7 +114,8 @@ int ChildProcess::wait(const std::function<void(const std::string&)>& on_line, s
             }
             if (i == 1) {
                 error_text.append(buffer, static_cast<std::size_t>(n));
-                if (error_text.size() > kErrorTail) error_text.erase(0, error_text.size() - kErrorTail);
+                if (error_text.size() > kErrorTail)
+                    error_text.erase(0, error_text.size() - kErrorTail);
                 continue;
             }
             for (ssize_t k = 0; k < n; ++k) {
@@ -145,7 +149,8 @@ ChildOutput run_child(const std::vector<std::string>& argv, const std::string& c
                       const std::function<bool()>& abandon) {
     ChildProcess child(argv, cwd);
     ChildOutput r;
-    r.exit_code = child.wait([&](const std::string& line) { r.out += line + '\n'; }, r.err, abandon);
+    r.exit_code =
+        child.wait([&](const std::string& line) { r.out += line + '\n'; }, r.err, abandon);
     return r;
 }
 

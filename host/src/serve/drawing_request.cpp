@@ -11,10 +11,12 @@
 namespace pathstream::host::serve {
 namespace {
 
-const std::string& text_value(const nlohmann::json& v, const std::string& key, const std::set<std::string>& allowed) {
+const std::string& text_value(const nlohmann::json& v, const std::string& key,
+                              const std::set<std::string>& allowed) {
     if (!v.is_string()) throw std::invalid_argument(key + ": want a string");
     const std::string& s = v.get_ref<const std::string&>();
-    if (!allowed.empty() && allowed.count(s) == 0) throw std::invalid_argument(key + ": '" + s + "' is not one of the choices");
+    if (!allowed.empty() && allowed.count(s) == 0)
+        throw std::invalid_argument(key + ": '" + s + "' is not one of the choices");
     return s;
 }
 
@@ -34,7 +36,8 @@ std::string number_text(double v) {
 std::string upload_file_name(const std::string& name) {
     std::string base = name.substr(std::min(name.size(), name.find_last_of("/\\") + 1));
     for (char& c : base) {
-        if (!std::isalnum(static_cast<unsigned char>(c)) && c != '.' && c != '_' && c != '-') c = '_';
+        if (!std::isalnum(static_cast<unsigned char>(c)) && c != '.' && c != '_' && c != '-')
+            c = '_';
     }
     while (!base.empty() && base.front() == '.') base.erase(0, 1);
     // The name is an argument of the commands the server runs: one starting with '-' would be
@@ -43,7 +46,8 @@ std::string upload_file_name(const std::string& name) {
     if (base.size() > 100) base = base.substr(base.size() - 100);
     const std::size_t dot = base.rfind('.');
     if (dot == std::string::npos || dot == 0 || format_of_file_name(base).empty()) {
-        throw std::invalid_argument("'" + name + "': the name must end in " + path_extension_list());
+        throw std::invalid_argument("'" + name + "': the name must end in " +
+                                    path_extension_list());
     }
     return base;
 }
@@ -54,7 +58,8 @@ std::vector<std::string> path_arguments(const nlohmann::json& options) {
     std::vector<std::string> args;
     static const std::set<std::string> papers = [] {
         std::set<std::string> p = {"area"};
-        for (const char* n : {"a0", "a1", "a2", "a3", "a4", "a5", "a6", "letter", "legal", "tabloid"}) {
+        for (const char* n :
+             {"a0", "a1", "a2", "a3", "a4", "a5", "a6", "letter", "legal", "tabloid"}) {
             p.insert(n);
             p.insert(std::string(n) + "-landscape");
         }
@@ -65,18 +70,22 @@ std::vector<std::string> path_arguments(const nlohmann::json& options) {
             if (v.is_string() && v.get_ref<const std::string&>().empty()) continue;
             args.push_back("--fit=" + text_value(v, key, papers));
         } else if (key == "margin") {
-            if (!v.is_number() || !std::isfinite(v.get<double>()) || v.get<double>() < 0 || v.get<double>() > 10000) {
+            if (!v.is_number() || !std::isfinite(v.get<double>()) || v.get<double>() < 0 ||
+                v.get<double>() > 10000) {
                 throw std::invalid_argument("margin: want mm from 0 to 10000");
             }
             if (v.get<double>() > 0) args.push_back("--margin=" + number_text(v.get<double>()));
         } else if (key == "align") {
             if (v.is_string() && v.get_ref<const std::string&>().empty()) continue;
-            args.push_back("--align=" + text_value(v, key, {"center", "top-left", "top", "top-right", "left", "right",
-                                                             "bottom-left", "bottom", "bottom-right"}));
+            args.push_back("--align=" +
+                           text_value(v, key,
+                                      {"center", "top-left", "top", "top-right", "left", "right",
+                                       "bottom-left", "bottom", "bottom-right"}));
         } else if (key == "origin") {
             args.push_back("--origin=" + text_value(v, key, {"top-left", "bottom-left"}));
         } else if (key == "rotate") {
-            if (!v.is_number_integer() || (v.get<int>() != 0 && v.get<int>() != 90 && v.get<int>() != 180 && v.get<int>() != 270)) {
+            if (!v.is_number_integer() || (v.get<int>() != 0 && v.get<int>() != 90 &&
+                                           v.get<int>() != 180 && v.get<int>() != 270)) {
                 throw std::invalid_argument("rotate: want 0, 90, 180 or 270");
             }
             if (v.get<int>() != 0) args.push_back("--rotate=" + std::to_string(v.get<int>()));
@@ -92,9 +101,11 @@ std::vector<std::string> path_arguments(const nlohmann::json& options) {
         } else if (key == "gcode_pen") {
             args.push_back("--gcode-pen=" + text_value(v, key, {"z", "spindle", "motion", "auto"}));
         } else if (key == "csv_basis") {
-            args.push_back("--csv-basis=" + text_value(v, key, {"bspline", "catmull-rom", "bezier", "polyline"}));
+            args.push_back("--csv-basis=" +
+                           text_value(v, key, {"bspline", "catmull-rom", "bezier", "polyline"}));
         } else if (key == "layers") {
-            if (!v.is_array() || v.size() > 256) throw std::invalid_argument("layers: want a list of at most 256 names");
+            if (!v.is_array() || v.size() > 256)
+                throw std::invalid_argument("layers: want a list of at most 256 names");
             for (const nlohmann::json& layer : v) {
                 if (!layer.is_string() || layer.get_ref<const std::string&>().empty() ||
                     layer.get_ref<const std::string&>().size() > 200) {

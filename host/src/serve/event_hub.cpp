@@ -19,7 +19,8 @@ std::uint64_t EventHub::publish(std::string json, const std::string& sticky_kind
     return sequence;
 }
 
-std::vector<HubEvent> EventHub::wait_after(std::uint64_t sequence, std::chrono::milliseconds timeout,
+std::vector<HubEvent> EventHub::wait_after(std::uint64_t sequence,
+                                           std::chrono::milliseconds timeout,
                                            std::uint64_t* missed) {
     std::unique_lock<std::mutex> lock(mutex_);
     changed_.wait_for(lock, timeout, [&] { return closed_ || next_ - 1 > sequence; });
@@ -37,7 +38,8 @@ std::vector<HubEvent> EventHub::sticky(std::uint64_t& continue_after) const {
     const std::lock_guard<std::mutex> lock(mutex_);
     std::vector<HubEvent> out;
     for (const auto& [kind, e] : sticky_) out.push_back(e);
-    std::sort(out.begin(), out.end(), [](const HubEvent& a, const HubEvent& b) { return a.sequence < b.sequence; });
+    std::sort(out.begin(), out.end(),
+              [](const HubEvent& a, const HubEvent& b) { return a.sequence < b.sequence; });
     continue_after = next_ - 1;
     return out;
 }

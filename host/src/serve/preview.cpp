@@ -37,8 +37,8 @@ public:
             kept_.push_back(v);
             return;
         }
-        if (!run_.empty() &&
-            (v.pen != run_.front().pen || v.layer != run_.front().layer || run_.size() >= kMaxRun || !fits(v))) {
+        if (!run_.empty() && (v.pen != run_.front().pen || v.layer != run_.front().layer ||
+                              run_.size() >= kMaxRun || !fits(v))) {
             kept_.push_back(run_.back());
             run_.clear();
         }
@@ -56,8 +56,10 @@ private:
 
     bool fits(const Vertex& v) const {
         const Vertex& a = kept_.back();
-        if (std::hypot(v.x - a.x, v.y - a.y) < std::hypot(run_.back().x - a.x, run_.back().y - a.y)) return false;
-        return std::all_of(run_.begin(), run_.end(), [&](const Vertex& p) { return off_chord(a, v, p) <= tolerance_; });
+        if (std::hypot(v.x - a.x, v.y - a.y) < std::hypot(run_.back().x - a.x, run_.back().y - a.y))
+            return false;
+        return std::all_of(run_.begin(), run_.end(),
+                           [&](const Vertex& p) { return off_chord(a, v, p) <= tolerance_; });
     }
 
     double tolerance_;
@@ -72,29 +74,36 @@ double rounded(double v, int digits) {
 
 }  // namespace
 
-nlohmann::ordered_json preview_json(const Plan& plan, const Path& path, const MachineProfile& machine,
-                                    const PreviewOptions& options) {
+nlohmann::ordered_json preview_json(const Plan& plan, const Path& path,
+                                    const MachineProfile& machine, const PreviewOptions& options) {
     const double mm = machine.mm_per_lsb;
     const std::size_t ax = machine.axes.size();
     Simplifier simplifier(options.tolerance_mm);
     std::set<std::size_t> drawn_subpaths;
     std::uint64_t tick = 0;
     // Speed bins over the plan's duration: the fastest span (its mean speed) in each.
-    const std::size_t bins = std::max<std::size_t>(1, std::min(options.speed_samples, plan.spans.size()));
+    const std::size_t bins =
+        std::max<std::size_t>(1, std::min(options.speed_samples, plan.spans.size()));
     std::vector<double> bin_speed(bins, 0.0);
     const double total = std::max<double>(1, static_cast<double>(plan.total_ticks));
     for (std::size_t i = 0; i < plan.spans.size(); ++i) {
         const CoreSpan& s = plan.spans[i];
         // The planner's spans are Hermite (P0, P1, T0, T1): P0 where it starts, P1 where it ends.
-        const std::size_t layer = s.subpath < path.subpaths.size() ? path.subpaths[s.subpath].layer : 0;
-        if (i == 0) simplifier.add({s.control.at(0)[0] * mm, ax > 1 ? s.control.at(1)[0] * mm : 0.0, 0, false, layer});
+        const std::size_t layer =
+            s.subpath < path.subpaths.size() ? path.subpaths[s.subpath].layer : 0;
+        if (i == 0)
+            simplifier.add(
+                {s.control.at(0)[0] * mm, ax > 1 ? s.control.at(1)[0] * mm : 0.0, 0, false, layer});
         const double dx = (s.control.at(0)[1] - s.control.at(0)[0]) * mm;
         const double dy = ax > 1 ? (s.control.at(1)[1] - s.control.at(1)[0]) * mm : 0.0;
-        const std::size_t bin = std::min(bins - 1, static_cast<std::size_t>(static_cast<double>(tick) / total * static_cast<double>(bins)));
+        const std::size_t bin =
+            std::min(bins - 1, static_cast<std::size_t>(static_cast<double>(tick) / total *
+                                                        static_cast<double>(bins)));
         bin_speed[bin] = std::max(bin_speed[bin], std::hypot(dx, dy) * machine.tick_hz / s.ticks);
         tick += s.ticks;
         if (s.pen_down) drawn_subpaths.insert(s.subpath);
-        simplifier.add({s.control.at(0)[1] * mm, ax > 1 ? s.control.at(1)[1] * mm : 0.0, tick, s.pen_down, layer});
+        simplifier.add({s.control.at(0)[1] * mm, ax > 1 ? s.control.at(1)[1] * mm : 0.0, tick,
+                        s.pen_down, layer});
     }
     const std::vector<Vertex> vertices = simplifier.finish();
 
@@ -114,7 +123,10 @@ nlohmann::ordered_json preview_json(const Plan& plan, const Path& path, const Ma
     nlohmann::ordered_json out;
     out["summary"] = summary;
     if (const auto area = work_area(machine)) {
-        out["work_area"] = {{"x_min", area->x_min}, {"y_min", area->y_min}, {"x_max", area->x_max}, {"y_max", area->y_max}};
+        out["work_area"] = {{"x_min", area->x_min},
+                            {"y_min", area->y_min},
+                            {"x_max", area->x_max},
+                            {"y_max", area->y_max}};
     } else {
         out["work_area"] = nullptr;
     }
@@ -137,7 +149,8 @@ nlohmann::ordered_json preview_json(const Plan& plan, const Path& path, const Ma
     out["path"] = {{"x", xs}, {"y", ys}, {"tick", ticks}, {"pen", pens}, {"layer", layers}};
     std::vector<double> t, v;
     for (std::size_t b = 0; b < bins; ++b) {
-        t.push_back(rounded(plan.duration * (static_cast<double>(b) + 0.5) / static_cast<double>(bins), 4));
+        t.push_back(
+            rounded(plan.duration * (static_cast<double>(b) + 0.5) / static_cast<double>(bins), 4));
         v.push_back(rounded(bin_speed[b], 3));
     }
     out["speed"] = {{"t", t}, {"v", v}};

@@ -3,9 +3,9 @@
 
 #include <nlohmann/json.hpp>
 
-#include "pathstream/machine/machine.hpp"
 #include "pathstream/host/path.hpp"
 #include "pathstream/host/plan.hpp"
+#include "pathstream/machine/machine.hpp"
 
 namespace pathstream::host::serve {
 
@@ -30,7 +30,8 @@ struct PreviewOptions {
 ///  speed: t (s) and v (mm/s), the fastest span speed in each of up to speed_samples bins;
 ///  pauses: the ticks of the programmed pauses.
 /// Cost: one pass over the spans (a few vertices' work per span). Any thread.
-nlohmann::ordered_json preview_json(const Plan& plan, const Path& path, const MachineProfile& machine,
+nlohmann::ordered_json preview_json(const Plan& plan, const Path& path,
+                                    const MachineProfile& machine,
                                     const PreviewOptions& options = {});
 
 }  // namespace pathstream::host::serve

@@ -11,10 +11,10 @@
 #include "drawing_request.hpp"
 #include "http_server.hpp"
 #include "pathstream/host/device_link.hpp"
-#include "pathstream/machine/device_setup.hpp"
 #include "pathstream/host/job_journal.hpp"
 #include "pathstream/host/placement.hpp"
 #include "pathstream/host/progress.hpp"
+#include "pathstream/machine/device_setup.hpp"
 #include "serve/web_assets.hpp"
 
 namespace pathstream::host::serve {
@@ -30,12 +30,14 @@ struct Server::Reply {
 
 namespace {
 
-
-Json error_body(const std::string& message) { return Json{{"ok", false}, {"error", message}}; }
+Json error_body(const std::string& message) {
+    return Json{{"ok", false}, {"error", message}};
+}
 
 void replace_all(std::string& text, const std::string& what, const std::string& with) {
     if (what.empty()) return;
-    for (std::size_t at = text.find(what); at != std::string::npos; at = text.find(what, at + with.size())) {
+    for (std::size_t at = text.find(what); at != std::string::npos;
+         at = text.find(what, at + with.size())) {
         text.replace(at, what.size(), with);
     }
 }
@@ -43,12 +45,14 @@ void replace_all(std::string& text, const std::string& what, const std::string& 
 // The paper a fit names, where placement puts it (from the machine's origin), with the margin
 // the drawing keeps from its edges; null for no fit or a fit to the work area.
 Json paper_json(const nlohmann::json& options) {
-    if (!options.is_object() || !options.contains("fit") || !options["fit"].is_string()) return nullptr;
+    if (!options.is_object() || !options.contains("fit") || !options["fit"].is_string())
+        return nullptr;
     const std::string fit = options["fit"].get<std::string>();
     if (fit.empty() || fit == "area") return nullptr;
     const Box2 b = paper_box(fit);
     const nlohmann::json margin = options.value("margin", nlohmann::json(0));
-    return Json{{"name", fit},        {"x_min", b.x_min}, {"y_min", b.y_min}, {"x_max", b.x_max},
+    return Json{{"name", fit},      {"x_min", b.x_min},
+                {"y_min", b.y_min}, {"x_max", b.x_max},
                 {"y_max", b.y_max}, {"margin_mm", margin.is_number() ? margin.get<double>() : 0.0}};
 }
 
@@ -66,7 +70,8 @@ std::string last_lines(const std::string& text, std::size_t count) {
         const std::size_t end = std::min(text.find('\n', at), text.size());
         std::string line = text.substr(at, end - at);
         // A progress bar redraws with carriage returns: its last state is what was seen.
-        if (const std::size_t cr = line.rfind('\r'); cr != std::string::npos) line = line.substr(cr + 1);
+        if (const std::size_t cr = line.rfind('\r'); cr != std::string::npos)
+            line = line.substr(cr + 1);
         if (!line.empty()) lines.push_back(line);
         at = end + 1;
     }
@@ -132,7 +137,8 @@ std::string Server::drawing_hash() const {
 // stream --resume JOURNAL" is the page's Resume job.
 std::string Server::clean_message(std::string message) const {
     const fs::path state(config_.state_dir);
-    replace_all(message, "pathstream stream --resume " + (state / "job.journal.json").string(), "Resume job on the page");
+    replace_all(message, "pathstream stream --resume " + (state / "job.journal.json").string(),
+                "Resume job on the page");
     replace_all(message, (state / "drawing").string() + "/", "");
     replace_all(message, state.string() + "/", "");
     replace_all(message, state.string(), "the server's state directory");
@@ -146,7 +152,8 @@ std::vector<std::string> Server::arguments(const nlohmann::json& options) const 
     const std::lock_guard<std::mutex> lock(device_mutex_);
     if (!rest_mm_.empty()) {
         std::string start = "--order-start=";
-        for (std::size_t a = 0; a < rest_mm_.size(); ++a) start += (a ? "," : "") + number_text(rest_mm_[a]);
+        for (std::size_t a = 0; a < rest_mm_.size(); ++a)
+            start += (a ? "," : "") + number_text(rest_mm_[a]);
         args.push_back(start);
     }
     return args;
@@ -159,11 +166,13 @@ Json Server::plan_preview(const std::vector<std::string>& args, const CancelToke
     const std::string name = drawing_file();
     if (name.empty()) throw std::invalid_argument("no drawing loaded");
     if (cancel.cancelled()) throw std::runtime_error("planning cancelled");
-    std::vector<std::string> argv = {config_.executable, "plan", "--machine=" + config_.machine_file, "--preview",
+    std::vector<std::string> argv = {config_.executable, "plan",
+                                     "--machine=" + config_.machine_file, "--preview",
                                      "--max-motion=" + number_text(config_.max_motion_s)};
     argv.insert(argv.end(), args.begin(), args.end());
     argv.insert(argv.end(), {"--", name});
-    const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(config_.plan_timeout_s);
+    const auto deadline =
+        std::chrono::steady_clock::now() + std::chrono::duration<double>(config_.plan_timeout_s);
     bool late = false;
     double estimated_s = -1;
     std::string document, errors;
@@ -172,7 +181,8 @@ Json Server::plan_preview(const std::vector<std::string>& args, const CancelToke
         [&](const std::string& line) {
             if (line.rfind("{\"event\":\"planning\"", 0) == 0) {
                 const nlohmann::json e = nlohmann::json::parse(line, nullptr, false);
-                if (e.is_object() && e.value("estimated_s", -1.0) >= 0) estimated_s = e.value("estimated_s", -1.0);
+                if (e.is_object() && e.value("estimated_s", -1.0) >= 0)
+                    estimated_s = e.value("estimated_s", -1.0);
                 hub_.publish(line);
                 return;
             }
@@ -184,7 +194,8 @@ Json Server::plan_preview(const std::vector<std::string>& args, const CancelToke
             return late || cancel.cancelled() || stopping_.load();
         });
     if (late) {
-        std::string message = "planning stopped after " + duration_text(config_.plan_timeout_s) + " (serve --plan-timeout)";
+        std::string message = "planning stopped after " + duration_text(config_.plan_timeout_s) +
+                              " (serve --plan-timeout)";
         if (estimated_s >= 0) message += ": the job moves for about " + duration_text(estimated_s);
         throw std::runtime_error(message);
     }
@@ -221,7 +232,8 @@ Json Server::placed_preview(const nlohmann::json& options, const CancelToken& ca
 
 Server::Reply Server::last_preview() const {
     const std::lock_guard<std::mutex> lock(preview_mutex_);
-    if (last_preview_.is_null()) return {404, error_body("no preview: no drawing is loaded, or it could not be planned")};
+    if (last_preview_.is_null())
+        return {404, error_body("no preview: no drawing is loaded, or it could not be planned")};
     Json p = last_preview_;
     p["ok"] = true;
     return {200, p};
@@ -246,7 +258,8 @@ Json Server::whole_job_ticks() const {
     if (!in) return nullptr;
     try {
         const nlohmann::json j = nlohmann::json::parse(in);
-        if (j.contains("plan_ticks") && j["plan_ticks"].is_number_unsigned()) return j["plan_ticks"].get<std::uint64_t>();
+        if (j.contains("plan_ticks") && j["plan_ticks"].is_number_unsigned())
+            return j["plan_ticks"].get<std::uint64_t>();
     } catch (const std::exception&) {
     }
     return nullptr;
@@ -258,8 +271,8 @@ void Server::claim_planning(const CancelToken& cancel) {
     newest_plan_ = cancel;
 }
 
-Server::Reply Server::upload(const std::string& given_name, const std::string& body, const nlohmann::json& options,
-                             const CancelToken& cancel) {
+Server::Reply Server::upload(const std::string& given_name, const std::string& body,
+                             const nlohmann::json& options, const CancelToken& cancel) {
     const std::string name = upload_file_name(given_name);
     const fs::path dir = fs::path(config_.state_dir) / "drawing";
     claim_planning(cancel);
@@ -295,9 +308,12 @@ Server::Reply Server::preview(const nlohmann::json& options, const CancelToken& 
     return {200, p};
 }
 
-bool Server::job_running() const { return job_running_.load(); }
+bool Server::job_running() const {
+    return job_running_.load();
+}
 
-bool Server::start_child(const std::string& kind, std::vector<std::string> argv, const Json& whole_ticks) {
+bool Server::start_child(const std::string& kind, std::vector<std::string> argv,
+                         const Json& whole_ticks) {
     const std::lock_guard<std::mutex> lock(job_mutex_);
     if (job_running_.load() || stopping_.load()) return false;
     if (job_thread_.joinable()) job_thread_.join();
@@ -319,11 +335,14 @@ bool Server::start_child(const std::string& kind, std::vector<std::string> argv,
             [&](const std::string& line) {
                 std::string sticky;
                 for (const char* k : {"job_start", "progress", "job_end", "pause", "state"}) {
-                    if (line.find(std::string("\"event\":\"") + k + "\"") != std::string::npos) sticky = k;
+                    if (line.find(std::string("\"event\":\"") + k + "\"") != std::string::npos)
+                        sticky = k;
                 }
                 if (sticky == "job_end") {
                     for (const char* o : {"finished", "held", "stopped", "failed"}) {
-                        if (line.find(std::string("\"outcome\":\"") + o + "\"") != std::string::npos) outcome = o;
+                        if (line.find(std::string("\"outcome\":\"") + o + "\"") !=
+                            std::string::npos)
+                            outcome = o;
                     }
                 }
                 if (sticky == "job_start" && kind == "stream") remember_whole_job(line);
@@ -339,10 +358,14 @@ bool Server::start_child(const std::string& kind, std::vector<std::string> argv,
         // queue as `ctl stop` does (the journal resumes from where the device rests).
         if (stop_requested_.load() && outcome == "held") {
             const ChildOutput r =
-                run_child({config_.executable, "ctl", "--wait=10", "--", config_.target, "stop"}, config_.state_dir);
-            hub_.publish(Json{{"event", "command"}, {"verb", "stop"}, {"ok", r.exit_code == 0},
-                              {"error", r.exit_code == 0 ? "" : clean_message(last_lines(r.err, 1))}}
-                             .dump());
+                run_child({config_.executable, "ctl", "--wait=10", "--", config_.target, "stop"},
+                          config_.state_dir);
+            hub_.publish(
+                Json{{"event", "command"},
+                     {"verb", "stop"},
+                     {"ok", r.exit_code == 0},
+                     {"error", r.exit_code == 0 ? "" : clean_message(last_lines(r.err, 1))}}
+                    .dump());
         }
         Json end{{"event", "process"}, {"kind", kind}, {"running", false}, {"exit", exit_code}};
         end["report"] = clean_message(last_lines(errors, 12));
@@ -354,27 +377,29 @@ bool Server::start_child(const std::string& kind, std::vector<std::string> argv,
 }
 
 Server::Reply Server::run_job(const nlohmann::json& options, const std::string& previewed_hash,
-                             const CancelToken& cancel) {
+                              const CancelToken& cancel) {
     claim_planning(cancel);
     // Upload, preview and run one at a time: the file streamed is the one this plan previews.
     const std::lock_guard<std::mutex> gate(gate_);
     if (job_running()) return {409, error_body("a job is running already")};
     const std::string name = drawing_file();
     if (!previewed_hash.empty() && previewed_hash != drawing_hash()) {
-        return {409, error_body("the drawing changed since this page's preview: " + name + " is loaded now")};
+        return {409, error_body("the drawing changed since this page's preview: " + name +
+                                " is loaded now")};
     }
     const std::vector<std::string> args = arguments(options);
-    Json p = placed_preview(options, cancel);  // throws for a drawing that cannot be planned: nothing starts
+    Json p = placed_preview(options,
+                            cancel);  // throws for a drawing that cannot be planned: nothing starts
     std::vector<std::string> argv = {config_.executable, "stream"};
     // --plan-first: the page shows the job's length from job_start on (web/app.js reads it
     // there), which a stream planned as it goes only knows at its end.
-    for (const std::string& a : {std::string("--machine=") + config_.machine_file, "--target=" + config_.target,
-                                 std::string("--lead-in"), std::string("--plan-first"), std::string("--events=-"),
-                                 // Start on the page draws anew: the last job's journal goes
-                                 // (Resume job continues it instead).
-                                 std::string("--replace-journal"),
-                                 "--events-rate=" + number_text(config_.events_rate),
-                                 "--journal=" + (fs::path(config_.state_dir) / "job.journal.json").string()}) {
+    for (const std::string& a :
+         {std::string("--machine=") + config_.machine_file, "--target=" + config_.target,
+          std::string("--lead-in"), std::string("--plan-first"), std::string("--events=-"),
+          // Start on the page draws anew: the last job's journal goes
+          // (Resume job continues it instead).
+          std::string("--replace-journal"), "--events-rate=" + number_text(config_.events_rate),
+          "--journal=" + (fs::path(config_.state_dir) / "job.journal.json").string()}) {
         argv.push_back(a);
     }
     argv.insert(argv.end(), args.begin(), args.end());
@@ -386,10 +411,16 @@ Server::Reply Server::run_job(const nlohmann::json& options, const std::string& 
 
 Server::Reply Server::resume() {
     const fs::path journal = fs::path(config_.state_dir) / "job.journal.json";
-    if (!fs::exists(journal)) return {409, error_body("no job journal: nothing was streamed from this page yet")};
-    const std::vector<std::string> argv = {config_.executable, "stream", "--resume=" + journal.string(),
-                                           "--events=-", "--events-rate=" + number_text(config_.events_rate), "--"};
-    if (!start_child("resume", argv, whole_job_ticks())) return {409, error_body("a job is running already")};
+    if (!fs::exists(journal))
+        return {409, error_body("no job journal: nothing was streamed from this page yet")};
+    const std::vector<std::string> argv = {config_.executable,
+                                           "stream",
+                                           "--resume=" + journal.string(),
+                                           "--events=-",
+                                           "--events-rate=" + number_text(config_.events_rate),
+                                           "--"};
+    if (!start_child("resume", argv, whole_job_ticks()))
+        return {409, error_body("a job is running already")};
     return {200, Json{{"ok", true}}};
 }
 
@@ -398,17 +429,21 @@ Server::Reply Server::simulate(const nlohmann::json& options, const CancelToken&
     const std::lock_guard<std::mutex> gate(gate_);
     const std::string name = drawing_file();
     if (name.empty()) return {409, error_body("no drawing loaded")};
-    std::vector<std::string> argv = {config_.executable, "sim", "--machine=" + config_.machine_file};
+    std::vector<std::string> argv = {config_.executable, "sim",
+                                     "--machine=" + config_.machine_file};
     const std::vector<std::string> args = arguments(options);
     argv.insert(argv.end(), args.begin(), args.end());
     argv.insert(argv.end(), {"--", name});
-    const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(config_.plan_timeout_s);
+    const auto deadline =
+        std::chrono::steady_clock::now() + std::chrono::duration<double>(config_.plan_timeout_s);
     bool late = false;
     const ChildOutput r = run_child(argv, (fs::path(config_.state_dir) / "drawing").string(), [&] {
         late = std::chrono::steady_clock::now() > deadline;
         return late || cancel.cancelled() || stopping_.load();
     });
-    if (late) return {422, error_body("the simulation stopped after " + duration_text(config_.plan_timeout_s) + " (serve --plan-timeout)")};
+    if (late)
+        return {422, error_body("the simulation stopped after " +
+                                duration_text(config_.plan_timeout_s) + " (serve --plan-timeout)")};
     Json body{{"ok", r.exit_code == 0}, {"exit", r.exit_code}, {"report", clean_message(r.out)}};
     if (r.exit_code != 0) body["error"] = clean_message(last_lines(r.err, 3));
     return {r.exit_code == 0 ? 200 : 422, body};
@@ -430,8 +465,8 @@ Server::Reply Server::control(const nlohmann::json& request) {
         return {200, Json{{"ok", true}, {"message", "stopping the job"}}};
     }
     // Options first, then `--`: no value from the page can become an option.
-    std::vector<std::string> argv = {config_.executable, "ctl", "--machine=" + config_.machine_file, "--json",
-                                     "--wait=60"};
+    std::vector<std::string> argv = {config_.executable, "ctl", "--machine=" + config_.machine_file,
+                                     "--json", "--wait=60"};
     std::vector<std::string> positional = {"--", config_.target, verb};
     const auto axis_name = [&](const nlohmann::json& v) {
         if (!v.is_string()) throw std::invalid_argument("axis: want an axis name");
@@ -443,18 +478,21 @@ Server::Reply Server::control(const nlohmann::json& request) {
     if (verb == "hold" || verb == "resume" || verb == "stop" || verb == "reset") {
     } else if (verb == "home") {
     } else if (verb == "pen") {
-        if (!request.contains("down") || !request["down"].is_boolean()) throw std::invalid_argument("pen: want down true or false");
+        if (!request.contains("down") || !request["down"].is_boolean())
+            throw std::invalid_argument("pen: want down true or false");
         positional.push_back(request["down"].get<bool>() ? "down" : "up");
     } else if (verb == "jog") {
         positional.push_back(axis_name(request.value("axis", nlohmann::json())));
         const nlohmann::json d = request.value("distance_mm", nlohmann::json());
-        if (!d.is_number() || !std::isfinite(d.get<double>()) || d.get<double>() == 0 || std::fabs(d.get<double>()) > 10000) {
+        if (!d.is_number() || !std::isfinite(d.get<double>()) || d.get<double>() == 0 ||
+            std::fabs(d.get<double>()) > 10000) {
             throw std::invalid_argument("jog: want distance_mm, not 0, at most 10000 either way");
         }
         positional.push_back(number_text(d.get<double>()));
         if (request.contains("feed")) {
             const nlohmann::json f = request["feed"];
-            if (!f.is_number() || !(f.get<double>() > 0) || f.get<double>() > 1e6) throw std::invalid_argument("jog: feed in mm/s, > 0");
+            if (!f.is_number() || !(f.get<double>() > 0) || f.get<double>() > 1e6)
+                throw std::invalid_argument("jog: feed in mm/s, > 0");
             argv.push_back("--feed=" + number_text(f.get<double>()));
         }
     } else {
@@ -473,7 +511,9 @@ Server::Reply Server::control(const nlohmann::json& request) {
         }
     }
     if (r.exit_code != 0) body["error"] = clean_message(last_lines(r.err, 1));
-    hub_.publish(Json{{"event", "command"}, {"verb", verb}, {"ok", r.exit_code == 0},
+    hub_.publish(Json{{"event", "command"},
+                      {"verb", verb},
+                      {"ok", r.exit_code == 0},
                       {"error", r.exit_code == 0 ? "" : clean_message(last_lines(r.err, 1))}}
                      .dump());
     return {r.exit_code == 0 ? 200 : 422, body};
@@ -482,13 +522,17 @@ Server::Reply Server::control(const nlohmann::json& request) {
 Json Server::state() const {
     Json axes = Json::array();
     for (const AxisLimits& a : machine_.axes) {
-        axes.push_back({{"name", a.name}, {"travel_min", a.travel_min}, {"travel_max", a.travel_max},
+        axes.push_back({{"name", a.name},
+                        {"travel_min", a.travel_min},
+                        {"travel_max", a.travel_max},
                         {"max_velocity", a.max_velocity}});
     }
     const fs::path journal = fs::path(config_.state_dir) / "job.journal.json";
     Json s{{"ok", true},
-           {"machine", {{"file", fs::path(config_.machine_file).filename().string()}, {"axes", axes},
-                        {"tick_hz", machine_.tick_hz}}},
+           {"machine",
+            {{"file", fs::path(config_.machine_file).filename().string()},
+             {"axes", axes},
+             {"tick_hz", machine_.tick_hz}}},
            {"target", config_.target},
            {"drawing", drawing_file()},
            {"job_running", job_running()},
@@ -538,7 +582,8 @@ void Server::poll_device() {
         } catch (const std::exception& e) {
             link.reset();
             const std::string message = e.what();
-            if (message != last_error) hub_.publish(Json{{"event", "device"}, {"error", message}}.dump(), "device");
+            if (message != last_error)
+                hub_.publish(Json{{"event", "device"}, {"error", message}}.dump(), "device");
             last_error = message;
             std::this_thread::sleep_for(std::chrono::milliseconds(500));
         }
@@ -548,13 +593,16 @@ void Server::poll_device() {
 
 namespace {
 
-HttpResponse json_response(int status, const Json& body) { return {status, "application/json", body.dump(), {}}; }
+HttpResponse json_response(int status, const Json& body) {
+    return {status, "application/json", body.dump(), {}};
+}
 
 // A stop goes to the lane no other work waits in. The body is small; anything larger is not a stop.
 Lane control_lane(const HttpRequest& request) {
     if (request.body.size() > 4096) return Lane::command;
     const nlohmann::json j = nlohmann::json::parse(request.body, nullptr, false);
-    return j.is_object() && j.value("verb", nlohmann::json()) == "stop" ? Lane::stop : Lane::command;
+    return j.is_object() && j.value("verb", nlohmann::json()) == "stop" ? Lane::stop
+                                                                        : Lane::command;
 }
 
 }  // namespace
@@ -573,14 +621,16 @@ void Server::routes() {
                            {"X-Frame-Options", "DENY"},
                            {"Referrer-Policy", "no-referrer"}};
         // The page keeps the token as a cookie that only this origin's requests carry.
-        if (const auto cookie = token_cookie(config_.access, facts, kTokenCookie)) verdict.headers.emplace_back("Set-Cookie", *cookie);
+        if (const auto cookie = token_cookie(config_.access, facts, kTokenCookie))
+            verdict.headers.emplace_back("Set-Cookie", *cookie);
         return verdict;
     });
     const auto json_handler = [this](auto&& body) {
         return [this, body](const HttpRequest& req, const CancelToken& cancel) {
             Reply reply;
             try {
-                nlohmann::json request = req.body.empty() ? nlohmann::json::object() : nlohmann::json::parse(req.body);
+                nlohmann::json request =
+                    req.body.empty() ? nlohmann::json::object() : nlohmann::json::parse(req.body);
                 reply = body(req, request, cancel);
             } catch (const nlohmann::json::parse_error&) {
                 reply = {400, error_body("the request body is not JSON")};
@@ -591,43 +641,56 @@ void Server::routes() {
             return json_response(reply.status, reply.body);
         };
     };
-    h.route("GET", "/api/state", Lane::command, json_handler([this](const HttpRequest&, const nlohmann::json&, const CancelToken&) {
-        return Reply{200, state()};
-    }));
-    h.route("POST", "/api/drawing", Lane::work, [this](const HttpRequest& req, const CancelToken& cancel) {
-        Reply reply;
-        try {
-            nlohmann::json options = nlohmann::json::object();
-            if (req.has_param("options")) options = nlohmann::json::parse(req.param("options"));
-            reply = upload(req.param("name"), req.body, options, cancel);
-        } catch (const nlohmann::json::parse_error&) {
-            reply = {400, error_body("options: not JSON")};
-        } catch (const std::exception& e) {
-            reply = {422, error_body(clean_message(e.what()))};
-        }
-        return json_response(reply.status, reply.body);
-    });
+    h.route("GET", "/api/state", Lane::command,
+            json_handler([this](const HttpRequest&, const nlohmann::json&, const CancelToken&) {
+                return Reply{200, state()};
+            }));
+    h.route("POST", "/api/drawing", Lane::work,
+            [this](const HttpRequest& req, const CancelToken& cancel) {
+                Reply reply;
+                try {
+                    nlohmann::json options = nlohmann::json::object();
+                    if (req.has_param("options"))
+                        options = nlohmann::json::parse(req.param("options"));
+                    reply = upload(req.param("name"), req.body, options, cancel);
+                } catch (const nlohmann::json::parse_error&) {
+                    reply = {400, error_body("options: not JSON")};
+                } catch (const std::exception& e) {
+                    reply = {422, error_body(clean_message(e.what()))};
+                }
+                return json_response(reply.status, reply.body);
+            });
     h.route("GET", "/api/preview", Lane::command, [this](const HttpRequest&, const CancelToken&) {
         const Reply reply = last_preview();
         return json_response(reply.status, reply.body);
     });
-    h.route("POST", "/api/preview", Lane::work, json_handler([this](const HttpRequest&, const nlohmann::json& j, const CancelToken& cancel) {
-        return preview(j.value("options", nlohmann::json::object()), cancel);
-    }));
-    h.route("POST", "/api/run", Lane::work, json_handler([this](const HttpRequest&, const nlohmann::json& j, const CancelToken& cancel) {
-        const nlohmann::json hash = j.value("drawing_hash", nlohmann::json(""));
-        if (!hash.is_string()) throw std::invalid_argument("drawing_hash: want the preview's drawing_hash");
-        return run_job(j.value("options", nlohmann::json::object()), hash.get<std::string>(), cancel);
-    }));
-    h.route("POST", "/api/simulate", Lane::work, json_handler([this](const HttpRequest&, const nlohmann::json& j, const CancelToken& cancel) {
-        return simulate(j.value("options", nlohmann::json::object()), cancel);
-    }));
-    h.route("POST", "/api/resume", Lane::command, json_handler([this](const HttpRequest&, const nlohmann::json&, const CancelToken&) {
-        return resume();
-    }));
-    h.route("POST", "/api/control", control_lane, json_handler([this](const HttpRequest&, const nlohmann::json& j, const CancelToken&) {
-        return control(j);
-    }));
+    h.route("POST", "/api/preview", Lane::work,
+            json_handler(
+                [this](const HttpRequest&, const nlohmann::json& j, const CancelToken& cancel) {
+                    return preview(j.value("options", nlohmann::json::object()), cancel);
+                }));
+    h.route("POST", "/api/run", Lane::work,
+            json_handler([this](const HttpRequest&, const nlohmann::json& j,
+                                const CancelToken& cancel) {
+                const nlohmann::json hash = j.value("drawing_hash", nlohmann::json(""));
+                if (!hash.is_string())
+                    throw std::invalid_argument("drawing_hash: want the preview's drawing_hash");
+                return run_job(j.value("options", nlohmann::json::object()),
+                               hash.get<std::string>(), cancel);
+            }));
+    h.route("POST", "/api/simulate", Lane::work,
+            json_handler(
+                [this](const HttpRequest&, const nlohmann::json& j, const CancelToken& cancel) {
+                    return simulate(j.value("options", nlohmann::json::object()), cancel);
+                }));
+    h.route("POST", "/api/resume", Lane::command,
+            json_handler([this](const HttpRequest&, const nlohmann::json&, const CancelToken&) {
+                return resume();
+            }));
+    h.route("POST", "/api/control", control_lane,
+            json_handler([this](const HttpRequest&, const nlohmann::json& j, const CancelToken&) {
+                return control(j);
+            }));
     h.events("/api/events");
     h.fallback([](const HttpRequest& req, const CancelToken&) {
         HttpResponse res;
@@ -637,9 +700,10 @@ void Server::routes() {
             res.body = error_body("no such page").dump();
             return res;
         }
-        res.headers.emplace_back("Content-Security-Policy",
-                                 "default-src 'self'; img-src 'self' data: blob:; style-src 'self'; script-src 'self'; "
-                                 "connect-src 'self'; frame-ancestors 'none'");
+        res.headers.emplace_back(
+            "Content-Security-Policy",
+            "default-src 'self'; img-src 'self' data: blob:; style-src 'self'; script-src 'self'; "
+            "connect-src 'self'; frame-ancestors 'none'");
         res.content_type = asset->content_type;
         res.body.assign(reinterpret_cast<const char*>(asset->data), asset->size);
         return res;

@@ -25,18 +25,18 @@ class HttpServer;
 /// Everything the server is started with; read-only once it runs.
 struct ServerConfig {
     std::string listen_host = "127.0.0.1";
-    unsigned port = 8080;             ///< 0: any free port (bound_port() says which)
+    unsigned port = 8080;  ///< 0: any free port (bound_port() says which)
     AccessPolicy access;
-    std::string machine_file;         ///< absolute path of the machine profile
-    std::string target;               ///< the device's URL, for stream and ctl
-    std::string state_dir;            ///< absolute; the uploaded drawing and the job journal live here
-    std::string executable;           ///< this program, whose stream, sim and ctl commands run the jobs
-    double events_rate = 10;          ///< stream --events-rate: progress updates per second
-    double status_hz = 10;            ///< device status reads per second
+    std::string machine_file;  ///< absolute path of the machine profile
+    std::string target;        ///< the device's URL, for stream and ctl
+    std::string state_dir;     ///< absolute; the uploaded drawing and the job journal live here
+    std::string executable;    ///< this program, whose stream, sim and ctl commands run the jobs
+    double events_rate = 10;   ///< stream --events-rate: progress updates per second
+    double status_hz = 10;     ///< device status reads per second
     std::size_t max_upload_bytes = 16u << 20;
-    HttpLimits limits;                ///< body_bytes comes from max_upload_bytes
-    double plan_timeout_s = 60;       ///< a preview's or run's planning is stopped after this
-    double max_motion_s = 86400;      ///< a job estimated to move longer is refused before planning
+    HttpLimits limits;            ///< body_bytes comes from max_upload_bytes
+    double plan_timeout_s = 60;   ///< a preview's or run's planning is stopped after this
+    double max_motion_s = 86400;  ///< a job estimated to move longer is refused before planning
 };
 
 /// The HTTP server and what runs behind it: a device status poller thread, at most one job
@@ -66,7 +66,8 @@ private:
     Reply preview(const nlohmann::json& options, const CancelToken& cancel);
     /// Streams the drawing as placed by `options`; `previewed_hash` (when not empty) is the
     /// drawing_hash of the preview the page shows, refused when another drawing is loaded.
-    Reply run_job(const nlohmann::json& options, const std::string& previewed_hash, const CancelToken& cancel);
+    Reply run_job(const nlohmann::json& options, const std::string& previewed_hash,
+                  const CancelToken& cancel);
     /// Cancels the plan that was newest until now: `cancel` is the newest.
     void claim_planning(const CancelToken& cancel);
     std::string drawing_hash() const;
@@ -81,7 +82,8 @@ private:
     Reply control(const nlohmann::json& request);
     nlohmann::ordered_json state() const;
     std::vector<std::string> arguments(const nlohmann::json& options) const;
-    nlohmann::ordered_json plan_preview(const std::vector<std::string>& args, const CancelToken& cancel);
+    nlohmann::ordered_json plan_preview(const std::vector<std::string>& args,
+                                        const CancelToken& cancel);
     bool start_child(const std::string& kind, std::vector<std::string> argv,
                      const nlohmann::ordered_json& whole_ticks = nullptr);
     bool job_running() const;
@@ -101,11 +103,12 @@ private:
     std::vector<double> rest_mm_;      ///< the device's last position read; empty: none yet
 
     mutable std::mutex drawing_mutex_;
-    std::string drawing_name_;         ///< the stored drawing's file name; empty: none
-    std::string drawing_hash_;         ///< content_hash of its bytes
-    std::mutex gate_;  ///< upload, preview, run and simulate one at a time: a run streams what it previewed
+    std::string drawing_name_;  ///< the stored drawing's file name; empty: none
+    std::string drawing_hash_;  ///< content_hash of its bytes
+    std::mutex gate_;  ///< upload, preview, run and simulate one at a time: a run streams what it
+                       ///< previewed
     std::mutex newest_plan_mutex_;
-    CancelToken newest_plan_;          ///< the plan running or waiting last: a newer one cancels it
+    CancelToken newest_plan_;  ///< the plan running or waiting last: a newer one cancels it
     mutable std::mutex preview_mutex_;
     nlohmann::ordered_json last_preview_;  ///< the last preview answered; null: none
 

@@ -37,23 +37,34 @@ const char* command_verb(device::Command c) {
 
 const char* axis_homing_name(device::AxisHoming h) {
     switch (h) {
-        case device::AxisHoming::kNotHomed: return "not homed";
-        case device::AxisHoming::kHoming: return "homing";
-        case device::AxisHoming::kHomed: return "homed";
-        case device::AxisHoming::kFailed: return "failed";
+        case device::AxisHoming::kNotHomed:
+            return "not homed";
+        case device::AxisHoming::kHoming:
+            return "homing";
+        case device::AxisHoming::kHomed:
+            return "homed";
+        case device::AxisHoming::kFailed:
+            return "failed";
     }
     return "unknown";
 }
 
 const char* homing_error_name(device::HomingError e) {
     switch (e) {
-        case device::HomingError::kNone: return "none";
-        case device::HomingError::kBadConfig: return "a homing velocity or distance is out of range";
-        case device::HomingError::kDeviceRefused: return "the device refused a homing step";
-        case device::HomingError::kSwitchNotFound: return "switch not found within max_travel";
-        case device::HomingError::kSwitchStuck: return "switch still active after moving off it";
-        case device::HomingError::kLatchNotFound: return "the slow approach did not find the switch again";
-        case device::HomingError::kInterrupted: return "interrupted by a fault, the e-stop or a stop";
+        case device::HomingError::kNone:
+            return "none";
+        case device::HomingError::kBadConfig:
+            return "a homing velocity or distance is out of range";
+        case device::HomingError::kDeviceRefused:
+            return "the device refused a homing step";
+        case device::HomingError::kSwitchNotFound:
+            return "switch not found within max_travel";
+        case device::HomingError::kSwitchStuck:
+            return "switch still active after moving off it";
+        case device::HomingError::kLatchNotFound:
+            return "the slow approach did not find the switch again";
+        case device::HomingError::kInterrupted:
+            return "interrupted by a fault, the e-stop or a stop";
     }
     return "unknown homing error";
 }
@@ -134,7 +145,8 @@ public:
         c.axis = static_cast<std::uint8_t>(axis);
         c.value = value;
         c.feed = feed;
-        const std::uint8_t r = link_.command_frame(pc::encode_command_args(options_.node, c), command);
+        const std::uint8_t r =
+            link_.command_frame(pc::encode_command_args(options_.node, c), command);
         if (r >= pc::kResultIncomplete) {
             link_.fail("command " + std::to_string(command) + ": " + can_result_name(r));
         }

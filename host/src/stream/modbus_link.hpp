@@ -9,10 +9,10 @@
 #include <string>
 #include <thread>
 
+#include "pathstream/device/modbus_map.hpp"
 #include "pathstream/hal/modbus_client.hpp"
 #include "pathstream/hal/modbus_error.hpp"
 #include "pathstream/host/device_link.hpp"
-#include "pathstream/device/modbus_map.hpp"
 #include "pathstream/host/modbus_stream.hpp"
 
 namespace pathstream::host {

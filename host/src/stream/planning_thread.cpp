@@ -25,8 +25,8 @@ private:
     PlanningThread& owner_;
 };
 
-PlanningThread::PlanningThread(SegmentSource& source, const MachineProfile& profile, const PlanOptions& options,
-                               Hooks hooks)
+PlanningThread::PlanningThread(SegmentSource& source, const MachineProfile& profile,
+                               const PlanOptions& options, Hooks hooks)
     : source_(source),
       profile_(profile),
       options_(options),
@@ -44,10 +44,11 @@ void PlanningThread::run() {
     const auto t0 = std::chrono::steady_clock::now();
     try {
         Forward sink(*this);
-        const PlanTotals totals = plan_stream(source_, profile_, options_, sink, nullptr, [this](double f) {
-            if (cancel_.load(std::memory_order_relaxed)) throw Cancelled{};
-            fraction_.store(f, std::memory_order_relaxed);
-        });
+        const PlanTotals totals =
+            plan_stream(source_, profile_, options_, sink, nullptr, [this](double f) {
+                if (cancel_.load(std::memory_order_relaxed)) throw Cancelled{};
+                fraction_.store(f, std::memory_order_relaxed);
+            });
         if (hooks_.finish) hooks_.finish(totals);
         totals_ = totals;
         fraction_.store(1, std::memory_order_relaxed);
@@ -108,7 +109,9 @@ std::optional<PlanTotals> PlanningThread::totals() const {
     return totals_;
 }
 
-double PlanningThread::planning_seconds() const { return finished() ? seconds_ : 0; }
+double PlanningThread::planning_seconds() const {
+    return finished() ? seconds_ : 0;
+}
 
 void PlanningThread::drain(const std::function<bool()>& keep_waiting) {
     QueuedSpan q;

@@ -43,7 +43,9 @@ public:
     /// Spans encoded so far.
     std::size_t count() const { return base_ + entries_.size(); }
     /// The encoded span `index` (released <= index < count()).
-    const std::vector<std::uint8_t>& bytes(std::size_t index) const { return entries_.at(index - base_).bytes; }
+    const std::vector<std::uint8_t>& bytes(std::size_t index) const {
+        return entries_.at(index - base_).bytes;
+    }
     /// Ticks of the spans before `index` (released <= index <= count()).
     std::uint64_t ticks_before(std::size_t index) const {
         return index == count() ? ticks_ : entries_.at(index - base_).ticks_before;

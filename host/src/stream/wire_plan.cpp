@@ -14,7 +14,8 @@ std::vector<std::uint8_t> WireEncoder::encode(const CoreSpan& c, bool last) {
         axes_ = static_cast<unsigned>(c.control.size());
         if (axes_ < 1 || axes_ > 8) throw std::invalid_argument("1 to 8 axes");
     }
-    if (c.basis != Basis::kHermite) throw std::invalid_argument("only Hermite spans stream (planned paths are)");
+    if (c.basis != Basis::kHermite)
+        throw std::invalid_argument("only Hermite spans stream (planned paths are)");
     if (c.control.size() != axes_) {
         throw std::invalid_argument("plan span " + std::to_string(i) + " has another axis count");
     }

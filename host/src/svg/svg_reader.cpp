@@ -10,10 +10,10 @@
 #include <sstream>
 #include <unordered_map>
 
-#include "pathstream/machine/input_error.hpp"
 #include "pathstream/host/svg_clip.hpp"
 #include "pathstream/host/svg_path.hpp"
 #include "pathstream/host/svg_warnings.hpp"
+#include "pathstream/machine/input_error.hpp"
 
 namespace pathstream::host {
 namespace {

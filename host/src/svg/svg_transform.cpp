@@ -162,7 +162,8 @@ Affine parse_transform(std::string_view text, bool css) {
                     s.advance();
                 }
                 const double factor = unit_factor(name, unit);
-                if (factor == 0) s.fail("unit '" + unit + "' not allowed in '" + name + "('", unit_at);
+                if (factor == 0)
+                    s.fail("unit '" + unit + "' not allowed in '" + name + "('", unit_at);
                 args.back() *= factor;
             }
             s.skip_space();

@@ -12,10 +12,10 @@
 
 #include "pathstream/hal/can_bus.hpp"
 #include "pathstream/hal/clock.hpp"
+#include "pathstream/host/plan.hpp"
+#include "pathstream/host/stream_types.hpp"
 #include "pathstream/machine/cia402_protocol.hpp"
 #include "pathstream/machine/machine.hpp"
-#include "pathstream/host/stream_types.hpp"
-#include "pathstream/host/plan.hpp"
 
 namespace pathstream::host {
 
@@ -42,8 +42,8 @@ struct Cia402Options {
     std::uint32_t cycle_ms = 2;          ///< SYNC period; a whole number of the profile's ticks
     std::uint16_t heartbeat_ms = 100;    ///< producer time written to every drive (0x1017)
     std::uint32_t heartbeat_timeout_ms = 350;  ///< consumer: no heartbeat for this long -> stop
-    std::uint32_t sdo_timeout_ms = 50;   ///< per SDO try
-    unsigned sdo_attempts = 3;           ///< expedited transfers are idempotent: retried on timeout
+    std::uint32_t sdo_timeout_ms = 50;         ///< per SDO try
+    unsigned sdo_attempts = 3;  ///< expedited transfers are idempotent: retried on timeout
     std::uint32_t boot_timeout_ms = 1000;    ///< wait for boot-up after reset communication
     std::uint32_t enable_timeout_ms = 500;   ///< shutdown -> switch on -> enable operation
     std::uint32_t settle_timeout_ms = 1000;  ///< after the end point: wait for the axes to arrive
@@ -56,20 +56,20 @@ struct Cia402Options {
     /// which target the drive applied, and counts lost RPDOs exactly (4 more bytes per axis
     /// per cycle on the bus).
     bool demand_echo = false;
-    bool disable_at_end = true;              ///< shutdown (0x06) after the settle phase
-    bool reset_communication = true;         ///< NMT reset communication before configuring
+    bool disable_at_end = true;       ///< shutdown (0x06) after the settle phase
+    bool reset_communication = true;  ///< NMT reset communication before configuring
 };
 
 /// Why the master stopped commanding motion.
 enum class Cia402Stop : std::uint8_t {
-    kNone = 0,          ///< completed: every cycle's setpoint was sent and the axes arrived
-    kDriveFault,        ///< a drive reported fault (statusword or EMCY)
-    kHeartbeatLost,     ///< no heartbeat within heartbeat_timeout_ms
-    kFeedbackLost,      ///< max_missed_feedback cycles without TPDO1
-    kDriveLeftOperation,///< the drive left operation enabled / NMT operational on its own
-    kStepLimit,         ///< the next target would step more than v_max x cycle (or a_max x cycle^2)
-    kBusOff,            ///< the controller went bus-off or refused to send
-    kSettleTimeout,     ///< the axes did not reach the end point within settle_timeout_ms
+    kNone = 0,            ///< completed: every cycle's setpoint was sent and the axes arrived
+    kDriveFault,          ///< a drive reported fault (statusword or EMCY)
+    kHeartbeatLost,       ///< no heartbeat within heartbeat_timeout_ms
+    kFeedbackLost,        ///< max_missed_feedback cycles without TPDO1
+    kDriveLeftOperation,  ///< the drive left operation enabled / NMT operational on its own
+    kStepLimit,      ///< the next target would step more than v_max x cycle (or a_max x cycle^2)
+    kBusOff,         ///< the controller went bus-off or refused to send
+    kSettleTimeout,  ///< the axes did not reach the end point within settle_timeout_ms
 };
 
 /// "drive fault", "heartbeat lost", ...
@@ -79,22 +79,23 @@ const char* cia402_stop_name(Cia402Stop stop);
 struct Cia402Report {
     bool completed = false;
     Cia402Stop stop = Cia402Stop::kNone;
-    std::string message;               ///< why it stopped, naming the node; empty when completed
-    std::uint64_t cycles = 0;          ///< SYNCs sent (enable, motion, settle, stop)
-    std::uint64_t motion_cycles = 0;   ///< cycles that carried a plan setpoint
+    std::string message;              ///< why it stopped, naming the node; empty when completed
+    std::uint64_t cycles = 0;         ///< SYNCs sent (enable, motion, settle, stop)
+    std::uint64_t motion_cycles = 0;  ///< cycles that carried a plan setpoint
     std::uint64_t total_motion_cycles = 0;  ///< what the plan needs
-    std::uint64_t path_ticks = 0;      ///< plan ticks covered by the setpoints sent
+    std::uint64_t path_ticks = 0;           ///< plan ticks covered by the setpoints sent
     std::uint64_t frames_sent = 0;
     std::uint64_t frames_received = 0;
-    std::uint64_t missed_feedback = 0; ///< drive-cycles without TPDO1
-    std::uint64_t demand_mismatches = 0;  ///< demand_echo: cycles whose applied target was not the one sent
-    std::uint16_t emcy_code = 0;       ///< first EMCY error code seen (0: none)
+    std::uint64_t missed_feedback = 0;  ///< drive-cycles without TPDO1
+    std::uint64_t demand_mismatches =
+        0;                        ///< demand_echo: cycles whose applied target was not the one sent
+    std::uint16_t emcy_code = 0;  ///< first EMCY error code seen (0: none)
     std::uint8_t emcy_node = 0;
-    std::int32_t max_step = 0;         ///< largest |target step| commanded, LSB per cycle
-    std::int32_t max_lag = 0;          ///< largest |target sent - actual reported| seen
+    std::int32_t max_step = 0;                 ///< largest |target step| commanded, LSB per cycle
+    std::int32_t max_lag = 0;                  ///< largest |target sent - actual reported| seen
     std::vector<std::int32_t> final_target;    ///< last target per axis
     std::vector<std::int32_t> final_position;  ///< last actual position per axis
-    double wall_seconds = 0;           ///< on the master's clock
+    double wall_seconds = 0;                   ///< on the master's clock
 };
 
 /// Progress: fraction of the plan's cycles sent.
@@ -107,13 +108,13 @@ struct Cia402DriveView {
     bool heartbeat_seen = false;
     std::uint64_t last_heartbeat_us = 0;
     std::uint16_t statusword = 0;
-    std::int32_t position = 0;          ///< position actual value from TPDO1
-    std::int32_t demand = 0;            ///< position demand value from TPDO2 (demand_echo)
-    std::uint64_t feedback_cycle = 0;   ///< cycle (1-based) of the last TPDO1; 0: none yet
+    std::int32_t position = 0;         ///< position actual value from TPDO1
+    std::int32_t demand = 0;           ///< position demand value from TPDO2 (demand_echo)
+    std::uint64_t feedback_cycle = 0;  ///< cycle (1-based) of the last TPDO1; 0: none yet
     std::uint64_t demand_cycle = 0;
     unsigned missed_in_row = 0;
-    std::uint16_t emcy_code = 0;        ///< last EMCY error code (0: none or reset)
-    bool emcy_pending = false;          ///< an EMCY with a non-zero code arrived
+    std::uint16_t emcy_code = 0;  ///< last EMCY error code (0: none or reset)
+    bool emcy_pending = false;    ///< an EMCY with a non-zero code arrived
     cia402::DriveState state() const { return cia402::decode_statusword(statusword); }
 };
 
@@ -139,7 +140,8 @@ public:
     void sdo_download(std::uint8_t node, std::uint16_t index, std::uint8_t sub, std::uint32_t value,
                       std::uint8_t size);
     /// Expedited SDO upload; returns the value (zero-extended) and its size in `size` if given.
-    std::uint32_t sdo_upload(std::uint8_t node, std::uint16_t index, std::uint8_t sub, std::uint8_t* size = nullptr);
+    std::uint32_t sdo_upload(std::uint8_t node, std::uint16_t index, std::uint8_t sub,
+                             std::uint8_t* size = nullptr);
 
     /// Sends an NMT command to `node` (0: all).
     void nmt(cia402::NmtCommand command, std::uint8_t node);
@@ -162,7 +164,8 @@ public:
     /// + 2 LSB) and every cycle's feedback; on any failure it stops commanding motion (quick
     /// stop with the last target held) and returns the report with the reason.
     /// Throws std::invalid_argument if the plan does not fit (axes, cycle vs tick rate).
-    Cia402Report run(const Plan& plan, const MachineProfile& profile, const Cia402Progress& progress = {});
+    Cia402Report run(const Plan& plan, const MachineProfile& profile,
+                     const Cia402Progress& progress = {});
 
     const std::vector<Cia402DriveView>& drives() const { return drives_; }
     const Cia402Report& report() const { return report_; }
@@ -172,7 +175,8 @@ private:
     void send(const hal::CanFrame& frame);
     void handle(const hal::CanFrame& frame);
     void wait_until(std::uint64_t deadline_us);
-    void exchange(const std::vector<std::uint16_t>& controlwords, const std::vector<std::int32_t>& targets);
+    void exchange(const std::vector<std::uint16_t>& controlwords,
+                  const std::vector<std::int32_t>& targets);
     Cia402Stop check_health(bool moving);
     Cia402Stop stop_with(Cia402Stop why, const std::string& message);
     void quick_stop(const std::vector<std::int32_t>& hold);
@@ -208,8 +212,9 @@ Cia402Target parse_cia402_target(const std::string& url, std::size_t axes);
 
 /// The whole job on an open bus: configure(), run(). Throws Cia402Error when run() stops
 /// before completion (the report's message), after the drives were stopped.
-Cia402Report stream_cia402(const Plan& plan, const MachineProfile& profile, const Cia402Options& options,
-                           hal::CanBus& bus, hal::Clock& clock_us, const Cia402Progress& progress = {});
+Cia402Report stream_cia402(const Plan& plan, const MachineProfile& profile,
+                           const Cia402Options& options, hal::CanBus& bus, hal::Clock& clock_us,
+                           const Cia402Progress& progress = {});
 
 }  // namespace pathstream::host
 
@@ -231,6 +236,7 @@ private:
 /// profile's axes, runs stream_cia402 on `bus` with a progress bar and prints the report
 /// (cycles, bus frames and worst-case load, following). Returns the exit code (0); throws
 /// Cia402Error (exit 6) when the drives stopped early, std::invalid_argument for a bad target.
-int run_cia402_stream(const Plan& plan, const MachineProfile& profile, const std::string& target, hal::CanBus& bus);
+int run_cia402_stream(const Plan& plan, const MachineProfile& profile, const std::string& target,
+                      hal::CanBus& bus);
 
 }  // namespace pathstream::host

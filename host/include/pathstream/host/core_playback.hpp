@@ -13,10 +13,10 @@ namespace pathstream::host {
 /// One executed tick: its index, the span that supplied it, and the setpoint of every axis.
 struct PlayedTick {
     std::uint64_t tick = 0;
-    std::size_t span = 0;         ///< index into the span list
+    std::size_t span = 0;  ///< index into the span list
     std::uint32_t tick_in_span = 0;
     const Lsb* setpoint = nullptr;  ///< `axes` values, valid during the callback only
-    bool pen_down = false;        ///< the core's outputs for this tick (kOutputPenDown)
+    bool pen_down = false;          ///< the core's outputs for this tick (kOutputPenDown)
 };
 
 /// Pushes `spans` into a SetpointStream (starting at the first span's tick-0 value) whenever

@@ -15,10 +15,10 @@
 #include <vector>
 
 #include "pathstream/device/device_state.hpp"
+#include "pathstream/host/plan.hpp"
+#include "pathstream/host/stream_types.hpp"
 #include "pathstream/machine/event_json.hpp"
 #include "pathstream/machine/machine.hpp"
-#include "pathstream/host/stream_types.hpp"
-#include "pathstream/host/plan.hpp"
 #include "pathstream/units.hpp"
 
 namespace pathstream::host {
@@ -63,7 +63,7 @@ struct JobInfo {
 
 /// One look at a job executing: a status read of a device, or a simulated tick.
 struct JobSample {
-    std::optional<double> sim_seconds;  ///< sim: simulated time (progress is paced by it)
+    std::optional<double> sim_seconds;         ///< sim: simulated time (progress is paced by it)
     std::optional<device::DeviceState> state;  ///< device state; sim: none
     std::uint16_t fault_code = 0;
     bool started = false;                  ///< the device has begun executing the job

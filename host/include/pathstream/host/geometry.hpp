@@ -14,11 +14,11 @@ namespace pathstream::host {
 /// One cubic Bezier piece, control points in mm (each PathPoint has Path::axes coordinates).
 struct BezierSegment {
     std::array<PathPoint, 4> p;
-    bool pen_down = true;     ///< false: pen-up travel between subpaths
-    std::size_t subpath = 0;  ///< index into Path::subpaths (travel: the subpath it leads to)
+    bool pen_down = true;       ///< false: pen-up travel between subpaths
+    std::size_t subpath = 0;    ///< index into Path::subpaths (travel: the subpath it leads to)
     std::uint32_t segment = 0;  ///< the subpath's curve segment it is (0 for travel)
-    double feed = 0;          ///< requested speed, mm/s (Subpath::feed); 0: the machine profile's
-                              ///< feed (travel_feed for pen-up travel)
+    double feed = 0;            ///< requested speed, mm/s (Subpath::feed); 0: the machine profile's
+                                ///< feed (travel_feed for pen-up travel)
     /// Set on a subpath's first drawing segment only (Subpath's fields of the same names): a
     /// programmed pause, and a rest in seconds with the pen down or up, before it draws.
     bool pause_before = false;
@@ -42,7 +42,8 @@ std::vector<BezierSegment> to_bezier_segments(const Path& path);
 /// at a time instead of stored: memory O(one subpath's B-spline windows), not O(segments).
 /// For readers of the whole path that keep nothing per segment (check's figures). Throws as
 /// to_bezier_segments.
-void for_each_bezier_segment(const Path& path, const std::function<void(const BezierSegment&)>& visit);
+void for_each_bezier_segment(const Path& path,
+                             const std::function<void(const BezierSegment&)>& visit);
 
 /// Puts a straight pen-up move from `from` (mm per axis: where the machine rests, e.g. after
 /// homing) to the first segment's start in front of `segments` (control points at thirds,

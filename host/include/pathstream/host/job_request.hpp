@@ -20,29 +20,29 @@ struct JobRequest {
     std::string format;                 ///< --format: json, csv, svg or gcode; empty: by extension
     std::string csv_basis = "bspline";  ///< basis for CSV point files
     bool csv_closed = false;
-    std::string gcode_pen = "z";        ///< "z", "spindle" (M3/M5), "motion" (G1 draws) or "auto"
-    double gcode_z_down = 0.0;          ///< pen down when Z <= this (mm)
+    std::string gcode_pen = "z";  ///< "z", "spindle" (M3/M5), "motion" (G1 draws) or "auto"
+    double gcode_z_down = 0.0;    ///< pen down when Z <= this (mm)
     std::vector<std::string> gcode_ignore;  ///< --ignore-code: more G/M codes to skip
-    double tolerance = 0.01;            ///< mm, arcs to cubics (SVG, G-code)
-    PlacementOptions placement;         ///< --rotate, --flip-y, --scale, --fit, ... (placement.hpp)
-    std::string translate;              ///< --translate "X,Y" (mm), parsed by load_path
-    bool keep_order = false;            ///< --keep-order: draw the subpaths as the file lists them
-    bool order = false;                 ///< --order: reorder where the default keeps the file's order
+    double tolerance = 0.01;                ///< mm, arcs to cubics (SVG, G-code)
+    PlacementOptions placement;  ///< --rotate, --flip-y, --scale, --fit, ... (placement.hpp)
+    std::string translate;       ///< --translate "X,Y" (mm), parsed by load_path
+    bool keep_order = false;     ///< --keep-order: draw the subpaths as the file lists them
+    bool order = false;          ///< --order: reorder where the default keeps the file's order
     /// The command keeps the file's order and direction unless --order (eval, setpoints: they
     /// show the file's spans). G-code files keep the program's order unless --order, whatever
     /// the command: reversing a cut flips climb and conventional milling.
     bool keep_order_by_default = false;
-    double merge_tolerance = 0.01;      ///< --merge-tolerance: mm between ends that are joined
-    std::string order_start;            ///< --order-start "X,Y,..." (mm); empty: the origin
-    std::vector<std::string> layers;    ///< --layer NAME|N (repeatable): plot only these layers
-    std::string pause = "pen";          ///< --pause: pen (between layers with other pens), layer, none
+    double merge_tolerance = 0.01;    ///< --merge-tolerance: mm between ends that are joined
+    std::string order_start;          ///< --order-start "X,Y,..." (mm); empty: the origin
+    std::vector<std::string> layers;  ///< --layer NAME|N (repeatable): plot only these layers
+    std::string pause = "pen";  ///< --pause: pen (between layers with other pens), layer, none
 };
 
 /// A loaded path and what placement and ordering did to it (for check).
 struct LoadedPath {
     Path path;
     PlacementReport placement;
-    bool placed = false;   ///< a placement option was given
+    bool placed = false;  ///< a placement option was given
     OrderReport order;
     bool ordered = false;  ///< ordering ran (not --keep-order)
     /// Why the file's order was kept when it was: "--keep-order", "G-code keeps the program's
@@ -70,6 +70,8 @@ Path load_path(const JobRequest& request, const MachineProfile* machine = nullpt
 std::string read_path_input(const JobRequest& request, std::string& format);
 
 /// How messages name the path file: "<stdin>" for "-", else the file name.
-inline std::string path_display_name(const std::string& file) { return file == "-" ? "<stdin>" : file; }
+inline std::string path_display_name(const std::string& file) {
+    return file == "-" ? "<stdin>" : file;
+}
 
 }  // namespace pathstream::host

@@ -6,9 +6,9 @@
 #include <string>
 #include <vector>
 
-#include "pathstream/machine/machine.hpp"
 #include "pathstream/host/path.hpp"
 #include "pathstream/host/path_order.hpp"
+#include "pathstream/machine/machine.hpp"
 
 namespace pathstream::host {
 

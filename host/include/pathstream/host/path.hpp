@@ -81,8 +81,8 @@ struct Path {
     std::size_t axes = 2;
     std::vector<Subpath> subpaths;
     std::vector<PathLayer> layers;  ///< empty: one unnamed layer; else every subpath's layer
-    std::string units = "mm";  ///< the file's own unit, for output in it ("mm" or "in")
-    double mm_per_unit = 1.0;  ///< coordinates above are already in mm; this converts back
+    std::string units = "mm";       ///< the file's own unit, for output in it ("mm" or "in")
+    double mm_per_unit = 1.0;       ///< coordinates above are already in mm; this converts back
 };
 
 /// A path with everything of `path` (axes, layers, units) but its subpaths: what the

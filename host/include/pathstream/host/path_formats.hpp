@@ -17,7 +17,8 @@ struct PathFormat {
     std::string description;              ///< for help texts
     /// Reads `text` (named `name` in messages) with the request's options; G-code notes its pen
     /// mode and why in `note`. Throws InputError for bad input; prints the reader's warnings.
-    Path (*read)(const std::string& text, const std::string& name, const JobRequest& request, std::string& note);
+    Path (*read)(const std::string& text, const std::string& name, const JobRequest& request,
+                 std::string& note);
 };
 
 /// Every format, in the order help texts list them. Constant after first use; any thread.

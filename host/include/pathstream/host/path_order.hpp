@@ -27,8 +27,8 @@ struct OrderReport {
     double travel_before = 0;  ///< mm of pen-up travel in document order, from the start point
     double travel_after = 0;   ///< mm of pen-up travel in the new order, from the start point
     std::size_t subpaths_before = 0, subpaths_after = 0;
-    std::size_t merged = 0;    ///< subpaths joined onto another (subpaths_before - subpaths_after)
-    std::size_t work = 0;      ///< candidate moves evaluated (<= work_limit plus one pass)
+    std::size_t merged = 0;  ///< subpaths joined onto another (subpaths_before - subpaths_after)
+    std::size_t work = 0;    ///< candidate moves evaluated (<= work_limit plus one pass)
 };
 
 /// Where the curve of `subpath` starts and ends (mm); a closed one ends where it starts.

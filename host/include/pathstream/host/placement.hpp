@@ -5,8 +5,8 @@
 #include <optional>
 #include <string>
 
-#include "pathstream/machine/machine.hpp"
 #include "pathstream/host/path.hpp"
+#include "pathstream/machine/machine.hpp"
 
 namespace pathstream::host {
 
@@ -21,13 +21,13 @@ struct Box2 {
 /// rotate, flip-y, scale or fit, align, translate. Every step is an affine map of the control
 /// points, which is exact for every basis (each curve point is an affine combination of them).
 struct PlacementOptions {
-    int rotate = 0;             ///< 0, 90, 180 or 270 degrees about the origin, x towards y
-    bool flip_y = false;        ///< y -> -y
-    double scale = 0;           ///< > 0: scale x and y about the origin; 0: none
+    int rotate = 0;       ///< 0, 90, 180 or 270 degrees about the origin, x towards y
+    bool flip_y = false;  ///< y -> -y
+    double scale = 0;     ///< > 0: scale x and y about the origin; 0: none
     /// "": no fit; "area": the machine's work area; a paper a0..a6, letter, legal, tabloid
     /// (portrait, [0, W] x [0, H]; append "-landscape" for W > H). Keeps the aspect ratio.
     std::string fit;
-    double margin = 0;          ///< mm kept free on every side of the fit box
+    double margin = 0;  ///< mm kept free on every side of the fit box
     /// Where the drawing goes in the fit box: center, top-left, top, top-right, left, right,
     /// bottom-left, bottom, bottom-right (default center). Without --fit, the named point of
     /// the drawing's box is moved to (0, 0).
@@ -43,7 +43,8 @@ struct PlacementOptions {
 
     /// Whether any option asks for a change.
     bool active() const {
-        return rotate != 0 || flip_y || scale != 0 || !fit.empty() || !align.empty() || translate.has_value();
+        return rotate != 0 || flip_y || scale != 0 || !fit.empty() || !align.empty() ||
+               translate.has_value();
     }
 };
 

@@ -44,7 +44,7 @@ struct PlanCheck {
     double max_acceleration_fraction = 0;
     std::vector<double> axis_velocity_fraction;      ///< per axis, as above
     std::vector<double> axis_acceleration_fraction;  ///< per axis, as above
-    double max_deviation = 0;              ///< mm, worst distance of a pen-down setpoint from the path
+    double max_deviation = 0;  ///< mm, worst distance of a pen-down setpoint from the path
     std::uint64_t worst_deviation_tick = 0;
     /// Every fraction <= 1: the per-tick ones after the quantisation allowance, the exact
     /// ones and the span ones (what a device validating each span against the limits checks),
@@ -78,25 +78,25 @@ struct PlanCheck {
     /// (pen-down: the subpath's feed; pen-up: travel_feed), after an allowance of
     /// 2 sqrt(axes) LSB per tick for the rounding of setpoints and span end points.
     double max_feed_fraction = 0;
-    std::uint64_t ticks_checked = 0;       ///< setpoints examined (the end point included)
+    std::uint64_t ticks_checked = 0;  ///< setpoints examined (the end point included)
 
     // Jerk, from the spans' exact cubics (docs/planner.md, section 7): the constant third
     // derivative inside each span, and the acceleration step at every join (the plan's start
     // and end, and both sides of a pause, join with rest). J = max_jerk T^3 / lsb LSB/tick^3;
     // a join may step by J * 1 tick. Always measured; part of within_limits only when the
     // profile sets a max_jerk (jerk_limited).
-    bool jerk_limited = false;                          ///< some axis has a max_jerk
-    std::vector<double> axis_jerk_lsb;                  ///< per axis, largest |jerk| in a span, LSB/tick^3
-    std::vector<double> axis_jerk;                      ///< the same in mm/s^3
+    bool jerk_limited = false;          ///< some axis has a max_jerk
+    std::vector<double> axis_jerk_lsb;  ///< per axis, largest |jerk| in a span, LSB/tick^3
+    std::vector<double> axis_jerk;      ///< the same in mm/s^3
     std::vector<double> axis_join_acceleration_step_lsb;  ///< largest |step| at a join, LSB/tick^2
     std::vector<double> axis_join_acceleration_step;      ///< the same in mm/s^2
-    std::vector<double> axis_jerk_limit_lsb;            ///< J in LSB/tick^3 (0: no limit)
+    std::vector<double> axis_jerk_limit_lsb;              ///< J in LSB/tick^3 (0: no limit)
     /// Per axis, axis_jerk_lsb / J and axis_join_acceleration_step_lsb / (J * 1 tick); 0
     /// without a limit on that axis.
     std::vector<double> axis_jerk_fraction_exact;
     std::vector<double> axis_join_acceleration_step_fraction;
-    double max_jerk_fraction_exact = 0;                 ///< max over the axes
-    double max_join_acceleration_step_fraction = 0;     ///< max over the axes
+    double max_jerk_fraction_exact = 0;              ///< max over the axes
+    double max_join_acceleration_step_fraction = 0;  ///< max over the axes
 };
 
 }  // namespace pathstream::host

@@ -10,10 +10,10 @@
 #include <string>
 #include <vector>
 
-#include "pathstream/host/geometry.hpp"
-#include "pathstream/machine/machine.hpp"
 #include "pathstream/host/core_spans.hpp"
+#include "pathstream/host/geometry.hpp"
 #include "pathstream/host/plan.hpp"
+#include "pathstream/machine/machine.hpp"
 
 namespace pathstream::host {
 
@@ -34,9 +34,9 @@ struct PlanOptions {
 
     /// Fractions of the machine's limits the executed spans are planned to. The per-tick check
     /// then verifies the whole plan against the full limits.
-    double velocity_margin = 1.0;        ///< per-axis velocity (checked exactly on each span)
-    double feed_margin = 0.999;          ///< requested feed (checked at eighths of each span)
-    double acceleration_margin = 1.0;    ///< per-axis acceleration (checked exactly on each span)
+    double velocity_margin = 1.0;      ///< per-axis velocity (checked exactly on each span)
+    double feed_margin = 0.999;        ///< requested feed (checked at eighths of each span)
+    double acceleration_margin = 1.0;  ///< per-axis acceleration (checked exactly on each span)
     /// The lookahead (backward pass) plans speed changes with this fraction of the executed
     /// acceleration budget, and bends (curvature) with `lookahead_bend_margin` of it, so that
     /// spans of whole ticks can nearly always follow it (where not, see max_local_retries).
@@ -61,25 +61,25 @@ struct PlanOptions {
     /// (on a machine with more than one core): the same spans, sooner. False: one thread.
     bool check_on_thread = true;
 
-    int max_replans = 8;          ///< whole-plan retries with lowered limits after a failed check
-    int max_local_retries = 24;   ///< per piece: lookahead retries with a locally lowered margin
+    int max_replans = 8;         ///< whole-plan retries with lowered limits after a failed check
+    int max_local_retries = 24;  ///< per piece: lookahead retries with a locally lowered margin
 };
 
 /// Figures of one planning run (for bench_plan and the CLI's verbose output).
 struct PlanStats {
-    std::size_t segments = 0;          ///< Bezier segments in
-    std::size_t grid_nodes = 0;        ///< lookahead grid nodes
-    std::size_t pieces = 0;            ///< stretches between stops (corners, pen changes, ends)
+    std::size_t segments = 0;    ///< Bezier segments in
+    std::size_t grid_nodes = 0;  ///< lookahead grid nodes
+    std::size_t pieces = 0;      ///< stretches between stops (corners, pen changes, ends)
     /// Ticks of a regular span: the profile's ticks_per_span, or more where the limits are below
     /// what spans that short can meet exactly on the LSB grid (docs/planner.md).
     std::uint32_t ticks_per_span = 0;
-    std::size_t motion_spans = 0;      ///< spans that move (dwells excluded)
-    std::uint64_t motion_ticks = 0;    ///< ticks of motion (dwells excluded)
-    std::uint64_t dwell_ticks = 0;     ///< ticks holding still while the pen moves
-    int replans = 0;                   ///< whole-plan retries after a failed per-tick check
-    std::size_t local_retries = 0;     ///< lookahead retries with a locally lowered margin
-    double velocity_scale = 1;         ///< smallest factor applied to a velocity limit by replans
-    double acceleration_scale = 1;     ///< same for acceleration limits
+    std::size_t motion_spans = 0;    ///< spans that move (dwells excluded)
+    std::uint64_t motion_ticks = 0;  ///< ticks of motion (dwells excluded)
+    std::uint64_t dwell_ticks = 0;   ///< ticks holding still while the pen moves
+    int replans = 0;                 ///< whole-plan retries after a failed per-tick check
+    std::size_t local_retries = 0;   ///< lookahead retries with a locally lowered margin
+    double velocity_scale = 1;       ///< smallest factor applied to a velocity limit by replans
+    double acceleration_scale = 1;   ///< same for acceleration limits
     /// Motion time (s) of the continuous TOPP-RA optimum on the same grid with the machine's
     /// full limits: the time-optimal reference the executed motion is compared with.
     double reference_motion_time = 0;
@@ -137,7 +137,8 @@ public:
 /// A SegmentSource over segments held in memory (not copied: `segments` must outlive it).
 class VectorSegmentSource : public SegmentSource {
 public:
-    explicit VectorSegmentSource(const std::vector<BezierSegment>& segments) : segments_(segments) {}
+    explicit VectorSegmentSource(const std::vector<BezierSegment>& segments)
+        : segments_(segments) {}
     bool next(BezierSegment& out) override {
         if (next_ >= segments_.size()) return false;
         out = segments_[next_++];
@@ -160,9 +161,9 @@ struct PlanTotals {
     std::size_t pen_changes = 0;
     std::size_t pauses = 0;
     std::uint64_t total_ticks = 0;
-    double duration = 0;        ///< s
-    double path_length = 0;     ///< mm, pen-down
-    double travel_length = 0;   ///< mm, pen-up
+    double duration = 0;       ///< s
+    double path_length = 0;    ///< mm, pen-down
+    double travel_length = 0;  ///< mm, pen-up
 };
 
 /// plan_path as a stream: plans the path in windows of segments with a bounded lookahead
@@ -172,14 +173,14 @@ struct PlanTotals {
 /// plan_path's (every span exact, checked on every tick); `stats`, when given, gets the
 /// run's figures except reference_motion_time (0 here). Throws PlanError as plan_path, and
 /// when a replan is needed but `sink` or `source` cannot start over.
-PlanTotals plan_stream(SegmentSource& source, const MachineProfile& profile, const PlanOptions& options,
-                       PlanSink& sink, PlanStats* stats = nullptr,
+PlanTotals plan_stream(SegmentSource& source, const MachineProfile& profile,
+                       const PlanOptions& options, PlanSink& sink, PlanStats* stats = nullptr,
                        const std::function<void(double fraction)>& progress = {});
 
 namespace planner_detail {
 class TickChecker;
 class JerkMeter;
-}
+}  // namespace planner_detail
 
 /// check_plan for a plan handed over in order, as a PlanSink (plan_stream's, or a chain):
 /// the same figures from finish(), without the plan held in memory. `segments` and `profile`
@@ -193,7 +194,9 @@ public:
     void pause(const PlanPause&) override { ++pauses_; }
     /// Called with every executed tick as the core makes it: tick number, setpoint (LSB per
     /// axis) and the pen output (the held end point comes last, from finish()).
-    void on_tick(std::function<void(std::uint64_t tick, const std::int64_t* setpoint, bool pen_down)> observer);
+    void on_tick(
+        std::function<void(std::uint64_t tick, const std::int64_t* setpoint, bool pen_down)>
+            observer);
     /// The held end point; the figures of the whole plan.
     PlanCheck finish();
     std::size_t spans() const { return spans_; }

@@ -11,10 +11,10 @@
 #include <optional>
 #include <thread>
 
-#include "pathstream/machine/machine.hpp"
 #include "pathstream/host/planner.hpp"
 #include "pathstream/host/span_supply.hpp"
 #include "pathstream/host/spsc_ring.hpp"
+#include "pathstream/machine/machine.hpp"
 #include "pathstream/span.hpp"
 
 namespace pathstream::host {

@@ -11,8 +11,8 @@
 #include <vector>
 
 #include "pathstream/host/geometry.hpp"
-#include "pathstream/machine/machine.hpp"
 #include "pathstream/host/plan.hpp"
+#include "pathstream/machine/machine.hpp"
 
 namespace pathstream::host::plot {
 

@@ -7,9 +7,9 @@
 #include <vector>
 
 #include "pathstream/host/geometry.hpp"
-#include "pathstream/machine/machine.hpp"
 #include "pathstream/host/path.hpp"
 #include "pathstream/host/plan.hpp"
+#include "pathstream/machine/machine.hpp"
 
 namespace pathstream::host {
 
