@@ -4,22 +4,22 @@
 # a crash or a broken property leaves its reproducer there and makes the script fail.
 #
 # Usage: fuzz/run.sh [SECONDS_PER_TARGET] [BUILD_DIR]
-#   SECONDS_PER_TARGET  default 10
-#   BUILD_DIR           the tree configured with the preset fuzz (default build/fuzz)
+#   SECONDS_PER_TARGET  default $PATHSTREAM_FUZZ_SECONDS, else 5 (what the tests fuzz.<name> run)
+#   BUILD_DIR           the tree configured with the preset asan (default build/asan)
 # Environment: FUZZ_TARGETS="json_path csv_path" runs only those; FUZZ_WORK=DIR keeps the
 # scratch corpora and reproducers there (default: a temporary directory, kept on failure);
 # FUZZ_RUNS=N also stops each target after N executions (whichever comes first).
 set -u
 here=$(cd "$(dirname "$0")" && pwd)
-seconds=${1:-10}
-build=${2:-$here/../build/fuzz}
+seconds=${1:-${PATHSTREAM_FUZZ_SECONDS:-5}}
+build=${2:-$here/../build/asan}
 targets=${FUZZ_TARGETS:-"json_path csv_path svg_path gcode_path machine_profile target_url modbus_map modbus_rtu_slave wire_spans can_node cia402_drive job_journal http_request"}
 work=${FUZZ_WORK:-$(mktemp -d)}
 failed=""
 for t in $targets; do
     exe=$(find "$build" -name "fuzz_$t" -type f -perm -u+x | head -n 1)
     if [ -z "$exe" ]; then
-        echo "fuzz_$t: not built in $build (cmake --preset fuzz && cmake --build --preset fuzz)" >&2
+        echo "fuzz_$t: not built in $build (cmake --preset asan && cmake --build --preset asan)" >&2
         failed="$failed $t"
         continue
     fi

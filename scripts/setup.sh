@@ -6,7 +6,7 @@ set -euo pipefail
 packages=(
   # host toolchain and test framework
   build-essential cmake ninja-build pkg-config catch2
-  # fuzz targets: clang with its libFuzzer runtime (scripts/test.sh preset fuzz)
+  # fuzz targets: clang with its libFuzzer runtime (the asan preset builds them with clang)
   clang libclang-rt-14-dev
   # the format check in the tests (scripts/check_format.sh) and the tidy preset (.clang-tidy)
   clang-format clang-tidy

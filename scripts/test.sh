@@ -1,10 +1,10 @@
 #!/usr/bin/env bash
 # Builds everything and runs the whole test suite, one CMake workflow preset after another:
 #   default  release build with the Cortex-M images under qemu and the real-kernel VM tests
-#   asan     AddressSanitizer + UBSan build of the host tests
+#   asan     AddressSanitizer + UBSan build (clang) of the host tests and the libFuzzer targets;
+#            each target is a test, fuzz.<name>, run PATHSTREAM_FUZZ_SECONDS (default 5) from
+#            its seed corpus (docs/fuzzing.md)
 #   tsan     ThreadSanitizer build of the test cases that run threads (Catch2 tag [threads])
-#   fuzz     the libFuzzer targets (clang, ASan + UBSan), each run PATHSTREAM_FUZZ_SECONDS
-#            (default 5) from its seed corpus by fuzz/run.sh (docs/fuzzing.md)
 # Every preset runs even when an earlier one failed; a summary of all of them comes last, and
 # the exit status is non-zero when any failed. A failed test fails its preset: nothing is run
 # again. A test that fails only under load is a defect; scripts/stress_tests.sh runs the
@@ -16,7 +16,7 @@
 set -uo pipefail
 cd "$(dirname "$0")/.."
 
-all_presets=(default asan tsan fuzz)
+all_presets=(default asan tsan)
 if [ "${1:-}" = "--quick" ]; then
   presets=(default)
 elif [ $# -gt 0 ]; then
@@ -39,17 +39,6 @@ start_all=$SECONDS
 for p in "${presets[@]}"; do
   echo "=== test.sh: preset $p: configure, build, test ==="
   t0=$SECONDS
-  if [ "$p" = fuzz ]; then
-    # No ctest here: each target runs for a bounded time; fuzz/run.sh prints one line each.
-    { cmake --preset fuzz && cmake --build --preset fuzz &&
-        fuzz/run.sh "${PATHSTREAM_FUZZ_SECONDS:-5}" build/fuzz; } 2>&1 | tee "build/$p.log"
-    status[$p]=${PIPESTATUS[0]}
-    seconds[$p]=$((SECONDS - t0))
-    total[$p]=$(grep -c '^fuzz_[a-z0-9_]*: ' "build/$p.log")
-    failed[$p]=$(grep -c '^fuzz_[a-z0-9_]*: \(FAILED\|not built\)' "build/$p.log")
-    passed[$p]=$((total[$p] - failed[$p]))
-    continue
-  fi
   cmake --workflow --preset "$p" 2>&1 | tee "build/$p.log"
   status[$p]=${PIPESTATUS[0]}
   seconds[$p]=$((SECONDS - t0))

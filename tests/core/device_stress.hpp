@@ -214,7 +214,7 @@ public:
         ++counts_.status_reads;
         if (s.tick_count != s.tick_check) fail("torn status read");
         if (samples_.size() < kMaxSamples && s.tick_count != 0) {
-            samples_.push_back({s.tick_count - 1, s.position[0], s.position[1]});
+            samples_.push_back({s.tick_count - 1, {s.position[0], s.position[1]}});
         }
         return s;
     }
