@@ -95,6 +95,57 @@ TEST_CASE("RTU framer: a frame ends at t3.5 of silence, an overlong one is dropp
     CHECK(f.length() == 2);
 }
 
+TEST_CASE("RTU framer: a request of known length ends at its last byte when the CRC is right",
+          "[modbus][rtu][slave]") {
+    ModbusRtuFramer f(1750);
+    const std::vector<std::vector<std::uint8_t>> requests = {
+        frame_of(7, {0x03, 0x00, 0x09, 0x00, 0x02}),                             // FC3: 8 bytes
+        frame_of(7, {0x04, 0x00, 0x02, 0x00, 0x01}),                             // FC4
+        frame_of(7, {0x06, 0x00, 0x0A, 0x12, 0x34}),                             // FC6
+        frame_of(7, {0x10, 0x00, 0x14, 0x00, 0x02, 4, 0xAB, 0xCD, 0x00, 0x01}),  // FC16: 9 + 4
+        frame_of(7, {0x17, 0x00, 0x1E, 0x00, 0x01, 0x00, 0x1E, 0x00, 0x01, 2, 0x00, 0x2A}),
+    };
+    std::uint32_t t = 0;
+    std::uint32_t ended = 0;
+    for (const auto& r : requests) {
+        // Ready at its last byte, with no silence after it.
+        for (std::size_t i = 0; i < r.size(); ++i) {
+            CHECK_FALSE(f.poll(t));
+            f.on_byte(r[i], t);
+            t += 100;
+        }
+        REQUIRE(f.poll(t - 100));
+        CHECK(f.length() == r.size());
+        CHECK(std::vector<std::uint8_t>(f.frame(), f.frame() + f.length()) == r);
+        f.take();
+        CHECK(f.ended_by_length() == ++ended);
+        t += 5000;
+    }
+    // A wrong CRC at the announced length waits for the silence, and the frame is whole there.
+    std::vector<std::uint8_t> bad = frame_of(7, {0x03, 0x00, 0x09, 0x00, 0x02});
+    bad.back() ^= 0x01;
+    for (const std::uint8_t b : bad) f.on_byte(b, t);
+    CHECK_FALSE(f.poll(t + 1749));
+    REQUIRE(f.poll(t + 1750));
+    CHECK(f.length() == 8);
+    CHECK(f.ended_by_length() == ended);
+    f.take();
+    // The silence still ends a request cut short: its first part is a frame of its own.
+    const std::vector<std::uint8_t> cut = frame_of(7, {0x03, 0x00, 0x09, 0x00, 0x02});
+    t += 10000;
+    for (std::size_t i = 0; i < 5; ++i) f.on_byte(cut[i], t);
+    REQUIRE(f.poll(t + 1750));
+    CHECK(f.length() == 5);
+    f.take();
+    // A function without a fixed request length ends only at the silence.
+    const std::vector<std::uint8_t> other = frame_of(7, {0x2B, 0x0E, 0x01, 0x00});
+    t += 10000;
+    for (const std::uint8_t b : other) f.on_byte(b, t);
+    CHECK_FALSE(f.poll(t + 1000));
+    CHECK(f.poll(t + 1750));
+    CHECK(f.ended_by_length() == ended);
+}
+
 TEST_CASE("RTU slave: every function code answers as the spec says", "[modbus][rtu][slave]") {
     RegisterArray registers;
     ModbusRtuSlave<RegisterArray> slave(registers, 7);
