@@ -135,3 +135,66 @@ TEST_CASE("random setpoint walks: steps equal the differences and keep the drive
         }
     }
 }
+
+TEST_CASE("step pulse train: every axis's pulses come in groups, each at most a window early",
+          "[device][step]") {
+    constexpr unsigned kAxes = 4;
+    std::mt19937_64 rng(pathstream::test::property_seed());
+    const std::uint64_t ticks =
+        std::max<std::uint64_t>(2000, pathstream::test::g_spans_per_basis / 50);
+    std::uint64_t groups = 0;
+    std::uint64_t pulses = 0;
+    for (std::uint64_t t = 0; t < ticks; ++t) {
+        const std::uint32_t period = std::uniform_int_distribution<std::uint32_t>(1, 100000)(rng);
+        const std::uint32_t window = std::uniform_int_distribution<std::uint32_t>(0, 200)(rng);
+        std::int32_t difference[kAxes];
+        std::vector<std::uint32_t> scheduled[kAxes];
+        for (unsigned a = 0; a < kAxes; ++a) {
+            const auto most = static_cast<std::int32_t>(std::min<std::uint32_t>(period, 300));
+            difference[a] = std::uniform_int_distribution<std::int32_t>(-most, most)(rng);
+            StepSchedule s;
+            REQUIRE(s.begin(period, difference[a]));
+            scheduled[a] = pulses_of(s);
+        }
+        StepPulseTrain<kAxes> train;
+        REQUIRE(train.begin(period, difference));
+        for (unsigned a = 0; a < kAxes; ++a)
+            CHECK(((train.forward_mask() >> a) & 1u) == (difference[a] >= 0 ? 1u : 0u));
+        std::vector<std::uint32_t> got[kAxes];
+        std::uint32_t offset = 0;
+        std::uint32_t mask = 0;
+        std::uint32_t last = 0;
+        while (train.next(window, offset, mask)) {
+            REQUIRE(mask != 0);
+            REQUIRE(offset >= last);  // groups in time order
+            last = offset;
+            ++groups;
+            for (unsigned a = 0; a < kAxes; ++a)
+                if ((mask >> a) & 1u) got[a].push_back(offset);
+        }
+        CHECK(train.left() == 0);
+        for (unsigned a = 0; a < kAxes; ++a) {
+            // As many pulses as the difference, each at most `window` before its schedule.
+            REQUIRE(got[a].size() == scheduled[a].size());
+            for (std::size_t i = 0; i < got[a].size(); ++i) {
+                REQUIRE(got[a][i] <= scheduled[a][i]);
+                REQUIRE(scheduled[a][i] - got[a][i] <= window);
+            }
+            pulses += got[a].size();
+        }
+    }
+    CHECK(groups <= pulses);
+}
+
+TEST_CASE("step pulse train: a difference out of bounds schedules nothing on any axis",
+          "[device][step]") {
+    StepPulseTrain<3> train;
+    const std::int32_t fine[3] = {5, -7, 0};
+    REQUIRE(train.begin(100, fine));
+    CHECK(train.left() == 12);
+    const std::int32_t too_many[3] = {5, 101, 3};  // more steps than counts in the tick
+    CHECK_FALSE(train.begin(100, too_many));
+    CHECK(train.left() == 0);
+    std::uint32_t offset = 0, mask = 0;
+    CHECK_FALSE(train.next(0, offset, mask));
+}

@@ -104,4 +104,72 @@ private:
     bool forward_ = true;
 };
 
+/// Every axis's step pulses within one tick, merged into groups that rise together: the
+/// earliest pending pulse and every other axis's next pulse within `window` counts after it
+/// (a pulse moves earlier by less than the window, never later, and never ahead of its own
+/// axis's previous pulse). One step timer compare per group instead of one per pulse. Plain
+/// value; tick and step-timer contexts at one interrupt priority (neither preempts the other).
+template <unsigned Axes>
+class StepPulseTrain {
+    static_assert(Axes >= 1 && Axes <= 32, "one bit per axis in a mask");
+
+public:
+    /// Starts a tick of `period` counts with each axis's setpoint difference. Returns false,
+    /// and schedules nothing on any axis, when a difference breaks StepSchedule's bounds.
+    /// Axes divisions.
+    [[nodiscard]] constexpr bool begin(std::uint32_t period,
+                                       const std::int32_t (&difference)[Axes]) {
+        forward_ = 0;
+        for (unsigned a = 0; a < Axes; ++a) {
+            if (!schedule_[a].begin(period, difference[a])) {
+                for (unsigned b = 0; b < Axes; ++b) pending_[b] = false;
+                for (unsigned b = 0; b <= a; ++b) (void)schedule_[b].begin(period, 0);
+                return false;
+            }
+            if (schedule_[a].forward()) forward_ |= 1u << a;
+            pending_[a] = schedule_[a].next(next_[a]);
+        }
+        return true;
+    }
+
+    /// Bit a set: axis a moves forward (or not at all) this tick; its direction line's level.
+    constexpr std::uint32_t forward_mask() const { return forward_; }
+
+    /// The next group: `offset` (counts from the tick's start) of its earliest pulse and the
+    /// `mask` of axes stepping in it. False when the tick has no pulse left. At most Axes
+    /// compares and one StepSchedule::next per axis in the group.
+    [[nodiscard]] constexpr bool next(std::uint32_t window, std::uint32_t& offset,
+                                      std::uint32_t& mask) {
+        bool any = false;
+        for (unsigned a = 0; a < Axes; ++a) {
+            if (pending_[a] && (!any || next_[a] < offset)) {
+                offset = next_[a];
+                any = true;
+            }
+        }
+        if (!any) return false;
+        mask = 0;
+        for (unsigned a = 0; a < Axes; ++a) {
+            if (pending_[a] && next_[a] - offset <= window) {
+                mask |= 1u << a;
+                pending_[a] = schedule_[a].next(next_[a]);
+            }
+        }
+        return true;
+    }
+
+    /// Pulses not yet taken, all axes.
+    constexpr std::uint32_t left() const {
+        std::uint32_t n = 0;
+        for (unsigned a = 0; a < Axes; ++a) n += schedule_[a].left() + (pending_[a] ? 1u : 0u);
+        return n;
+    }
+
+private:
+    StepSchedule schedule_[Axes] = {};
+    std::uint32_t next_[Axes] = {};
+    bool pending_[Axes] = {};
+    std::uint32_t forward_ = 0;
+};
+
 }  // namespace pathstream::device
