@@ -306,7 +306,10 @@ int run_jog(DeviceLink& link, const CtlCommandOptions& o, const Units& u) {
                           device_state_name(before.state) +
                           fault_suffix(before.state, before.fault_code) + ": " + status_name(r));
     }
-    const DeviceSnapshot s = wait_for_job(link, before.last_accepted + 1, wait_seconds(o, 5));
+    // --wait 0: the jog is started and left to run (a script holds or stops it next).
+    const bool no_wait = wait_seconds(o, 5) == 0;
+    const DeviceSnapshot s =
+        no_wait ? link.status() : wait_for_job(link, before.last_accepted + 1, wait_seconds(o, 5));
     const bool done =
         s.state == device::DeviceState::kIdle && s.finished_job == before.last_accepted + 1;
     if (o.json) {
@@ -320,11 +323,16 @@ int run_jog(DeviceLink& link, const CtlCommandOptions& o, const Units& u) {
         j["status"] = to_json(s, u, link.name());
         std::printf("%s\n", j.dump(2).c_str());
     } else {
-        std::printf("jog           %s by %d LSB: %s in %u ticks\n", u.axis_name(axis).c_str(),
-                    distance, done ? "done" : "NOT done", s.finished_job_ticks);
+        if (no_wait && !done) {
+            std::printf("jog           %s by %d LSB: started (--wait 0: not waited for)\n",
+                        u.axis_name(axis).c_str(), distance);
+        } else {
+            std::printf("jog           %s by %d LSB: %s in %u ticks\n", u.axis_name(axis).c_str(),
+                        distance, done ? "done" : "NOT done", s.finished_job_ticks);
+        }
         std::printf("position      %s\n", position_text(s, u).c_str());
     }
-    if (!done) {
+    if (!done && !no_wait) {
         throw StreamError(link.name() + ": the jog did not finish within " +
                           std::to_string(wait_seconds(o, 5)) + " s: the device is " +
                           device_state_name(s.state) + fault_suffix(s.state, s.fault_code));
