@@ -1,6 +1,7 @@
 #!/usr/bin/python3
 """Which folder includes which: every `#include "pathstream/..."` in production code, as an
-arrow between layers: core (firmware_core), hal, machine (what host and device share), host
+arrow between layers: core (firmware_core), hal, firmware (the microcontroller images, on core
+and hal alone), machine (what host and device share), host
 (the libraries under host/src but its CLI and web server), linux_device (the device runtime),
 sim (what stands in for hardware), app (host/src/cli, host/src/serve, host/src/main.cpp and
 device_cli: the executables). ALLOWED says which arrows
@@ -16,10 +17,12 @@ import os
 import re
 import sys
 
-RANK = {"core": 0, "hal": 1, "machine": 2, "host": 3, "linux_device": 4, "sim": 5, "app": 6}
+RANK = {"core": 0, "hal": 1, "firmware": 2, "machine": 3, "host": 4, "linux_device": 5, "sim": 6,
+        "app": 7}
 ALLOWED = {
     "core": set(),
     "hal": {"core"},
+    "firmware": {"core", "hal"},
     "machine": {"core", "hal"},
     "host": {"core", "hal", "machine"},
     "linux_device": {"core", "hal", "machine"},
@@ -35,6 +38,8 @@ def layer_of_file(path):
         return "core"
     if rel.startswith("hal/"):
         return "hal"
+    if rel.startswith("firmware/"):
+        return "firmware"
     if rel.startswith("machine/"):
         return "machine"
     if rel.startswith(("host/src/cli/", "host/src/serve/", "device_cli/")) or rel == "host/src/main.cpp":
@@ -56,7 +61,7 @@ def layer_of_include(name):
 
 
 arrows = collections.Counter()
-for folder in ("firmware_core", "hal", "machine", "host", "linux_device", "sim", "device_cli"):
+for folder in ("firmware_core", "hal", "firmware", "machine", "host", "linux_device", "sim", "device_cli"):
     for root, dirs, files in os.walk(os.path.join(source, folder)):
         dirs[:] = [d for d in dirs if d not in ("node_modules", "build")]
         for f in files:

@@ -6,44 +6,20 @@
 // Works on ARMv6-M (Cortex-M0/M0+) and ARMv7-M (Cortex-M3/M4): only word loads and stores.
 #include <cstdint>
 
+#include "memory_init.hpp"
 #include "semihosting.hpp"
 
 extern "C" {
-// Symbols from the linker scripts (mps2-an386.ld, microbit.ld).
-extern std::uint32_t __data_load[], __data_start[], __data_end[];
-extern std::uint32_t __bss_start[], __bss_end[];
+// From the linker scripts (mps2-an386.ld, microbit.ld).
 extern std::uint32_t __stack_top[];
-extern void (*__preinit_array_start[])();
-extern void (*__preinit_array_end[])();
-extern void (*__init_array_start[])();
-extern void (*__init_array_end[])();
 
 int main();
 [[noreturn]] void reset_handler();
 [[noreturn]] void fault_handler();
 }
 
-namespace {
-
-// Plain word loops; volatile so that GCC does not turn them into memcpy/memset calls
-// (there is no C library to provide those).
-void copy_words(std::uint32_t* dst, const std::uint32_t* src, std::uint32_t* end) {
-    volatile std::uint32_t* d = dst;
-    while (d < end) *d++ = *src++;
-}
-
-void zero_words(std::uint32_t* dst, std::uint32_t* end) {
-    volatile std::uint32_t* d = dst;
-    while (d < end) *d++ = 0;
-}
-
-}  // namespace
-
 extern "C" [[noreturn]] void reset_handler() {
-    copy_words(__data_start, __data_load, __data_end);
-    zero_words(__bss_start, __bss_end);
-    for (auto f = __preinit_array_start; f != __preinit_array_end; ++f) (*f)();
-    for (auto f = __init_array_start; f != __init_array_end; ++f) (*f)();
+    cortex_m::init_memory();
     const int status = main();
     cortex_m::exit(status == 0);
 }

@@ -1,0 +1,259 @@
+// pathstream on an STM32F405: the device of `pathstream device`, with its Modbus register map
+// served over RTU on USART1, ticked by a timer interrupt, driving step/dir, enable and pen
+// outputs. The split is the core's: the tick interrupt runs the device's tick side and the
+// outputs; the main loop is the task, serving the bus, feeding the device's own moves and
+// writing the trace. Everything they share is written by one side only (docs/firmware.md,
+// "Contexts").
+#include <atomic>
+#include <cstddef>
+#include <cstdint>
+
+#include "board.hpp"
+#include "clock.hpp"
+#include "firmware.hpp"
+#include "pathstream/device/gpio_logic.hpp"
+#include "pathstream/device/modbus_register_map.hpp"
+#include "pathstream/device/motion_device.hpp"
+#include "pathstream/device/tick_clock.hpp"
+#include "pathstream/hal/modbus_rtu_slave.hpp"
+#include "pathstream/span_queue.hpp"
+#include "pins.hpp"
+#include "registers.hpp"
+#include "step_output.hpp"
+#include "switch_inputs.hpp"
+#include "trace.hpp"
+#include "usart.hpp"
+
+using namespace pathstream;
+
+namespace {
+
+constexpr unsigned kAxes = board::kAxes;
+using Device = device::MotionDevice<kAxes, board::kQueueCapacity>;
+using RegisterMap = device::ModbusRegisterMap<kAxes, board::kQueueCapacity>;
+using ModbusLine = firmware::UsartPort<stm32::kUsart1>;
+using Tim2 = stm32::Timer<stm32::kTim2>;
+using Tim5 = stm32::Timer<stm32::kTim5>;
+
+/// The tick rate before the host configures one (the machine profiles' usual rate).
+constexpr std::uint32_t kDefaultTickHz = 1000;
+/// Most ticks one interrupt entry runs; a longer backlog waits for the next entries.
+constexpr std::uint32_t kMaxTicksPerEntry = 16;
+
+constexpr Lsb kStart[kAxes] = {};
+
+// --- owned by init, then by one context each (see the comments) ------------------------------
+Device g_device(kStart);
+RegisterMap g_map(g_device);                                                         // task
+hal::ModbusRtuSlave<RegisterMap> g_slave(g_map, board::kModbusUnit);                 // task
+hal::ModbusRtuFramer g_framer(board::kFrameSilenceUs*(board::kTimerHz / 1000000u));  // task
+std::uint8_t g_reply[hal::kModbusRtuMaxFrame];                                       // task
+firmware::SwitchInputs<kAxes> g_inputs;                                              // task
+device::TickClock g_clock;            // tick interrupt
+firmware::StepOutput<kAxes> g_steps;  // tick and step interrupts
+Lsb g_last[kAxes] = {};               // tick interrupt
+
+/// A byte from the Modbus line and when it came (TIM2 counts).
+struct RxByte {
+    std::uint8_t byte;
+    std::uint32_t at;
+};
+SpanQueue<RxByte, 512> g_rx;                           // producer: USART1 interrupt; consumer: task
+std::atomic<std::uint32_t> g_rx_lost{0};               // USART1 interrupt only
+std::atomic<std::uint32_t> g_rx_overruns{0};           // USART1 interrupt only
+std::atomic<std::uint32_t> g_tick_hz{kDefaultTickHz};  // task only: the rate it wants
+std::atomic<std::uint32_t> g_ticks_run{0};             // tick interrupt only
+std::atomic<std::uint32_t> g_ticks_dropped{0};         // tick interrupt only: g_clock.dropped()
+
+#ifdef PATHSTREAM_FW_TRACE
+firmware::Trace<kAxes> g_trace;        // records: tick interrupt; lines: task
+std::int32_t g_steps_reported[kAxes];  // task
+
+// The line's counters, as notes whenever one changes. Task context.
+void note_line_counters() {
+    static std::uint32_t last[6] = {};
+    const std::uint32_t now[6] = {
+        g_rx_lost.load(),     g_rx_overruns.load(),          g_slave.counters().bad_crc,
+        g_framer.overflows(), g_slave.counters().other_unit, g_ticks_dropped.load()};
+    static const char* const names[6] = {"rx_lost",         "rx_overruns", "bad_crc",
+                                         "frame_overflows", "other_unit",  "ticks_dropped"};
+    for (unsigned k = 0; k < 6; ++k) {
+        if (now[k] != last[k]) {
+            last[k] = now[k];
+            g_trace.note(names[k], now[k], 0);
+        }
+    }
+}
+#endif
+
+void bump(std::atomic<std::uint32_t>& counter) {
+    counter.store(counter.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
+}
+
+// One device tick and its outputs; `now` is the interrupt's TIM2 count. Tick interrupt.
+void run_tick(std::uint32_t now) {
+    Lsb out[kAxes];
+    const std::uint64_t before = g_device.ticks_executed();
+    g_device.tick(out);
+    const device::DeviceState state = g_device.state();
+    const std::uint8_t outputs = g_device.outputs();
+    firmware::pins::drive(board::kEnable,
+                          device::enable_asserted(state) != board::kEnableActiveLow);
+    firmware::pins::drive(board::kPen, device::pen_down(state, outputs));
+    std::int32_t difference[kAxes];
+    for (unsigned a = 0; a < kAxes; ++a) {
+        difference[a] = static_cast<std::int32_t>(out[a] - g_last[a]);
+        g_last[a] = out[a];
+    }
+    g_steps.start_tick(difference, now);
+#ifdef PATHSTREAM_FW_TRACE
+    if (g_device.ticks_executed() != before) g_trace.record(out, device::pen_down(state, outputs));
+#else
+    (void)before;
+#endif
+    bump(g_ticks_run);
+}
+
+// Follows the rate the host configured: the task publishes it, the tick takes it here.
+void serve_bus() {
+    while (const RxByte* r = g_rx.front()) {
+        g_framer.on_byte(r->byte, r->at);
+        g_rx.release();
+    }
+    if (!g_framer.poll(Tim2::Cnt::read())) return;
+    const std::size_t n = g_slave.handle(g_framer.frame(), g_framer.length(), g_reply);
+    g_framer.take();
+    if (n != 0) ModbusLine::write(g_reply, n);
+    if (g_device.configured() && g_device.limits().tick_hz != g_tick_hz.load()) {
+        g_tick_hz.store(g_device.limits().tick_hz);
+    }
+}
+
+void init_pins() {
+    using namespace firmware::pins;
+    configure(stm32::kGpioA, 9, stm32::kModeAlternate, 7);   // USART1 TX
+    configure(stm32::kGpioA, 10, stm32::kModeAlternate, 7);  // USART1 RX
+    configure(stm32::kGpioA, 2, stm32::kModeAlternate, 7);   // USART2 TX (trace)
+    firmware::halt_outputs();
+    for (unsigned a = 0; a < kAxes; ++a) {
+        configure(board::kStepDirPort, board::kStepPin[a], stm32::kModeOutput);
+        configure(board::kStepDirPort, board::kDirPin[a], stm32::kModeOutput);
+    }
+    configure(board::kEnable.port, board::kEnable.number, stm32::kModeOutput);
+    configure(board::kPen.port, board::kPen.number, stm32::kModeOutput);
+    if constexpr (board::kSwitchInputs) {
+        configure(board::kEstop.port, board::kEstop.number, stm32::kModeInput, 0, stm32::kPullUp);
+        for (unsigned k = 0; k < 2 * kAxes; ++k) {
+            configure(stm32::kGpioE, board::kLimitPinFirst + k, stm32::kModeInput, 0,
+                      stm32::kPullUp);
+        }
+    }
+}
+
+// TIM2 counts freely over 32 bits (the time base of the tick, the frames and the step
+// pulses); TIM5 interrupts once per tick period. On the qemu model, writing PSC, CNT or EGR
+// would reset its time base: only CR1, DIER and ARR are written, in that order.
+void init_timers() {
+    Tim2::Cr1::write(stm32::kTimCr1Cen);
+    Tim2::Arr::write(0xFFFFFFFFu);
+    (void)g_clock.start(board::kTimerHz, kDefaultTickHz, Tim2::Cnt::read());
+    g_steps.set_period(board::kTimerHz / kDefaultTickHz);
+    Tim5::Dier::write(stm32::kTimDierUie);
+    Tim5::Cr1::write(stm32::kTimCr1Cen);
+    Tim5::Arr::write(board::kTimerHz / kDefaultTickHz - 1u);
+    // The receiver first (one byte of buffer), then the step pulses and the tick at one level,
+    // so neither preempts the other in the middle of the pulse train.
+    stm32::nvic_priority<stm32::kIrqUsart1>(0);
+    stm32::nvic_priority<stm32::kIrqTim2>(1);
+    stm32::nvic_priority<stm32::kIrqTim5>(1);
+    stm32::nvic_enable<stm32::kIrqUsart1>();
+    stm32::nvic_enable<stm32::kIrqTim5>();
+    if constexpr (firmware::StepOutput<kAxes>::kEnabled) stm32::nvic_enable<stm32::kIrqTim2>();
+}
+
+}  // namespace
+
+namespace firmware {
+
+void halt_outputs() {
+    g_steps.halt();
+    pins::drive(board::kEnable, board::kEnableActiveLow);
+    pins::drive(board::kPen, false);
+}
+
+}  // namespace firmware
+
+extern "C" void tim5_irq() {
+    Tim5::Sr::write(~stm32::kTimSrUif);  // rc_w0: clears UIF alone
+    const std::uint32_t now = Tim2::Cnt::read();
+    const std::uint32_t wanted = g_tick_hz.load(std::memory_order_relaxed);
+    if (wanted != g_clock.tick_hz() && g_clock.retune(wanted, now)) {
+        Tim5::Arr::write(board::kTimerHz / wanted - 1u);
+        g_steps.set_period(board::kTimerHz / wanted);
+    }
+    for (std::uint32_t due = g_clock.advance(now, kMaxTicksPerEntry); due > 0; --due) run_tick(now);
+    g_ticks_dropped.store(g_clock.dropped(), std::memory_order_relaxed);
+}
+
+extern "C" void usart1_irq() {
+    std::uint8_t byte = 0;
+    bool overrun = false;
+    const bool got = ModbusLine::read(byte, overrun);
+    if (overrun) bump(g_rx_overruns);
+    if (!got) return;
+    RxByte* slot = g_rx.claim();
+    if (slot == nullptr) {
+        bump(g_rx_lost);
+        return;
+    }
+    *slot = {byte, Tim2::Cnt::read()};
+    g_rx.publish();
+}
+
+extern "C" void tim2_irq() {
+    g_steps.on_compare();
+}
+
+int main() {
+    firmware::clock_init();
+    init_pins();
+    ModbusLine::init(board::kUsart1Hz, board::kModbusBaud, true);
+#ifdef PATHSTREAM_FW_TRACE
+    firmware::UsartPort<stm32::kUsart2>::init(board::kUsart2Hz, board::kTraceBaud, false);
+    g_trace.header(board::kQemu, board::kModbusBaud, board::kModbusUnit);
+#endif
+    init_timers();
+    stm32::enable_interrupts();
+    std::uint32_t stack_reported = 0;
+    std::uint32_t passes = 0;
+    for (;;) {
+        serve_bus();
+        g_map.service();
+        if constexpr (board::kSwitchInputs) g_inputs.poll(g_device);
+#ifdef PATHSTREAM_FW_TRACE
+        g_trace.drain();
+        note_line_counters();
+        // At rest, the steps made so far (the test compares them with the setpoints).
+        if (g_device.state() == device::DeviceState::kIdle) {
+            for (unsigned a = 0; a < kAxes; ++a) {
+                const std::int32_t net = g_steps.net_steps(a);
+                if (net != g_steps_reported[a]) {
+                    g_steps_reported[a] = net;
+                    g_trace.note_axis("steps", a, net);
+                }
+            }
+        }
+        // The stack's high-water mark, whenever it has grown (a scan every 4096 passes).
+        if ((++passes & 4095u) == 0) {
+            const std::uint32_t used = firmware::stack_bytes_used();
+            if (used > stack_reported) {
+                stack_reported = used;
+                g_trace.note("stack_used", used, firmware::stack_bytes_total());
+            }
+        }
+#else
+        (void)stack_reported;
+        (void)passes;
+#endif
+    }
+}
