@@ -198,7 +198,7 @@ public:
 [[noreturn]] void child(std::size_t points, const ScalingOptions& options,
                         const host::MachineProfile& profile, int fd) {
     alarm(options.timeout_seconds);
-#if !defined(__SANITIZE_ADDRESS__) && !defined(__SANITIZE_THREAD__)
+#ifndef PATHSTREAM_SANITIZED
     // Sanitizers reserve terabytes of shadow address space up front: under them no ceiling.
     const rlim_t limit = static_cast<rlim_t>(options.memory_limit_mb) << 20;
     const rlimit address_space{limit, limit};
@@ -345,7 +345,7 @@ bool scaling_passed(const std::vector<ScalingRow>& rows) {
 
 void print_scaling(const std::vector<ScalingRow>& rows, const ScalingOptions& options,
                    bool markdown) {
-#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+#ifdef PATHSTREAM_SANITIZED
     const char* const address_note = " (not applied: sanitizer build)";
 #else
     const char* const address_note = "";

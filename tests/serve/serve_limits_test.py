@@ -170,6 +170,9 @@ def trickle():
 trickler = threading.Thread(target=trickle)
 trickler.start()
 time.sleep(1.5)
+# The stop must find the job streaming (its journal written with the first batch), however long
+# planning its first window takes on this machine.
+wait_for("the job streams", lambda: os.path.exists(os.path.join(state, "job.journal.json")), 60)
 t0 = time.time()
 status, stopped = request("POST", "/api/control", {"verb": "stop"}, timeout=30)
 answered = time.time() - t0
