@@ -9,12 +9,17 @@
  *   range=A:B      the same; may be repeated (up to 64 ranges, counted separately)
  *   mark=A         each time the instruction at address A executes, record a snapshot of
  *                  the total and of every range counter (up to 4096 snapshots)
+ *   interval=A:B   the instructions executed from each execution of A to the next of B
+ *                  (B's included, A's not): a function's cost per call, callees and any
+ *                  interrupt taken meanwhile included, with A its entry and B the
+ *                  instruction its caller returns to; kept per call (up to 2^24 calls)
  *   out=PATH       write the report to PATH instead of stderr
  *
  * Report, written when QEMU exits (e.g. through semihosting SYS_EXIT):
  *   insn_count total N
  *   insn_count range I LO HI N
  *   insn_count mark I TOTAL C0 C1 ...     (C_i: range i's counter at that moment)
+ *   insn_count interval A B CALLS MIN MEDIAN P99 P999 MAX SUM
  *
  * Counting is exact: every instruction gets an inline 64-bit add before it executes,
  * including instructions inside IT blocks whose condition fails (they occupy an issue slot
@@ -46,6 +51,40 @@ static uint64_t *g_snapshots; /* kMaxMarks rows of (1 + g_range_count) */
 static unsigned g_mark_count;
 static const char *g_out_path;
 static int g_reported;
+static uint64_t g_interval_a, g_interval_b;
+static int g_have_interval, g_interval_open;
+static uint64_t g_interval_start;
+static uint64_t *g_interval_values;
+static size_t g_interval_count, g_interval_capacity;
+enum { kMaxIntervals = 1 << 24 };
+
+static void on_interval_start(unsigned int vcpu_index, void *userdata) {
+    (void)vcpu_index;
+    (void)userdata;
+    g_interval_open = 1;
+    g_interval_start = g_total;
+}
+
+static void on_interval_end(unsigned int vcpu_index, void *userdata) {
+    (void)vcpu_index;
+    (void)userdata;
+    if (!g_interval_open) return;
+    g_interval_open = 0;
+    if (g_interval_count == g_interval_capacity) {
+        if (g_interval_capacity == kMaxIntervals) return;
+        const size_t grown = g_interval_capacity == 0 ? 4096 : 2 * g_interval_capacity;
+        uint64_t *v = realloc(g_interval_values, grown * sizeof *v);
+        if (v == NULL) return;
+        g_interval_values = v;
+        g_interval_capacity = grown;
+    }
+    g_interval_values[g_interval_count++] = g_total - g_interval_start;
+}
+
+static int compare_u64(const void *a, const void *b) {
+    const uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
+    return x < y ? -1 : x > y;
+}
 
 static void on_mark(unsigned int vcpu_index, void *userdata) {
     (void)vcpu_index;
@@ -73,6 +112,14 @@ static void on_tb_translate(qemu_plugin_id_t id, struct qemu_plugin_tb *tb) {
         }
         if (g_have_mark && vaddr == g_mark_addr) {
             qemu_plugin_register_vcpu_insn_exec_cb(insn, on_mark, QEMU_PLUGIN_CB_NO_REGS, NULL);
+        }
+        if (g_have_interval && vaddr == g_interval_a) {
+            qemu_plugin_register_vcpu_insn_exec_cb(insn, on_interval_start, QEMU_PLUGIN_CB_NO_REGS,
+                                                   NULL);
+        }
+        if (g_have_interval && vaddr == g_interval_b) {
+            qemu_plugin_register_vcpu_insn_exec_cb(insn, on_interval_end, QEMU_PLUGIN_CB_NO_REGS,
+                                                   NULL);
         }
     }
 }
@@ -102,6 +149,19 @@ static void report(void) {
     }
     if (g_mark_count > kMaxMarks) {
         fprintf(out, "insn_count marks_dropped %u\n", g_mark_count - kMaxMarks);
+    }
+    if (g_have_interval) {
+        const size_t n = g_interval_count;
+        uint64_t sum = 0;
+        for (size_t i = 0; i < n; ++i) sum += g_interval_values[i];
+        if (n > 0) qsort(g_interval_values, n, sizeof *g_interval_values, compare_u64);
+#define PERCENTILE(p) (n > 0 ? g_interval_values[(size_t)((double)(n - 1) * (p))] : 0)
+        fprintf(out,
+                "insn_count interval 0x%" PRIx64 " 0x%" PRIx64 " %zu %" PRIu64 " %" PRIu64
+                " %" PRIu64 " %" PRIu64 " %" PRIu64 " %" PRIu64 "\n",
+                g_interval_a, g_interval_b, n, PERCENTILE(0.0), PERCENTILE(0.5), PERCENTILE(0.99),
+                PERCENTILE(0.999), PERCENTILE(1.0), sum);
+#undef PERCENTILE
     }
     if (out != stderr) fclose(out);
     else fflush(out);
@@ -163,6 +223,17 @@ QEMU_PLUGIN_EXPORT int qemu_plugin_install(qemu_plugin_id_t id, const qemu_info_
         } else if (key_len == 4 && strncmp(arg, "mark", 4) == 0) {
             bad = parse_u64(value, &g_mark_addr);
             g_have_mark = 1;
+        } else if (key_len == 8 && strncmp(arg, "interval", 8) == 0) {
+            char a_text[32];
+            const char *colon = strchr(value, ':');
+            if (colon == NULL || (size_t)(colon - value) >= sizeof a_text) {
+                bad = -1;
+            } else {
+                memcpy(a_text, value, (size_t)(colon - value));
+                a_text[colon - value] = '\0';
+                bad = parse_u64(a_text, &g_interval_a) || parse_u64(colon + 1, &g_interval_b);
+                g_have_interval = 1;
+            }
         } else if (key_len == 3 && strncmp(arg, "out", 3) == 0) {
             g_out_path = value; /* argv stays valid for the plugin's lifetime */
         } else {
