@@ -40,7 +40,7 @@ static_assert(kAxes >= 1 && kAxes <= 4, "the pin map has step/dir pins for four 
 /// Spans the device queues (the Linux device's Modbus capacity).
 inline constexpr std::uint32_t kQueueCapacity = 64;
 
-// --- The Modbus line (USART1: TX PA9, RX PA10, AF7) --------------------------------------------
+// --- The Modbus line (USART1: TX PA9, RX PA10, AF7), 8E1 as the serial-line spec's default ----
 inline constexpr std::uint32_t kModbusBaud = 115200;
 inline constexpr std::uint8_t kModbusUnit = 1;
 /// The silence that ends a frame: the spec's t3.5 on a board; under qemu a pty feeds the model

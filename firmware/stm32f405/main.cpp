@@ -52,6 +52,8 @@ firmware::SwitchInputs<kAxes> g_inputs;                                         
 device::TickClock g_clock;            // tick interrupt
 firmware::StepOutput<kAxes> g_steps;  // tick and step interrupts
 Lsb g_last[kAxes] = {};               // tick interrupt
+std::uint32_t g_positions_set = 0;    // tick interrupt
+std::uint64_t g_ticks_executed = 0;   // tick interrupt
 
 /// A byte from the Modbus line and when it came (TIM2 counts).
 struct RxByte {
@@ -90,27 +92,34 @@ void bump(std::atomic<std::uint32_t>& counter) {
     counter.store(counter.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
 }
 
-// One device tick and its outputs; `now` is the interrupt's TIM2 count. Tick interrupt.
-void run_tick(std::uint32_t now) {
+// One device tick and its outputs; `now` is the interrupt's TIM2 count. Tick interrupt. Kept
+// out of line: firmware/stm32f405/figures.py counts its instructions per call under qemu.
+[[gnu::noinline]] void run_tick(std::uint32_t now) {
     Lsb out[kAxes];
-    const std::uint64_t before = g_device.ticks_executed();
     g_device.tick(out);
-    const device::DeviceState state = g_device.state();
-    const std::uint8_t outputs = g_device.outputs();
+    // One copy of the status the tick just wrote (the tick is its writer: no torn read).
+    const device::DeviceStatus<kAxes> status = g_device.status();
+    const device::DeviceState state = status.device_state();
+    const auto outputs = static_cast<std::uint8_t>(status.outputs);
     firmware::pins::drive(board::kEnable,
                           device::enable_asserted(state) != board::kEnableActiveLow);
     firmware::pins::drive(board::kPen, device::pen_down(state, outputs));
+    // A position set at rest ("set zero", homing) moves the coordinates, not the axes: that
+    // tick makes no steps.
+    const bool moved_coordinates = status.position_applied != g_positions_set;
+    g_positions_set = status.position_applied;
     std::int32_t difference[kAxes];
     for (unsigned a = 0; a < kAxes; ++a) {
-        difference[a] = static_cast<std::int32_t>(out[a] - g_last[a]);
+        difference[a] = moved_coordinates ? 0 : static_cast<std::int32_t>(out[a] - g_last[a]);
         g_last[a] = out[a];
     }
     g_steps.start_tick(difference, now);
+    // A path tick (supplied by an accepted span) advances ticks_executed.
+    const std::uint64_t executed = status.ticks_executed();
 #ifdef PATHSTREAM_FW_TRACE
-    if (g_device.ticks_executed() != before) g_trace.record(out, device::pen_down(state, outputs));
-#else
-    (void)before;
+    if (executed != g_ticks_executed) g_trace.record(out, device::pen_down(state, outputs));
 #endif
+    g_ticks_executed = executed;
     bump(g_ticks_run);
 }
 
@@ -217,9 +226,9 @@ extern "C" void tim2_irq() {
 int main() {
     firmware::clock_init();
     init_pins();
-    ModbusLine::init(board::kUsart1Hz, board::kModbusBaud, true);
+    ModbusLine::init(board::kUsart1Hz, board::kModbusBaud, true, true);
 #ifdef PATHSTREAM_FW_TRACE
-    firmware::UsartPort<stm32::kUsart2>::init(board::kUsart2Hz, board::kTraceBaud, false);
+    firmware::UsartPort<stm32::kUsart2>::init(board::kUsart2Hz, board::kTraceBaud, false, false);
     g_trace.header(board::kQemu, board::kModbusBaud, board::kModbusUnit);
 #endif
     init_timers();

@@ -67,9 +67,11 @@ struct Usart {
     using Brr = Reg<Base + 0x08>;
     using Cr1 = Reg<Base + 0x0C>;
 };
-inline constexpr std::uint32_t kUsartSrOre = 1u << 3, kUsartSrRxne = 1u << 5, kUsartSrTxe = 1u << 7;
+inline constexpr std::uint32_t kUsartSrPe = 1u << 0, kUsartSrFe = 1u << 1, kUsartSrOre = 1u << 3,
+                               kUsartSrRxne = 1u << 5, kUsartSrTxe = 1u << 7;
 inline constexpr std::uint32_t kUsartCr1Re = 1u << 2, kUsartCr1Te = 1u << 3,
-                               kUsartCr1Rxneie = 1u << 5, kUsartCr1Ue = 1u << 13;
+                               kUsartCr1Rxneie = 1u << 5, kUsartCr1Pce = 1u << 10,
+                               kUsartCr1M = 1u << 12, kUsartCr1Ue = 1u << 13;
 
 // --- TIM2-5 (RM0090 section 18.4) ---------------------------------------------------------------
 inline constexpr std::uintptr_t kTim2 = 0x40000000u, kTim5 = 0x40000C00u;

@@ -1,7 +1,8 @@
 // Step/dir pins from the setpoints: each tick sets the direction lines at its start and
 // spreads the axes' steps across the tick (StepPulseTrain), raised by TIM2's compare channel 1
 // and lowered a pulse width later by channel 2. On the qemu model, whose timers raise no
-// compare interrupts, the train is still built and counted every tick but no pin moves.
+// compare interrupts, each tick's train is still begun (its divisions are in the tick's cost)
+// and its steps counted, but no pulse is raised.
 #pragma once
 
 #include <atomic>
@@ -29,7 +30,7 @@ public:
     /// at least the direction setup later (step_timing_check). Pulses of the last tick still
     /// pending are dropped and counted (the tick came before they were out). Tick interrupt.
     void start_tick(const std::int32_t (&difference)[Axes], std::uint32_t tick_start) {
-        if (train_.left() != 0) bump(late_);
+        if (kEnabled && train_.left() != 0) bump(late_);
         if (!train_.begin(period_, difference)) {
             bump(refused_);
             return;
@@ -47,12 +48,7 @@ public:
             }
         }
         pins::write(board::kStepDirPort, forward, backward);
-        if constexpr (!kEnabled) {
-            std::uint32_t offset = 0, mask = 0;
-            while (train_.next(board::kStepPulseCounts, offset, mask)) {
-            }
-            return;
-        }
+        if constexpr (!kEnabled) return;  // the schedule is made; nothing raises its pulses
         tick_start_ = tick_start;
         Tim2::Dier::clear_bits(stm32::kTimDierCc1ie | stm32::kTimDierCc2ie);
         pins::write(board::kStepDirPort, 0, step_pins(all_axes()));

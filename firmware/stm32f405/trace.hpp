@@ -25,7 +25,7 @@ public:
         text(qemu ? " qemu" : " board");
         text(" axes ");
         number(Axes);
-        text(" modbus-rtu baud ");
+        text(" modbus-rtu 8E1 baud ");
         number(baud);
         text(" unit ");
         number(unit);
