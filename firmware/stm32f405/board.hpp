@@ -70,6 +70,7 @@ inline constexpr Pin kPen = {stm32::kGpioD, 9};
 /// E-stop (PE0) and limit switches x-, x+, y-, y+, ... (PE1..PE8), active low with pull-ups:
 /// a broken wire reads as pressed.
 inline constexpr Pin kEstop = {stm32::kGpioE, 0};
+inline constexpr std::uintptr_t kLimitPort = stm32::kGpioE;
 inline constexpr unsigned kLimitPinFirst = 1;  ///< axis a, side s (0 -, 1 +): PE(1 + 2a + s)
 inline constexpr bool kSwitchInputs = !kQemu;
 

@@ -15,6 +15,7 @@
 #include "pathstream/device/modbus_register_map.hpp"
 #include "pathstream/device/motion_device.hpp"
 #include "pathstream/device/tick_clock.hpp"
+#include "pathstream/hal/machine_lines.hpp"
 #include "pathstream/hal/modbus_rtu_slave.hpp"
 #include "pathstream/span_queue.hpp"
 #include "pins.hpp"
@@ -41,6 +42,9 @@ constexpr std::uint32_t kDefaultTickHz = 1000;
 constexpr std::uint32_t kMaxTicksPerEntry = 16;
 
 constexpr Lsb kStart[kAxes] = {};
+constexpr firmware::pins::Output kEnableLine{board::kEnable, board::kEnableActiveLow};
+constexpr firmware::pins::Output kPenLine{board::kPen, false};
+static_assert(hal::OutputLine<firmware::pins::Output>);
 
 // --- owned by init, then by one context each (see the comments) ------------------------------
 Device g_device(kStart);
@@ -101,9 +105,8 @@ void bump(std::atomic<std::uint32_t>& counter) {
     const device::DeviceStatus<kAxes> status = g_device.status();
     const device::DeviceState state = status.device_state();
     const auto outputs = static_cast<std::uint8_t>(status.outputs);
-    firmware::pins::drive(board::kEnable,
-                          device::enable_asserted(state) != board::kEnableActiveLow);
-    firmware::pins::drive(board::kPen, device::pen_down(state, outputs));
+    kEnableLine.set(device::enable_asserted(state));
+    kPenLine.set(device::pen_down(state, outputs));
     // A position set at rest ("set zero", homing) moves the coordinates, not the axes: that
     // tick makes no steps.
     const bool moved_coordinates = status.position_applied != g_positions_set;
@@ -153,7 +156,7 @@ void init_pins() {
     if constexpr (board::kSwitchInputs) {
         configure(board::kEstop.port, board::kEstop.number, stm32::kModeInput, 0, stm32::kPullUp);
         for (unsigned k = 0; k < 2 * kAxes; ++k) {
-            configure(stm32::kGpioE, board::kLimitPinFirst + k, stm32::kModeInput, 0,
+            configure(board::kLimitPort, board::kLimitPinFirst + k, stm32::kModeInput, 0,
                       stm32::kPullUp);
         }
     }
@@ -186,8 +189,8 @@ namespace firmware {
 
 void halt_outputs() {
     g_steps.halt();
-    pins::drive(board::kEnable, board::kEnableActiveLow);
-    pins::drive(board::kPen, false);
+    kEnableLine.set(false);
+    kPenLine.set(false);
 }
 
 }  // namespace firmware

@@ -41,4 +41,43 @@ inline bool level(board::Pin p) {
     return ((reg(p.port, 0x10) >> p.number) & 1u) != 0;
 }
 
+/// One output pin as a hal::OutputLine: set(true) asserts it at the board's polarity.
+struct Output {
+    board::Pin pin;
+    bool active_low;
+    void set(bool active) const { drive(pin, active != active_low); }
+};
+
+/// One input pin as a hal::InputLevel: active() after the board's polarity.
+struct Input {
+    board::Pin pin;
+    bool active_low;
+    bool active() const { return level(pin) != active_low; }
+};
+
+/// Every axis's step and direction pins, on one port, as hal::StepDirLines: each call is one
+/// BSRR write, so the steps of a group rise together.
+template <unsigned Axes>
+struct StepDirPins {
+    static std::uint32_t step_pins(std::uint32_t axes) {
+        std::uint32_t mask = 0;
+        for (unsigned a = 0; a < Axes; ++a)
+            if (((axes >> a) & 1u) != 0) mask |= 1u << board::kStepPin[a];
+        return mask;
+    }
+    void set_directions(std::uint32_t forward) const {
+        std::uint32_t up = 0, down = 0;
+        for (unsigned a = 0; a < Axes; ++a) {
+            if (((forward >> a) & 1u) != 0) {
+                up |= 1u << board::kDirPin[a];
+            } else {
+                down |= 1u << board::kDirPin[a];
+            }
+        }
+        write(board::kStepDirPort, up, down);
+    }
+    void raise_steps(std::uint32_t axes) const { write(board::kStepDirPort, step_pins(axes), 0); }
+    void lower_steps(std::uint32_t axes) const { write(board::kStepDirPort, 0, step_pins(axes)); }
+};
+
 }  // namespace firmware::pins

@@ -10,6 +10,7 @@
 
 #include "board.hpp"
 #include "pathstream/device/step_pulses.hpp"
+#include "pathstream/hal/machine_lines.hpp"
 #include "pins.hpp"
 #include "registers.hpp"
 
@@ -18,6 +19,8 @@ namespace firmware {
 template <unsigned Axes>
 class StepOutput {
     using Tim2 = stm32::Timer<stm32::kTim2>;
+    using Lines = pins::StepDirPins<Axes>;
+    static_assert(pathstream::hal::StepDirLines<Lines>);
 
 public:
     /// Whether pulses reach the pins (TIM2 compare interrupts exist).
@@ -39,19 +42,11 @@ public:
             net_[a].store(net_[a].load(std::memory_order_relaxed) + difference[a],
                           std::memory_order_relaxed);
         }
-        std::uint32_t forward = 0, backward = 0;
-        for (unsigned a = 0; a < Axes; ++a) {
-            if (((train_.forward_mask() >> a) & 1u) != 0) {
-                forward |= 1u << board::kDirPin[a];
-            } else {
-                backward |= 1u << board::kDirPin[a];
-            }
-        }
-        pins::write(board::kStepDirPort, forward, backward);
+        lines_.set_directions(train_.forward_mask());
         if constexpr (!kEnabled) return;  // the schedule is made; nothing raises its pulses
         tick_start_ = tick_start;
         Tim2::Dier::clear_bits(stm32::kTimDierCc1ie | stm32::kTimDierCc2ie);
-        pins::write(board::kStepDirPort, 0, step_pins(all_axes()));
+        lines_.lower_steps(all_axes());
         schedule_next();
     }
 
@@ -61,14 +56,14 @@ public:
         const std::uint32_t sr = Tim2::Sr::read();
         if ((sr & stm32::kTimSrCc1if) != 0 && (Tim2::Dier::read() & stm32::kTimDierCc1ie) != 0) {
             Tim2::Sr::write(~stm32::kTimSrCc1if);
-            pins::write(board::kStepDirPort, step_pins(group_), 0);
+            lines_.raise_steps(group_);
             Tim2::Dier::clear_bits(stm32::kTimDierCc1ie);
             arm(Tim2::Ccr2::ref(), Tim2::Cnt::read() + board::kStepPulseCounts);
             Tim2::Dier::set_bits(stm32::kTimDierCc2ie);
         }
         if ((sr & stm32::kTimSrCc2if) != 0 && (Tim2::Dier::read() & stm32::kTimDierCc2ie) != 0) {
             Tim2::Sr::write(~stm32::kTimSrCc2if);
-            pins::write(board::kStepDirPort, 0, step_pins(group_));
+            lines_.lower_steps(group_);
             Tim2::Dier::clear_bits(stm32::kTimDierCc2ie);
             schedule_next();
         }
@@ -77,7 +72,7 @@ public:
     /// Stops the pulses and lowers the step pins. Any context.
     void halt() {
         if constexpr (kEnabled) Tim2::Dier::clear_bits(stm32::kTimDierCc1ie | stm32::kTimDierCc2ie);
-        pins::write(board::kStepDirPort, 0, step_pins(all_axes()));
+        lines_.lower_steps(all_axes());
     }
 
     /// Steps made on `axis` since reset, forward minus backward. Any context.
@@ -91,12 +86,6 @@ public:
 
 private:
     static constexpr std::uint32_t all_axes() { return (1u << Axes) - 1u; }
-    static std::uint32_t step_pins(std::uint32_t axes) {
-        std::uint32_t pins_mask = 0;
-        for (unsigned a = 0; a < Axes; ++a)
-            if (((axes >> a) & 1u) != 0) pins_mask |= 1u << board::kStepPin[a];
-        return pins_mask;
-    }
     static void bump(std::atomic<std::uint32_t>& c) {
         c.store(c.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
     }
@@ -117,6 +106,7 @@ private:
     }
 
     pathstream::device::StepPulseTrain<Axes> train_;  // tick and step interrupts (one level)
+    Lines lines_;
     std::uint32_t period_ = 1;
     std::uint32_t tick_start_ = 0;
     std::uint32_t group_ = 0;

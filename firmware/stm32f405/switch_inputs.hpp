@@ -1,45 +1,41 @@
-// E-stop and limit switches read as levels by the task (the board profile's pins, active low
-// with pull-ups). The rules are the Linux device's (gpio_logic.hpp and DeviceGpio): the e-stop
-// is held from its first active level until it is released and the device has entered e-stop;
-// a limit switch faults on its edge to active (or when active at the first poll), so that a
-// machine standing on a switch can be moved off it after a reset.
+// E-stop and limit switches read as levels by the task, through the board's input lines
+// (hal::InputLevel), applied by the core's SwitchRules: the rules the Linux device applies to
+// its edges. A level poll sees a pulse only if it lasts a main-loop pass (microseconds).
 #pragma once
 
 #include "board.hpp"
-#include "pathstream/device/gpio_logic.hpp"
-#include "pathstream/device/motion_device.hpp"
+#include "pathstream/device/switch_rules.hpp"
+#include "pathstream/hal/machine_lines.hpp"
 #include "pins.hpp"
 
 namespace firmware {
 
 template <unsigned Axes>
 class SwitchInputs {
+    static_assert(pathstream::hal::InputLevel<pins::Input>);
+
 public:
     /// Reads every switch and applies it to `device`. Task context, every main-loop pass.
     template <typename Device>
     void poll(Device& device) {
-        const bool estop = !pins::level(board::kEstop);
-        if (estop) estop_held_ = true;
-        if (estop_held_ && !estop && device.state() == pathstream::device::DeviceState::kEstop)
-            estop_held_ = false;
-        device.set_estop_input(estop_held_);
+        const bool estop = pins::Input{board::kEstop, true}.active();
+        rules_.estop(device, estop, estop);
         for (unsigned a = 0; a < Axes; ++a) {
             for (unsigned side = 0; side < 2; ++side) {
-                const board::Pin pin = {stm32::kGpioE, board::kLimitPinFirst + 2 * a + side};
-                const bool active = !pins::level(pin);
-                if (active && (first_ || !was_[a][side])) {
-                    device.raise_fault(pathstream::device::limit_fault(
-                        a, static_cast<pathstream::device::LimitSide>(side)));
-                }
+                const pins::Input in{{board::kLimitPort, board::kLimitPinFirst + 2 * a + side},
+                                     true};
+                const bool active = in.active();
+                // An edge is a level that was not there at the last pass.
+                const bool tripped = active && !was_[a][side];
                 was_[a][side] = active;
+                (void)rules_.limit(device, a, static_cast<pathstream::device::LimitSide>(side),
+                                   tripped, active);
             }
         }
-        first_ = false;
     }
 
 private:
-    bool estop_held_ = false;
-    bool first_ = true;
+    pathstream::device::SwitchRules<Axes> rules_;
     bool was_[Axes][2] = {};
 };
 

@@ -1,5 +1,6 @@
 // The I/O glue between a MotionDevice and its discrete lines: e-stop and limit-switch inputs
-// in, enable and pen-lift outputs out. The rules are firmware_core's (gpio_logic.hpp); this
+// in, enable and pen-lift outputs out. The rules are firmware_core's (gpio_logic.hpp,
+// switch_rules.hpp: the firmware applies the same ones); this
 // class only moves levels, edges and requests between the hal interfaces and the device. The
 // same code runs against the simulated lines (tests) and libgpiod (the VM test's driver).
 #pragma once
@@ -8,6 +9,7 @@
 
 #include "pathstream/device/gpio_logic.hpp"
 #include "pathstream/device/motion_device.hpp"
+#include "pathstream/device/switch_rules.hpp"
 #include "pathstream/hal/gpio.hpp"
 
 namespace pathstream::linux_device {
@@ -53,13 +55,7 @@ public:
                     ++estop_edges_;
                 }
             }
-            const bool level = wiring_.estop->active();
-            if (activated || level) estop_held_ = true;
-            if (estop_held_ && !level && !activated &&
-                device_.state() == device::DeviceState::kEstop) {
-                estop_held_ = false;
-            }
-            device_.set_estop_input(estop_held_);
+            rules_.estop(device_, activated, wiring_.estop->active());
         }
         for (unsigned a = 0; a < Axes; ++a) {
             for (unsigned side = 0; side < 2; ++side) {
@@ -68,17 +64,10 @@ public:
                 hal::InputEdge e;
                 bool tripped = false;
                 while (in->next_edge(e)) tripped = tripped || e.active;
-                const bool level = in->active();
-                if (first_poll_ && level) tripped = true;
-                limit_level_[a][side] = level || tripped;
-                if (tripped && !masked_[a][side]) {
-                    device_.raise_fault(
-                        device::limit_fault(a, static_cast<device::LimitSide>(side)));
-                    ++limit_trips_;
-                }
+                (void)rules_.limit(device_, a, static_cast<device::LimitSide>(side), tripped,
+                                   in->active());
             }
         }
-        first_poll_ = false;
     }
 
     /// Drives enable and pen from the state the last tick left. Cheap: each output switches
@@ -91,26 +80,22 @@ public:
 
     /// Masks (or unmasks) one switch's fault: homing drives onto its own switch on purpose.
     void mask_limit(unsigned axis, device::LimitSide side, bool masked) {
-        masked_[axis][static_cast<unsigned>(side)] = masked;
+        rules_.mask_limit(axis, side, masked);
     }
     /// The switch's level seen by the last poll_inputs (true also for a pulse seen then).
     bool limit_active(unsigned axis, device::LimitSide side) const {
-        return limit_level_[axis][static_cast<unsigned>(side)];
+        return rules_.limit_active(axis, side);
     }
     std::uint32_t estop_edges() const { return estop_edges_; }
-    std::uint32_t limit_trips() const { return limit_trips_; }
+    std::uint32_t limit_trips() const { return rules_.limit_trips(); }
     /// Timestamp of the last activating e-stop edge (backend clock, ns; 0 if none).
     std::uint64_t last_estop_edge_ns() const { return last_estop_edge_ns_; }
 
 private:
     Device& device_;
     DeviceWiring<Axes> wiring_;
-    bool first_poll_ = true;
-    bool estop_held_ = false;
-    bool masked_[Axes][2] = {};
-    bool limit_level_[Axes][2] = {};
+    device::SwitchRules<Axes> rules_;
     std::uint32_t estop_edges_ = 0;
-    std::uint32_t limit_trips_ = 0;
     std::uint64_t last_estop_edge_ns_ = 0;
 };
 
