@@ -131,6 +131,7 @@ def measure(axes, work):
         if pty is None:
             raise RuntimeError(f"qemu did not start: {open(log.name).read()}")
         held = os.open(pty, os.O_RDWR | os.O_NOCTTY)  # see tests/firmware/qemu_stream_test.sh
+        time.sleep(1.2)
         target = f"modbus-rtu://{pty}?baud=115200"
         start = job["subpaths"][0]["points"][0]
         for a, value in enumerate(start):

@@ -126,8 +126,12 @@ void bump(std::atomic<std::uint32_t>& counter) {
     bump(g_ticks_run);
 }
 
-// Follows the rate the host configured: the task publishes it, the tick takes it here.
+// Serves at most one request per pass; after it, publishes the tick rate the host configured
+// (the tick takes it at its next entry). Task context.
 void serve_bus() {
+    // Every byte received so far: a request that more bytes followed before it could be
+    // answered is stale (its master timed out and asked again), and the framer lets the newer
+    // one replace it, so the master never reads an answer meant for the try it gave up.
     while (const RxByte* r = g_rx.front()) {
         g_framer.on_byte(r->byte, r->at);
         g_rx.release();

@@ -44,6 +44,7 @@ done
 # first request of every new client would wait up to a second (and time out) otherwise. A
 # board's serial port has no such pause. Nothing reads or writes on this descriptor.
 exec 3<>"$pty"
+sleep 1.2  # until qemu's once-a-second poll has seen it open
 fw="modbus-rtu://$pty?baud=115200"  # the image's line: 8E1, unit 1
 
 # --- the Linux device, the same machine, on its own RTU pty ------------------------------------
