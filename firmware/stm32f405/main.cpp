@@ -68,7 +68,6 @@ SpanQueue<RxByte, 512> g_rx;                           // producer: USART1 inter
 std::atomic<std::uint32_t> g_rx_lost{0};               // USART1 interrupt only
 std::atomic<std::uint32_t> g_rx_overruns{0};           // USART1 interrupt only
 std::atomic<std::uint32_t> g_tick_hz{kDefaultTickHz};  // task only: the rate it wants
-std::atomic<std::uint32_t> g_ticks_run{0};             // tick interrupt only
 std::atomic<std::uint32_t> g_ticks_dropped{0};         // tick interrupt only: g_clock.dropped()
 
 #ifdef PATHSTREAM_FW_TRACE
@@ -123,7 +122,6 @@ void bump(std::atomic<std::uint32_t>& counter) {
     if (executed != g_ticks_executed) g_trace.record(out, device::pen_down(state, outputs));
 #endif
     g_ticks_executed = executed;
-    bump(g_ticks_run);
 }
 
 // Serves at most one request per pass; after it, publishes the tick rate the host configured

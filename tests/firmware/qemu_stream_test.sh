@@ -59,6 +59,20 @@ for _ in $(seq 200); do
 done
 [ -n "$linux" ] || { echo "FAIL the Linux device did not start: $(cat device.log)"; exit 1; }
 
+# The path ticks of a trace or a record ("k,x,y,pen" lines; '#' notes and the header skipped),
+# for the comparisons below.
+cat > trace_rows.py <<'EOF'
+def rows(name):
+    out = []
+    with open(name) as f:
+        for line in f:
+            if line.startswith("#") or line.startswith("tick"):
+                continue
+            c = line.rstrip("\n").split(",")
+            out.append((int(c[1]), int(c[2]), int(c[3])))
+    return out
+EOF
+
 # Runs a command with a bound; a hang is a failure with its output, not a slow machine.
 run() { timeout -k 5 120 "$@"; }
 
@@ -117,15 +131,7 @@ run "$bin" plan "$src/examples/rose.json" -m "$machine" --order-start 50,50 --ou
 for _ in $(seq 100); do grep -q "^# steps y" trace.txt && break; sleep 0.05; done
 if out=$($py - <<'EOF'
 import json, sys
-def rows(name):
-    out = []
-    with open(name) as f:
-        for line in f:
-            if line.startswith("#") or line.startswith("tick"):
-                continue
-            c = line.rstrip("\n").split(",")
-            out.append((int(c[1]), int(c[2]), int(c[3])))
-    return out
+from trace_rows import rows
 fw = rows("trace.txt")
 plan = []
 with open("rose-plan.csv") as f:
@@ -234,15 +240,7 @@ grep -q "^# trace_lost" trace.txt && fail "the trace lost records: $(grep '^# tr
 kill -INT "$device_pid"; wait "$device_pid"; device_pid=
 if out=$($py - "$two_job_ticks" <<'EOF'
 import sys
-def rows(name, limit=None):
-    out = []
-    with open(name) as f:
-        for line in f:
-            if line.startswith("#") or line.startswith("tick"):
-                continue
-            c = line.rstrip("\n").split(",")
-            out.append((int(c[1]), int(c[2]), int(c[3])))
-    return out
+from trace_rows import rows
 n = int(sys.argv[1])
 fw = rows("trace.txt")[:n]
 lx = rows("linux.csv")
