@@ -358,8 +358,13 @@ void TickChecker::visit(const std::array<std::int64_t, kAxesMax>& p,
             Vec q{};
             for (std::size_t a = 0; a < axes_; ++a)
                 q[a] = static_cast<double>(p[a]) * profile_.mm_per_lsb;
-            std::size_t seg = 0;
-            distance_ = projector_->distance(q, seg);
+            // Only the largest distance matters: the exact search runs where the cheap bound
+            // could pass it.
+            distance_ = projector_->follow(q);
+            if (distance_ > out_.max_deviation) {
+                std::size_t seg = 0;
+                distance_ = projector_->distance(q, seg);
+            }
             have_distance_ = true;
         }
         if (distance_ > out_.max_deviation) {

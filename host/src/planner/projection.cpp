@@ -244,6 +244,33 @@ double PathProjector::segment_distance(std::size_t i, const Vec& p, double bound
     return std::sqrt(best);
 }
 
+double PathProjector::follow(const Vec& p) {
+    if (!started_ || cursor_ >= segs_.size()) return std::numeric_limits<double>::infinity();
+    double u = last_u_;
+    for (int hop = 0; hop < 4; ++hop) {
+        const Cubic& c = segs_[cursor_];
+        for (int it = 0; it < 4; ++it) {
+            const Vec d = sub(c.point(u), p), d1 = c.d1(u), d2 = c.d2(u);
+            const double f = dot(d, d1), df = dot(d1, d1) + dot(d, d2);
+            if (!(df > 0)) break;
+            u = std::clamp(u - f / df, 0.0, 1.0);
+        }
+        if (u >= 1 && cursor_ + 1 < segs_.size() && segs_[cursor_ + 1].p[0] == c.p[3]) {
+            ++cursor_;
+            u = 0;
+        } else if (u <= 0 && cursor_ > 0 && segs_[cursor_ - 1].p[3] == c.p[0]) {
+            --cursor_;
+            u = 1;
+        } else {
+            break;
+        }
+    }
+    last_u_ = u;
+    last_d_ = norm(sub(segs_[cursor_].point(u), p));
+    last_p_ = p;
+    return last_d_;
+}
+
 double PathProjector::distance(const Vec& p, std::size_t& segment) {
     const std::size_t n = segs_.size();
     const double step = started_ ? norm(sub(p, last_p_)) : 0;

@@ -24,6 +24,11 @@ public:
     PathProjector(std::vector<Cubic> segments, std::vector<std::size_t> index, double global_below);
     /// Distance (mm) from p to the nearest segment; `segment` gets its index (as given).
     double distance(const Vec& p, std::size_t& segment);
+    /// An upper bound of distance(p), in a few Newton steps: the distance to the point of the
+    /// path the cursor follows (from the last answer, onto the joined segment after or before
+    /// when it runs off an end). Moves the cursor there. Infinity before the first distance().
+    /// A caller after the largest distance needs distance() only where this bound passes it.
+    double follow(const Vec& p);
     bool empty() const { return segs_.empty(); }
 
 private:
