@@ -6,6 +6,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "pathstream/host/segment_source.hpp"
+
 namespace pathstream::host {
 namespace {
 
@@ -19,27 +21,6 @@ PathPoint combine(PointRef a, double wa, PointRef b, double wb) {
 
 PathPoint reflect(PointRef end, PointRef next) {  // phantom point 2 end - next
     return combine(end, 2.0, next, -1.0);
-}
-
-/// Four-point windows of a uniform B-spline or Catmull-Rom subpath, as core_spans.cpp makes
-/// them: open ends get phantom points 2 P0 - P1 and 2 Pm - Pm-1; closed subpaths are periodic.
-/// Hands them to `visit` one at a time: a window list of a 10^6-point subpath is ~40 MB.
-template <typename Visit>
-void for_each_window(const PointList& pts, bool closed, Visit&& visit) {
-    const std::size_t m = pts.size();
-    if (closed) {
-        for (std::size_t i = 0; i < m; ++i) {
-            visit(Window{pts[(i + m - 1) % m], pts[i], pts[(i + 1) % m], pts[(i + 2) % m]});
-        }
-        return;
-    }
-    const PathPoint before = reflect(pts[0], pts[1]), after = reflect(pts[m - 1], pts[m - 2]);
-    // The extended list: before, pts[0], ..., pts[m - 1], after (m + 2 points).
-    const auto ext = [&](std::size_t i) {
-        return i == 0 ? PointRef(before) : i == m + 1 ? PointRef(after) : pts[i - 1];
-    };
-    for (std::size_t i = 0; i + 3 < m + 2; ++i)
-        visit(Window{ext(i), ext(i + 1), ext(i + 2), ext(i + 3)});
 }
 
 /// Weighted sum w0 Q0 + w1 Q1 + w2 Q2 + w3 Q3 of a window.
@@ -71,134 +52,187 @@ std::array<PathPoint, 4> straight(PointRef a, PointRef b) {
 
 using Controls = std::array<PathPoint, 4>;
 
-/// Hands a subpath's cubics to `emit` one at a time, with the joints shared exactly (not
-/// merely to rounding: each segment's P0 is a copy of the previous P3) and a closed subpath
-/// ending where it starts. One segment is held back until the next is known, so the whole
-/// subpath is never held at once.
-class JointSharer {
-public:
-    JointSharer(bool closed, const std::function<void(Controls&)>& emit)
-        : closed_(closed), emit_(emit) {}
-
-    void add(Controls&& c) {
-        if (held_) {
-            c[0] = pending_[3];
-            emit_(pending_);
-        } else {
-            first_ = c[0];
-        }
-        pending_ = std::move(c);
-        held_ = true;
-    }
-    /// The last segment (`last_end`: its end point, for open B-spline and Catmull-Rom ends).
-    void finish(const PointRef* last_end) {
-        if (!held_) return;
-        if (last_end != nullptr) pending_[3] = last_end->vector();
-        if (closed_) pending_[3] = first_;
-        emit_(pending_);
-        held_ = false;
-    }
-
-private:
-    bool closed_;
-    const std::function<void(Controls&)>& emit_;
-    Controls pending_;
-    PathPoint first_;
-    bool held_ = false;
-};
-
-void subpath_segments(const Subpath& sp, std::size_t index,
-                      const std::function<void(Controls&)>& emit) {
-    const auto& pts = sp.points;
+/// Segment k of a subpath of m points as its basis makes it, before the joints are shared.
+Controls raw_segment(const Subpath& sp, std::size_t k) {
+    const PointList& pts = sp.points;
     const std::size_t m = pts.size();
-    const auto too_few = [&](const char* need) {
-        throw std::invalid_argument("subpath " + std::to_string(index) + ": " +
-                                    basis_name(sp.basis) + " needs " + need + " points, got " +
-                                    std::to_string(m));
-    };
-    JointSharer out(sp.closed, emit);
     switch (sp.basis) {
         case PathBasis::kBSpline:
         case PathBasis::kCatmullRom: {
-            if (m < (sp.closed ? 3u : 2u)) too_few(sp.closed ? "at least 3" : "at least 2");
-            bool first = true;
-            for_each_window(pts, sp.closed, [&](const Window& w) {
-                Controls c = sp.basis == PathBasis::kBSpline ? bspline_to_bezier(w)
-                                                             : catmull_rom_to_bezier(w);
-                if (first && !sp.closed)
-                    c[0] = pts.front();  // the clamped start is exactly the first point
-                first = false;
-                out.add(std::move(c));
-            });
-            const PointRef last = pts.back();
-            out.finish(sp.closed ? nullptr : &last);  // and the clamped end the last
-            return;
+            // Open ends get phantom points 2 P0 - P1 and 2 Pm - Pm-1 (as core_spans.cpp makes
+            // them); closed subpaths are periodic.
+            const auto convert = [&](const Window& w) {
+                return sp.basis == PathBasis::kBSpline ? bspline_to_bezier(w)
+                                                       : catmull_rom_to_bezier(w);
+            };
+            if (sp.closed)
+                return convert({pts[(k + m - 1) % m], pts[k], pts[(k + 1) % m], pts[(k + 2) % m]});
+            PathPoint before, after;
+            if (k == 0) before = reflect(pts[0], pts[1]);
+            if (k + 3 >= m + 1) after = reflect(pts[m - 1], pts[m - 2]);
+            // The extended list: before, pts[0], ..., pts[m - 1], after (m + 2 points).
+            const auto ext = [&](std::size_t i) {
+                return i == 0 ? PointRef(before) : i == m + 1 ? PointRef(after) : pts[i - 1];
+            };
+            return convert({ext(k), ext(k + 1), ext(k + 2), ext(k + 3)});
         }
-        case PathBasis::kBezier: {
-            if (sp.closed ? (m < 3 || m % 3 != 0) : (m < 4 || m % 3 != 1))
-                too_few(sp.closed ? "3k" : "3k + 1");
-            const std::size_t count = sp.closed ? m / 3 : (m - 1) / 3;
-            for (std::size_t i = 0; i < count; ++i) {
-                out.add({pts[3 * i], pts[3 * i + 1], pts[3 * i + 2], pts[(3 * i + 3) % m]});
-            }
+        case PathBasis::kBezier:
+            return {pts[3 * k], pts[3 * k + 1], pts[3 * k + 2], pts[(3 * k + 3) % m]};
+        case PathBasis::kPolyline:
             break;
-        }
-        case PathBasis::kPolyline: {
-            if (m < (sp.closed ? 3u : 2u)) too_few(sp.closed ? "at least 3" : "at least 2");
-            const std::size_t count = sp.closed ? m : m - 1;
-            for (std::size_t i = 0; i < count; ++i) out.add(straight(pts[i], pts[(i + 1) % m]));
-            break;
-        }
     }
-    out.finish(nullptr);
+    return straight(pts[k], pts[(k + 1) % m]);
 }
 
 }  // namespace
 
+PathSegmentSource::PathSegmentSource(const Path& path, std::optional<PathPoint> lead_in_from)
+    : path_(path), lead_in_from_(std::move(lead_in_from)) {}
+
+bool PathSegmentSource::rewind() {
+    lead_in_done_ = false;
+    s_ = k_ = count_ = 0;
+    in_subpath_ = any_ = false;
+    held_.reset();
+    next_stop_ = 0;
+    return true;
+}
+
+std::size_t PathSegmentSource::size_hint() const {
+    if (!sized_) {
+        for (std::size_t s = 0; s < path_.subpaths.size(); ++s) {
+            const Subpath& sp = path_.subpaths[s];
+            const std::size_t m = sp.points.size();
+            std::size_t n = 0;
+            if (sp.basis == PathBasis::kBezier)
+                n = sp.closed ? m / 3 : (m > 0 ? (m - 1) / 3 : 0);
+            else
+                n = sp.closed ? m : (m > 0 ? m - 1 : 0);
+            size_ += n + (s > 0 ? 1 : 0);
+        }
+        sized_ = true;
+    }
+    return size_;
+}
+
+std::size_t PathSegmentSource::begin_subpath() {
+    const Subpath& sp = path_.subpaths[s_];
+    const std::size_t m = sp.points.size();
+    if (m > 0 && sp.points.axes() != path_.axes) {  // a list's points have one size
+        throw std::invalid_argument("subpath " + std::to_string(s_) + ": a point has " +
+                                    std::to_string(sp.points.axes()) + " coordinates, expected " +
+                                    std::to_string(path_.axes));
+    }
+    const auto too_few = [&](const char* need) {
+        throw std::invalid_argument("subpath " + std::to_string(s_) + ": " + basis_name(sp.basis) +
+                                    " needs " + need + " points, got " + std::to_string(m));
+    };
+    if (sp.basis == PathBasis::kBezier) {
+        if (sp.closed ? (m < 3 || m % 3 != 0) : (m < 4 || m % 3 != 1))
+            too_few(sp.closed ? "3k" : "3k + 1");
+        return sp.closed ? m / 3 : (m - 1) / 3;
+    }
+    if (m < (sp.closed ? 3u : 2u)) too_few(sp.closed ? "at least 3" : "at least 2");
+    return sp.closed ? m : m - 1;
+}
+
+void PathSegmentSource::make_segment(BezierSegment& seg) {
+    const Subpath& sp = path_.subpaths[s_];
+    const bool spline = sp.basis == PathBasis::kBSpline || sp.basis == PathBasis::kCatmullRom;
+    Controls c = raw_segment(sp, k_);
+    // Joints shared exactly (each P0 a copy of the previous P3, not merely equal to rounding),
+    // the clamped open ends exactly the end points, a closed subpath ending where it starts.
+    if (k_ == 0 && spline && !sp.closed) c[0] = sp.points.front().vector();
+    if (k_ > 0) c[0] = previous_end_;
+    if (k_ + 1 == count_) {
+        if (spline && !sp.closed) c[3] = sp.points.back().vector();
+        if (sp.closed) c[3] = k_ == 0 ? c[0] : first_start_;
+    }
+    if (k_ == 0) first_start_ = c[0];
+    previous_end_ = c[3];
+    const bool first = k_ == 0;
+    seg = BezierSegment{};
+    seg.p = std::move(c);
+    seg.pen_down = true;
+    seg.subpath = s_;
+    seg.feed = sp.feed;
+    seg.blend_tolerance = sp.corner_mode != CornerMode::kBlend ? 0.0
+                          : sp.blend_tolerance > 0             ? sp.blend_tolerance
+                                                               : -1.0;
+    seg.pause_before = first && sp.pause_before;
+    seg.dwell_before = first ? sp.dwell_before : 0;
+    seg.dwell_pen_down = first && sp.dwell_pen_down;
+    const bool stops = sp.corner_mode == CornerMode::kExactStop;
+    while (stops && next_stop_ < sp.stops.size() && sp.stops[next_stop_] < k_) ++next_stop_;
+    seg.stop_before = stops && !first && next_stop_ < sp.stops.size() && sp.stops[next_stop_] == k_;
+    seg.segment = static_cast<std::uint32_t>(k_);
+    ++k_;
+}
+
+bool PathSegmentSource::next(BezierSegment& out) {
+    if (held_) {
+        out = std::move(*held_);
+        held_.reset();
+        last_end_ = out.p[3];
+        return true;
+    }
+    while (s_ < path_.subpaths.size()) {
+        if (!in_subpath_) {
+            count_ = begin_subpath();
+            k_ = 0;
+            next_stop_ = 0;
+            in_subpath_ = true;
+        }
+        if (k_ >= count_) {
+            in_subpath_ = false;
+            ++s_;
+            continue;
+        }
+        BezierSegment seg;
+        make_segment(seg);
+        if (k_ == 1 && (any_ || (lead_in_from_ && !lead_in_done_))) {
+            // A straight pen-up move to this start first: from the last end point, or (before
+            // anything) from where the machine rests.
+            const PathPoint from = any_ ? last_end_ : *lead_in_from_;
+            lead_in_done_ = true;
+            if (!any_ && from.size() != seg.p[0].size()) {
+                throw std::invalid_argument("lead-in: the machine has " +
+                                            std::to_string(from.size()) + " axes, the path " +
+                                            std::to_string(seg.p[0].size()));
+            }
+            if (any_ || from != seg.p[0]) {
+                out = BezierSegment{};
+                if (any_) {
+                    out.p = straight(from, seg.p[0]);
+                } else {  // as prepend_lead_in makes it
+                    for (int k = 0; k < 4; ++k) {
+                        out.p[k].resize(from.size());
+                        for (std::size_t i = 0; i < from.size(); ++i)
+                            out.p[k][i] = from[i] + (seg.p[0][i] - from[i]) * k / 3.0;
+                    }
+                }
+                out.p[0] = from;
+                out.p[3] = seg.p[0];
+                out.pen_down = false;
+                out.subpath = any_ ? s_ : 0;
+                any_ = true;
+                held_ = std::move(seg);
+                return true;
+            }
+        }
+        any_ = true;
+        out = std::move(seg);
+        last_end_ = out.p[3];
+        return true;
+    }
+    return false;
+}
+
 void for_each_bezier_segment(const Path& path,
                              const std::function<void(const BezierSegment&)>& visit) {
-    bool any = false;
-    PathPoint last_end;
-    for (std::size_t s = 0; s < path.subpaths.size(); ++s) {
-        const Subpath& sp = path.subpaths[s];
-        if (!sp.points.empty() && sp.points.axes() != path.axes) {  // a list's points have one size
-            throw std::invalid_argument("subpath " + std::to_string(s) + ": a point has " +
-                                        std::to_string(sp.points.axes()) +
-                                        " coordinates, expected " + std::to_string(path.axes));
-        }
-        bool first = true;
-        BezierSegment seg;
-        seg.pen_down = true;
-        seg.subpath = s;
-        seg.feed = sp.feed;
-        seg.blend_tolerance = sp.corner_mode != CornerMode::kBlend ? 0.0
-                              : sp.blend_tolerance > 0             ? sp.blend_tolerance
-                                                                   : -1.0;
-        std::size_t joint = 0;  // index of the segment about to be visited
-        auto next_stop = sp.stops.begin();
-        const bool stops = sp.corner_mode == CornerMode::kExactStop;
-        subpath_segments(sp, s, [&](Controls& c) {
-            if (first && any) {  // straight pen-up travel from the last end point to this start
-                BezierSegment travel;
-                travel.p = straight(last_end, c[0]);
-                travel.pen_down = false;
-                travel.subpath = s;
-                visit(travel);
-            }
-            seg.p = std::move(c);
-            seg.pause_before = first && sp.pause_before;
-            seg.dwell_before = first ? sp.dwell_before : 0;
-            seg.dwell_pen_down = first && sp.dwell_pen_down;
-            while (stops && next_stop != sp.stops.end() && *next_stop < joint) ++next_stop;
-            seg.stop_before = stops && !first && next_stop != sp.stops.end() && *next_stop == joint;
-            seg.segment = static_cast<std::uint32_t>(joint);
-            ++joint;
-            first = false;
-            any = true;
-            visit(seg);
-            last_end = seg.p[3];
-        });
-    }
+    PathSegmentSource source(path);
+    BezierSegment seg;
+    while (source.next(seg)) visit(seg);
 }
 
 std::vector<BezierSegment> to_bezier_segments(const Path& path) {

@@ -6,6 +6,7 @@
 
 #include "pathstream/basis.hpp"
 #include "pathstream/host/geometry.hpp"
+#include "pathstream/host/segment_source.hpp"
 
 using namespace pathstream::host;
 
@@ -206,4 +207,45 @@ TEST_CASE("too few points is an error, not a crash", "[geometry]") {
     sp.points = {{1, 2}};
     path.subpaths = {sp};
     CHECK_THROWS_AS(to_bezier_segments(path), std::invalid_argument);
+}
+
+TEST_CASE("a path's segments made one at a time: the list's, a lead-in first, again on rewind",
+          "[geometry]") {
+    std::mt19937_64 rng(37);
+    Path path;
+    const PathBasis bases[] = {PathBasis::kBSpline, PathBasis::kCatmullRom, PathBasis::kBezier,
+                               PathBasis::kPolyline};
+    for (int i = 0; i < 12; ++i) {
+        Subpath sp;
+        sp.basis = bases[i % 4];
+        sp.closed = i % 3 == 1;
+        const std::size_t n = sp.basis == PathBasis::kBezier ? (sp.closed ? 9 : 10) : 2 + i;
+        for (const PathPoint& p : random_points(rng, n, 2)) sp.points.push_back(p);
+        sp.feed = i;
+        path.subpaths.push_back(sp);
+    }
+    std::vector<BezierSegment> expected = to_bezier_segments(path);
+    const PathPoint rest{-3, 7};
+    prepend_lead_in(expected, rest);
+    PathSegmentSource source(path, rest);
+    CHECK(source.size_hint() + 1 == expected.size());
+    for (int pass = 0; pass < 2; ++pass) {
+        std::size_t k = 0;
+        BezierSegment s;
+        while (source.next(s)) {
+            REQUIRE(k < expected.size());
+            CHECK(s.p == expected[k].p);
+            CHECK(s.pen_down == expected[k].pen_down);
+            CHECK(s.subpath == expected[k].subpath);
+            CHECK(s.feed == expected[k].feed);
+            ++k;
+        }
+        CHECK(k == expected.size());
+        REQUIRE(source.rewind());
+    }
+    // At the start already: no lead-in.
+    PathSegmentSource at_start(path, expected[1].p[0]);
+    BezierSegment first;
+    REQUIRE(at_start.next(first));
+    CHECK(first.pen_down);
 }

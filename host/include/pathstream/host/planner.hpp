@@ -13,6 +13,7 @@
 #include "pathstream/host/core_spans.hpp"
 #include "pathstream/host/geometry.hpp"
 #include "pathstream/host/plan.hpp"
+#include "pathstream/host/segment_source.hpp"
 #include "pathstream/machine/machine.hpp"
 
 namespace pathstream::host {
@@ -119,40 +120,6 @@ public:
     /// failed, docs/planner.md §7). Return false when what was received cannot be taken back
     /// (then planning fails with PlanError).
     virtual bool restart() { return false; }
-};
-
-/// Gives the path's Bezier segments in order, one at a time, so that a job need not be held
-/// whole in memory. Called from the planning thread only.
-class SegmentSource {
-public:
-    virtual ~SegmentSource() = default;
-    /// The next segment into `out`; false at the end of the path.
-    virtual bool next(BezierSegment& out) = 0;
-    /// Back to the first segment (for a replan); false when the source cannot rewind.
-    virtual bool rewind() = 0;
-    /// Number of segments when known (for progress), else 0.
-    virtual std::size_t size_hint() const { return 0; }
-};
-
-/// A SegmentSource over segments held in memory (not copied: `segments` must outlive it).
-class VectorSegmentSource : public SegmentSource {
-public:
-    explicit VectorSegmentSource(const std::vector<BezierSegment>& segments)
-        : segments_(segments) {}
-    bool next(BezierSegment& out) override {
-        if (next_ >= segments_.size()) return false;
-        out = segments_[next_++];
-        return true;
-    }
-    bool rewind() override {
-        next_ = 0;
-        return true;
-    }
-    std::size_t size_hint() const override { return segments_.size(); }
-
-private:
-    const std::vector<BezierSegment>& segments_;
-    std::size_t next_ = 0;
 };
 
 /// What a streamed plan came to (the Plan's totals, without its spans).
