@@ -69,13 +69,21 @@ PeerPlan plan_klipper_style(std::vector<LineMove> moves, const host::MachineProf
     // `waiting` until the smoothed peak before them is known.
     struct Waiting {
         std::size_t move;
-        double start2, end2;
+        double start2;
     };
     std::vector<Waiting> waiting;
     std::vector<TimedMove> timed(n);
-    const auto set_profile = [&](std::size_t k, double start2, double cruise2, double end2) {
-        timed[k] = make_trapezoid(q[k].length, q[k].accel, std::min(start2, cruise2), cruise2,
-                                  std::min(end2, cruise2));
+    // A move ends at the speed the next one starts at: that one is already set (the pass runs
+    // backward, and waiting moves are set later ones first, before the move that releases
+    // them). Klipper ends at min(end, cruise), which leaves a velocity step at the junction
+    // where the next move's start was capped by a different peak (or not at all); the cruise
+    // is raised to that start instead (reachable: a start is capped by what the previous move
+    // can reach), never slower than Klipper.
+    const auto set_profile = [&](std::size_t k, double start2, double cruise2) {
+        const double end2 = k + 1 < n ? timed[k + 1].v_entry * timed[k + 1].v_entry : 0;
+        cruise2 = std::max(cruise2, end2);
+        timed[k] =
+            make_trapezoid(q[k].length, q[k].accel, std::min(start2, cruise2), cruise2, end2);
     };
     double next_end2 = 0, next_smoothed2 = 0, peak_cruise2 = 0;
     for (std::size_t k = n; k-- > 0;) {
@@ -92,21 +100,21 @@ PeerPlan plan_klipper_style(std::vector<LineMove> moves, const host::MachineProf
                 peak_cruise2 = std::min(m.max_cruise2, 0.5 * (smoothed2 + reachable_smoothed2));
                 for (const Waiting& w : waiting) {
                     const double cruise2 = std::min(peak_cruise2, w.start2);
-                    set_profile(w.move, w.start2, cruise2, w.end2);
+                    set_profile(w.move, w.start2, cruise2);
                 }
                 waiting.clear();
             }
             const double cruise2 =
                 std::min({0.5 * (start2 + reachable_start2), m.max_cruise2, peak_cruise2});
-            set_profile(k, start2, cruise2, next_end2);
+            set_profile(k, start2, cruise2);
         } else {
-            waiting.push_back({k, start2, next_end2});
+            waiting.push_back({k, start2});
         }
         next_end2 = start2;
         next_smoothed2 = smoothed2;
     }
     for (const Waiting& w : waiting)
-        set_profile(w.move, w.start2, std::min(peak_cruise2, w.start2), w.end2);
+        set_profile(w.move, w.start2, std::min(peak_cruise2, w.start2));
 
     PeerPlan plan;
     plan.timed = std::move(timed);

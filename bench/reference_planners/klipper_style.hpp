@@ -22,7 +22,9 @@
 //   * a backward pass from the end (at rest) takes each move's start speed as the smaller of
 //     its cap and what it can brake from, its cruise speed as the smallest of its cruise limit,
 //     the peak of the triangle between its ends and the smoothed peak, and builds the
-//     trapezoid (accelerate, cruise, decelerate at the move's acceleration).
+//     trapezoid (accelerate, cruise, decelerate at the move's acceleration), ending at the
+//     next move's start (where Klipper's min(end, cruise) would step the speed there, the
+//     cruise is raised to that start: never slower than Klipper).
 // Like grbl, the machine follows the polyline exactly, so the velocity vector steps at every
 // junction crossed above zero.
 #pragma once
