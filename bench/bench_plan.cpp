@@ -21,8 +21,10 @@
 //    (0.5-2.5 rad) and shallow (0.05-0.3 rad) corners, the random walk, the rose and every
 //    drawing in examples/, planned by pathstream and by the reference planners of
 //    bench/reference_planners/ (grbl-style junction deviation, Klipper-style square corner
-//    velocity); pathstream's motion time over theirs, its continuous optimum, and the peers'
-//    largest per-tick velocity step and acceleration sampled from their own profiles.
+//    velocity), each on its own junction rule and held to the per-tick limits (no junction
+//    stepping an axis's velocity by more than a T); pathstream's motion time over theirs, its
+//    continuous optimum, and the peers' largest per-tick velocity step and acceleration
+//    sampled from their own profiles.
 // 3. --scaling (plan_scaling.hpp): 1k, 10k, 100k, 1M-point random walks, each planned in a
 //    forked child with a wall-time limit: time per segment, its ratio to 1k, peak RSS, load.
 // Every pathstream plan goes through check_plan (every tick, the core's setpoints): within the
@@ -35,7 +37,8 @@
 //        bench_plan --self-test
 // Exit status (also printed by --help): 0 every plan passed its check (and the peers are
 // self-consistent); 1 a plan failed its check or could not be made, a peer's result is
-// inconsistent, or a self-test check failed; 2 usage error.
+// inconsistent (or a held peer steps an axis's velocity by more than a T at a junction), or a
+// self-test check failed; 2 usage error.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -382,7 +385,8 @@ constexpr const char* kUsageText =
     "  plotter and prints planning time, motion time against the same planner on a D times denser\n"
     "  grid (default 16) and the continuous optimum, and the check of every executed tick; then\n"
     "  the peer table: pathstream's motion time against grbl-style and Klipper-style reference\n"
-    "  planners on spirals, random polylines, a random walk, a rose and the examples, with the\n"
+    "  planners on spirals, random polylines, a random walk, a rose and the examples, each peer\n"
+    "  on its own junction rule and held to one tick of acceleration per junction, with the\n"
     "  peers' largest per-tick velocity step and acceleration.\n"
     "  --quick          1000 segments, one run, peer paths a tenth the size (the ctest smoke run)\n"
     "  --segments N     segments per path of the grid table (>= 10)\n"
@@ -405,8 +409,8 @@ constexpr const char* kUsageText =
     "1.5 sqrt(2) LSB; the peers' results self-consistent. Times and ratios are printed, never "
     "judged.\n"
     "exit status: 0 every plan passed; 1 a plan failed its check or could not be made, a peer's\n"
-    "result is inconsistent, a scaling size failed to plan, or a self-test check failed; 2 usage\n"
-    "error.\n";
+    "result is inconsistent (or a held peer steps an axis by more than a T at a junction), a\n"
+    "scaling size failed to plan, or a self-test check failed; 2 usage error.\n";
 
 int main(int argc, char** argv) {
     std::size_t segments = 10000;

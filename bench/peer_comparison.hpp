@@ -1,6 +1,7 @@
 // bench_plan's peer table: one drawing planned by pathstream and by the grbl-style and
-// Klipper-style reference planners (bench/reference_planners/) on the same machine limits,
-// their motion times against pathstream's, and what the peers' profiles do at the device tick.
+// Klipper-style reference planners (bench/reference_planners/) on the same machine limits, each
+// peer on its own junction rule and held to the per-tick limits pathstream keeps, their motion
+// times against pathstream's, and what the peers' profiles do at the device tick.
 #pragma once
 
 #include <cstddef>
@@ -13,6 +14,12 @@
 
 namespace pathstream::bench {
 
+/// One peer planner's figures on one drawing.
+struct PeerFigures {
+    double motion = 0;  ///< motion time, s (continuous, dwells excluded)
+    TickFigures ticks;  ///< its profile sampled at the device tick
+};
+
 /// One drawing's figures.
 struct PeerRow {
     std::string name;
@@ -21,15 +28,19 @@ struct PeerRow {
     double motion = 0;              ///< pathstream's motion time, s (whole ticks, dwells excluded)
     double optimum = 0;             ///< PlanStats::reference_motion_time, s (continuous TOPP-RA)
     double acceleration_exact = 0;  ///< pathstream's exact acceleration peak over the limit
-    double grbl = 0, klipper = 0;   ///< the peers' motion times, s (continuous, dwells excluded)
-    TickFigures grbl_ticks, klipper_ticks;
-    /// Empty when pathstream's plan passed its check and both peers are self-consistent
-    /// (positive times, continuous speeds, at rest at stops and at the end, the sampled motion
-    /// ending at the path's end); else what failed.
+    PeerFigures grbl, klipper;      ///< the peers on their own junction rules
+    /// The peers held to the per-tick limits (JunctionRule::per_tick): no axis's velocity steps
+    /// by more than one tick of its acceleration at a junction.
+    PeerFigures grbl_held, klipper_held;
+    /// Empty when pathstream's plan passed its check and all four peer plans are
+    /// self-consistent (positive times, continuous speeds, at rest at stops and at the end, the
+    /// sampled motion ending at the path's end) and the held ones keep every junction's velocity
+    /// step within one tick of acceleration; else what failed.
     std::string problem;
 };
 
-/// Plans `path` with pathstream (default options; check_plan on every tick) and both peers.
+/// Plans `path` with pathstream (default options; check_plan on every tick) and both peers,
+/// each on its own junction rule and held (JunctionRule::per_tick).
 /// Never throws: a failure becomes the row's problem.
 PeerRow compare_with_peers(const std::string& name, const host::Path& path,
                            const host::MachineProfile& profile);

@@ -28,7 +28,7 @@ double grbl_junction_speed2(const host::PathPoint& from, const host::PathPoint& 
 }
 
 PeerPlan plan_grbl_style(std::vector<LineMove> moves, const host::MachineProfile& profile,
-                         double junction_deviation) {
+                         JunctionRule rule, double junction_deviation) {
     const std::size_t n = moves.size();
     std::vector<double> nominal2(n), accel(n), max_entry2(n), entry2(n);
     for (std::size_t k = 0; k < n; ++k) {
@@ -38,8 +38,11 @@ PeerPlan plan_grbl_style(std::vector<LineMove> moves, const host::MachineProfile
         if (k == 0 || moves[k].stop_before) {
             max_entry2[k] = 0;
         } else {
-            const double junction2 =
-                grbl_junction_speed2(moves[k - 1].unit, moves[k].unit, profile, junction_deviation);
+            const host::PathPoint& from = moves[k - 1].unit;
+            const host::PathPoint& to = moves[k].unit;
+            double junction2 = grbl_junction_speed2(from, to, profile, junction_deviation);
+            if (rule == JunctionRule::per_tick)
+                junction2 = std::min(junction2, per_tick_junction_speed2(from, to, profile));
             max_entry2[k] = std::min({junction2, nominal2[k], nominal2[k - 1]});
         }
     }

@@ -11,6 +11,8 @@
 //     the vertex, is followed with centripetal acceleration a_j; a_j is the acceleration limit
 //     along the direction u2 - u1. A reversal gets 0, a straight continuation no limit;
 //     v_j is capped by both moves' nominal speeds;
+//   * held (JunctionRule::per_tick; not grbl's rule, the bench's fair form): v_j is also capped
+//     so that no axis's velocity steps by more than one tick of its acceleration;
 //   * a backward pass from the end (at rest) lowers each entry speed to what the move can
 //     brake from within its length; a forward pass from the start (at rest) lowers it to what
 //     the previous move can reach;
@@ -34,8 +36,10 @@ constexpr double kGrblJunctionDeviation = 0.01;
 double grbl_junction_speed2(const host::PathPoint& from, const host::PathPoint& to,
                             const host::MachineProfile& profile, double junction_deviation);
 
-/// Plans `moves` (flatten_to_lines) with the rules above. O(moves).
+/// Plans `moves` (flatten_to_lines) with the rules above; with JunctionRule::per_tick every
+/// junction speed is also capped by per_tick_junction_speed2 before the passes. O(moves).
 PeerPlan plan_grbl_style(std::vector<LineMove> moves, const host::MachineProfile& profile,
+                         JunctionRule rule = JunctionRule::peer,
                          double junction_deviation = kGrblJunctionDeviation);
 
 }  // namespace pathstream::bench

@@ -18,9 +18,10 @@ struct QueuedMove {
     double max_smoothed2 = 0;
 };
 
-/// The junction caps of `m` after `previous` (unit directions `from`, `to`).
+/// The junction caps of `m` after `previous` (unit directions `from`, `to`); `tick_cap2` is
+/// the per-tick cap (infinite when the peer runs on its own rule).
 void cap_junction(QueuedMove& m, const QueuedMove& previous, const host::PathPoint& from,
-                  const host::PathPoint& to, double junction_deviation) {
+                  const host::PathPoint& to, double junction_deviation, double tick_cap2) {
     double start2 =
         std::min({m.max_cruise2, previous.max_cruise2, previous.max_start2 + previous.delta2});
     double cos_turn = 0;  // -u1.u2: -1 straight on, +1 back
@@ -34,14 +35,17 @@ void cap_junction(QueuedMove& m, const QueuedMove& previous, const host::PathPoi
                            r * junction_deviation * previous.accel, m.delta2 * tan_quarter,
                            previous.delta2 * tan_quarter});
     }
-    m.max_start2 = start2;
-    m.max_smoothed2 = std::min(start2, previous.max_smoothed2 + previous.smooth_delta2);
+    // On top of Klipper's own caps, and before the smoothed cap is derived from them, so that
+    // both lookaheads see the held junction.
+    m.max_start2 = std::min(start2, tick_cap2);
+    m.max_smoothed2 = std::min(m.max_start2, previous.max_smoothed2 + previous.smooth_delta2);
 }
 
 }  // namespace
 
 PeerPlan plan_klipper_style(std::vector<LineMove> moves, const host::MachineProfile& profile,
-                            double square_corner_velocity, double minimum_cruise_ratio) {
+                            JunctionRule rule, double square_corner_velocity,
+                            double minimum_cruise_ratio) {
     double a_max = std::numeric_limits<double>::infinity();
     for (const host::AxisLimits& axis : profile.axes)
         a_max = std::min(a_max, axis.max_acceleration);
@@ -61,7 +65,12 @@ PeerPlan plan_klipper_style(std::vector<LineMove> moves, const host::MachineProf
         if (k == 0 || moves[k].stop_before) {
             m.max_start2 = m.max_smoothed2 = 0;  // from rest
         } else {
-            cap_junction(m, q[k - 1], moves[k - 1].unit, moves[k].unit, junction_deviation);
+            const host::PathPoint& from = moves[k - 1].unit;
+            const host::PathPoint& to = moves[k].unit;
+            const double tick_cap2 = rule == JunctionRule::per_tick
+                                         ? per_tick_junction_speed2(from, to, profile)
+                                         : std::numeric_limits<double>::infinity();
+            cap_junction(m, q[k - 1], from, to, junction_deviation, tick_cap2);
         }
     }
 

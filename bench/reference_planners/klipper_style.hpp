@@ -14,6 +14,8 @@
 //         moves no further than mid-move": the centripetal term of short moves),
 //       - both moves' cruise speeds, and what the previous move can reach from its own
 //         largest start speed (v^2 + 2 a L);
+//       - held (JunctionRule::per_tick; not Klipper's rule, the bench's fair form): the speed
+//         at which no axis's velocity steps by more than one tick of its acceleration;
 //   * smoothed lookahead: a second, slower acceleration a (1 - r) (r = minimum cruise ratio,
 //     default 0.5, Klipper's replacement of max_accel_to_decel = a / 2) is run through the
 //     same junction caps; wherever the smoothed speed profile peaks, the real cruise speed of
@@ -37,8 +39,11 @@ namespace pathstream::bench {
 constexpr double kKlipperSquareCornerVelocity = 5.0;
 constexpr double kKlipperMinimumCruiseRatio = 0.5;
 
-/// Plans `moves` (flatten_to_lines) with the rules above. O(moves).
+/// Plans `moves` (flatten_to_lines) with the rules above; with JunctionRule::per_tick every
+/// move's start speed is also capped by per_tick_junction_speed2, for both lookaheads, before
+/// the backward pass. O(moves).
 PeerPlan plan_klipper_style(std::vector<LineMove> moves, const host::MachineProfile& profile,
+                            JunctionRule rule = JunctionRule::peer,
                             double square_corner_velocity = kKlipperSquareCornerVelocity,
                             double minimum_cruise_ratio = kKlipperMinimumCruiseRatio);
 

@@ -91,6 +91,18 @@ double along_direction_acceleration(const PathPoint& unit, const MachineProfile&
     return a;
 }
 
+double per_tick_junction_speed2(const PathPoint& from, const PathPoint& to,
+                                const MachineProfile& profile) {
+    double v2 = std::numeric_limits<double>::infinity();
+    for (std::size_t i = 0; i < to.size(); ++i) {
+        const double jump = std::fabs(to[i] - from[i]);  // the axis's velocity step per mm/s
+        if (jump == 0) continue;
+        const double v = profile.axes[i].max_acceleration / (profile.tick_hz * jump);
+        v2 = std::min(v2, v * v);
+    }
+    return v2;
+}
+
 TimedMove make_trapezoid(double length, double accel, double v_entry2, double v_cruise2,
                          double v_exit2) {
     TimedMove t;
@@ -118,6 +130,20 @@ double PeerPlan::motion_time() const {
     double t = 0;
     for (const TimedMove& m : timed) t += m.duration();
     return t;
+}
+
+double max_junction_step_fraction(const PeerPlan& plan, const MachineProfile& profile) {
+    double worst = 0;
+    for (std::size_t k = 1; k < plan.moves.size(); ++k) {
+        const PathPoint& from = plan.moves[k - 1].unit;
+        const PathPoint& to = plan.moves[k].unit;
+        const double v = plan.timed[k - 1].v_exit;
+        for (std::size_t i = 0; i < to.size(); ++i) {
+            const double step_limit = profile.axes[i].max_acceleration / profile.tick_hz;
+            worst = std::max(worst, v * std::fabs(to[i] - from[i]) / step_limit);
+        }
+    }
+    return worst;
 }
 
 std::string consistency_problem(const PeerPlan& plan) {

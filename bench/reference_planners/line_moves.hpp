@@ -38,6 +38,23 @@ double along_direction_velocity(const host::PathPoint& unit, const host::Machine
 double along_direction_acceleration(const host::PathPoint& unit,
                                     const host::MachineProfile& profile);
 
+/// Which junction speeds a reference planner allows.
+enum class JunctionRule {
+    /// The peer's own rule only: an axis's velocity may step by any amount at a junction.
+    peer,
+    /// Also capped by per_tick_junction_speed2, so that no axis's velocity steps by more than
+    /// one tick of its acceleration (pathstream's per-tick limit; "held" in the peer table).
+    per_tick,
+};
+
+/// The largest junction speed squared (mm^2/s^2) between moves with unit directions `from` and
+/// `to` at which no axis's velocity steps by more than one tick of its acceleration: a peer
+/// follows the polyline exactly, so axis i's velocity jumps by v (to_i - from_i) within a tick,
+/// and |v (to_i - from_i)| <= a_i / tick_hz gives v^2 <= min over axes of
+/// (a_i / (tick_hz |to_i - from_i|))^2. Infinite when no axis changes. Cost: O(axes).
+double per_tick_junction_speed2(const host::PathPoint& from, const host::PathPoint& to,
+                                const host::MachineProfile& profile);
+
 /// One move's planned speed profile: accelerate at `accel` from v_entry to v_cruise, cruise,
 /// decelerate at `accel` to v_exit (mm/s, mm/s^2; phases may be empty).
 struct TimedMove {
@@ -61,6 +78,11 @@ struct PeerPlan {
     /// ticks, excluded), continuous (not rounded to whole ticks).
     double motion_time() const;
 };
+
+/// The largest velocity jump of one axis at a junction of `plan` (v_exit |to_i - from_i|, the
+/// step a peer takes within one tick) over one tick of that axis's acceleration, a_i / tick_hz:
+/// at most 1 (plus rounding) for plans made with JunctionRule::per_tick. O(moves * axes).
+double max_junction_step_fraction(const PeerPlan& plan, const host::MachineProfile& profile);
 
 /// Empty when `plan` is self-consistent: one profile per move, finite non-negative phase times
 /// and distances adding up to each move's length, speeds within each move's cruise speed and

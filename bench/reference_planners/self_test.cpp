@@ -66,6 +66,12 @@ PeerPlan grbl(std::vector<LineMove> m, const MachineProfile& p) {
 PeerPlan klipper(std::vector<LineMove> m, const MachineProfile& p) {
     return plan_klipper_style(std::move(m), p);
 }
+PeerPlan grbl_held(std::vector<LineMove> m, const MachineProfile& p) {
+    return plan_grbl_style(std::move(m), p, JunctionRule::per_tick);
+}
+PeerPlan klipper_held(std::vector<LineMove> m, const MachineProfile& p) {
+    return plan_klipper_style(std::move(m), p, JunctionRule::per_tick);
+}
 
 /// `cruise_ratio`: the share of a lone short move spent cruising (0 for grbl's triangle).
 void straight_lines(Checker& c, const char* name, Planner plan, double cruise_ratio) {
@@ -142,6 +148,65 @@ void corners(Checker& c) {
            "Klipper stops at a pen change");
 }
 
+/// A closed polyline through `points` (back to the first), one straight segment per side.
+std::vector<LineMove> closed_polyline(const std::vector<PathPoint>& points,
+                                      const MachineProfile& p) {
+    std::vector<BezierSegment> sides;
+    for (std::size_t k = 0; k < points.size(); ++k)
+        sides.push_back(straight(points[k], points[(k + 1) % points.size()]));
+    return flatten_to_lines(sides, p);
+}
+
+/// The held peers (JunctionRule::per_tick) at the corners of `moves`: every junction at
+/// `held_speed`, no junction stepping an axis's velocity by more than a T, and the step sampled
+/// at the tick within `sampled_bound`; the peers on their own rules step by more than a T.
+void held_shape(Checker& c, const std::string& shape, const std::vector<LineMove>& moves,
+                double held_speed, double sampled_bound) {
+    const MachineProfile p = test_profile();
+    const struct {
+        const char* name;
+        Planner own, held;
+    } peers[] = {{"grbl", grbl, grbl_held}, {"Klipper", klipper, klipper_held}};
+    for (const auto& peer : peers) {
+        const std::string n = std::string("held ") + peer.name + " " + shape;
+        const PeerPlan plan = peer.held(moves, p);
+        c.expect(consistency_problem(plan).empty(),
+                 n + " consistent: " + consistency_problem(plan));
+        for (std::size_t k = 0; k + 1 < plan.timed.size(); ++k)
+            c.near(plan.timed[k].v_exit, held_speed, 1e-9, n + " junction " + std::to_string(k));
+        c.near(max_junction_step_fraction(plan, p), 1, 1e-9,
+               n + ": the junctions step an axis by exactly a T");
+        const TickFigures f = sample_at_ticks(plan, p);
+        c.expect(f.max_velocity_step <= sampled_bound + 1e-9,
+                 n + ": sampled velocity step " + std::to_string(f.max_velocity_step) +
+                     " mm/s within " + std::to_string(sampled_bound));
+        c.expect(max_junction_step_fraction(peer.own(moves, p), p) > 1,
+                 std::string(peer.name) + " " + shape + " on its own rule steps by more than a T");
+    }
+}
+
+/// Closed forms of the per-tick cap, min over axes of a_i T / |to_i - from_i| (a T = 3 mm/s).
+/// Sampled at the tick, the second difference straddling a junction at t_j weighs the jump J by
+/// s = 1 - |t_j - t_k| / T and the acceleration around it by a triangle of area T, so it is at
+/// most J s + a T (1 - s^2 / 2) where the axis brakes at a before the junction and stands after,
+/// and J + a T where it runs at a on both sides in the direction of the jump.
+void held_corners(Checker& c) {
+    const MachineProfile p = test_profile();
+    const double a_t = 3000.0 / 1000;
+    // Axis-aligned square: at each corner one axis stops (from v to 0) and the other starts,
+    // |to_i - from_i| = 1 on both, so the held speed is a T = 3 mm/s (under grbl's 10.12 and
+    // Klipper's 5). The stopping axis brakes at a before the corner and stands after it: the
+    // sampled step is at most J + a T / 2 = 1.5 a T (s = 1).
+    held_shape(c, "square", closed_polyline({{0, 0}, {50, 0}, {50, 50}, {0, 50}}, p), a_t,
+               1.5 * a_t);
+    // The square turned by 45 degrees: at each corner one axis reverses, from v / sqrt 2 to
+    // -v / sqrt 2 (|to_i - from_i| = sqrt 2), so the held speed is a T / sqrt 2 = 2.121 mm/s.
+    // That axis brakes at a before the corner and, reversed, speeds up at a after it, both in
+    // the direction of the jump: the sampled step is at most J + a T = 2 a T.
+    held_shape(c, "diamond", closed_polyline({{0, 0}, {25, 25}, {0, 50}, {-25, 25}}, p),
+               a_t / std::sqrt(2.0), 2 * a_t);
+}
+
 void flattening(Checker& c) {
     MachineProfile p = test_profile();
     // A quarter circle of radius 20 as one cubic: every chord within the tolerance of it.
@@ -182,13 +247,18 @@ void random_polylines(Checker& c) {
             at = to;
         }
         const std::vector<LineMove> moves = flatten_to_lines(segs, p);
-        for (Planner plan : {grbl, klipper}) {
+        for (Planner plan : {grbl, klipper, grbl_held, klipper_held}) {
             const PeerPlan result = plan(moves, p);
             const std::string problem = consistency_problem(result);
             c.expect(problem.empty(), "random polyline " + std::to_string(path) + ": " + problem);
             const TickFigures f = sample_at_ticks(result, p);
             c.expect(f.end_error < 1e-9,
                      "random polyline " + std::to_string(path) + " ends at its end");
+            if (plan == grbl_held || plan == klipper_held) {
+                c.expect(max_junction_step_fraction(result, p) <= 1 + 1e-9,
+                         "random polyline " + std::to_string(path) +
+                             ": held junctions within one tick of acceleration");
+            }
         }
     }
 }
@@ -200,6 +270,7 @@ int run_reference_self_test() {
     straight_lines(c, "grbl", grbl, 0);
     straight_lines(c, "Klipper", klipper, kKlipperMinimumCruiseRatio);
     corners(c);
+    held_corners(c);
     flattening(c);
     random_polylines(c);
     std::printf("reference planner self-test: %d of %d checks passed\n", c.run - c.failed, c.run);
