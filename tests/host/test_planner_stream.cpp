@@ -196,3 +196,57 @@ TEST_CASE("PlanChecker on a streamed plan gives check_plan's figures and the cor
     CHECK(check.max_acceleration_fraction_exact == whole.max_acceleration_fraction_exact);
     CHECK(check.axis_max_step == whole.axis_max_step);
 }
+
+TEST_CASE("PlanChecker reading the path as it goes gives check_plan's figures",
+          "[planner][stream]") {
+    // Three subpaths (two travels, feeds per subpath) and, in the long one, more segments than
+    // the deviation's window holds ahead and behind: the window moves along while the figures
+    // stay those of the whole path.
+    Path path;
+    path.axes = 2;
+    for (int c = 0; c < 3; ++c) {
+        Subpath s;
+        s.basis = c == 1 ? PathBasis::kPolyline : PathBasis::kBSpline;
+        s.feed = c == 2 ? 30 : 0;
+        const int n = c == 0 ? 12000 : 40;
+        for (int i = 0; i < n; ++i) {  // a spiral: no turn comes back near an earlier one
+            const double r = 3 + 0.002 * i, a = 0.1 * i;
+            s.points.push_back({60.0 * c + r * std::cos(a), r * std::sin(a)});
+        }
+        path.subpaths.push_back(s);
+    }
+    const MachineProfile p = pen_plotter();
+    const auto segments = to_bezier_segments(path);
+    REQUIRE(segments.size() > 2 * (std::size_t{4096} + 1024));  // PathWindow kAhead, kBehind
+    PlanChecker whole(segments, p);
+    PathSegmentSource planned(path), checked(path);
+    PlanChecker streamed(checked, p);
+    struct Both : PlanSink {
+        PlanChecker& a;
+        PlanChecker& b;
+        Both(PlanChecker& x, PlanChecker& y) : a(x), b(y) {}
+        void span(const CoreSpan& s) override {
+            a.span(s);
+            b.span(s);
+        }
+        void pen(const PenEvent& e) override {
+            a.pen(e);
+            b.pen(e);
+        }
+        void pause(const PlanPause& q) override {
+            a.pause(q);
+            b.pause(q);
+        }
+    } both(whole, streamed);
+    (void)plan_stream(planned, p, PlanOptions{}, both);
+    const PlanCheck w = whole.finish(), s = streamed.finish();
+    CHECK(s.within_limits == w.within_limits);
+    INFO(w.ticks_checked);
+    CHECK(w.max_deviation > 0);
+    CHECK(s.max_deviation == w.max_deviation);
+    CHECK(s.worst_deviation_tick == w.worst_deviation_tick);
+    CHECK(s.ticks_checked == w.ticks_checked);
+    CHECK(s.max_feed_fraction == w.max_feed_fraction);
+    CHECK(s.axis_max_step == w.axis_max_step);
+    CHECK(s.axis_max_second_difference == w.axis_max_second_difference);
+}

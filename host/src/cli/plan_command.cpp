@@ -11,6 +11,7 @@
 #include "pathstream/host/layers.hpp"
 #include "pathstream/host/planner.hpp"
 #include "pathstream/host/progress.hpp"
+#include "pathstream/host/segment_source.hpp"
 #include "pathstream/host/work_area.hpp"
 #include "pathstream/machine/atomic_file.hpp"
 #include "pathstream/machine/input_error.hpp"
@@ -183,7 +184,7 @@ void write_plan_row(const PlannedJob& job, std::uint64_t tick, const std::int64_
 class StreamedPlan : public PlanSink {
 public:
     StreamedPlan(PlannedJob& job, const std::string& file, std::ostream* csv)
-        : job_(job), file_(file), checker_(job.segments, job.machine) {
+        : job_(job), file_(file), checked_path_(job.path), checker_(checked_path_, job.machine) {
         if (csv != nullptr) {
             write_plan_header(job.path.axes, *csv);
             checker_.on_tick(
@@ -202,7 +203,7 @@ public:
     /// Plans the job through this sink; the check's figures and the counts go into the job.
     void run() {
         const auto t0 = std::chrono::steady_clock::now();
-        VectorSegmentSource source(job_.segments);
+        PathSegmentSource source(job_.path);
         PlanTotals totals;
         {
             ProgressBar bar("planning");
@@ -224,6 +225,7 @@ public:
 private:
     PlannedJob& job_;
     const std::string& file_;
+    PathSegmentSource checked_path_;  ///< the check's own pass over the path
     PlanChecker checker_;
 };
 
@@ -236,7 +238,7 @@ int run_plan(const PlanCommandOptions& o) {
     // The plan is streamed: checked, and written as CSV rows when asked, as it is made (an
     // output file appears whole or not at all).
     if (o.preview) return run_plan_preview(o);
-    PlannedJob job = prepare_job(o.path, o.machine, nullptr);
+    PlannedJob job = prepare_streamed_job(o.path, o.machine);
     refuse_long_motion(job, o.max_motion);
     if (o.output.empty()) {
         StreamedPlan(job, o.path.file, nullptr).run();

@@ -6,14 +6,18 @@
 #include "pathstream/host/job_estimate.hpp"
 #include "pathstream/host/planner.hpp"
 #include "pathstream/host/progress.hpp"
+#include "pathstream/host/segment_source.hpp"
 #include "pathstream/host/work_area.hpp"
 #include "pathstream/machine/input_error.hpp"
 
 namespace pathstream::host {
 
 void refuse_long_motion(const PlannedJob& job, double max_motion_s) {
-    if (max_motion_s <= 0 || job.segments.empty()) return;
-    const double estimate = JobEstimate(job.segments, job.machine).model_seconds();
+    if (max_motion_s <= 0) return;
+    PathSegmentSource path(job.path);
+    const double estimate = job.segments.empty()
+                                ? JobEstimate(path, job.machine).model_seconds()
+                                : JobEstimate(job.segments, job.machine).model_seconds();
     if (estimate > max_motion_s) {
         throw PlanError("the job moves for about " + duration_text(estimate) +
                         " (estimated before planning), longer than " + duration_text(max_motion_s) +
@@ -21,8 +25,11 @@ void refuse_long_motion(const PlannedJob& job, double max_motion_s) {
     }
 }
 
-PlannedJob prepare_job(const JobRequest& path_options, const std::string& machine_file,
-                       const std::vector<double>* lead_in_from) {
+namespace {
+
+/// Both files loaded and checked to agree (axis count); no segments made yet.
+PlannedJob load_job(const JobRequest& path_options, const std::string& machine_file,
+                    const std::vector<double>* lead_in_from) {
     PlannedJob job;
     job.machine = load_machine_profile(machine_file);
     // The work area serves --fit area; the lead-in's origin is where the order starts from.
@@ -33,6 +40,22 @@ PlannedJob prepare_job(const JobRequest& path_options, const std::string& machin
                              " axes but " + path_options.file + " has " +
                              std::to_string(job.path.axes));
     }
+    return job;
+}
+
+}  // namespace
+
+PlannedJob prepare_streamed_job(const JobRequest& path_options, const std::string& machine_file) {
+    PlannedJob job = load_job(path_options, machine_file, nullptr);
+    for_each_bezier_segment(job.path, [&](const BezierSegment& s) {
+        check_segment_work_area(s, job.path, job.machine, path_options.file);
+    });
+    return job;
+}
+
+PlannedJob prepare_job(const JobRequest& path_options, const std::string& machine_file,
+                       const std::vector<double>* lead_in_from) {
+    PlannedJob job = load_job(path_options, machine_file, lead_in_from);
     job.segments = to_bezier_segments(job.path);
     check_work_area(job.segments, job.path, job.machine, path_options.file);
     if (lead_in_from != nullptr && !job.segments.empty()) {

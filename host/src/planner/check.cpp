@@ -27,6 +27,7 @@
 
 #include "cubic.hpp"
 #include "jerk_meter.hpp"
+#include "path_window.hpp"
 #include "pathstream/host/geometry.hpp"
 #include "pathstream/host/plan.hpp"
 #include "pathstream/host/planner.hpp"
@@ -217,6 +218,13 @@ TickChecker::TickChecker(const MachineProfile& profile, const std::vector<Bezier
     }
 }
 
+TickChecker::TickChecker(const MachineProfile& profile, SegmentSource& path)
+    : TickChecker(profile, nullptr, false) {
+    do_deviation_ = true;
+    window_ = std::make_unique<PathWindow>(path, 0.5 * profile.chord_tolerance,
+                                           [this](const BezierSegment& s) { feeds_->add(s); });
+}
+
 TickChecker::~TickChecker() = default;
 
 void TickChecker::note_feed(std::size_t subpath, bool pen_down, double feed) {
@@ -253,6 +261,7 @@ void TickChecker::span(const CoreSpan& cs) {
         throw PlanError(m.str());
     }
     ++spans_;
+    if (window_) window_->prepare(cs.subpath, cs.pen_down);
     std::array<std::int64_t, kAxesMax> p{};
     std::array<double, kAxesMax> e{};
     const double feed = feeds_->feed(cs);  // once per span, not per tick
@@ -353,17 +362,18 @@ void TickChecker::visit(const std::array<std::int64_t, kAxesMax>& p,
     // Deviation of a pen-down setpoint.
     const bool down = pen_down_at(k);
     if (!down) have_distance_ = false;
-    if (do_deviation_ && down && !projector_->empty()) {
+    PathProjector* const projector = window_ ? window_->projector() : projector_.get();
+    if (do_deviation_ && down && projector != nullptr && !projector->empty()) {
         if (k == 0 || moved || !have_distance_) {
             Vec q{};
             for (std::size_t a = 0; a < axes_; ++a)
                 q[a] = static_cast<double>(p[a]) * profile_.mm_per_lsb;
             // Only the largest distance matters: the exact search runs where the cheap bound
             // could pass it.
-            distance_ = projector_->follow(q);
+            distance_ = projector->follow(q);
             if (distance_ > out_.max_deviation) {
                 std::size_t seg = 0;
-                distance_ = projector_->distance(q, seg);
+                distance_ = projector->distance(q, seg);
             }
             have_distance_ = true;
         }
@@ -455,6 +465,10 @@ namespace pathstream::host {
 
 PlanChecker::PlanChecker(const std::vector<BezierSegment>& segments, const MachineProfile& profile)
     : impl_(std::make_unique<planner_detail::TickChecker>(profile, &segments, true)),
+      jerk_(std::make_unique<planner_detail::JerkMeter>(profile)) {}
+
+PlanChecker::PlanChecker(SegmentSource& path, const MachineProfile& profile)
+    : impl_(std::make_unique<planner_detail::TickChecker>(profile, path)),
       jerk_(std::make_unique<planner_detail::JerkMeter>(profile)) {}
 
 PlanChecker::~PlanChecker() = default;

@@ -12,6 +12,7 @@
 
 #include "pathstream/host/geometry.hpp"
 #include "pathstream/host/plan.hpp"
+#include "pathstream/host/segment_source.hpp"
 #include "pathstream/machine/core_span.hpp"
 #include "pathstream/machine/machine.hpp"
 #include "vec.hpp"
@@ -21,6 +22,7 @@ namespace pathstream::host::planner_detail {
 class FeedTable;
 class CoreStepper;
 class PathProjector;
+class PathWindow;
 
 /// The per-tick check of check_plan, fed a plan in order (pen events before the spans at
 /// their ticks), so that a streamed plan is checked as it is made.
@@ -29,6 +31,9 @@ public:
     /// `segments` (optional) give the feeds and, with `deviation`, the path to measure from.
     TickChecker(const MachineProfile& profile, const std::vector<BezierSegment>* segments,
                 bool deviation);
+    /// The same with the deviation measured against `path`, read as the check goes (the
+    /// feeds too): memory O(a window of segments), not O(path). `path` must outlive it.
+    TickChecker(const MachineProfile& profile, SegmentSource& path);
     ~TickChecker();
     TickChecker(const TickChecker&) = delete;
     TickChecker& operator=(const TickChecker&) = delete;
@@ -75,6 +80,7 @@ private:
     PlanCheck out_;
     std::array<double, kAxesMax> vlim_{}, alim_{};
     std::unique_ptr<PathProjector> projector_;
+    std::unique_ptr<PathWindow> window_;  ///< instead of projector_, for a path read as it goes
     std::unique_ptr<CoreStepper> stepper_;
     std::vector<std::pair<std::uint64_t, std::uint64_t>> windows_;
     std::vector<PenEvent> pens_;

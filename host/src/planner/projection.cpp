@@ -244,6 +244,26 @@ double PathProjector::segment_distance(std::size_t i, const Vec& p, double bound
     return std::sqrt(best);
 }
 
+PathProjector::Cursor PathProjector::cursor() const {
+    Cursor c;
+    c.segment = started_ && cursor_ < index_.size() ? index_[cursor_] : 0;
+    c.u = last_u_;
+    c.p = last_p_;
+    c.d = last_d_;
+    c.started = started_ && cursor_ < index_.size();
+    return c;
+}
+
+void PathProjector::resume(const Cursor& c) {
+    const auto it = std::lower_bound(index_.begin(), index_.end(), c.segment);
+    if (!c.started || it == index_.end() || *it != c.segment) return;
+    cursor_ = static_cast<std::size_t>(it - index_.begin());
+    last_u_ = c.u;
+    last_p_ = c.p;
+    last_d_ = c.d;
+    started_ = true;
+}
+
 double PathProjector::follow(const Vec& p) {
     if (!started_ || cursor_ >= segs_.size()) return std::numeric_limits<double>::infinity();
     double u = last_u_;

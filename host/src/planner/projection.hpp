@@ -31,6 +31,20 @@ public:
     double follow(const Vec& p);
     bool empty() const { return segs_.empty(); }
 
+    /// Where the search stands: the segment of the last answer (as indexed) and its parameter,
+    /// the point asked and its distance.
+    struct Cursor {
+        std::size_t segment = 0;
+        double u = 0;
+        Vec p{};
+        double d = 0;
+        bool started = false;
+    };
+    Cursor cursor() const;
+    /// Continues from another projector's cursor (over an overlapping set of segments): when
+    /// its segment is here, the next search starts there; else as if nothing was asked yet.
+    void resume(const Cursor& c);
+
 private:
     /// Distance from p to segment i when it is below `bound` (mm), else a value >= bound;
     /// `at` (optional) gets the parameter of the nearest point when one below bound is found.

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "pathstream/host/segment_source.hpp"
+
 namespace pathstream::host {
 namespace {
 
@@ -42,12 +44,24 @@ AxisCaps axis_caps(const BezierSegment& s, const MachineProfile& profile) {
 
 JobEstimate::JobEstimate(const std::vector<BezierSegment>& segments, const MachineProfile& profile)
     : tick_hz_(profile.tick_hz) {
-    length_.reserve(segments.size() + 1);
-    seconds_.reserve(segments.size() + 1);
+    VectorSegmentSource source(segments);
+    add(source, profile);
+}
+
+JobEstimate::JobEstimate(SegmentSource& source, const MachineProfile& profile)
+    : tick_hz_(profile.tick_hz) {
+    add(source, profile);
+    source.rewind();
+}
+
+void JobEstimate::add(SegmentSource& source, const MachineProfile& profile) {
+    length_.reserve(source.size_hint() + 1);
+    seconds_.reserve(source.size_hint() + 1);
     length_.push_back(0);
     seconds_.push_back(0);
-    for (std::size_t k = 0; k < segments.size(); ++k) {
-        const BezierSegment& s = segments[k];
+    BezierSegment s;
+    bool first = true, previous_pen_down = false;
+    while (source.next(s)) {
         const double feed = s.feed > 0 ? s.feed : (s.pen_down ? profile.feed : profile.travel_feed);
         const AxisCaps caps = axis_caps(s, profile);
         const double v = std::max(1e-6, std::min(feed, caps.velocity));
@@ -55,11 +69,13 @@ JobEstimate::JobEstimate(const std::vector<BezierSegment>& segments, const Machi
         double t = mm / v + s.dwell_before;
         // Rest at the start of this segment: a stop before it and a start after (each v / 2a
         // longer than at full speed).
-        const bool rest = k == 0 || s.pen_down != segments[k - 1].pen_down || s.pause_before ||
+        const bool rest = first || s.pen_down != previous_pen_down || s.pause_before ||
                           s.stop_before || s.dwell_before > 0;
         if (rest && caps.acceleration > 0) t += v / caps.acceleration;
         length_.push_back(length_.back() + mm);
         seconds_.push_back(seconds_.back() + t);
+        first = false;
+        previous_pen_down = s.pen_down;
     }
 }
 

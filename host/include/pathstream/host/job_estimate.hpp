@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "pathstream/host/geometry.hpp"
+#include "pathstream/host/segment_source.hpp"
 #include "pathstream/machine/machine.hpp"
 
 namespace pathstream::host {
@@ -19,6 +20,8 @@ namespace pathstream::host {
 class JobEstimate {
 public:
     JobEstimate(const std::vector<BezierSegment>& segments, const MachineProfile& profile);
+    /// The same from every segment of `source`, which is rewound after (16 bytes a segment).
+    JobEstimate(SegmentSource& source, const MachineProfile& profile);
 
     /// The model's seconds for the whole job.
     double model_seconds() const { return seconds_.back(); }
@@ -32,6 +35,8 @@ public:
     std::uint64_t total_ticks(double planned_mm, std::uint64_t planned_ticks) const;
 
 private:
+    void add(SegmentSource& source, const MachineProfile& profile);
+
     std::vector<double> length_;   ///< mm of path before segment k (k = 0 .. segments)
     std::vector<double> seconds_;  ///< the model's seconds before segment k
     double tick_hz_;

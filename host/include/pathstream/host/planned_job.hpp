@@ -30,6 +30,11 @@ struct PlannedJob {
 PlannedJob prepare_job(const JobRequest& request, const std::string& machine_file,
                        const std::vector<double>* lead_in_from = nullptr);
 
+/// prepare_job without the segment list (segments stays empty): the work area is checked
+/// segment by segment and a planner or check reads the path through PathSegmentSource, so
+/// that memory holds the path and nothing per segment. No lead-in.
+PlannedJob prepare_streamed_job(const JobRequest& request, const std::string& machine_file);
+
 /// Loads both files, checks they agree (axis count), plans with a progress bar and checks
 /// every tick. Throws InputError for bad files, PlanError when planning fails.
 /// `lead_in_from` (mm per axis, optional): the machine's position; when it is not the path's
@@ -38,7 +43,7 @@ PlannedJob plan_job(const JobRequest& request, const std::string& machine_file,
                     const std::vector<double>* lead_in_from = nullptr);
 
 /// Throws PlanError when the job's estimated motion time passes `max_motion_s` (> 0), naming
-/// both; before any planning.
+/// both; before any planning. From the segments, or from the path when there are none.
 void refuse_long_motion(const PlannedJob& job, double max_motion_s);
 
 }  // namespace pathstream::host

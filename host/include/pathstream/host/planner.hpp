@@ -155,6 +155,10 @@ class JerkMeter;
 class PlanChecker : public PlanSink {
 public:
     PlanChecker(const std::vector<BezierSegment>& segments, const MachineProfile& profile);
+    /// The same with the path read from `path` as the check goes (its own source: not the one
+    /// being planned), so that memory stays flat: the deviation is then measured against the
+    /// path near the motion (docs/planner.md §7), never below check_plan's.
+    PlanChecker(SegmentSource& path, const MachineProfile& profile);
     ~PlanChecker() override;
     void span(const CoreSpan& span) override;
     void pen(const PenEvent& event) override;
