@@ -16,6 +16,7 @@
 #include "pathstream/host/core_playback.hpp"
 #include "pathstream/host/geometry.hpp"
 #include "pathstream/host/planner.hpp"
+#include "pathstream/host/segment_source.hpp"
 #include "pen_plotter_profile.hpp"
 #include "random_walk_source.hpp"
 
@@ -249,4 +250,29 @@ TEST_CASE("PlanChecker reading the path as it goes gives check_plan's figures",
     CHECK(s.max_feed_fraction == w.max_feed_fraction);
     CHECK(s.axis_max_step == w.axis_max_step);
     CHECK(s.axis_max_second_difference == w.axis_max_second_difference);
+}
+
+TEST_CASE("a slow job's windows hold a bounded number of spans, not the job", "[planner][stream]") {
+    // 100 straight 2 mm moves at 10 mm/min (about 2.6 M ticks with the corner stops), far
+    // fewer segments than a window reads: its reading stops at about window_ticks of motion
+    // (more where the window must reach past the stopping distance at the machine's feed).
+    Path path;
+    path.axes = 2;
+    Subpath s;
+    s.basis = PathBasis::kPolyline;
+    s.feed = 10.0 / 60;
+    for (int i = 0; i <= 100; ++i) s.points.push_back({10 + 1.5 * i, 10 + 1.3 * (i % 2)});
+    path.subpaths.push_back(s);
+    const MachineProfile p = pen_plotter();
+    PathSegmentSource source(path);
+    CountingSink sink;
+    PlanStats stats;
+    const PlanOptions o;
+    const PlanTotals totals = plan_stream(source, p, o, sink, &stats);
+    CHECK(sink.discontinuities == 0);
+    CHECK(totals.total_ticks > 1400000);
+    INFO("spans " << totals.spans << ", ticks per span " << stats.ticks_per_span);
+    CHECK(stats.max_window_spans > 0);
+    CHECK(stats.max_window_spans * stats.ticks_per_span < 4 * o.window_ticks);
+    CHECK(stats.max_window_spans < totals.spans / 3);
 }

@@ -209,28 +209,54 @@ private:
         return false;
     }
 
-    /// Reads until `want` segments lie at or after the carry's segment, or the path ends.
+    /// Reads until `want` segments lie at or after the carry's segment, or they would take
+    /// about window_ticks (times want over the usual count) at their feeds, or the path ends:
+    /// a slow job's window holds a bounded number of spans, not hours of them.
     void read(std::size_t want) {
-        while (!exhausted_ && buffer_.size() - (carry_.segment - base_) < want) {
+        const double tick_cap =
+            static_cast<double>(std::max<std::uint64_t>(options_.window_ticks, 1000)) *
+            static_cast<double>(want) / static_cast<double>(window_segments());
+        double ticks = 0;
+        for (std::size_t i = carry_.segment - base_; i < buffer_.size(); ++i)
+            ticks += nominal_ticks(buffer_[i]);
+        while (!exhausted_ && buffer_.size() - (carry_.segment - base_) < want &&
+               ticks < tick_cap) {
             BezierSegment s;
             if (!source_.next(s)) {
                 exhausted_ = true;
                 break;
             }
             account(s);
+            ticks += nominal_ticks(s);
             next_.feeds.push_back({s.subpath, s.pen_down, s.feed});
             top_speed_ = std::max(top_speed_, std::min(v_axes_, s.feed));
             buffer_.push_back(std::move(s));
         }
     }
 
+    /// Ticks a segment takes at its feed (at most the axes' combined speed), not counting
+    /// speed changes: enough to bound a window's length in time.
+    double nominal_ticks(const BezierSegment& s) const {
+        const double length = segment_length(s);
+        const double feed =
+            s.feed > 0 ? s.feed : (s.pen_down ? profile_.feed : profile_.travel_feed);
+        const double speed = std::min(v_axes_, feed);
+        return speed > 0 ? length / speed * profile_.tick_hz : 0.0;
+    }
+
+    /// Arc length of a segment, mm (0 for a degenerate one or one with the wrong axis count).
+    double segment_length(const BezierSegment& s) const {
+        if (s.p[0].size() != profile_.axes.size()) return 0;  // build_grid reports it
+        const Cubic c = to_cubic(s);
+        if (c.size() < 1e-9) return 0;
+        const double length = arc_length(c, 0, 0.5) + arc_length(c, 0.5, 1);
+        return length >= 1e-9 ? length : 0.0;
+    }
+
     /// The pen-down and travel length of a new segment (degenerate ones count nothing).
     void account(const BezierSegment& s) {
-        if (s.p[0].size() != profile_.axes.size()) return;  // build_grid reports it
-        const Cubic c = to_cubic(s);
-        if (c.size() < 1e-9) return;
-        const double length = arc_length(c, 0, 0.5) + arc_length(c, 0.5, 1);
-        if (!(length >= 1e-9)) return;
+        const double length = segment_length(s);
+        if (length <= 0) return;
         (s.pen_down ? pen_down_length_ : travel_length_) += length;
         last_subpath_ = s.subpath;
     }
@@ -442,6 +468,10 @@ private:
     bool deliver() {
         if (!collect_checked()) return false;
         emitter().take(next_.events);
+        const auto window_spans = static_cast<std::size_t>(
+            std::count_if(next_.events.begin(), next_.events.end(),
+                          [](const PlanEvent& e) { return e.kind == PlanEvent::Kind::kSpan; }));
+        st_.max_window_spans = std::max(st_.max_window_spans, window_spans);
         check_.submit(next_);
         next_.feeds.clear();
         return true;

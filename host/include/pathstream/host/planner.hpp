@@ -57,6 +57,9 @@ struct PlanOptions {
     /// Segments read per window of plan_stream (plan_path too): memory grows with this, not
     /// with the job. A window is read further where its lookahead horizon needs it.
     std::size_t window_segments = 2048;
+    /// ...and at most about this many ticks of motion at the segments' feeds (a window's spans
+    /// are held until its check passes: this bounds a slow job's memory).
+    std::uint64_t window_ticks = 250000;
 
     /// plan_stream checks each window tick by tick on a second thread while it plans the next
     /// (on a machine with more than one core): the same spans, sooner. False: one thread.
@@ -89,6 +92,9 @@ struct PlanStats {
     /// With a jerk limit: motion ticks the jerk stage added to the second-order plan (the
     /// filter's length and the rest at the end of every piece), else 0.
     std::uint64_t jerk_added_ticks = 0;
+    /// plan_stream: the most spans one window held before it went to the check (bounded by
+    /// the window's length in segments and in ticks, not by the job).
+    std::size_t max_window_spans = 0;
 };
 
 /// Plans `segments` (consecutive, continuous; to_bezier_segments makes them) for `profile`:
