@@ -49,6 +49,7 @@
 #include <string>
 #include <vector>
 
+#include "cli_scaling.hpp"
 #include "pathstream/host/geometry.hpp"
 #include "pathstream/host/planner.hpp"
 #include "peer_comparison.hpp"
@@ -395,7 +396,8 @@ constexpr const char* kUsageText =
     "  --no-peers       the grid table only\n"
     "  --markdown       the tables in Markdown\n"
     "  --scaling        planning time and peak memory of 1k, 10k, 100k and 1M-point random walks,\n"
-    "                   each in its own process (this table only)\n"
+    "                   each in its own process; then the same walks as files through\n"
+    "                   `pathstream plan` and `pathstream sim` (these tables only)\n"
     "  --max-segments N largest scaling size (default 1000000)\n"
     "  --timeout S      wall seconds a scaling size may take (default 300)\n"
     "  --jerk           the cost of a jerk limit: motion and planning time with max_jerk 1e5 and\n"
@@ -479,6 +481,10 @@ int main(int argc, char** argv) {
         const std::vector<ScalingRow> rows = run_scaling(scaling_options, profile);
         print_scaling(rows, scaling_options, markdown);
         ok = scaling_passed(rows);
+        const std::vector<CliRow> commands = run_cli_scaling(
+            scaling_options, PATHSTREAM_CLI, kSource + "/examples/machines/pen_plotter.json");
+        print_cli_scaling(commands, rows, markdown);
+        ok = cli_scaling_passed(commands) && ok;
     } else {
         ok = run_grid_table(segments, density, runs, markdown, profile);
         if (peers) ok = run_peer_table(quick, markdown, profile) && ok;

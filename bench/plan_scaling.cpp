@@ -27,6 +27,15 @@
 
 namespace pathstream::bench {
 
+std::array<double, 2> RandomWalk::next() {
+    const std::array<double, 2> at{x_, y_};
+    heading_ += turn_(rng_);
+    x_ += 1.5 * std::cos(heading_);
+    y_ += 1.5 * std::sin(heading_);
+    if (std::fabs(x_) > 100 || std::fabs(y_) > 100) heading_ = std::atan2(-y_, -x_) + turn_(rng_);
+    return at;
+}
+
 namespace {
 
 /// What a child writes to its pipe: once after planning, once after the check.
@@ -113,8 +122,7 @@ public:
         return true;
     }
     bool rewind() override {
-        rng_.seed(20261122);
-        x_ = y_ = heading_ = 0;
+        walk_ = RandomWalk{};
         made_.clear();
         window_.clear();
         window_index_ = -1;
@@ -138,17 +146,12 @@ private:
         }
         return walk(static_cast<std::size_t>(i));
     }
-    /// Points of the walk, the last few kept (as wander_path makes them).
+    /// Points of the walk, the last few kept.
     std::array<double, 2> walk(std::size_t i) {
         while (made_.empty() || made_.back().first < i) {
             const std::size_t k = made_.empty() ? 0 : made_.back().first + 1;
-            made_.push_back({k, {x_, y_}});
+            made_.push_back({k, walk_.next()});
             if (made_.size() > 4) made_.erase(made_.begin());
-            heading_ += turn_(rng_);
-            x_ += 1.5 * std::cos(heading_);
-            y_ += 1.5 * std::sin(heading_);
-            if (std::fabs(x_) > 100 || std::fabs(y_) > 100)
-                heading_ = std::atan2(-y_, -x_) + turn_(rng_);
         }
         for (const auto& [k, p] : made_) {
             if (k == i) return p;
@@ -157,9 +160,7 @@ private:
     }
 
     std::size_t points_;
-    std::mt19937_64 rng_;
-    std::normal_distribution<double> turn_{0, 0.25};
-    double x_ = 0, y_ = 0, heading_ = 0;
+    RandomWalk walk_;
     std::vector<std::pair<std::size_t, std::array<double, 2>>> made_;
     std::vector<std::array<double, 2>> window_;
     long window_index_ = -1;

@@ -5,13 +5,28 @@
 // that takes too long or too much memory is stopped without stopping the bench.
 #pragma once
 
+#include <array>
 #include <cstddef>
+#include <random>
 #include <string>
 #include <vector>
 
 #include "pathstream/machine/machine.hpp"
 
 namespace pathstream::bench {
+
+/// The scaling table's random walk: 1.5 mm steps whose heading turns by a normal(0, 0.25) rad,
+/// steered back towards the middle when it leaves a 200 mm square; the same points every time.
+class RandomWalk {
+public:
+    /// The next point (the first is 0, 0).
+    std::array<double, 2> next();
+
+private:
+    std::mt19937_64 rng_{20261122};
+    std::normal_distribution<double> turn_{0, 0.25};
+    double x_ = 0, y_ = 0, heading_ = 0;
+};
 
 struct ScalingOptions {
     std::size_t max_segments = 1'000'000;  ///< sizes above this are skipped
