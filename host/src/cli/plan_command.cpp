@@ -4,6 +4,7 @@
 #include <cmath>
 #include <iostream>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <stdexcept>
 
 #include "pathstream/host/core_playback.hpp"
@@ -179,40 +180,49 @@ void write_plan_row(const PlannedJob& job, std::uint64_t tick, const std::int64_
     csv << ',' << (pen_down ? 1 : 0) << '\n';
 }
 
-/// The plan as it is made: into the per-tick check (whose ticks become CSV rows when `csv` is
-/// given) and through the device's travel check, span by span; nothing of it is kept.
+/// The plan as it is made, span by span, through the device's travel check; with `csv`, also
+/// through a second per-tick check whose ticks become the CSV rows. Without, plan_stream's own
+/// check gives the figures (deviation against the path read alongside): every tick is stepped
+/// once. Nothing of the plan is kept.
 class StreamedPlan : public PlanSink {
 public:
     StreamedPlan(PlannedJob& job, const std::string& file, std::ostream* csv)
-        : job_(job), file_(file), checked_path_(job.path), checker_(checked_path_, job.machine) {
+        : job_(job), file_(file), checked_path_(job.path) {
         if (csv != nullptr) {
+            checker_.emplace(checked_path_, job.machine);
             write_plan_header(job.path.axes, *csv);
-            checker_.on_tick(
+            checker_->on_tick(
                 [this, csv](std::uint64_t tick, const std::int64_t* setpoint, bool pen_down) {
                     write_plan_row(job_, tick, setpoint, pen_down, *csv);
                 });
         }
     }
     void span(const CoreSpan& s) override {
-        check_span_travel(s, checker_.spans(), job_.path, job_.machine, file_);
-        checker_.span(s);
+        check_span_travel(s, spans_++, job_.path, job_.machine, file_);
+        if (checker_) checker_->span(s);
     }
-    void pen(const PenEvent& e) override { checker_.pen(e); }
-    void pause(const PlanPause& p) override { checker_.pause(p); }
+    void pen(const PenEvent& e) override {
+        if (checker_) checker_->pen(e);
+    }
+    void pause(const PlanPause& p) override {
+        if (checker_) checker_->pause(p);
+    }
 
     /// Plans the job through this sink; the check's figures and the counts go into the job.
     void run() {
         const auto t0 = std::chrono::steady_clock::now();
         PathSegmentSource source(job_.path);
         PlanTotals totals;
+        StreamCheck own;
+        if (!checker_) own.path = &checked_path_;
         {
             ProgressBar bar("planning");
-            totals = plan_stream(source, job_.machine, PlanOptions{}, *this, nullptr,
+            totals = plan_stream(source, job_.machine, PlanOptions{}, *this, &own, nullptr,
                                  [&](double f) { bar.update(f); });
         }
         job_.planning_seconds =
             std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-        job_.check = checker_.finish();
+        job_.check = checker_ ? checker_->finish() : own.result;
         job_.plan.total_ticks = totals.total_ticks;
         job_.plan.duration = totals.duration;
         job_.plan.path_length = totals.path_length;
@@ -226,7 +236,8 @@ private:
     PlannedJob& job_;
     const std::string& file_;
     PathSegmentSource checked_path_;  ///< the check's own pass over the path
-    PlanChecker checker_;
+    std::optional<PlanChecker> checker_;
+    std::size_t spans_ = 0;
 };
 
 }  // namespace

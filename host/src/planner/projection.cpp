@@ -273,7 +273,10 @@ double PathProjector::follow(const Vec& p) {
             const Vec d = sub(c.point(u), p), d1 = c.d1(u), d2 = c.d2(u);
             const double f = dot(d, d1), df = dot(d1, d1) + dot(d, d2);
             if (!(df > 0)) break;
-            u = std::clamp(u - f / df, 0.0, 1.0);
+            const double next = std::clamp(u - f / df, 0.0, 1.0);
+            const bool settled = std::fabs(next - u) < 1e-10;  // any further step moves < 1 nm
+            u = next;
+            if (settled) break;
         }
         if (u >= 1 && cursor_ + 1 < segs_.size() && segs_[cursor_ + 1].p[0] == c.p[3]) {
             ++cursor_;

@@ -14,6 +14,7 @@
 #include <cstdint>
 #include <functional>
 #include <limits>
+#include <memory>
 #include <optional>
 #include <sstream>
 #include <string>
@@ -28,6 +29,7 @@
 #include "forward_pass.hpp"
 #include "grid.hpp"
 #include "jerk.hpp"
+#include "jerk_meter.hpp"
 #include "limits.hpp"
 #include "lsb_rounding.hpp"
 #include "pathstream/host/geometry.hpp"
@@ -95,7 +97,7 @@ class WindowPlanner {
 public:
     WindowPlanner(SegmentSource& source, const MachineProfile& profile, const PlanOptions& options,
                   const Limits& limits, PlanSink& sink, PlanStats& stats, Progress& report,
-                  double lo, double hi)
+                  double lo, double hi, SegmentSource* check_path)
         : source_(source),
           profile_(profile),
           options_(options),
@@ -105,7 +107,9 @@ public:
           report_(report),
           lo_(lo),
           hi_(hi),
-          checker_(profile, nullptr, false),
+          checker_(check_path != nullptr ? std::make_unique<TickChecker>(profile, *check_path)
+                                         : std::make_unique<TickChecker>(profile, nullptr, false)),
+          jerk_meter_(profile),
           check_([this](const CheckBatch& batch) { return check_batch(batch); },
                  options.check_on_thread && std::thread::hardware_concurrency() > 1
                      ? HandoffWorker<CheckBatch>::Mode::kThread
@@ -175,7 +179,8 @@ public:
                                   static_cast<double>(total_));
         }
         if (!collect_checked()) return fail(check);
-        check = checker_.finish();
+        check = checker_->finish();
+        jerk_meter_.finish(check);
         if (!check.within_limits) return false;
         totals.spans = spans_;
         totals.pen_changes = pens_;
@@ -205,7 +210,7 @@ private:
     /// a failed jerk stage) is first finished and, if it passed, sent as it would have been.
     bool fail(PlanCheck& check) {
         (void)collect_checked();
-        check = checker_.finish();
+        check = checker_->finish();
         return false;
     }
 
@@ -505,14 +510,17 @@ private:
     /// The check's job (on its thread): the batch's feeds, then its events tick by tick; true
     /// when every tick so far is within the limits.
     bool check_batch(const CheckBatch& batch) {
-        for (const FeedNote& f : batch.feeds) checker_.note_feed(f.subpath, f.pen_down, f.feed);
+        for (const FeedNote& f : batch.feeds) checker_->note_feed(f.subpath, f.pen_down, f.feed);
         for (const PlanEvent& e : batch.events) {
             if (e.kind == PlanEvent::Kind::kSpan)
-                checker_.span(e.span);
+            {
+                checker_->span(e.span);
+                jerk_meter_.span(e.span);
+            }
             else if (e.kind == PlanEvent::Kind::kPen)
-                checker_.pen(e.pen);
+                checker_->pen(e.pen);
         }
-        return !checker_.over_limits();
+        return !checker_->over_limits();
     }
 
     CheckBatch next_;     ///< the feeds read and then the events of the window being planned
@@ -525,7 +533,8 @@ private:
     PlanStats& st_;
     Progress& report_;
     double lo_, hi_;
-    TickChecker checker_;
+    std::unique_ptr<TickChecker> checker_;
+    JerkMeter jerk_meter_;  ///< the jerk figures of the PlanCheck (plan_stream's `check`)
     std::optional<SpanEmitter> emitter_;
     JerkSetup jerk_setup_;
     std::optional<JerkStage> jerk_;
@@ -549,6 +558,12 @@ private:
 PlanTotals plan_stream(SegmentSource& source, const MachineProfile& machine_profile,
                        const PlanOptions& requested, PlanSink& sink, PlanStats* stats,
                        const std::function<void(double fraction)>& progress) {
+    return plan_stream(source, machine_profile, requested, sink, nullptr, stats, progress);
+}
+
+PlanTotals plan_stream(SegmentSource& source, const MachineProfile& machine_profile,
+                       const PlanOptions& requested, PlanSink& sink, StreamCheck* stream_check,
+                       PlanStats* stats, const std::function<void(double fraction)>& progress) {
     const PlanOptions options = profile_options(requested, machine_profile);
     validate_plan_inputs(machine_profile, options);
     MachineProfile profile = machine_profile;  // what is planned with: spans of regular_span_ticks
@@ -582,8 +597,13 @@ PlanTotals plan_stream(SegmentSource& source, const MachineProfile& machine_prof
     for (int attempt = 0;; ++attempt) {
         PlanCheck check;
         PlanTotals totals;
-        WindowPlanner planner(input, profile, options, limits, sink, st, report, lo, hi);
+        SegmentSource* const check_path = stream_check != nullptr ? stream_check->path : nullptr;
+        if (check_path != nullptr && attempt > 0 && !check_path->rewind())
+            throw PlanError("the plan needs lowered limits but the checked path cannot rewind");
+        WindowPlanner planner(input, profile, options, limits, sink, st, report, lo, hi,
+                              check_path);
         if (planner.run(check, totals)) {
+            if (stream_check != nullptr) stream_check->result = check;
             st.jerk_filter_ticks = planner.jerk_filter_ticks();
             st.jerk_added_ticks = planner.jerk_added_ticks();
             report(1);

@@ -150,6 +150,23 @@ PlanTotals plan_stream(SegmentSource& source, const MachineProfile& profile,
                        const PlanOptions& options, PlanSink& sink, PlanStats* stats = nullptr,
                        const std::function<void(double fraction)>& progress = {});
 
+/// What plan_stream's own per-tick check measures beyond the limits, for a caller that wants
+/// the whole PlanCheck without checking the plan a second time.
+struct StreamCheck {
+    /// The path to measure the deviation from: a pass of its own over the planned path (not
+    /// the planner's source), read as the check goes (PlanChecker(SegmentSource&) explains
+    /// the window). Null: no deviation (0 in the result).
+    SegmentSource* path = nullptr;
+    /// When planning succeeded: the figures of the whole plan, jerk included (check_plan's).
+    PlanCheck result;
+};
+
+/// plan_stream with its check's figures in `check` (optional).
+PlanTotals plan_stream(SegmentSource& source, const MachineProfile& profile,
+                       const PlanOptions& options, PlanSink& sink, StreamCheck* check,
+                       PlanStats* stats = nullptr,
+                       const std::function<void(double fraction)>& progress = {});
+
 namespace planner_detail {
 class TickChecker;
 class JerkMeter;
