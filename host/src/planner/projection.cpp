@@ -270,8 +270,19 @@ double PathProjector::follow(const Vec& p) {
     for (int hop = 0; hop < 4; ++hop) {
         const Cubic& c = segs_[cursor_];
         for (int it = 0; it < 4; ++it) {
-            const Vec d = sub(c.point(u), p), d1 = c.d1(u), d2 = c.d2(u);
-            const double f = dot(d, d1), df = dot(d1, d1) + dot(d, d2);
+            // Newton on (q(u) - p) . q'(u) = 0 over the used axes only (this runs every tick).
+            const double v = 1 - u;
+            double f = 0, df = 0;
+            for (std::size_t i = 0; i < c.axes; ++i) {
+                const double p0 = c.p[0][i], p1 = c.p[1][i], p2 = c.p[2][i], p3 = c.p[3][i];
+                const double a = v * p0 + u * p1, b = v * p1 + u * p2, e = v * p2 + u * p3;
+                const double d = v * (v * a + u * b) + u * (v * b + u * e) - p[i];
+                const double d1 =
+                    3 * (v * v * (p1 - p0) + 2 * u * v * (p2 - p1) + u * u * (p3 - p2));
+                const double d2 = 6 * (v * (p2 - 2 * p1 + p0) + u * (p3 - 2 * p2 + p1));
+                f += d * d1;
+                df += d1 * d1 + d * d2;
+            }
             if (!(df > 0)) break;
             const double next = std::clamp(u - f / df, 0.0, 1.0);
             const bool settled = std::fabs(next - u) < 1e-10;  // any further step moves < 1 nm
