@@ -486,7 +486,7 @@ int stream_while_planning(const PlannedJob& job, const StreamCommandOptions& o,
     const std::string spans_file =
         journal_path.empty() ? "" : std::filesystem::absolute(journal_path + ".plan").string();
     StreamPlanTap tap(job, o.path.file, spans_file);
-    VectorSegmentSource source(job.segments);
+    PathSegmentSource source(job.path, job.lead_in);
     PlanningThread planning(source, job.machine, PlanOptions{},
                             {&tap, [&tap](const PlanTotals& totals) { tap.finish(totals); }});
     {
@@ -508,7 +508,8 @@ int stream_while_planning(const PlannedJob& job, const StreamCommandOptions& o,
         CoreSpan none;
         (void)planning.take(none);
     }
-    const JobEstimate estimate(job.segments, job.machine);
+    PathSegmentSource estimated(job.path, job.lead_in);
+    const JobEstimate estimate(estimated, job.machine);
     return stream_job({planning, nullptr, &planning, &tap, &job.path, job.path.subpaths.size(),
                        [&estimate, &tap]() -> std::optional<std::uint64_t> {
                            const StreamPlanTap::Planned p = tap.planned();
@@ -623,7 +624,8 @@ int run_stream(const StreamCommandOptions& o) {
             std::filesystem::absolute(journal_path + ".input").string());
         journal.replan = job_recipe_json(recipe);
     }
-    const PlannedJob prepared = prepare_job(path, o.machine, lead_in ? &rest_mm : nullptr);
+    const PlannedJob prepared =
+        prepare_streamed_job(path, o.machine, lead_in ? &rest_mm : nullptr);
     if (lead_in) print_lead_in(prepared, rest_mm);
     return stream_while_planning(prepared, o, journal, journal_path, channel);
 }

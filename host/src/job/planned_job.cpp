@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <stdexcept>
 
 #include "pathstream/host/job_estimate.hpp"
 #include "pathstream/host/planner.hpp"
@@ -14,7 +15,7 @@ namespace pathstream::host {
 
 void refuse_long_motion(const PlannedJob& job, double max_motion_s) {
     if (max_motion_s <= 0) return;
-    PathSegmentSource path(job.path);
+    PathSegmentSource path(job.path, job.lead_in);
     const double estimate = job.segments.empty()
                                 ? JobEstimate(path, job.machine).model_seconds()
                                 : JobEstimate(job.segments, job.machine).model_seconds();
@@ -45,11 +46,31 @@ PlannedJob load_job(const JobRequest& path_options, const std::string& machine_f
 
 }  // namespace
 
-PlannedJob prepare_streamed_job(const JobRequest& path_options, const std::string& machine_file) {
-    PlannedJob job = load_job(path_options, machine_file, nullptr);
+/// Whether the machine resting at `from` (mm) is at `start` on the LSB grid: the device rests
+/// on the grid, and a travel shorter than an LSB would be a span that goes nowhere.
+bool rests_at(const std::vector<double>& from, const PathPoint& start, double mm_per_lsb) {
+    bool at = from.size() == start.size();
+    for (std::size_t a = 0; at && a < start.size(); ++a)
+        at = std::llround(from[a] / mm_per_lsb) == std::llround(start[a] / mm_per_lsb);
+    return at;
+}
+
+PlannedJob prepare_streamed_job(const JobRequest& path_options, const std::string& machine_file,
+                                const std::vector<double>* lead_in_from) {
+    PlannedJob job = load_job(path_options, machine_file, lead_in_from);
+    bool first = true;
     for_each_bezier_segment(job.path, [&](const BezierSegment& s) {
+        if (first && lead_in_from != nullptr &&
+            !rests_at(*lead_in_from, s.p[0], job.machine.mm_per_lsb))
+            job.lead_in = PathPoint(lead_in_from->begin(), lead_in_from->end());
+        first = false;
         check_segment_work_area(s, job.path, job.machine, path_options.file);
     });
+    if (job.lead_in && job.lead_in->size() != job.path.axes) {
+        throw std::invalid_argument("lead-in: the machine has " +
+                                    std::to_string(job.lead_in->size()) + " axes, the path " +
+                                    std::to_string(job.path.axes));
+    }
     return job;
 }
 
@@ -58,17 +79,9 @@ PlannedJob prepare_job(const JobRequest& path_options, const std::string& machin
     PlannedJob job = load_job(path_options, machine_file, lead_in_from);
     job.segments = to_bezier_segments(job.path);
     check_work_area(job.segments, job.path, job.machine, path_options.file);
-    if (lead_in_from != nullptr && !job.segments.empty()) {
-        // The device rests on the LSB grid: at the start's grid point it needs no move (a
-        // travel shorter than an LSB would be a span that goes nowhere).
-        const PathPoint& start = job.segments.front().p[0];
-        bool at_start = lead_in_from->size() == start.size();
-        for (std::size_t a = 0; at_start && a < start.size(); ++a) {
-            at_start = std::llround((*lead_in_from)[a] / job.machine.mm_per_lsb) ==
-                       std::llround(start[a] / job.machine.mm_per_lsb);
-        }
-        if (!at_start) prepend_lead_in(job.segments, *lead_in_from);
-    }
+    if (lead_in_from != nullptr && !job.segments.empty() &&
+        !rests_at(*lead_in_from, job.segments.front().p[0], job.machine.mm_per_lsb))
+        prepend_lead_in(job.segments, *lead_in_from);
     return job;
 }
 

@@ -3,6 +3,7 @@
 // JobRequest to a checked plan that a streamer or the simulator takes.
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -18,7 +19,10 @@ namespace pathstream::host {
 struct PlannedJob {
     Path path;
     MachineProfile machine;
-    std::vector<BezierSegment> segments;
+    std::vector<BezierSegment> segments;  ///< empty for a streamed job (prepare_streamed_job)
+    /// A streamed job's lead-in: where the machine rests, when it is not the path's start
+    /// (PathSegmentSource(path, lead_in) makes the move); prepare_job puts it in segments.
+    std::optional<PathPoint> lead_in;
     Plan plan;  ///< empty when the plan was streamed (run_plan): the counts below hold
     PlanCheck check;
     double planning_seconds = 0;
@@ -31,9 +35,10 @@ PlannedJob prepare_job(const JobRequest& request, const std::string& machine_fil
                        const std::vector<double>* lead_in_from = nullptr);
 
 /// prepare_job without the segment list (segments stays empty): the work area is checked
-/// segment by segment and a planner or check reads the path through PathSegmentSource, so
-/// that memory holds the path and nothing per segment. No lead-in.
-PlannedJob prepare_streamed_job(const JobRequest& request, const std::string& machine_file);
+/// segment by segment and a planner or check reads the path through
+/// PathSegmentSource(path, lead_in), so that memory holds the path and nothing per segment.
+PlannedJob prepare_streamed_job(const JobRequest& request, const std::string& machine_file,
+                                const std::vector<double>* lead_in_from = nullptr);
 
 /// Loads both files, checks they agree (axis count), plans with a progress bar and checks
 /// every tick. Throws InputError for bad files, PlanError when planning fails.
