@@ -8,6 +8,7 @@
 #include <csignal>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
 #include <iostream>
 #include <stdexcept>
 
@@ -52,6 +53,19 @@ void unguard_temp() {
 }  // namespace
 
 AtomicFile::AtomicFile(std::string path) : path_(std::move(path)) {
+    std::error_code ec;
+    const auto status = std::filesystem::status(path_, ec);
+    if (!ec && std::filesystem::exists(status) && !std::filesystem::is_regular_file(status) &&
+        !std::filesystem::is_directory(status)) {
+        // A device or a pipe (/dev/null, a FIFO): written in place. Renaming a file onto it
+        // would replace the device node (as root, /dev/null became a regular file once).
+        direct_ = true;
+        out_.open(path_, std::ios::binary);
+        if (!out_) {
+            throw std::runtime_error(path_ + ": cannot open output: " + std::strerror(errno));
+        }
+        return;
+    }
     temp_ = path_ + ".tmp-" + std::to_string(::getpid());
     guarded_ = guard_temp(temp_);
     out_.open(temp_, std::ios::binary | std::ios::trunc);
@@ -63,6 +77,7 @@ AtomicFile::AtomicFile(std::string path) : path_(std::move(path)) {
 }
 
 AtomicFile::~AtomicFile() {
+    if (direct_) return;
     if (!committed_) {
         out_.close();
         std::remove(temp_.c_str());
@@ -74,6 +89,8 @@ void AtomicFile::commit() {
     out_.flush();
     out_.close();
     if (!out_) throw std::runtime_error(path_ + ": write failed (disk full?)");
+    committed_ = direct_;
+    if (direct_) return;
     if (std::rename(temp_.c_str(), path_.c_str()) != 0) {
         throw std::runtime_error(path_ +
                                  ": cannot rename output into place: " + std::strerror(errno));

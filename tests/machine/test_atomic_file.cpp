@@ -1,5 +1,6 @@
 // Output files appear whole or not at all: after an error, and after an interrupt that ends
 // the process while the file is being written.
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -93,5 +94,28 @@ TEST_CASE("a command's own interrupt handler is kept while a file is written", "
     }
     CHECK(fs::exists(dir / "j.json"));
     std::signal(SIGINT, previous);
+    fs::remove_all(dir);
+}
+
+TEST_CASE("an output to a FIFO is written in place, the FIFO stays one", "[host][atomic]") {
+    // Renaming a finished file onto a device or a pipe would replace it: run as root,
+    // `plan -o /dev/null` once turned /dev/null into a regular file.
+    const fs::path dir = fresh_dir("fifo");
+    const std::string fifo = (dir / "rows").string();
+    REQUIRE(::mkfifo(fifo.c_str(), 0600) == 0);
+    const pid_t reader = fork();
+    REQUIRE(reader >= 0);
+    if (reader == 0) {
+        std::ifstream in(fifo);
+        std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+        _exit(text == "tick,x\n0,1\n" ? 0 : 1);
+    }
+    write_output(fifo, [](std::ostream& out) { out << "tick,x\n0,1\n"; });
+    int status = 0;
+    REQUIRE(waitpid(reader, &status, 0) == reader);
+    CHECK(WIFEXITED(status));
+    CHECK(WEXITSTATUS(status) == 0);
+    CHECK(fs::is_fifo(fifo));
+    CHECK(files_in(dir) == 1);
     fs::remove_all(dir);
 }

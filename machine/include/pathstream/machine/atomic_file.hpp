@@ -13,7 +13,8 @@ namespace pathstream::host {
 /// A SIGINT, SIGTERM or SIGHUP that would end the process while the file is open (no other
 /// handler installed) removes it too, then ends the process as the signal would have. One
 /// AtomicFile at a time per process has that protection (the commands write one at a time);
-/// construct and destroy it from the main thread.
+/// construct and destroy it from the main thread. A PATH that is a device or a pipe
+/// (/dev/null, a FIFO) is written in place: there is nothing to replace atomically.
 class AtomicFile {
 public:
     explicit AtomicFile(std::string path);
@@ -30,6 +31,7 @@ private:
     std::string temp_;
     std::ofstream out_;
     bool committed_ = false;
+    bool direct_ = false;   ///< PATH is a device or a pipe: written in place
     bool guarded_ = false;  ///< this file's temporary name is the one the signal handler removes
 };
 
