@@ -318,3 +318,43 @@ TEST_CASE("serve: a child's output, error text and exit status", "[serve]") {
     CHECK(killed.exit_code == 128 + 15);
     CHECK_THROWS_AS(run_child({"/nonexistent/program"}, "/"), std::system_error);
 }
+
+TEST_CASE("serve: the preview of a streamed plan has the whole plan's path and figures",
+          "[serve]") {
+    MachineProfile m;
+    m.axes = {{"x", 250, 3000}, {"y", 250, 3000}};
+    Path path;
+    std::mt19937_64 rng(41);
+    std::uniform_real_distribution<double> d(0, 150);
+    for (int k = 0; k < 6; ++k) {
+        Subpath s;
+        s.basis = k % 2 == 0 ? PathBasis::kBSpline : PathBasis::kPolyline;
+        for (int i = 0; i < 40; ++i) s.points.push_back({d(rng), d(rng)});
+        path.subpaths.push_back(s);
+    }
+    PreviewOptions few;
+    few.speed_samples = 50;
+    const Plan plan = plan_path(to_bezier_segments(path), m);
+    const nlohmann::ordered_json whole = preview_json(plan, path, m, few);
+    PreviewRecorder recorder(path, m, few);
+    for (const CoreSpan& s : plan.spans) recorder.span(s);
+    const nlohmann::ordered_json streamed = recorder.finish(
+        plan.duration, plan.total_ticks, plan.pen.size(), plan.path_length, plan.travel_length);
+    CHECK(streamed["summary"] == whole["summary"]);
+    CHECK(streamed["path"] == whole["path"]);
+    CHECK(streamed["speed"]["t"] == whole["speed"]["t"]);
+    // Speeds: each bin takes the fastest fine bin starting in it, so a span near a boundary
+    // may count in the bin before; the fastest speed of the job is the same.
+    const auto& a = streamed["speed"]["v"];
+    const auto& b = whole["speed"]["v"];
+    REQUIRE(a.size() == b.size());
+    double fastest_a = 0, fastest_b = 0, total_a = 0, total_b = 0;
+    for (std::size_t i = 0; i < a.size(); ++i) {
+        fastest_a = std::max(fastest_a, a[i].get<double>());
+        fastest_b = std::max(fastest_b, b[i].get<double>());
+        total_a += a[i].get<double>();
+        total_b += b[i].get<double>();
+    }
+    CHECK(fastest_a == fastest_b);
+    CHECK(total_a == Approx(total_b).epsilon(0.1));
+}

@@ -74,55 +74,108 @@ double rounded(double v, int digits) {
 
 }  // namespace
 
-nlohmann::ordered_json preview_json(const Plan& plan, const Path& path,
-                                    const MachineProfile& machine, const PreviewOptions& options) {
-    const double mm = machine.mm_per_lsb;
-    const std::size_t ax = machine.axes.size();
-    Simplifier simplifier(options.tolerance_mm);
+struct PreviewRecorder::State {
+    State(const Path& p, const MachineProfile& m, const PreviewOptions& o)
+        : path(p), machine(m), options(o), simplifier(o.tolerance_mm) {
+        fine.assign(std::max<std::size_t>(2, 2 * o.speed_samples), 0.0);
+    }
+    const Path& path;
+    const MachineProfile& machine;
+    PreviewOptions options;
+    Simplifier simplifier;
     std::set<std::size_t> drawn_subpaths;
     std::uint64_t tick = 0;
-    // Speed bins over the plan's duration: the fastest span (its mean speed) in each.
-    const std::size_t bins =
-        std::max<std::size_t>(1, std::min(options.speed_samples, plan.spans.size()));
-    std::vector<double> bin_speed(bins, 0.0);
-    const double total = std::max<double>(1, static_cast<double>(plan.total_ticks));
-    for (std::size_t i = 0; i < plan.spans.size(); ++i) {
-        const CoreSpan& s = plan.spans[i];
-        // The planner's spans are Hermite (P0, P1, T0, T1): P0 where it starts, P1 where it ends.
-        const std::size_t layer =
-            s.subpath < path.subpaths.size() ? path.subpaths[s.subpath].layer : 0;
-        if (i == 0)
-            simplifier.add(
-                {s.control.at(0)[0] * mm, ax > 1 ? s.control.at(1)[0] * mm : 0.0, 0, false, layer});
-        const double dx = (s.control.at(0)[1] - s.control.at(0)[0]) * mm;
-        const double dy = ax > 1 ? (s.control.at(1)[1] - s.control.at(1)[0]) * mm : 0.0;
-        const std::size_t bin =
-            std::min(bins - 1, static_cast<std::size_t>(static_cast<double>(tick) / total *
-                                                        static_cast<double>(bins)));
-        bin_speed[bin] = std::max(bin_speed[bin], std::hypot(dx, dy) * machine.tick_hz / s.ticks);
-        tick += s.ticks;
-        if (s.pen_down) drawn_subpaths.insert(s.subpath);
-        simplifier.add({s.control.at(0)[1] * mm, ax > 1 ? s.control.at(1)[1] * mm : 0.0, tick,
-                        s.pen_down, layer});
+    std::size_t spans = 0;
+    /// Known total (preview_json of a whole plan): each span goes to its final bin at once.
+    std::uint64_t known_total = 0;
+    std::vector<double> exact;
+    /// Unknown total: fine bins of `width` ticks, merged in pairs when the job outgrows them.
+    std::vector<double> fine;
+    double width = 256;
+
+    void add_speed(std::uint64_t start, double speed) {
+        if (known_total > 0) {
+            const std::size_t bins = exact.size();
+            const std::size_t bin =
+                std::min(bins - 1, static_cast<std::size_t>(static_cast<double>(start) /
+                                                            static_cast<double>(known_total) *
+                                                            static_cast<double>(bins)));
+            exact[bin] = std::max(exact[bin], speed);
+            return;
+        }
+        while (static_cast<double>(start) / width >= static_cast<double>(fine.size())) {
+            const std::size_t half = fine.size() / 2;
+            for (std::size_t i = 0; i < half; ++i) fine[i] = std::max(fine[2 * i], fine[2 * i + 1]);
+            std::fill(fine.begin() + static_cast<std::ptrdiff_t>(half), fine.end(), 0.0);
+            width *= 2;
+        }
+        const auto k = static_cast<std::size_t>(static_cast<double>(start) / width);
+        fine[k] = std::max(fine[k], speed);
     }
-    const std::vector<Vertex> vertices = simplifier.finish();
+};
+
+PreviewRecorder::PreviewRecorder(const Path& path, const MachineProfile& machine,
+                                 const PreviewOptions& options)
+    : state_(std::make_unique<State>(path, machine, options)) {}
+
+PreviewRecorder::~PreviewRecorder() = default;
+
+void PreviewRecorder::span(const CoreSpan& s) {
+    State& st = *state_;
+    const double mm = st.machine.mm_per_lsb;
+    const std::size_t ax = st.machine.axes.size();
+    // The planner's spans are Hermite (P0, P1, T0, T1): P0 where it starts, P1 where it ends.
+    const std::size_t layer =
+        s.subpath < st.path.subpaths.size() ? st.path.subpaths[s.subpath].layer : 0;
+    if (st.spans == 0)
+        st.simplifier.add(
+            {s.control.at(0)[0] * mm, ax > 1 ? s.control.at(1)[0] * mm : 0.0, 0, false, layer});
+    const double dx = (s.control.at(0)[1] - s.control.at(0)[0]) * mm;
+    const double dy = ax > 1 ? (s.control.at(1)[1] - s.control.at(1)[0]) * mm : 0.0;
+    st.add_speed(st.tick, std::hypot(dx, dy) * st.machine.tick_hz / s.ticks);
+    st.tick += s.ticks;
+    ++st.spans;
+    if (s.pen_down) st.drawn_subpaths.insert(s.subpath);
+    st.simplifier.add({s.control.at(0)[1] * mm, ax > 1 ? s.control.at(1)[1] * mm : 0.0, st.tick,
+                       s.pen_down, layer});
+}
+
+nlohmann::ordered_json PreviewRecorder::finish(double duration_s, std::uint64_t total_ticks,
+                                               std::size_t pen_changes, double drawn_length_mm,
+                                               double travel_length_mm) {
+    State& st = *state_;
+    const std::vector<Vertex> vertices = st.simplifier.finish();
+    const std::size_t bins = std::max<std::size_t>(1, std::min(st.options.speed_samples, st.spans));
+    std::vector<double> bin_speed(bins, 0.0);
+    if (st.known_total > 0) {
+        bin_speed = st.exact;
+    } else {
+        const double total = std::max<double>(1, static_cast<double>(total_ticks));
+        for (std::size_t k = 0; k < st.fine.size(); ++k) {
+            const double start = static_cast<double>(k) * st.width;
+            if (start >= total) break;
+            const std::size_t bin = std::min(
+                bins - 1, static_cast<std::size_t>(start / total * static_cast<double>(bins)));
+            bin_speed[bin] = std::max(bin_speed[bin], st.fine[k]);
+        }
+    }
 
     nlohmann::ordered_json summary;
-    summary["duration_s"] = plan.duration;
-    summary["ticks"] = plan.total_ticks;
-    summary["tick_hz"] = machine.tick_hz;
-    summary["spans"] = plan.spans.size();
-    summary["subpaths"] = drawn_subpaths.size();
-    summary["pen_changes"] = plan.pen.size();
-    summary["pauses"] = plan.pauses.size();
-    summary["layers"] = layers_json(path);
-    summary["drawn_length_mm"] = plan.path_length;
-    summary["travel_length_mm"] = plan.travel_length;
+    summary["duration_s"] = duration_s;
+    summary["ticks"] = total_ticks;
+    summary["tick_hz"] = st.machine.tick_hz;
+    summary["spans"] = st.spans;
+    summary["subpaths"] = st.drawn_subpaths.size();
+    summary["pen_changes"] = pen_changes;
+    summary["pauses"] = pauses_.size();
+    summary["layers"] = layers_json(st.path);
+    summary["drawn_length_mm"] = drawn_length_mm;
+    summary["travel_length_mm"] = travel_length_mm;
     summary["vertices"] = vertices.size();
 
     nlohmann::ordered_json out;
     out["summary"] = summary;
-    if (const auto area = work_area(machine)) {
+    if (const auto area = work_area(st.machine)) {
         out["work_area"] = {{"x_min", area->x_min},
                             {"y_min", area->y_min},
                             {"x_max", area->x_max},
@@ -150,14 +203,24 @@ nlohmann::ordered_json preview_json(const Plan& plan, const Path& path,
     std::vector<double> t, v;
     for (std::size_t b = 0; b < bins; ++b) {
         t.push_back(
-            rounded(plan.duration * (static_cast<double>(b) + 0.5) / static_cast<double>(bins), 4));
+            rounded(duration_s * (static_cast<double>(b) + 0.5) / static_cast<double>(bins), 4));
         v.push_back(rounded(bin_speed[b], 3));
     }
     out["speed"] = {{"t", t}, {"v", v}};
-    std::vector<std::uint64_t> pauses;
-    for (const PlanPause& p : plan.pauses) pauses.push_back(p.tick);
-    out["pauses"] = pauses;
+    out["pauses"] = pauses_;
     return out;
+}
+
+nlohmann::ordered_json preview_json(const Plan& plan, const Path& path,
+                                    const MachineProfile& machine, const PreviewOptions& options) {
+    PreviewRecorder recorder(path, machine, options);
+    recorder.state_->known_total = std::max<std::uint64_t>(1, plan.total_ticks);
+    recorder.state_->exact.assign(
+        std::max<std::size_t>(1, std::min(options.speed_samples, plan.spans.size())), 0.0);
+    for (const CoreSpan& s : plan.spans) recorder.span(s);
+    for (const PlanPause& p : plan.pauses) recorder.pause(p.tick);
+    return recorder.finish(plan.duration, plan.total_ticks, plan.pen.size(), plan.path_length,
+                           plan.travel_length);
 }
 
 }  // namespace pathstream::host::serve

@@ -1,7 +1,10 @@
 // What the page draws before a run: the planned path to scale, its timing and its figures.
 #pragma once
 
+#include <cstdint>
+#include <memory>
 #include <nlohmann/json.hpp>
+#include <vector>
 
 #include "pathstream/host/path.hpp"
 #include "pathstream/host/plan.hpp"
@@ -33,5 +36,32 @@ struct PreviewOptions {
 nlohmann::ordered_json preview_json(const Plan& plan, const Path& path,
                                     const MachineProfile& machine,
                                     const PreviewOptions& options = {});
+
+/// preview_json's document made from the spans as they come (a streamed plan), without the
+/// plan: memory O(kept vertices + speed bins), not O(spans). The total is not known until the
+/// end, so a span's speed goes to fine bins of a width that doubles as the job grows (at least
+/// 2 speed_samples of them); each of the document's bins then takes the fastest fine bin that
+/// starts in it (preview_json, which knows the total, bins each span exactly). Any thread.
+class PreviewRecorder {
+public:
+    PreviewRecorder(const Path& path, const MachineProfile& machine,
+                    const PreviewOptions& options = {});
+    ~PreviewRecorder();
+    PreviewRecorder(const PreviewRecorder&) = delete;
+    PreviewRecorder& operator=(const PreviewRecorder&) = delete;
+    void span(const CoreSpan& span);
+    void pause(std::uint64_t tick) { pauses_.push_back(tick); }
+    /// The document; `duration_s` and the counts from the plan's totals.
+    nlohmann::ordered_json finish(double duration_s, std::uint64_t total_ticks,
+                                  std::size_t pen_changes, double drawn_length_mm,
+                                  double travel_length_mm);
+
+private:
+    friend nlohmann::ordered_json preview_json(const Plan&, const Path&, const MachineProfile&,
+                                               const PreviewOptions&);
+    struct State;
+    std::unique_ptr<State> state_;
+    std::vector<std::uint64_t> pauses_;
+};
 
 }  // namespace pathstream::host::serve
