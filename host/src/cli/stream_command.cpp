@@ -624,8 +624,7 @@ int run_stream(const StreamCommandOptions& o) {
             std::filesystem::absolute(journal_path + ".input").string());
         journal.replan = job_recipe_json(recipe);
     }
-    const PlannedJob prepared =
-        prepare_streamed_job(path, o.machine, lead_in ? &rest_mm : nullptr);
+    const PlannedJob prepared = prepare_streamed_job(path, o.machine, lead_in ? &rest_mm : nullptr);
     if (lead_in) print_lead_in(prepared, rest_mm);
     return stream_while_planning(prepared, o, journal, journal_path, channel);
 }

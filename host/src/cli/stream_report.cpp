@@ -205,11 +205,11 @@ void print_lead_in(const PlannedJob& job, const std::vector<double>& rest_mm) {
                       rest_mm[a]);
         at += value;
     }
-    const bool moved = job.segments.empty()
-                           ? job.lead_in.has_value()
-                           : !job.segments.front().pen_down && job.segments.size() > 1 &&
-                                 job.segments.front().p[0] ==
-                                     PathPoint(rest_mm.begin(), rest_mm.end());
+    const bool moved =
+        job.segments.empty()
+            ? job.lead_in.has_value()
+            : !job.segments.front().pen_down && job.segments.size() > 1 &&
+                  job.segments.front().p[0] == PathPoint(rest_mm.begin(), rest_mm.end());
     if (moved) {
         std::printf("lead-in       pen up from where the device rests,%s, to the drawing's start\n",
                     at.c_str());

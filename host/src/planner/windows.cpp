@@ -512,12 +512,10 @@ private:
     bool check_batch(const CheckBatch& batch) {
         for (const FeedNote& f : batch.feeds) checker_->note_feed(f.subpath, f.pen_down, f.feed);
         for (const PlanEvent& e : batch.events) {
-            if (e.kind == PlanEvent::Kind::kSpan)
-            {
+            if (e.kind == PlanEvent::Kind::kSpan) {
                 checker_->span(e.span);
                 jerk_meter_.span(e.span);
-            }
-            else if (e.kind == PlanEvent::Kind::kPen)
+            } else if (e.kind == PlanEvent::Kind::kPen)
                 checker_->pen(e.pen);
         }
         return !checker_->over_limits();
