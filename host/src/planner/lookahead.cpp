@@ -17,6 +17,7 @@
 #include "grid.hpp"
 #include "limits.hpp"
 #include "lp2.hpp"
+#include "lsb_rounding.hpp"
 #include "pathstream/host/planner.hpp"
 #include "pathstream/machine/machine.hpp"
 #include "vec.hpp"
@@ -62,10 +63,12 @@ std::vector<double> speed_caps(const PathGrid& pg, const Limits& limits,
                                const MachineProfile& profile, const PlanOptions& options) {
     const Grid& g = pg.grid;
     const double tick = 1.0 / profile.tick_hz;
-    const double span = tick * profile.ticks_per_span;
     const double delta = profile.chord_tolerance;
     std::vector<double> caps(g.size(), kNoCap);
     for (std::size_t k = 0; k < g.size(); ++k) {
+        // The node's regular span: longer where its feed is far below an LSB per span.
+        const double span = tick * feed_span_ticks(profile.ticks_per_span, g.feed[k],
+                                                   profile.tick_hz, profile.mm_per_lsb);
         double s = g.feed[k] * options.feed_margin;
         for (std::size_t i = 0; i < g.axes; ++i) {
             const double t = std::fabs(g.tangent[k][i]);
@@ -175,10 +178,13 @@ void jerk_caps(const PathGrid& pg, const Limits& limits, const MachineProfile& p
 }
 
 void reserve_for_corners(const PathGrid& pg, const Limits& limits, const std::vector<double>& caps,
-                         double span_time, std::vector<double>& factor) {
+                         const MachineProfile& profile, std::vector<double>& factor) {
     const Grid& g = pg.grid;
     for (std::size_t k = 0; k < g.size(); ++k) {
         const double jump = norm(g.corner_jump[k]);
+        const double span_time = feed_span_ticks(profile.ticks_per_span, g.feed[k], profile.tick_hz,
+                                                 profile.mm_per_lsb) /
+                                 profile.tick_hz;
         if (jump <= 0 || span_time <= 0) continue;
         const double v = std::sqrt(caps[k]);
         double share = 0;

@@ -28,9 +28,10 @@ void jerk_caps(const PathGrid& g, const Limits& limits, const MachineProfile& pr
 /// A span that crosses a corner at speed v turns on axis i at up to 4 v |J_i| / span_time:
 /// caps the lookahead's acceleration factor within two spans' travel of every crossed corner
 /// to 1 minus that share (at most half), so that the deceleration into it leaves room for it.
-/// `caps` are the squared-speed caps (the corner speed is the corner node's cap).
+/// `caps` are the squared-speed caps (the corner speed is the corner node's cap); span_time is
+/// the node's regular span (the profile's, longer at a feed far below an LSB per span).
 void reserve_for_corners(const PathGrid& g, const Limits& limits, const std::vector<double>& caps,
-                         double span_time, std::vector<double>& factor);
+                         const MachineProfile& profile, std::vector<double>& factor);
 
 /// TOPP-RA backward pass over one piece: beta[k] (k = first..last, indexed by node) is the
 /// largest squared speed at node k from which the rest of the piece can still be run to a stop

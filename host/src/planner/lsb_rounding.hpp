@@ -2,10 +2,12 @@
 // pass checks the spans the device will run only if both round alike, bit for bit.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
 
+#include "pathstream/units.hpp"
 #include "vec.hpp"
 
 namespace pathstream::host::planner_detail {
@@ -32,6 +34,22 @@ inline long long scaled_tangent_lsb(double velocity, double scale) {
     else if (fraction <= -0.5)
         --i;
     return i;
+}
+
+/// Ticks of the regular span of a piece whose feed is `feed` (mm/s), `ticks` being the
+/// profile's regular span (regular_span_ticks): more where the feed is fine against the LSB
+/// grid. A span of n ticks carries its velocity as whole-LSB tangents, in steps of 1/n LSB per
+/// tick, so, as regular_span_ticks does for the axes' velocity limits, spans are lengthened
+/// until the feed covers 8 LSB per span (up to the core's longest span). Without this a feed
+/// far below an LSB per span (1 mm/min on 1 um and 1 kHz: 0.017 LSB per tick) has tangents
+/// that round to 0: the motion becomes hops of one LSB from rest to rest within one span, at
+/// ten times the feed and more (a diagonal hop broke the planner's feed check, and no motion
+/// was found at all). With the lengthened spans the tangents carry the feed within 1/16.
+inline std::uint32_t feed_span_ticks(std::uint32_t ticks, double feed, double tick_hz, double lsb) {
+    if (!(feed > 0) || !(lsb > 0) || !(tick_hz > 0)) return ticks;
+    const double n = std::ceil(8 * lsb * tick_hz / feed - 1e-9);
+    if (!(n > ticks)) return ticks;
+    return static_cast<std::uint32_t>(std::min<double>(n, kMaxSpanTicks));
 }
 
 /// A point on the LSB grid (mm), rounded as the emitter rounds span end points.

@@ -13,6 +13,7 @@
 #include "jerk.hpp"
 #include "limits.hpp"
 #include "lookahead.hpp"
+#include "lsb_rounding.hpp"
 #include "pathstream/host/planner.hpp"
 #include "pathstream/machine/machine.hpp"
 #include "vec.hpp"
@@ -21,12 +22,7 @@ namespace pathstream::host::planner_detail {
 
 WindowLookahead::WindowLookahead(const PathGrid& grid, const Limits& lim,
                                  const MachineProfile& prof, const PlanOptions& opt)
-    : pg(grid),
-      limits(lim),
-      profile(prof),
-      options(opt),
-      span_time(prof.ticks_per_span / prof.tick_hz),
-      end_zone(0.5 * prof.mm_per_lsb) {
+    : pg(grid), limits(lim), profile(prof), options(opt), end_zone(0.5 * prof.mm_per_lsb) {
     const std::size_t n = pg.grid.size();
     base_caps = speed_caps(pg, limits, profile, options);
     if (limits.has_jerk())
@@ -38,7 +34,7 @@ WindowLookahead::WindowLookahead(const PathGrid& grid, const Limits& lim,
     factor.assign(n, 1.0);
     beta.assign(n, 0.0);
     dip.assign(n, 0.0);
-    reserve_for_corners(pg, limits, base_caps, span_time, corner_factor);
+    reserve_for_corners(pg, limits, base_caps, profile, corner_factor);
     for (std::size_t k = 0; k < n; ++k) set_factor(k);
 }
 
@@ -67,7 +63,12 @@ PieceMotion plan_piece(WindowLookahead& la, const Piece& piece, const Vec& start
     const auto resume_at = [&](double lambda) {
         return std::max(lambda, floor + 1e-9 * (1 + std::fabs(floor)));
     };
-    backward_pass(pg, piece, la.limits, la.factor, options.lookahead_margin, la.caps, la.span_time,
+    // The piece's regular span: longer than the window's where its feed is far below an LSB
+    // per span (feed_span_ticks), as the forward pass takes it.
+    const double span_time = feed_span_ticks(la.profile.ticks_per_span, piece.feed,
+                                             la.profile.tick_hz, la.profile.mm_per_lsb) /
+                             la.profile.tick_hz;
+    backward_pass(pg, piece, la.limits, la.factor, options.lookahead_margin, la.caps, span_time,
                   la.end_zone, la.dip, la.beta);
     PieceMotion motion = forward_pass(pg, piece, la.limits, la.caps, la.beta, la.profile, options,
                                       start_q, carried, resume_at(g.lambda[piece.first]));
@@ -103,7 +104,7 @@ PieceMotion plan_piece(WindowLookahead& la, const Piece& piece, const Vec& start
             whole ? piece.first : std::max(piece.first, f > 2 * w ? f - 2 * w : 0);
         std::size_t to = whole ? piece.last : std::min(piece.last, f + 8 * w);
         while (to < piece.last &&
-               g.lambda[to] <= motion.fail_lambda + motion.fail_speed * la.span_time)
+               g.lambda[to] <= motion.fail_lambda + motion.fail_speed * span_time)
             ++to;
         for (std::size_t k = from; k <= to; ++k) {
             if (retry % 4 == 3) {
@@ -114,14 +115,14 @@ PieceMotion plan_piece(WindowLookahead& la, const Piece& piece, const Vec& start
             // below the speed it failed at, so that the next attempt arrives slower.
             double x = 0.96 * la.beta[k];
             const double ahead = g.lambda[k] - motion.fail_lambda;
-            if (ahead >= -1e-9 && ahead <= motion.fail_speed * la.span_time + 1e-9)
+            if (ahead >= -1e-9 && ahead <= motion.fail_speed * span_time + 1e-9)
                 x = std::min(x, 0.9 * fail_speed2);
             la.local_cap[k] = std::min(la.local_cap[k], x / std::max(la.base_caps[k], 1e-300));
             la.caps[k] = la.base_caps[k] * la.local_cap[k];
         }
         const std::size_t changed =
             backward_pass(pg, piece, la.limits, la.factor, options.lookahead_margin, la.caps,
-                          la.span_time, la.end_zone, la.dip, la.beta, to + 1, from);
+                          span_time, la.end_zone, la.dip, la.beta, to + 1, from);
         const bool short_spans = retry >= 2 * options.max_local_retries / 3;
         // Knots in the interval ending at the first changed node interpolate its beta: resume
         // before that interval (never before what was sent).

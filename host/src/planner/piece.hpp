@@ -26,7 +26,6 @@ struct WindowLookahead {
     const Limits& limits;
     const MachineProfile& profile;
     const PlanOptions& options;
-    double span_time;
     double end_zone;  ///< half an LSB: dips this close to a piece's end count as it (backward_pass)
     std::vector<double> base_caps, caps, local_factor, local_cap, corner_factor, factor, beta, dip;
 };

@@ -75,6 +75,19 @@ inline double PieceTimer::solve_under_beta(const Knot& k, double tau, double a_l
                 }
             }
         }
+        // The final interval's stop (final_stop): (s + A tau)^2 <= 2 u (end - l1(A)), and
+        // at most its largest s^2.
+        if (stop_decel_ > 0 && lj == stop_from_ && lj1 > lj && lo <= hi) {
+            const double u = stop_decel_;
+            const double qa = tau2, qb = 2 * s * tau + u * tau2,
+                         qc = x0 - 2 * u * (end_lambda_ - k.lambda - s * tau);
+            const double disc = qb * qb - 4 * qa * qc;
+            if (disc >= 0) {
+                const double root = (-qb + std::sqrt(disc)) / (2 * qa);
+                const double a = std::min({hi, root, (std::sqrt(stop_x_) - s) / tau});
+                if (a >= lo) best = std::max(best, a);
+            }
+        }
         if (seg_hi >= top) break;
     }
     return best;

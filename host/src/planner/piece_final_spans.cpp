@@ -23,6 +23,7 @@ std::uint32_t PieceTimer::finish(const Knot& k) {
     const double d = end_lambda_ - k.lambda;
     double lo_f, hi_f;
     if (d > (k.speed * tick_ + acc_norm_ * tick_ * tick_) * n_ * n_) return 0;  // far away
+    if (d > feed_reach(k, 1)) return 0;  // farther than the feed goes
     // A knot whose velocity rounds to no motion on the grid starts the final span from rest.
     const Vec v_grid = span_velocity(k.v, n_);
     bool moving = false;
@@ -87,7 +88,7 @@ bool PieceTimer::finish_ok(const Knot& k, const Arrival& in, std::uint32_t ticks
             speed2 += v * v;
         }
         const double l = k.lambda + d * std::clamp(along / c2, 0.0, 1.0);
-        const double speed = std::max(0.0, std::sqrt(speed2) - root_axes_ * lsb_ / tau);
+        const double speed = std::max(0.0, std::sqrt(speed2) - speed_rounding(tau));
         if (speed * speed > interpolate(caps_, l) * (1 + 1e-6) + 1e-9) return false;
     }
     const double len2 = c2;
@@ -112,16 +113,19 @@ bool PieceTimer::finish_ok(const Knot& k, const Arrival& in, std::uint32_t ticks
 /// needed 250 retries with m fixed, 93 with it free). Along the path both spans' end
 /// accelerations are affine in A, so for each (m, f) the A that keep them within the path
 /// acceleration limit L (the smallest a_i / |t_i| at the end) form an exact interval; its
-/// middle, then its ends, are checked on the executed spans. Returns f (0: none), the knot
+/// middle, then its ends, are checked on the executed spans (at most 16,384 of them per knot,
+/// which bounds only spans of about 200 ticks and more). Returns f (0: none), the knot
 /// between the two spans and m (`first_ticks`).
 std::uint32_t PieceTimer::land(const Knot& k, Knot& mid, std::uint32_t& first_ticks) {
     const double tau_n = n_ * tick_;
     const double d = end_lambda_ - k.lambda, v = k.speed;
     // Reachable only if the end is within two spans at the current speed plus full
     // acceleration; cheap test first.
-    if (d > v * 2 * tau_n + acc_norm_ * 2 * tau_n * tau_n) return 0;
+    if (d > v * 2 * tau_n + acc_norm_ * 2 * tau_n * tau_n || d > feed_reach(k, 2)) return 0;
     std::size_t h = hint_;
     const double lim = path_acceleration_limit(path_at(pg_, piece_, end_lambda_, h).t);
+    constexpr std::uint32_t kMaxEvaluated = 16384;
+    std::uint32_t evaluated = 0;
     // At most 16 first-span lengths: with spans of thousands of ticks (the profile allows up
     // to 65536) the pairs would otherwise be billions at every knot near the end.
     const std::uint32_t m_min =
@@ -133,6 +137,15 @@ std::uint32_t PieceTimer::land(const Knot& k, Knot& mid, std::uint32_t& first_ti
             const double tf = f * tick_;
             double lo = std::max(-lim, -v / tau), hi = lim;      // the first span, and V' >= 0
             hi = std::min(hi, 2 * (d - v * tau) / (tau * tau));  // d' >= 0
+            // The final span's length d' within what the feed covers in tf: its velocity is
+            // quadratic in time, so Simpson's rule gives its chord exactly from its start
+            // (under beta, so the feed), its middle (checked against the feed plus the
+            // rounding allowance) and its end (rest); 5 % and two more allowances for the
+            // path's arc over the chord and the grid. At a slow feed, with spans of thousands
+            // of ticks, nearly every pair passes the acceleration bounds below, and the pairs
+            // whose final span could only fail the feed made landing cost seconds.
+            lo = std::max(
+                lo, 2 * (d - v * tau - 1.05 * feed_ * tf - 3 * root_axes_ * lsb_) / (tau * tau));
             // Final span along the path: a0 = 6 d'/tf^2 - 4 V'/tf, a1 = -6 d'/tf^2 + 2 V'/tf.
             const double base = 6 * (d - v * tau) / (tf * tf);
             const double a0c = base - 4 * v / tf, a0s = -(3 * tau * tau / (tf * tf) + 4 * tau / tf);
@@ -147,6 +160,10 @@ std::uint32_t PieceTimer::land(const Knot& k, Knot& mid, std::uint32_t& first_ti
             for (const double a :
                  {0.5 * (lo + hi), hi, lo, lo + 0.75 * (hi - lo), lo + 0.25 * (hi - lo)}) {
                 if (!under_beta(k, a, tau)) continue;
+                // Spans of thousands of ticks (a profile's, or a slow feed's, with 1-LSB hops
+                // where even the longest span covers under an LSB) have millions of pairs:
+                // the next knot tries again, nearer.
+                if (++evaluated > kMaxEvaluated) return 0;
                 Candidate c = evaluate(k, a, m);
                 // A knot on the end point: moving, the final span would leave it and come back
                 // (a stop with a wiggle of an LSB); at rest, it would only wait there.

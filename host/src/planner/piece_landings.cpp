@@ -23,7 +23,8 @@ namespace pathstream::host::planner_detail {
 /// point, not over a whole span. Returns the ticks (0: no such span, take a regular one).
 std::uint32_t PieceTimer::corner_landing(const Knot& k, Knot& out) {
     const double tau_n = n_ * tick_;
-    const double reach = k.speed * tau_n + 0.5 * acc_norm_ * tau_n * tau_n;
+    const double reach =
+        std::min(k.speed * tau_n + 0.5 * acc_norm_ * tau_n * tau_n, feed_reach(k, 1));
     std::size_t c = 0;
     bool found = false;
     for (std::size_t i = interval(k.lambda); i <= piece_.last && g_.lambda[i] <= k.lambda + reach;
@@ -84,7 +85,8 @@ std::uint32_t PieceTimer::corner_landing(const Knot& k, Knot& out) {
 std::uint32_t PieceTimer::dip_landing(const Knot& k, Knot& out) {
     constexpr std::uint32_t kSpansAhead = 3;
     const double tau_n = n_ * tick_, horizon = kSpansAhead * tau_n;
-    const double reach = k.speed * horizon + 0.5 * acc_norm_ * horizon * horizon;
+    const double reach = std::min(k.speed * horizon + 0.5 * acc_norm_ * horizon * horizon,
+                                  feed_reach(k, kSpansAhead));
     std::size_t c = 0;
     bool found = false;
     for (std::size_t i = std::max(interval(k.lambda), piece_.first + 1);

@@ -110,7 +110,7 @@ double PieceTimer::violation(const Knot& k0, const Arrival& in, const Knot& k1, 
     }
     // Speed along the path at every eighth of the span, against the feed and the speed cap
     // where the path profile (constant acceleration) is then.
-    const double acc = (k1.speed - k0.speed) / tau, rounding = root_axes_ * lsb_ / tau;
+    const double acc = (k1.speed - k0.speed) / tau, rounding = speed_rounding(tau);
     for (int s = 0; s < kSamples; ++s) {
         const double t = kW[s] * tau;
         const double speed = std::max(0.0, norm(at[s]) - rounding);

@@ -18,6 +18,7 @@
 #include "forward_pass.hpp"
 #include "grid.hpp"
 #include "limits.hpp"
+#include "lsb_rounding.hpp"
 #include "pathstream/host/planner.hpp"
 #include "pathstream/machine/machine.hpp"
 #include "piece_timer.hpp"
@@ -36,7 +37,8 @@ PieceTimer::PieceTimer(const PathGrid& pg, const Piece& piece, const Limits& lim
       axes_(pg.grid.axes),
       tick_(1.0 / profile.tick_hz),
       tick_hz_(profile.tick_hz),
-      n_(profile.ticks_per_span),
+      // Longer where the piece's feed is far below an LSB per span (feed_span_ticks).
+      n_(feed_span_ticks(profile.ticks_per_span, piece.feed, profile.tick_hz, profile.mm_per_lsb)),
       jerk_limited_(limits.has_jerk()) {
     // The spans are checked exactly as the device will run them (end points and tangents
     // rounded to LSB), against the limits less a hair for the double arithmetic.
@@ -55,6 +57,34 @@ PieceTimer::PieceTimer(const PathGrid& pg, const Piece& piece, const Limits& lim
     deviation_limit_ = 0.5 * delta_ + root_axes_ * lsb_;
     end_lambda_ = g_.lambda[piece.last];
     end_q_ = grid_point(g_.q[piece.last]);
+    // The final interval. Between nodes beta is linear in arc length (TOPP-RA's constant path
+    // acceleration), and in the interval that ends at rest that is a constant deceleration
+    // across the whole interval: where stopping takes far less (a slow feed, 1 mm/min, stops
+    // within nanometres; the interval may be 0.5 mm long), the motion crawled to the end at
+    // a speed falling with the square root of the distance left, up to the interval's time
+    // at the feed lost at every stop (17 % of a 0.6 mm line's). There, s^2 may also be what
+    // braking at half the acceleration along the path stops from at the end (less what the
+    // curvature of the interval takes at the interval's beta), up to that beta: the final
+    // spans are checked against the limits as every span is.
+    std::size_t i = piece.last;
+    while (i > piece.first && !(g_.lambda[i - 1] < end_lambda_)) --i;
+    if (i > piece.first) {
+        const std::size_t a = i - 1, b = piece.last;
+        const double x = std::min(beta_[a], caps_[b]), dl = end_lambda_ - g_.lambda[a];
+        double u = acc_norm_;
+        for (std::size_t ax = 0; ax < axes_; ++ax) {
+            const double kappa =
+                std::max(std::fabs(g_.curvature[a][ax]), std::fabs(g_.curvature[b][ax]));
+            u = std::min(u, 0.5 * acc_[ax] - kappa * x);
+        }
+        // Only where the linear beta brakes at under a quarter of that: elsewhere the
+        // interval's stop is as the lookahead planned it.
+        if (u > 0 && x > 0 && 2 * u * dl >= 4 * x) {
+            stop_from_ = g_.lambda[a];
+            stop_decel_ = u;
+            stop_x_ = x;
+        }
+    }
 }
 
 PieceMotion PieceTimer::run(const Vec& start_q, PieceMotion* resume, double resume_lambda,
@@ -206,12 +236,17 @@ bool PieceTimer::step(const Knot& k, std::uint32_t m, Knot& next) {
 
 /// The feasible end of [lo, hi] (lo within the limits, hi not): regula falsi (Illinois) on
 /// the violation, to 1e-4 of the acceleration limit (a finer one bought no measurable
-/// motion time). Spans of m ticks with the path acceleration's slope `jerk` (evaluate).
+/// motion time), or to 1e-3 of the speed over the span where that is finer: at a feed far
+/// below what the acceleration reaches in one span (1 mm/min at 3000 mm/s^2, 0.48 s spans)
+/// the whole bracket from stopping to cruising is under 1e-4 of the limit, and the search
+/// stopped the motion wherever the cruise's rounding onto the LSB grid failed a check.
+/// Spans of m ticks with the path acceleration's slope `jerk` (evaluate).
 PieceTimer::Candidate PieceTimer::boundary(const Knot& k, Candidate lo, Candidate hi,
                                            std::uint32_t m, double jerk) {
     int side = 0;
     double flo = lo.f, fhi = hi.f;
-    for (int it = 0; it < 40 && hi.a - lo.a > 1e-4 * acc_norm_; ++it) {
+    const double tol = std::min(1e-4 * acc_norm_, 1e-3 * std::max(k.speed, feed_) / (m * tick_));
+    for (int it = 0; it < 40 && hi.a - lo.a > tol; ++it) {
         double a = lo.a - flo * (hi.a - lo.a) / (fhi - flo);
         if (!(a > lo.a && a < hi.a)) a = 0.5 * (lo.a + hi.a);
         Candidate c = evaluate(k, a, m, jerk);

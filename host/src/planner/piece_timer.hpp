@@ -127,6 +127,13 @@ private:
     std::uint32_t land(const Knot& k, Knot& mid, std::uint32_t& first_ticks);
     /// The fewest ticks of a rest-to-rest span from q to the end within limits and feed (0: at it).
     std::uint32_t creep_ticks(const Vec& q) const;
+    /// What the rounding of a span of tau seconds onto the LSB grid (end points, tangents) may
+    /// add to its speed, as the feed and speed-cap checks allow it: an LSB per axis over the
+    /// span, or over a regular span where this one is shorter.
+    double speed_rounding(double tau) const;
+    /// More than `spans` regular spans from k can cover: the speed stays under the feed (beta,
+    /// the feed check at eighths), less what the rounding of the tangents lets through.
+    double feed_reach(const Knot& k, std::uint32_t spans) const;
 
     // Grid lookups and roundings of every candidate span (inline, below).
 
@@ -140,8 +147,12 @@ private:
     std::size_t interval(double lambda) const;
     /// Per-node values v at arc length lambda, linear between nodes.
     double interpolate(const std::vector<double>& v, double lambda) const;
-    /// The lookahead's bound on s^2 at arc length l.
+    /// The lookahead's bound on s^2 at arc length l: linear between nodes, and in the final
+    /// interval also the stop at stop_decel_ (final_stop).
     double beta_at(double l) const;
+    /// In the final interval (from stop_from_ to the end): the s^2 from which braking at
+    /// stop_decel_ stops at the end, at most stop_x_ (0 where that does not apply).
+    double final_stop(double l) const;
     /// Curvature vector at arc length l, linear between nodes.
     Vec curvature_at(double l) const;
     /// The largest path acceleration the axes allow along unit tangent t (no curvature).
@@ -173,6 +184,9 @@ private:
     Arrival arrival_;  ///< the span that arrived at the current knot
     double end_lambda_ = 0;
     Vec end_q_{};
+    /// The final interval's stop (final_stop): where it starts, the deceleration and the
+    /// largest s^2 it applies to; stop_decel_ 0: beta is linear there as everywhere.
+    double stop_from_ = 0, stop_decel_ = 0, stop_x_ = 0;
     std::size_t hint_ = 0;  ///< path_at's search hint, moving along the piece with the knots
     mutable std::size_t interval_hint_ = 0;  ///< interval()'s last answer
 };
@@ -191,6 +205,22 @@ inline Vec PieceTimer::span_velocity(const Vec& v, std::uint32_t m) const {
     for (std::size_t i = 0; i < axes_; ++i)
         r[i] = static_cast<double>(scaled_tangent_lsb(v[i], scale)) / scale;
     return r;
+}
+
+// Twice the feed's distance: the speed along a span is the Hermite cubic's, checked against
+// the feed at eighths of it (its peak between samples is less than twice that), plus the
+// rounding allowance of that check and an LSB per axis for the grid.
+inline double PieceTimer::feed_reach(const Knot& k, std::uint32_t spans) const {
+    const double tau = spans * n_ * tick_;
+    return 2 * tau * std::max(k.speed, feed_) + 3 * spans * root_axes_ * lsb_;
+}
+
+// Over the span itself the allowance lets a short span hop a whole LSB at any speed: at a feed
+// far below an LSB per tick the final span of a piece covered its last LSB in a few ticks,
+// 15 times the feed (1 mm/min: 0.25 mm/s and 167 mm/s^2 on the 6 m arc). A regular span is
+// long enough to carry the feed (feed_span_ticks), so its allowance is the floor.
+inline double PieceTimer::speed_rounding(double tau) const {
+    return root_axes_ * lsb_ / std::max(tau, n_ * tick_);
 }
 
 inline Knot PieceTimer::end_knot() const {
@@ -236,7 +266,12 @@ inline double PieceTimer::interpolate(const std::vector<double>& v, double lambd
 // beta interpolated linearly in x = s^2, as TOPP-RA's constant path acceleration between
 // nodes has it.
 inline double PieceTimer::beta_at(double l) const {
-    return interpolate(beta_, l);
+    const double b = interpolate(beta_, l);
+    return l > stop_from_ && stop_decel_ > 0 ? std::max(b, final_stop(l)) : b;
+}
+
+inline double PieceTimer::final_stop(double l) const {
+    return std::min(stop_x_, 2 * stop_decel_ * std::max(0.0, end_lambda_ - l));
 }
 
 inline Vec PieceTimer::curvature_at(double l) const {
