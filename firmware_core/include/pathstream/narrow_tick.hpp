@@ -55,12 +55,30 @@
 #endif
 
 #if defined(PATHSTREAM_ARM_TICK_ASM) && defined(__thumb2__)
-// Thumb-2. One LDMIA brings K (r3), the countdown (r4) and axis 0: jerk remainder and quotient
-// (r5, r6), remainders 0..2 (r8..r10), quotients 0..2 (r11, r12, lr); one STMDB writes the
-// countdown and the state back. Each further axis is one LDMIA of its eight words and one STMDB
-// of the six that change. Per level: ADDS (the carry), ADC (the quotient) and, unless binary,
-// the correction by K in an IT block: levels 0 and 2 are stored biased by K (add K after a
-// carry), level 1 unbiased (subtract K when there was none).
+// The Thumb-2 tick is an asm goto whose outputs must hold on its jumps to labels as well: GCC
+// 11 on, clang 16 on. Other compilers take the C++ step.
+#if defined(__clang__)
+#if __has_extension(gnu_asm_goto_with_outputs_full)
+#define PATHSTREAM_T2_TICK_ASM 1
+#endif
+#elif __GNUC__ >= 11
+#define PATHSTREAM_T2_TICK_ASM 1
+#endif
+// Thumb-2: the whole tick of a narrow span, in narrow_tick_fast, addressed from the stream's
+// tick state at `this` (NarrowTick). One LDMIA brings K (r3), the countdown (r4) and axis 0:
+// jerk remainder and quotient (r5, r6), remainders 0..2 (r8..r10), quotients 0..2 (r11, r12,
+// lr); one STMDB writes the countdown and the state back. Each further axis is one LDMIA of
+// its eight words and one STMDB of the six that change. Per level: ADDS (the carry), ADC (the
+// quotient) and, unless binary, the correction by K in an IT block: levels 0 and 2 are stored
+// biased by K (add K after a carry), level 1 unbiased (subtract K when there was none).
+//
+// Between the LDMIA and the steps, one SUBS of the countdown and one conditional branch: a
+// general span with ticks left after this one goes to its step (label 8, last in the
+// statement, so that its end is the statement's fall-through). Otherwise (the countdown's
+// encoding: narrow_countdown) a binary span with ticks left takes its step after two more
+// branches and leaves for `moving`; the last tick of either kind takes the general step (exact
+// for binary spans too, K = 0) at label 7, looped over the axes, and leaves for `last`; no
+// narrow span leaves for `slow` having stored nothing. r2 counts the looped axes.
 #define PATHSTREAM_T2_LEVELS(FIX0, FIX1, FIX2) \
     "adds  r8, r8, r9\n\t"                     \
     "adc   r11, r11, r12\n\t" FIX0             \
@@ -72,31 +90,52 @@
     "it    cs\n\taddcs r8, r8, r3\n\t", "it    cc\n\tsubcc r9, r9, r3\n\t", \
         "it    cs\n\taddcs r10, r10, r3\n\t"
 #define PATHSTREAM_T2_BINARY "", "", ""
-#define PATHSTREAM_T2_FIRST(...)                                   \
+#define PATHSTREAM_T2_HEAD                                         \
     "ldmia %[p]!, {r3, r4, r5, r6, r8, r9, r10, r11, r12, lr}\n\t" \
-    "str   r11, [%[o]], #4\n\t"                                    \
-    "subs  r4, r4, #1\n\t" PATHSTREAM_T2_LEVELS(                   \
+    "subs  r4, r4, #1\n\t"                                         \
+    "bgt   8f\n\t"                                                 \
+    "bpl   7f\n\t"                                                 \
+    "bcc   %l[slow]\n\t"
+#define PATHSTREAM_T2_FIRST(...)                      \
+    "str   r11, [%[o]], #4\n\t" PATHSTREAM_T2_LEVELS( \
         __VA_ARGS__) "stmdb %[p], {r4, r5, r6, r8, r9, r10, r11, r12, lr}\n\t"
 #define PATHSTREAM_T2_NEXT(...)                            \
     "ldmia %[p]!, {r5, r6, r8, r9, r10, r11, r12, lr}\n\t" \
     "str   r11, [%[o]], #4\n\t" PATHSTREAM_T2_LEVELS(      \
         __VA_ARGS__) "stmdb %[p], {r8, r9, r10, r11, r12, lr}\n\t"
+#define PATHSTREAM_T2_LOOP(...) \
+    "9:\n\t" PATHSTREAM_T2_NEXT(__VA_ARGS__) "subs  r2, r2, #1\n\tbne   9b\n\t"
+// The steps of every axis: FIRST, then NEXT repeated (unrolled) or looped (r2 counts).
+#define PATHSTREAM_T2_UNROLLED_STEPS(REPEAT, ...) \
+    PATHSTREAM_T2_FIRST(__VA_ARGS__) REPEAT(PATHSTREAM_T2_NEXT(__VA_ARGS__))
+#define PATHSTREAM_T2_LOOPED_STEPS(...) \
+    PATHSTREAM_T2_FIRST(__VA_ARGS__) PATHSTREAM_T2_LOOP(__VA_ARGS__)
 #define PATHSTREAM_T2_CLOBBERS \
-    "r3", "r5", "r6", "r8", "r9", "r10", "r11", "r12", "lr", "cc", "memory"
-#define PATHSTREAM_T2_UNROLLED(REPEAT, ...)                                               \
-    asm volatile(PATHSTREAM_T2_FIRST(__VA_ARGS__) REPEAT(PATHSTREAM_T2_NEXT(__VA_ARGS__)) \
-                 : [p] "+r"(p), [o] "+r"(o), "=&r"(left)                                  \
-                 :                                                                        \
-                 : PATHSTREAM_T2_CLOBBERS)
-#define PATHSTREAM_T2_UNROLLED_GENERAL(REPEAT) PATHSTREAM_T2_UNROLLED(REPEAT, PATHSTREAM_T2_GENERAL)
-#define PATHSTREAM_T2_UNROLLED_BINARY(REPEAT) PATHSTREAM_T2_UNROLLED(REPEAT, PATHSTREAM_T2_BINARY)
-#define PATHSTREAM_T2_LOOPED(...) \
-    asm volatile(PATHSTREAM_T2_FIRST(__VA_ARGS__) "9:\n\t" PATHSTREAM_T2_NEXT(__VA_ARGS__) \
-                 "subs  %[n], %[n], #1\n\t"                                    \
-                 "bne   9b\n\t"                                                \
-                 : [p] "+r"(p), [o] "+r"(o), "=&r"(left), [n] "+r"(n)          \
-                 :                                                             \
-                 : PATHSTREAM_T2_CLOBBERS)
+    "r3", "r4", "r5", "r6", "r8", "r9", "r10", "r11", "r12", "lr", "cc", "memory"
+// The statement: SETUP, HEAD, the binary steps, the last tick's (label 7), the general steps
+// (label 8). The arguments after GENERAL_STEPS are more clobbers, each after a comma.
+#define PATHSTREAM_T2_TICK(SETUP, BINARY_STEPS, LAST_STEPS, GENERAL_STEPS, ...) \
+    asm goto(SETUP PATHSTREAM_T2_HEAD BINARY_STEPS                              \
+             "b     %l[moving]\n\t"                                             \
+             "7:\n\t" LAST_STEPS                                                \
+             "b     %l[last]\n\t"                                               \
+             "8:\n\t" GENERAL_STEPS                                             \
+             : [p] "+r"(p), [o] "+r"(o)                                         \
+             : [rest] "i"(Axes - 1)                                             \
+             : PATHSTREAM_T2_CLOBBERS __VA_ARGS__                               \
+             : slow, last, moving)
+#define PATHSTREAM_T2_ONE_AXIS                                        \
+    PATHSTREAM_T2_TICK("", PATHSTREAM_T2_FIRST(PATHSTREAM_T2_BINARY), \
+                       PATHSTREAM_T2_FIRST(PATHSTREAM_T2_GENERAL),    \
+                       PATHSTREAM_T2_FIRST(PATHSTREAM_T2_GENERAL))
+#define PATHSTREAM_T2_UNROLLED_N(REPEAT)                                                          \
+    PATHSTREAM_T2_TICK("", PATHSTREAM_T2_UNROLLED_STEPS(REPEAT, PATHSTREAM_T2_BINARY),            \
+                       "movs  r2, %[rest]\n\t" PATHSTREAM_T2_LOOPED_STEPS(PATHSTREAM_T2_GENERAL), \
+                       PATHSTREAM_T2_UNROLLED_STEPS(REPEAT, PATHSTREAM_T2_GENERAL), , "r2")
+#define PATHSTREAM_T2_LOOPED                                                                      \
+    PATHSTREAM_T2_TICK("movs  r2, %[rest]\n\t", PATHSTREAM_T2_LOOPED_STEPS(PATHSTREAM_T2_BINARY), \
+                       PATHSTREAM_T2_LOOPED_STEPS(PATHSTREAM_T2_GENERAL),                         \
+                       PATHSTREAM_T2_LOOPED_STEPS(PATHSTREAM_T2_GENERAL), , "r2")
 #endif
 
 #if defined(PATHSTREAM_ARM_TICK_ASM) && !defined(__thumb2__)
@@ -161,54 +200,24 @@
 namespace pathstream {
 
 /// Writes each axis's setpoint for this tick to `out`, advances every axis one tick and counts
-/// the span down. Returns the ticks the span has left after this one (0: it was the last).
-/// Requires a narrow span (D < 2^32) with ticks left. `Binary` must equal
-/// `span.narrow_bias == 0` (D a power of two): its remainders are binary fractions of the word,
-/// the word's carry is the mixed-radix carry as it stands, and the correction by K is skipped;
-/// the general step (Binary false) is exact for binary spans too, only slower. `Compact`:
-/// Cortex-M code loops over the axes (two more instructions per axis) instead of repeating
-/// the per-axis code, which keeps it short at high axis counts.
-/// Cost in executed instructions (sim/cortex_m budget tests), unrolled: Cortex-M4 15 per axis
-/// (binary 9) plus 1; Cortex-M0+ 25.5 per axis on average (binary 21) plus 7 (binary 4);
-/// compact adds 2 per axis after the first, plus 1. The caller adds its own entry, pointer
-/// test and return. Interrupt context; touches only `span` and `out`.
+/// the span down. Returns the new countdown word (NarrowTick). Requires a narrow span with
+/// ticks left. `Binary` must be true only for a binary span (K = 0, D a power of two): its
+/// remainders are binary fractions of the word, the word's carry is the mixed-radix carry as it
+/// stands, and the correction by K is skipped; the general step (Binary false) is exact for
+/// binary spans too, only slower. `Compact`: Cortex-M0+ code loops over the axes instead of
+/// repeating the per-axis code, which keeps it short at high axis counts. The C++ and the
+/// Thumb-1 step (Thumb-2 has its own, inside narrow_tick_fast). Cost in executed instructions
+/// (sim/cortex_m budget tests) on Cortex-M0+, unrolled: 25.5 per axis on average (binary 21)
+/// plus 7 (binary 4). Interrupt context; touches only `state` and `out`.
 template <bool Binary, bool Compact, unsigned Axes>
-[[gnu::always_inline]] inline std::uint32_t narrow_tick(PreparedSpan<Axes>& span,
-                                                        Lsb (&out)[Axes]) {
-#if defined(PATHSTREAM_ARM_TICK_ASM)
-    // The assembly loads K and the countdown with the first axis: they must sit right before it.
-    static_assert(offsetof(PreparedSpan<Axes>, narrow_bias) == 0 &&
-                      offsetof(PreparedSpan<Axes>, countdown) == 4 &&
-                      offsetof(PreparedSpan<Axes>, narrow) == 8,
-                  "tick header layout");
-    static_assert(sizeof(NarrowDifferences) == 32 &&
-                      offsetof(NarrowDifferences, jerk_remainder) == 0 &&
-                      offsetof(NarrowDifferences, jerk_quotient) == 4 &&
-                      offsetof(NarrowDifferences, remainder) == 8 &&
-                      offsetof(NarrowDifferences, quotient) == 20,
-                  "narrow state layout");
-#if defined(__thumb2__)
-    // Pinned where a caller with (this, out) in (r0, r1) has them or can load them directly.
-    register std::uint32_t* p asm("r2") = &span.narrow_bias;
-    register Lsb* o asm("r1") = out;
-    register std::uint32_t left asm("r4");
-    if constexpr (Compact && Axes > 1) {
-        std::uint32_t n = Axes - 1;
-        if constexpr (Binary) {
-            PATHSTREAM_T2_LOOPED(PATHSTREAM_T2_BINARY);
-        } else {
-            PATHSTREAM_T2_LOOPED(PATHSTREAM_T2_GENERAL);
-        }
-    } else if constexpr (Binary) {
-        PATHSTREAM_FOR_AXES(PATHSTREAM_T2_UNROLLED_BINARY, 1)
-    } else {
-        PATHSTREAM_FOR_AXES(PATHSTREAM_T2_UNROLLED_GENERAL, 1)
-    }
-#else
-    std::uint32_t* p = &span.narrow_bias;
+[[gnu::always_inline]] inline std::uint32_t narrow_tick(NarrowTick<Axes>& state, Lsb (&out)[Axes]) {
+    // The countdown first: `out` (int32) may alias the state's words (uint32) as far as the
+    // compiler knows, so stored after the step it would be loaded again.
+    const std::uint32_t left = state.countdown - 1;
+    state.countdown = left;
+#if defined(PATHSTREAM_ARM_TICK_ASM) && !defined(__thumb2__)
+    std::uint32_t* p = &state.bias;
     Lsb* o = out;
-    const std::uint32_t left = span.countdown - 1;
-    span.countdown = left;
     if constexpr (Compact && Axes > 1) {
         std::uint32_t n = Axes;
         if constexpr (Binary) {
@@ -221,11 +230,87 @@ template <bool Binary, bool Compact, unsigned Axes>
     } else {
         PATHSTREAM_FOR_AXES(PATHSTREAM_T1_UNROLLED_GENERAL, 0)
     }
+#else
+    emit_and_step(state.axis, out, Binary ? std::uint32_t{0} : state.bias);
 #endif
     return left;
+}
+
+/// What narrow_tick_fast did.
+enum class FastTick : std::uint8_t {
+    kPlayed,      ///< it played this tick of the narrow span in progress, not its last
+    kLastPlayed,  ///< it played the span's last tick: the span is to be finished
+    kNotPlayed,   ///< nothing (no narrow span in progress, or a tick it leaves to the caller)
+};
+
+/// The tick interrupt's narrow spans: plays this tick of the narrow span in progress (NarrowTick
+/// at `state`; the general or the binary step, the general one for the span's last tick) and
+/// says which it was; kNotPlayed (no narrow span in progress) changes nothing. Unless
+/// kPlayed, `state` and `out` are as they came, for the caller's out-of-line paths. Cost in
+/// executed instructions (sim/cortex_m budget tests), unrolled: Cortex-M4 15 per axis plus 2
+/// (the countdown's SUBS and one branch; the LDM loads it with axis 0), binary 9 per axis plus
+/// 5 (three branches and one back); compact adds 2 per axis after the first, plus 1.
+/// Cortex-M0+: narrow_tick plus the C++ tests of the countdown. The caller adds its own entry
+/// and return. Interrupt context; touches only `*state` and `out`.
+template <bool Compact, unsigned Axes>
+[[gnu::always_inline]] inline FastTick narrow_tick_fast(NarrowTick<Axes>*& state, Lsb*& out) {
+#if defined(PATHSTREAM_ARM_TICK_ASM)
+    // The assembly loads K and the countdown with the first axis: they must sit right before it.
+    static_assert(offsetof(NarrowTick<Axes>, bias) == 0 &&
+                      offsetof(NarrowTick<Axes>, countdown) == 4 &&
+                      offsetof(NarrowTick<Axes>, axis) == 8 &&
+                      sizeof(NarrowTick<Axes>) == 8 + sizeof(NarrowDifferences) * Axes,
+                  "tick header layout");
+    static_assert(sizeof(NarrowDifferences) == 32 &&
+                      offsetof(NarrowDifferences, jerk_remainder) == 0 &&
+                      offsetof(NarrowDifferences, jerk_quotient) == 4 &&
+                      offsetof(NarrowDifferences, remainder) == 8 &&
+                      offsetof(NarrowDifferences, quotient) == 20,
+                  "narrow state layout");
+#endif
+#if defined(PATHSTREAM_T2_TICK_ASM)
+    // Pinned where a caller with (this, out) in (r0, r1) has them. The LDMIAs move p on
+    // before the branches to `slow` and `last`, where the state's address is taken back from
+    // it: a copy kept for those paths would cost the fast path a move and a register.
+    register std::uint32_t* p asm("r0") = &state->bias;
+    register Lsb* o asm("r1") = out;
+    if constexpr (Axes == 1) {
+        PATHSTREAM_T2_ONE_AXIS;
+    } else if constexpr (Compact) {
+        PATHSTREAM_T2_LOOPED;
+    } else {
+        PATHSTREAM_FOR_AXES(PATHSTREAM_T2_UNROLLED_N, 1)
+    }
+    return FastTick::kPlayed;
+moving:
+    return FastTick::kPlayed;
+last:
+    state = reinterpret_cast<NarrowTick<Axes>*>(reinterpret_cast<std::uintptr_t>(p) -
+                                                sizeof(NarrowTick<Axes>));
+    return FastTick::kLastPlayed;
+slow:
+    state = reinterpret_cast<NarrowTick<Axes>*>(reinterpret_cast<std::uintptr_t>(p) -
+                                                offsetof(NarrowTick<Axes>, axis) -
+                                                sizeof(NarrowDifferences));
+    out = o;
+    return FastTick::kNotPlayed;
 #else
-    emit_and_step(span.narrow, out, Binary ? std::uint32_t{0} : span.narrow_bias);
-    return --span.countdown;
+    Lsb(&o)[Axes] = *reinterpret_cast<Lsb(*)[Axes]>(out);
+    const std::uint32_t countdown = state->countdown;
+    if (narrow_fast(countdown, false)) [[likely]] {
+        narrow_tick<false, Compact>(*state, o);
+        return FastTick::kPlayed;
+    }
+    if (narrow_fast(countdown, true)) [[likely]] {
+        narrow_tick<true, Compact>(*state, o);
+        return FastTick::kPlayed;
+    }
+    if (countdown == narrow_countdown(1, false) || countdown == narrow_countdown(1, true)) {
+        // The last tick: the general step is exact for binary spans too (their K is 0).
+        narrow_tick<false, Compact>(*state, o);
+        return FastTick::kLastPlayed;
+    }
+    return FastTick::kNotPlayed;
 #endif
 }
 
@@ -244,15 +329,20 @@ template <bool Binary, bool Compact, unsigned Axes>
 #undef PATHSTREAM_REPEAT_8
 #undef PATHSTREAM_FOR_AXES
 #if defined(__thumb2__)
+#undef PATHSTREAM_T2_TICK_ASM
 #undef PATHSTREAM_T2_LEVELS
 #undef PATHSTREAM_T2_GENERAL
 #undef PATHSTREAM_T2_BINARY
+#undef PATHSTREAM_T2_HEAD
 #undef PATHSTREAM_T2_FIRST
 #undef PATHSTREAM_T2_NEXT
+#undef PATHSTREAM_T2_LOOP
+#undef PATHSTREAM_T2_UNROLLED_STEPS
+#undef PATHSTREAM_T2_LOOPED_STEPS
 #undef PATHSTREAM_T2_CLOBBERS
-#undef PATHSTREAM_T2_UNROLLED
-#undef PATHSTREAM_T2_UNROLLED_GENERAL
-#undef PATHSTREAM_T2_UNROLLED_BINARY
+#undef PATHSTREAM_T2_TICK
+#undef PATHSTREAM_T2_ONE_AXIS
+#undef PATHSTREAM_T2_UNROLLED_N
 #undef PATHSTREAM_T2_LOOPED
 #else
 #undef PATHSTREAM_T1_LEVEL

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <type_traits>
 
 #include "pathstream/narrow_tick.hpp"
 #include "pathstream/span.hpp"
@@ -11,6 +12,17 @@
 #include "pathstream/units.hpp"
 
 namespace pathstream {
+
+namespace detail {
+// Ticks the span in progress has supplied: its countdown at the start less the one counted
+// down, in either encoding (the other countdown is 0). A free function, so that an explicit
+// instantiation of the stream (the size probe, docs/cortex-m.md) emits no copy of it.
+template <unsigned Axes>
+inline std::uint32_t ticks_supplied(const PreparedSpan<Axes>& span, const NarrowTick<Axes>& narrow,
+                                    std::uint32_t wide_left) {
+    return span.countdown - narrow.countdown - wide_left;
+}
+}  // namespace detail
 
 /// What tick() produced.
 enum class TickState : std::uint8_t {
@@ -64,28 +76,32 @@ public:
     }
 
     /// Consumer (tick interrupt): writes this tick's setpoint for every axis to `out`.
-    /// Steady state on a narrow span tests one pointer (two when D is a power of two) and runs
-    /// narrow_tick: one forward-differencing step per axis and the span's countdown; everything
-    /// else (a span boundary, a wide span, an empty queue) is out of line. Always inlined, so
-    /// that the interrupt handler holds the fast path itself.
+    /// Every tick of a narrow span is played by narrow_tick_fast on the stream's own copy of
+    /// the span's state (first in the object, so that no pointer is loaded): one test of the
+    /// countdown, one forward-differencing step per axis, and finish_span() after the last.
+    /// Everything else (starting a span, a wide span, an empty queue) is out of line, in
+    /// tick_slow(). Always inlined, so that the interrupt handler holds the fast path itself.
     [[gnu::always_inline]] TickState tick(Lsb (&out)[Axes]) {
-        if (PreparedSpan<Axes>* const span = narrow_active_; span != nullptr) [[likely]] {
-            // An opaque copy of `this`: GCC then keeps it where it came (r0 on ARM) instead
-            // of copying it to a callee-saved register on every tick for the rare call below.
-            SetpointStream* self = this;
-            asm("" : "+r"(self));
-            if (narrow_tick<false, kCompactTick>(*span, out) == 0) [[unlikely]]
+        static_assert(std::is_standard_layout_v<SetpointStream>, "narrow_ at offset 0");
+        NarrowTick<Axes>* state = &narrow_;
+        Lsb* o = out;
+        for (;;) {
+            const FastTick fast = narrow_tick_fast<kCompactTick>(state, o);
+            if (fast == FastTick::kPlayed) [[likely]]
+                return TickState::kMoving;
+            // `this` and `out` as they came (narrow_tick_fast), taken from the registers it
+            // left them in: copies kept for these paths would cost the fast one a move each.
+            SetpointStream* const self = reinterpret_cast<SetpointStream*>(state);
+            if (fast == FastTick::kLastPlayed) {
                 self->finish_span();
-            return TickState::kMoving;
+                return TickState::kMoving;
+            }
+            const Slow slow = self->tick_slow(*reinterpret_cast<Lsb(*)[Axes]>(o));
+            if (slow != Slow::kStarted) return static_cast<TickState>(slow);
+            // A narrow span started: its first tick is narrow_tick_fast's.
+            state = &self->narrow_;
+            o = self->started_out_;
         }
-        if (PreparedSpan<Axes>* const span = binary_active_; span != nullptr) [[likely]] {
-            SetpointStream* self = this;
-            asm("" : "+r"(self));
-            if (narrow_tick<true, kCompactTick>(*span, out) == 0) [[unlikely]]
-                self->finish_span();
-            return TickState::kMoving;
-        }
-        return tick_slow(out);
     }
 
     /// Consumer, for code that wants many ticks at once (a host simulator, a batch fill; the
@@ -109,16 +125,17 @@ public:
                 }
                 start_span();
             }
-            const std::uint32_t left = active_->countdown;
+            const std::uint32_t left =
+                active_->ticks - detail::ticks_supplied(*active_, narrow_, wide_left_);
             const std::uint32_t k = left < count - done ? left : count - done;
             if (active_->wide) {
                 emit_span_ticks(active_->wide_state, out + done, k, active_->bias);
+                wide_left_ = left - k;
             } else {
-                emit_span_ticks(active_->narrow, out + done, k,
-                                static_cast<std::uint32_t>(active_->bias));
+                emit_span_ticks(narrow_.axis, out + done, k, narrow_.bias);
+                narrow_.countdown -= k;  // either encoding; finish_span() clears it at 0
             }
             done += k;
-            active_->countdown = left - k;
             if (left == k) finish_span();
         }
         return idle;
@@ -130,9 +147,7 @@ public:
     std::uint32_t free_slots() const { return queue_.free_slots(); }
     static constexpr std::uint32_t capacity() { return Capacity; }
     /// Ticks supplied by spans since construction (idle ticks excluded). Consumer context.
-    std::uint64_t ticks_executed() const {
-        return completed_ticks_ + (active_ != nullptr ? active_->ticks - active_->countdown : 0u);
-    }
+    std::uint64_t ticks_executed() const { return completed_ticks_ + ticks_into_span(); }
     /// Tag of the last span whose every tick was supplied; 0 before the first. Consumer.
     std::uint32_t last_completed_tag() const { return last_completed_tag_; }
     /// Discrete outputs (Span::outputs) in force: those of the span that supplied the last
@@ -149,14 +164,13 @@ public:
     /// Ticks the span in progress has supplied (1 .. its ticks - 1; 0 between spans): the
     /// next tick() supplies its tick k = ticks_into_span(). Consumer context.
     std::uint32_t ticks_into_span() const {
-        return active_ != nullptr ? active_->ticks - active_->countdown : 0u;
+        return active_ != nullptr ? detail::ticks_supplied(*active_, narrow_, wide_left_) : 0u;
     }
     /// The setpoint the next tick() supplies for `axis` from the span in progress (the exact
     /// curve at its tick k, rounded once), without supplying it. Precondition: a span is in
     /// progress. O(1). Consumer context.
     Lsb next_setpoint(unsigned axis) const {
-        return active_->wide ? active_->wide_state[axis].position()
-                             : active_->narrow[axis].position();
+        return active_->wide ? active_->wide_state[axis].position() : narrow_.axis[axis].position();
     }
     /// Where the axes rest between spans (the last span's end point, or the start). Consumer.
     Lsb resting_position(unsigned axis) const { return hold_[axis]; }
@@ -170,8 +184,8 @@ public:
     /// O(queued spans). Consumer context.
     void discard_all(const Lsb (&position)[Axes]) {
         if (active_ != nullptr) {
-            completed_ticks_ += active_->ticks - active_->countdown;  // the ticks it did supply
-            narrow_active_ = binary_active_ = nullptr;
+            completed_ticks_ += ticks_into_span();  // the ticks it did supply
+            narrow_.countdown = wide_left_ = 0;
             active_ = nullptr;
             queue_.release();
         }
@@ -195,42 +209,54 @@ private:
     // instructions per axis and keeps the core within 8 KiB at 8 axes (docs/cortex-m.md).
     static constexpr bool kCompactTick = Axes > 4;
 
-    // Everything but a narrow span in progress: taking the next span from the queue, wide
-    // spans (D >= 2^32: long spans) and holding when the queue is empty.
-    [[gnu::noinline]] TickState tick_slow(Lsb (&out)[Axes]) {
+    // What tick_slow() did: TickState's values, or kStarted (a narrow span, not yet played).
+    enum class Slow : std::uint8_t {
+        kMoving = static_cast<std::uint8_t>(TickState::kMoving),
+        kIdle = static_cast<std::uint8_t>(TickState::kIdle),
+        kStarted,
+    };
+
+    // Everything tick() does not: taking the next span from the queue, every tick of a wide
+    // span (D >= 2^32: long spans) and holding when the queue is empty.
+    [[gnu::noinline]] Slow tick_slow(Lsb (&out)[Axes]) {
         if (active_ == nullptr) {
             active_ = queue_.front();
             if (active_ == nullptr) {
                 for (unsigned a = 0; a < Axes; ++a) out[a] = hold_[a];
-                return TickState::kIdle;
+                return Slow::kIdle;
             }
-            start_span();
-            if (!active_->wide) {
-                // The first tick: the general step is exact for binary spans too (their K is
-                // 0), and its compact form keeps this rare path short.
-                if (narrow_tick<false, true>(*active_, out) == 0) finish_span();
-                return TickState::kMoving;
+            if (start_span()) {
+                started_out_ = out;
+                return Slow::kStarted;
             }
         }
         emit_and_step(active_->wide_state, out, active_->bias);
-        if (--active_->countdown == 0) finish_span();
-        return TickState::kMoving;
+        if (--wide_left_ == 0) finish_span();
+        return Slow::kMoving;
     }
 
-    // Makes the queue's front span (active_) the one in progress.
-    void start_span() {
-        active_->countdown = active_->ticks;
+    // Makes the queue's front span (active_) the one in progress: a narrow one's K, countdown
+    // and states are copied to narrow_, where the tick steps them; a wide one's countdown to
+    // wide_left_. True when it is narrow. Out of line: tick_slow() and tick_many() share it.
+    [[gnu::noinline]] bool start_span() {
         outputs_ = active_->outputs;
-        if (!active_->wide) (active_->narrow_bias == 0 ? binary_active_ : narrow_active_) = active_;
+        if (active_->wide) {
+            wide_left_ = active_->countdown;
+            return false;
+        }
+        narrow_.bias = active_->narrow_bias;
+        narrow_.countdown = active_->countdown;
+        for (unsigned a = 0; a < Axes; ++a) narrow_.axis[a] = active_->narrow[a];
+        return true;
     }
 
     [[gnu::noinline]] void finish_span() {
         // The state has stepped once past the last tick: it now holds the end point.
         for (unsigned a = 0; a < Axes; ++a) {
             hold_[a] =
-                active_->wide ? active_->wide_state[a].position() : active_->narrow[a].position();
+                active_->wide ? active_->wide_state[a].position() : narrow_.axis[a].position();
         }
-        narrow_active_ = binary_active_ = nullptr;
+        narrow_.countdown = 0;
         last_completed_tag_ = active_->tag;
         completed_ticks_ += active_->ticks;
         ++spans_completed_;
@@ -238,10 +264,11 @@ private:
         queue_.release();
     }
 
-    // First, so that the tick interrupt reaches them without an offset load (ARMv6-M).
-    PreparedSpan<Axes>* narrow_active_ = nullptr;  // == active_ when narrow and K != 0, else null
-    PreparedSpan<Axes>* binary_active_ = nullptr;  // == active_ when narrow and K == 0, else null
-    SpanQueue<PreparedSpan<Axes>, Capacity> queue_;
+    // First: tick() addresses it as `this` (narrow_tick_fast). Consumer side only.
+    NarrowTick<Axes> narrow_;  // the narrow span in progress (countdown 0: none)
+    // The small fields before the queue, so that Thumb code reaches each with one offset load.
+    std::uint32_t wide_left_ = 0;           // ticks the wide span in progress has to supply
+    Lsb* started_out_ = nullptr;            // tick_slow()'s `out` when it started a narrow span
     PreparedSpan<Axes>* active_ = nullptr;  // span being played, narrow or wide
     std::uint64_t completed_ticks_ = 0;
     std::uint32_t last_completed_tag_ = 0;
@@ -249,6 +276,7 @@ private:
     std::uint8_t outputs_ = 0;
     Lsb hold_[Axes] = {};        // consumer side: where the axes rest when idle
     Lsb pushed_end_[Axes] = {};  // producer side: end point of the last pushed span
+    SpanQueue<PreparedSpan<Axes>, Capacity> queue_;
 };
 
 }  // namespace pathstream

@@ -45,21 +45,48 @@ struct SpanStamp {
     bool pause_after = false;  ///< the device holds at this span's end (it ends at rest)
 };
 
+/// The narrow span in progress as the tick interrupt steps it: the consumer's own copy of the
+/// span's K, countdown and states, made when the span starts (SetpointStream keeps it first,
+/// at offset 0, so that the tick reaches it from `this` without loading a pointer; one LDM
+/// loads K, the countdown and axis 0 on Cortex-M4). Consumer context only.
+template <unsigned Axes>
+struct NarrowTick {
+    std::uint32_t bias = 0;        ///< K = 2^32 - D, or 0 when D is a power of two
+    std::uint32_t countdown = 0;   ///< encoded ticks left (narrow_countdown), 0: none
+    NarrowDifferences axis[Axes];  ///< meaningful only while countdown != 0
+};
+
+/// NarrowTick::countdown for a span with `ticks_left` >= 1 ticks to supply, this one included:
+/// the count itself for the general step, 2^31 - 1 + the count when D is a power of two (the
+/// binary step). Then one SUBS of 1 tells the cases apart by its flags: GT for a general span
+/// with ticks left after this one (the fast path), MI with carry for a binary one, PL (zero,
+/// or 2^31 - 1 with overflow) for the last tick of either, carry clear for 0 (no narrow span).
+constexpr std::uint32_t narrow_countdown(std::uint32_t ticks_left, bool binary) {
+    return binary ? ticks_left + 0x7fffffffu : ticks_left;
+}
+/// True when a NarrowTick::countdown stands for a tick the fast path plays: ticks left after it,
+/// general (binary false) or binary.
+constexpr bool narrow_fast(std::uint32_t countdown, bool binary) {
+    return binary ? static_cast<std::int32_t>(countdown - 1) < -1
+                  : static_cast<std::int32_t>(countdown) > 1;
+}
+
 /// A span validated and converted to forward-differencing state at its first tick.
 /// Holds either narrow or wide state for all axes (they share D). ~40 or ~48 bytes per axis.
 template <unsigned Axes>
 struct PreparedSpan {
-    // The tick interrupt reads these two words and the states from the span pointer itself:
-    // on Cortex-M one LDM loads K, the countdown and the first axis (narrow_tick.hpp).
+    // A narrow span's K, countdown and states, laid out as NarrowTick: the consumer copies
+    // them to its tick state when the span starts, and never writes to the queue entry.
     std::uint32_t narrow_bias = 0;  ///< narrow: K = 2^32 - D, or 0 when D is a power of two
-    std::uint32_t countdown = 0;    ///< ticks still to supply; counted down by the consumer
+    std::uint32_t countdown = 0;    ///< at its first tick: narrow_countdown() when narrow, the
+                                    ///< ticks when wide (the consumer counts down its own copy)
     union {
         NarrowDifferences narrow[Axes];
         WideDifferences wide_state[Axes];
     };
     std::uint32_t ticks = 0;
     std::uint32_t tag = 0;
-    std::uint64_t bias = 0;  ///< K = 2^W - D (its low 32 bits when narrow)
+    std::uint64_t bias = 0;  ///< K = 2^W - D (its low 32 bits when narrow), 0 when D = 2^m
     bool wide = false;
     std::uint8_t outputs = 0;  ///< Span::outputs, applied while the span plays
     SpanStamp<Axes> stamp;     ///< the producer's stamp (never read by the tick loop)
@@ -108,8 +135,9 @@ void prepare_validated(const ValidatedSpan<Axes>& v, PreparedSpan<Axes>& out) {
     out.outputs = v.outputs;
     out.wide = !narrow;
     out.bias = difference_bias(v.timing);
+    // Narrow: K (0 for a binary span) and the tick state's countdown; wide: the ticks.
     out.narrow_bias = narrow ? static_cast<std::uint32_t>(out.bias) : 0u;
-    out.countdown = v.timing.ticks;
+    out.countdown = narrow_countdown(v.timing.ticks, narrow && is_binary(v.timing));
 }
 
 /// Validates `span` on every axis and writes its prepared form to `out`. Either every axis

@@ -18,7 +18,8 @@
 //
 // Method (docs/cortex-m.md): the address ranges of budget_tick_<A> (SetpointStream::tick
 // inlined into an out-of-line function), SetpointStream<A,16>::tick_slow (span start, wide
-// spans and the empty queue, called from tick) and finish_span come from `nm -S`. The
+// spans and the empty queue, called from tick), start_span (called from tick_slow) and
+// finish_span come from `nm -S`. The
 // plugin counts the instructions executed in each range and snapshots all counters at every
 // budget_mark() call, which brackets each phase. For each axis count and span width the
 // image runs three phases, (n, S spans), (2n, S), (n, 2S); differences between them cancel
@@ -239,7 +240,8 @@ int main(int argc, char** argv) {
     std::vector<Range> ranges;
     std::optional<std::uint64_t> mark;
     const std::regex tick_re(R"(^budget_tick_(\d+)(\..*| .*)?$)");
-    const std::regex member_re(R"(SetpointStream<(\d+)u?l?, 16u?l?>::(tick_slow|finish_span)\()");
+    const std::regex member_re(
+        R"(SetpointStream<(\d+)u?l?, 16u?l?>::(tick_slow|start_span|finish_span)\()");
     for (const Symbol& s : symbols) {
         std::smatch m;
         if (s.name == "budget_mark")
@@ -250,7 +252,7 @@ int main(int argc, char** argv) {
             ranges.push_back({s, Role::kTick, static_cast<unsigned>(std::stoul(m[1]))});
         } else if (std::regex_search(s.name, m, member_re)) {
             const std::string f = m[2];
-            const Role role = f == "tick_slow" ? Role::kSlowPath : Role::kFinishSpan;
+            const Role role = f == "finish_span" ? Role::kFinishSpan : Role::kSlowPath;
             ranges.push_back({s, role, static_cast<unsigned>(std::stoul(m[1]))});
         }
     }
@@ -545,7 +547,7 @@ int main(int argc, char** argv) {
                " remainders.\n"
                "- per axis per setpoint: that divided by A; the budget applies to it.\n"
                "- marginal: extra instructions per tick for each added axis.\n"
-               "- amortized: everything tick() executes (tick_slow, finish_span"
+               "- amortized: everything tick() executes (tick_slow, start_span, finish_span"
                " included) over a run of spans of n ticks, per tick, per axis.\n"
                "- whole run: difference of runs with S and 2S spans of n ticks: the driver"
                " loop, push() (validation, prepare_span) and tick(), per tick, per axis.\n";
