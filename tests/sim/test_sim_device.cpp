@@ -397,3 +397,80 @@ TEST_CASE("clocks and the simulated output keep their contracts", "[sim]") {
     CHECK(linux_clock.now() >= 20);
     CHECK_THROWS_AS(hal::LinuxClock(0), std::invalid_argument);
 }
+
+TEST_CASE("a simulator fed span by span runs as the whole plan, keeping no tick unless asked",
+          "[sim]") {
+    // 120 spans (more than the queue holds), pen changes, a servo plant; a fast and a slow
+    // producer, settling.
+    std::vector<CoreSpan> spans;
+    LsbPoint at{0, 0};
+    for (int i = 0; i < 120; ++i) {
+        const LsbPoint to{at[0] + 300 + 7 * i, at[1] + (i % 2 ? 250 : -180)};
+        spans.push_back(i % 10 == 9 ? dwell(at, 6, i % 20 < 10)
+                                    : line(at, to, 3 + i % 5, i % 20 < 10));
+        if (i % 10 != 9) at = to;
+    }
+    const MachineProfile profile = profile_for(2);
+    for (int variant = 0; variant < 3; ++variant) {
+        SimOptions options;
+        options.plant = PlantModel::kServo;
+        options.servo.bandwidth_hz = 40;
+        if (variant == 1) {
+            options.producer_interval_ticks = 3;
+            options.max_pushes_per_run = 2;
+        }
+        if (variant == 2) options.settle_ticks = 50;
+        INFO("variant " << variant);
+        const SimulationResult whole = sim::simulate(spans, profile, options);
+
+        SimOptions streamed = options;
+        streamed.record_ticks = false;
+        std::vector<Lsb> setpoints;
+        std::vector<double> positions;
+        std::vector<std::uint8_t> pen;
+        sim::TickProbe last;
+        streamed.tick_observer = [&](const sim::TickProbe& p) {
+            setpoints.insert(setpoints.end(), p.setpoints, p.setpoints + 2);
+            positions.insert(positions.end(), p.positions, p.positions + 2);
+            pen.push_back(p.pen_down ? 1 : 0);
+            last = p;
+        };
+        sim::Simulator simulator(profile, streamed);
+        for (std::size_t i = 0; i < spans.size(); ++i) {
+            simulator.push(spans[i]);
+            // The device is kept fed: at most a queue and one span wait beyond what it took.
+            if (variant == 0 && i > sim::kQueueCapacity + 1) {
+                const std::size_t taken = last.last_completed_tag + last.queued_spans;
+                REQUIRE(taken + sim::kQueueCapacity + 1 >= i + 1);
+            }
+        }
+        const SimulationResult r = simulator.finish();
+        CHECK(r.setpoints.empty());
+        CHECK(r.positions.empty());
+        CHECK(r.pen.empty());
+        CHECK(setpoints == whole.setpoints);
+        CHECK(positions == whole.positions);
+        CHECK(pen == whole.pen);
+        CHECK(r.ticks == whole.ticks);
+        CHECK(r.plan_ticks == whole.plan_ticks);
+        CHECK(r.spans_pushed == whole.spans_pushed);
+        CHECK(r.underruns == whole.underruns);
+        CHECK(r.pen_switch_ticks == whole.pen_switch_ticks);
+        CHECK(r.stream.idle_ticks == whole.stream.idle_ticks);
+        CHECK(r.stream.queue_full == whole.stream.queue_full);
+        CHECK(r.stream.max_queued == whole.stream.max_queued);
+        CHECK(r.stream.ticks_executed == whole.stream.ticks_executed);
+        CHECK(last.ticks_pushed == whole.plan_ticks);
+        for (std::size_t a = 0; a < 2; ++a) {
+            CHECK(r.following[a].max_mm == whole.following[a].max_mm);
+            CHECK(r.following[a].max_tick == whole.following[a].max_tick);
+            CHECK(r.following[a].rms_mm == whole.following[a].rms_mm);
+        }
+        if (variant == 1) CHECK(r.underruns > 0);
+    }
+    sim::Simulator empty(profile, SimOptions{});
+    CHECK_THROWS_AS(empty.finish(), std::invalid_argument);
+    sim::Simulator wrong(profile, SimOptions{});
+    wrong.push(spans[0]);
+    CHECK_THROWS_WITH(wrong.push(line({0}, {10}, 2, true)), "span 1 has 1 axes, the first span 2");
+}

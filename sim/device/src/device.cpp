@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <deque>
 #include <memory>
 #include <optional>
 #include <sstream>
@@ -46,164 +47,287 @@ void start_point(const CoreSpan& first, Lsb (&start)[Axes]) {
     }
 }
 
-template <unsigned Axes>
-SimulationResult run(const std::vector<CoreSpan>& spans, const host::MachineProfile& profile,
-                     const SimOptions& options, hal::Clock* pacing, const Progress& progress) {
-    using Stream = SetpointStream<Axes, kQueueCapacity>;
-    const auto wall_start = std::chrono::steady_clock::now();
-    const std::size_t span_count = spans.size();
-
-    SimulationResult r;
-    r.axes = Axes;
-    r.tick_hz = profile.tick_hz;
-    r.mm_per_lsb = profile.mm_per_lsb;
-    r.plant = options.plant;
-    r.servo = options.servo;
-    r.paced = pacing != nullptr;
-    for (const CoreSpan& s : spans) r.plan_ticks += s.ticks;
-
-    Lsb start[Axes];
-    start_point<Axes>(spans.front(), start);
-    auto stream = std::make_unique<Stream>(start);  // ~13 KB at 8 axes: heap on the host
-
-    VirtualClock device_time;          // the device's tick counter
-    SimulatedOutput pen(device_time);  // the pen lift, stamped in device ticks
-
-    std::vector<ServoAxis> servo;
-    if (options.plant == PlantModel::kServo) {
-        for (unsigned a = 0; a < Axes; ++a) {
-            servo.emplace_back(options.servo, profile.tick_seconds(),
-                               start[a] * profile.mm_per_lsb);
-        }
+/// Checks what a run needs of the profile.
+void check_profile(const host::MachineProfile& profile) {
+    if (!(profile.tick_hz > 0) || !(profile.mm_per_lsb > 0)) {
+        throw std::invalid_argument(
+            "the machine profile needs a positive tick rate and mm per LSB");
     }
-
-    const std::uint64_t expected_rows = r.plan_ticks + 1 + options.settle_ticks;
-    r.setpoints.reserve(expected_rows * Axes);
-    r.positions.reserve(expected_rows * Axes);
-    r.pen.reserve(expected_rows);
-    std::vector<double> sum_sq(Axes, 0.0);
-    r.following.assign(Axes, FollowingError{});
-
-    std::size_t next = 0;  // next span to push
-    const auto produce = [&] {
-        std::uint32_t pushed = 0;
-        while (next < span_count &&
-               (options.max_pushes_per_run == 0 || pushed < options.max_pushes_per_run)) {
-            const Status s = stream->push(
-                host::to_core_span<Axes>(spans[next], static_cast<std::uint32_t>(next + 1)));
-            if (s == Status::kQueueFull) {
-                ++r.stream.queue_full;
-                break;
-            }
-            if (s != Status::kOk) throw std::runtime_error(span_error(next, s));
-            ++next;
-            ++pushed;
-            ++r.spans_pushed;
-        }
-        r.stream.max_queued = std::max(r.stream.max_queued, stream->queued_spans());
-    };
-
-    const std::uint32_t interval = std::max<std::uint32_t>(1, options.producer_interval_ticks);
-    const std::uint64_t progress_stride = std::max<std::uint64_t>(1, expected_rows / 100);
-    std::uint64_t rows_after_end = 1 + options.settle_ticks;  // end point + settling
-    Lsb out[Axes];
-    for (std::uint64_t k = 0;; ++k) {
-        if (k % interval == 0) produce();  // the producer task, between two tick interrupts
-        if (pacing != nullptr) {
-            pacing->wait_until(k);
-            if (pacing->now() > k) ++r.late_ticks;
-        }
-        device_time.wait_until(k);
-        const bool finished = stream->spans_completed() == span_count;
-
-        // --- the tick interrupt ---
-        const TickState state = stream->tick(out);
-        pen.set((stream->outputs() & kOutputPenDown) != 0);
-        // ---
-
-        if (state == TickState::kIdle) {
-            ++r.stream.idle_ticks;
-            if (!finished) ++r.underruns;
-        }
-        r.pen.push_back(pen.state() ? 1 : 0);
-        for (unsigned a = 0; a < Axes; ++a) {
-            const double setpoint_mm = out[a] * profile.mm_per_lsb;
-            double position = setpoint_mm;
-            if (!servo.empty()) {
-                position = servo[a].position();  // at this tick's instant, before its hold
-                servo[a].step(setpoint_mm);
-            }
-            r.setpoints.push_back(out[a]);
-            r.positions.push_back(position);
-            const double e = std::fabs(setpoint_mm - position);
-            sum_sq[a] += e * e;
-            if (e > r.following[a].max_mm) {
-                r.following[a].max_mm = e;
-                r.following[a].max_tick = k;
-            }
-        }
-        r.ticks = k + 1;
-        if (options.tick_observer) {
-            options.tick_observer({k, stream->ticks_executed(), stream->last_completed_tag(),
-                                   stream->queued_spans(), out});
-        }
-        if (progress && r.ticks % progress_stride == 0) {
-            progress(
-                std::min(1.0, static_cast<double>(r.ticks) / static_cast<double>(expected_rows)));
-        }
-        if (finished && --rows_after_end == 0) break;
-    }
-
-    for (unsigned a = 0; a < Axes; ++a) {
-        r.following[a].rms_mm = std::sqrt(sum_sq[a] / static_cast<double>(r.ticks));
-    }
-    r.stream.ticks_executed = stream->ticks_executed();
-    r.stream.spans_completed = stream->spans_completed();
-    r.stream.last_completed_tag = stream->last_completed_tag();
-    r.pen_switch_ticks = pen.switch_ticks();
-    r.simulated_seconds = static_cast<double>(r.ticks) / profile.tick_hz;
-    r.wall_seconds =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
-    if (progress) progress(1.0);
-    return r;
 }
 
-SimulationResult dispatch(const std::vector<CoreSpan>& spans, const host::MachineProfile& profile,
-                          const SimOptions& options, hal::Clock* pacing, const Progress& progress) {
-    if (spans.empty()) throw std::invalid_argument("no spans: nothing to simulate");
-    const std::size_t axes = spans.front().control.size();
+/// The axis count of a plan whose first span is `first`, checked against the device and the
+/// profile.
+std::size_t plan_axes(const CoreSpan& first, const host::MachineProfile& profile) {
+    const std::size_t axes = first.control.size();
     if (axes < 1 || axes > kMaxAxes) {
         throw std::invalid_argument("the plan has " + std::to_string(axes) +
                                     " axes; the device supports 1 to 8");
-    }
-    for (std::size_t i = 0; i < spans.size(); ++i) {
-        if (spans[i].control.size() != axes) {
-            throw std::invalid_argument("span " + std::to_string(i) + " has " +
-                                        std::to_string(spans[i].control.size()) +
-                                        " axes, the first span " + std::to_string(axes));
-        }
     }
     if (profile.axes.size() != axes) {
         throw std::invalid_argument("the plan has " + std::to_string(axes) +
                                     " axes but the machine profile " +
                                     std::to_string(profile.axes.size()));
     }
-    if (!(profile.tick_hz > 0) || !(profile.mm_per_lsb > 0)) {
-        throw std::invalid_argument(
-            "the machine profile needs a positive tick rate and mm per LSB");
+    return axes;
+}
+
+void check_span_axes(const CoreSpan& span, std::size_t index, std::size_t axes) {
+    if (span.control.size() != axes) {
+        throw std::invalid_argument("span " + std::to_string(index) + " has " +
+                                    std::to_string(span.control.size()) + " axes, the first span " +
+                                    std::to_string(axes));
     }
-    return host::with_axes(axes, [&](auto n) {
-        return run<decltype(n)::value>(spans, profile, options, pacing, progress);
-    });
 }
 
 }  // namespace
 
+/// The run of one axis count: the stream, the pen, the plants and the spans waiting.
+class Simulator::Engine {
+public:
+    virtual ~Engine() = default;
+    virtual void push(const CoreSpan& span) = 0;
+    virtual SimulationResult finish() = 0;
+    virtual std::uint64_t ticks() const = 0;
+};
+
+namespace {
+
+template <unsigned Axes>
+class AxesEngine final : public Simulator::Engine {
+public:
+    using Stream = SetpointStream<Axes, kQueueCapacity>;
+
+    AxesEngine(const CoreSpan& first, const host::MachineProfile& profile,
+               const SimOptions& options, hal::Clock* pacing, const Progress& progress,
+               std::uint64_t expected_ticks)
+        : profile_(profile),
+          options_(options),
+          pacing_(pacing),
+          progress_(progress),
+          wall_start_(std::chrono::steady_clock::now()),
+          pen_(device_time_),
+          interval_(std::max<std::uint32_t>(1, options.producer_interval_ticks)),
+          rows_after_end_(1 + options.settle_ticks) {
+        r_.axes = Axes;
+        r_.tick_hz = profile.tick_hz;
+        r_.mm_per_lsb = profile.mm_per_lsb;
+        r_.plant = options.plant;
+        r_.servo = options.servo;
+        r_.paced = pacing != nullptr;
+        Lsb start[Axes];
+        start_point<Axes>(first, start);
+        stream_ = std::make_unique<Stream>(start);  // ~13 KB at 8 axes: heap on the host
+        if (options.plant == PlantModel::kServo) {
+            for (unsigned a = 0; a < Axes; ++a) {
+                servo_.emplace_back(options.servo, profile.tick_seconds(),
+                                    start[a] * profile.mm_per_lsb);
+            }
+        }
+        expected_rows_ = expected_ticks + 1 + options.settle_ticks;
+        if (options.record_ticks && expected_ticks > 0) {
+            r_.setpoints.reserve(expected_rows_ * Axes);
+            r_.positions.reserve(expected_rows_ * Axes);
+            r_.pen.reserve(expected_rows_);
+        }
+        progress_stride_ =
+            expected_ticks > 0 ? std::max<std::uint64_t>(1, expected_rows_ / 100) : 0;
+        r_.following.assign(Axes, FollowingError{});
+    }
+
+    void push(const CoreSpan& span) override {
+        r_.plan_ticks += span.ticks;
+        pending_.push_back(span);
+        advance(false);
+    }
+
+    SimulationResult finish() override {
+        advance(true);
+        for (unsigned a = 0; a < Axes; ++a) {
+            r_.following[a].rms_mm = std::sqrt(sum_sq_[a] / static_cast<double>(r_.ticks));
+        }
+        r_.stream.ticks_executed = stream_->ticks_executed();
+        r_.stream.spans_completed = stream_->spans_completed();
+        r_.stream.last_completed_tag = stream_->last_completed_tag();
+        r_.pen_switch_ticks = pen_.switch_ticks();
+        r_.simulated_seconds = static_cast<double>(r_.ticks) / profile_.tick_hz;
+        r_.wall_seconds =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start_).count();
+        if (progress_) progress_(1.0);
+        return std::move(r_);
+    }
+
+    std::uint64_t ticks() const override { return r_.ticks; }
+
+private:
+    /// The producer task: pushes waiting spans while the queue takes them.
+    void produce() {
+        std::uint32_t pushed = 0;
+        while (!pending_.empty() &&
+               (options_.max_pushes_per_run == 0 || pushed < options_.max_pushes_per_run)) {
+            const std::size_t index = next_;
+            const Status s = stream_->push(
+                host::to_core_span<Axes>(pending_.front(), static_cast<std::uint32_t>(index + 1)));
+            if (s == Status::kQueueFull) {
+                ++r_.stream.queue_full;
+                break;
+            }
+            if (s != Status::kOk) throw std::runtime_error(span_error(index, s));
+            ticks_pushed_ += pending_.front().ticks;
+            pending_.pop_front();
+            ++next_;
+            ++pushed;
+            ++r_.spans_pushed;
+        }
+        r_.stream.max_queued = std::max(r_.stream.max_queued, stream_->queued_spans());
+    }
+
+    /// Runs ticks until the run ends or, unless `final`, until the producer is due with no
+    /// more spans waiting than the queue could take: what it does then depends on the spans
+    /// still to come (a whole plan's run would have them), so they are needed first.
+    void advance(bool final) {
+        while (!done_) {
+            const std::uint64_t k = k_;
+            if (k % interval_ == 0 && !produced_) {
+                if (!final && pending_.size() <= kQueueCapacity) return;
+                produce();  // the producer task, between two tick interrupts
+                produced_ = true;
+            }
+            if (pacing_ != nullptr) {
+                pacing_->wait_until(k);
+                if (pacing_->now() > k) ++r_.late_ticks;
+            }
+            device_time_.wait_until(k);
+            // Not final: spans are still waiting, so the plan cannot have finished.
+            const bool finished = final && pending_.empty() && stream_->spans_completed() == next_;
+
+            // --- the tick interrupt ---
+            const TickState state = stream_->tick(out_);
+            pen_.set((stream_->outputs() & kOutputPenDown) != 0);
+            // ---
+
+            if (state == TickState::kIdle) {
+                ++r_.stream.idle_ticks;
+                if (!finished) ++r_.underruns;
+            }
+            const bool pen_down = pen_.state();
+            if (options_.record_ticks) r_.pen.push_back(pen_down ? 1 : 0);
+            double positions[Axes];
+            for (unsigned a = 0; a < Axes; ++a) {
+                const double setpoint_mm = out_[a] * profile_.mm_per_lsb;
+                double position = setpoint_mm;
+                if (!servo_.empty()) {
+                    position = servo_[a].position();  // at this tick's instant, before its hold
+                    servo_[a].step(setpoint_mm);
+                }
+                positions[a] = position;
+                if (options_.record_ticks) {
+                    r_.setpoints.push_back(out_[a]);
+                    r_.positions.push_back(position);
+                }
+                const double e = std::fabs(setpoint_mm - position);
+                sum_sq_[a] += e * e;
+                if (e > r_.following[a].max_mm) {
+                    r_.following[a].max_mm = e;
+                    r_.following[a].max_tick = k;
+                }
+            }
+            r_.ticks = k + 1;
+            if (options_.tick_observer) {
+                options_.tick_observer({k, stream_->ticks_executed(), stream_->last_completed_tag(),
+                                        stream_->queued_spans(), ticks_pushed_, out_, positions,
+                                        pen_down});
+            }
+            if (progress_ && progress_stride_ > 0 && r_.ticks % progress_stride_ == 0) {
+                progress_(std::min(
+                    1.0, static_cast<double>(r_.ticks) / static_cast<double>(expected_rows_)));
+            }
+            ++k_;
+            produced_ = false;
+            if (finished && --rows_after_end_ == 0) done_ = true;
+        }
+    }
+
+    const host::MachineProfile& profile_;
+    const SimOptions& options_;
+    hal::Clock* pacing_;
+    const Progress& progress_;
+    std::chrono::steady_clock::time_point wall_start_;
+    SimulationResult r_;
+    std::unique_ptr<Stream> stream_;
+    VirtualClock device_time_;  // the device's tick counter
+    SimulatedOutput pen_;       // the pen lift, stamped in device ticks
+    std::vector<ServoAxis> servo_;
+    std::deque<CoreSpan> pending_;  // spans given, not yet taken by the device
+    std::size_t next_ = 0;          // spans the device took
+    std::uint64_t ticks_pushed_ = 0;
+    std::uint32_t interval_;
+    std::uint64_t rows_after_end_;  // end point + settling
+    std::uint64_t expected_rows_ = 0;
+    std::uint64_t progress_stride_ = 0;
+    std::uint64_t k_ = 0;    // the next tick
+    bool produced_ = false;  // the producer ran before tick k_
+    bool done_ = false;
+    double sum_sq_[Axes] = {};
+    Lsb out_[Axes] = {};
+};
+
+SimulationResult dispatch(const std::vector<CoreSpan>& spans, const host::MachineProfile& profile,
+                          const SimOptions& options, hal::Clock* pacing, const Progress& progress) {
+    if (spans.empty()) throw std::invalid_argument("no spans: nothing to simulate");
+    const std::size_t axes = plan_axes(spans.front(), profile);
+    for (std::size_t i = 0; i < spans.size(); ++i) check_span_axes(spans[i], i, axes);
+    check_profile(profile);
+    std::uint64_t ticks = 0;
+    for (const CoreSpan& s : spans) ticks += s.ticks;
+    Simulator simulator(profile, options, pacing, progress, ticks);
+    for (const CoreSpan& s : spans) simulator.push(s);
+    return simulator.finish();
+}
+
+}  // namespace
+
+Simulator::Simulator(const host::MachineProfile& profile, const SimOptions& options,
+                     hal::Clock* pacing, Progress progress, std::uint64_t expected_ticks)
+    : profile_(profile),
+      options_(options),
+      pacing_(pacing),
+      progress_(std::move(progress)),
+      expected_ticks_(expected_ticks) {
+    check_profile(profile);
+}
+
+Simulator::~Simulator() = default;
+
+void Simulator::push(const CoreSpan& span) {
+    if (!engine_) {
+        axes_ = plan_axes(span, profile_);
+        // Real time: the Linux clock's tick 0 is the first span's arrival.
+        if (pacing_ == nullptr && options_.realtime) {
+            own_clock_ = std::make_unique<hal::LinuxClock>(profile_.tick_hz);
+            pacing_ = own_clock_.get();
+        }
+        engine_ = host::with_axes(axes_, [&](auto n) -> std::unique_ptr<Engine> {
+            return std::make_unique<AxesEngine<decltype(n)::value>>(
+                span, profile_, options_, pacing_, progress_, expected_ticks_);
+        });
+    }
+    check_span_axes(span, spans_, axes_);
+    ++spans_;
+    engine_->push(span);
+}
+
+SimulationResult Simulator::finish() {
+    if (!engine_) throw std::invalid_argument("no spans: nothing to simulate");
+    return engine_->finish();
+}
+
+std::uint64_t Simulator::ticks() const {
+    return engine_ ? engine_->ticks() : 0;
+}
+
 SimulationResult simulate(const std::vector<CoreSpan>& spans, const host::MachineProfile& profile,
                           const SimOptions& options, const Progress& progress) {
-    if (!options.realtime) return dispatch(spans, profile, options, nullptr, progress);
-    hal::LinuxClock clock(profile.tick_hz);
-    return dispatch(spans, profile, options, &clock, progress);
+    return dispatch(spans, profile, options, nullptr, progress);
 }
 
 SimulationResult simulate_paced(const std::vector<CoreSpan>& spans,

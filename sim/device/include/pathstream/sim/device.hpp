@@ -1,10 +1,12 @@
 // The simulated device: the firmware core's SetpointStream fed with a plan's spans and ticked
-// by a clock, driving a pen output and a plant per axis, with everything recorded per tick.
+// by a clock, driving a pen output and a plant per axis. Fed span by span (Simulator) or with a
+// whole plan (simulate); every tick is recorded unless SimOptions::record_ticks is off.
 #pragma once
 
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -25,7 +27,10 @@ struct TickProbe {
     std::uint64_t ticks_executed = 0;      ///< path ticks so far (SetpointStream::ticks_executed)
     std::uint32_t last_completed_tag = 0;  ///< tag (span index + 1) of the last span done, 0: none
     std::uint32_t queued_spans = 0;        ///< spans queued, the one in progress included
+    std::uint64_t ticks_pushed = 0;        ///< ticks of every span the device accepted so far
     const Lsb* setpoints = nullptr;        ///< the tick's setpoints, one per axis
+    const double* positions = nullptr;     ///< mm per axis: the plant's position at the tick
+    bool pen_down = false;                 ///< the pen output after the tick
 };
 
 /// How to run.
@@ -41,6 +46,9 @@ struct SimOptions {
     std::uint32_t max_pushes_per_run = 0;
     /// Called after every tick when set: keep it cheap, it runs at the tick rate.
     std::function<void(const TickProbe&)> tick_observer;
+    /// Keep every tick in SimulationResult::setpoints, positions and pen. Off: those stay
+    /// empty and memory does not grow with the run (a tick_observer sees every tick instead).
+    bool record_ticks = true;
 };
 
 /// Following error of one axis, |setpoint - plant position| over every recorded tick.
@@ -60,9 +68,9 @@ struct StreamCounters {
     std::uint32_t max_queued = 0;          ///< deepest the queue got (<= kQueueCapacity)
 };
 
-/// Everything one run produced. Per-tick records are row-major, row k = tick k: ticks 0 to
-/// plan ticks - 1 come from spans, then one tick holding the end point, then settle_ticks
-/// (more rows if the queue ran dry: see underruns).
+/// Everything one run produced. Per-tick records (only with SimOptions::record_ticks) are
+/// row-major, row k = tick k: ticks 0 to plan ticks - 1 come from spans, then one tick holding
+/// the end point, then settle_ticks (more rows if the queue ran dry: see underruns).
 struct SimulationResult {
     std::size_t axes = 0;
     double tick_hz = 0;
@@ -97,6 +105,49 @@ struct SimulationResult {
 /// Called now and then (about every 1 % of the ticks, and with 1.0 at the end) with the
 /// fraction done.
 using Progress = std::function<void(double fraction)>;
+
+/// The simulated device fed a plan span by span, as a planner makes them: memory stays bounded
+/// whatever the plan's length (with SimOptions::record_ticks off). The run is the one
+/// simulate() makes of the same spans, tick for tick: push() runs the device only as far as
+/// it can without knowing the spans still to come (the producer always has more spans waiting
+/// than the queue can take), finish() runs it to the end.
+class Simulator {
+public:
+    /// `pacing`: as simulate_paced (null: options.realtime decides). `expected_ticks`: the
+    /// plan's ticks when known (0: not), for `progress` (called as simulate's; else only with
+    /// 1.0 at the end) and to reserve the per-tick record. Throws std::invalid_argument for a
+    /// profile without a positive tick rate and mm per LSB.
+    Simulator(const host::MachineProfile& profile, const SimOptions& options,
+              hal::Clock* pacing = nullptr, Progress progress = {},
+              std::uint64_t expected_ticks = 0);
+    ~Simulator();
+    Simulator(const Simulator&) = delete;
+    Simulator& operator=(const Simulator&) = delete;
+
+    /// The plan's next span (its tag: spans pushed before it + 1); runs the device's ticks
+    /// that do not depend on the spans after it. Keeps at most kQueueCapacity + 1 spans
+    /// waiting. Throws as simulate does, for this span (std::invalid_argument for its axis
+    /// count, std::runtime_error when the device refuses it).
+    void push(const host::CoreSpan& span);
+    /// The plan ended: runs the device to the end point and settle_ticks, and returns the
+    /// run (std::invalid_argument when no span was pushed). Call once.
+    SimulationResult finish();
+    /// Ticks run so far.
+    std::uint64_t ticks() const;
+
+    class Engine;
+
+private:
+    const host::MachineProfile& profile_;
+    SimOptions options_;
+    hal::Clock* pacing_;
+    std::unique_ptr<hal::Clock> own_clock_;
+    Progress progress_;
+    std::uint64_t expected_ticks_;
+    std::unique_ptr<Engine> engine_;
+    std::size_t axes_ = 0;
+    std::size_t spans_ = 0;
+};
 
 /// Runs `spans` (a plan's) on the simulated device: a SetpointStream<axes, kQueueCapacity> (axes =
 /// the spans' axis count, 1..8) starting at the first span's start point, a producer pushing the
