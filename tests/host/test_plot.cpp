@@ -605,3 +605,141 @@ TEST_CASE("a drawing simulated on the servo plant, plotted and reported end to e
     CHECK(report.find("4 pen lifts and lowers") != std::string::npos);
     if (keep != nullptr) std::ofstream(out / "report.txt") << report;
 }
+
+namespace {
+
+/// A series of `n` ticks on `axes` axes: wavy motion rounded to the LSB, pen changes.
+plot::TickSeries wavy_series(std::size_t n, std::size_t axes) {
+    plot::TickSeries s;
+    s.name = "setpoints";
+    s.axes = axes;
+    s.quantum_mm = 0.001;
+    for (std::size_t k = 0; k < n; ++k) {
+        const double t = static_cast<double>(k) * 0.001;
+        for (std::size_t a = 0; a < axes; ++a) {
+            const double mm = 20 * std::sin(1.3 * t + a) + 3 * std::sin(17.0 * t * (a + 1));
+            s.position.push_back(std::round(mm / 0.001) * 0.001);
+        }
+        s.pen_down.push_back((k / 700) % 3 != 2 ? 1 : 0);
+    }
+    return s;
+}
+
+plot::RunRecord recorded(const plot::TickSeries& s, const plot::TickSeries* plant,
+                         const MachineProfile& m, std::size_t capacity, unsigned h = 0) {
+    plot::RunRecorder recorder(m, s.axes, s.tick_hz, s.quantum_mm, plant != nullptr, capacity, h);
+    for (std::size_t k = 0; k < s.ticks(); ++k) {
+        recorder.add(s.position.data() + k * s.axes,
+                     plant != nullptr ? plant->position.data() + k * s.axes : nullptr,
+                     s.pen_down[k] != 0);
+    }
+    plot::RunRecord r = recorder.finish();
+    r.executed_name = s.name;
+    if (plant != nullptr) r.plant_name = plant->name;
+    return r;
+}
+
+MachineProfile profile_axes(std::size_t axes) {
+    MachineProfile m;
+    for (std::size_t a = 0; a < axes; ++a)
+        m.axes.push_back({std::string(1, "xyz"[a]), 120.0, 2000.0});
+    m.mm_per_lsb = 0.001;
+    m.tick_hz = 1000;
+    m.feed = 50;
+    m.travel_feed = 90;
+    return m;
+}
+
+}  // namespace
+
+TEST_CASE("a recorder seeing the ticks one by one gives the whole series' figures exactly",
+          "[plot]") {
+    for (std::size_t axes : {1, 2, 3}) {
+        const MachineProfile m = profile_axes(axes);
+        // Around the window (h = 4 here: 2 h + 1 = 9 ticks) and long ones.
+        for (std::size_t n : {0, 1, 2, 3, 5, 8, 9, 10, 17, 1000, 30000}) {
+            for (unsigned h : {0u, 1u, 7u}) {
+                INFO("axes " << axes << " ticks " << n << " half window " << h);
+                const plot::TickSeries s = wavy_series(n, axes);
+                const plot::ExecutedFigures whole = plot::executed_figures(s, m, h);
+                for (std::size_t capacity : {std::size_t{0}, std::size_t{64}}) {
+                    const plot::ExecutedFigures f = recorded(s, nullptr, m, capacity, h).figures;
+                    CHECK(f.ticks == whole.ticks);
+                    CHECK(f.pen_down_ticks == whole.pen_down_ticks);
+                    CHECK(f.pen_downs == whole.pen_downs);
+                    CHECK(f.pen_ups == whole.pen_ups);
+                    CHECK(f.half_window == whole.half_window);
+                    CHECK(f.acceleration_noise == whole.acceleration_noise);
+                    CHECK(f.peak_velocity == whole.peak_velocity);
+                    CHECK(f.peak_acceleration == whole.peak_acceleration);
+                    CHECK(f.peak_speed == whole.peak_speed);
+                }
+            }
+        }
+    }
+}
+
+TEST_CASE("a record keeps every tick until its capacity, then stays within it", "[plot]") {
+    const MachineProfile m = profile_xy();
+    SECTION("short: the same plots as the whole series") {
+        const plot::TickSeries s = wavy_series(5000, 2);
+        plot::TickSeries plant = s;
+        plant.name = "servo plant";
+        plant.quantum_mm = 0;
+        for (double& v : plant.position) v += 0.0123;
+        const plot::RunRecord r = recorded(s, &plant, m, 8192);
+        CHECK_FALSE(r.thinned);
+        const std::vector<BezierSegment> ideal = {straight({0, 0}, {20, 20}, true)};
+        VectorSegmentSource source(ideal);
+        plot::Options o;
+        CHECK(plot::path_svg(source, r, m, o) == plot::path_svg(ideal, s, &plant, m, o));
+        CHECK(plot::speed_svg(r, m, o) == plot::speed_svg(s, m, o));
+        CHECK(plot::acceleration_svg(r, m, o) == plot::acceleration_svg(s, m, o));
+        const plot::TickSeries one = wavy_series(3000, 1);
+        const MachineProfile m1 = profile_axes(1);
+        VectorSegmentSource none_source(ideal);
+        CHECK(plot::path_svg(none_source, recorded(one, nullptr, m1, 8192), m1, o) ==
+              plot::path_svg(ideal, one, nullptr, m1, o));
+    }
+    SECTION("long: bounded, peaks and ends kept") {
+        const std::size_t capacity = 512;
+        const plot::TickSeries s = wavy_series(200000, 2);
+        plot::TickSeries plant = s;
+        const plot::RunRecord r = recorded(s, &plant, m, capacity);
+        const plot::RunRecord whole = recorded(s, &plant, m, 0);
+        CHECK(r.thinned);
+        CHECK_FALSE(whole.thinned);
+        CHECK(r.speed.size() <= 2 * capacity + 2);
+        for (const auto& a : r.acceleration) CHECK(a.size() <= 2 * capacity + 2);
+        CHECK(r.executed_path.size() <= capacity + 1);
+        CHECK(r.plant_path.size() <= capacity + 1);
+        CHECK(r.pen_up.size() <= capacity);
+        CHECK(whole.speed.size() == s.ticks());
+        CHECK(whole.executed_path.size() == s.ticks());
+        // The figures are over every tick; the envelope keeps the peak and both ends.
+        CHECK(r.figures.peak_speed == whole.figures.peak_speed);
+        double peak = 0;
+        for (const plot::Point& p : r.speed) peak = std::max(peak, p.y);
+        CHECK(peak == r.figures.peak_speed);
+        CHECK(r.speed.front().x == 0);
+        CHECK(r.speed.back().x == Approx(199.999));
+        CHECK(r.executed_path.front().x == s.at(0, 0));
+        CHECK(r.executed_path.back().x == s.at(s.ticks() - 1, 0));
+        CHECK(r.executed_path.back().y == s.at(s.ticks() - 1, 1));
+        // 95 pen-up intervals of 700 ticks: all kept, each whole.
+        REQUIRE(r.pen_up == whole.pen_up);
+        CHECK(r.pen_up.size() == 95);
+        CHECK(r.pen_up.front() == std::pair<std::uint64_t, std::uint64_t>{1400, 2100});
+        // Every kept point is a tick of the series, in order.
+        std::size_t k = 0;
+        for (const plot::TracePoint& p : r.executed_path) {
+            while (k < s.ticks() && !(s.at(k, 0) == p.x && s.at(k, 1) == p.y)) ++k;
+            REQUIRE(k < s.ticks());
+        }
+        const std::vector<BezierSegment> ideal = {straight({0, 0}, {20, 20}, true)};
+        VectorSegmentSource source(ideal);
+        plot::Options o;
+        const std::string svg = plot::path_svg(source, r, m, o);
+        CHECK(svg.size() < plot::path_svg(ideal, s, &plant, m, o).size() * 2);
+    }
+}

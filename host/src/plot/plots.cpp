@@ -60,21 +60,21 @@ void add_px(std::vector<Point>& run, Point p, double min_px = 0.4) {
     run.push_back(p);
 }
 
-/// Draws a TickSeries' two axes as pen-down (solid) and pen-up (dashed) runs, in pixels,
-/// thinned to points at least 0.75 px apart (the last point of every run kept).
-void draw_executed(Canvas& c, const TickSeries& s, std::size_t ax, std::size_t ay,
-                   const std::string& colour, double width) {
-    const std::size_t n = s.ticks();
+/// Draws a path's points as pen-down (solid) and pen-up (dashed) runs, in pixels, thinned to
+/// points at least 0.75 px apart (the last point of every run kept).
+void draw_executed(Canvas& c, const std::vector<TracePoint>& s, const std::string& colour,
+                   double width) {
+    const std::size_t n = s.size();
     std::size_t k = 0;
     while (k < n) {
-        const bool down = k < s.pen_down.size() && s.pen_down[k] != 0;
+        const bool down = s[k].pen_down;
         std::vector<Point> run;
         std::size_t j = k;
-        for (; j < n && ((j < s.pen_down.size() && s.pen_down[j] != 0) == down); ++j) {
-            add_px(run, {c.px(s.at(j, ax)), c.py(s.at(j, ay))}, 0.75);
+        for (; j < n && s[j].pen_down == down; ++j) {
+            add_px(run, {c.px(s[j].x), c.py(s[j].y)}, 0.75);
         }
         const std::size_t last = j < n ? j : n - 1;  // share the boundary point with the next run
-        const Point end{c.px(s.at(last, ax)), c.py(s.at(last, ay))};
+        const Point end{c.px(s[last].x), c.py(s[last].y)};
         if (run.empty() || run.back().x != end.x || run.back().y != end.y) run.push_back(end);
         c.polyline_px(run, colour, width, down ? "" : kPenUpDash, down ? "pen-down" : "pen-up");
         k = j;
@@ -87,15 +87,15 @@ LegendEntry pen_up_legend() {
     return {"pen up", kPenUpShade, "", 10};
 }
 
-/// Shades the pen-up intervals of a series (merging ones closer than a pixel).
-void shade_pen_up(Canvas& c, const TickSeries& s) {
-    const double t = 1.0 / s.tick_hz;
+/// Shades the pen-up intervals of a run (merging ones closer than a pixel).
+void shade_pen_up(Canvas& c, const RunRecord& r) {
+    const double t = 1.0 / r.tick_hz;
     const double merge = 1.0 / std::max(1e-12, c.px(1) - c.px(0));  // one pixel in seconds
     double from = -1, to = -1;
     c.body() << "<g id=\"pen-up-intervals\">\n";
-    for (std::size_t k = 0; k < s.pen_down.size(); ++k) {
-        if (s.pen_down[k] != 0) continue;
-        const double a = static_cast<double>(k) * t, b = a + t;
+    for (const auto& [first, end] : r.pen_up) {
+        const double a = static_cast<double>(first) * t;
+        const double b = static_cast<double>(end - 1) * t + t;
         if (from >= 0 && a - to <= merge) {
             to = b;
             continue;
@@ -108,17 +108,23 @@ void shade_pen_up(Canvas& c, const TickSeries& s) {
     c.body() << "</g>\n";
 }
 
-std::vector<double> times(std::size_t n, double tick_hz) {
-    std::vector<double> t(n);
-    for (std::size_t k = 0; k < n; ++k) t[k] = static_cast<double>(k) / tick_hz;
-    return t;
+/// A record's points as the x and y vectors of decimate_min_max.
+std::vector<Point> decimate_points(const std::vector<Point>& points, double x_min, double x_max,
+                                   std::size_t columns) {
+    std::vector<double> x, y;
+    x.reserve(points.size());
+    y.reserve(points.size());
+    for (const Point& p : points) {
+        x.push_back(p.x);
+        y.push_back(p.y);
+    }
+    return decimate_min_max(x, y, x_min, x_max, columns);
 }
 
-std::vector<double> column(const std::vector<double>& rows, std::size_t axes, std::size_t axis) {
-    std::vector<double> out;
-    out.reserve(rows.size() / std::max<std::size_t>(1, axes));
-    for (std::size_t i = axis; i < rows.size(); i += axes) out.push_back(rows[i]);
-    return out;
+/// Time of the last tick of a run (1 when it has fewer than two).
+double end_time(const RunRecord& r) {
+    const std::uint64_t n = r.figures.ticks;
+    return n > 1 ? static_cast<double>(n - 1) / r.tick_hz : 1;
 }
 
 std::string title_of(const Options& o, const std::string& what) {
@@ -134,34 +140,32 @@ std::size_t columns_of(const Canvas& c) {
 }
 
 /// One axis: position against time for the executed series (and plant).
-std::string position_time_svg(const TickSeries& executed, const TickSeries* plant,
-                              const MachineProfile& profile, const Options& options) {
+std::string position_time_svg(const RunRecord& r, const MachineProfile& profile,
+                              const Options& options) {
     const double w = width_of(options);
     Canvas c(w, std::round(w * 0.5), kMarginLeft, kMarginTop, kMarginRight, kMarginBottom);
     c.title(title_of(options, "Path (one axis)"));
-    const std::size_t n = executed.ticks();
-    const double t_end = n > 1 ? static_cast<double>(n - 1) / executed.tick_hz : 1;
+    const double t_end = end_time(r);
     double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-    for (const TickSeries* s : {&executed, plant}) {
-        if (s == nullptr) continue;
-        for (double v : s->position) lo = std::min(lo, v), hi = std::max(hi, v);
+    for (int series = 0; series < (r.has_plant ? 2 : 1); ++series) {
+        if (r.bounded[series])
+            lo = std::min(lo, r.lo[series][0]), hi = std::max(hi, r.hi[series][0]);
     }
     if (!(hi >= lo)) lo = 0, hi = 1;
     const double pad = std::max(1e-6, (hi - lo) * 0.05);
     c.set_range(0, t_end, lo - pad, hi + pad, false);
     c.axes("time (s)", axis_name(profile, 0) + " (mm)");
-    shade_pen_up(c, executed);
+    shade_pen_up(c, r);
     std::vector<LegendEntry> legend;
-    const auto draw = [&](const TickSeries& s, const char* id, const char* colour, double width) {
+    const auto draw = [&](int series, const std::string& name, const char* id, const char* colour,
+                          double width) {
         c.begin_series(id);
-        c.polyline(decimate_min_max(times(s.ticks(), s.tick_hz), column(s.position, s.axes, 0), 0,
-                                    t_end, columns_of(c)),
-                   colour, width);
+        c.polyline(decimate_points(r.position[series], 0, t_end, columns_of(c)), colour, width);
         c.end_group();
-        legend.push_back({s.name, colour, "", width});
+        legend.push_back({name, colour, "", width});
     };
-    draw(executed, "setpoints", detail::kSetpointColour, 2.5);
-    if (plant != nullptr) draw(*plant, "plant", detail::kPlantColour, 1.2);
+    draw(0, r.executed_name, "setpoints", detail::kSetpointColour, 2.5);
+    if (r.has_plant) draw(1, r.plant_name, "plant", detail::kPlantColour, 1.2);
     legend.push_back(pen_up_legend());
     c.legend(legend);
     c.note("One axis: position against time (no ideal path drawn). Pen-up time shaded.");
@@ -309,21 +313,24 @@ std::size_t layer_of(const Options& o, const BezierSegment& s) {
     return s.subpath < o.subpath_layers.size() ? o.subpath_layers[s.subpath] : 0;
 }
 
-std::string path_svg(const std::vector<BezierSegment>& path, const TickSeries& executed,
-                     const TickSeries* plant, const MachineProfile& profile,
+std::string path_svg(SegmentSource& path, const RunRecord& r, const MachineProfile& profile,
                      const Options& options) {
-    if (executed.axes == 1) return position_time_svg(executed, plant, profile, options);
-    if (executed.axes == 0)
-        throw std::invalid_argument("path_svg: the executed series has no axes");
+    if (r.axes == 1) return position_time_svg(r, profile, options);
+    if (r.axes == 0) throw std::invalid_argument("path_svg: the executed series has no axes");
     const std::size_t ax = 0, ay = 1;
 
     // Bounds: the executed series and the ideal path (16 samples per segment suffice).
     Bounds b;
-    for (const TickSeries* s : {&executed, plant}) {
-        if (s == nullptr) continue;
-        for (std::size_t k = 0; k < s->ticks(); ++k) b.add(s->at(k, ax), s->at(k, ay));
+    for (int series = 0; series < (r.has_plant ? 2 : 1); ++series) {
+        if (!r.bounded[series]) continue;
+        b.add(r.lo[series][0], r.lo[series][1]);
+        b.add(r.hi[series][0], r.hi[series][1]);
     }
-    for (const BezierSegment& seg : path) {
+    BezierSegment seg;
+    bool any_segment = false;
+    if (!path.rewind()) throw std::invalid_argument("path_svg: the path cannot be read again");
+    while (path.next(seg)) {
+        any_segment = true;
         if (seg.p[0].size() <= ay) continue;
         for (int i = 0; i <= 16; ++i) {
             const Point p = bezier_xy(seg, ax, ay, i / 16.0);
@@ -368,7 +375,8 @@ std::string path_svg(const std::vector<BezierSegment>& path, const TickSeries& e
         c.polyline_px(run, colour, run_down ? 5 : 2, run_down ? "" : kTravelDash, cls);
         run.clear();
     };
-    for (const BezierSegment& seg : path) {
+    if (!path.rewind()) throw std::invalid_argument("path_svg: the path cannot be read again");
+    while (path.next(seg)) {
         if (seg.p[0].size() <= ay) continue;
         const std::size_t layer = layer_of(options, seg);
         if (!run.empty() && (seg.pen_down != run_down || (seg.pen_down && layer != run_layer))) {
@@ -392,53 +400,50 @@ std::string path_svg(const std::vector<BezierSegment>& path, const TickSeries& e
     c.end_group();
 
     c.begin_series("setpoints");
-    draw_executed(c, executed, ax, ay, detail::kSetpointColour, 1.6);
+    draw_executed(c, r.executed_path, detail::kSetpointColour, 1.6);
     c.end_group();
     std::vector<LegendEntry> legend;
-    if (!path.empty() && layered) {
+    if (any_segment && layered) {
         for (std::size_t l = 0; l < options.layers.size(); ++l)
             legend.push_back({"layer " + options.layers[l], layer_colour(options, l), "", 5});
         legend.push_back({"ideal travel (pen up)", detail::kIdealColour, kTravelDash, 2});
-    } else if (!path.empty()) {
+    } else if (any_segment) {
         legend.push_back({"ideal path", detail::kIdealColour, "", 5});
         legend.push_back({"ideal travel (pen up)", detail::kIdealColour, kTravelDash, 2});
     }
-    legend.push_back(
-        {executed.name.empty() ? "setpoints" : executed.name, detail::kSetpointColour, "", 1.6});
-    if (plant != nullptr && plant->axes == executed.axes) {
+    legend.push_back({r.executed_name.empty() ? "setpoints" : r.executed_name,
+                      detail::kSetpointColour, "", 1.6});
+    if (r.has_plant) {
         c.begin_series("plant");
-        draw_executed(c, *plant, ax, ay, detail::kPlantColour, 1);
+        draw_executed(c, r.plant_path, detail::kPlantColour, 1);
         c.end_group();
         legend.push_back(
-            {plant->name.empty() ? "plant" : plant->name, detail::kPlantColour, "", 1});
+            {r.plant_name.empty() ? "plant" : r.plant_name, detail::kPlantColour, "", 1});
     }
     c.legend(legend);
     std::string note =
         "Equal scale; +" + axis_name(profile, ay) +
         (options.y_up ? " points up." : " points down (SVG / plotter coordinates).") +
         " Executed pen-up moves dashed.";
-    if (executed.axes > 2)
+    if (r.axes > 2)
         note += " Axes " + axis_name(profile, ax) + ", " + axis_name(profile, ay) + " of " +
-                std::to_string(executed.axes) + ".";
+                std::to_string(r.axes) + ".";
     c.note(note);
     return c.finish();
 }
 
-std::string speed_svg(const TickSeries& executed, const MachineProfile& profile,
-                      const Options& options) {
-    const Derivatives d = differentiate(executed, profile, options.half_window_ticks);
+std::string speed_svg(const RunRecord& r, const MachineProfile& profile, const Options& options) {
     const double w = width_of(options);
     Canvas c(w, std::round(w * 0.5), kMarginLeft, kMarginTop, kMarginRight, kMarginBottom);
     c.title(title_of(options, "Path speed"));
-    const std::size_t n = executed.ticks();
-    const double t_end = n > 1 ? static_cast<double>(n - 1) / executed.tick_hz : 1;
+    const double t_end = end_time(r);
     double top = std::max(profile.feed, profile.travel_feed);
-    for (double v : d.speed) top = std::max(top, v);
+    top = std::max(top, r.figures.peak_speed);
     for (const AxisLimits& l : profile.axes) top = std::max(top, l.max_velocity);
     c.set_range(0, t_end, 0, std::max(top, 1e-6) * 1.08, false);
     c.axes("time (s)", "speed (mm/s)");
-    shade_pen_up(c, executed);
-    const std::vector<LimitGroup> limits = limit_groups(profile, executed.axes, false);
+    shade_pen_up(c, r);
+    const std::vector<LimitGroup> limits = limit_groups(profile, r.axes, false);
     c.body() << "<g id=\"velocity-limits\">\n";
     for (const LimitGroup& g : limits) {
         c.hline(g.value, g.colour(), "4 3", "velocity-limit-" + g.names(profile, "-"),
@@ -450,8 +455,7 @@ std::string speed_svg(const TickSeries& executed, const MachineProfile& profile,
     c.hline(profile.travel_feed, detail::kFeedColour, "2 3", "travel-feed",
             "travel feed " + detail::format_number(profile.travel_feed, 0) + " mm/s");
     c.begin_series("speed");
-    c.polyline(decimate_min_max(times(n, executed.tick_hz), d.speed, 0, t_end, columns_of(c)),
-               "#000", 1.3);
+    c.polyline(decimate_points(r.speed, 0, t_end, columns_of(c)), "#000", 1.3);
     c.end_group();
     std::vector<LegendEntry> legend = {{"path speed", "#000", "", 1.5},
                                        {"feed", detail::kFeedColour, "", 1.5},
@@ -460,31 +464,29 @@ std::string speed_svg(const TickSeries& executed, const MachineProfile& profile,
         legend.push_back({g.names(profile, ", ") + " limit", g.colour(), "4 3", 1.5});
     legend.push_back(pen_up_legend());
     c.legend(legend);
-    c.note("Speed = |v| of the " + executed.name + " over all axes, central differences over +/-" +
-           std::to_string(d.half_window) +
+    c.note("Speed = |v| of the " + r.executed_name +
+           " over all axes, central differences over +/-" + std::to_string(r.figures.half_window) +
            " tick(s); pen-up time shaded. An axis limit bounds that axis' own speed, not |v|.");
     return c.finish();
 }
 
-std::string acceleration_svg(const TickSeries& executed, const MachineProfile& profile,
+std::string acceleration_svg(const RunRecord& r, const MachineProfile& profile,
                              const Options& options) {
-    const Derivatives d = differentiate(executed, profile, options.half_window_ticks);
     const double w = width_of(options);
     Canvas c(w, std::round(w * 0.55), kMarginLeft, kMarginTop, kMarginRight, kMarginBottom);
     c.title(title_of(options, "Axis acceleration"));
-    const std::size_t n = executed.ticks();
-    const double t_end = n > 1 ? static_cast<double>(n - 1) / executed.tick_hz : 1;
+    const double t_end = end_time(r);
     double top = 0;
-    for (double a : d.acceleration) top = std::max(top, std::fabs(a));
-    for (std::size_t a = 0; a < executed.axes && a < profile.axes.size(); ++a) {
+    for (double a : r.figures.peak_acceleration) top = std::max(top, a);
+    for (std::size_t a = 0; a < r.axes && a < profile.axes.size(); ++a) {
         top = std::max(top, profile.axes[a].max_acceleration);
     }
     top = std::max(top, 1e-6) * 1.08;
     c.set_range(0, t_end, -top, top, false);
     c.axes("time (s)", "acceleration (mm/s\xc2\xb2)");
-    shade_pen_up(c, executed);
+    shade_pen_up(c, r);
     c.body() << "<g id=\"acceleration-limits\">\n";
-    for (const LimitGroup& g : limit_groups(profile, executed.axes, true)) {
+    for (const LimitGroup& g : limit_groups(profile, r.axes, true)) {
         const std::string id = "acceleration-limit-" + g.names(profile, "-"),
                           names = g.names(profile, ", ");
         c.hline(g.value, g.colour(), "4 3", id, names + " +" + detail::format_number(g.value, 0));
@@ -492,24 +494,45 @@ std::string acceleration_svg(const TickSeries& executed, const MachineProfile& p
                 names + " \xe2\x88\x92" + detail::format_number(g.value, 0));
     }
     c.body() << "</g>\n";
-    const std::vector<double> t = times(n, executed.tick_hz);
     std::vector<LegendEntry> legend;
-    for (std::size_t a = 0; a < executed.axes; ++a) {
+    for (std::size_t a = 0; a < r.axes; ++a) {
         const std::string name = axis_name(profile, a);
         c.begin_series("acceleration-" + name);
-        c.polyline(
-            decimate_min_max(t, column(d.acceleration, executed.axes, a), 0, t_end, columns_of(c)),
-            detail::axis_colour(a), 1.2);
+        c.polyline(decimate_points(r.acceleration.at(a), 0, t_end, columns_of(c)),
+                   detail::axis_colour(a), 1.2);
         c.end_group();
         legend.push_back({name, detail::axis_colour(a), "", 1.5});
     }
     legend.push_back({"limits", "#555", "4 3", 1.5});
     legend.push_back(pen_up_legend());
     c.legend(legend);
-    c.note("Second differences of the " + executed.name + " over +/-" +
-           std::to_string(d.half_window) + " tick(s): rounding noise up to " +
-           detail::format_number(d.acceleration_noise, 0) + " mm/s\xc2\xb2. Pen-up time shaded.");
+    c.note("Second differences of the " + r.executed_name + " over +/-" +
+           std::to_string(r.figures.half_window) + " tick(s): rounding noise up to " +
+           detail::format_number(r.figures.acceleration_noise, 0) +
+           " mm/s\xc2\xb2. Pen-up time shaded.");
     return c.finish();
+}
+
+std::string path_svg(const std::vector<BezierSegment>& path, const TickSeries& executed,
+                     const TickSeries* plant, const MachineProfile& profile,
+                     const Options& options) {
+    if (executed.axes == 0)
+        throw std::invalid_argument("path_svg: the executed series has no axes");
+    VectorSegmentSource source(path);
+    return path_svg(source, record_of(executed, plant, profile, options.half_window_ticks), profile,
+                    options);
+}
+
+std::string speed_svg(const TickSeries& executed, const MachineProfile& profile,
+                      const Options& options) {
+    return speed_svg(record_of(executed, nullptr, profile, options.half_window_ticks), profile,
+                     options);
+}
+
+std::string acceleration_svg(const TickSeries& executed, const MachineProfile& profile,
+                             const Options& options) {
+    return acceleration_svg(record_of(executed, nullptr, profile, options.half_window_ticks),
+                            profile, options);
 }
 
 }  // namespace pathstream::host::plot

@@ -43,10 +43,8 @@ std::string name_of(const MachineProfile& profile, std::size_t axis) {
     return "axis" + std::to_string(axis);
 }
 
-/// Pen-lift edges and down time on the executed ticks, and the plan's pen dwells: the time
-/// the axes are held still while the pen moves (no drawing then).
-void pen_figures(const Plan& plan, const MachineProfile& profile, const TickSeries& executed,
-                 ReportFigures& f) {
+/// Pen-lift edges and down time on the executed ticks.
+void pen_figures(const TickSeries& executed, ExecutedFigures& f) {
     for (std::size_t k = 0; k < executed.pen_down.size(); ++k) {
         const bool down = executed.pen_down[k] != 0;
         const bool before = k > 0 && executed.pen_down[k - 1] != 0;
@@ -54,11 +52,7 @@ void pen_figures(const Plan& plan, const MachineProfile& profile, const TickSeri
         if (down && !before) ++f.pen_downs;
         if (!down && before) ++f.pen_ups;
     }
-    f.executed_ticks = executed.pen_down.size();
-    for (const auto& e : plan.pen) {
-        f.dwell_ticks +=
-            delay_ticks(e.down ? profile.pen_down_delay : profile.pen_up_delay, profile.tick_hz);
-    }
+    f.ticks = executed.pen_down.size();
 }
 
 /// The largest element (0 when empty): the peak of per-axis fractions.
@@ -86,17 +80,13 @@ void checked_axis_figures(const PlanCheck* check, std::size_t a, AxisFigures& f)
 
 /// One axis's row: the check's figures, the executed series' peaks, the following error.
 AxisFigures axis_figures(const PlanCheck* check, const MachineProfile& profile,
-                         const TickSeries& executed, const Derivatives& d, const RunSummary& run,
-                         std::size_t a) {
+                         const ExecutedFigures& executed, const RunSummary& run, std::size_t a) {
     AxisFigures f;
     f.name = name_of(profile, a);
     checked_axis_figures(check, a, f);
-    const std::size_t axes = executed.axes;
-    for (std::size_t k = 0; k < executed.ticks(); ++k) {
-        f.executed_velocity = std::max(f.executed_velocity, std::fabs(d.velocity[k * axes + a]));
-        f.executed_acceleration =
-            std::max(f.executed_acceleration, std::fabs(d.acceleration[k * axes + a]));
-    }
+    f.executed_velocity = a < executed.peak_velocity.size() ? executed.peak_velocity[a] : 0;
+    f.executed_acceleration =
+        a < executed.peak_acceleration.size() ? executed.peak_acceleration[a] : 0;
     f.max_velocity = a < profile.axes.size() ? profile.axes[a].max_velocity : 0;
     f.max_acceleration = a < profile.axes.size() ? profile.axes[a].max_acceleration : 0;
     f.following = a < run.max_following_error_mm.size();
@@ -108,28 +98,81 @@ AxisFigures axis_figures(const PlanCheck* check, const MachineProfile& profile,
 
 }  // namespace
 
-ReportFigures report_figures(const Plan& plan, const PlanCheck* check,
-                             const MachineProfile& profile, const TickSeries& executed,
-                             const RunSummary& run) {
-    ReportFigures f;
-    f.duration =
-        plan.duration > 0 ? plan.duration : static_cast<double>(plan.total_ticks) / profile.tick_hz;
-    pen_figures(plan, profile, executed, f);
-    if (check != nullptr) {
-        f.velocity_fraction_cubic = peak_of(check->axis_velocity_fraction_exact);
-        f.acceleration_fraction_cubic = peak_of(check->axis_acceleration_fraction_exact);
-    }
-    const Derivatives d = differentiate(executed, profile);
-    f.executed_half_window = d.half_window;
-    f.executed_acceleration_noise = d.acceleration_noise;
-    for (std::size_t a = 0; a < executed.axes; ++a) {
-        f.axes.push_back(axis_figures(check, profile, executed, d, run, a));
+ExecutedFigures executed_figures(const TickSeries& executed, const MachineProfile& profile,
+                                 unsigned half_window) {
+    ExecutedFigures f;
+    f.axes = executed.axes;
+    pen_figures(executed, f);
+    const Derivatives d = differentiate(executed, profile, half_window);
+    f.half_window = d.half_window;
+    f.acceleration_noise = d.acceleration_noise;
+    f.peak_velocity.assign(executed.axes, 0.0);
+    f.peak_acceleration.assign(executed.axes, 0.0);
+    const std::size_t axes = executed.axes;
+    for (std::size_t k = 0; k < executed.ticks(); ++k) {
+        for (std::size_t a = 0; a < axes; ++a) {
+            f.peak_velocity[a] = std::max(f.peak_velocity[a], std::fabs(d.velocity[k * axes + a]));
+            f.peak_acceleration[a] =
+                std::max(f.peak_acceleration[a], std::fabs(d.acceleration[k * axes + a]));
+        }
+        f.peak_speed = std::max(f.peak_speed, d.speed[k]);
     }
     return f;
 }
 
+PlanFigures plan_figures(const Plan& plan, const MachineProfile& profile) {
+    PlanFigures f;
+    f.duration =
+        plan.duration > 0 ? plan.duration : static_cast<double>(plan.total_ticks) / profile.tick_hz;
+    f.total_ticks = plan.total_ticks;
+    f.path_length = plan.path_length;
+    f.travel_length = plan.travel_length;
+    for (const auto& e : plan.pen) {
+        f.dwell_ticks +=
+            delay_ticks(e.down ? profile.pen_down_delay : profile.pen_up_delay, profile.tick_hz);
+    }
+    return f;
+}
+
+ReportFigures report_figures(const PlanFigures& plan, const PlanCheck* check,
+                             const MachineProfile& profile, const ExecutedFigures& executed,
+                             const RunSummary& run) {
+    ReportFigures f;
+    f.duration =
+        plan.duration > 0 ? plan.duration : static_cast<double>(plan.total_ticks) / profile.tick_hz;
+    f.pen_downs = executed.pen_downs;
+    f.pen_ups = executed.pen_ups;
+    f.pen_down_ticks = executed.pen_down_ticks;
+    f.executed_ticks = executed.ticks;
+    f.dwell_ticks = plan.dwell_ticks;
+    if (check != nullptr) {
+        f.velocity_fraction_cubic = peak_of(check->axis_velocity_fraction_exact);
+        f.acceleration_fraction_cubic = peak_of(check->axis_acceleration_fraction_exact);
+    }
+    f.executed_half_window = executed.half_window;
+    f.executed_acceleration_noise = executed.acceleration_noise;
+    for (std::size_t a = 0; a < executed.axes; ++a) {
+        f.axes.push_back(axis_figures(check, profile, executed, run, a));
+    }
+    return f;
+}
+
+ReportFigures report_figures(const Plan& plan, const PlanCheck* check,
+                             const MachineProfile& profile, const TickSeries& executed,
+                             const RunSummary& run) {
+    return report_figures(plan_figures(plan, profile), check, profile,
+                          executed_figures(executed, profile), run);
+}
+
 std::string text_report(const Plan& plan, const PlanCheck* check, const MachineProfile& profile,
                         const TickSeries& executed, const RunSummary& run) {
+    return text_report(plan_figures(plan, profile), check, profile,
+                       executed_figures(executed, profile), run);
+}
+
+std::string text_report(const PlanFigures& plan, const PlanCheck* check,
+                        const MachineProfile& profile, const ExecutedFigures& executed,
+                        const RunSummary& run) {
     std::ostringstream o;
     const ReportFigures f = report_figures(plan, check, profile, executed, run);
     const std::size_t axes = executed.axes;

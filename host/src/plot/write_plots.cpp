@@ -141,11 +141,21 @@ void svg_to_png(const std::string& rsvg, const std::string& svg_file, const std:
 WrittenPlots write_plots(const std::string& directory, const std::vector<BezierSegment>& path,
                          const TickSeries& executed, const TickSeries* plant,
                          const MachineProfile& profile, const Options& options) {
+    if (executed.axes == 0)
+        throw std::invalid_argument("path_svg: the executed series has no axes");
+    VectorSegmentSource source(path);
+    return write_plots(directory, source,
+                       record_of(executed, plant, profile, options.half_window_ticks), profile,
+                       options);
+}
+
+WrittenPlots write_plots(const std::string& directory, SegmentSource& path, const RunRecord& record,
+                         const MachineProfile& profile, const Options& options) {
     WrittenPlots w;
     const std::string names[3] = {"path", "speed", "acceleration"};
-    const std::string svgs[3] = {path_svg(path, executed, plant, profile, options),
-                                 speed_svg(executed, profile, options),
-                                 acceleration_svg(executed, profile, options)};
+    const std::string svgs[3] = {path_svg(path, record, profile, options),
+                                 speed_svg(record, profile, options),
+                                 acceleration_svg(record, profile, options)};
     for (int i = 0; i < 3; ++i) {
         const std::string file = join(directory, names[i] + ".svg");
         write_text(file, svgs[i]);

@@ -1,17 +1,23 @@
 // Plots of an executed path (SVG, optional PNG) and the one-screen text report of a run.
 //
-// Everything here works on positions sampled once per tick (TickSeries), whatever executed
-// them: the simulated device's setpoints and plant positions, or a real device's read-back.
+// Everything here works on positions sampled once per tick, whatever executed them: the
+// simulated device's setpoints and plant positions, or a real device's read-back. Either held
+// whole (TickSeries), or seen once each as they come (RunRecorder): then the report's figures
+// are computed over every tick as it passes and the plots are drawn from a record of bounded
+// size (RunRecord), so that memory does not grow with the run.
 #pragma once
 
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "pathstream/host/geometry.hpp"
 #include "pathstream/host/plan.hpp"
+#include "pathstream/host/segment_source.hpp"
 #include "pathstream/machine/machine.hpp"
 
 namespace pathstream::host::plot {
@@ -61,6 +67,94 @@ struct Point {
 std::vector<Point> decimate_min_max(const std::vector<double>& x, const std::vector<double>& y,
                                     double x_min, double x_max, std::size_t columns);
 
+/// What the report needs of the executed ticks, over every one of them (exact: the same
+/// numbers from a whole TickSeries and from a RunRecorder that saw its ticks one by one).
+struct ExecutedFigures {
+    std::size_t axes = 0;
+    std::uint64_t ticks = 0;                   ///< ticks in the executed series
+    std::uint64_t pen_down_ticks = 0;          ///< of them, with the pen down
+    std::uint64_t pen_downs = 0, pen_ups = 0;  ///< pen edges between two ticks
+    unsigned half_window = 1;                  ///< Derivatives::half_window
+    double acceleration_noise = 0;             ///< Derivatives::acceleration_noise, mm/s^2
+    std::vector<double> peak_velocity;         ///< mm/s per axis: largest |v| of Derivatives
+    std::vector<double> peak_acceleration;     ///< mm/s^2 per axis: largest |a|
+    double peak_speed = 0;                     ///< mm/s: largest Derivatives::speed
+};
+
+/// The figures of a whole series: pen edges and down ticks from its pen_down, the peaks of
+/// differentiate(series, profile, half_window).
+ExecutedFigures executed_figures(const TickSeries& series, const MachineProfile& profile,
+                                 unsigned half_window = 0);
+
+/// One kept point of an executed path (path.svg): axes 0 and 1 in mm, and the pen.
+struct TracePoint {
+    double x = 0;
+    double y = 0;
+    bool pen_down = false;
+};
+
+/// A run as the plots need it, of bounded size: its figures, each series' path thinned to
+/// points at least a distance apart (that grows as needed; pen changes kept), the speed and
+/// the accelerations as the minimum and maximum of each of up to `capacity` stretches of
+/// time, and the pen-up intervals (ones closer than a gap that grows as needed merged). With
+/// capacity 0 nothing is thinned: every tick is kept (what the TickSeries functions draw).
+struct RunRecord {
+    ExecutedFigures figures;
+    double tick_hz = 1000;
+    std::size_t axes = 0;
+    std::string executed_name = "setpoints";
+    std::string plant_name;  ///< the plant series' name
+    bool has_plant = false;
+    /// Axes >= 2: axes 0 and 1 of the executed series and of the plant (path.svg).
+    std::vector<TracePoint> executed_path, plant_path;
+    /// Exact bounds over every tick of axes 0 and 1 (finite points only): [series][axis].
+    double lo[2][2] = {}, hi[2][2] = {};
+    bool bounded[2] = {false, false};  ///< the series had a finite point
+    /// Times (s) and values, in time order, first and last tick included: the path speed,
+    /// each axis's acceleration, and with one axis the positions of axis 0 ([0] executed,
+    /// [1] plant).
+    std::vector<Point> speed;
+    std::vector<std::vector<Point>> acceleration;
+    std::vector<Point> position[2];
+    /// Pen-up intervals in ticks, [first, end), in order.
+    std::vector<std::pair<std::uint64_t, std::uint64_t>> pen_up;
+    bool thinned = false;  ///< something was thinned or merged
+};
+
+/// Builds a RunRecord from ticks seen once each, in order: memory O(capacity), whatever the
+/// run's length (plus a window of 2 h + 1 ticks for the differences).
+class RunRecorder {
+public:
+    /// `axes`, `tick_hz`, `quantum_mm`: the executed series' (as TickSeries). `plant`: a
+    /// second series comes with every tick (add()'s `plant_mm`). `half_window`: as
+    /// differentiate's. `capacity`: the record's size (0: every tick kept); `plots`: false
+    /// keeps the figures only.
+    RunRecorder(const MachineProfile& profile, std::size_t axes, double tick_hz, double quantum_mm,
+                bool plant, std::size_t capacity = kDefaultCapacity, unsigned half_window = 0,
+                bool plots = true);
+    ~RunRecorder();
+    RunRecorder(const RunRecorder&) = delete;
+    RunRecorder& operator=(const RunRecorder&) = delete;
+
+    /// The next tick: the executed positions (mm per axis), the plant's when the recorder has
+    /// a plant (else ignored, may be null), and the pen.
+    void add(const double* executed_mm, const double* plant_mm, bool pen_down);
+    /// After the last tick. Call once.
+    RunRecord finish();
+
+    static constexpr std::size_t kDefaultCapacity = 8192;
+
+private:
+    struct State;
+    std::unique_ptr<State> s_;
+};
+
+/// The record of whole series (every tick kept): what the TickSeries plot functions draw.
+/// `plant` (optional) must have the ticks and axes of `executed`.
+RunRecord record_of(const TickSeries& executed, const TickSeries* plant,
+                    const MachineProfile& profile, unsigned half_window = 0,
+                    std::size_t capacity = 0);
+
 /// Plot settings.
 struct Options {
     unsigned width_px = 960;         ///< SVG width; heights follow
@@ -97,6 +191,15 @@ std::string speed_svg(const TickSeries& executed, const MachineProfile& profile,
 std::string acceleration_svg(const TickSeries& executed, const MachineProfile& profile,
                              const Options& options);
 
+/// The same plots from a record (RunRecord), the ideal path read from `path` (rewound and read
+/// twice: bounds, then drawing).
+std::string path_svg(SegmentSource& path, const RunRecord& record, const MachineProfile& profile,
+                     const Options& options);
+std::string speed_svg(const RunRecord& record, const MachineProfile& profile,
+                      const Options& options);
+std::string acceleration_svg(const RunRecord& record, const MachineProfile& profile,
+                             const Options& options);
+
 /// What write_plots wrote.
 struct WrittenPlots {
     std::vector<std::string> files;  ///< every file written, SVGs then PNGs
@@ -110,6 +213,10 @@ struct WrittenPlots {
 /// fails; a missing rsvg-convert is not an error (see WrittenPlots::note).
 WrittenPlots write_plots(const std::string& directory, const std::vector<BezierSegment>& path,
                          const TickSeries& executed, const TickSeries* plant,
+                         const MachineProfile& profile, const Options& options);
+
+/// write_plots from a record, the ideal path read from `path`.
+WrittenPlots write_plots(const std::string& directory, SegmentSource& path, const RunRecord& record,
                          const MachineProfile& profile, const Options& options);
 
 /// Full path of the first executable rsvg-convert on PATH, if any.
@@ -170,9 +277,25 @@ struct ReportFigures {
     std::vector<AxisFigures> axes;
 };
 
+/// What the report needs of the plan: a Plan's totals and dwells, or a streamed plan's.
+struct PlanFigures {
+    double duration = 0;  ///< s
+    std::uint64_t total_ticks = 0;
+    double path_length = 0;    ///< mm, pen-down
+    double travel_length = 0;  ///< mm, pen-up
+    std::uint64_t dwell_ticks = 0;
+};
+
+/// A plan's figures; dwell_ticks from its pen events.
+PlanFigures plan_figures(const Plan& plan, const MachineProfile& profile);
+
 /// The figures the report shows, for text_report and machine-readable output alike.
 ReportFigures report_figures(const Plan& plan, const PlanCheck* check,
                              const MachineProfile& profile, const TickSeries& executed,
+                             const RunSummary& run);
+/// The same from the figures of a plan and of the executed ticks (a streamed run's).
+ReportFigures report_figures(const PlanFigures& plan, const PlanCheck* check,
+                             const MachineProfile& profile, const ExecutedFigures& executed,
                              const RunSummary& run);
 
 /// The one-screen report: duration, pen-down length and travel, the planner's maximum
@@ -181,5 +304,9 @@ ReportFigures report_figures(const Plan& plan, const PlanCheck* check,
 /// spans, pen switches, underruns, simulated against wall time. Lines <= 80 columns.
 std::string text_report(const Plan& plan, const PlanCheck* check, const MachineProfile& profile,
                         const TickSeries& executed, const RunSummary& run);
+/// The same from the figures of a plan and of the executed ticks (a streamed run's).
+std::string text_report(const PlanFigures& plan, const PlanCheck* check,
+                        const MachineProfile& profile, const ExecutedFigures& executed,
+                        const RunSummary& run);
 
 }  // namespace pathstream::host::plot
