@@ -416,8 +416,8 @@ TEST_CASE("a simulator fed span by span runs as the whole plan, keeping no tick 
         options.plant = PlantModel::kServo;
         options.servo.bandwidth_hz = 40;
         if (variant == 1) {
-            options.producer_interval_ticks = 3;
-            options.max_pushes_per_run = 2;
+            options.producer_interval_ticks = 10;  // one span per 10 ticks: it starves
+            options.max_pushes_per_run = 1;
         }
         if (variant == 2) options.settle_ticks = 50;
         INFO("variant " << variant);
