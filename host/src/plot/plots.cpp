@@ -108,17 +108,59 @@ void shade_pen_up(Canvas& c, const RunRecord& r) {
     c.body() << "</g>\n";
 }
 
-/// A record's points as the x and y vectors of decimate_min_max.
+/// decimate_min_max over `n` samples (x(i), y(i)).
+template <typename X, typename Y>
+std::vector<Point> decimate(std::size_t n, X x, Y y, double x_min, double x_max,
+                            std::size_t columns) {
+    std::vector<Point> out;
+    if (n <= 2 * columns || columns == 0 || !(x_max > x_min)) {
+        out.reserve(n);
+        for (std::size_t i = 0; i < n; ++i) {
+            if (!std::isnan(y(i))) out.push_back({x(i), y(i)});
+        }
+        return out;
+    }
+    out.reserve(2 * columns + 2);
+    const double scale = static_cast<double>(columns) / (x_max - x_min);
+    std::size_t i = 0;
+    const auto emit = [&](std::size_t idx) {
+        if (out.empty() || out.back().x != x(idx) || out.back().y != y(idx))
+            out.push_back({x(idx), y(idx)});
+    };
+    // The first sample always (even a NaN-free start is what a reader expects at t = 0).
+    while (i < n && std::isnan(y(i))) ++i;
+    if (i == n) return out;
+    const std::size_t first = i;
+    std::size_t last = first;
+    emit(first);
+    while (i < n) {
+        const double cx = std::floor((x(i) - x_min) * scale);
+        std::size_t lo = n, hi = n;
+        for (; i < n && std::floor((x(i) - x_min) * scale) == cx; ++i) {
+            if (std::isnan(y(i))) continue;
+            if (lo == n || y(i) < y(lo)) lo = i;
+            if (hi == n || y(i) > y(hi)) hi = i;
+            last = i;
+        }
+        if (lo == n) continue;
+        if (lo <= hi) {
+            emit(lo);
+            emit(hi);
+        } else {
+            emit(hi);
+            emit(lo);
+        }
+    }
+    emit(last);
+    return out;
+}
+
+/// decimate_min_max of a record's points.
 std::vector<Point> decimate_points(const std::vector<Point>& points, double x_min, double x_max,
                                    std::size_t columns) {
-    std::vector<double> x, y;
-    x.reserve(points.size());
-    y.reserve(points.size());
-    for (const Point& p : points) {
-        x.push_back(p.x);
-        y.push_back(p.y);
-    }
-    return decimate_min_max(x, y, x_min, x_max, columns);
+    return decimate(
+        points.size(), [&](std::size_t i) { return points[i].x; },
+        [&](std::size_t i) { return points[i].y; }, x_min, x_max, columns);
 }
 
 /// Time of the last tick of a run (1 when it has fewer than two).
@@ -251,48 +293,9 @@ Derivatives differentiate(const TickSeries& s, const MachineProfile& profile,
 
 std::vector<Point> decimate_min_max(const std::vector<double>& x, const std::vector<double>& y,
                                     double x_min, double x_max, std::size_t columns) {
-    const std::size_t n = std::min(x.size(), y.size());
-    std::vector<Point> out;
-    if (n <= 2 * columns || columns == 0 || !(x_max > x_min)) {
-        out.reserve(n);
-        for (std::size_t i = 0; i < n; ++i) {
-            if (!std::isnan(y[i])) out.push_back({x[i], y[i]});
-        }
-        return out;
-    }
-    out.reserve(2 * columns + 2);
-    const double scale = static_cast<double>(columns) / (x_max - x_min);
-    std::size_t i = 0;
-    const auto emit = [&](std::size_t idx) {
-        if (out.empty() || out.back().x != x[idx] || out.back().y != y[idx])
-            out.push_back({x[idx], y[idx]});
-    };
-    // The first sample always (even a NaN-free start is what a reader expects at t = 0).
-    while (i < n && std::isnan(y[i])) ++i;
-    if (i == n) return out;
-    const std::size_t first = i;
-    std::size_t last = first;
-    emit(first);
-    while (i < n) {
-        const double cx = std::floor((x[i] - x_min) * scale);
-        std::size_t lo = n, hi = n;
-        for (; i < n && std::floor((x[i] - x_min) * scale) == cx; ++i) {
-            if (std::isnan(y[i])) continue;
-            if (lo == n || y[i] < y[lo]) lo = i;
-            if (hi == n || y[i] > y[hi]) hi = i;
-            last = i;
-        }
-        if (lo == n) continue;
-        if (lo <= hi) {
-            emit(lo);
-            emit(hi);
-        } else {
-            emit(hi);
-            emit(lo);
-        }
-    }
-    emit(last);
-    return out;
+    return decimate(
+        std::min(x.size(), y.size()), [&](std::size_t i) { return x[i]; },
+        [&](std::size_t i) { return y[i]; }, x_min, x_max, columns);
 }
 
 // A layer's colour: its name when that is a colour ("#rrggbb"), else one of a palette that

@@ -41,15 +41,19 @@ public:
     }
 
     bool thinned() const { return width_ > 1; }
+    void reserve(std::uint64_t ticks) {
+        if (capacity_ == 0) every_.reserve(ticks);
+    }
 
     /// Every value kept, as (time, value) in tick order: the first and the last tick, and each
-    /// stretch's minimum and maximum.
-    std::vector<Point> points(double tick_hz) const {
+    /// stretch's minimum and maximum. Call once: what they were kept in is released.
+    std::vector<Point> take_points(double tick_hz) {
         std::vector<Point> out;
         const auto time = [&](std::uint64_t k) { return static_cast<double>(k) / tick_hz; };
         if (capacity_ == 0) {
             out.reserve(every_.size());
             for (std::size_t k = 0; k < every_.size(); ++k) out.push_back({time(k), every_[k]});
+            std::vector<double>().swap(every_);
             return out;
         }
         if (!have_first_) return out;
@@ -127,6 +131,9 @@ public:
     }
 
     bool thinned() const { return d_ > 0 || coarse_; }
+    void reserve(std::uint64_t ticks) {
+        if (capacity_ == 0) points_.reserve(ticks + 1);
+    }
 
     std::vector<TracePoint> finish() {
         if (!points_.empty() && !last_kept_) points_.push_back(last_seen_);
@@ -343,6 +350,11 @@ RunRecorder::RunRecorder(const MachineProfile& profile, std::size_t axes, double
 
 RunRecorder::~RunRecorder() = default;
 
+void RunRecorder::reserve(std::uint64_t ticks) {
+    for (Envelope& e : s_->envelopes) e.reserve(ticks);
+    for (Trace& t : s_->traces) t.reserve(ticks);
+}
+
 void RunRecorder::add(const double* executed_mm, const double* plant_mm, bool pen_down) {
     State& s = *s_;
     const std::uint64_t k = s.n;
@@ -430,16 +442,16 @@ RunRecord RunRecorder::finish() {
     RunRecord r = std::move(s.r);
     r.figures = s.f;
     if (!s.plots) return r;
-    r.speed = s.speed_envelope().points(s.tick_hz);
+    r.speed = s.speed_envelope().take_points(s.tick_hz);
     bool thinned = s.pen_gap > 0;
     for (std::size_t ax = 0; ax < s.axes; ++ax) {
-        r.acceleration.push_back(s.acceleration_envelope(ax).points(s.tick_hz));
+        r.acceleration.push_back(s.acceleration_envelope(ax).take_points(s.tick_hz));
         thinned = thinned || s.acceleration_envelope(ax).thinned();
     }
     thinned = thinned || s.speed_envelope().thinned();
     if (s.axes == 1) {
         for (std::size_t series = 0; series < (s.has_plant ? 2u : 1u); ++series) {
-            r.position[series] = s.envelopes[1 + s.axes + series].points(s.tick_hz);
+            r.position[series] = s.envelopes[1 + s.axes + series].take_points(s.tick_hz);
             thinned = thinned || s.envelopes[1 + s.axes + series].thinned();
         }
     }
@@ -457,6 +469,7 @@ RunRecord record_of(const TickSeries& executed, const TickSeries* plant,
     RunRecorder recorder(profile, executed.axes, executed.tick_hz, executed.quantum_mm, with_plant,
                          capacity, half_window);
     const std::size_t n = executed.ticks();
+    recorder.reserve(n);
     const std::size_t axes = executed.axes;
     for (std::size_t k = 0; k < n; ++k) {
         const double* p = executed.position.data() + k * axes;
@@ -466,8 +479,17 @@ RunRecord record_of(const TickSeries& executed, const TickSeries* plant,
     RunRecord r = recorder.finish();
     r.executed_name = executed.name;
     if (with_plant) r.plant_name = plant->name;
-    // The figures of the series as the report counts them (its pen_down may be shorter).
-    r.figures = executed_figures(executed, profile, half_window);
+    // The pen's figures as the report counts them: from pen_down (which may be shorter than
+    // the positions; the ticks stay the positions', the plots' time axis).
+    plot::ExecutedFigures& f = r.figures;
+    f.pen_down_ticks = f.pen_downs = f.pen_ups = 0;
+    for (std::size_t k = 0; k < executed.pen_down.size(); ++k) {
+        const bool down = executed.pen_down[k] != 0;
+        const bool before = k > 0 && executed.pen_down[k - 1] != 0;
+        f.pen_down_ticks += down ? 1 : 0;
+        if (down && !before) ++f.pen_downs;
+        if (!down && before) ++f.pen_ups;
+    }
     return r;
 }
 

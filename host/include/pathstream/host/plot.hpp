@@ -139,6 +139,8 @@ public:
     /// The next tick: the executed positions (mm per axis), the plant's when the recorder has
     /// a plant (else ignored, may be null), and the pen.
     void add(const double* executed_mm, const double* plant_mm, bool pen_down);
+    /// Room for `ticks` ticks when every tick is kept (capacity 0; else nothing).
+    void reserve(std::uint64_t ticks);
     /// After the last tick. Call once.
     RunRecord finish();
 
