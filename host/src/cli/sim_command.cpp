@@ -1,15 +1,23 @@
 #include "sim_command.hpp"
 
 #include <algorithm>
+#include <chrono>
+#include <cmath>
 #include <filesystem>
 #include <iostream>
 #include <nlohmann/json.hpp>
+#include <optional>
+#include <thread>
 
 #include "pathstream/host/events.hpp"
+#include "pathstream/host/job_estimate.hpp"
 #include "pathstream/host/layers.hpp"
 #include "pathstream/host/planner.hpp"
+#include "pathstream/host/planning_thread.hpp"
 #include "pathstream/host/plot.hpp"
 #include "pathstream/host/progress.hpp"
+#include "pathstream/host/segment_source.hpp"
+#include "pathstream/host/work_area.hpp"
 #include "pathstream/machine/exit_codes.hpp"
 #include "pathstream/sim/device.hpp"
 #include "plan_command.hpp"
@@ -51,6 +59,9 @@ void add_sim_command(CLI::App& app, SimCommandOptions& o) {
                     "progress events per second of simulated time, at most (with --events)")
         ->capture_default_str()
         ->check(CLI::Range(0.1, 1000.0));
+    cmd->add_flag("--plan-first", o.plan_first,
+                  "plan the whole job before running it and keep every tick for the report and "
+                  "plots (default: plan as the device runs, memory bounded; docs/cli.md)");
     cmd->callback([&o] {
         if (o.json && o.events == "-") {
             throw CLI::ValidationError("--events",
@@ -90,6 +101,14 @@ Json axis_json(const plot::AxisFigures& x) {
     return j;
 }
 
+/// What the report of a run needs, whichever way it was planned and recorded.
+struct SimRun {
+    PlannedJob job;                ///< path, machine, the plan's totals (its spans: --plan-first)
+    plot::PlanFigures plan;        ///< the plan's totals and dwells
+    sim::SimulationResult result;  ///< the device's counters (every tick: --plan-first)
+    plot::RunRecord record;        ///< the executed ticks' figures, and the plots' record
+};
+
 /// The machine and plant lines of the report.
 void machine_json(const SimCommandOptions& o, const PlannedJob& job, const plot::RunSummary& run,
                   Json& j) {
@@ -107,17 +126,16 @@ void machine_json(const SimCommandOptions& o, const PlannedJob& job, const plot:
 }
 
 /// The duration, path, pen and device lines of the report.
-void run_json(const PlannedJob& job, const plot::RunSummary& run, const plot::ReportFigures& f,
-              Json& j) {
-    const double tick_hz = job.machine.tick_hz;
+void run_json(const SimRun& s, const plot::RunSummary& run, const plot::ReportFigures& f, Json& j) {
+    const double tick_hz = s.job.machine.tick_hz;
     j["planned_duration_s"] = f.duration;
     j["simulated_duration_s"] = run.simulated_seconds;
     j["wall_time_s"] = run.wall_seconds;
     j["speedup"] =
         run.wall_seconds > 0 ? Json(run.simulated_seconds / run.wall_seconds) : Json(nullptr);
     j["realtime"] = run.realtime;
-    j["drawn_length_mm"] = job.plan.path_length;
-    j["travel_length_mm"] = job.plan.travel_length;
+    j["drawn_length_mm"] = s.plan.path_length;
+    j["travel_length_mm"] = s.plan.travel_length;
     j["pen_switches"] = run.pen_switches;
     j["pen"] = {{"downs", f.pen_downs},
                 {"ups", f.pen_ups},
@@ -164,30 +182,33 @@ void limits_json(const PlannedJob& job, const plot::ReportFigures& f, Json& j) {
 }
 
 /// The report for machines: every figure of the text report, unrounded, units in the keys.
-Json report_json(const SimCommandOptions& o, const PlannedJob& job,
-                 const plot::TickSeries& executed, const plot::RunSummary& run) {
+Json report_json(const SimCommandOptions& o, const SimRun& s, const plot::RunSummary& run) {
     const plot::ReportFigures f =
-        plot::report_figures(job.plan, &job.check, job.machine, executed, run);
+        plot::report_figures(s.plan, &s.job.check, s.job.machine, s.record.figures, run);
     Json j;
-    machine_json(o, job, run, j);
-    run_json(job, run, f, j);
-    limits_json(job, f, j);
-    j["layers"] = layers_json(job.path);
-    j["pauses"] = job.plan.pauses.size();
+    machine_json(o, s.job, run, j);
+    run_json(s, run, f, j);
+    limits_json(s.job, f, j);
+    j["layers"] = layers_json(s.job.path);
+    j["pauses"] = s.job.pause_count;
     return j;
 }
 
-/// Writes the plots into o.plot_dir (created if needed).
-plot::WrittenPlots write_sim_plots(const SimCommandOptions& o, const PlannedJob& job,
-                                   const plot::TickSeries& executed,
-                                   const plot::TickSeries* plant) {
+/// Writes the plots into o.plot_dir (created if needed): the ideal path from the job's segments
+/// (--plan-first) or read from its path again.
+plot::WrittenPlots write_sim_plots(const SimCommandOptions& o, const SimRun& s) {
     std::filesystem::create_directories(o.plot_dir);
     plot::Options plot_options;
     plot_options.y_up = o.y_up;
     plot_options.title = path_display_name(o.path.file);
-    for (const PathLayer& l : job.path.layers) plot_options.layers.push_back(l.name);
-    for (const Subpath& s : job.path.subpaths) plot_options.subpath_layers.push_back(s.layer);
-    return plot::write_plots(o.plot_dir, job.segments, executed, plant, job.machine, plot_options);
+    for (const PathLayer& l : s.job.path.layers) plot_options.layers.push_back(l.name);
+    for (const Subpath& p : s.job.path.subpaths) plot_options.subpath_layers.push_back(p.layer);
+    if (!s.job.segments.empty()) {
+        VectorSegmentSource segments(s.job.segments);
+        return plot::write_plots(o.plot_dir, segments, s.record, s.job.machine, plot_options);
+    }
+    PathSegmentSource segments(s.job.path);
+    return plot::write_plots(o.plot_dir, segments, s.record, s.job.machine, plot_options);
 }
 
 /// Prints what write_sim_plots wrote, as the text report's last lines.
@@ -205,51 +226,211 @@ std::size_t count_subpaths(const Plan& plan) {
     return n;
 }
 
-/// One simulated tick as the events see it: the device always runs, in simulated time.
-/// `prefix`: ticks before each span of the plan (size spans + 1).
-JobSample sim_sample(const sim::TickProbe& p, const PlannedJob& job,
-                     const std::vector<std::uint64_t>& prefix) {
-    const std::size_t spans = job.plan.spans.size();
+/// One simulated tick as the events see it: the device always runs, in simulated time. Its
+/// counters say where the job is: spans completed, queued, and the ticks of the spans the
+/// device took (what is queued ends there).
+JobSample sim_sample(const sim::TickProbe& p, std::size_t axes, double tick_hz) {
     JobSample s;
-    s.sim_seconds = static_cast<double>(p.tick + 1) / job.machine.tick_hz;
+    s.sim_seconds = static_cast<double>(p.tick + 1) / tick_hz;
     s.started = true;
-    s.next_span = std::min<std::size_t>(p.last_completed_tag, spans);
-    s.ticks = std::min(p.ticks_executed, job.plan.total_ticks);
-    const std::uint64_t queued_end =
-        prefix[std::min<std::size_t>(s.next_span + p.queued_spans, spans)];
-    s.queued_ticks = queued_end > s.ticks ? queued_end - s.ticks : 0;
+    s.next_span = p.last_completed_tag;
+    s.ticks = std::min(p.ticks_executed, p.ticks_pushed);
+    s.queued_ticks = p.ticks_pushed > s.ticks ? p.ticks_pushed - s.ticks : 0;
     s.queued_spans = p.queued_spans;
-    std::copy(p.setpoints, p.setpoints + job.machine.axes.size(), s.position);
+    std::copy(p.setpoints, p.setpoints + axes, s.position);
     return s;
 }
 
-/// Runs the plan on the simulated device, with a progress bar on standard error and, with
-/// --events, the run's events from every tick.
-sim::SimulationResult simulate_job(const SimCommandOptions& o, const PlannedJob& job,
-                                   JobEvents& events) {
+/// The device's options from the command line's.
+sim::SimOptions device_options(const SimCommandOptions& o) {
     sim::SimOptions options;
     options.plant = o.plant == "ideal" ? sim::PlantModel::kIdeal : sim::PlantModel::kServo;
     options.servo.bandwidth_hz = o.bandwidth_hz;
     options.servo.damping = o.damping;
     options.realtime = o.realtime;
-    std::vector<std::uint64_t> prefix;
+    return options;
+}
+
+/// --plan-first: the whole plan, then the device's run with every tick kept (the report and
+/// plots from all of them).
+SimRun run_plan_first(const SimCommandOptions& o, const EventChannel& channel,
+                      std::optional<JobEvents>& events) {
+    SimRun s;
+    s.job = plan_job(o.path, o.machine);
+    const PlannedJob& job = s.job;
+    s.plan = plot::plan_figures(job.plan, job.machine);
+    events.emplace(channel, job.plan, job.machine,
+                   JobInfo{"sim", path_display_name(o.path.file), "sim", count_subpaths(job.plan)});
+    sim::SimOptions options = device_options(o);
     if (!o.events.empty()) {
-        prefix.reserve(job.plan.spans.size() + 1);
-        prefix.push_back(0);
-        for (const CoreSpan& s : job.plan.spans) prefix.push_back(prefix.back() + s.ticks);
         options.tick_observer = [&](const sim::TickProbe& p) {
-            events.sample(sim_sample(p, job, prefix));
+            events->sample(sim_sample(p, job.machine.axes.size(), job.machine.tick_hz));
         };
     }
     ProgressBar bar(o.realtime ? "running (real time)" : "simulating");
-    events.start(std::nullopt);
+    events->start(std::nullopt);
     try {
-        return sim::simulate(job.plan.spans, job.machine, options,
-                             [&](double f) { bar.update(f); });
+        s.result =
+            sim::simulate(job.plan.spans, job.machine, options, [&](double f) { bar.update(f); });
     } catch (const std::exception& e) {
-        events.end("failed", e.what());
+        events->end("failed", e.what());
         throw;
     }
+    bar.finish();
+    // The series take the run's ticks over: the run keeps its counters only.
+    const plot::TickSeries executed = setpoint_series(s.result);
+    std::vector<Lsb>().swap(s.result.setpoints);
+    const bool servo = s.result.plant == sim::PlantModel::kServo;
+    plot::TickSeries plant;
+    if (servo && !o.plot_dir.empty()) {
+        std::vector<double> positions = std::move(s.result.positions);
+        s.result.positions.clear();
+        plant = plant_series(s.result);
+        plant.position = std::move(positions);
+    }
+    std::vector<double>().swap(s.result.positions);
+    std::vector<std::uint8_t>().swap(s.result.pen);
+    if (o.plot_dir.empty()) {
+        s.record.figures = plot::executed_figures(executed, job.machine);
+    } else {
+        s.record = plot::record_of(executed, servo ? &plant : nullptr, job.machine);
+    }
+    return s;
+}
+
+/// The planning thread's look at the plan before the device gets it: the device's travel
+/// check, the per-tick check (against its own pass over the path) and the dwells.
+class SimPlanTap : public PlanSink {
+public:
+    SimPlanTap(const PlannedJob& job, const std::string& file)
+        : job_(job), file_(file), checked_path_(job.path), checker_(checked_path_, job.machine) {}
+    void span(const CoreSpan& s) override {
+        check_span_travel(s, checker_.spans(), job_.path, job_.machine, file_);
+        checker_.span(s);
+    }
+    void pen(const PenEvent& e) override {
+        checker_.pen(e);
+        dwell_ticks_ += delay_ticks(
+            e.down ? job_.machine.pen_down_delay : job_.machine.pen_up_delay, job_.machine.tick_hz);
+    }
+    void pause(const PlanPause& p) override { checker_.pause(p); }
+    /// PlanningThread::Hooks::finish: the check's figures.
+    void finish(const PlanTotals&) { check_ = checker_.finish(); }
+    /// Once planning finished.
+    const PlanCheck& check() const { return check_; }
+    std::uint64_t dwell_ticks() const { return dwell_ticks_; }
+
+private:
+    const PlannedJob& job_;
+    const std::string& file_;
+    PathSegmentSource checked_path_;  ///< the check's own pass over the path
+    PlanChecker checker_;
+    PlanCheck check_;
+    std::uint64_t dwell_ticks_ = 0;
+};
+
+/// The default: the plan made on a planning thread as the device runs it (the device fed span
+/// by span through the thread's bounded queue), every tick into a record of bounded size.
+SimRun run_streamed(const SimCommandOptions& o, const EventChannel& channel,
+                    std::optional<JobEvents>& events) {
+    SimRun s;
+    s.job = prepare_streamed_job(o.path, o.machine);
+    PlannedJob& job = s.job;
+    const std::size_t axes = job.machine.axes.size();
+    events.emplace(channel, job.machine,
+                   JobInfo{"sim", path_display_name(o.path.file), "sim", job.path.subpaths.size()});
+    // Until planning ends, the events' fraction is the job's ticks estimated from its path.
+    std::optional<JobEstimate> estimate;
+    double taken_mm = 0;
+    std::uint64_t taken_ticks = 0;
+    if (!o.events.empty()) {
+        PathSegmentSource path(job.path);
+        estimate.emplace(path, job.machine);
+        events->set_progress_basis(0, [&]() -> std::optional<std::uint64_t> {
+            return estimate->total_ticks(taken_mm, taken_ticks);
+        });
+    }
+    const bool servo = o.plant != "ideal";
+    plot::RunRecorder recorder(job.machine, axes, job.machine.tick_hz, job.machine.mm_per_lsb,
+                               servo, plot::RunRecorder::kDefaultCapacity, 0, !o.plot_dir.empty());
+    sim::SimOptions options = device_options(o);
+    options.record_ticks = false;
+    std::vector<double> setpoint_mm(axes);
+    options.tick_observer = [&](const sim::TickProbe& p) {
+        for (std::size_t a = 0; a < axes; ++a)
+            setpoint_mm[a] = p.setpoints[a] * job.machine.mm_per_lsb;
+        recorder.add(setpoint_mm.data(), p.positions, p.pen_down);
+        if (!o.events.empty()) events->sample(sim_sample(p, axes, job.machine.tick_hz));
+    };
+
+    SimPlanTap tap(job, o.path.file);
+    PathSegmentSource source(job.path);
+    events->start(std::nullopt);
+    try {
+        PlanningThread planning(source, job.machine, PlanOptions{},
+                                {&tap, [&tap](const PlanTotals& t) { tap.finish(t); }});
+        sim::Simulator simulator(job.machine, options);
+        ProgressBar bar(o.realtime ? "planning and running (real time)"
+                                   : "planning and simulating");
+        bool totals_known = false;
+        const auto learn_totals = [&] {
+            if (totals_known || !planning.finished()) return;
+            if (const std::optional<PlanTotals> t = planning.totals()) {
+                totals_known = true;
+                events->set_totals(t->total_ticks, t->spans, t->pauses);
+            }
+        };
+        CoreSpan span;
+        for (std::size_t taken = 0;;) {
+            const SpanSupply::Take take = planning.take(span);
+            if (take == SpanSupply::Take::kEnd) break;
+            if (take == SpanSupply::Take::kWait) {
+                bar.update(planning.fraction());
+                std::this_thread::sleep_for(std::chrono::microseconds(200));
+                continue;
+            }
+            learn_totals();
+            if (!o.events.empty()) {
+                events->add_span(span);
+                double chord = 0;
+                for (const auto& axis : span.control) {
+                    const double d = static_cast<double>(axis[1]) - static_cast<double>(axis[0]);
+                    chord += d * d;
+                }
+                taken_mm += std::sqrt(chord) * job.machine.mm_per_lsb;
+                taken_ticks += span.ticks;
+            }
+            simulator.push(span);
+            if (++taken % 256 == 0) bar.update(planning.fraction());
+        }
+        learn_totals();
+        s.result = simulator.finish();
+        bar.update(1.0);
+        bar.finish();
+        const std::optional<PlanTotals> totals = planning.totals();
+        if (!totals) throw PlanError("planning ended without its totals");
+        job.planning_seconds = planning.planning_seconds();
+        job.check = tap.check();
+        job.plan.total_ticks = totals->total_ticks;
+        job.plan.duration = totals->duration;
+        job.plan.path_length = totals->path_length;
+        job.plan.travel_length = totals->travel_length;
+        job.span_count = totals->spans;
+        job.pen_count = totals->pen_changes;
+        job.pause_count = totals->pauses;
+    } catch (const std::exception& e) {
+        events->end("failed", e.what());
+        throw;
+    }
+    s.plan.duration = job.plan.duration;
+    s.plan.total_ticks = job.plan.total_ticks;
+    s.plan.path_length = job.plan.path_length;
+    s.plan.travel_length = job.plan.travel_length;
+    s.plan.dwell_ticks = tap.dwell_ticks();
+    s.record = recorder.finish();
+    s.record.executed_name = "setpoints";
+    s.record.plant_name = servo ? "servo plant" : "ideal plant";
+    return s;
 }
 
 /// job_end of the run: finished, or failed with the reason run_sim exits with.
@@ -273,31 +454,30 @@ int run_sim(const SimCommandOptions& o) {
     EventChannel channel;
     channel.progress_hz = o.events_rate;
     if (!o.events.empty()) channel.writer = NdjsonWriter::open(o.events);
-    const PlannedJob job = plan_job(o.path, o.machine);
-    JobEvents events(channel, job.plan, job.machine,
-                     {"sim", path_display_name(o.path.file), "sim", count_subpaths(job.plan)});
-    const sim::SimulationResult result = simulate_job(o, job, events);
-    const plot::TickSeries executed = setpoint_series(result);
-    const plot::TickSeries plant = plant_series(result);
+    std::optional<JobEvents> events;
+    const SimRun s =
+        o.plan_first ? run_plan_first(o, channel, events) : run_streamed(o, channel, events);
+    const PlannedJob& job = s.job;
+    const sim::SimulationResult& result = s.result;
     const plot::RunSummary run = run_summary(result);
-    const bool servo = result.plant == sim::PlantModel::kServo;
     const bool failed =
         result.underruns != 0 || !job.check.within_limits || job.check.drawing_while_pen_moves;
-    end_events(events, result, failed);
+    end_events(*events, result, failed);
+    const auto report = [&] {
+        return plot::text_report(s.plan, &job.check, job.machine, s.record.figures, run);
+    };
     // With --json, standard output holds the document or, on failure, nothing: the text
     // report the error message points to then goes to standard error.
     if (!o.json) {
-        std::cout << plot::text_report(job.plan, &job.check, job.machine, executed, run);
+        std::cout << report();
         if (const std::string layers = layers_text(job.path); !layers.empty())
             std::cout << "  " << layers << " (the operator's time is not in the durations)\n";
     }
-    if (o.json && failed)
-        std::cerr << plot::text_report(job.plan, &job.check, job.machine, executed, run);
+    if (o.json && failed) std::cerr << report();
     Json document;
-    if (o.json) document = report_json(o, job, executed, run);
+    if (o.json) document = report_json(o, s, run);
     if (!o.plot_dir.empty()) {
-        const plot::WrittenPlots written =
-            write_sim_plots(o, job, executed, servo ? &plant : nullptr);
+        const plot::WrittenPlots written = write_sim_plots(o, s);
         if (o.json) {
             document["plots"] = written.files;
             document["plot_note"] = written.note.empty() ? Json(nullptr) : Json(written.note);
