@@ -400,8 +400,8 @@ TEST_CASE("clocks and the simulated output keep their contracts", "[sim]") {
 
 TEST_CASE("a simulator fed span by span runs as the whole plan, keeping no tick unless asked",
           "[sim]") {
-    // 120 spans (more than the queue holds), pen changes, a servo plant; a fast and a slow
-    // producer, settling.
+    // 120 spans (more than the queue holds), pen changes, a servo plant; a fast, a starving and
+    // a throttled producer, settling.
     std::vector<CoreSpan> spans;
     LsbPoint at{0, 0};
     for (int i = 0; i < 120; ++i) {
@@ -411,7 +411,7 @@ TEST_CASE("a simulator fed span by span runs as the whole plan, keeping no tick 
         if (i % 10 != 9) at = to;
     }
     const MachineProfile profile = profile_for(2);
-    for (int variant = 0; variant < 3; ++variant) {
+    for (int variant = 0; variant < 4; ++variant) {
         SimOptions options;
         options.plant = PlantModel::kServo;
         options.servo.bandwidth_hz = 40;
@@ -420,6 +420,10 @@ TEST_CASE("a simulator fed span by span runs as the whole plan, keeping no tick 
             options.max_pushes_per_run = 1;
         }
         if (variant == 2) options.settle_ticks = 50;
+        if (variant == 3) {
+            options.producer_interval_ticks = 2;  // three spans per 2 ticks: kept full
+            options.max_pushes_per_run = 3;
+        }
         INFO("variant " << variant);
         const SimulationResult whole = sim::simulate(spans, profile, options);
 

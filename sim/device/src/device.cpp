@@ -113,7 +113,7 @@ public:
         r_.mm_per_lsb = profile.mm_per_lsb;
         r_.plant = options.plant;
         r_.servo = options.servo;
-        r_.paced = pacing != nullptr;
+        r_.paced = pacing != nullptr || options.realtime;
         Lsb start[Axes];
         start_point<Axes>(first, start);
         stream_ = std::make_unique<Stream>(start);  // ~13 KB at 8 axes: heap on the host
@@ -181,24 +181,42 @@ private:
         r_.stream.max_queued = std::max(r_.stream.max_queued, stream_->queued_spans());
     }
 
-    /// Runs ticks until the run ends or, unless `final`, until the producer is due with no
-    /// more spans waiting than the queue could take: what it does then depends on the spans
-    /// still to come (a whole plan's run would have them), so they are needed first.
+    /// Spans the producer's next run takes or tries with a whole plan waiting: up to
+    /// max_pushes_per_run when the queue has room for them, else as many as it has room for
+    /// and one more (answered kQueueFull).
+    std::size_t wanted() const {
+        const std::uint32_t room = kQueueCapacity - stream_->queued_spans();
+        const std::uint32_t most = options_.max_pushes_per_run;
+        return most > 0 && room >= most ? most : std::size_t{room} + 1;
+    }
+
+    /// Runs ticks until the run ends or, unless `final`, until the producer is due with fewer
+    /// spans waiting than it would take or try with the whole plan there, or every span given
+    /// is done: what happens then depends on the spans still to come, so they are needed first.
     void advance(bool final) {
         while (!done_) {
             const std::uint64_t k = k_;
             if (k % interval_ == 0 && !produced_) {
-                if (!final && pending_.size() <= kQueueCapacity) return;
+                if (!final && pending_.size() < wanted()) return;
                 produce();  // the producer task, between two tick interrupts
                 produced_ = true;
+            }
+            // Every span given done: whether the plan ended (no underrun, the end point next)
+            // depends on the spans still to come.
+            const bool all_done = pending_.empty() && stream_->spans_completed() == next_;
+            if (!final && all_done) return;
+            const bool finished = final && all_done;
+            if (pacing_ == nullptr && options_.realtime) {
+                // Real time: the Linux clock's tick 0 is the first tick's, not the first span's
+                // arrival (the device may wait for more spans first).
+                own_clock_ = std::make_unique<hal::LinuxClock>(profile_.tick_hz);
+                pacing_ = own_clock_.get();
             }
             if (pacing_ != nullptr) {
                 pacing_->wait_until(k);
                 if (pacing_->now() > k) ++r_.late_ticks;
             }
             device_time_.wait_until(k);
-            // Not final: spans are still waiting, so the plan cannot have finished.
-            const bool finished = final && pending_.empty() && stream_->spans_completed() == next_;
 
             // --- the tick interrupt ---
             const TickState state = stream_->tick(out_);
@@ -250,6 +268,7 @@ private:
     const host::MachineProfile& profile_;
     const SimOptions& options_;
     hal::Clock* pacing_;
+    std::unique_ptr<hal::LinuxClock> own_clock_;  // real time without an injected clock
     const Progress& progress_;
     std::chrono::steady_clock::time_point wall_start_;
     SimulationResult r_;
@@ -301,11 +320,6 @@ Simulator::~Simulator() = default;
 void Simulator::push(const CoreSpan& span) {
     if (!engine_) {
         axes_ = plan_axes(span, profile_);
-        // Real time: the Linux clock's tick 0 is the first span's arrival.
-        if (pacing_ == nullptr && options_.realtime) {
-            own_clock_ = std::make_unique<hal::LinuxClock>(profile_.tick_hz);
-            pacing_ = own_clock_.get();
-        }
         engine_ = host::with_axes(axes_, [&](auto n) -> std::unique_ptr<Engine> {
             return std::make_unique<AxesEngine<decltype(n)::value>>(
                 span, profile_, options_, pacing_, progress_, expected_ticks_);

@@ -109,11 +109,13 @@ using Progress = std::function<void(double fraction)>;
 /// The simulated device fed a plan span by span, as a planner makes them: memory stays bounded
 /// whatever the plan's length (with SimOptions::record_ticks off). The run is the one
 /// simulate() makes of the same spans, tick for tick: push() runs the device only as far as
-/// it can without knowing the spans still to come (the producer always has more spans waiting
-/// than the queue can take), finish() runs it to the end.
+/// it can without knowing the spans still to come (the producer runs only with as many spans
+/// waiting as it would push, and one more where the queue would answer kQueueFull), finish()
+/// runs it to the end.
 class Simulator {
 public:
-    /// `pacing`: as simulate_paced (null: options.realtime decides). `expected_ticks`: the
+    /// `pacing`: as simulate_paced (null: options.realtime decides, with the Linux clock's tick
+    /// 0 at the first tick). `expected_ticks`: the
     /// plan's ticks when known (0: not), for `progress` (called as simulate's; else only with
     /// 1.0 at the end) and to reserve the per-tick record. Throws std::invalid_argument for a
     /// profile without a positive tick rate and mm per LSB.
@@ -141,7 +143,6 @@ private:
     const host::MachineProfile& profile_;
     SimOptions options_;
     hal::Clock* pacing_;
-    std::unique_ptr<hal::Clock> own_clock_;
     Progress progress_;
     std::uint64_t expected_ticks_;
     std::unique_ptr<Engine> engine_;
