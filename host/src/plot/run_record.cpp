@@ -344,7 +344,9 @@ RunRecorder::RunRecorder(const MachineProfile& profile, std::size_t axes, double
     if (plots) {
         for (std::size_t i = 0; i < 1 + axes + (axes == 1 ? 2 : 0); ++i)
             s.envelopes.emplace_back(capacity);
-        if (axes >= 2) s.traces.assign(plant ? 2 : 1, Trace(capacity));
+        // A path's points: eight times as many, so that even a dense drawing keeps them
+        // closer than a pixel (65,536 points of 24 bytes by default).
+        if (axes >= 2) s.traces.assign(plant ? 2 : 1, Trace(8 * capacity));
     }
 }
 

@@ -94,10 +94,11 @@ struct TracePoint {
 };
 
 /// A run as the plots need it, of bounded size: its figures, each series' path thinned to
-/// points at least a distance apart (that grows as needed; pen changes kept), the speed and
-/// the accelerations as the minimum and maximum of each of up to `capacity` stretches of
-/// time, and the pen-up intervals (ones closer than a gap that grows as needed merged). With
-/// capacity 0 nothing is thinned: every tick is kept (what the TickSeries functions draw).
+/// at most 8 x `capacity` points at least a distance apart (that grows as needed; pen changes
+/// kept), the speed and the accelerations as the minimum and maximum of each of up to
+/// `capacity` stretches of time, and up to `capacity` pen-up intervals (ones closer than a gap
+/// that grows as needed merged). With capacity 0 nothing is thinned: every tick is kept (what
+/// the TickSeries functions draw).
 struct RunRecord {
     ExecutedFigures figures;
     double tick_hz = 1000;
