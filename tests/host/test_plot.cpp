@@ -743,4 +743,27 @@ TEST_CASE("a record keeps every tick until its capacity, then stays within it", 
         const std::string svg = plot::path_svg(source, r, m, o);
         CHECK(svg.size() < plot::path_svg(ideal, s, &plant, m, o).size() * 2);
     }
+    SECTION("many pen changes: merged and thinned, the figures still exact") {
+        const std::size_t capacity = 64;
+        plot::TickSeries s = wavy_series(40000, 2);
+        for (std::size_t k = 0; k < s.ticks(); ++k) s.pen_down[k] = (k / 10) % 2;
+        const plot::RunRecord r = recorded(s, nullptr, m, capacity);
+        const plot::ExecutedFigures whole = plot::executed_figures(s, m);
+        CHECK(r.figures.pen_downs == whole.pen_downs);
+        CHECK(r.figures.pen_ups == whole.pen_ups);
+        CHECK(r.figures.pen_down_ticks == whole.pen_down_ticks);
+        CHECK(r.figures.peak_acceleration == whole.peak_acceleration);
+        CHECK(r.pen_up.size() <= capacity);
+        CHECK(r.executed_path.size() <= 8 * capacity + 1);
+        // The merged intervals still cover every pen-up tick, in order.
+        for (std::size_t i = 1; i < r.pen_up.size(); ++i)
+            CHECK(r.pen_up[i - 1].second < r.pen_up[i].first);
+        std::size_t i = 0;
+        for (std::size_t k = 0; k < s.ticks(); ++k) {
+            if (s.pen_down[k] != 0) continue;
+            while (i < r.pen_up.size() && r.pen_up[i].second <= k) ++i;
+            REQUIRE(i < r.pen_up.size());
+            REQUIRE(r.pen_up[i].first <= k);
+        }
+    }
 }
