@@ -118,15 +118,16 @@ same_sim rose "$src/examples/rose.json" --plant ideal && passed=$((passed + 1)) 
   { echo "FAIL sim rose.json: streamed and --plan-first reports differ"; failures=$((failures + 1)); }
 same_sim leaf "$src/examples/leaf.ngc" && passed=$((passed + 1)) ||
   { echo "FAIL sim leaf.ngc: streamed and --plan-first reports differ"; failures=$((failures + 1)); }
-# A slow job keeps sim's memory flat: 150 short G1 moves at F10 mm/min, 1.9 million ticks,
+# A slow job keeps sim's memory flat: 150 short G1 moves at F10 mm/min, 1.8 million ticks,
 # within an address-space ceiling (RLIMIT_AS; the planning threads' stacks and malloc arenas
-# count: it passes from about 140 MB). With every tick kept, as before, it took 284 MB resident
-# and failed under 300 MB. The plots without PNG copies: rsvg-convert would run under the
-# ceiling too. Sanitizers reserve terabytes of shadow address space: there it runs without it.
+# count: it passes from about 120 MB, 18 MB resident). With every tick kept (--plan-first, and
+# sim before it planned as it ran) it takes 256 MB resident and fails under 300 MB. The plots
+# without PNG copies: rsvg-convert would run under the ceiling too. Sanitizers reserve
+# terabytes of shadow address space: there it runs without the ceiling.
 awk 'BEGIN { srand(7); print "G21 G90\nG0 Z3\nG0 X20 Y20\nG1 Z-0.5 F600";
   for (i = 0; i < 150; i++) printf "G1 X%.3f Y%.3f F10\n", 20 + (i % 20) * 1.0 + rand(), 20 + int(i / 20) * 1.0 + rand();
   print "G0 Z3\nM2" }' > "$work/slow.ngc"
-ceiling="ulimit -v 250000 &&"
+ceiling="ulimit -v 200000 &&"
 [ -n "${PATHSTREAM_SANITIZED:-}" ] && ceiling=''
 expect sim-slow-flat-memory 0 "0 underruns" -- \
   bash -c "$ceiling PATH=/nonexistent exec \"$bin\" sim \"$work/slow.ngc\" -m \"$machine\" --plot \"$work/slow-plots\""

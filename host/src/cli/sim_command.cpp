@@ -299,33 +299,33 @@ SimRun run_plan_first(const SimCommandOptions& o, const EventChannel& channel,
 }
 
 /// The planning thread's look at the plan before the device gets it: the device's travel
-/// check, the per-tick check (against its own pass over the path) and the dwells.
+/// check and the dwells. The per-tick check is plan_stream's own (check(): StreamCheck with its
+/// own pass over the path for the deviation).
 class SimPlanTap : public PlanSink {
 public:
     SimPlanTap(const PlannedJob& job, const std::string& file)
-        : job_(job), file_(file), checked_path_(job.path), checker_(checked_path_, job.machine) {}
+        : job_(job), file_(file), checked_path_(job.path) {
+        check_.path = &checked_path_;
+    }
     void span(const CoreSpan& s) override {
-        check_span_travel(s, checker_.spans(), job_.path, job_.machine, file_);
-        checker_.span(s);
+        check_span_travel(s, spans_++, job_.path, job_.machine, file_);
     }
     void pen(const PenEvent& e) override {
-        checker_.pen(e);
         dwell_ticks_ += delay_ticks(
             e.down ? job_.machine.pen_down_delay : job_.machine.pen_up_delay, job_.machine.tick_hz);
     }
-    void pause(const PlanPause& p) override { checker_.pause(p); }
-    /// PlanningThread::Hooks::finish: the check's figures.
-    void finish(const PlanTotals&) { check_ = checker_.finish(); }
-    /// Once planning finished.
-    const PlanCheck& check() const { return check_; }
+    void pause(const PlanPause&) override {}
+    /// For PlanningThread::Hooks::check; its result once planning finished.
+    StreamCheck* stream_check() { return &check_; }
+    const PlanCheck& check() const { return check_.result; }
     std::uint64_t dwell_ticks() const { return dwell_ticks_; }
 
 private:
     const PlannedJob& job_;
     const std::string& file_;
     PathSegmentSource checked_path_;  ///< the check's own pass over the path
-    PlanChecker checker_;
-    PlanCheck check_;
+    StreamCheck check_;
+    std::size_t spans_ = 0;
     std::uint64_t dwell_ticks_ = 0;
 };
 
@@ -367,8 +367,7 @@ SimRun run_streamed(const SimCommandOptions& o, const EventChannel& channel,
     PathSegmentSource source(job.path);
     events->start(std::nullopt);
     try {
-        PlanningThread planning(source, job.machine, PlanOptions{},
-                                {&tap, [&tap](const PlanTotals& t) { tap.finish(t); }});
+        PlanningThread planning(source, job.machine, PlanOptions{}, {&tap, {}, tap.stream_check()});
         sim::Simulator simulator(job.machine, options);
         ProgressBar bar(o.realtime ? "planning and running (real time)"
                                    : "planning and simulating");

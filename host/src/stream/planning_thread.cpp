@@ -45,7 +45,7 @@ void PlanningThread::run() {
     try {
         Forward sink(*this);
         const PlanTotals totals =
-            plan_stream(source_, profile_, options_, sink, nullptr, [this](double f) {
+            plan_stream(source_, profile_, options_, sink, hooks_.check, nullptr, [this](double f) {
                 if (cancel_.load(std::memory_order_relaxed)) throw Cancelled{};
                 fraction_.store(f, std::memory_order_relaxed);
             });

@@ -50,6 +50,9 @@ public:
     struct Hooks {
         PlanSink* tap = nullptr;
         std::function<void(const PlanTotals&)> finish;
+        /// plan_stream's own per-tick check, given to it (its result is set before `finish`
+        /// runs): the whole PlanCheck, the deviation included, without a second check.
+        StreamCheck* check = nullptr;
     };
 
     /// Starts planning `source` for `profile` with `options` on a new thread. `source`,
