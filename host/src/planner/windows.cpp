@@ -141,6 +141,8 @@ public:
             const std::size_t window_first = window_start();
             buffer_.erase(buffer_.begin(),
                           buffer_.begin() + static_cast<std::ptrdiff_t>(window_first - base_));
+            nominal_.erase(nominal_.begin(),
+                           nominal_.begin() + static_cast<std::ptrdiff_t>(window_first - base_));
             base_ = window_first;
             const PathGrid pg = build_grid(buffer_, profile_, options_, base_);
             const double end = pg.grid.size() > 0 ? pg.grid.lambda.back() : 0.0;
@@ -222,8 +224,7 @@ private:
             static_cast<double>(std::max<std::uint64_t>(options_.window_ticks, 1000)) *
             static_cast<double>(want) / static_cast<double>(window_segments());
         double ticks = 0;
-        for (std::size_t i = carry_.segment - base_; i < buffer_.size(); ++i)
-            ticks += nominal_ticks(buffer_[i]);
+        for (std::size_t i = carry_.segment - base_; i < nominal_.size(); ++i) ticks += nominal_[i];
         while (!exhausted_ && buffer_.size() - (carry_.segment - base_) < want &&
                ticks < tick_cap) {
             BezierSegment s;
@@ -231,18 +232,19 @@ private:
                 exhausted_ = true;
                 break;
             }
-            account(s);
-            ticks += nominal_ticks(s);
+            const double length = segment_length(s);
+            account(s, length);
+            nominal_.push_back(nominal_ticks(s, length));
+            ticks += nominal_.back();
             next_.feeds.push_back({s.subpath, s.pen_down, s.feed});
             top_speed_ = std::max(top_speed_, std::min(v_axes_, s.feed));
             buffer_.push_back(std::move(s));
         }
     }
 
-    /// Ticks a segment takes at its feed (at most the axes' combined speed), not counting
-    /// speed changes: enough to bound a window's length in time.
-    double nominal_ticks(const BezierSegment& s) const {
-        const double length = segment_length(s);
+    /// Ticks a segment of `length` mm takes at its feed (at most the axes' combined speed), not
+    /// counting speed changes: enough to bound a window's length in time.
+    double nominal_ticks(const BezierSegment& s, double length) const {
         const double feed =
             s.feed > 0 ? s.feed : (s.pen_down ? profile_.feed : profile_.travel_feed);
         const double speed = std::min(v_axes_, feed);
@@ -258,9 +260,8 @@ private:
         return length >= 1e-9 ? length : 0.0;
     }
 
-    /// The pen-down and travel length of a new segment (degenerate ones count nothing).
-    void account(const BezierSegment& s) {
-        const double length = segment_length(s);
+    /// The pen-down and travel length of a new segment, `length` mm (degenerate ones: 0).
+    void account(const BezierSegment& s, double length) {
         if (length <= 0) return;
         (s.pen_down ? pen_down_length_ : travel_length_) += length;
         last_subpath_ = s.subpath;
@@ -538,6 +539,7 @@ private:
     std::optional<JerkStage> jerk_;
     JerkFailure jerk_failure_;
     std::vector<BezierSegment> buffer_;  ///< segments base_ .. base_ + size - 1
+    std::vector<double> nominal_;        ///< their nominal_ticks, so each is measured once
     std::size_t base_ = 0;
     bool exhausted_ = false;
     bool cut_ = false;

@@ -43,18 +43,6 @@ std::string name_of(const MachineProfile& profile, std::size_t axis) {
     return "axis" + std::to_string(axis);
 }
 
-/// Pen-lift edges and down time on the executed ticks.
-void pen_figures(const TickSeries& executed, ExecutedFigures& f) {
-    for (std::size_t k = 0; k < executed.pen_down.size(); ++k) {
-        const bool down = executed.pen_down[k] != 0;
-        const bool before = k > 0 && executed.pen_down[k - 1] != 0;
-        f.pen_down_ticks += down ? 1 : 0;
-        if (down && !before) ++f.pen_downs;
-        if (!down && before) ++f.pen_ups;
-    }
-    f.ticks = executed.pen_down.size();
-}
-
 /// The largest element (0 when empty): the peak of per-axis fractions.
 double peak_of(const std::vector<double>& values) {
     double m = 0;
@@ -97,6 +85,17 @@ AxisFigures axis_figures(const PlanCheck* check, const MachineProfile& profile,
 }
 
 }  // namespace
+
+void pen_figures(const TickSeries& executed, ExecutedFigures& f) {
+    for (std::size_t k = 0; k < executed.pen_down.size(); ++k) {
+        const bool down = executed.pen_down[k] != 0;
+        const bool before = k > 0 && executed.pen_down[k - 1] != 0;
+        f.pen_down_ticks += down ? 1 : 0;
+        if (down && !before) ++f.pen_downs;
+        if (!down && before) ++f.pen_ups;
+    }
+    f.ticks = executed.pen_down.size();
+}
 
 ExecutedFigures executed_figures(const TickSeries& executed, const MachineProfile& profile,
                                  unsigned half_window) {

@@ -484,14 +484,10 @@ RunRecord record_of(const TickSeries& executed, const TickSeries* plant,
     // The pen's figures as the report counts them: from pen_down (which may be shorter than
     // the positions; the ticks stay the positions', the plots' time axis).
     plot::ExecutedFigures& f = r.figures;
+    const std::size_t ticks = f.ticks;
     f.pen_down_ticks = f.pen_downs = f.pen_ups = 0;
-    for (std::size_t k = 0; k < executed.pen_down.size(); ++k) {
-        const bool down = executed.pen_down[k] != 0;
-        const bool before = k > 0 && executed.pen_down[k - 1] != 0;
-        f.pen_down_ticks += down ? 1 : 0;
-        if (down && !before) ++f.pen_downs;
-        if (!down && before) ++f.pen_ups;
-    }
+    pen_figures(executed, f);
+    f.ticks = ticks;
     return r;
 }
 

@@ -81,6 +81,10 @@ struct ExecutedFigures {
     double peak_speed = 0;                     ///< mm/s: largest Derivatives::speed
 };
 
+/// Adds the pen's lowerings, lifts and down ticks of `executed.pen_down` to `f`, and sets
+/// f.ticks to its length. O(ticks).
+void pen_figures(const TickSeries& executed, ExecutedFigures& f);
+
 /// The figures of a whole series: pen edges and down ticks from its pen_down, the peaks of
 /// differentiate(series, profile, half_window).
 ExecutedFigures executed_figures(const TickSeries& series, const MachineProfile& profile,
