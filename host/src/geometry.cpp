@@ -153,7 +153,7 @@ void PathSegmentSource::make_segment(BezierSegment& seg) {
     const bool first = k_ == 0;
     seg = BezierSegment{};
     seg.p = std::move(c);
-    seg.pen_down = true;
+    seg.pen_down = !sp.travel;
     seg.subpath = s_;
     seg.feed = sp.feed;
     seg.blend_tolerance = sp.corner_mode != CornerMode::kBlend ? 0.0
@@ -215,6 +215,15 @@ bool PathSegmentSource::next(BezierSegment& out) {
                 out.p[3] = seg.p[0];
                 out.pen_down = false;
                 out.subpath = any_ ? s_ : 0;
+                if (!seg.pen_down && any_) {
+                    // Joins the travel subpath's run: the run's pause and dwell go first.
+                    out.pause_before = seg.pause_before;
+                    out.dwell_before = seg.dwell_before;
+                    out.dwell_pen_down = seg.dwell_pen_down;
+                    seg.pause_before = false;
+                    seg.dwell_before = 0;
+                    seg.dwell_pen_down = false;
+                }
                 any_ = true;
                 held_ = std::move(seg);
                 return true;

@@ -71,8 +71,8 @@ TEST_CASE("G-code: expression errors", "[gcode]") {
     CHECK(error_of("G1 X#<a>") == "t.ngc:1:5: parameter #<a> is not defined");
     CHECK(error_of("G1 X#1.5") ==
           "t.ngc:1:5: parameter number 1.5 is not a whole number from 1 to 5602");
-    CHECK(error_of("G1 @5 ^90") == "t.ngc:1:4: polar coordinates ('@' words) are not supported");
-    CHECK(error_of("G1 X5 ^90") == "t.ngc:1:7: polar coordinates ('^' words) are not supported");
+    CHECK(error_of("G1 @5 ^90 @1") == "t.ngc:1:11: repeated word @ in one block");
+    CHECK(error_of("G1 X5 ^90") == "t.ngc:1:7: polar coordinates (@ ^) and X or Y in one block");
     CHECK(error_of("#1") ==
           "t.ngc:1:3: expected '=' after #1 (a parameter is read only inside a value)");
     CHECK(error_of("G1 X[" + std::string(100, '[') + "1" + std::string(101, ']'))
@@ -159,9 +159,10 @@ TEST_CASE("G-code: G92 offsets and G53", "[gcode]") {
     CHECK(pts[1] == PathPoint{15, 10});  // lines only: a polyline of their ends
     CHECK(pts[2] == PathPoint{1, 1});
     CHECK(pts[3] == PathPoint{2, 2});
-    CHECK(error_of("G92\n") == "t.ngc:1:1: G92 needs at least one of X, Y, Z");
+    CHECK(error_of("G92\n") == "t.ngc:1:1: G92 needs at least one axis word");
     CHECK(error_of("G92 G1 X1\n") ==
-          "t.ngc:1:5: G28, G30 and G92 use the block's axis words: no motion code with them");
+          "t.ngc:1:5: G10, G28, G30, G43.1 and G92 use the block's axis words: no motion code "
+          "with them");
     CHECK(error_of("G91 G53 G1 X1\n") ==
           "t.ngc:1:5: G53 needs a G0 or G1 move in absolute mode (G90) in its block");
 }
@@ -213,8 +214,11 @@ TEST_CASE("G-code: skipped codes warn once each", "[gcode]") {
 }
 
 TEST_CASE("G-code: unsupported planes and cycles", "[gcode]") {
-    CHECK(error_of("G18\n") == "t.ngc:1:1: only the XY plane (G17) is supported");
-    CHECK(error_of("G81 X1 Y1 Z-1 R1\n") == "t.ngc:1:1: canned cycles (G81) are not supported");
+    CHECK(error_of("G18 G2 X1 K1\n") ==
+          "t.ngc:1:5: G18 arcs move Z, which is not one of this machine's axes (XY)");
+    CHECK(error_of("G81 X1 Y1 Z-1 R1\n") ==
+          "t.ngc:1:1: G81: canned cycles need a machine whose moves keep their order "
+          "(--gcode-pen machine, the default on a machine with a Z axis)");
     CHECK(error_of("G1 Z-1\nG1 X1\nM2\nG1 X[1/0]\n") == "no error");  // nothing after M2 is read
 }
 

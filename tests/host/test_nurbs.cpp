@@ -273,7 +273,8 @@ TEST_CASE("NURBS: G5.2 errors", "[gcode][nurbs]") {
     CHECK(error("G5.2 X1 Y1 Z1\n") == "t.ngc:1:12: Z is not allowed with G5.2 (XY plane only)");
     CHECK(error("G5.2 X1 Y1 P0\n") == "t.ngc:1:12: G5.2 weight P must be positive");
     CHECK(error("G5.2 X1 Y1\nG1 X2\n") ==
-          "t.ngc:2:1: the G5.2 curve must end with G5.3 before other motion or G4, G28, G30, G53, "
+          "t.ngc:2:1: the G5.2 curve must end with G5.3 before other motion or G4, G10, G28, G30, "
+          "G53, "
           "G92");
     CHECK(error("G5.2 X1 Y1\nX2 Y0\nM2\n") ==
           "t.ngc:3:1: program ends inside a G5.2 curve (no G5.3)");

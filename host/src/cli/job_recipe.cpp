@@ -58,6 +58,7 @@ std::string job_recipe_json(const JobRecipe& r) {
     d["csv_closed"] = p.csv_closed;
     d["gcode_pen"] = p.gcode_pen;
     d["gcode_z_down"] = p.gcode_z_down;
+    d["gcode_tool_table"] = p.gcode_tool_table;
     d["gcode_ignore"] = p.gcode_ignore;
     d["tolerance"] = p.tolerance;
     d["rotate"] = p.placement.rotate;
@@ -104,6 +105,7 @@ JobRecipe parse_job_recipe(const std::string& json, const std::string& journal) 
     get("csv_closed", p.csv_closed);
     get("gcode_pen", p.gcode_pen);
     get("gcode_z_down", p.gcode_z_down);
+    get("gcode_tool_table", p.gcode_tool_table);
     get("gcode_ignore", p.gcode_ignore);
     get("tolerance", p.tolerance);
     get("rotate", p.placement.rotate);

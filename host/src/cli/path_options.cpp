@@ -42,9 +42,14 @@ void add_path_options(CLI::App& command, JobRequest& o) {
     command
         .add_option("--gcode-pen", o.gcode_pen,
                     "G-code pen control: z (down at Z <= --gcode-z-down), spindle (M3/M5), "
-                    "motion (G1 draws, G0 travels) or auto (chosen from the file)")
-        ->capture_default_str()
-        ->check(CLI::IsMember({"z", "spindle", "motion", "auto"}));
+                    "motion (G1 draws, G0 travels), machine (every move in the program's order, "
+                    "Z an axis when the machine has one) or auto (chosen from the file); "
+                    "default: z, machine on a machine with a z axis")
+        ->check(CLI::IsMember({"z", "spindle", "motion", "machine", "auto"}));
+    command
+        .add_option("--tool-table", o.gcode_tool_table,
+                    "G-code: LinuxCNC tool table file that G43 H reads")
+        ->check(CLI::ExistingFile);
     command.add_option(
         "--ignore-code", o.gcode_ignore,
         "G-code: skip this G or M code with a warning, like M300 (repeatable; M6, M7-M9 and "

@@ -73,7 +73,11 @@ public:
                 const double angle =
                     guess + std::remainder(std::atan2(d.y, d.x) - guess, 2 * std::numbers::pi);
                 const double expected = r0_ + (r1_ - r0_) * (angle - a0_) / arc_.sweep;
-                worst = std::max(worst, std::fabs(std::hypot(d.x, d.y) - expected));
+                // A helix's normal axis is at (k + t) / n of the rise on the piece; on the
+                // helix it is at the sample's angle.
+                const double axial =
+                    arc_.rise * ((static_cast<double>(k) + t) / n - (angle - a0_) / arc_.sweep);
+                worst = std::max(worst, std::hypot(std::hypot(d.x, d.y) - expected, axial));
             }
         }
         return worst;

@@ -17,6 +17,10 @@ struct Arc {
     Vec2 end;
     Vec2 center;
     double sweep = 0;
+    /// A helix: how far the axis normal to the plane moves over the sweep, linearly in the
+    /// angle. The pieces carry only the plane; the tolerance covers the normal axis too when
+    /// it is made linear in each piece's parameter (Interpreter::lift).
+    double rise = 0;
 };
 
 /// Pieces approximating `arc`: each turns at most 90 degrees, the first starts exactly at

@@ -1,5 +1,6 @@
-// G2/G3: the arc's center from I J (offsets, or absolute under G90.1) or from R, LinuxCNC's
-// checks on it, then Bezier pieces (docs/formats-gcode.md, "Arcs").
+// G2/G3 in the plane G17/G18/G19 selects: the center from the plane's offsets (I J, K I, J K;
+// absolute under G90.1) or from R, LinuxCNC's checks on it, then Bezier pieces, with the
+// normal axis linear in the angle (a helix) (docs/formats-gcode.md, "Arcs").
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -52,13 +53,36 @@ void Interpreter::check_end_radius(double r0_mm, double r1_mm, SourceLocation at
                  in_units(r1_mm) + ", difference " + in_units(abs_err) + " is " + why);
 }
 
-void Interpreter::arc(const Command& c, Motion move, Vec2 to, SourceLocation at) {
+void Interpreter::arc(const Command& c, Motion move, const Axes& to3, SourceLocation at) {
     const char* name = move == Motion::kArcCw ? "G2" : "G3";
-    const Word *i = c.value('I'), *j = c.value('J'), *r = c.value('R'), *p = c.value('P');
-    const Vec2 from = position_;
-    if (r && (i || j)) fail(r->at, "give either I and J (the center) or R (the radius), not both");
+    const Plane& pl = plane_;
+    for (const char letter : {'I', 'J', 'K'}) {
+        if (const Word* w = c.value(letter);
+            w && letter != pl.first_offset && letter != pl.second_offset) {
+            fail(w->at, std::string(1, letter) + " is no center offset of a " + pl.name +
+                            " arc (it takes " + pl.first_offset + " and " + pl.second_offset + ")");
+        }
+    }
+    for (const std::size_t axis : {pl.first, pl.second}) {
+        if (!on_path(axis)) {
+            fail(at, std::string(pl.name) + " arcs move " + kAxisLetters[axis] +
+                         ", which is not one of this machine's axes (" + options_.axes + ")");
+        }
+    }
+    if (!on_path(pl.normal) && to3[pl.normal] != pos_[pl.normal]) {
+        const Word* w = c.value(kAxisLetters[pl.normal]);
+        fail(w ? w->at : at, std::string(1, kAxisLetters[pl.normal]) + " changes during " + name +
+                                 " but is not a motion axis here (a helix needs a " +
+                                 kAxisLetters[pl.normal] + " axis)");
+    }
+    const Word *i = c.value(pl.first_offset), *j = c.value(pl.second_offset), *r = c.value('R'),
+               *p = c.value('P');
+    const Vec2 from = in_plane(pos_, pl), to = in_plane(to3, pl);
+    const std::string offsets = std::string(1, pl.first_offset) + " and " + pl.second_offset;
+    if (r && (i || j))
+        fail(r->at, "give either " + offsets + " (the center) or R (the radius), not both");
     if (!r && !i && !j)
-        fail(at, std::string(name) + " needs I and J (the center) or R (the radius)");
+        fail(at, std::string(name) + " needs " + offsets + " (the center) or R (the radius)");
 
     int turns = 1;
     if (p) {
@@ -73,9 +97,8 @@ void Interpreter::arc(const Command& c, Motion move, Vec2 to, SourceLocation at)
     if (r) {
         const double radius = length(*r);
         if (to == from) {
-            fail(r->at,
-                 "R arc with the end point equal to the start point (use I and J for a "
-                 "full circle)");
+            fail(r->at, "R arc with the end point equal to the start point (use " + offsets +
+                            " for a full circle)");
         }
         // As LinuxCNC's arc_data_r: the center lies on the chord's perpendicular bisector; R < 0
         // asks for the arc of more than 180 degrees.
@@ -99,9 +122,10 @@ void Interpreter::arc(const Command& c, Motion move, Vec2 to, SourceLocation at)
         } else {
             if (!i || !j) {
                 fail(i ? i->at : j->at,
-                     std::string(name) + " with absolute centers (G90.1) needs both I and J");
+                     std::string(name) + " with absolute centers (G90.1) needs both " + offsets);
             }
-            center = Vec2{length(*i), length(*j)};
+            // G90.1: the center in program coordinates of the plane's axes.
+            center = Vec2{length(*i) + offset(pl.first), length(*j) + offset(pl.second)};
         }
         const double r0 = std::hypot(from.x - center.x, from.y - center.y);
         const double r1 = std::hypot(to.x - center.x, to.y - center.y);
@@ -111,6 +135,8 @@ void Interpreter::arc(const Command& c, Motion move, Vec2 to, SourceLocation at)
         check_end_radius(r0, r1, at);
     }
 
+    // G2 is clockwise seen from the plane's positive normal (LinuxCNC's G18 included: its
+    // first axis is Z, so the view is from +Y).
     const bool ccw = move == Motion::kArcCcw;
     double sweep = 0;
     if (to == from) {
@@ -123,9 +149,13 @@ void Interpreter::arc(const Command& c, Motion move, Vec2 to, SourceLocation at)
     }
     sweep += (ccw ? 2 : -2) * std::numbers::pi * (turns - 1);
 
-    check_point(center, at);
-    follow(arc_to_cubics(Arc{from, to, center, sweep}, options_.arc_tolerance_mm), pen_down(z_, z_),
-           to, at);
+    if (!(std::fabs(center.x) <= 1e6) || !(std::fabs(center.y) <= 1e6)) {
+        fail(at, "arc center is out of range (|value| <= 1e+06 mm)");
+    }
+    Arc geometry{from, to, center, sweep};
+    if (on_path(pl.normal)) geometry.rise = to3[pl.normal] - pos_[pl.normal];
+    follow(lift(arc_to_cubics(geometry, options_.arc_tolerance_mm), to3),
+           pen_down(pos_[kZ], to3[kZ]), to3, at);
 }
 
 }  // namespace pathstream::host::gcode

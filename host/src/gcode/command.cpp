@@ -27,6 +27,8 @@ enum Group {
     kPathControl,
     kStopping,
     kSpindle,
+    kRetract,
+    kToolChange,
     kGroupCount
 };
 
@@ -35,7 +37,10 @@ struct Seen {
     std::string name;
 };
 
-constexpr std::string_view kSupportedLetters = "FGIJLMNPQRSTXYZ";
+// LinuxCNC's letters but D (cutter radius compensation, not read here): axis words, I J K
+// offsets, F H L P Q R S T values.
+constexpr std::string_view kSupportedLetters = "ABCFHIJKLPQRSTUVWXYZ";
+constexpr const char* kSupportedLettersText = "A B C F H I J K L P Q R S T U V W X Y Z";
 
 class Decoder {
 public:
@@ -58,10 +63,15 @@ public:
                     g_word(w, c);
                 else
                     m_word(w, c);
+            } else if (w.letter == '@' || w.letter == '^') {
+                auto& slot = w.letter == '@' ? c.polar_distance : c.polar_angle;
+                if (slot) fail(w, std::string("repeated word ") + w.letter + " in one block");
+                slot = w;
+                meaningful = true;
             } else if (kSupportedLetters.find(w.letter) == std::string_view::npos) {
                 if (!unsupported) unsupported = &w;
             } else {
-                if (w.letter == 'X' || w.letter == 'Y' || w.letter == 'Z') meaningful = true;
+                if (axis_index(w.letter) < kAxisCount) meaningful = true;
                 value_word(w, c);
             }
         }
@@ -70,8 +80,11 @@ public:
             return c;
         }
         if (unsupported) {
-            fail(*unsupported, std::string("unsupported word letter '") + unsupported->letter +
-                                   "' (supported: F G I J L M N P Q R S T X Y Z)");
+            fail(*unsupported,
+                 std::string("unsupported word letter '") + unsupported->letter + "'" +
+                     (unsupported->letter == 'D'
+                          ? " (D is the cutter radius compensation's tool; G41/G42 are not read)"
+                          : std::string(" (supported: G M N O ") + kSupportedLettersText + ")"));
         }
         return c;
     }
@@ -183,23 +196,49 @@ private:
                 non_modal(NonModal::kRestoreOffset);
                 break;
             case 730:
-            case 760:
+                motion(Motion::kPeckChipBreak);
+                break;
             case 810:
+                motion(Motion::kDrill);
+                break;
             case 820:
+                motion(Motion::kDrillDwell);
+                break;
             case 830:
-            case 840:
+                motion(Motion::kPeck);
+                break;
             case 850:
+                motion(Motion::kBore);
+                break;
             case 860:
+                motion(Motion::kBoreSpindleStop);
+                break;
+            case 890:
+                motion(Motion::kBoreDwell);
+                break;
+            case 740:
+            case 840:
+            case 331:
+                fail(w, name +
+                            " (tapping) needs a spindle whose turning the axes follow; this "
+                            "machine's spindle is an output");
+            case 330:
+            case 760:
+                fail(w, name + " (threading) needs a lathe spindle with an encoder");
             case 870:
             case 880:
-            case 890:
-                fail(w, "canned cycles (" + name + ") are not supported");
-            case 170:
-                claim(kPlane, w, name);
+                fail(w, name + " needs an oriented spindle stop (" +
+                            (tenths == 870 ? "back boring" : "boring with a manual retract") +
+                            "), which this machine has not");
+            case 100:
+                non_modal(NonModal::kSetCoordinates);
                 break;
+            case 170:
             case 180:
             case 190:
-                fail(w, "only the XY plane (G17) is supported");
+                claim(kPlane, w, name);
+                c.plane = tenths == 170 ? kPlaneXY : tenths == 180 ? kPlaneZX : kPlaneYZ;
+                break;
             case 200:
                 claim(kUnits, w, name);
                 c.inch = true;
@@ -210,12 +249,40 @@ private:
                 break;
             case 400:
                 claim(kCutterComp, w, name);
+                c.cutter_compensation_off = true;
                 break;
+            case 410:
+            case 411:
+            case 420:
+            case 421:
+                fail(w, "cutter radius compensation (" + name + ") is not supported");
+            case 430:
+            case 431:
             case 490:
                 claim(kToolLength, w, name);
+                c.tool_length = tenths == 430   ? ToolLength::kTable
+                                : tenths == 431 ? ToolLength::kDynamic
+                                                : ToolLength::kCancel;
+                c.tool_length_at = w.at;
                 break;
             case 540:
+            case 550:
+            case 560:
+            case 570:
+            case 580:
+            case 590:
+            case 591:
+            case 592:
+            case 593:
                 claim(kCoordinateSystem, w, name);
+                c.coordinate_system = tenths < 591 ? static_cast<std::size_t>((tenths - 540) / 10)
+                                                   : static_cast<std::size_t>(6 + tenths - 591);
+                c.coordinate_system_at = w.at;
+                break;
+            case 980:
+            case 990:
+                claim(kRetract, w, name);
+                c.retract_to_r = tenths == 990;
                 break;
             case 610:
             case 611:
@@ -242,8 +309,10 @@ private:
                 claim(kArcDistance, w, name);
                 c.arc_incremental = true;
                 break;
+            case 930:
             case 940:
                 claim(kFeedMode, w, name);
+                c.inverse_time = tenths == 930;
                 break;
             default:
                 fail(w, "unsupported G code " + name);
@@ -275,6 +344,10 @@ private:
             case 5:
                 claim(kSpindle, w, name);
                 c.spindle_on = false;
+                break;
+            case 6:
+                claim(kToolChange, w, name);
+                c.tool_change = true;
                 break;
             default:
                 fail(w, "unsupported M code " + name + " (skip it with --ignore-code " + name +

@@ -9,27 +9,53 @@
 #include <string>
 #include <vector>
 
+#include "axes.hpp"
 #include "lexer.hpp"
 #include "pathstream/host/path.hpp"
 
 namespace pathstream::host::gcode {
 
 /// Motion modes (modal group 1). kNone: no motion mode yet, or G80.
-enum class Motion { kNone, kRapid, kLine, kArcCw, kArcCcw, kCubic, kQuadratic, kNurbs };
+enum class Motion {
+    kNone,
+    kRapid,
+    kLine,
+    kArcCw,
+    kArcCcw,
+    kCubic,
+    kQuadratic,
+    kNurbs,
+    kPeckChipBreak,    ///< G73
+    kDrill,            ///< G81
+    kDrillDwell,       ///< G82
+    kPeck,             ///< G83
+    kBore,             ///< G85: feed in, feed out
+    kBoreSpindleStop,  ///< G86: feed in, spindle stop, rapid out
+    kBoreDwell,        ///< G89: feed in, dwell, feed out
+};
+
+/// Whether `m` is a canned cycle (G73, G81-G89).
+inline bool is_cycle(Motion m) {
+    return m >= Motion::kPeckChipBreak;
+}
+
+/// G43 (H from the tool table), G43.1 (dynamic, from the block's axis words), G49 (none).
+enum class ToolLength { kTable, kDynamic, kCancel };
 
 /// The non-modal codes of group 0 (one per block).
 enum class NonModal {
     kNone,
-    kDwell,          ///< G4
-    kSetOffset,      ///< G92
-    kClearOffset,    ///< G92.1
-    kSuspendOffset,  ///< G92.2
-    kRestoreOffset,  ///< G92.3
-    kHome,           ///< G28
-    kSetHome,        ///< G28.1
-    kHome2,          ///< G30
-    kSetHome2,       ///< G30.1
-    kMachineCoords,  ///< G53
+    kDwell,           ///< G4
+    kSetOffset,       ///< G92
+    kClearOffset,     ///< G92.1
+    kSuspendOffset,   ///< G92.2
+    kRestoreOffset,   ///< G92.3
+    kHome,            ///< G28
+    kSetHome,         ///< G28.1
+    kHome2,           ///< G30
+    kSetHome2,        ///< G30.1
+    kMachineCoords,   ///< G53
+    kSetCoordinates,  ///< G10 (L2, L20)
 };
 
 /// A code the reader skips (it has no meaning for the machine), where it first appeared.
@@ -38,29 +64,39 @@ struct IgnoredCode {
     SourceLocation at;
 };
 
-/// One block, decoded. Codes the reader accepts and ignores (G17, G40, G49, G54, G94, S, T)
-/// leave no trace here.
+/// One block, decoded. S and T leave no trace here.
 struct Command {
-    SourceLocation start;                    ///< the block's first word
-    std::optional<Motion> motion;            ///< G0 G1 G2 G3 G5 G5.1 G80
-    SourceLocation motion_at;                ///< where that G word is
-    std::optional<bool> inch;                ///< G20 (true) / G21 (false)
-    std::optional<bool> incremental;         ///< G91 (true) / G90 (false)
-    std::optional<bool> arc_incremental;     ///< G91.1 (true) / G90.1 (false)
-    NonModal non_modal = NonModal::kNone;    ///< G4, G28, G30, G53, G92...
-    SourceLocation non_modal_at;             ///< where that G word is
-    bool nurbs_end = false;                  ///< G5.3
+    SourceLocation start;                          ///< the block's first word
+    std::optional<Motion> motion;                  ///< G0 G1 G2 G3 G5 G5.1 G80
+    SourceLocation motion_at;                      ///< where that G word is
+    std::optional<bool> inch;                      ///< G20 (true) / G21 (false)
+    std::optional<bool> incremental;               ///< G91 (true) / G90 (false)
+    std::optional<bool> arc_incremental;           ///< G91.1 (true) / G90.1 (false)
+    std::optional<Plane> plane;                    ///< G17, G18, G19
+    std::optional<bool> inverse_time;              ///< G93 (true) / G94 (false)
+    std::optional<bool> retract_to_r;              ///< G99 (true) / G98 (false)
+    std::optional<std::size_t> coordinate_system;  ///< G54 (0) .. G59.3 (8)
+    SourceLocation coordinate_system_at;
+    std::optional<ToolLength> tool_length;  ///< G43, G43.1, G49
+    SourceLocation tool_length_at;
+    std::optional<bool> cutter_compensation_off;  ///< G40
+    NonModal non_modal = NonModal::kNone;         ///< G4, G28, G30, G53, G92...
+    SourceLocation non_modal_at;                  ///< where that G word is
+    bool nurbs_end = false;                       ///< G5.3
     std::optional<CornerMode> path_control;  ///< G61 (exact path), G61.1 (exact stop), G64 (P, Q)
     SourceLocation path_control_at;          ///< where that G word is
     std::optional<bool> spindle_on;          ///< M3, M4 (true) / M5 (false)
     bool end_program = false;                ///< M2, M30
     bool pause = false;                      ///< M0, M1
+    bool tool_change = false;                ///< M6 (when not skipped)
     /// Codes skipped in this block; when `skip` the whole block is skipped (it held only
     /// skipped codes and their words).
     std::vector<IgnoredCode> ignored;
     bool skip = false;
-    /// The value words (F I J P Q R S T X Y Z), indexed by letter - 'A'.
+    /// The value words (A-Z but G M N O), indexed by letter - 'A'.
     std::array<std::optional<Word>, 26> values;
+    /// Polar coordinates: '@' the distance, '^' the angle in degrees (LinuxCNC).
+    std::optional<Word> polar_distance, polar_angle;
 
     /// The value word for `letter` ('A'..'Z'), or nullptr.
     const Word* value(char letter) const {
@@ -80,8 +116,8 @@ std::optional<std::string> normalise_code_name(const std::string& text);
 
 /// Decodes a block. Codes named in `ignored` are listed in Command::ignored and skipped; a
 /// block of only such codes and non-axis words is skipped whole. Throws InputError at the
-/// offending word for: an unsupported letter, G or M code (G18/G19: "only the XY plane (G17)
-/// is supported"; canned cycles), two codes of one modal group, and a letter given twice.
+/// offending word for: an unsupported letter, G or M code, two codes of one modal group, and a
+/// letter given twice.
 Command decode_block(const Block& block, const std::string& file,
                      const std::set<std::string>& ignored);
 

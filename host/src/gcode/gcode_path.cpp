@@ -58,12 +58,27 @@ PenControl choose_pen(const gcode::PenEvidence& e, double z_down_max, std::strin
 // One run of the whole program in one pen mode.
 Path run(const std::vector<std::string_view>& lines, const std::string& file,
          const GcodeOptions& options, const std::set<std::string>& ignored, bool allow_empty,
-         gcode::PenEvidence* evidence, std::vector<std::string>& warnings) {
+         gcode::PenEvidence* evidence, std::vector<std::string>& warnings,
+         const gcode::ToolTable& tools) {
     gcode::Parameters parameters;
-    gcode::Interpreter interpreter(file, options, parameters);
+    gcode::Interpreter interpreter(file, options, parameters, tools);
     gcode::run_program(lines, file, ignored, interpreter, parameters, warnings);
     if (evidence) *evidence = interpreter.evidence();
     return interpreter.finish(allow_empty);
+}
+
+// The axis letters a path may have: XYZABCUVW, each once, X and Y among them.
+void check_axes(const std::string& axes) {
+    const std::string letters = "XYZABCUVW";
+    for (std::size_t i = 0; i < axes.size(); ++i) {
+        if (letters.find(axes[i]) == std::string::npos || axes.find(axes[i]) != i) {
+            throw std::invalid_argument("G-code axes \"" + axes +
+                                        "\": each of X Y Z A B C U V W at most once");
+        }
+    }
+    if (axes.find('X') == std::string::npos || axes.find('Y') == std::string::npos) {
+        throw std::invalid_argument("G-code axes \"" + axes + "\" need X and Y");
+    }
 }
 
 }  // namespace
@@ -78,6 +93,8 @@ const char* pen_control_name(PenControl pen) {
             return "motion";
         case PenControl::kAuto:
             return "auto";
+        case PenControl::kMachine:
+            return "machine";
     }
     return "?";
 }
@@ -90,6 +107,21 @@ Path parse_gcode_path(const std::string& text, const std::string& file, const Gc
     if (!(options.arc_tolerance_mm >= 1e-6) || !std::isfinite(options.arc_tolerance_mm)) {
         throw std::invalid_argument("GcodeOptions::arc_tolerance_mm must be finite and >= 1e-6");
     }
+    check_axes(options.axes);
+    if (!(options.rapid_feed >= 0) || !std::isfinite(options.rapid_feed)) {
+        throw std::invalid_argument("GcodeOptions::rapid_feed must be finite and >= 0");
+    }
+    const bool z_axis = options.axes.find('Z') != std::string::npos;
+    if (z_axis && options.pen != PenControl::kMachine && options.pen != PenControl::kAuto) {
+        throw std::invalid_argument(std::string("--gcode-pen ") + pen_control_name(options.pen) +
+                                    ": Z is a motion axis " + "of this machine (axes " +
+                                    options.axes +
+                                    "), so moves are the machine's: use "
+                                    "--gcode-pen machine (the default there)");
+    }
+    const gcode::ToolTable tools = options.tool_table.empty()
+                                       ? gcode::ToolTable{}
+                                       : gcode::ToolTable::load(options.tool_table);
     std::set<std::string> ignored = gcode::default_ignored_codes();
     for (const std::string& code : options.ignore_codes) {
         const auto name = gcode::normalise_code_name(code);
@@ -99,25 +131,34 @@ Path parse_gcode_path(const std::string& text, const std::string& file, const Gc
         }
         ignored.insert(*name);
     }
+    // On a machine M6 is a tool change: the job pauses for it unless asked to skip it.
+    const bool m6_skip_asked =
+        std::any_of(options.ignore_codes.begin(), options.ignore_codes.end(),
+                    [](const std::string& c) { return gcode::normalise_code_name(c) == "M6"; });
+    if (!m6_skip_asked && (z_axis || options.pen == PenControl::kMachine)) ignored.erase("M6");
     const std::vector<std::string_view> lines = split_lines(text);
     GcodeReadInfo local;
     GcodeReadInfo& out = info ? *info : local;
     out = {};
     GcodeOptions chosen = options;
     Path path;
-    if (options.pen == PenControl::kAuto) {
+    if (options.pen == PenControl::kAuto && z_axis) {
+        chosen.pen = PenControl::kMachine;
+        out.pen_reason = "auto: Z is a motion axis of this machine";
+        path = run(lines, file, chosen, ignored, false, nullptr, out.warnings, tools);
+    } else if (options.pen == PenControl::kAuto) {
         gcode::PenEvidence evidence;
         chosen.pen = PenControl::kZ;
-        path = run(lines, file, chosen, ignored, true, &evidence, out.warnings);
+        path = run(lines, file, chosen, ignored, true, &evidence, out.warnings, tools);
         chosen.pen = choose_pen(evidence, options.z_down_max, out.pen_reason);
         if (chosen.pen != PenControl::kZ || path.subpaths.empty()) {
             std::vector<std::string> again;  // the warnings of the first run stand
             path = Path{};                   // not held through the second run
-            path = run(lines, file, chosen, ignored, false, nullptr, again);
+            path = run(lines, file, chosen, ignored, false, nullptr, again, tools);
         }
     } else {
         out.pen_reason = "as asked";
-        path = run(lines, file, chosen, ignored, false, nullptr, out.warnings);
+        path = run(lines, file, chosen, ignored, false, nullptr, out.warnings, tools);
     }
     out.pen = chosen.pen;
     return path;

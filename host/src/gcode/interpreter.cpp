@@ -2,6 +2,7 @@
 #include "interpreter.hpp"
 
 #include <cmath>
+#include <numbers>
 #include <sstream>
 
 #include "pathstream/machine/input_error.hpp"
@@ -12,11 +13,6 @@ namespace {
 
 constexpr double kMaxCoordinateMm = 1e6;  // as the JSON reader: catches unit mix-ups
 constexpr double kMaxFeedMmPerMin = 1e6;
-// LinuxCNC's parameters for the G28 and G30 positions and the G92 offset (X, Y, Z).
-constexpr long kG28Position = 5161;
-constexpr long kG30Position = 5181;
-constexpr long kG92Applied = 5210;
-constexpr long kG92Offset = 5211;
 
 // The shortest usual form of a number, for messages.
 std::string number(double v) {
@@ -25,16 +21,24 @@ std::string number(double v) {
     return s.str();
 }
 
-// A reference to numbered parameter #n.
-ParameterRef numbered(long n) {
-    return ParameterRef{n, {}};
+std::vector<std::size_t> axis_indices(const std::string& letters) {
+    std::vector<std::size_t> indices;
+    for (const char c : letters) indices.push_back(axis_index(c));
+    return indices;
 }
 
 }  // namespace
 
 Interpreter::Interpreter(const std::string& file, const GcodeOptions& options,
-                         Parameters& parameters)
-    : file_(file), options_(options), parameters_(parameters) {}
+                         Parameters& parameters, const ToolTable& tools)
+    : file_(file),
+      options_(options),
+      parameters_(parameters),
+      tools_(tools),
+      runs_(axis_indices(options.axes)) {
+    for (const char c : options.axes) path_axis_[axis_index(c)] = true;
+    parameters_.set(ParameterRef{5220, {}}, 1);  // G54
+}
 
 void Interpreter::fail(SourceLocation at, const std::string& message) const {
     throw InputError(file_, at, message);
@@ -49,10 +53,22 @@ double Interpreter::length(const Word& w) const {
     return mm;
 }
 
-void Interpreter::check_point(Vec2 p, SourceLocation at) const {
-    if (!(std::fabs(p.x) <= kMaxCoordinateMm) || !(std::fabs(p.y) <= kMaxCoordinateMm)) {
-        fail(at, "curve point (" + number(p.x) + ", " + number(p.y) +
-                     ") mm is out of range (|value| <= " + number(kMaxCoordinateMm) + " mm)");
+double Interpreter::axis_value(const Word& w, std::size_t axis) const {
+    if (!is_rotary(axis)) return length(w);
+    if (std::fabs(w.value) > kMaxCoordinateMm) {
+        fail(w.at, std::string(1, w.letter) + " " + number(w.value) +
+                       " degrees is out of range (|value| <= " + number(kMaxCoordinateMm) + ")");
+    }
+    return w.value;
+}
+
+void Interpreter::check_point(const Axes& p, SourceLocation at) const {
+    for (std::size_t a = 0; a < kAxisCount; ++a) {
+        if (!(std::fabs(p[a]) <= kMaxCoordinateMm)) {
+            const char* unit = is_rotary(a) ? "" : " mm";
+            fail(at, std::string("curve point ") + kAxisLetters[a] + " " + number(p[a]) + unit +
+                         " is out of range (|value| <= " + number(kMaxCoordinateMm) + unit + ")");
+        }
     }
 }
 
@@ -61,6 +77,7 @@ bool Interpreter::pen_down(double from, double to) const {
         case PenControl::kSpindle:
             return spindle_;
         case PenControl::kMotion:
+        case PenControl::kMachine:
             return true;
         default:
             return z_known_ && from <= options_.z_down_max && to <= options_.z_down_max;
@@ -72,29 +89,46 @@ bool Interpreter::pen_down_now() const {
         case PenControl::kSpindle:
             return spindle_;
         case PenControl::kMotion:
+        case PenControl::kMachine:
             return last_move_drew_;
         default:
-            return z_known_ && z_ <= options_.z_down_max;
+            return z_known_ && pos_[kZ] <= options_.z_down_max;
     }
+}
+
+void Interpreter::feed_word(const Command& c) {
+    if (c.inverse_time) inverse_time_ = *c.inverse_time;
+    inverse_minutes_ = 0;
+    const Word* f = c.value('F');
+    if (!f) return;
+    if (inverse_time_) {
+        // G93: the move takes 1/F minutes; F is per block, not modal.
+        if (!(f->value > 0) || !std::isfinite(1 / f->value)) {
+            fail(f->at, "inverse time feed F" + f->text + " must be positive (G93: 1/F minutes)");
+        }
+        inverse_minutes_ = 1 / f->value;
+        return;
+    }
+    const double mm_per_min = f->value * scale();
+    if (!(mm_per_min > 0) || mm_per_min > kMaxFeedMmPerMin) {
+        fail(f->at, "feed F" + f->text + " is out of range (0 < F <= " + number(kMaxFeedMmPerMin) +
+                        " mm/min)");
+    }
+    feed_ = mm_per_min / 60.0;
 }
 
 bool Interpreter::execute(const Command& c) {
     if (!nurbs_.empty() && ((c.motion && *c.motion != Motion::kNurbs) ||
                             (c.non_modal != NonModal::kNone && !c.nurbs_end))) {
         fail(c.motion ? c.motion_at : c.non_modal_at,
-             "the G5.2 curve must end with G5.3 before other motion or G4, G28, G30, G53, G92");
+             "the G5.2 curve must end with G5.3 before other motion or G4, G10, G28, G30, G53, "
+             "G92");
     }
     if (c.inch) inch_ = *c.inch;
+    if (c.plane) plane_ = *c.plane;
     if (c.incremental) incremental_ = *c.incremental;
     if (c.arc_incremental) arc_incremental_ = *c.arc_incremental;
-    if (const Word* f = c.value('F')) {
-        const double mm_per_min = f->value * scale();
-        if (!(mm_per_min > 0) || mm_per_min > kMaxFeedMmPerMin) {
-            fail(f->at, "feed F" + f->text +
-                            " is out of range (0 < F <= " + number(kMaxFeedMmPerMin) + " mm/min)");
-        }
-        feed_ = mm_per_min / 60.0;
-    }
+    feed_word(c);
     if (c.path_control) path_control(c);
     if (c.spindle_on) {
         spindle_ = *c.spindle_on;
@@ -110,37 +144,49 @@ bool Interpreter::execute(const Command& c) {
         runs_.lift();
         runs_.dwell_next(p->value, down);
     }
+    offsets_modes(c);
+    if (c.retract_to_r) retract_to_r_ = *c.retract_to_r;
     if (c.nurbs_end) {
         if (nurbs_.empty()) fail(c.start, "G5.3 without a G5.2 curve to end");
         nurbs_end(c.start);
         motion_ = Motion::kNone;
     }
     if (c.motion) {
+        if (!is_cycle(*c.motion)) cycle_r_known_ = cycle_z_known_ = false;
         motion_ = *c.motion;
         if (motion_ == Motion::kNurbs && nurbs_.empty()) nurbs_at_ = c.motion_at;
     }
 
-    const bool axis_words = c.value('X') || c.value('Y') || c.value('Z');
+    const Word* first_axis = nullptr;
+    for (const char letter : kAxisLetters) {
+        if (const Word* w = c.value(letter); w && !first_axis) first_axis = w;
+    }
+    if (!first_axis && c.polar_distance) first_axis = &*c.polar_distance;
+    if (!first_axis && c.polar_angle) first_axis = &*c.polar_angle;
+    const bool axis_words = first_axis != nullptr;
     const bool uses_axes = c.non_modal == NonModal::kSetOffset || c.non_modal == NonModal::kHome ||
-                           c.non_modal == NonModal::kHome2;
+                           c.non_modal == NonModal::kHome2 ||
+                           c.non_modal == NonModal::kSetCoordinates ||
+                           c.tool_length == ToolLength::kDynamic;
     if (uses_axes && c.motion && *c.motion != Motion::kNone) {
-        fail(c.motion_at, "G28, G30 and G92 use the block's axis words: no motion code with them");
+        fail(c.motion_at,
+             "G10, G28, G30, G43.1 and G92 use the block's axis words: no motion code with them");
     }
     if (c.non_modal != NonModal::kNone && c.non_modal != NonModal::kDwell &&
         c.non_modal != NonModal::kMachineCoords) {
         non_modal(c);
     }
-    const bool arc_words = c.value('I') || c.value('J') || c.value('R');
+    const bool arc_words = c.value('I') || c.value('J') || c.value('K') || c.value('R');
     const bool arc_mode = motion_ == Motion::kArcCw || motion_ == Motion::kArcCcw;
     const bool moving = !uses_axes && ((c.motion && *c.motion != Motion::kNone) || axis_words ||
                                        (arc_words && arc_mode));
     if (!uses_axes && axis_words && motion_ == Motion::kNone) {
-        const Word* w = c.value('X') ? c.value('X') : c.value('Y') ? c.value('Y') : c.value('Z');
-        fail(w->at,
+        fail(first_axis->at,
              c.motion || c.nurbs_end
                  ? "axis words cannot be used with " + std::string(c.nurbs_end ? "G5.3" : "G80")
-                 : std::string("axis word ") + w->letter +
-                       " with no motion mode (give G0, G1, G2, G3, G5, G5.1 or G5.2 first)");
+                 : std::string("axis word ") + first_axis->letter +
+                       " with no motion mode (give G0, G1, G2, G3, G5, G5.1, G5.2 or a canned "
+                       "cycle first)");
     }
     if (c.non_modal == NonModal::kMachineCoords &&
         (!moving || (motion_ != Motion::kRapid && motion_ != Motion::kLine) || incremental_)) {
@@ -150,9 +196,12 @@ bool Interpreter::execute(const Command& c) {
     if (moving) move(c, motion_, c.motion ? c.motion_at : c.start);
 
     if (c.value('Z') && z_known_)
-        (z_ <= options_.z_down_max ? evidence_.z_low : evidence_.z_high) = true;
-    if (c.pause || c.end_program) runs_.lift();
-    if (c.pause) runs_.pause_next();
+        (pos_[kZ] <= options_.z_down_max ? evidence_.z_low : evidence_.z_high) = true;
+    // M6 after the block's moves (LinuxCNC runs it before them; a change pauses with the tool
+    // where the program last left it, which is the same place when M6 has a block of its own).
+    const bool pause = c.pause || c.tool_change;
+    if (pause || c.end_program) runs_.lift();
+    if (pause) runs_.pause_next();
     if (c.end_program) {
         if (!nurbs_.empty()) fail(c.start, "program ends inside a G5.2 curve (no G5.3)");
         return false;
@@ -181,17 +230,24 @@ void Interpreter::check_words_used(const Command& c, Motion move, bool moving) c
     const bool spline = moving && (move == Motion::kCubic || move == Motion::kQuadratic);
     const bool cubic = moving && move == Motion::kCubic;
     const bool nurbs = moving && move == Motion::kNurbs;
+    const bool cycle = moving && is_cycle(move);
+    const bool peck = cycle && (move == Motion::kPeck || move == Motion::kPeckChipBreak);
+    const bool cycle_dwell = cycle && (move == Motion::kDrillDwell || move == Motion::kBoreDwell);
     const bool blending = c.path_control == CornerMode::kBlend;
+    const bool g10 = c.non_modal == NonModal::kSetCoordinates;
     const struct {
         char letter;
         bool used;
     } uses[] = {
         {'I', arc || spline},
         {'J', arc || spline},
-        {'R', arc},
-        {'P', arc || cubic || nurbs || c.non_modal == NonModal::kDwell || blending},
-        {'Q', cubic || blending},
-        {'L', nurbs},
+        {'K', arc},
+        {'R', arc || cycle || g10},
+        {'P', arc || cubic || nurbs || cycle_dwell || c.non_modal == NonModal::kDwell || blending ||
+                  g10},
+        {'Q', cubic || blending || peck},
+        {'L', nurbs || cycle || g10},
+        {'H', c.tool_length == ToolLength::kTable},
     };
     if (const Word* p = c.value('P');
         p && blending && (arc || cubic || nurbs || c.non_modal == NonModal::kDwell)) {
@@ -207,127 +263,77 @@ void Interpreter::check_words_used(const Command& c, Motion move, bool moving) c
     }
 }
 
-void Interpreter::targets(const Command& c, Vec2& to, double& z_to, bool machine) const {
-    auto axis = [&](char letter, double current, double offset) {
-        const Word* w = c.value(letter);
-        if (!w) return current;
-        const double v = incremental_ ? current + length(*w) : length(*w) + (machine ? 0 : offset);
-        if (std::fabs(v) > kMaxCoordinateMm) {
-            fail(w->at, std::string(1, letter) + " " + number(v) +
-                            " mm is out of range (|value| <= " + number(kMaxCoordinateMm) + " mm)");
+Axes Interpreter::targets(const Command& c, bool machine_coordinates) const {
+    Axes to = pos_;
+    for (std::size_t a = 0; a < kAxisCount; ++a) {
+        const Word* w = c.value(kAxisLetters[a]);
+        if (!w) continue;
+        if (!on_path(a) && a != kZ) {
+            fail(w->at, std::string("axis ") + w->letter + " is not one of this machine's axes (" +
+                            options_.axes + ")");
         }
-        return v;
-    };
-    to.x = axis('X', position_.x, offset_.x);
-    to.y = axis('Y', position_.y, offset_.y);
-    z_to = axis('Z', z_, z_offset_);
+        const double v = incremental_ ? pos_[a] + axis_value(*w, a)
+                                      : axis_value(*w, a) + (machine_coordinates ? 0 : offset(a));
+        if (std::fabs(v) > kMaxCoordinateMm) {
+            const char* unit = is_rotary(a) ? "" : " mm";
+            fail(w->at, std::string(1, w->letter) + " " + number(v) + unit +
+                            " is out of range (|value| <= " + number(kMaxCoordinateMm) + unit +
+                            ")");
+        }
+        to[a] = v;
+    }
+    if (c.polar_distance || c.polar_angle) {
+        // As LinuxCNC: polar about the program's XY origin; in G91 @ and ^ add to the current
+        // point's distance and angle.
+        const Word* at = c.polar_distance ? &*c.polar_distance : &*c.polar_angle;
+        if (c.value('X') || c.value('Y')) {
+            fail(at->at, "polar coordinates (@ ^) and X or Y in one block");
+        }
+        if (plane_.normal != kZ) fail(at->at, "polar coordinates need the XY plane (G17)");
+        const double x0 = pos_[kX] - offset(kX), y0 = pos_[kY] - offset(kY);
+        const double r0 = std::hypot(x0, y0), a0 = std::atan2(y0, x0) * 180 / std::numbers::pi;
+        double r = r0, angle = a0;
+        if (c.polar_distance) r = (incremental_ ? r0 : 0) + length(*c.polar_distance);
+        if (c.polar_angle) angle = (incremental_ ? a0 : 0) + c.polar_angle->value;
+        const double rad = angle * std::numbers::pi / 180;
+        to[kX] = r * std::cos(rad) + offset(kX);
+        to[kY] = r * std::sin(rad) + offset(kY);
+        if (std::fabs(to[kX]) > kMaxCoordinateMm || std::fabs(to[kY]) > kMaxCoordinateMm) {
+            fail(at->at,
+                 "polar point is out of range (|value| <= " + number(kMaxCoordinateMm) + " mm)");
+        }
+    }
+    return to;
 }
 
-void Interpreter::travel(Vec2 to, double z_to) {
+void Interpreter::travel(const Axes& to, SourceLocation at) {
+    if (machine()) {
+        follow({line_piece(pos_, to)}, false, to, at);
+        return;
+    }
     runs_.lift();
     last_move_drew_ = false;
-    position_ = to;
-    z_ = z_to;
-}
-
-void Interpreter::non_modal(const Command& c) {
-    // As LinuxCNC, these parameters are in the machine's units (mm here), whatever G20/G21.
-    auto store_offset = [&] {
-        parameters_.set(numbered(kG92Offset), offset_.x);
-        parameters_.set(numbered(kG92Offset + 1), offset_.y);
-        parameters_.set(numbered(kG92Offset + 2), z_offset_);
-    };
-    switch (c.non_modal) {
-        case NonModal::kSetOffset: {
-            if (!c.value('X') && !c.value('Y') && !c.value('Z')) {
-                fail(c.non_modal_at, "G92 needs at least one of X, Y, Z");
-            }
-            // The current point gets the given coordinates: offset = machine - program.
-            if (const Word* w = c.value('X')) offset_.x = position_.x - length(*w);
-            if (const Word* w = c.value('Y')) offset_.y = position_.y - length(*w);
-            if (const Word* w = c.value('Z')) {
-                z_offset_ = z_ - length(*w);
-                z_known_ = true;
-            }
-            store_offset();
-            parameters_.set(numbered(kG92Applied), 1);
-            break;
-        }
-        case NonModal::kClearOffset:
-        case NonModal::kSuspendOffset:
-            offset_ = {};
-            z_offset_ = 0;
-            if (c.non_modal == NonModal::kClearOffset) store_offset();
-            parameters_.set(numbered(kG92Applied), 0);
-            break;
-        case NonModal::kRestoreOffset:
-            offset_ = {*parameters_.get(numbered(kG92Offset)),
-                       *parameters_.get(numbered(kG92Offset + 1))};
-            z_offset_ = *parameters_.get(numbered(kG92Offset + 2));
-            parameters_.set(numbered(kG92Applied), 1);
-            break;
-        case NonModal::kSetHome:
-        case NonModal::kSetHome2: {
-            const long base = c.non_modal == NonModal::kSetHome ? kG28Position : kG30Position;
-            parameters_.set(numbered(base), position_.x);
-            parameters_.set(numbered(base + 1), position_.y);
-            parameters_.set(numbered(base + 2), z_);
-            break;
-        }
-        case NonModal::kHome:
-        case NonModal::kHome2: {
-            // As LinuxCNC: through the given point, then to the stored position, both at rapid;
-            // with axis words only those axes move.
-            const long base = c.non_modal == NonModal::kHome ? kG28Position : kG30Position;
-            const bool all = !c.value('X') && !c.value('Y') && !c.value('Z');
-            Vec2 via = position_;
-            double z_via = z_;
-            targets(c, via, z_via, false);
-            travel(via, z_via);
-            auto home = [&](char letter, long n, double current) {
-                if (!all && !c.value(letter)) return current;
-                const double v = *parameters_.get(numbered(n));
-                if (std::fabs(v) > kMaxCoordinateMm) {
-                    fail(c.non_modal_at, "#" + std::to_string(n) + " " + number(v) +
-                                             " mm is out of range (|value| <= " +
-                                             number(kMaxCoordinateMm) + " mm)");
-                }
-                return v;
-            };
-            const Vec2 to{home('X', base, position_.x), home('Y', base + 1, position_.y)};
-            const double z_to = home('Z', base + 2, z_);
-            if (all || c.value('Z')) z_known_ = true;
-            travel(to, z_to);
-            break;
-        }
-        default:
-            break;
-    }
+    pos_ = to;
 }
 
 void Interpreter::move(const Command& c, Motion move, SourceLocation at) {
-    Vec2 to = position_;
-    double z_to = z_;
-    targets(c, to, z_to, c.non_modal == NonModal::kMachineCoords);
-
+    if (is_cycle(move)) {
+        canned_cycle(c, move, at);
+        return;
+    }
+    const Axes to = targets(c, c.non_modal == NonModal::kMachineCoords);
+    const bool z_word = c.value('Z') != nullptr;
     switch (move) {
-        case Motion::kNone:
-            break;  // not reached: execute() rejects axis words without a mode
         case Motion::kRapid:
-            travel(to, z_);
+            travel(to, at);
             break;
         case Motion::kLine:
-            line(to, z_to, at);
+            line(to, at);
             break;
         case Motion::kArcCw:
-        case Motion::kArcCcw: {
-            const Word* z = c.value('Z');
-            if (z && (!z_known_ || z_to != z_)) {
-                fail(z->at, "helical arcs are not supported (Z changes during G2/G3)");
-            }
+        case Motion::kArcCcw:
             arc(c, move, to, at);
             break;
-        }
         case Motion::kCubic:
             cubic(c, to, at);
             break;
@@ -337,44 +343,106 @@ void Interpreter::move(const Command& c, Motion move, SourceLocation at) {
         case Motion::kNurbs:
             nurbs_point(c, to, at);
             break;
+        default:
+            break;  // kNone: execute() rejects axis words without a mode
     }
-    if (c.value('Z')) {
-        z_ = z_to;
+    if (z_word) {
+        pos_[kZ] = to[kZ];
         z_known_ = true;
     }
     if (move != Motion::kCubic) last_cubic_control_.reset();
 }
 
-void Interpreter::follow(const std::vector<Cubic>& pieces, bool down, Vec2 to, SourceLocation at) {
-    for (const Cubic& piece : pieces) {
-        for (const Vec2& p : piece.p) check_point(p, at);
+double Interpreter::move_feed(const std::vector<Piece>& pieces, SourceLocation at) const {
+    // Chord lengths: the path's feed is along all its axes, F along X Y Z when they move
+    // (LinuxCNC), else along U V W, else A B C (degrees per minute).
+    double all = 0, xyz = 0, uvw = 0, abc = 0;
+    for (const Piece& piece : pieces) {
+        for (int k = 0; k < 3; ++k) {
+            double s_all = 0, s_xyz = 0, s_uvw = 0, s_abc = 0;
+            for (std::size_t a = 0; a < kAxisCount; ++a) {
+                if (!on_path(a)) continue;
+                const double d = piece.p[k + 1][a] - piece.p[k][a];
+                s_all += d * d;
+                (a < 3 ? s_xyz : is_rotary(a) ? s_abc : s_uvw) += d * d;
+            }
+            all += std::sqrt(s_all);
+            xyz += std::sqrt(s_xyz);
+            uvw += std::sqrt(s_uvw);
+            abc += std::sqrt(s_abc);
+        }
+    }
+    if (inverse_time_) {
+        if (inverse_minutes_ <= 0) fail(at, "G93 (inverse time) needs F on every feed move");
+        return all / (60 * inverse_minutes_);
+    }
+    if (feed_ <= 0) {
+        if (!machine()) return 0;  // a plotter: the profile's feed
+        fail(at, "feed move with no feed rate (give F first)");
+    }
+    const double primary = xyz > 1e-9 ? xyz : uvw > 1e-9 ? uvw : abc;
+    if (primary <= 1e-9 || std::fabs(all - primary) <= 1e-12 * all) return feed_;
+    return feed_ * all / primary;
+}
+
+std::vector<Piece> Interpreter::lift(const std::vector<Cubic>& pieces, const Axes& to) const {
+    std::vector<Piece> out;
+    out.reserve(pieces.size());
+    const double n = static_cast<double>(pieces.size());
+    for (std::size_t k = 0; k < pieces.size(); ++k) {
+        Piece piece;
+        for (int i = 0; i < 4; ++i) {
+            const double f = (static_cast<double>(k) + i / 3.0) / n;
+            for (std::size_t a = 0; a < kAxisCount; ++a) {
+                piece.p[i][a] = i == 3 && k + 1 == pieces.size() ? to[a]
+                                : i == 0 && k == 0               ? pos_[a]
+                                                                 : pos_[a] + f * (to[a] - pos_[a]);
+            }
+            piece.p[i][plane_.first] = pieces[k].p[i].x;
+            piece.p[i][plane_.second] = pieces[k].p[i].y;
+        }
+        if (k > 0) piece.p[0] = out.back().p[3];
+        out.push_back(piece);
+    }
+    return out;
+}
+
+void Interpreter::follow(const std::vector<Piece>& pieces, bool down, const Axes& to,
+                         SourceLocation at) {
+    for (const Piece& piece : pieces) {
+        for (const Axes& p : piece.p) check_point(p, at);
     }
     if (down) {
-        for (const Cubic& piece : pieces) runs_.draw(piece, feed_, at, file_);
+        const double feed = move_feed(pieces, at);
+        for (const Piece& piece : pieces) runs_.draw(piece, feed, at, file_);
         runs_.end_block();
+    } else if (machine()) {
+        for (const Piece& piece : pieces) runs_.travel(piece, options_.rapid_feed, at, file_);
     } else {
         runs_.lift();
     }
     last_move_drew_ = down;
-    position_ = to;
+    pos_ = to;
 }
 
-void Interpreter::line(Vec2 to, double z_to, SourceLocation at) {
-    const Vec2 from = position_;
-    follow({line_piece(from, to)}, pen_down(z_, z_to), to, at);
+void Interpreter::line(const Axes& to, SourceLocation at) {
+    follow({line_piece(pos_, to)}, pen_down(pos_[kZ], to[kZ]), to, at);
 }
 
 Path Interpreter::finish(bool allow_empty) {
     Path path;
-    path.axes = 2;
+    path.axes = options_.axes.size();
     path.subpaths = runs_.finish();
-    if (path.subpaths.empty() && !allow_empty) {
+    bool drawn = false;
+    for (const Subpath& s : path.subpaths) drawn = drawn || !s.travel;
+    if (!drawn && !allow_empty) {
         std::string why;
         switch (options_.pen) {
             case PenControl::kSpindle:
                 why = "moves between M3 or M4 and M5";
                 break;
             case PenControl::kMotion:
+            case PenControl::kMachine:
                 why = "moves (G0 travels)";
                 break;
             default:

@@ -1,17 +1,19 @@
 // The G-code reader's third stage: executes decoded blocks against the modal state (units,
-// distance modes, offsets, motion mode, feed, pen) and turns moves into pen-down Bezier pieces.
+// distance modes, plane, offsets, motion mode, feed, pen) and turns moves into pieces: pen-down
+// runs, and on a machine whose moves keep their order (PenControl::kMachine) travel runs too.
 #pragma once
 
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "axes.hpp"
 #include "command.hpp"
 #include "parameters.hpp"
 #include "pathstream/host/gcode_path.hpp"
 #include "pathstream/host/path.hpp"
 #include "runs.hpp"
-#include "vec2.hpp"
+#include "tool_table.hpp"
 
 namespace pathstream::host::gcode {
 
@@ -24,9 +26,11 @@ struct PenEvidence {
 
 class Interpreter {
 public:
-    /// `options` must already be checked (pen not kAuto); `file` names the source in error
-    /// messages; `parameters` holds the G28/G30 positions and receives G92 offsets.
-    Interpreter(const std::string& file, const GcodeOptions& options, Parameters& parameters);
+    /// `options` must already be checked (pen not kAuto, axes valid); `file` names the source
+    /// in error messages; `parameters` holds the G28/G30 positions, the coordinate systems and
+    /// receives G92 offsets; `tools` the tool table (G43 H).
+    Interpreter(const std::string& file, const GcodeOptions& options, Parameters& parameters,
+                const ToolTable& tools);
 
     /// Executes one block (in LinuxCNC's order: units, distance modes, F, spindle, dwell,
     /// offsets and homing, motion, then M0/M1 and program end). Returns false after M2 or
@@ -45,54 +49,82 @@ private:
     double scale() const { return inch_ ? 25.4 : 1.0; }
     /// A length word in mm, checked against the coordinate range.
     double length(const Word& w) const;
+    /// An axis word's value in machine units: mm (linear, G20 scaled) or degrees (rotary).
+    double axis_value(const Word& w, std::size_t axis) const;
     /// Checks that a computed position or control point is within the coordinate range.
-    void check_point(Vec2 p, SourceLocation at) const;
+    void check_point(const Axes& p, SourceLocation at) const;
     /// Whether a feed move from Z `from` to Z `to` draws.
     bool pen_down(double from, double to) const;
     /// Whether the pen is down where the machine stands now (for G4).
     bool pen_down_now() const;
+    bool machine() const { return options_.pen == PenControl::kMachine; }
+    /// Whether the path has axis `axis` (else: Z is the pen signal; others are refused).
+    bool on_path(std::size_t axis) const { return path_axis_[axis]; }
 
+    void feed_word(const Command& c);
     /// G61, G61.1, G64 [P] [Q]: the corner rule for the moves that follow.
     void path_control(const Command& c);
     void check_words_used(const Command& c, Motion move, bool moving) const;
-    /// G92, G92.1, G92.2, G92.3, G28.1, G30.1; G28 and G30 travel.
+    /// G92, G92.1, G92.2, G92.3, G28.1, G30.1, G10; G28 and G30 travel.
     void non_modal(const Command& c);
-    /// Travel to `to` (mm, machine coordinates) with Z `z_to`.
-    void travel(Vec2 to, double z_to);
-    /// The block's X Y Z as machine coordinates in mm (G90/G91, G92 offset, G53).
-    void targets(const Command& c, Vec2& to, double& z_to, bool machine) const;
+    /// G10 L2, L20: a coordinate system's origin.
+    void set_coordinates(const Command& c);
+    /// G54..G59.3 and G43/G43.1/G49: the offsets from program to machine coordinates.
+    void offsets_modes(const Command& c);
+    /// Program coordinates -> machine coordinates of one axis (G54.., G92, tool length).
+    double offset(std::size_t axis) const;
+    /// Travel to `to` (machine coordinates).
+    void travel(const Axes& to, SourceLocation at);
+    /// The block's axis words as machine coordinates (G90/G91, offsets, G53, polar @ ^).
+    Axes targets(const Command& c, bool machine_coordinates) const;
     void move(const Command& c, Motion move, SourceLocation at);
-    void line(Vec2 to, double z_to, SourceLocation at);
-    void arc(const Command& c, Motion move, Vec2 to, SourceLocation at);
+    void line(const Axes& to, SourceLocation at);
+    void arc(const Command& c, Motion move, const Axes& to, SourceLocation at);
     /// Throws at `at` when an I J arc's end radius is too far from its start radius.
     void check_end_radius(double r0_mm, double r1_mm, SourceLocation at) const;
-    void cubic(const Command& c, Vec2 to, SourceLocation at);
-    void quadratic(const Command& c, Vec2 to, SourceLocation at);
+    void cubic(const Command& c, const Axes& to, SourceLocation at);
+    void quadratic(const Command& c, const Axes& to, SourceLocation at);
     /// G5.2 blocks: collects a control point; G5.3 (or leaving G5.2) draws the curve.
-    void nurbs_point(const Command& c, Vec2 to, SourceLocation at);
+    void nurbs_point(const Command& c, const Axes& to, SourceLocation at);
     void nurbs_end(SourceLocation at);
+    /// G73, G81-G89: one canned cycle block (L repeats).
+    void canned_cycle(const Command& c, Motion cycle, SourceLocation at);
+    /// The feed (mm/s along the path's axes) of a feed move made of `pieces`, from F, G93/G94
+    /// and LinuxCNC's rule that F is along X Y Z when they move. Throws at `at` without F.
+    double move_feed(const std::vector<Piece>& pieces, SourceLocation at) const;
+    /// Plane pieces of a move from pos_ to `to` lifted into all axes: the plane's axes from
+    /// the pieces, every other axis linear in the piece index (the arcs' equal angle steps).
+    std::vector<Piece> lift(const std::vector<Cubic>& pieces, const Axes& to) const;
     /// Draws (pen down) or travels along pieces ending at `to`, then moves there.
-    void follow(const std::vector<Cubic>& pieces, bool down, Vec2 to, SourceLocation at);
+    void follow(const std::vector<Piece>& pieces, bool down, const Axes& to, SourceLocation at);
 
     const std::string& file_;
     GcodeOptions options_;
     Parameters& parameters_;
+    const ToolTable& tools_;
     RunBuilder runs_;
     PenEvidence evidence_;
+    std::array<bool, kAxisCount> path_axis_{};
 
-    Vec2 position_;         ///< mm, machine coordinates; X0 Y0 at the start
-    double z_ = 0;          ///< mm
-    bool z_known_ = false;  ///< false until a Z word: the pen counts as up (kZ)
-    Vec2 offset_;           ///< G92 offset (mm): machine = program + offset
-    double z_offset_ = 0;   ///< G92 offset of Z (mm)
+    Axes pos_{};              ///< machine coordinates; all 0 at the start
+    bool z_known_ = false;    ///< false until a Z word: the pen counts as up (kZ)
+    Axes g92_{};              ///< G92 offset: added to program coordinates
+    std::size_t system_ = 0;  ///< G54 (0) .. G59.3 (8)
+    Axes tool_offset_{};      ///< G43 / G43.1 tool length offsets
+    Plane plane_ = kPlaneXY;  ///< G17, G18, G19
     Motion motion_ = Motion::kNone;
     bool inch_ = false;                       ///< G20
     bool incremental_ = false;                ///< G91
     bool arc_incremental_ = true;             ///< G91.1 (LinuxCNC's default)
-    double feed_ = 0;                         ///< mm/s; 0 until F
+    bool inverse_time_ = false;               ///< G93
+    double feed_ = 0;                         ///< mm/s (deg/s on rotary-only moves); 0 until F
+    double inverse_minutes_ = 0;              ///< G93: this block's move takes 1/F minutes
     bool spindle_ = false;                    ///< M3/M4 given, no M5 since
     bool last_move_drew_ = false;             ///< kMotion: the pen is down
     std::optional<Vec2> last_cubic_control_;  ///< second control point of the last move, if G5
+    bool retract_to_r_ = false;               ///< G99 (true) / G98 (false)
+    double cycle_r_ = 0, cycle_z_ = 0, cycle_q_ = 0, cycle_p_ = 0;  ///< sticky cycle words
+    bool cycle_r_known_ = false, cycle_z_known_ = false;
 
     struct NurbsPoint {
         Vec2 at;
@@ -101,6 +133,7 @@ private:
     std::vector<NurbsPoint> nurbs_;  ///< G5.2 control points so far (the first: the start)
     int nurbs_order_ = 0;            ///< G5.2 L
     SourceLocation nurbs_at_;        ///< where the G5.2 is
+    Axes nurbs_start_{};             ///< where the G5.2 curve starts
 };
 
 }  // namespace pathstream::host::gcode

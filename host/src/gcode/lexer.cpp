@@ -27,6 +27,10 @@ public:
         while (true) {
             skip_blanks_and_comments();
             if (c_.done() || c_.peek() == ';') break;
+            if (c_.peek() == '*') {
+                checksum();
+                break;
+            }
             if (c_.peek() == '#') {
                 if (b.words.empty() && b.assignments.empty() && !seen_n_) b.start = c_.at(c_.i);
                 b.assignments.push_back(assignment());
@@ -63,6 +67,31 @@ private:
         }
     }
 
+    // "*nn" as senders append it (RepRap, Marlin): the XOR of every byte before the '*'. Only
+    // blanks and comments may follow.
+    void checksum() {
+        const std::size_t star = c_.i;
+        ++c_.i;
+        c_.skip_blanks();
+        const std::size_t begin = c_.i;
+        unsigned value = 0;
+        while (!c_.done() && is_digit(c_.peek()) && c_.i - begin < 4) {
+            value = value * 10 + static_cast<unsigned>(c_.peek() - '0');
+            ++c_.i;
+        }
+        if (c_.i == begin || value > 255) c_.fail(star, "a checksum '*' needs a number 0..255");
+        unsigned expected = 0;
+        for (std::size_t k = 0; k < star; ++k) expected ^= static_cast<unsigned char>(c_.text[k]);
+        if (value != expected) {
+            c_.fail(star, "checksum *" + std::to_string(value) + " does not match the line (*" +
+                              std::to_string(expected) + ")");
+        }
+        skip_blanks_and_comments();
+        if (!c_.done() && c_.peek() != ';') {
+            c_.fail(c_.i, "unexpected " + describe_char(c_.peek()) + " after the checksum");
+        }
+    }
+
     // "#ref = value"; the reference's own expression is read with the old values too.
     Assignment assignment() {
         Assignment a;
@@ -81,10 +110,7 @@ private:
     Word word() {
         const std::size_t at = c_.i;
         const char ch = c_.peek();
-        if (ch == '@' || ch == '^') {
-            c_.fail(at, std::string("polar coordinates ('") + ch + "' words) are not supported");
-        }
-        if (!is_letter(ch)) {
+        if (!is_letter(ch) && ch != '@' && ch != '^') {
             c_.fail(at, "unexpected character " + describe_char(ch) +
                             " (expected a word: letter and number)");
         }

@@ -18,13 +18,15 @@ double weight(const Word* p) {
 
 // As LinuxCNC's convert_nurbs: the first block of a curve also takes the current point (its
 // weight from a P without X Y); an L above 3 on any block sets the order, lower ones do not.
-void Interpreter::nurbs_point(const Command& c, Vec2 to, SourceLocation at) {
+void Interpreter::nurbs_point(const Command& c, const Axes& to3, SourceLocation at) {
+    if (plane_.normal != kZ) fail(at, "G5.2 needs the XY plane (G17)");
+    const Vec2 to = in_plane(to3, kPlaneXY);
     const Word *x = c.value('X'), *y = c.value('Y'), *p = c.value('P'), *l = c.value('L');
     if (const Word* z = c.value('Z')) fail(z->at, "Z is not allowed with G5.2 (XY plane only)");
     if (p && !(p->value > 0)) fail(p->at, "G5.2 weight P must be positive");
     if (nurbs_.empty()) {
         nurbs_order_ = kDefaultOrder;
-        nurbs_.push_back({position_, x || y ? 1.0 : weight(p)});
+        nurbs_.push_back({in_plane(pos_, kPlaneXY), x || y ? 1.0 : weight(p)});
     } else if (!x && !y) {
         fail(at, "a G5.2 control point needs X and Y (P alone weighs only the start point)");
     }
@@ -39,7 +41,10 @@ void Interpreter::nurbs_point(const Command& c, Vec2 to, SourceLocation at) {
     if (!x && !y) return;
     if (!x || !y) fail(at, "a G5.2 control point needs both X and Y");
     nurbs_.push_back({to, weight(p)});
-    position_ = to;
+    // The curve is drawn at G5.3 from its first point: the position moves on now.
+    nurbs_start_ = nurbs_.size() == 2 ? pos_ : nurbs_start_;
+    pos_[kX] = to.x;
+    pos_[kY] = to.y;
 }
 
 void Interpreter::nurbs_end(SourceLocation at) {
@@ -68,9 +73,10 @@ void Interpreter::nurbs_end(SourceLocation at) {
         for (std::size_t i = 0; i < 4; ++i) piece.p[i] = Vec2{chain[k + i][0], chain[k + i][1]};
         pieces.push_back(piece);
     }
-    const Vec2 end = nurbs_.back().at;
+    const Axes end = pos_;
     nurbs_.clear();
-    follow(pieces, pen_down(z_, z_), end, nurbs_at_);
+    pos_ = nurbs_start_;  // lift() runs from the curve's start
+    follow(lift(pieces, end), pen_down(pos_[kZ], pos_[kZ]), end, nurbs_at_);
 }
 
 }  // namespace pathstream::host::gcode

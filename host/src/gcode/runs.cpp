@@ -9,46 +9,77 @@
 
 namespace pathstream::host::gcode {
 
+PathPoint RunBuilder::point(const Axes& a) const {
+    PathPoint p(path_axes_.size());
+    for (std::size_t k = 0; k < path_axes_.size(); ++k) p[k] = a[path_axes_[k]];
+    return p;
+}
+
 namespace {
-PathPoint point(Vec2 v) {
-    return PathPoint{v.x, v.y};
-}
-
-Vec2 vec(PointRef p) {
-    return {p[0], p[1]};
-}
-
 /// A polyline run as the Bezier chain of its line pieces (a curve is joining it).
 void to_bezier_chain(Subpath& run) {
-    PointList chain(2);
-    chain.reserve(3 * run.points.size(), 2);
+    const std::size_t axes = run.points.axes();
+    PointList chain(axes);
+    chain.reserve(3 * run.points.size(), axes);
     chain.push_back(run.points.front());
+    PathPoint p(axes);
     for (std::size_t i = 1; i < run.points.size(); ++i) {
-        const Cubic line = line_piece(vec(run.points[i - 1]), vec(run.points[i]));
-        for (std::size_t k = 1; k < line.p.size(); ++k) chain.push_back({line.p[k].x, line.p[k].y});
+        for (int third = 1; third <= 3; ++third) {
+            for (std::size_t a = 0; a < axes; ++a) {
+                const double from = run.points[i - 1][a], to = run.points[i][a];
+                p[a] = third == 3 ? to : from + (third / 3.0) * (to - from);
+            }
+            chain.push_back(p);
+        }
     }
     run.points = std::move(chain);
     run.basis = PathBasis::kBezier;
 }
+
+/// Whether the path's coordinates of `piece` are those of a straight piece (the other axes
+/// may move: they are not on the path).
+bool path_line(const PathPoint& p0, const PathPoint& p1, const PathPoint& p2, const PathPoint& p3) {
+    for (std::size_t a = 0; a < p0.size(); ++a) {
+        if (p1[a] != p0[a] + (1.0 / 3.0) * (p3[a] - p0[a]) ||
+            p2[a] != p0[a] + (2.0 / 3.0) * (p3[a] - p0[a])) {
+            return false;
+        }
+    }
+    return true;
+}
 }  // namespace
 
-void RunBuilder::draw(const Cubic& piece, double feed_mm_s, SourceLocation at,
+void RunBuilder::draw(const Piece& piece, double feed_mm_s, SourceLocation at,
                       const std::string& file) {
-    const Vec2 p0 = piece.p[0];
-    if (piece.p[1] == p0 && piece.p[2] == p0 && piece.p[3] == p0) return;  // zero length
+    add(piece, feed_mm_s, false, at, file);
+}
+
+void RunBuilder::travel(const Piece& piece, double feed_mm_s, SourceLocation at,
+                        const std::string& file) {
+    add(piece, feed_mm_s, true, at, file);
+}
+
+void RunBuilder::add(const Piece& piece, double feed_mm_s, bool travel, SourceLocation at,
+                     const std::string& file) {
+    const PathPoint p0 = point(piece.p[0]), p1 = point(piece.p[1]), p2 = point(piece.p[2]),
+                    p3 = point(piece.p[3]);
+    if (p1 == p0 && p2 == p0 && p3 == p0) return;  // zero length on the path's axes
     if (++pieces_ > kMaxPieces) {
         throw InputError(
             file, at,
             "more than " + std::to_string(kMaxPieces) + " curve pieces drawn (the reader's limit)");
     }
-    if (open_ && (done_.back().feed != feed_mm_s || done_.back().corner_mode != corner_mode_ ||
+    if (open_ && (done_.back().travel != travel || done_.back().feed != feed_mm_s ||
+                  done_.back().corner_mode != corner_mode_ ||
                   done_.back().blend_tolerance != blend_tolerance_)) {
         close_run();  // one feed and one path control mode per subpath
     }
+    const bool line = path_line(p0, p1, p2, p3);
     if (!open_) {
         Subpath sp;
-        sp.basis = is_line_piece(piece) ? PathBasis::kPolyline : PathBasis::kBezier;
+        sp.basis = line ? PathBasis::kPolyline : PathBasis::kBezier;
         sp.closed = false;
+        sp.travel = travel;
         sp.feed = feed_mm_s;
         sp.location = at;
         sp.pause_before = pause_next_;
@@ -59,21 +90,24 @@ void RunBuilder::draw(const Cubic& piece, double feed_mm_s, SourceLocation at,
         pause_next_ = false;
         dwell_next_ = 0;
         dwell_pen_down_ = false;
-        sp.points.push_back(point(p0));
+        sp.points = PointList(path_axes_.size());
+        sp.points.push_back(p0);
         done_.push_back(std::move(sp));
         open_ = true;
-    } else if (done_.back().points.back() != point(p0)) {
+    } else if (done_.back().points.back() != p0) {
         throw std::logic_error("RunBuilder::draw: piece does not start where the run ends");
     }
     Subpath& run = done_.back();
     // One curve segment per piece, as a polyline and as a Bezier chain alike.
     run.segment_lines.push_back(static_cast<std::uint32_t>(at.line));
-    if (run.basis == PathBasis::kPolyline && is_line_piece(piece)) {
-        run.points.push_back(point(piece.p[3]));  // the planner makes the same cubic of it
+    if (run.basis == PathBasis::kPolyline && line) {
+        run.points.push_back(p3);  // the planner makes the same cubic of it
         return;
     }
     if (run.basis == PathBasis::kPolyline) to_bezier_chain(run);
-    for (std::size_t k = 1; k < piece.p.size(); ++k) run.points.push_back(point(piece.p[k]));
+    run.points.push_back(p1);
+    run.points.push_back(p2);
+    run.points.push_back(p3);
 }
 
 void RunBuilder::end_block() {

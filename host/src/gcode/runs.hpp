@@ -1,18 +1,22 @@
-// Collects the pieces of pen-down moves into subpaths: one open subpath per maximal run of
-// pen-down moves with one feed and one path control mode, a polyline while the run has only
-// line pieces, else a Bezier chain.
+// Collects the pieces of moves into subpaths: one open subpath per maximal run of pen-down
+// moves with one feed and one path control mode (and, on a machine, per run of rapids: a
+// travel subpath), a polyline while the run has only line pieces, else a Bezier chain.
 #pragma once
 
 #include <string>
 #include <vector>
 
+#include "axes.hpp"
 #include "pathstream/host/path.hpp"
-#include "vec2.hpp"
 
 namespace pathstream::host::gcode {
 
 class RunBuilder {
 public:
+    /// `path_axes`: the G-code axis index of each path axis, in path order ({kX, kY} for a
+    /// plotter, {kX, kY, kZ} for a router).
+    explicit RunBuilder(std::vector<std::size_t> path_axes) : path_axes_(std::move(path_axes)) {}
+
     /// At most this many pieces in all: bounds the memory a hostile program can take.
     static constexpr std::size_t kMaxPieces = 2'000'000;
 
@@ -20,7 +24,9 @@ public:
     /// four points are all equal is dropped. The piece starts a new subpath (located at `at`)
     /// when no run is open or when the open run has a different feed; otherwise it must start
     /// where the run ends. Throws InputError at `at` (naming `file`) past kMaxPieces.
-    void draw(const Cubic& piece, double feed_mm_s, SourceLocation at, const std::string& file);
+    void draw(const Piece& piece, double feed_mm_s, SourceLocation at, const std::string& file);
+    /// As draw, for a rapid: the piece joins (or starts) a travel run (Subpath::travel).
+    void travel(const Piece& piece, double feed_mm_s, SourceLocation at, const std::string& file);
 
     /// Ends the open run, if any (pen up).
     void lift();
@@ -45,11 +51,16 @@ public:
     /// Pieces drawn so far.
     std::size_t pieces() const { return pieces_; }
 
-    /// The subpaths drawn so far (open, 2 axes; kPolyline of the piece ends where every piece
-    /// is line_piece of its ends, else kBezier with 3k + 1 points); ends the open run.
+    /// The subpaths drawn so far (open, path_axes coordinates; kPolyline of the piece ends where
+    /// every piece is line_piece of its ends, else kBezier with 3k + 1 points); ends the open run.
     std::vector<Subpath> finish();
 
 private:
+    void add(const Piece& piece, double feed_mm_s, bool travel, SourceLocation at,
+             const std::string& file);
+    PathPoint point(const Axes& a) const;
+
+    std::vector<std::size_t> path_axes_;
     std::vector<Subpath> done_;
     bool open_ = false;
     bool pause_next_ = false;

@@ -1,6 +1,7 @@
 // Loading a request's path: read by format, placed, split by layer, ordered.
 #include "pathstream/host/job_request.hpp"
 
+#include <cctype>
 #include <charconv>
 #include <cmath>
 #include <stdexcept>
@@ -34,10 +35,36 @@ std::vector<double> parse_numbers(const std::string& text, const std::string& op
 
 }  // namespace
 
-LoadedPath load_path_report(const JobRequest& o, const MachineProfile* machine,
+/// The G-code axis letters of a machine's axes ("XYZ" for axes named x, y, z), or "" when
+/// its names are not all G-code axis letters with x and y among them.
+std::string gcode_axes(const MachineProfile& machine) {
+    std::string letters;
+    for (const AxisLimits& a : machine.axes) {
+        if (a.name.size() != 1) return "";
+        const char c = static_cast<char>(std::toupper(static_cast<unsigned char>(a.name[0])));
+        if (std::string("XYZABCUVW").find(c) == std::string::npos ||
+            letters.find(c) != std::string::npos)
+            return "";
+        letters += c;
+    }
+    if (letters.find('X') == std::string::npos || letters.find('Y') == std::string::npos) return "";
+    return letters;
+}
+
+LoadedPath load_path_report(const JobRequest& request, const MachineProfile* machine,
                             const std::vector<double>* start) {
     LoadedPath loaded;
     std::string format;
+    JobRequest o = request;
+    if (machine != nullptr && o.gcode_axes.empty()) {
+        // A G-code program's axes are the machine's, by name; a machine whose names are no
+        // axis letters reads X Y (a plotter's two axes).
+        o.gcode_axes = gcode_axes(*machine);
+        if (o.gcode_axes.empty()) o.gcode_axes = "XY";
+        double fastest = 0;
+        for (const AxisLimits& a : machine->axes) fastest += a.max_velocity * a.max_velocity;
+        o.gcode_rapid_feed = std::sqrt(fastest);
+    }
     Path path = read_request_path(o, loaded.gcode_pen, format);
     PlacementOptions placement = o.placement;
     if (machine != nullptr)
@@ -67,6 +94,13 @@ LoadedPath load_path_report(const JobRequest& o, const MachineProfile* machine,
         loaded.kept_order_because = "this command keeps the file's order; --order to reorder";
     }
     if (loaded.kept_order_because.empty()) {
+        for (const Subpath& s : path.subpaths) {
+            if (s.travel) {
+                throw std::invalid_argument(
+                    "--order: this program's rapids are the machine's own moves (--gcode-pen "
+                    "machine): its order is the machinist's and stays");
+            }
+        }
         OrderOptions order;
         order.merge_tolerance = o.merge_tolerance;
         if (!o.order_start.empty()) {

@@ -28,10 +28,16 @@ PathBasis basis_from_name(const std::string& name) {
 /// The G-code reader's options from the command line's.
 GcodeOptions gcode_options(const JobRequest& o) {
     GcodeOptions g;
-    g.pen = o.gcode_pen == "spindle"  ? PenControl::kSpindle
-            : o.gcode_pen == "motion" ? PenControl::kMotion
-            : o.gcode_pen == "auto"   ? PenControl::kAuto
-                                      : PenControl::kZ;
+    if (!o.gcode_axes.empty()) g.axes = o.gcode_axes;
+    const bool z_axis = g.axes.find('Z') != std::string::npos;
+    g.pen = o.gcode_pen == "spindle"        ? PenControl::kSpindle
+            : o.gcode_pen == "motion"       ? PenControl::kMotion
+            : o.gcode_pen == "auto"         ? PenControl::kAuto
+            : o.gcode_pen == "machine"      ? PenControl::kMachine
+            : o.gcode_pen.empty() && z_axis ? PenControl::kMachine
+                                            : PenControl::kZ;
+    g.rapid_feed = o.gcode_rapid_feed;
+    g.tool_table = o.gcode_tool_table;
     g.z_down_max = o.gcode_z_down;
     g.arc_tolerance_mm = o.tolerance;
     g.ignore_codes = o.gcode_ignore;

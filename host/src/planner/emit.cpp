@@ -132,8 +132,9 @@ void SpanEmitter::pen(bool down, std::size_t subpath, bool last) {
     pen_ = down;
 }
 
-// Before a subpath's pen goes down: its programmed pause (the device holds at the end of the
-// last span, which must be a still pen-up one) and its pen-up rest.
+// Before a subpath's pen goes down (or a routed travel starts): its programmed pause (the
+// device holds at the end of the last span, which must be a still pen-up one) and its pen-up
+// rest.
 void SpanEmitter::before_pen_down(const Run& run) {
     if (run.pause_before) {
         // The pause follows a still pen-up span, held back so that it can be marked.
@@ -156,8 +157,19 @@ void SpanEmitter::begin_run(const Run& run) {
     in_run_ = true;
     run_pen_down_ = run.pen_down;
     run_subpath_ = run.subpath;
-    if (run.pen_down && !pen_) before_pen_down(run);
-    if (run.pen_down != pen_) pen(run.pen_down, run.subpath, false);
+    if (!run.pen_down) {
+        // A travel subpath the file routes (G-code rapids): a dwell with the pen down happens
+        // before the lift; its pause and a pen-up dwell after it, where the machine rests.
+        const bool dwell_down = run.dwell_before > 0 && run.dwell_pen_down && pen_;
+        if (dwell_down) dwell(delay_ticks(run.dwell_before, profile_.tick_hz), run.subpath, true);
+        if (pen_) pen(false, run.subpath, false);
+        before_pen_down(run);  // the pause, and the dwell when it was asked with the pen up
+        if (run.dwell_before > 0 && run.dwell_pen_down && !dwell_down)
+            dwell(delay_ticks(run.dwell_before, profile_.tick_hz), run.subpath, false);
+        return;
+    }
+    if (!pen_) before_pen_down(run);
+    if (!pen_) pen(true, run.subpath, false);
     if (run.pen_down && run.dwell_before > 0 && run.dwell_pen_down) {
         dwell(delay_ticks(run.dwell_before, profile_.tick_hz), run.subpath, true);
     }

@@ -99,7 +99,8 @@ std::vector<std::string> path_arguments(const nlohmann::json& options) {
         } else if (key == "pause") {
             args.push_back("--pause=" + text_value(v, key, {"pen", "layer", "none"}));
         } else if (key == "gcode_pen") {
-            args.push_back("--gcode-pen=" + text_value(v, key, {"z", "spindle", "motion", "auto"}));
+            args.push_back("--gcode-pen=" +
+                           text_value(v, key, {"z", "spindle", "motion", "machine", "auto"}));
         } else if (key == "csv_basis") {
             args.push_back("--csv-basis=" +
                            text_value(v, key, {"bspline", "catmull-rom", "bezier", "polyline"}));

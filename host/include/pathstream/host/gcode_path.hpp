@@ -15,6 +15,11 @@ enum class PenControl {
     kSpindle,  ///< down during feed moves made between M3 (or M4) and M5
     kMotion,   ///< down during every feed move: G1 draws, G0 travels (files with no pen codes)
     kAuto,     ///< one of the above, chosen from what the program does (GcodeReadInfo says why)
+    /// A machine, not a pen: every move is made in the program's order, feed moves (G1 G2 G3
+    /// G5 ...) as drawn subpaths, rapids (G0, G28, G30, canned cycle retracts) as travel
+    /// subpaths (Subpath::travel) with every waypoint kept. Z is a motion axis when `axes` has
+    /// it. The only mode for a machine with a Z axis; kAuto picks it there.
+    kMachine,
 };
 
 /// "z", "spindle", "motion", "auto": the name the CLI uses.
@@ -28,6 +33,16 @@ struct GcodeOptions {
     /// G and M codes skipped with a warning, besides the default ones (M6, M7, ...):
     /// "M300", "G43", "m05" (case and leading zeros do not matter).
     std::vector<std::string> ignore_codes;
+    /// The path's axes by G-code letter, in the machine profile's order: "XY" (a plotter: Z
+    /// is the pen signal), "XYZ" (a router), "XYZA". Letters from XYZABCUVW, each once, X and Y
+    /// among them. Axis words of letters not here are an error (Z: the pen signal).
+    std::string axes = "XY";
+    /// mm/s: the feed of rapids (G0) in kMachine mode, as high as the machine's axes allow so
+    /// that each axis's own limit governs (the profile's fastest straight move); 0: the
+    /// profile's travel_feed.
+    double rapid_feed = 0;
+    /// A LinuxCNC tool table file (G43 H reads it); empty: none (G43 H then fails).
+    std::string tool_table;
 };
 
 /// What a read found beside the path.
@@ -39,17 +54,17 @@ struct GcodeReadInfo {
     std::vector<std::string> warnings;
 };
 
-/// Parses a G-code program into a 2-axis path (X, Y in mm): one subpath (basis kBezier, open,
-/// points P0 C C P1 C C ... of 3k + 1) per maximal run of pen-down moves with one feed and one
-/// path control mode (G61, G61.1, G64 [P]: Subpath::corner_mode, blend_tolerance, stops); G0 and
-/// pen-up moves are travel between subpaths. Subpath::feed is the F word in mm/s (0 until the
-/// program gives F). `file` names the source in error messages.
-/// Throws InputError ("file:line:col: what is wrong") at the offending word for syntax errors,
-/// unsupported words and codes, missing or repeated words, out-of-range numbers (> 1e6 mm) and
-/// impossible arcs; and ("file: no pen-down moves ...") when nothing is drawn.
-/// Runs parameters, expressions and O-word control flow as LinuxCNC does, within budgets.
-/// Throws std::invalid_argument when `options` is out of range (also an ignore_codes entry
-/// that is no G or M code). When `info` is given it receives the pen mode and the warnings.
+/// Parses a G-code program into a path of options.axes (X, Y in mm for a plotter): one subpath
+/// (basis kBezier, open, points P0 C C P1 C C ... of 3k + 1) per maximal run of pen-down moves with
+/// one feed and one path control mode (G61, G61.1, G64 [P]: Subpath::corner_mode, blend_tolerance,
+/// stops); G0 and pen-up moves are travel between subpaths. Subpath::feed is the F word in mm/s (0
+/// until the program gives F). `file` names the source in error messages. Throws InputError
+/// ("file:line:col: what is wrong") at the offending word for syntax errors, unsupported words and
+/// codes, missing or repeated words, out-of-range numbers (> 1e6 mm) and impossible arcs; and
+/// ("file: no pen-down moves ...") when nothing is drawn. Runs parameters, expressions and O-word
+/// control flow as LinuxCNC does, within budgets. Throws std::invalid_argument when `options` is
+/// out of range (also an ignore_codes entry that is no G or M code). When `info` is given it
+/// receives the pen mode and the warnings.
 Path parse_gcode_path(const std::string& text, const std::string& file,
                       const GcodeOptions& options = {}, GcodeReadInfo* info = nullptr);
 

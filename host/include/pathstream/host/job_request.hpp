@@ -20,8 +20,16 @@ struct JobRequest {
     std::string format;                 ///< --format: json, csv, svg or gcode; empty: by extension
     std::string csv_basis = "bspline";  ///< basis for CSV point files
     bool csv_closed = false;
-    std::string gcode_pen = "z";  ///< "z", "spindle" (M3/M5), "motion" (G1 draws) or "auto"
-    double gcode_z_down = 0.0;    ///< pen down when Z <= this (mm)
+    /// "z", "spindle" (M3/M5), "motion" (G1 draws), "machine" (every move in order, Z an axis
+    /// when the machine has one) or "auto"; "": z on a machine without a Z axis, else machine.
+    std::string gcode_pen;
+    /// The path's axes as G-code letters ("XY", "XYZ"): set from the machine profile's axis
+    /// names by load_path_report; empty: "XY".
+    std::string gcode_axes;
+    double gcode_rapid_feed =
+        0;  ///< mm/s for G0 in machine mode (set from the profile); 0: travel_feed
+    std::string gcode_tool_table;           ///< --tool-table: LinuxCNC tool table for G43 H
+    double gcode_z_down = 0.0;              ///< pen down when Z <= this (mm)
     std::vector<std::string> gcode_ignore;  ///< --ignore-code: more G/M codes to skip
     double tolerance = 0.01;                ///< mm, arcs to cubics (SVG, G-code)
     PlacementOptions placement;  ///< --rotate, --flip-y, --scale, --fit, ... (placement.hpp)

@@ -27,7 +27,7 @@ enum class CornerMode {
     kExactStop,  ///< also come to rest at the joints in Subpath::stops (G61.1: each block's end)
 };
 
-/// A connected piece of the path, drawn pen-down.
+/// A connected piece of the path, drawn pen-down (or, when `travel`, moved along pen-up).
 struct Subpath {
     PathBasis basis = PathBasis::kBSpline;
     bool closed = false;
@@ -56,6 +56,10 @@ struct Subpath {
     /// error names the move, not the subpath's first line. Empty from the other readers, and
     /// after an order step that rotates or joins the subpath (reversing keeps them).
     std::vector<std::uint32_t> segment_lines{};
+    /// A pen-up move whose route the file gives (G-code rapids on a machine: G0 waypoints, a
+    /// canned cycle's retracts): planned along its points with the pen up, at `feed` (0: the
+    /// profile's travel_feed); never reordered, reversed or joined. False: drawn pen-down.
+    bool travel = false;
 };
 
 /// Curve segments of a polyline or Bezier chain: the joints Subpath::stops counts lie between

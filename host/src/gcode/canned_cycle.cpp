@@ -1,0 +1,151 @@
+// Canned cycles G73, G81, G82, G83, G85, G86, G89 with G98/G99 and L repeats, as LinuxCNC
+// runs them (docs/formats-gcode.md, "Canned cycles"): expanded into the rapids and feed moves
+// they stand for, the drill axis being the plane's normal (Z under G17).
+#include <algorithm>
+#include <cmath>
+
+#include "interpreter.hpp"
+
+namespace pathstream::host::gcode {
+
+namespace {
+// LinuxCNC's G83 rapid-down clearance above the last peck and G73's chip-break retract
+// (G83_RAPID_DELTA and G73_RETRACT: 0.010 inch).
+constexpr double kPeckClearanceMm = 0.254;
+constexpr double kChipBreakRetractMm = 0.254;
+constexpr long kMaxRepeats = 100000;
+
+const char* cycle_name(Motion m) {
+    switch (m) {
+        case Motion::kPeckChipBreak:
+            return "G73";
+        case Motion::kDrill:
+            return "G81";
+        case Motion::kDrillDwell:
+            return "G82";
+        case Motion::kPeck:
+            return "G83";
+        case Motion::kBore:
+            return "G85";
+        case Motion::kBoreSpindleStop:
+            return "G86";
+        default:
+            return "G89";
+    }
+}
+}  // namespace
+
+void Interpreter::canned_cycle(const Command& c, Motion cycle, SourceLocation at) {
+    const char* name = cycle_name(cycle);
+    if (!machine()) {
+        fail(at, std::string(name) +
+                     ": canned cycles need a machine whose moves keep their order "
+                     "(--gcode-pen machine, the default on a machine with a Z axis)");
+    }
+    const std::size_t drill = plane_.normal;
+    const char drill_letter = kAxisLetters[drill];
+    if (!on_path(drill)) {
+        fail(at, std::string(name) + " drills along " + drill_letter +
+                     ", which is not one of this machine's axes (" + options_.axes + ")");
+    }
+    if (c.polar_distance || c.polar_angle) fail(at, "polar coordinates with a canned cycle");
+    // Sticky words: R, the bottom, Q and P stay from the cycle's earlier blocks.
+    const double initial = pos_[drill];
+    const Word* r = c.value('R');
+    const Word* bottom_word = c.value(drill_letter);
+    if (r) {
+        cycle_r_ = incremental_ ? initial + length(*r) : length(*r) + offset(drill);
+        cycle_r_known_ = true;
+    } else if (!cycle_r_known_) {
+        fail(at, std::string(name) + " needs R (the retract plane)");
+    }
+    if (bottom_word) {
+        cycle_z_ =
+            incremental_ ? cycle_r_ + length(*bottom_word) : length(*bottom_word) + offset(drill);
+        cycle_z_known_ = true;
+    } else if (!cycle_z_known_) {
+        fail(at, std::string(name) + " needs " + drill_letter + " (the bottom of the hole)");
+    }
+    if (cycle_z_ > cycle_r_) {
+        fail(bottom_word ? bottom_word->at : at,
+             std::string(name) + ": the bottom " + drill_letter + " is above the retract plane R");
+    }
+    if (cycle == Motion::kPeck || cycle == Motion::kPeckChipBreak) {
+        if (const Word* q = c.value('Q')) {
+            if (!(q->value > 0)) fail(q->at, std::string(name) + " peck depth Q must be positive");
+            cycle_q_ = length(*q);
+        } else if (!(cycle_q_ > 0)) {
+            fail(at, std::string(name) + " needs Q (the peck depth)");
+        }
+    }
+    if (const Word* p = c.value('P')) {
+        if (p->value < 0) fail(p->at, std::string(name) + " dwell P must not be negative");
+        cycle_p_ = p->value;
+    }
+    long repeats = 1;
+    if (const Word* l = c.value('L')) {
+        if (l->value != std::floor(l->value) || l->value < 0 || l->value > kMaxRepeats) {
+            fail(l->at,
+                 "L (repeats) must be a whole number from 0 to " + std::to_string(kMaxRepeats));
+        }
+        repeats = static_cast<long>(l->value);
+    }
+    // The cycle's own words are not position words: targets() must not read the drill axis.
+    Command position = c;
+    position.values[static_cast<std::size_t>(drill_letter - 'A')].reset();
+    const double clear = retract_to_r_ ? cycle_r_ : std::max(initial, cycle_r_);
+
+    auto to = [&](double depth) {
+        Axes p = pos_;
+        p[drill] = depth;
+        return p;
+    };
+    auto dwell = [&] {
+        if (cycle_p_ <= 0) return;
+        runs_.lift();
+        runs_.dwell_next(cycle_p_, pen_down_now());
+    };
+    // Preliminary motion: up to R first when below it.
+    if (pos_[drill] < cycle_r_) travel(to(cycle_r_), at);
+    for (long k = 0; k < repeats; ++k) {
+        Axes hole = targets(position, false);
+        hole[drill] = pos_[drill];
+        travel(hole, at);
+        travel(to(cycle_r_), at);
+        switch (cycle) {
+            case Motion::kPeck:
+            case Motion::kPeckChipBreak: {
+                double depth = cycle_r_;
+                while (depth > cycle_z_) {
+                    const double next = std::max(depth - cycle_q_, cycle_z_);
+                    line(to(next), at);
+                    depth = next;
+                    if (depth <= cycle_z_) break;
+                    if (cycle == Motion::kPeck) {
+                        travel(to(cycle_r_), at);
+                        travel(to(std::min(depth + kPeckClearanceMm, cycle_r_)), at);
+                    } else {
+                        travel(to(std::min(depth + kChipBreakRetractMm, cycle_r_)), at);
+                    }
+                }
+                travel(to(clear), at);
+                break;
+            }
+            case Motion::kBore:
+            case Motion::kBoreDwell:
+                line(to(cycle_z_), at);
+                if (cycle == Motion::kBoreDwell) dwell();
+                line(to(cycle_r_), at);
+                if (clear > cycle_r_) travel(to(clear), at);
+                break;
+            default:  // G81, G82, G86 (the spindle's stop and restart are outputs)
+                line(to(cycle_z_), at);
+                if (cycle == Motion::kDrillDwell) dwell();
+                travel(to(clear), at);
+                break;
+        }
+    }
+    if (on_path(kZ) || drill == kZ) z_known_ = true;
+}
+
+}  // namespace pathstream::host::gcode
