@@ -1,0 +1,303 @@
+// The G-code reader on a machine (axes X Y Z, --gcode-pen machine): moves in the program's
+// order with rapids as routed travel, planes and helices, canned cycles, offsets and the tool
+// table, polar coordinates, checksums, feed modes; each against hand-computed moves.
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <fstream>
+#include <numbers>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "pathstream/host/gcode_path.hpp"
+#include "pathstream/machine/input_error.hpp"
+
+using namespace pathstream::host;
+
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+
+GcodeOptions router(const std::string& axes = "XYZ") {
+    GcodeOptions o;
+    o.axes = axes;
+    o.pen = PenControl::kMachine;
+    o.rapid_feed = 150;
+    return o;
+}
+
+Path gcode(const std::string& text, const GcodeOptions& options = router()) {
+    return parse_gcode_path(text, "t.ngc", options);
+}
+
+std::string error_of(const std::string& text, const GcodeOptions& options = router()) {
+    try {
+        gcode(text, options);
+    } catch (const InputError& e) {
+        return e.what();
+    }
+    return "no error";
+}
+
+/// A move's end point, and whether it was a rapid (travel) or a feed move.
+struct Waypoint {
+    bool travel;
+    std::vector<double> at;
+};
+
+/// The end point of every curve segment, in order.
+std::vector<Waypoint> waypoints(const Path& path) {
+    std::vector<Waypoint> out;
+    for (const Subpath& s : path.subpaths) {
+        const std::size_t step = s.basis == PathBasis::kBezier ? 3 : 1;
+        for (std::size_t i = step; i < s.points.size(); i += step)
+            out.push_back({s.travel, s.points[i].vector()});
+    }
+    return out;
+}
+
+void check_waypoints(const Path& path, const std::vector<Waypoint>& expected) {
+    const std::vector<Waypoint> got = waypoints(path);
+    REQUIRE(got.size() == expected.size());
+    for (std::size_t i = 0; i < got.size(); ++i) {
+        INFO("waypoint " << i);
+        CHECK(got[i].travel == expected[i].travel);
+        REQUIRE(got[i].at.size() == expected[i].at.size());
+        for (std::size_t a = 0; a < got[i].at.size(); ++a)
+            CHECK(got[i].at[a] == Approx(expected[i].at[a]).margin(1e-9));
+    }
+}
+
+std::vector<double> bezier(const Subpath& s, std::size_t piece, double t) {
+    const double u = 1 - t;
+    std::vector<double> p(s.points.axes());
+    for (std::size_t a = 0; a < p.size(); ++a) {
+        p[a] = u * u * u * s.points[3 * piece][a] + 3 * u * u * t * s.points[3 * piece + 1][a] +
+               3 * u * t * t * s.points[3 * piece + 2][a] + t * t * t * s.points[3 * piece + 3][a];
+    }
+    return p;
+}
+
+constexpr bool T = true, D = false;
+
+}  // namespace
+
+TEST_CASE("G-code machine: Z is an axis and rapids keep their waypoints", "[gcode][machine]") {
+    const Path p = gcode("G21 G90\nG0 Z5\nG0 X10 Y10\nG1 Z-1 F600\nG1 X20\nG0 Z5\nM2\n");
+    CHECK(p.axes == 3);
+    check_waypoints(
+        p,
+        {{T, {0, 0, 5}}, {T, {10, 10, 5}}, {D, {10, 10, -1}}, {D, {20, 10, -1}}, {T, {20, 10, 5}}});
+    REQUIRE(p.subpaths.size() == 3);
+    CHECK(p.subpaths[0].feed == 150);  // rapids: GcodeOptions::rapid_feed
+    CHECK(p.subpaths[1].feed == 10);   // F600 mm/min
+    // A plotter reads the same program with Z as its pen: only the feed move at Z-1 draws.
+    const Path plot = gcode("G21 G90\nG0 Z5\nG0 X10 Y10\nG1 Z-1 F600\nG1 X20\nG0 Z5\nM2\n", {});
+    CHECK(plot.axes == 2);
+    check_waypoints(plot, {{D, {20, 10}}});
+}
+
+TEST_CASE("G-code machine: helical arcs stay on the helix", "[gcode][machine]") {
+    // Three turns of radius 10 about the origin, falling 6 mm, then a flat turn.
+    const Path p = gcode("G0 X10 Y0 Z0\nG3 X10 Y0 I-10 J0 Z-6 P3 F600\n");
+    REQUIRE(p.subpaths.size() == 2);
+    const Subpath& helix = p.subpaths[1];
+    REQUIRE(helix.basis == PathBasis::kBezier);
+    const std::size_t pieces = (helix.points.size() - 1) / 3;
+    CHECK(pieces >= 12);
+    CHECK(helix.points[helix.points.size() - 1].vector() == std::vector<double>{10, 0, -6});
+    double turned = 0, last_angle = 0, worst = 0;
+    for (std::size_t k = 0; k < pieces; ++k) {
+        for (int j = 0; j <= 16; ++j) {
+            const std::vector<double> q = bezier(helix, k, j / 16.0);
+            const double angle = std::atan2(q[1], q[0]);
+            turned += std::remainder(angle - last_angle, 2 * kPi);
+            last_angle = angle;
+            const double z = -6 * turned / (6 * kPi);
+            worst = std::max(worst, std::hypot(std::hypot(q[0], q[1]) - 10, q[2] - z));
+        }
+    }
+    CHECK(turned == Approx(6 * kPi));
+    CHECK(worst <= 0.01);  // the arc tolerance
+}
+
+TEST_CASE("G-code machine: G18 and G19 arcs turn as LinuxCNC's", "[gcode][machine]") {
+    // G18: the plane is Z X (K I offsets); G2 is clockwise seen from +Y, so from X10 Z0 about
+    // the origin to X0 Z10 it is the quarter through X7.07 Z7.07.
+    const Path zx = gcode("G0 X10 Y0 Z0\nG18 G2 X0 Z10 I-10 K0 F600\n");
+    const std::vector<double> mid = bezier(zx.subpaths[1], 0, 0.5);
+    CHECK(mid[0] == Approx(10 * std::sqrt(0.5)).margin(0.01));
+    CHECK(mid[2] == Approx(10 * std::sqrt(0.5)).margin(0.01));
+    CHECK(mid[1] == 0);
+    // G19: the plane is Y Z (J K); G3 from Y10 Z0 about the origin to Y0 Z10 is the quarter.
+    const Path yz = gcode("G0 X0 Y10 Z0\nG19 G3 Y0 Z10 J-10 K0 F600\n");
+    const std::vector<double> mid2 = bezier(yz.subpaths[1], 0, 0.5);
+    CHECK(mid2[1] == Approx(10 * std::sqrt(0.5)).margin(0.01));
+    CHECK(mid2[2] == Approx(10 * std::sqrt(0.5)).margin(0.01));
+    CHECK(error_of("G0 X10\nG18 G2 X0 Z10 J1 K0 F600") ==
+          "t.ngc:2:15: J is no center offset of a G18 arc (it takes K and I)");
+}
+
+TEST_CASE("G-code machine: G81 with G99 and L repeats in G91", "[gcode][machine][cycle]") {
+    // R = 10 - 8 = 2 and the bottom 2 - 5 = -3 (G91: R from the initial Z, Z from R).
+    const Path p = gcode("G0 X0 Y0 Z10\nG91 G99 G81 X10 Y0 Z-5 R-8 L3 F600\n");
+    check_waypoints(p, {{T, {0, 0, 10}},
+                        {T, {10, 0, 10}},
+                        {T, {10, 0, 2}},
+                        {D, {10, 0, -3}},
+                        {T, {10, 0, 2}},
+                        {T, {20, 0, 2}},
+                        {D, {20, 0, -3}},
+                        {T, {20, 0, 2}},
+                        {T, {30, 0, 2}},
+                        {D, {30, 0, -3}},
+                        {T, {30, 0, 2}}});
+}
+
+TEST_CASE("G-code machine: G83 pecks and G98 returns to the initial Z", "[gcode][machine][cycle]") {
+    const Path p = gcode("G0 X0 Y0 Z10\nG98 G83 X5 Y5 Z-5 R2 Q3 F600\nG80\n");
+    // Pecks of 3 from R2: -1, -4, -5; between them up to R and back down to 0.254 mm above.
+    check_waypoints(p, {{T, {0, 0, 10}},
+                        {T, {5, 5, 10}},
+                        {T, {5, 5, 2}},
+                        {D, {5, 5, -1}},
+                        {T, {5, 5, 2}},
+                        {T, {5, 5, -0.746}},
+                        {D, {5, 5, -4}},
+                        {T, {5, 5, 2}},
+                        {T, {5, 5, -3.746}},
+                        {D, {5, 5, -5}},
+                        {T, {5, 5, 10}}});
+    // G73 breaks the chip with a 0.254 mm rapid up; G82 dwells at the bottom.
+    const Path chip = gcode("G0 X0 Y0 Z2\nG99 G73 X0 Y0 Z-5 R2 Q3 F600\n");
+    check_waypoints(chip, {{T, {0, 0, 2}},
+                           {D, {0, 0, -1}},
+                           {T, {0, 0, -0.746}},
+                           {D, {0, 0, -4}},
+                           {T, {0, 0, -3.746}},
+                           {D, {0, 0, -5}},
+                           {T, {0, 0, 2}}});
+    const Path dwell = gcode("G0 Z5\nG82 X1 Y1 Z-1 R1 P0.5 F600\n");
+    REQUIRE(dwell.subpaths.size() == 3);
+    CHECK(dwell.subpaths[2].travel);
+    CHECK(dwell.subpaths[2].dwell_before == 0.5);
+    // Sticky R and Z: the next block drills the next hole the same way.
+    check_waypoints(gcode("G0 Z5\nG81 X1 Y1 Z-1 R1 F600\nX2\n"), {{T, {0, 0, 5}},
+                                                                  {T, {1, 1, 5}},
+                                                                  {T, {1, 1, 1}},
+                                                                  {D, {1, 1, -1}},
+                                                                  {T, {1, 1, 5}},
+                                                                  {T, {2, 1, 5}},
+                                                                  {T, {2, 1, 1}},
+                                                                  {D, {2, 1, -1}},
+                                                                  {T, {2, 1, 5}}});
+    CHECK(error_of("G0 Z5\nG81 X1 Y1 Z2 R1 F600") ==
+          "t.ngc:2:11: G81: the bottom Z is above the retract plane R");
+    CHECK(error_of("G0 Z5\nG83 X1 Y1 Z-2 R1 F600") == "t.ngc:2:1: G83 needs Q (the peck depth)");
+    CHECK(error_of("G0 Z5\nG81 X1 Y1 Z-2 F600") == "t.ngc:2:1: G81 needs R (the retract plane)");
+    CHECK(error_of("G84 X1 Y1 Z-2 R1") ==
+          "t.ngc:1:1: G84 (tapping) needs a spindle whose turning the axes follow; this "
+          "machine's spindle is an output");
+}
+
+TEST_CASE("G-code machine: coordinate systems, G92 and tool length offsets", "[gcode][machine]") {
+    const std::string table_file = "gcode_machine_tools.tbl";
+    std::ofstream(table_file) << "; tools\nT1 P1 Z25 D6 ; end mill\nT2 P2 Z-1.5\n";
+    GcodeOptions o = router();
+    o.tool_table = table_file;
+    const Path p = gcode(
+        "G10 L2 P1 X100 Y50 Z-20\n"
+        "G54 G0 X0 Y0 Z0\n"              // (100, 50, -20)
+        "G10 L20 P2 X0 Y0 Z0\n"          // G55's origin is here
+        "G55 G0 X1\n"                    // (101, 50, -20)
+        "G92 X0\n"                       // this point is X0 now
+        "G0 X5\n"                        // (106, 50, -20)
+        "G92.1 G0 X5\n"                  // (105, 50, -20)
+        "G43 H1 G0 Z0\n"                 // (105, 50, 5)
+        "G43.1 Z3\nG0 Z0\n"              // (105, 50, -17)
+        "G49 G0 Z0\n"                    // (105, 50, -20)
+        "G91 G10 L2 P2 X1\nG90 G0 X0\n"  // G55's X moves 1: (101, 50, -20)
+        "G1 X1 F60\n",
+        o);
+    check_waypoints(p, {{T, {100, 50, -20}},
+                        {T, {101, 50, -20}},
+                        {T, {106, 50, -20}},
+                        {T, {105, 50, -20}},
+                        {T, {105, 50, 5}},
+                        {T, {105, 50, -17}},
+                        {T, {105, 50, -20}},
+                        {T, {101, 50, -20}},
+                        {D, {102, 50, -20}}});
+    CHECK(error_of("G43 H9 G0 Z0\nG1 X1 F60", o) ==
+          "t.ngc:1:5: G43 H9: tool 9 is not in the tool table gcode_machine_tools.tbl");
+    CHECK(error_of("G43 H1\nG1 X1 F60") ==
+          "t.ngc:1:5: G43 H1: no tool table (give one with --tool-table)");
+    CHECK(error_of("G10 L1 P1 Z3\n") ==
+          "t.ngc:1:5: G10 L1 edits the tool table: edit the tool table file instead");
+    CHECK(error_of("G10 L2 P10 X1\n") ==
+          "t.ngc:1:8: G10 L2 needs P from 0 (the current system) to 9 (G59.3)");
+}
+
+TEST_CASE("G-code machine: the tool table's errors name the line", "[gcode][machine]") {
+    auto table_error = [](const std::string& text) {
+        std::ofstream("gcode_machine_bad.tbl") << text;
+        GcodeOptions o = router();
+        o.tool_table = "gcode_machine_bad.tbl";
+        try {
+            gcode("G1 X1 F60", o);
+        } catch (const InputError& e) {
+            return std::string(e.what());
+        }
+        return std::string("no error");
+    };
+    CHECK(table_error("T1 P1 Z1\nP2 Z3\n") ==
+          "gcode_machine_bad.tbl:2:1: tool line without T (the tool number)");
+    CHECK(table_error("T1 Z1\nT1 Z2\n") == "gcode_machine_bad.tbl:2:1: tool T1 is given twice");
+    CHECK(table_error("T1 E2\n") ==
+          "gcode_machine_bad.tbl:1:4: unknown tool table word E (T P X Y Z A B C U V W D I J Q)");
+    CHECK(table_error("T1.5\n") == "gcode_machine_bad.tbl:1:1: T must be a whole number >= 0");
+    CHECK(table_error("T1 Z\n") == "gcode_machine_bad.tbl:1:5: missing number after Z");
+}
+
+TEST_CASE("G-code machine: polar coordinates", "[gcode][machine]") {
+    // G90: about the origin; G91: ^ and @ add to the current point's angle and distance.
+    check_waypoints(gcode("G1 @10 ^90 F600\nG91 ^90\nG90 @5\nG91 @2 ^-90\n"),
+                    {{D, {0, 10, 0}}, {D, {-10, 0, 0}}, {D, {-5, 0, 0}}, {D, {0, 7, 0}}});
+}
+
+TEST_CASE("G-code machine: checksums as senders write them", "[gcode][machine]") {
+    const std::string line = "N12 G1 X5 F600";
+    unsigned sum = 0;
+    for (const char c : line) sum ^= static_cast<unsigned char>(c);
+    check_waypoints(gcode(line + "*" + std::to_string(sum) + "\n"), {{D, {5, 0, 0}}});
+    CHECK(error_of(line + "*" + std::to_string(sum ^ 1u)) ==
+          "t.ngc:1:15: checksum *" + std::to_string(sum ^ 1u) + " does not match the line (*" +
+              std::to_string(sum) + ")");
+    CHECK(error_of("G1 X5 F600*") == "t.ngc:1:11: a checksum '*' needs a number 0..255");
+}
+
+TEST_CASE("G-code machine: feed modes and rotary axes", "[gcode][machine]") {
+    // G93: 60 mm in 1/2 minute is 2 mm/s.
+    CHECK(gcode("G93 G1 X60 F2\n").subpaths[0].feed == Approx(2));
+    CHECK(error_of("G93 G1 X60 F2\nX70\n") ==
+          "t.ngc:2:1: G93 (inverse time) needs F on every feed move");
+    // F is along X Y Z; the path's feed is along every axis (A in degrees).
+    const Path a = gcode("G1 X30 A40 F600\nG1 A90\n", router("XYZA"));
+    REQUIRE(a.subpaths.size() == 2);
+    CHECK(a.subpaths[0].feed == Approx(10.0 * 50 / 30));
+    CHECK(a.subpaths[1].feed == Approx(10));  // A alone: F600 degrees per minute
+    CHECK(error_of("G1 X10\n") == "t.ngc:1:1: feed move with no feed rate (give F first)");
+    CHECK(error_of("G1 X10 B1 F60\n") ==
+          "t.ngc:1:8: axis B is not one of this machine's axes (XYZ)");
+}
+
+TEST_CASE("G-code machine: M6 pauses, and pen modes that cannot be", "[gcode][machine]") {
+    const Path p = gcode("G0 Z5\nG1 X1 F60\nT2 M6\nG1 X2\n");
+    REQUIRE(p.subpaths.size() == 3);
+    CHECK(p.subpaths[2].pause_before);
+    GcodeOptions z = router();
+    z.pen = PenControl::kZ;
+    CHECK_THROWS_AS(gcode("G1 X1 F60\n", z), std::invalid_argument);
+    GcodeOptions bad = router("XZ");
+    CHECK_THROWS_AS(gcode("G1 X1 F60\n", bad), std::invalid_argument);
+}
