@@ -178,9 +178,11 @@ TEST_CASE("G-code machine: G83 pecks and G98 returns to the initial Z", "[gcode]
                            {D, {0, 0, -5}},
                            {T, {0, 0, 2}}});
     const Path dwell = gcode("G0 Z5\nG82 X1 Y1 Z-1 R1 P0.5 F600\n");
-    REQUIRE(dwell.subpaths.size() == 3);
-    CHECK(dwell.subpaths[2].travel);
-    CHECK(dwell.subpaths[2].dwell_before == 0.5);
+    // The cycle runs in exact path mode: its moves are subpaths of their own (G64 outside).
+    REQUIRE(dwell.subpaths.size() == 4);
+    CHECK(dwell.subpaths[3].travel);
+    CHECK(dwell.subpaths[3].dwell_before == 0.5);
+    CHECK(dwell.subpaths[3].corner_mode == CornerMode::kExactPath);
     // Sticky R and Z: the next block drills the next hole the same way.
     check_waypoints(gcode("G0 Z5\nG81 X1 Y1 Z-1 R1 F600\nX2\n"), {{T, {0, 0, 5}},
                                                                   {T, {1, 1, 5}},
@@ -216,7 +218,7 @@ TEST_CASE("G-code machine: coordinate systems, G92 and tool length offsets", "[g
         "G43 H1 G0 Z0\n"                 // (105, 50, 5)
         "G43.1 Z3\nG0 Z0\n"              // (105, 50, -17)
         "G49 G0 Z0\n"                    // (105, 50, -20)
-        "G91 G10 L2 P2 X1\nG90 G0 X0\n"  // G55's X moves 1: (101, 50, -20)
+        "G91 G10 L2 P2 X1\nG90 G0 X0\n"  // G91 changes nothing: G55's X is 1
         "G1 X1 F60\n",
         o);
     check_waypoints(p, {{T, {100, 50, -20}},
@@ -226,8 +228,8 @@ TEST_CASE("G-code machine: coordinate systems, G92 and tool length offsets", "[g
                         {T, {105, 50, 5}},
                         {T, {105, 50, -17}},
                         {T, {105, 50, -20}},
-                        {T, {101, 50, -20}},
-                        {D, {102, 50, -20}}});
+                        {T, {1, 50, -20}},
+                        {D, {2, 50, -20}}});
     CHECK(error_of("G43 H9 G0 Z0\nG1 X1 F60", o) ==
           "t.ngc:1:5: G43 H9: tool 9 is not in the tool table gcode_machine_tools.tbl");
     CHECK(error_of("G43 H1\nG1 X1 F60") ==
@@ -300,4 +302,54 @@ TEST_CASE("G-code machine: M6 pauses, and pen modes that cannot be", "[gcode][ma
     CHECK_THROWS_AS(gcode("G1 X1 F60\n", z), std::invalid_argument);
     GcodeOptions bad = router("XZ");
     CHECK_THROWS_AS(gcode("G1 X1 F60\n", bad), std::invalid_argument);
+}
+
+TEST_CASE("G-code machine: a series of cycles as LinuxCNC runs it", "[gcode][machine][cycle]") {
+    // The initial level stays for the series: G98 after G99 goes back to Z10, not to R.
+    check_waypoints(gcode("G0 Z10\nG99 G81 X1 Y0 Z-1 R2 F600\nG98 X2\n"), {{T, {0, 0, 10}},
+                                                                           {T, {1, 0, 10}},
+                                                                           {T, {1, 0, 2}},
+                                                                           {D, {1, 0, -1}},
+                                                                           {T, {1, 0, 2}},
+                                                                           {T, {2, 0, 2}},
+                                                                           {D, {2, 0, -1}},
+                                                                           {T, {2, 0, 10}}});
+    // G89 dwells and feeds straight out to the clearance level.
+    const Path g89 = gcode("G0 Z10\nG98 G89 X1 Y0 Z-1 R2 P1 F600\n");
+    const std::vector<Waypoint> w = waypoints(g89);
+    REQUIRE(w.size() == 5);
+    CHECK_FALSE(w[4].travel);
+    CHECK(w[4].at == std::vector<double>{1, 0, 10});
+    CHECK(error_of("G0 Z5\nG86 X1 Y1 Z-1 R1 F600") ==
+          "t.ngc:2:1: G86 needs P (the dwell at the bottom, seconds)");
+    // A new cycle mode needs its words again.
+    CHECK(error_of("G0 Z5\nG81 X1 Y1 Z-1 R1 F600\nG82 X2 P1") ==
+          "t.ngc:3:1: G82 needs R (the retract plane)");
+    CHECK(error_of("G0 Z5\nG81 X1 Y1 Z-1 R1 L0 F600") ==
+          "t.ngc:2:18: L (repeats) must be a whole number from 1 to 100000");
+    CHECK(error_of("G0 Z5\nG81 X1 Y1 Z-1 R1 A3 F600", router("XYZA")) ==
+          "t.ngc:2:18: axis word A in a canned cycle (G81)");
+    CHECK(error_of("G0 Z5\nG93 G81 X1 Y1 Z-1 R1 F6") ==
+          "t.ngc:2:5: G81 with inverse time feed (G93): give G94");
+}
+
+TEST_CASE("G-code machine: the loaded tool, G43.1 and units", "[gcode][machine]") {
+    const std::string table_file = "gcode_machine_tools2.tbl";
+    std::ofstream(table_file) << "T3 P3 Z10 D6 ; ball\n";
+    GcodeOptions o = router();
+    o.tool_table = table_file;
+    // G43 without H: the tool M6 loaded; G43.1 X replaces X's offset and keeps Z's.
+    check_waypoints(gcode("T3 M6\nG43\nG0 Z0\nG43.1 X1\nG0 X0\nG1 X1 F60\n", o),
+                    {{T, {0, 0, 10}}, {T, {1, 0, 10}}, {D, {2, 0, 10}}});
+    CHECK(error_of("G43\nG1 X1 F60\n", o) ==
+          "t.ngc:1:1: G43 (no H): no tool loaded (give H, or T and M6 first)");
+    // G20: F is inches per minute along X, degrees per minute along A alone.
+    const Path inch = gcode("G20 G1 X1 F60\nG1 A90\n", router("XYZA"));
+    CHECK(inch.subpaths[0].feed == Approx(25.4));
+    CHECK(inch.subpaths[1].feed == Approx(1));
+    // G93 -> G94 needs a new F.
+    CHECK(error_of("G93 G1 X1 F2\nG94 G1 X2\n") ==
+          "t.ngc:2:5: feed move with no feed rate (give F first)");
+    CHECK(error_of("G1 @5 F60\n") ==
+          "t.ngc:1:4: polar coordinates at the origin need ^ (the angle)");
 }

@@ -313,10 +313,14 @@ void handle_pauses(InterruptOptions& interrupt, const JournalWriter& writer, Job
     interrupt.on_pause = [&writer, &events, target, terminal](std::size_t index) {
         const std::vector<std::string>& pauses = writer.journal().pauses;
         const std::string next = index < pauses.size() ? pauses[index] : "the rest of the job";
-        std::fprintf(
-            stderr,
-            "\npathstream: paused for a pen change, %s next: %s `pathstream ctl %s resume`\n",
-            next.c_str(), terminal ? "press Enter to go on, or" : "go on with", target.c_str());
+        // A G-code stop or tool change says so (its note); others are a plotter's pen change.
+        const bool noted = next.rfind("tool change", 0) == 0 ||
+                           next.rfind("program stop", 0) == 0 ||
+                           next.rfind("optional stop", 0) == 0;
+        const std::string what = noted ? next : "a pen change, " + next + " next";
+        std::fprintf(stderr, "\npathstream: paused for %s: %s `pathstream ctl %s resume`\n",
+                     what.c_str(), terminal ? "press Enter to go on, or" : "go on with",
+                     target.c_str());
         events.pause(index, next);
     };
     if (terminal) interrupt.resume_requested = enter_pressed;

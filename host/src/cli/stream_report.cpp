@@ -51,6 +51,7 @@ std::string pause_description(const Path& path, std::size_t subpath) {
     const Subpath& s = path.subpaths.at(subpath);
     const bool new_layer =
         !path.layers.empty() && (subpath == 0 || path.subpaths[subpath - 1].layer != s.layer);
+    if (!s.pause_note.empty()) return s.pause_note;
     if (new_layer) return "layer \"" + path.layers.at(s.layer).name + "\"";
     return "subpath " + std::to_string(subpath + 1) +
            (s.location.line > 0 ? " (line " + std::to_string(s.location.line) + ")" : "");

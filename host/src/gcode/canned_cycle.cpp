@@ -49,24 +49,37 @@ void Interpreter::canned_cycle(const Command& c, Motion cycle, SourceLocation at
                      ", which is not one of this machine's axes (" + options_.axes + ")");
     }
     if (c.polar_distance || c.polar_angle) fail(at, "polar coordinates with a canned cycle");
-    // Sticky words: R, the bottom, Q and P stay from the cycle's earlier blocks.
-    const double initial = pos_[drill];
+    if (inverse_time_) fail(at, std::string(name) + " with inverse time feed (G93): give G94");
+    for (std::size_t a = 3; a < kAxisCount; ++a) {
+        // LinuxCNC: no rotary word in a cycle, and U V W only where they are the plane's.
+        if (const Word* w = c.value(kAxisLetters[a])) {
+            fail(w->at,
+                 std::string("axis word ") + w->letter + " in a canned cycle (" + name + ")");
+        }
+    }
+    // Sticky words, as LinuxCNC: R, the bottom, Q and P stay while the same cycle repeats;
+    // a new cycle mode needs them again. The initial level stays for the whole series of
+    // cycle blocks (G98 returns to it; G91 R counts from it).
+    const bool same = last_cycle_ == cycle;
+    if (!cycle_initial_) cycle_initial_ = pos_[drill];
+    const double initial = *cycle_initial_;
     const Word* r = c.value('R');
     const Word* bottom_word = c.value(drill_letter);
     if (r) {
-        cycle_r_ = incremental_ ? initial + length(*r) : length(*r) + offset(drill);
-        cycle_r_known_ = true;
-    } else if (!cycle_r_known_) {
+        cycle_r_ = length(*r);
+        cycle_r_incremental_ = incremental_;
+    } else if (!same) {
         fail(at, std::string(name) + " needs R (the retract plane)");
     }
     if (bottom_word) {
-        cycle_z_ =
-            incremental_ ? cycle_r_ + length(*bottom_word) : length(*bottom_word) + offset(drill);
-        cycle_z_known_ = true;
-    } else if (!cycle_z_known_) {
+        cycle_z_ = length(*bottom_word);
+        cycle_z_incremental_ = incremental_;
+    } else if (!same) {
         fail(at, std::string(name) + " needs " + drill_letter + " (the bottom of the hole)");
     }
-    if (cycle_z_ > cycle_r_) {
+    const double retract = cycle_r_incremental_ ? initial + cycle_r_ : cycle_r_ + offset(drill);
+    const double bottom = cycle_z_incremental_ ? retract + cycle_z_ : cycle_z_ + offset(drill);
+    if (bottom > retract) {
         fail(bottom_word ? bottom_word->at : at,
              std::string(name) + ": the bottom " + drill_letter + " is above the retract plane R");
     }
@@ -74,26 +87,35 @@ void Interpreter::canned_cycle(const Command& c, Motion cycle, SourceLocation at
         if (const Word* q = c.value('Q')) {
             if (!(q->value > 0)) fail(q->at, std::string(name) + " peck depth Q must be positive");
             cycle_q_ = length(*q);
-        } else if (!(cycle_q_ > 0)) {
+        } else if (!same) {
             fail(at, std::string(name) + " needs Q (the peck depth)");
         }
     }
+    const bool dwells = cycle == Motion::kDrillDwell || cycle == Motion::kBoreSpindleStop ||
+                        cycle == Motion::kBoreDwell;
     if (const Word* p = c.value('P')) {
         if (p->value < 0) fail(p->at, std::string(name) + " dwell P must not be negative");
         cycle_p_ = p->value;
+    } else if (dwells && !same) {
+        fail(at, std::string(name) + " needs P (the dwell at the bottom, seconds)");
     }
     long repeats = 1;
     if (const Word* l = c.value('L')) {
-        if (l->value != std::floor(l->value) || l->value < 0 || l->value > kMaxRepeats) {
+        if (l->value != std::floor(l->value) || l->value < 1 || l->value > kMaxRepeats) {
             fail(l->at,
-                 "L (repeats) must be a whole number from 0 to " + std::to_string(kMaxRepeats));
+                 "L (repeats) must be a whole number from 1 to " + std::to_string(kMaxRepeats));
         }
         repeats = static_cast<long>(l->value);
     }
     // The cycle's own words are not position words: targets() must not read the drill axis.
     Command position = c;
     position.values[static_cast<std::size_t>(drill_letter - 'A')].reset();
-    const double clear = retract_to_r_ ? cycle_r_ : std::max(initial, cycle_r_);
+    const double clear = retract_to_r_ ? retract : std::max(initial, retract);
+    last_cycle_ = cycle;
+    // LinuxCNC runs a cycle in exact path mode: no corner of it is rounded.
+    const CornerMode corners = runs_.corner_mode();
+    const double blend = runs_.blend_tolerance();
+    runs_.set_corners(CornerMode::kExactPath, 0);
 
     auto to = [&](double depth) {
         Axes p = pos_;
@@ -106,45 +128,49 @@ void Interpreter::canned_cycle(const Command& c, Motion cycle, SourceLocation at
         runs_.dwell_next(cycle_p_, pen_down_now());
     };
     // Preliminary motion: up to R first when below it.
-    if (pos_[drill] < cycle_r_) travel(to(cycle_r_), at);
+    if (pos_[drill] < retract) travel(to(retract), at);
     for (long k = 0; k < repeats; ++k) {
         Axes hole = targets(position, false);
         hole[drill] = pos_[drill];
         travel(hole, at);
-        travel(to(cycle_r_), at);
+        travel(to(retract), at);
         switch (cycle) {
             case Motion::kPeck:
             case Motion::kPeckChipBreak: {
-                double depth = cycle_r_;
-                while (depth > cycle_z_) {
-                    const double next = std::max(depth - cycle_q_, cycle_z_);
+                double depth = retract;
+                while (depth > bottom) {
+                    const double next = std::max(depth - cycle_q_, bottom);
                     line(to(next), at);
                     depth = next;
-                    if (depth <= cycle_z_) break;
+                    if (depth <= bottom) break;
                     if (cycle == Motion::kPeck) {
-                        travel(to(cycle_r_), at);
-                        travel(to(std::min(depth + kPeckClearanceMm, cycle_r_)), at);
+                        travel(to(retract), at);
+                        travel(to(std::min(depth + kPeckClearanceMm, retract)), at);
                     } else {
-                        travel(to(std::min(depth + kChipBreakRetractMm, cycle_r_)), at);
+                        travel(to(std::min(depth + kChipBreakRetractMm, retract)), at);
                     }
                 }
                 travel(to(clear), at);
                 break;
             }
-            case Motion::kBore:
-            case Motion::kBoreDwell:
-                line(to(cycle_z_), at);
-                if (cycle == Motion::kBoreDwell) dwell();
-                line(to(cycle_r_), at);
-                if (clear > cycle_r_) travel(to(clear), at);
+            case Motion::kBore:  // G85: feed out to R, then up to the clearance
+                line(to(bottom), at);
+                line(to(retract), at);
+                if (clear > retract) travel(to(clear), at);
+                break;
+            case Motion::kBoreDwell:  // G89: dwell, then feed out to the clearance
+                line(to(bottom), at);
+                dwell();
+                line(to(clear), at);
                 break;
             default:  // G81, G82, G86 (the spindle's stop and restart are outputs)
-                line(to(cycle_z_), at);
-                if (cycle == Motion::kDrillDwell) dwell();
+                line(to(bottom), at);
+                if (dwells) dwell();
                 travel(to(clear), at);
                 break;
         }
     }
+    runs_.set_corners(corners, blend);
     if (on_path(kZ) || drill == kZ) z_known_ = true;
 }
 

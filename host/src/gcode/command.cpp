@@ -330,6 +330,8 @@ private:
             case 1:
                 claim(kStopping, w, name);
                 c.pause = true;
+                c.pause_at = w.at;
+                c.optional_stop = code == 1;
                 break;
             case 2:
             case 30:
@@ -348,6 +350,7 @@ private:
             case 6:
                 claim(kToolChange, w, name);
                 c.tool_change = true;
+                c.pause_at = w.at;
                 break;
             default:
                 fail(w, "unsupported M code " + name + " (skip it with --ignore-code " + name +

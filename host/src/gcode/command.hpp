@@ -88,6 +88,8 @@ struct Command {
     std::optional<bool> spindle_on;          ///< M3, M4 (true) / M5 (false)
     bool end_program = false;                ///< M2, M30
     bool pause = false;                      ///< M0, M1
+    SourceLocation pause_at;                 ///< where the M0, M1 or M6 is
+    bool optional_stop = false;              ///< M1
     bool tool_change = false;                ///< M6 (when not skipped)
     /// Codes skipped in this block; when `skip` the whole block is skipped (it held only
     /// skipped codes and their words).

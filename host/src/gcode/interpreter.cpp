@@ -97,7 +97,10 @@ bool Interpreter::pen_down_now() const {
 }
 
 void Interpreter::feed_word(const Command& c) {
-    if (c.inverse_time) inverse_time_ = *c.inverse_time;
+    if (c.inverse_time) {
+        if (*c.inverse_time != inverse_time_) feed_ = 0;  // as LinuxCNC: a new mode needs F
+        inverse_time_ = *c.inverse_time;
+    }
     inverse_minutes_ = 0;
     const Word* f = c.value('F');
     if (!f) return;
@@ -114,7 +117,7 @@ void Interpreter::feed_word(const Command& c) {
         fail(f->at, "feed F" + f->text + " is out of range (0 < F <= " + number(kMaxFeedMmPerMin) +
                         " mm/min)");
     }
-    feed_ = mm_per_min / 60.0;
+    feed_ = f->value / 60.0;  // program units: scaled per move, rotary-only moves are not
 }
 
 bool Interpreter::execute(const Command& c) {
@@ -129,6 +132,11 @@ bool Interpreter::execute(const Command& c) {
     if (c.incremental) incremental_ = *c.incremental;
     if (c.arc_incremental) arc_incremental_ = *c.arc_incremental;
     feed_word(c);
+    if (const Word* t = c.value('T')) {
+        if (t->value != std::floor(t->value) || t->value < 0 || t->value > 1e9)
+            fail(t->at, "T must be a whole tool number >= 0");
+        selected_tool_ = static_cast<long>(t->value);
+    }
     if (c.path_control) path_control(c);
     if (c.spindle_on) {
         spindle_ = *c.spindle_on;
@@ -152,7 +160,10 @@ bool Interpreter::execute(const Command& c) {
         motion_ = Motion::kNone;
     }
     if (c.motion) {
-        if (!is_cycle(*c.motion)) cycle_r_known_ = cycle_z_known_ = false;
+        if (!is_cycle(*c.motion)) {
+            last_cycle_ = Motion::kNone;  // the series of cycle blocks ends
+            cycle_initial_.reset();
+        }
         motion_ = *c.motion;
         if (motion_ == Motion::kNurbs && nurbs_.empty()) nurbs_at_ = c.motion_at;
     }
@@ -201,12 +212,24 @@ bool Interpreter::execute(const Command& c) {
     // where the program last left it, which is the same place when M6 has a block of its own).
     const bool pause = c.pause || c.tool_change;
     if (pause || c.end_program) runs_.lift();
-    if (pause) runs_.pause_next();
+    if (pause) runs_.pause_next(pause_note(c));
+    if (c.tool_change) load_tool();
     if (c.end_program) {
         if (!nurbs_.empty()) fail(c.start, "program ends inside a G5.2 curve (no G5.3)");
         return false;
     }
     return true;
+}
+
+std::string Interpreter::pause_note(const Command& c) const {
+    const std::string line = ", line " + std::to_string(c.pause_at.line);
+    if (!c.tool_change)
+        return std::string(c.optional_stop ? "optional stop (M1)" : "program stop (M0)") + line;
+    if (selected_tool_ < 0) return "tool change (M6, no T given)" + line;
+    std::string note = "tool change to T" + std::to_string(selected_tool_);
+    if (const ToolEntry* t = tools_.find(selected_tool_); t && !t->comment.empty())
+        note += " (" + t->comment + ")";
+    return note + line;
 }
 
 void Interpreter::path_control(const Command& c) {
@@ -232,7 +255,8 @@ void Interpreter::check_words_used(const Command& c, Motion move, bool moving) c
     const bool nurbs = moving && move == Motion::kNurbs;
     const bool cycle = moving && is_cycle(move);
     const bool peck = cycle && (move == Motion::kPeck || move == Motion::kPeckChipBreak);
-    const bool cycle_dwell = cycle && (move == Motion::kDrillDwell || move == Motion::kBoreDwell);
+    const bool cycle_dwell = cycle && (move == Motion::kDrillDwell || move == Motion::kBoreDwell ||
+                                       move == Motion::kBoreSpindleStop);
     const bool blending = c.path_control == CornerMode::kBlend;
     const bool g10 = c.non_modal == NonModal::kSetCoordinates;
     const struct {
@@ -290,8 +314,14 @@ Axes Interpreter::targets(const Command& c, bool machine_coordinates) const {
             fail(at->at, "polar coordinates (@ ^) and X or Y in one block");
         }
         if (plane_.normal != kZ) fail(at->at, "polar coordinates need the XY plane (G17)");
+        if (machine_coordinates) fail(at->at, "polar coordinates with G53");
         const double x0 = pos_[kX] - offset(kX), y0 = pos_[kY] - offset(kY);
         const double r0 = std::hypot(x0, y0), a0 = std::atan2(y0, x0) * 180 / std::numbers::pi;
+        if (r0 == 0 && (incremental_ || !c.polar_angle)) {
+            fail(at->at, incremental_ ? "incremental polar coordinates at the origin: the angle "
+                                        "is undefined there"
+                                      : "polar coordinates at the origin need ^ (the angle)");
+        }
         double r = r0, angle = a0;
         if (c.polar_distance) r = (incremental_ ? r0 : 0) + length(*c.polar_distance);
         if (c.polar_angle) angle = (incremental_ ? a0 : 0) + c.polar_angle->value;
@@ -304,16 +334,6 @@ Axes Interpreter::targets(const Command& c, bool machine_coordinates) const {
         }
     }
     return to;
-}
-
-void Interpreter::travel(const Axes& to, SourceLocation at) {
-    if (machine()) {
-        follow({line_piece(pos_, to)}, false, to, at);
-        return;
-    }
-    runs_.lift();
-    last_move_drew_ = false;
-    pos_ = to;
 }
 
 void Interpreter::move(const Command& c, Motion move, SourceLocation at) {
@@ -351,82 +371,6 @@ void Interpreter::move(const Command& c, Motion move, SourceLocation at) {
         z_known_ = true;
     }
     if (move != Motion::kCubic) last_cubic_control_.reset();
-}
-
-double Interpreter::move_feed(const std::vector<Piece>& pieces, SourceLocation at) const {
-    // Chord lengths: the path's feed is along all its axes, F along X Y Z when they move
-    // (LinuxCNC), else along U V W, else A B C (degrees per minute).
-    double all = 0, xyz = 0, uvw = 0, abc = 0;
-    for (const Piece& piece : pieces) {
-        for (int k = 0; k < 3; ++k) {
-            double s_all = 0, s_xyz = 0, s_uvw = 0, s_abc = 0;
-            for (std::size_t a = 0; a < kAxisCount; ++a) {
-                if (!on_path(a)) continue;
-                const double d = piece.p[k + 1][a] - piece.p[k][a];
-                s_all += d * d;
-                (a < 3 ? s_xyz : is_rotary(a) ? s_abc : s_uvw) += d * d;
-            }
-            all += std::sqrt(s_all);
-            xyz += std::sqrt(s_xyz);
-            uvw += std::sqrt(s_uvw);
-            abc += std::sqrt(s_abc);
-        }
-    }
-    if (inverse_time_) {
-        if (inverse_minutes_ <= 0) fail(at, "G93 (inverse time) needs F on every feed move");
-        return all / (60 * inverse_minutes_);
-    }
-    if (feed_ <= 0) {
-        if (!machine()) return 0;  // a plotter: the profile's feed
-        fail(at, "feed move with no feed rate (give F first)");
-    }
-    const double primary = xyz > 1e-9 ? xyz : uvw > 1e-9 ? uvw : abc;
-    if (primary <= 1e-9 || std::fabs(all - primary) <= 1e-12 * all) return feed_;
-    return feed_ * all / primary;
-}
-
-std::vector<Piece> Interpreter::lift(const std::vector<Cubic>& pieces, const Axes& to) const {
-    std::vector<Piece> out;
-    out.reserve(pieces.size());
-    const double n = static_cast<double>(pieces.size());
-    for (std::size_t k = 0; k < pieces.size(); ++k) {
-        Piece piece;
-        for (int i = 0; i < 4; ++i) {
-            const double f = (static_cast<double>(k) + i / 3.0) / n;
-            for (std::size_t a = 0; a < kAxisCount; ++a) {
-                piece.p[i][a] = i == 3 && k + 1 == pieces.size() ? to[a]
-                                : i == 0 && k == 0               ? pos_[a]
-                                                                 : pos_[a] + f * (to[a] - pos_[a]);
-            }
-            piece.p[i][plane_.first] = pieces[k].p[i].x;
-            piece.p[i][plane_.second] = pieces[k].p[i].y;
-        }
-        if (k > 0) piece.p[0] = out.back().p[3];
-        out.push_back(piece);
-    }
-    return out;
-}
-
-void Interpreter::follow(const std::vector<Piece>& pieces, bool down, const Axes& to,
-                         SourceLocation at) {
-    for (const Piece& piece : pieces) {
-        for (const Axes& p : piece.p) check_point(p, at);
-    }
-    if (down) {
-        const double feed = move_feed(pieces, at);
-        for (const Piece& piece : pieces) runs_.draw(piece, feed, at, file_);
-        runs_.end_block();
-    } else if (machine()) {
-        for (const Piece& piece : pieces) runs_.travel(piece, options_.rapid_feed, at, file_);
-    } else {
-        runs_.lift();
-    }
-    last_move_drew_ = down;
-    pos_ = to;
-}
-
-void Interpreter::line(const Axes& to, SourceLocation at) {
-    follow({line_piece(pos_, to)}, pen_down(pos_[kZ], to[kZ]), to, at);
 }
 
 Path Interpreter::finish(bool allow_empty) {

@@ -62,6 +62,8 @@ private:
     bool on_path(std::size_t axis) const { return path_axis_[axis]; }
 
     void feed_word(const Command& c);
+    /// "tool change to T2 (3 mm drill), line 6", "program stop (M0), line 9".
+    std::string pause_note(const Command& c) const;
     /// G61, G61.1, G64 [P] [Q]: the corner rule for the moves that follow.
     void path_control(const Command& c);
     void check_words_used(const Command& c, Motion move, bool moving) const;
@@ -69,6 +71,8 @@ private:
     void non_modal(const Command& c);
     /// G10 L2, L20: a coordinate system's origin.
     void set_coordinates(const Command& c);
+    /// M6: the selected tool is in the spindle (#5400, #5401-#5409, #5410 describe it).
+    void load_tool();
     /// G54..G59.3 and G43/G43.1/G49: the offsets from program to machine coordinates.
     void offsets_modes(const Command& c);
     /// Program coordinates -> machine coordinates of one axis (G54.., G92, tool length).
@@ -113,18 +117,24 @@ private:
     Axes tool_offset_{};      ///< G43 / G43.1 tool length offsets
     Plane plane_ = kPlaneXY;  ///< G17, G18, G19
     Motion motion_ = Motion::kNone;
-    bool inch_ = false;                       ///< G20
-    bool incremental_ = false;                ///< G91
-    bool arc_incremental_ = true;             ///< G91.1 (LinuxCNC's default)
-    bool inverse_time_ = false;               ///< G93
-    double feed_ = 0;                         ///< mm/s (deg/s on rotary-only moves); 0 until F
-    double inverse_minutes_ = 0;              ///< G93: this block's move takes 1/F minutes
-    bool spindle_ = false;                    ///< M3/M4 given, no M5 since
-    bool last_move_drew_ = false;             ///< kMotion: the pen is down
+    bool inch_ = false;            ///< G20
+    bool incremental_ = false;     ///< G91
+    bool arc_incremental_ = true;  ///< G91.1 (LinuxCNC's default)
+    bool inverse_time_ = false;    ///< G93
+    double feed_ = 0;              ///< F in program units (mm or inch, degrees) per s; 0 until F
+    double inverse_minutes_ = 0;   ///< G93: this block's move takes 1/F minutes
+    bool spindle_ = false;         ///< M3/M4 given, no M5 since
+    long selected_tool_ = -1;      ///< the last T word; -1: none
+    long loaded_tool_ = -1;        ///< the tool the last M6 loaded; -1: none
+    bool last_move_drew_ = false;  ///< kMotion: the pen is down
     std::optional<Vec2> last_cubic_control_;  ///< second control point of the last move, if G5
     bool retract_to_r_ = false;               ///< G99 (true) / G98 (false)
-    double cycle_r_ = 0, cycle_z_ = 0, cycle_q_ = 0, cycle_p_ = 0;  ///< sticky cycle words
-    bool cycle_r_known_ = false, cycle_z_known_ = false;
+    /// Sticky cycle words as written (mm, seconds), and whether R and the bottom were given
+    /// in G91 (then R counts from the initial level, the bottom from R).
+    double cycle_r_ = 0, cycle_z_ = 0, cycle_q_ = 0, cycle_p_ = 0;
+    bool cycle_r_incremental_ = false, cycle_z_incremental_ = false;
+    Motion last_cycle_ = Motion::kNone;    ///< the cycle of the series, kNone out of one
+    std::optional<double> cycle_initial_;  ///< the series' initial level on the drill axis
 
     struct NurbsPoint {
         Vec2 at;

@@ -18,9 +18,7 @@ constexpr long kG92Offset = 5211;
 constexpr long kCurrentSystem = 5220;  // 1 (G54) .. 9 (G59.3)
 constexpr long kSystemOffsets = 5221;  // G54's X; +20 per system; +9: its rotation R
 constexpr long kSystemStride = 20;
-constexpr long kToolNumber = 5400;
-constexpr long kToolOffsets = 5401;
-constexpr long kToolDiameter = 5410;
+constexpr long kAppliedToolOffsets = 5081;  // the offsets G43 applies
 
 ParameterRef numbered(long n) {
     return ParameterRef{n, {}};
@@ -46,6 +44,17 @@ double Interpreter::offset(std::size_t axis) const {
            tool_offset_[axis];
 }
 
+void Interpreter::load_tool() {
+    if (selected_tool_ < 0) return;
+    loaded_tool_ = selected_tool_;
+    parameters_.set(numbered(5400), static_cast<double>(loaded_tool_));
+    const ToolEntry* entry = tools_.find(loaded_tool_);
+    for (std::size_t a = 0; a < kAxisCount; ++a) {
+        parameters_.set(numbered(5401 + static_cast<long>(a)), entry ? entry->offsets[a] : 0.0);
+    }
+    parameters_.set(numbered(5410), entry ? entry->diameter : 0.0);
+}
+
 void Interpreter::offsets_modes(const Command& c) {
     if (c.coordinate_system) {
         const std::size_t system = *c.coordinate_system;
@@ -64,35 +73,40 @@ void Interpreter::offsets_modes(const Command& c) {
             tool_offset_ = {};
             break;
         case ToolLength::kTable: {
+            // Without H (or H0), the tool in the spindle: the one the last M6 loaded.
             const Word* h = c.value('H');
-            if (!h) fail(c.tool_length_at, "G43 needs H (the tool's number in the tool table)");
-            if (h->value != std::floor(h->value) || h->value < 0) {
+            if (h && (h->value != std::floor(h->value) || h->value < 0)) {
                 fail(h->at, "H must be a whole tool number >= 0");
             }
-            const auto tool = static_cast<long>(h->value);
+            const SourceLocation h_at = h ? h->at : c.tool_length_at;
+            const std::string h_text = h ? "H" + h->text : std::string("(no H)");
+            long tool = h ? static_cast<long>(h->value) : 0;
+            if (tool == 0) {
+                if (loaded_tool_ < 0) {
+                    fail(h_at, "G43 " + h_text + ": no tool loaded (give H, or T and M6 first)");
+                }
+                tool = loaded_tool_;
+            }
             if (tools_.empty()) {
-                fail(h->at, "G43 H" + h->text + ": no tool table (give one with --tool-table)");
+                fail(h_at, "G43 " + h_text + ": no tool table (give one with --tool-table)");
             }
             const ToolEntry* entry = tools_.find(tool);
             if (!entry) {
-                fail(h->at, "G43 H" + h->text + ": tool " + std::to_string(tool) +
-                                " is not in the tool table " + tools_.source());
+                fail(h_at, "G43 " + h_text + ": tool " + std::to_string(tool) +
+                               " is not in the tool table " + tools_.source());
             }
             tool_offset_ = entry->offsets;
-            parameters_.set(numbered(kToolNumber), static_cast<double>(tool));
-            parameters_.set(numbered(kToolDiameter), entry->diameter);
             break;
         }
         case ToolLength::kDynamic:
-            // G43.1: the block's axis words are the offsets (program units), nothing moves.
-            tool_offset_ = {};
+            // G43.1: the block's axis words replace those axes' offsets, nothing moves.
             for (std::size_t a = 0; a < kAxisCount; ++a) {
                 if (const Word* w = c.value(kAxisLetters[a])) tool_offset_[a] = axis_value(*w, a);
             }
             break;
     }
     for (std::size_t a = 0; a < kAxisCount; ++a) {
-        parameters_.set(numbered(kToolOffsets + static_cast<long>(a)), tool_offset_[a]);
+        parameters_.set(numbered(kAppliedToolOffsets + static_cast<long>(a)), tool_offset_[a]);
     }
 }
 
@@ -184,6 +198,7 @@ void Interpreter::set_coordinates(const Command& c) {
         fail(p ? p->at : c.non_modal_at,
              "G10 L" + l->text + " needs P from 0 (the current system) to 9 (G59.3)");
     }
+    if (r && l->value == 20) fail(r->at, "R is not allowed with G10 L20");
     if (r && r->value != 0) fail(r->at, "coordinate system rotation (G10 R) is not supported");
     const std::size_t system = p->value == 0 ? system_ : static_cast<std::size_t>(p->value) - 1;
     const long base = kSystemOffsets + kSystemStride * static_cast<long>(system);
@@ -192,10 +207,7 @@ void Interpreter::set_coordinates(const Command& c) {
         if (!w) continue;
         const ParameterRef ref = numbered(base + static_cast<long>(a));
         double v = axis_value(*w, a);
-        if (l->value == 2) {
-            // L2: the system's origin in machine coordinates (G91: added to it, as LinuxCNC).
-            if (incremental_) v += *parameters_.get(ref);
-        } else {
+        if (l->value == 20) {
             // L20: the origin such that the machine's current point has the given coordinates.
             v = pos_[a] - g92_[a] - tool_offset_[a] - v;
         }

@@ -38,11 +38,16 @@ public:
         corner_mode_ = mode;
         blend_tolerance_ = mode == CornerMode::kBlend ? blend_tolerance_mm : 0;
     }
+    CornerMode corner_mode() const { return corner_mode_; }
+    double blend_tolerance() const { return blend_tolerance_; }
     /// A block's pieces are drawn: in exact stop mode (G61.1) the motion rests where it ended.
     void end_block();
 
     /// The next subpath started gets Subpath::pause_before (M0, M1).
-    void pause_next() { pause_next_ = true; }
+    void pause_next(std::string note = {}) {
+        pause_next_ = true;
+        pause_note_ = std::move(note);
+    }
     /// The next subpath started rests `seconds` more at its start (G4), pen down or up.
     void dwell_next(double seconds, bool pen_down) {
         dwell_next_ += seconds;
@@ -64,6 +69,7 @@ private:
     std::vector<Subpath> done_;
     bool open_ = false;
     bool pause_next_ = false;
+    std::string pause_note_;
     double dwell_next_ = 0;
     bool dwell_pen_down_ = false;
     std::size_t pieces_ = 0;

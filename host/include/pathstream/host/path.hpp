@@ -60,6 +60,9 @@ struct Subpath {
     /// canned cycle's retracts): planned along its points with the pen up, at `feed` (0: the
     /// profile's travel_feed); never reordered, reversed or joined. False: drawn pen-down.
     bool travel = false;
+    /// Why the machine pauses before this subpath when the file says (G-code: "tool change to
+    /// T2 (3 mm drill), line 6", "program stop (M0), line 9"); empty: a pen change.
+    std::string pause_note{};
 };
 
 /// Curve segments of a polyline or Bezier chain: the joints Subpath::stops counts lie between
