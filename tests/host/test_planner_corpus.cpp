@@ -1,10 +1,11 @@
 // Every example (examples/*.json, *.svg, *.ngc, *.csv) and every test input under tests/data/
 // that the readers accept plans on the pen plotter within its limits and the chord tolerance,
-// checked tick by tick (check_plan). Files are found by listing the folders, not by name: a
-// file a reader refuses is skipped by that verdict (and said so), and so is a job whose
-// motion is estimated before planning (JobEstimate) at over kMotionBudget seconds, because
-// the check costs time per tick: tests/data/gcode/arc_f1_medium.ngc and arc_f1_big.ngc, 1 mm/min
-// for 52 and 157 hours, are planned by their own hidden test (test_planner_slow_feed.cpp).
+// checked tick by tick (check_plan); an input of three axes on the 3-axis router of
+// tests/data/machines/ (whose machine profiles are not inputs). Files are found by listing the
+// folders, not by name: a file a reader refuses is skipped by that verdict (and said so), and so is
+// a job whose motion is estimated before planning (JobEstimate) at over kMotionBudget seconds,
+// because the check costs time per tick: tests/data/gcode/arc_f1_medium.ngc and arc_f1_big.ngc, 1
+// mm/min for 52 and 157 hours, are planned by their own hidden test (test_planner_slow_feed.cpp).
 #include <algorithm>
 #include <catch2/catch.hpp>
 #include <cmath>
@@ -52,7 +53,7 @@ std::vector<fs::path> inputs(const fs::path& dir, bool recursive) {
     const auto take = [&](const fs::directory_entry& e) {
         static const std::vector<std::string> kExt = {".json", ".svg", ".ngc", ".gcode",
                                                       ".nc",   ".gc",  ".csv"};
-        if (e.is_regular_file() &&
+        if (e.is_regular_file() && e.path().parent_path().filename() != "machines" &&
             std::find(kExt.begin(), kExt.end(), e.path().extension().string()) != kExt.end())
             out.push_back(e.path());
     };
@@ -83,8 +84,10 @@ struct Tally {
 
 /// Reads, plans and checks every input of `dir`.
 Tally plan_all(const fs::path& dir, bool recursive) {
-    const MachineProfile p =
+    const MachineProfile plotter =
         load_machine_profile(source_dir() + "/examples/machines/pen_plotter.json");
+    const MachineProfile router =
+        load_machine_profile(source_dir() + "/tests/data/machines/router_3axis.json");
     Tally t;
     for (const fs::path& file : inputs(dir, recursive)) {
         const std::string name = fs::relative(file, source_dir()).string();
@@ -96,6 +99,7 @@ Tally plan_all(const fs::path& dir, bool recursive) {
             ++t.refused;
             continue;
         }
+        const MachineProfile& p = path.axes == router.axes.size() ? router : plotter;
         const auto segs = to_bezier_segments(path);
         const double estimate = JobEstimate(segs, p).model_seconds();
         if (estimate > kMotionBudget) {

@@ -35,7 +35,8 @@ void add_sim_command(CLI::App& app, SimCommandOptions& o) {
         ->required()
         ->check(CLI::ExistingFile);
     cmd->add_option("--plot", o.plot_dir,
-                    "directory for path/speed/acceleration plots (SVG, and PNG with rsvg-convert)");
+                    "directory for path/speed/acceleration plots, and z with x, y, z axes (SVG, "
+                    "and PNG with rsvg-convert)");
     cmd->add_flag("--realtime", o.realtime,
                   "pace the device at its real tick rate (default: as fast as possible)");
     cmd->add_option("--plant", o.plant,
@@ -49,7 +50,8 @@ void add_sim_command(CLI::App& app, SimCommandOptions& o) {
         ->capture_default_str()
         ->check(CLI::Range(0.05, 20.0));
     cmd->add_flag("--y-up", o.y_up,
-                  "draw path.svg with +y upwards (default: downwards, like SVG and most plotters)");
+                  "draw path.svg with +y upwards (default: downwards, like SVG and most "
+                  "plotters; the 3-D view has z up)");
     cmd->add_flag("--json", o.json, "print the report as one JSON document on standard output");
     cmd->add_option(
         "--events", o.events,

@@ -196,6 +196,7 @@ std::string path_svg(SegmentSource& path, const RunRecord& r, const MachineProfi
                      const Options& options) {
     if (r.axes == 1) return position_time_svg(r, profile, options);
     if (r.axes == 0) throw std::invalid_argument("path_svg: the executed series has no axes");
+    if (r.xyz) return isometric_path_svg(path, r, profile, options);
     const std::size_t ax = 0, ay = 1;
 
     // Bounds: the executed series and the ideal path (16 samples per segment suffice).

@@ -115,15 +115,16 @@ private:
     bool have_first_ = false, have_last_ = false;
 };
 
-/// A path (axes 0 and 1) thinned to points at least `d` apart, the first point of every pen
-/// run kept; when more than `capacity` points are kept, `d` doubles and the points kept are
-/// thinned again (pen runs too, once they alone are too many). Capacity 0 keeps every point.
+/// A path (axes 0 and 1, or x, y, z in 3-D) thinned to points at least `d` apart, the first
+/// point of every pen run kept; when more than `capacity` points are kept, `d` doubles and the
+/// points kept are thinned again (pen runs too, once they alone are too many). Capacity 0
+/// keeps every point.
 class Trace {
 public:
-    explicit Trace(std::size_t capacity) : capacity_(capacity) {}
+    Trace(std::size_t capacity, bool three_d) : capacity_(capacity), three_d_(three_d) {}
 
-    void add(double x, double y, bool pen_down) {
-        const TracePoint p{x, y, pen_down};
+    void add(double x, double y, double z, bool pen_down) {
+        const TracePoint p{x, y, z, pen_down};
         last_seen_ = p;
         last_kept_ = keep(p, points_.empty() ? nullptr : &points_.back(), d_);
         if (last_kept_) points_.push_back(p);
@@ -144,19 +145,27 @@ private:
     bool keep(const TracePoint& p, const TracePoint* last, double d) const {
         if (last == nullptr || d == 0) return true;
         if (p.pen_down != last->pen_down && !coarse_) return true;
-        return std::hypot(p.x - last->x, p.y - last->y) >= d;
+        return distance(p, *last) >= d;
+    }
+
+    // In 2-D the plane's distance alone, as it always was: z is 0 there, but the three-argument
+    // hypot may round differently, and a plotter's plots must not change by a point.
+    double distance(const TracePoint& a, const TracePoint& b) const {
+        return three_d_ ? std::hypot(a.x - b.x, a.y - b.y, a.z - b.z)
+                        : std::hypot(a.x - b.x, a.y - b.y);
     }
 
     void thin() {
         // The first tolerance: the points' extent over the capacity.
         if (d_ == 0) {
-            double x0 = points_.front().x, x1 = x0, y0 = points_.front().y, y1 = y0;
+            TracePoint lo = points_.front(), hi = lo;
             for (const TracePoint& p : points_) {
-                if (!std::isfinite(p.x) || !std::isfinite(p.y)) continue;
-                x0 = std::min(x0, p.x), x1 = std::max(x1, p.x);
-                y0 = std::min(y0, p.y), y1 = std::max(y1, p.y);
+                if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) continue;
+                lo.x = std::min(lo.x, p.x), hi.x = std::max(hi.x, p.x);
+                lo.y = std::min(lo.y, p.y), hi.y = std::max(hi.y, p.y);
+                lo.z = std::min(lo.z, p.z), hi.z = std::max(hi.z, p.z);
             }
-            const double extent = std::hypot(x1 - x0, y1 - y0);
+            const double extent = distance(hi, lo);
             d_ = std::isfinite(extent) && extent > 0 ? extent / static_cast<double>(capacity_)
                                                      : 1e-9;
         }
@@ -177,6 +186,7 @@ private:
     }
 
     std::size_t capacity_;
+    bool three_d_;
     double d_ = 0;
     bool coarse_ = false;  ///< pen runs are thinned too
     std::vector<TracePoint> points_;
@@ -195,6 +205,7 @@ struct RunRecorder::State {
     std::size_t capacity;
     unsigned requested_h;
     bool plots;
+    std::optional<XyzAxes> xyz;  ///< the 3-D view's axes, when the machine has them
 
     unsigned h = 1;       ///< the half window once known
     std::uint64_t n = 0;  ///< ticks seen
@@ -226,7 +237,12 @@ struct RunRecorder::State {
           has_plant(plant),
           capacity(cap),
           requested_h(hw),
-          plots(pl) {}
+          plots(pl) {
+        // The profile's x, y, z, when the series has them (a recorder's axes are the profile's).
+        if (const std::optional<XyzAxes> named = xyz_axes(p);
+            named && std::max({named->x, named->y, named->z}) < ax)
+            xyz = named;
+    }
 
     /// Row `k` (k in the ring's window) of the executed series, axis `axis`.
     double at(std::uint64_t k, std::size_t axis) const {
@@ -341,12 +357,15 @@ RunRecorder::RunRecorder(const MachineProfile& profile, std::size_t axes, double
     s.r.tick_hz = tick_hz;
     s.r.axes = axes;
     s.r.has_plant = plant;
+    s.r.xyz = s.xyz;
     if (plots) {
-        for (std::size_t i = 0; i < 1 + axes + (axes == 1 ? 2 : 0); ++i)
+        // Speed, accelerations, and with one axis or in 3-D a position against time per series.
+        const bool positions = axes == 1 || s.xyz;
+        for (std::size_t i = 0; i < 1 + axes + (positions ? 2 : 0); ++i)
             s.envelopes.emplace_back(capacity);
         // A path's points: eight times as many, so that even a dense drawing keeps them
-        // closer than a pixel (65,536 points of 24 bytes by default).
-        if (axes >= 2) s.traces.assign(plant ? 2 : 1, Trace(8 * capacity));
+        // closer than a pixel (65,536 points of 32 bytes by default).
+        if (axes >= 2) s.traces.assign(plant ? 2 : 1, Trace(8 * capacity, s.xyz.has_value()));
     }
 }
 
@@ -381,18 +400,23 @@ void RunRecorder::add(const double* executed_mm, const double* plant_mm, bool pe
     for (std::size_t series = 0; series < (s.has_plant ? 2u : 1u); ++series) {
         const double* p = series == 0 ? executed_mm : plant_mm;
         if (s.axes >= 2) {
-            if (std::isfinite(p[0]) && std::isfinite(p[1])) {
-                for (int ax = 0; ax < 2; ++ax) {
+            // The plane's axes 0 and 1, or in 3-D the axes named x, y and z.
+            const double v[3] = {p[s.xyz ? s.xyz->x : 0], p[s.xyz ? s.xyz->y : 1],
+                                 s.xyz ? p[s.xyz->z] : 0.0};
+            const int kept = s.xyz ? 3 : 2;
+            if (std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2])) {
+                for (int ax = 0; ax < kept; ++ax) {
                     if (!s.r.bounded[series]) {
-                        s.r.lo[series][ax] = s.r.hi[series][ax] = p[ax];
+                        s.r.lo[series][ax] = s.r.hi[series][ax] = v[ax];
                     } else {
-                        s.r.lo[series][ax] = std::min(s.r.lo[series][ax], p[ax]);
-                        s.r.hi[series][ax] = std::max(s.r.hi[series][ax], p[ax]);
+                        s.r.lo[series][ax] = std::min(s.r.lo[series][ax], v[ax]);
+                        s.r.hi[series][ax] = std::max(s.r.hi[series][ax], v[ax]);
                     }
                 }
                 s.r.bounded[series] = true;
             }
-            s.traces[series].add(p[0], p[1], pen_down);
+            s.traces[series].add(v[0], v[1], v[2], pen_down);
+            if (s.xyz) s.envelopes[1 + s.axes + series].add(k, v[2]);
         } else {
             if (!s.r.bounded[series]) {
                 s.r.lo[series][0] = s.r.hi[series][0] = p[0];
@@ -451,7 +475,7 @@ RunRecord RunRecorder::finish() {
         thinned = thinned || s.acceleration_envelope(ax).thinned();
     }
     thinned = thinned || s.speed_envelope().thinned();
-    if (s.axes == 1) {
+    if (s.axes == 1 || s.xyz) {
         for (std::size_t series = 0; series < (s.has_plant ? 2u : 1u); ++series) {
             r.position[series] = s.envelopes[1 + s.axes + series].take_points(s.tick_hz);
             thinned = thinned || s.envelopes[1 + s.axes + series].thinned();

@@ -152,11 +152,16 @@ WrittenPlots write_plots(const std::string& directory, const std::vector<BezierS
 WrittenPlots write_plots(const std::string& directory, SegmentSource& path, const RunRecord& record,
                          const MachineProfile& profile, const Options& options) {
     WrittenPlots w;
-    const std::string names[3] = {"path", "speed", "acceleration"};
-    const std::string svgs[3] = {path_svg(path, record, profile, options),
-                                 speed_svg(record, profile, options),
-                                 acceleration_svg(record, profile, options)};
-    for (int i = 0; i < 3; ++i) {
+    std::vector<std::string> names = {"path", "speed", "acceleration"};
+    std::vector<std::string> svgs = {path_svg(path, record, profile, options),
+                                     speed_svg(record, profile, options),
+                                     acceleration_svg(record, profile, options)};
+    // A machine with x, y and z: z against time too, where plunges and retracts show.
+    if (record.xyz) {
+        names.push_back("z");
+        svgs.push_back(z_svg(record, profile, options));
+    }
+    for (std::size_t i = 0; i < names.size(); ++i) {
         const std::string file = join(directory, names[i] + ".svg");
         write_text(file, svgs[i]);
         w.files.push_back(file);
@@ -169,9 +174,9 @@ WrittenPlots write_plots(const std::string& directory, SegmentSource& path, cons
             "librsvg2-bin, or run scripts/setup.sh)";
         return w;
     }
-    for (int i = 0; i < 3; ++i) {
+    for (std::size_t i = 0; i < names.size(); ++i) {
         const std::string png = join(directory, names[i] + ".png");
-        svg_to_png(*rsvg, w.files[static_cast<std::size_t>(i)], png);
+        svg_to_png(*rsvg, w.files[i], png);
         w.files.push_back(png);
     }
     w.png = true;

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "pathstream/host/geometry.hpp"
+#include "pathstream/host/isometric.hpp"
 #include "pathstream/host/plan.hpp"
 #include "pathstream/host/segment_source.hpp"
 #include "pathstream/machine/machine.hpp"
@@ -90,10 +91,12 @@ void pen_figures(const TickSeries& executed, ExecutedFigures& f);
 ExecutedFigures executed_figures(const TickSeries& series, const MachineProfile& profile,
                                  unsigned half_window = 0);
 
-/// One kept point of an executed path (path.svg): axes 0 and 1 in mm, and the pen.
+/// One kept point of an executed path (path.svg): axes 0 and 1 in mm, and the pen; in the
+/// 3-D view (RunRecord::xyz) the axes named x, y and z.
 struct TracePoint {
     double x = 0;
     double y = 0;
+    double z = 0;  ///< 0 but in the 3-D view
     bool pen_down = false;
 };
 
@@ -110,14 +113,19 @@ struct RunRecord {
     std::string executed_name = "setpoints";
     std::string plant_name;  ///< the plant series' name
     bool has_plant = false;
-    /// Axes >= 2: axes 0 and 1 of the executed series and of the plant (path.svg).
+    /// The machine's x, y and z axes when it has them (xyz_axes): path.svg is then the
+    /// isometric view, and write_plots adds z.svg.
+    std::optional<XyzAxes> xyz;
+    /// Axes >= 2: axes 0 and 1 of the executed series and of the plant (path.svg); with xyz,
+    /// axes x, y and z.
     std::vector<TracePoint> executed_path, plant_path;
-    /// Exact bounds over every tick of axes 0 and 1 (finite points only): [series][axis].
-    double lo[2][2] = {}, hi[2][2] = {};
+    /// Exact bounds over every tick of what the paths hold (finite points only):
+    /// [series][0, 1 and, with xyz, 2 for z].
+    double lo[2][3] = {}, hi[2][3] = {};
     bool bounded[2] = {false, false};  ///< the series had a finite point
     /// Times (s) and values, in time order, first and last tick included: the path speed,
-    /// each axis's acceleration, and with one axis the positions of axis 0 ([0] executed,
-    /// [1] plant).
+    /// each axis's acceleration, and the positions ([0] executed, [1] plant) of axis 0 with
+    /// one axis, of axis z with xyz.
     std::vector<Point> speed;
     std::vector<std::vector<Point>> acceleration;
     std::vector<Point> position[2];
@@ -181,7 +189,8 @@ struct Options {
 /// travel dashed, grey and wide underneath; with layers, each layer's pen-down path in its
 /// colour with a legend entry) and the executed positions of `executed` and, if
 /// given, `plant` (pen-down solid, pen-up dashed), axes 0 and 1 at equal scale with mm ticks
-/// and a legend above the plot. One axis: position against time instead.
+/// and a legend above the plot. One axis: position against time instead; a machine with x, y
+/// and z axes (xyz_axes): the isometric view (isometric_path_svg).
 /// Series are SVG groups with ids "ideal-path", "setpoints" (executed) and "plant".
 std::string path_svg(const std::vector<BezierSegment>& path, const TickSeries& executed,
                      const TickSeries* plant, const MachineProfile& profile,
@@ -207,6 +216,23 @@ std::string speed_svg(const RunRecord& record, const MachineProfile& profile,
 std::string acceleration_svg(const RunRecord& record, const MachineProfile& profile,
                              const Options& options);
 
+/// path.svg of a record with xyz (what path_svg draws then): the ideal path and the executed
+/// motion in 3-D, in the isometric view (isometric(): +x to the lower right, +y to the upper
+/// right, +z up, a mm along any axis a mm on the plot), at equal scale. Pen-down (feed) moves
+/// solid, pen-up travel (rapids) dashed; the box that holds the path and the motion in thin
+/// grey; left of it arrows along +x, +y, +z named by the axes' names (group "axis-arrows"),
+/// right of it an upright scale bar (group "scale"), both one nice length in mm (1, 2 or 5 x
+/// 10^n, at most a quarter of the largest extent). Groups "ideal-path", "setpoints", "plant",
+/// "bounding-box" too. Throws std::invalid_argument without xyz.
+std::string isometric_path_svg(SegmentSource& path, const RunRecord& record,
+                               const MachineProfile& profile, const Options& options);
+
+/// z.svg of a record with xyz: z against time, the setpoints (what the device is commanded:
+/// group "setpoints") and the plant's position (what it executed: group "plant"; without a
+/// plant the setpoints are both, which the note says), pen-up (rapid) time shaded. Throws
+/// std::invalid_argument without xyz.
+std::string z_svg(const RunRecord& record, const MachineProfile& profile, const Options& options);
+
 /// What write_plots wrote.
 struct WrittenPlots {
     std::vector<std::string> files;  ///< every file written, SVGs then PNGs
@@ -214,7 +240,8 @@ struct WrittenPlots {
     std::string note;                ///< why not, when options.png was set but no PNG came
 };
 
-/// Writes DIRECTORY/path.svg, speed.svg, acceleration.svg (each atomically: whole or absent)
+/// Writes DIRECTORY/path.svg, speed.svg, acceleration.svg (each atomically: whole or absent),
+/// with the machine's x, y and z axes (xyz_axes) path.svg in 3-D and a fourth, z.svg,
 /// and, when options.png and rsvg-convert is on PATH, a PNG of each. The directory must exist.
 /// Throws std::runtime_error naming the file when a file cannot be written or rsvg-convert
 /// fails; a missing rsvg-convert is not an error (see WrittenPlots::note).
@@ -222,7 +249,8 @@ WrittenPlots write_plots(const std::string& directory, const std::vector<BezierS
                          const TickSeries& executed, const TickSeries* plant,
                          const MachineProfile& profile, const Options& options);
 
-/// write_plots from a record, the ideal path read from `path`.
+/// write_plots from a record, the ideal path read from `path`. With record.xyz, also z.svg
+/// (and z.png).
 WrittenPlots write_plots(const std::string& directory, SegmentSource& path, const RunRecord& record,
                          const MachineProfile& profile, const Options& options);
 
