@@ -102,7 +102,7 @@ function setOrigin(origin) {
 // The layer list under the preview is its legend too: each layer's colour, name and
 // subpaths, and a box that plans it or leaves it out (`chosen`: the layers planned, by
 // number from 1 or name; none: all).
-function showLayers(layers, chosen) {
+function showLayers(layers, chosen, rapids) {
   if (!chosen || page.allLayers.length !== layers.length) page.allLayers = layers;
   page.colours = layerColours(layers);
   const entries = layers.length < 2 ? [] : page.allLayers.map((l, i) => {
@@ -128,7 +128,7 @@ function showLayers(layers, chosen) {
   travel.className = 'entry';
   const dash = document.createElement('span');
   dash.className = 'swatch travel';
-  travel.append(dash, ' pen-up travel');
+  travel.append(dash, rapids ? ' rapids (pen-up travel)' : ' pen-up travel');
   $('layers').replaceChildren(...entries, travel);
 }
 
@@ -159,7 +159,7 @@ function showPreview(p) {
   setFigure('fig-pens', s.pen_changes, `${s.pen_changes}, ${s.pauses}`);
   $('drawing-name').textContent = p.drawing;
   // summary.layers lists every layer of the drawing, planned or not: the colours stay.
-  showLayers(s.layers, p.options && p.options.layers);
+  showLayers(s.layers, p.options && p.options.layers, Boolean(p.view));
   $('preview').hidden = false;
   $('speed').hidden = false;
   $('no-preview').hidden = true;
@@ -326,7 +326,7 @@ function showDevice(d) {
   $('alarm').textContent = alarm;
   if (!page.jobRunning) {
     const axes = Object.values(d.position_mm);
-    view.marker = axes.length >= 2 ? axes.slice(0, 2) : null;
+    view.marker = view.iso ? view.projectPosition(d.position_mm) : (axes.length >= 2 ? axes.slice(0, 2) : null);
     if (page.preview) scheduleDraw();
   }
 }
@@ -386,7 +386,7 @@ function onEvent(e) {
       $('progress-text').textContent =
         `${percent(f)}  ETA ${e.eta_s === null ? '?' : minutes(e.eta_s)}  queue ${e.queue_s.toFixed(2)} s (${e.queue_spans} spans) ${pen}`;
       const axes = Object.values(e.position_mm);
-      view.marker = axes.slice(0, 2);
+      view.marker = view.iso ? view.projectPosition(e.position_mm) : axes.slice(0, 2);
       // The preview's tick: the job's end is the preview's end (a lead-in or a move back
       // onto the drawing comes before the drawing's ticks).
       if (page.preview && page.preview === page.jobPreview && e.plan_ticks !== null) {

@@ -4,6 +4,9 @@
 // marker. Vertices come from the server's preview (span end points of the plan).
 // y points the way the machine's does: down from a top-left origin, or up from a bottom-left
 // one (`yUp`), so the jog pad's arrows and the pen's marker move the same way on screen.
+// A machine with x, y and z axes (a router: the preview has `view` and path.z) is shown in
+// the isometric view instead, the one path.svg of `pathstream sim --plot` draws: x to the
+// lower right, y to the upper right, z up; its work volume as a box.
 
 const TRAVEL = '#9aa5b1';
 const BACKGROUND = '#dee2e6', AREA_FILL = '#f8f9fa', AREA_EDGE = '#adb5bd';
@@ -16,6 +19,18 @@ const MARKER = '#d62828', CUT = '#2a9d8f', LABEL = '#495057';
 // other and from the travel's grey, the outlines, the paper and the marker's red.
 const PALETTE = ['#1d3557', '#2a9d8f', '#f4a261', '#b5179e', '#0096c7', '#7f5539', '#f77f00', '#4cc9f0', '#9d0208',
   '#3a86ff', '#2b9348', '#8338ec'];
+
+// The isometric view of a point, mm: [right, up] = [(x + y) cos 30°, z + (y - x) / 2]
+// (host/include/pathstream/host/isometric.hpp; a mm along any axis is a mm on the view).
+const COS30 = 0.8660254037844386;
+export function isometric(x, y, z) {
+  return [(x + y) * COS30, z + (y - x) * 0.5];
+}
+
+// The box's eight corners, corner k taking each axis's max where its bit (x 1, y 2, z 4) is set.
+function boxCorners(b) {
+  return [0, 1, 2, 3, 4, 5, 6, 7].map(k => [k & 1 ? b.x_max : b.x_min, k & 2 ? b.y_max : b.y_min, k & 4 ? b.z_max : b.z_min]);
+}
 
 function luminance(hex) {
   const n = parseInt(hex.slice(1), 16);
@@ -46,6 +61,7 @@ export class PreviewView {
     this.doneTick = -1;          // the job's progress on this plan; -1: no job on it
     this.marker = null;          // [x, y] mm
     this.rest = null;            // where the pen is before the job (the lead-in starts there)
+    this.iso = null;             // the preview's `view` when it is the 3-D (isometric) one
   }
 
   // Keeps the arrays in typed form: a 10^5-vertex path redraws without allocation. null: no
@@ -56,13 +72,22 @@ export class PreviewView {
     this.doneTick = -1;
     if (!p) {
       this.preview = null;
+      this.iso = null;
       return;
     }
     const n = p.path.x.length;
+    // In 3-D the view's x and y are the isometric view's right and up, mm: all that draws
+    // below works on them as on a plotter's x and y.
+    const iso = p.view && p.view.projection === 'isometric' && Array.isArray(p.path.z) ? p.view : null;
+    const x = Float64Array.from(p.path.x), y = Float64Array.from(p.path.y);
+    if (iso) {
+      for (let i = 0; i < n; i++) [x[i], y[i]] = isometric(p.path.x[i], p.path.y[i], p.path.z[i]);
+    }
+    this.iso = iso;
     this.preview = {
       n,
-      x: Float64Array.from(p.path.x),
-      y: Float64Array.from(p.path.y),
+      x,
+      y,
       tick: Float64Array.from(p.path.tick),
       pen: Uint8Array.from(p.path.pen),
       layer: Uint16Array.from(p.path.layer || new Array(n).fill(0)),
@@ -73,7 +98,19 @@ export class PreviewView {
     };
     this.colours = colours.length ? colours : [PALETTE[0]];
     this.rest = p.rest_mm && p.rest_mm.length >= 2 ? p.rest_mm : null;
+    if (this.rest && iso) {
+      const [ax, ay, az] = iso.axes;
+      this.rest = p.rest_mm.length > Math.max(ax, ay, az) ? isometric(p.rest_mm[ax], p.rest_mm[ay], p.rest_mm[az]) : null;
+    }
+    this.canvas.dataset.view = iso ? 'isometric' : 'plan';
     this.fitView();
+  }
+
+  // The 3-D view's marker for a device position by axis name ({x: .., y: .., z: ..}): its
+  // projection; null without all three (a plotter's marker is its first two axes).
+  projectPosition(position) {
+    if (!this.iso || !position || ![position.x, position.y, position.z].every(Number.isFinite)) return null;
+    return isometric(position.x, position.y, position.z);
   }
 
   setYUp(up) {
@@ -87,7 +124,10 @@ export class PreviewView {
     const p = this.preview;
     let x0 = Infinity, y0 = Infinity, x1 = -Infinity, y1 = -Infinity;
     const grow = (x, y) => { x0 = Math.min(x0, x); x1 = Math.max(x1, x); y0 = Math.min(y0, y); y1 = Math.max(y1, y); };
-    if (p) {
+    if (p && this.iso) {
+      if (this.iso.box) for (const c of boxCorners(this.iso.box)) grow(...isometric(...c));
+      for (let i = 0; i < p.n; i++) grow(p.x[i], p.y[i]);
+    } else if (p) {
       if (p.area) { grow(p.area.x_min, p.area.y_min); grow(p.area.x_max, p.area.y_max); }
       if (p.paper) { grow(p.paper.x_min, p.paper.y_min); grow(p.paper.x_max, p.paper.y_max); }
       for (let i = 0; i < p.n; i++) grow(p.x[i], p.y[i]);
@@ -121,7 +161,8 @@ export class PreviewView {
     const w = this.canvas.width, h = this.canvas.height, pad = 18 * this.dpr;
     const scale = Math.min((w - 2 * pad) / Math.max(x1 - x0, 1e-6), (h - 2 * pad) / Math.max(y1 - y0, 1e-6));
     const left = (w - (x1 - x0) * scale) / 2, top = (h - (y1 - y0) * scale) / 2;
-    this.view = this.yUp
+    // The isometric view's up is up, whichever corner a plotter's origin would be in.
+    this.view = this.yUp || this.iso
       ? { sx: scale, sy: -scale, ox: left - x0 * scale, oy: top + y1 * scale }
       : { sx: scale, sy: scale, ox: left - x0 * scale, oy: top - y0 * scale };
   }
@@ -205,13 +246,15 @@ export class PreviewView {
     ctx.fillStyle = BACKGROUND;
     ctx.fillRect(0, 0, this.base.width, this.base.height);
     const marks = {};
-    if (p.area) {
+    if (this.iso) {
+      marks.area = this.volume(ctx);
+    } else if (p.area) {
       const r = this.rect(p.area);
       this.outline(ctx, r, AREA_FILL, AREA_EDGE, 1, []);
       this.label(ctx, `work area ${size(p.area)}`, r.left + 3 * this.dpr, r.top - 2 * this.dpr);
       marks.area = r;
     }
-    if (p.paper) {
+    if (p.paper && !this.iso) {
       const r = this.rect(p.paper);
       this.outline(ctx, r, PAPER_FILL, PAPER_EDGE, 1, []);
       const m = p.paper.margin_mm || 0;
@@ -223,7 +266,8 @@ export class PreviewView {
         r.left + 3 * this.dpr, r.bottom + 13 * this.dpr);
       marks.paper = r;
     }
-    // Where the outlines are, CSS pixels (left, top, right, bottom): for the page's tests.
+    // Where the outlines are, CSS pixels (left, top, right, bottom): for the page's tests. In
+    // 3-D `area` is the box around the work volume's view.
     const css = r => r ? [r.left, r.top, r.right, r.bottom].map(v => +(v / this.dpr).toFixed(1)).join(',') : '';
     this.canvas.dataset.area = css(marks.area);
     this.canvas.dataset.paper = css(marks.paper);
@@ -249,6 +293,48 @@ export class PreviewView {
     ctx.getImageData(0, 0, 1, 1);
     this.built = { last, done, running };
     return performance.now() - t0;
+  }
+
+  // The 3-D view's frame: the work volume's edges (when every axis has a travel) and, in the
+  // lower left corner, arrows along +x, +y, +z (their directions on the view, 36 px long).
+  // Returns the volume's bounding box on the canvas (device px), or undefined without one.
+  volume(ctx) {
+    const { sx, sy, ox, oy } = this.view, dpr = this.dpr, b = this.iso.box;
+    ctx.lineWidth = dpr;
+    let box;
+    if (b) {
+      const corners = boxCorners(b).map(c => isometric(...c)).map(([u, v]) => [ox + u * sx, oy + v * sy]);
+      ctx.beginPath();
+      for (let k = 0; k < 8; k++) {
+        for (const bit of [1, 2, 4]) {
+          if (k & bit) continue;
+          ctx.moveTo(...corners[k]);
+          ctx.lineTo(...corners[k | bit]);
+        }
+      }
+      ctx.strokeStyle = AREA_EDGE;
+      ctx.stroke();
+      const xs = corners.map(c => c[0]), ys = corners.map(c => c[1]);
+      box = { left: Math.min(...xs), top: Math.min(...ys), right: Math.max(...xs), bottom: Math.max(...ys) };
+      const top = corners.reduce((a, c) => (c[1] < a[1] ? c : a));
+      this.label(ctx, `work volume ${+(b.x_max - b.x_min).toFixed(1)} × ${+(b.y_max - b.y_min).toFixed(1)} × ${+(b.z_max - b.z_min).toFixed(1)} mm`,
+        top[0] - 60 * dpr, top[1] - 3 * dpr);
+    }
+    const o = [14 * dpr, this.base.height - 30 * dpr];
+    ctx.font = `${11 * dpr}px system-ui, sans-serif`;
+    ctx.textBaseline = 'middle';
+    [['x', 1, 0, 0], ['y', 0, 1, 0], ['z', 0, 0, 1]].forEach(([name, ...e]) => {
+      const [u, v] = isometric(...e);
+      const tip = [o[0] + 36 * dpr * u, o[1] - 36 * dpr * v];
+      ctx.beginPath();
+      ctx.moveTo(...o);
+      ctx.lineTo(...tip);
+      ctx.strokeStyle = LABEL;
+      ctx.stroke();
+      ctx.fillStyle = LABEL;
+      ctx.fillText(name, tip[0] + 6 * dpr * u - 3 * dpr, tip[1] - 8 * dpr * v);
+    });
+    return box;
   }
 
   // Shows the current state; returns the milliseconds of a full redraw of the path, or 0 when

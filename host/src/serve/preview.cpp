@@ -4,6 +4,7 @@
 #include <cmath>
 #include <set>
 
+#include "pathstream/host/isometric.hpp"
 #include "pathstream/host/layers.hpp"
 #include "pathstream/host/placement.hpp"
 
@@ -12,6 +13,7 @@ namespace {
 
 struct Vertex {
     double x = 0, y = 0;
+    double z = 0;  ///< the 3-D view's z; 0 in 2-D
     std::uint64_t tick = 0;
     bool pen = false;
     std::size_t layer = 0;  ///< Path::layers index of the subpath the piece ending here belongs to
@@ -25,12 +27,22 @@ double off_chord(const Vertex& a, const Vertex& b, const Vertex& p) {
     return std::fabs(dx * (p.y - a.y) - dy * (p.x - a.x)) / length;
 }
 
+// The same in 3-D: |(b - a) x (p - a)| / |b - a|. Apart from off_chord so that a plotter's
+// preview stays what it was to the bit.
+double off_chord_3d(const Vertex& a, const Vertex& b, const Vertex& p) {
+    const double dx = b.x - a.x, dy = b.y - a.y, dz = b.z - a.z;
+    const double ex = p.x - a.x, ey = p.y - a.y, ez = p.z - a.z;
+    const double length = std::hypot(dx, dy, dz);
+    if (length < 1e-12) return std::hypot(ex, ey, ez);
+    return std::hypot(dy * ez - dz * ey, dz * ex - dx * ez, dx * ey - dy * ex) / length;
+}
+
 // Keeps the vertices that the tolerance needs: a run from the last kept vertex grows while
 // every point in it stays within `tolerance` of the chord and the pen stays the same; the
 // runs are bounded so that a long gentle curve costs a fixed amount of work per vertex.
 class Simplifier {
 public:
-    explicit Simplifier(double tolerance) : tolerance_(tolerance) {}
+    Simplifier(double tolerance, bool three_d) : tolerance_(tolerance), three_d_(three_d) {}
 
     void add(const Vertex& v) {
         if (kept_.empty()) {
@@ -56,6 +68,15 @@ private:
 
     bool fits(const Vertex& v) const {
         const Vertex& a = kept_.back();
+        if (three_d_) {
+            const Vertex& b = run_.back();
+            if (std::hypot(v.x - a.x, v.y - a.y, v.z - a.z) <
+                std::hypot(b.x - a.x, b.y - a.y, b.z - a.z))
+                return false;
+            return std::all_of(run_.begin(), run_.end(), [&](const Vertex& p) {
+                return off_chord_3d(a, v, p) <= tolerance_;
+            });
+        }
         if (std::hypot(v.x - a.x, v.y - a.y) < std::hypot(run_.back().x - a.x, run_.back().y - a.y))
             return false;
         return std::all_of(run_.begin(), run_.end(),
@@ -63,6 +84,7 @@ private:
     }
 
     double tolerance_;
+    bool three_d_;
     std::vector<Vertex> kept_, run_;
 };
 
@@ -76,12 +98,17 @@ double rounded(double v, int digits) {
 
 struct PreviewRecorder::State {
     State(const Path& p, const MachineProfile& m, const PreviewOptions& o)
-        : path(p), machine(m), options(o), simplifier(o.tolerance_mm) {
+        : path(p),
+          machine(m),
+          options(o),
+          xyz(xyz_axes(m)),
+          simplifier(o.tolerance_mm, xyz.has_value()) {
         fine.assign(std::max<std::size_t>(2, 2 * o.speed_samples), 0.0);
     }
     const Path& path;
     const MachineProfile& machine;
     PreviewOptions options;
+    std::optional<XyzAxes> xyz;  ///< a router's x, y, z: the page shows the isometric view
     Simplifier simplifier;
     std::set<std::size_t> drawn_subpaths;
     std::uint64_t tick = 0;
@@ -123,20 +150,43 @@ PreviewRecorder::~PreviewRecorder() = default;
 void PreviewRecorder::span(const CoreSpan& s) {
     State& st = *state_;
     const double mm = st.machine.mm_per_lsb;
-    const std::size_t ax = st.machine.axes.size();
     // The planner's spans are Hermite (P0, P1, T0, T1): P0 where it starts, P1 where it ends.
     const std::size_t layer =
         s.subpath < st.path.subpaths.size() ? st.path.subpaths[s.subpath].layer : 0;
+    if (st.xyz) {
+        const XyzAxes& a = *st.xyz;
+        const auto at = [&](int end) {
+            return Vertex{s.control.at(a.x)[end] * mm,
+                          s.control.at(a.y)[end] * mm,
+                          s.control.at(a.z)[end] * mm,
+                          0,
+                          false,
+                          layer};
+        };
+        if (st.spans == 0) st.simplifier.add(at(0));
+        Vertex v = at(1);
+        const Vertex from = at(0);
+        st.add_speed(st.tick, std::hypot(v.x - from.x, v.y - from.y, v.z - from.z) *
+                                  st.machine.tick_hz / s.ticks);
+        st.tick += s.ticks;
+        ++st.spans;
+        if (s.pen_down) st.drawn_subpaths.insert(s.subpath);
+        v.tick = st.tick;
+        v.pen = s.pen_down;
+        st.simplifier.add(v);
+        return;
+    }
+    const std::size_t ax = st.machine.axes.size();
     if (st.spans == 0)
         st.simplifier.add(
-            {s.control.at(0)[0] * mm, ax > 1 ? s.control.at(1)[0] * mm : 0.0, 0, false, layer});
+            {s.control.at(0)[0] * mm, ax > 1 ? s.control.at(1)[0] * mm : 0.0, 0, 0, false, layer});
     const double dx = (s.control.at(0)[1] - s.control.at(0)[0]) * mm;
     const double dy = ax > 1 ? (s.control.at(1)[1] - s.control.at(1)[0]) * mm : 0.0;
     st.add_speed(st.tick, std::hypot(dx, dy) * st.machine.tick_hz / s.ticks);
     st.tick += s.ticks;
     ++st.spans;
     if (s.pen_down) st.drawn_subpaths.insert(s.subpath);
-    st.simplifier.add({s.control.at(0)[1] * mm, ax > 1 ? s.control.at(1)[1] * mm : 0.0, st.tick,
+    st.simplifier.add({s.control.at(0)[1] * mm, ax > 1 ? s.control.at(1)[1] * mm : 0.0, 0, st.tick,
                        s.pen_down, layer});
 }
 
@@ -183,7 +233,25 @@ nlohmann::ordered_json PreviewRecorder::finish(double duration_s, std::uint64_t 
     } else {
         out["work_area"] = nullptr;
     }
-    std::vector<double> xs, ys;
+    if (st.xyz) {
+        // The page draws x, y, z in the isometric view; `axes` are the machine's indexes of
+        // them (rest_mm is in the machine's order), `box` its x, y, z travel when all have one.
+        const XyzAxes& a = *st.xyz;
+        const AxisLimits &x = st.machine.axes[a.x], &y = st.machine.axes[a.y],
+                         &z = st.machine.axes[a.z];
+        nlohmann::ordered_json view;
+        view["projection"] = "isometric";
+        view["axes"] = {a.x, a.y, a.z};
+        if (x.has_travel && y.has_travel && z.has_travel) {
+            view["box"] = {{"x_min", x.travel_min}, {"y_min", y.travel_min},
+                           {"z_min", z.travel_min}, {"x_max", x.travel_max},
+                           {"y_max", y.travel_max}, {"z_max", z.travel_max}};
+        } else {
+            view["box"] = nullptr;
+        }
+        out["view"] = view;
+    }
+    std::vector<double> xs, ys, zs;
     std::vector<std::uint64_t> ticks;
     std::vector<int> pens;
     std::vector<std::size_t> layers;
@@ -195,11 +263,13 @@ nlohmann::ordered_json PreviewRecorder::finish(double duration_s, std::uint64_t 
     for (const Vertex& v : vertices) {
         xs.push_back(rounded(v.x, 4));
         ys.push_back(rounded(v.y, 4));
+        if (st.xyz) zs.push_back(rounded(v.z, 4));
         ticks.push_back(v.tick);
         pens.push_back(v.pen ? 1 : 0);
         layers.push_back(v.layer);
     }
     out["path"] = {{"x", xs}, {"y", ys}, {"tick", ticks}, {"pen", pens}, {"layer", layers}};
+    if (st.xyz) out["path"]["z"] = zs;
     std::vector<double> t, v;
     for (std::size_t b = 0; b < bins; ++b) {
         t.push_back(

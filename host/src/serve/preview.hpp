@@ -32,6 +32,11 @@ struct PreviewOptions {
 ///    end point, merged as `options` says (never across a change of pen or layer);
 ///  speed: t (s) and v (mm/s), the fastest span speed in each of up to speed_samples bins;
 ///  pauses: the ticks of the programmed pauses.
+/// A machine with axes named x, y and z (xyz_axes: a router) previews in 3-D: the path's x, y
+/// and a third array z are those axes (merged within the tolerance in 3-D, speeds over all
+/// three), and `view` says how the page shows them: projection "isometric" (isometric()),
+/// axes (the machine's indexes of x, y, z) and box (their travel, x_min .. z_max, or null).
+/// Other machines' documents have no `view` and no z: the page's 2-D view of axes 0 and 1.
 /// Cost: one pass over the spans (a few vertices' work per span). Any thread.
 nlohmann::ordered_json preview_json(const Plan& plan, const Path& path,
                                     const MachineProfile& machine,
