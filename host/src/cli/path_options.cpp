@@ -50,10 +50,10 @@ void add_path_options(CLI::App& command, JobRequest& o) {
         .add_option("--tool-table", o.gcode_tool_table,
                     "G-code: LinuxCNC tool table file that G43 H reads")
         ->check(CLI::ExistingFile);
-    command.add_option(
-        "--ignore-code", o.gcode_ignore,
-        "G-code: skip this G or M code with a warning, like M300 (repeatable; M6, M7-M9 and "
-        "others are skipped already)");
+    command.add_option("--ignore-code", o.gcode_ignore,
+                       "G-code: skip this G or M code with a warning, like M300 (repeatable; M6 on "
+                       "a plotter, M7-M9 and "
+                       "others are skipped already)");
     command
         .add_option("--gcode-z-down", o.gcode_z_down, "G-code: highest Z (mm) with the pen down")
         ->capture_default_str();
