@@ -3,6 +3,7 @@
 // table, polar coordinates, checksums, feed modes; each against hand-computed moves.
 #include <catch2/catch.hpp>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <numbers>
 #include <stdexcept>
@@ -352,4 +353,35 @@ TEST_CASE("G-code machine: the loaded tool, G43.1 and units", "[gcode][machine]"
           "t.ngc:2:5: feed move with no feed rate (give F first)");
     CHECK(error_of("G1 @5 F60\n") ==
           "t.ngc:1:4: polar coordinates at the origin need ^ (the angle)");
+}
+
+TEST_CASE("G-code: subroutine files, labels from parameters, LinuxCNC's parameter forms",
+          "[gcode][oword]") {
+    std::filesystem::create_directories("gcode_subs/lib");
+    std::ofstream("gcode_subs/lib/touchoff.ngc")
+        << "o<touchoff> sub\nG1 X[#1] Y[#2]\no<touchoff> endsub\n";
+    std::ofstream("gcode_subs/lib/bad.ngc") << "o<bad> sub\nG1 X1 Q\no<bad> endsub\n";
+    std::ofstream("gcode_subs/lib/other.ngc") << "o<elsewhere> sub\no<elsewhere> endsub\n";
+    GcodeOptions o = router();
+    o.subroutine_path = {"gcode_subs/none", "gcode_subs/lib"};
+    // The file's subroutine, then one the program defines called through a parameter, then
+    // #ATAN[1]/[1] is #45 and EXISTS of a numbered parameter is 1.
+    check_waypoints(gcode("G1 X0 F60\no<touchoff> call [5] [7]\n#<s>=100\no100 sub\nG1 X1 Y1\n"
+                          "o100 endsub\no#<s> call\n#atan[1]/[1]=3\no1 if [EXISTS[#1]]\n"
+                          "G1 X#45\no1 endif\no<touchoff> call [2] [2]\n",
+                          o),
+                    {{D, {5, 7, 0}}, {D, {1, 1, 0}}, {D, {3, 1, 0}}, {D, {2, 2, 0}}});
+    // Errors in a subroutine file name that file.
+    CHECK(error_of("G1 X0 F60\no<bad> call\n", o) ==
+          "gcode_subs/lib/bad.ngc:2:7: missing number after Q");
+    CHECK(error_of("o<missing> call\n", o) ==
+          "t.ngc:1:1: O<missing> call: no such subroutine in this file, nor missing.ngc in the "
+          "subroutine path (gcode_subs/none, gcode_subs/lib)");
+    std::filesystem::copy_file("gcode_subs/lib/other.ngc", "gcode_subs/lib/misnamed.ngc",
+                               std::filesystem::copy_options::overwrite_existing);
+    CHECK(error_of("o<misnamed> call\n", o) ==
+          "t.ngc:1:1: O<misnamed> call: gcode_subs/lib/misnamed.ngc does not define "
+          "O<misnamed> sub");
+    CHECK(error_of("o#<s> sub\no#<s> endsub\n", o) ==
+          "t.ngc:1:1: only a call may take its label from a parameter (O#... call)");
 }

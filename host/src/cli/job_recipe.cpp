@@ -59,6 +59,7 @@ std::string job_recipe_json(const JobRecipe& r) {
     d["gcode_pen"] = p.gcode_pen;
     d["gcode_z_down"] = p.gcode_z_down;
     d["gcode_tool_table"] = p.gcode_tool_table;
+    d["gcode_subroutine_path"] = p.gcode_subroutine_path;
     d["gcode_ignore"] = p.gcode_ignore;
     d["tolerance"] = p.tolerance;
     d["rotate"] = p.placement.rotate;
@@ -106,6 +107,7 @@ JobRecipe parse_job_recipe(const std::string& json, const std::string& journal) 
     get("gcode_pen", p.gcode_pen);
     get("gcode_z_down", p.gcode_z_down);
     get("gcode_tool_table", p.gcode_tool_table);
+    get("gcode_subroutine_path", p.gcode_subroutine_path);
     get("gcode_ignore", p.gcode_ignore);
     get("tolerance", p.tolerance);
     get("rotate", p.placement.rotate);

@@ -46,6 +46,9 @@ void add_path_options(CLI::App& command, JobRequest& o) {
                     "Z an axis when the machine has one) or auto (chosen from the file); "
                     "default: z, machine on a machine with a z axis")
         ->check(CLI::IsMember({"z", "spindle", "motion", "machine", "auto"}));
+    command.add_option("--subroutine-path", o.gcode_subroutine_path,
+                       "G-code: directory searched for NAME.ngc when the program calls a "
+                       "subroutine it does not define (repeatable; default: the program's own)");
     command
         .add_option("--tool-table", o.gcode_tool_table,
                     "G-code: LinuxCNC tool table file that G43 H reads")

@@ -140,7 +140,9 @@ public:
             c_.i = close + 1;
             return ref;
         }
-        const double n = c_.peek() == '#' || c_.peek() == '[' ? value() : number();
+        // "#[1+2]", "##1", and as LinuxCNC a function: "#ATAN[1]/[1]" is #45.
+        const double n =
+            c_.peek() == '#' || c_.peek() == '[' || is_letter(c_.peek()) ? value() : number();
         const double whole = std::round(n);
         if (std::fabs(n - whole) > 1e-6 || whole < 1 ||
             whole > static_cast<double>(Parameters::kMaxParameter)) {
@@ -415,13 +417,13 @@ private:
     double exists() {
         const std::size_t open = c_.i++;
         c_.skip_blanks();
-        if (c_.peek() != '#') c_.fail(c_.i, "EXISTS takes a named parameter: EXISTS[#<name>]");
+        if (c_.peek() != '#') c_.fail(c_.i, "EXISTS takes a parameter: EXISTS[#<name>]");
         const ParameterRef ref = parameter_ref();
-        if (ref.name.empty()) c_.fail(open, "EXISTS takes a named parameter: EXISTS[#<name>]");
         c_.skip_blanks();
         if (c_.peek() != ']') c_.fail(c_.done() ? open : c_.i, "expected ']' after EXISTS[#<name>");
         ++c_.i;
-        return parameters_.exists(ref.name) ? 1 : 0;
+        // A numbered parameter always exists (it is 0 until set), as LinuxCNC answers.
+        return ref.name.empty() || parameters_.exists(ref.name) ? 1 : 0;
     }
 
     LineCursor& c_;

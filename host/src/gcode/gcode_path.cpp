@@ -62,7 +62,8 @@ Path run(const std::vector<std::string_view>& lines, const std::string& file,
          const gcode::ToolTable& tools) {
     gcode::Parameters parameters;
     gcode::Interpreter interpreter(file, options, parameters, tools);
-    gcode::run_program(lines, file, ignored, interpreter, parameters, warnings);
+    gcode::run_program(lines, file, ignored, interpreter, parameters, warnings,
+                       options.subroutine_path);
     if (evidence) *evidence = interpreter.evidence();
     return interpreter.finish(allow_empty);
 }

@@ -31,7 +31,8 @@ std::vector<std::size_t> axis_indices(const std::string& letters) {
 
 Interpreter::Interpreter(const std::string& file, const GcodeOptions& options,
                          Parameters& parameters, const ToolTable& tools)
-    : file_(file),
+    : file_(&file),
+      main_file_(file),
       options_(options),
       parameters_(parameters),
       tools_(tools),
@@ -41,7 +42,7 @@ Interpreter::Interpreter(const std::string& file, const GcodeOptions& options,
 }
 
 void Interpreter::fail(SourceLocation at, const std::string& message) const {
-    throw InputError(file_, at, message);
+    throw InputError(*file_, at, message);
 }
 
 double Interpreter::length(const Word& w) const {
@@ -393,7 +394,7 @@ Path Interpreter::finish(bool allow_empty) {
                 why = "moves at Z <= " + number(options_.z_down_max) + " mm";
         }
         throw InputError(
-            file_, {},
+            main_file_, {},
             "no pen-down moves (the pen is down during G1, G2, G3, G5, G5.1 and G5.2 " + why + ")");
     }
     return path;

@@ -32,6 +32,10 @@ public:
     Interpreter(const std::string& file, const GcodeOptions& options, Parameters& parameters,
                 const ToolTable& tools);
 
+    /// The file the next blocks come from (a subroutine file's), for messages. The string must
+    /// outlive the interpreter's use of it.
+    void set_file(const std::string& file) { file_ = &file; }
+
     /// Executes one block (in LinuxCNC's order: units, distance modes, F, spindle, dwell,
     /// offsets and homing, motion, then M0/M1 and program end). Returns false after M2 or
     /// M30: read no further. Throws InputError at the offending word.
@@ -102,7 +106,8 @@ private:
     /// Draws (pen down) or travels along pieces ending at `to`, then moves there.
     void follow(const std::vector<Piece>& pieces, bool down, const Axes& to, SourceLocation at);
 
-    const std::string& file_;
+    const std::string* file_;
+    const std::string& main_file_;
     GcodeOptions options_;
     Parameters& parameters_;
     const ToolTable& tools_;

@@ -79,10 +79,10 @@ void Interpreter::follow(const std::vector<Piece>& pieces, bool down, const Axes
     }
     if (down) {
         const double feed = move_feed(pieces, at);
-        for (const Piece& piece : pieces) runs_.draw(piece, feed, at, file_);
+        for (const Piece& piece : pieces) runs_.draw(piece, feed, at, *file_);
         runs_.end_block();
     } else if (machine()) {
-        for (const Piece& piece : pieces) runs_.travel(piece, options_.rapid_feed, at, file_);
+        for (const Piece& piece : pieces) runs_.travel(piece, options_.rapid_feed, at, *file_);
     } else {
         runs_.lift();
     }

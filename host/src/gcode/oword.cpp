@@ -226,6 +226,22 @@ std::optional<OLine> scan_oword(std::string_view text, std::size_t line_number,
         while (is_digit(c.peek())) o.label += c.text[c.i++];
         const std::size_t nonzero = o.label.find_first_not_of('0');
         o.label = nonzero == std::string::npos ? "0" : o.label.substr(nonzero);
+    } else if (c.peek() == '#') {
+        // LinuxCNC: a call's label may be a parameter's value ("o#<sub> call"); skip the
+        // reference here, it is read when the call runs.
+        o.label_value_at = c.i;
+        o.label = "#";
+        ++c.i;
+        if (c.peek() == '<') {
+            const std::size_t close = text.find('>', c.i);
+            if (close == std::string_view::npos) c.fail(c.i, "unclosed parameter name '<'");
+            c.i = close + 1;
+        } else {
+            while (is_digit(c.peek())) ++c.i;
+        }
+        if (c.i == o.label_value_at + 1) {
+            c.fail(o.label_value_at, "an O-word label from a parameter is #<name> or #number");
+        }
     } else {
         c.fail(o_index, "O-word without a number or <name>");
     }
@@ -237,6 +253,9 @@ std::optional<OLine> scan_oword(std::string_view text, std::size_t line_number,
         if (keyword == k.name) {
             o.kind = k.kind;
             o.args_begin = c.i;
+            if (o.label_value_at != 0 && o.kind != OKind::kCall) {
+                c.fail(o_index, "only a call may take its label from a parameter (O#... call)");
+            }
             return o;
         }
     }

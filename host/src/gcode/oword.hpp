@@ -45,6 +45,12 @@ struct OLine {
     /// repeat <-> endrepeat, break/continue -> the loop's first line (0-based line index).
     std::size_t partner = static_cast<std::size_t>(-1);
     bool closes_do = false;  ///< a while that ends a do
+    /// `O#<sub> call`: the label is the value at this index of the line (a whole number),
+    /// read when the call runs; 0: a written label.
+    std::size_t label_value_at = 0;
+    /// The file the line is in when it is not the program's (a subroutine file); nullptr: the
+    /// program's.
+    const std::string* file = nullptr;
 };
 
 /// "O100 while", "O<name> sub": how messages name a statement.

@@ -2,8 +2,12 @@
 // (docs/formats-gcode.md, "O-words" and "Budgets").
 #include "program.hpp"
 
+#include <cctype>
 #include <cmath>
+#include <deque>
+#include <fstream>
 #include <map>
+#include <sstream>
 
 #include "cursor.hpp"
 #include "expression.hpp"
@@ -17,9 +21,10 @@ class Runner {
 public:
     Runner(const std::vector<std::string_view>& lines, const std::string& file,
            const std::set<std::string>& ignored, Interpreter& interpreter, Parameters& parameters,
-           std::vector<std::string>& warnings)
+           std::vector<std::string>& warnings, const std::vector<std::string>& search_path)
         : lines_(lines),
           file_(file),
+          search_path_(search_path),
           ignored_(ignored),
           interpreter_(interpreter),
           parameters_(parameters),
@@ -32,7 +37,7 @@ public:
         while (pc < lines_.size()) {
             characters_ += lines_[pc].size();
             if (++blocks_ > kMaxBlocksRun || characters_ > kMaxCharactersRun) {
-                throw InputError(file_, SourceLocation{pc + 1, 1},
+                throw InputError(file_of(pc), SourceLocation{line_of(pc), 1},
                                  "more than " + std::to_string(kMaxBlocksRun) + " lines or " +
                                      std::to_string(kMaxCharactersRun) +
                                      " characters run (the reader's limit; a loop that never "
@@ -42,14 +47,15 @@ public:
                 pc = control(pc);
                 continue;
             }
-            const auto block = lex_line(lines_[pc], pc + 1, file_, parameters_);
+            const std::string& file = file_of(pc);
+            const auto block = lex_line(lines_[pc], line_of(pc), file, parameters_);
             ++pc;
             if (!block) continue;
             if (block->dollar) {
                 warn("$", block->start, "grbl '$' line skipped");
                 continue;
             }
-            const Command command = decode_block(*block, file_, ignored_);
+            const Command command = decode_block(*block, file, ignored_);
             for (const IgnoredCode& code : command.ignored) {
                 warn(code.name, code.at, code.name + " skipped (it means nothing to this machine)");
             }
@@ -57,11 +63,16 @@ public:
             // take effect before the block runs.
             for (const Assignment& a : block->assignments) parameters_.set(a.target, a.value);
             if (command.skip) continue;
+            interpreter_.set_file(file);
             if (!interpreter_.execute(command)) return;
         }
     }
 
 private:
+    struct Unit {
+        std::size_t begin = 0;  ///< its first line's index in lines_
+        std::string file;
+    };
     struct Frame {
         std::size_t return_to = 0;
         std::map<std::size_t, long> repeats_left;  ///< repeat line -> passes still to run
@@ -70,7 +81,82 @@ private:
     const OLine& o(std::size_t pc) const { return structure_.olines.at(pc); }
 
     [[noreturn]] void fail(const OLine& line, const std::string& message) const {
-        throw InputError(file_, line.at, message);
+        throw InputError(line.file ? *line.file : file_, line.at, message);
+    }
+
+    // Lines past the program's own are subroutine files', appended as they are called.
+    const Unit& unit_of(std::size_t pc) const {
+        std::size_t k = units_.size();
+        while (k > 0 && units_[k - 1].begin > pc) --k;
+        return units_[k - 1];
+    }
+    const std::string& file_of(std::size_t pc) const {
+        return pc < main_lines_ ? file_ : unit_of(pc).file;
+    }
+    std::size_t line_of(std::size_t pc) const {
+        return pc < main_lines_ ? pc + 1 : pc - unit_of(pc).begin + 1;
+    }
+
+    // "O<name> call" of a subroutine the program does not define: LinuxCNC's subroutine files,
+    // NAME.ngc holding "O<name> sub" ... "endsub", from the search path, loaded once.
+    std::size_t external_sub(const OLine& line, const std::string& label) {
+        if (const auto known = structure_.subs.find(label); known != structure_.subs.end())
+            return known->second;
+        const bool numbered = !label.empty() && std::isdigit(static_cast<unsigned char>(label[0]));
+        const std::string what = "O" + (numbered ? label : "<" + label + ">") + " call";
+        if (search_path_.empty()) fail(line, what + ": no such subroutine in this file");
+        std::string found;
+        for (const std::string& dir : search_path_) {
+            const std::string candidate =
+                (dir.empty() ? std::string(".") : dir) + "/" + label + ".ngc";
+            if (std::ifstream(candidate).good()) {
+                found = candidate;
+                break;
+            }
+        }
+        if (found.empty()) {
+            std::string dirs;
+            for (const std::string& dir : search_path_) dirs += (dirs.empty() ? "" : ", ") + dir;
+            fail(line, what + ": no such subroutine in this file, nor " + label +
+                           ".ngc in the subroutine path (" + dirs + ")");
+        }
+        if (units_.size() >= kMaxSubroutineFiles) {
+            fail(line, what + ": more than " + std::to_string(kMaxSubroutineFiles) +
+                           " subroutine files (the reader's limit)");
+        }
+        std::ifstream in(found, std::ios::binary);
+        std::ostringstream buffer;
+        buffer << in.rdbuf();
+        texts_.push_back(buffer.str());
+        characters_ += texts_.back().size();
+        const std::size_t begin = lines_.size();
+        units_.push_back(Unit{begin, found});
+        std::vector<std::string_view> added;
+        std::string_view rest(texts_.back());
+        while (!rest.empty()) {
+            const std::size_t end = rest.find('\n');
+            std::string_view current = rest.substr(0, end);
+            rest.remove_prefix(end == std::string_view::npos ? rest.size() : end + 1);
+            if (!current.empty() && current.back() == '\r') current.remove_suffix(1);
+            added.push_back(current);
+        }
+        ProgramStructure s = scan_structure(added, units_.back().file);
+        const auto sub = s.subs.find(label);
+        if (sub == s.subs.end()) {
+            fail(line, what + ": " + found + " does not define O<" + label + "> sub");
+        }
+        for (auto& [index, o] : s.olines) {
+            o.file = &units_.back().file;
+            if (o.partner != ProgramStructure::kNone) o.partner += begin;
+            structure_.olines.emplace(index + begin, o);
+        }
+        for (auto& [index, branches] : s.branches) {
+            for (std::size_t& b : branches) b += begin;
+            structure_.branches.emplace(index + begin, branches);
+        }
+        for (const auto& [name, index] : s.subs) structure_.subs.emplace(name, index + begin);
+        lines_.insert(lines_.end(), added.begin(), added.end());
+        return sub->second + begin;
     }
 
     void warn(const std::string& code, SourceLocation at, const std::string& what) {
@@ -82,7 +168,7 @@ private:
 
     // The [ ] values after an O-word's keyword, at most `most`.
     std::vector<double> arguments(std::size_t pc, std::size_t most) {
-        LineCursor c{lines_[pc], pc + 1, file_, o(pc).args_begin};
+        LineCursor c{lines_[pc], line_of(pc), file_of(pc), o(pc).args_begin};
         std::vector<double> values;
         while (true) {
             c.skip_blanks();
@@ -136,10 +222,17 @@ private:
                 return back;
             }
             case OKind::kCall: {
-                const auto sub = structure_.subs.find(line.label);
-                if (sub == structure_.subs.end()) {
-                    fail(line, oline_text(line) + ": no such subroutine in this file");
+                std::string label = line.label;
+                if (line.label_value_at != 0) {
+                    LineCursor c{lines_[pc], line_of(pc), file_of(pc), line.label_value_at};
+                    const double v = read_value(c, parameters_, 0);
+                    if (v != std::floor(v) || v < 0 || v > 1e9) {
+                        fail(line, "O# call: the label's value " + std::to_string(v) +
+                                       " is not a whole number >= 0");
+                    }
+                    label = std::to_string(static_cast<long>(v));
                 }
+                const std::size_t sub_line = external_sub(line, label);
                 const std::vector<double> args = arguments(pc, Parameters::kCallArguments);
                 if (frames_.size() > kMaxCallDepth) {
                     fail(line, oline_text(line) + ": calls nested more than " +
@@ -147,7 +240,7 @@ private:
                 }
                 parameters_.enter_call(args);
                 frames_.push_back(Frame{pc + 1, {}});
-                return sub->second + 1;
+                return sub_line + 1;
             }
             case OKind::kIf:
                 if (condition(pc) != 0) return pc + 1;
@@ -214,8 +307,12 @@ private:
         return o(if_line).partner + 1;
     }
 
-    const std::vector<std::string_view>& lines_;
+    std::vector<std::string_view> lines_;
     const std::string& file_;
+    const std::vector<std::string>& search_path_;
+    std::size_t main_lines_ = lines_.size();
+    std::deque<Unit> units_;         ///< subroutine files (stable: messages refer to names)
+    std::deque<std::string> texts_;  ///< their text
     const std::set<std::string>& ignored_;
     Interpreter& interpreter_;
     Parameters& parameters_;
@@ -232,8 +329,9 @@ private:
 
 void run_program(const std::vector<std::string_view>& lines, const std::string& file,
                  const std::set<std::string>& ignored, Interpreter& interpreter,
-                 Parameters& parameters, std::vector<std::string>& warnings) {
-    Runner(lines, file, ignored, interpreter, parameters, warnings).run();
+                 Parameters& parameters, std::vector<std::string>& warnings,
+                 const std::vector<std::string>& search_path) {
+    Runner(lines, file, ignored, interpreter, parameters, warnings, search_path).run();
 }
 
 }  // namespace pathstream::host::gcode

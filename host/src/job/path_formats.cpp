@@ -38,6 +38,11 @@ GcodeOptions gcode_options(const JobRequest& o) {
                                             : PenControl::kZ;
     g.rapid_feed = o.gcode_rapid_feed;
     g.tool_table = o.gcode_tool_table;
+    g.subroutine_path = o.gcode_subroutine_path;
+    if (g.subroutine_path.empty() && o.file != "-") {
+        const std::filesystem::path dir = std::filesystem::path(o.file).parent_path();
+        g.subroutine_path.push_back(dir.empty() ? "." : dir.string());
+    }
     g.z_down_max = o.gcode_z_down;
     g.arc_tolerance_mm = o.tolerance;
     g.ignore_codes = o.gcode_ignore;

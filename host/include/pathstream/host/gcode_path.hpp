@@ -43,6 +43,9 @@ struct GcodeOptions {
     double rapid_feed = 0;
     /// A LinuxCNC tool table file (G43 H reads it); empty: none (G43 H then fails).
     std::string tool_table;
+    /// Directories searched, in order, for NAME.ngc when the program calls a subroutine it
+    /// does not define (LinuxCNC's SUBROUTINE_PATH); empty: such a call is an error.
+    std::vector<std::string> subroutine_path;
 };
 
 /// What a read found beside the path.

@@ -28,7 +28,10 @@ struct JobRequest {
     std::string gcode_axes;
     double gcode_rapid_feed =
         0;  ///< mm/s for G0 in machine mode (set from the profile); 0: travel_feed
-    std::string gcode_tool_table;           ///< --tool-table: LinuxCNC tool table for G43 H
+    std::string gcode_tool_table;  ///< --tool-table: LinuxCNC tool table for G43 H
+    /// --subroutine-path: directories for NAME.ngc subroutine files; empty: the program's own
+    /// directory.
+    std::vector<std::string> gcode_subroutine_path;
     double gcode_z_down = 0.0;              ///< pen down when Z <= this (mm)
     std::vector<std::string> gcode_ignore;  ///< --ignore-code: more G/M codes to skip
     double tolerance = 0.01;                ///< mm, arcs to cubics (SVG, G-code)
