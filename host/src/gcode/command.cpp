@@ -342,6 +342,7 @@ private:
             case 4:
                 claim(kSpindle, w, name);
                 c.spindle_on = true;
+                c.spindle_at = w.at;
                 break;
             case 5:
                 claim(kSpindle, w, name);

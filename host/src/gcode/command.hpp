@@ -86,6 +86,7 @@ struct Command {
     std::optional<CornerMode> path_control;  ///< G61 (exact path), G61.1 (exact stop), G64 (P, Q)
     SourceLocation path_control_at;          ///< where that G word is
     std::optional<bool> spindle_on;          ///< M3, M4 (true) / M5 (false)
+    SourceLocation spindle_at;               ///< where that M word is
     bool end_program = false;                ///< M2, M30
     bool pause = false;                      ///< M0, M1
     SourceLocation pause_at;                 ///< where the M0, M1 or M6 is

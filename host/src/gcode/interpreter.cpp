@@ -140,6 +140,11 @@ bool Interpreter::execute(const Command& c) {
     }
     if (c.path_control) path_control(c);
     if (c.spindle_on) {
+        if (*c.spindle_on && machine() && warn_) {
+            warn_("M3", c.spindle_at,
+                  "M3/M4 drive no spindle output yet (the moves run, the spindle must be started "
+                  "by hand)");
+        }
         spindle_ = *c.spindle_on;
         if (spindle_) evidence_.spindle = true;
         if (!spindle_ && options_.pen == PenControl::kSpindle) runs_.lift();

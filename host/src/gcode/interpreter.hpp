@@ -3,6 +3,7 @@
 // runs, and on a machine whose moves keep their order (PenControl::kMachine) travel runs too.
 #pragma once
 
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -35,6 +36,9 @@ public:
     /// The file the next blocks come from (a subroutine file's), for messages. The string must
     /// outlive the interpreter's use of it.
     void set_file(const std::string& file) { file_ = &file; }
+    /// Where warnings go: (code, where, text); the runner says each code's first one.
+    using Warn = std::function<void(const std::string&, SourceLocation, const std::string&)>;
+    void set_warn(Warn warn) { warn_ = std::move(warn); }
 
     /// Executes one block (in LinuxCNC's order: units, distance modes, F, spindle, dwell,
     /// offsets and homing, motion, then M0/M1 and program end). Returns false after M2 or
@@ -108,6 +112,7 @@ private:
 
     const std::string* file_;
     const std::string& main_file_;
+    Warn warn_;
     GcodeOptions options_;
     Parameters& parameters_;
     const ToolTable& tools_;

@@ -29,7 +29,10 @@ public:
           interpreter_(interpreter),
           parameters_(parameters),
           warnings_(warnings),
-          structure_(scan_structure(lines, file)) {}
+          structure_(scan_structure(lines, file)) {
+        interpreter_.set_warn([this](const std::string& code, SourceLocation at,
+                                     const std::string& text) { warn(code, at, text); });
+    }
 
     void run() {
         frames_.push_back(Frame{});
