@@ -4,6 +4,8 @@
 
 #include <array>
 #include <cstddef>
+#include <sstream>
+#include <string>
 #include <string_view>
 
 #include "vec2.hpp"
@@ -14,6 +16,17 @@ namespace pathstream::host::gcode {
 inline constexpr std::string_view kAxisLetters = "XYZABCUVW";
 inline constexpr std::size_t kAxisCount = 9;
 inline constexpr std::size_t kX = 0, kY = 1, kZ = 2;
+
+/// The largest |coordinate| a program may reach, mm or degrees: as the JSON reader, it
+/// catches unit mix-ups.
+inline constexpr double kMaxCoordinateMm = 1e6;
+
+/// The shortest usual form of a number, for messages ("1.5", "1e+06").
+inline std::string number_text(double v) {
+    std::ostringstream s;
+    s << v;
+    return s.str();
+}
 
 /// A position: mm on X Y Z U V W, degrees on A B C (machine coordinates).
 using Axes = std::array<double, kAxisCount>;

@@ -11,15 +11,7 @@ namespace pathstream::host::gcode {
 
 namespace {
 
-constexpr double kMaxCoordinateMm = 1e6;  // as the JSON reader: catches unit mix-ups
 constexpr double kMaxFeedMmPerMin = 1e6;
-
-// The shortest usual form of a number, for messages.
-std::string number(double v) {
-    std::ostringstream s;
-    s << v;
-    return s.str();
-}
 
 std::vector<std::size_t> axis_indices(const std::string& letters) {
     std::vector<std::size_t> indices;
@@ -48,8 +40,8 @@ void Interpreter::fail(SourceLocation at, const std::string& message) const {
 double Interpreter::length(const Word& w) const {
     const double mm = w.value * scale();
     if (std::fabs(mm) > kMaxCoordinateMm) {
-        fail(w.at, std::string(1, w.letter) + " " + number(mm) +
-                       " mm is out of range (|value| <= " + number(kMaxCoordinateMm) + " mm)");
+        fail(w.at, std::string(1, w.letter) + " " + number_text(mm) +
+                       " mm is out of range (|value| <= " + number_text(kMaxCoordinateMm) + " mm)");
     }
     return mm;
 }
@@ -57,8 +49,9 @@ double Interpreter::length(const Word& w) const {
 double Interpreter::axis_value(const Word& w, std::size_t axis) const {
     if (!is_rotary(axis)) return length(w);
     if (std::fabs(w.value) > kMaxCoordinateMm) {
-        fail(w.at, std::string(1, w.letter) + " " + number(w.value) +
-                       " degrees is out of range (|value| <= " + number(kMaxCoordinateMm) + ")");
+        fail(w.at, std::string(1, w.letter) + " " + number_text(w.value) +
+                       " degrees is out of range (|value| <= " + number_text(kMaxCoordinateMm) +
+                       ")");
     }
     return w.value;
 }
@@ -67,8 +60,9 @@ void Interpreter::check_point(const Axes& p, SourceLocation at) const {
     for (std::size_t a = 0; a < kAxisCount; ++a) {
         if (!(std::fabs(p[a]) <= kMaxCoordinateMm)) {
             const char* unit = is_rotary(a) ? "" : " mm";
-            fail(at, std::string("curve point ") + kAxisLetters[a] + " " + number(p[a]) + unit +
-                         " is out of range (|value| <= " + number(kMaxCoordinateMm) + unit + ")");
+            fail(at, std::string("curve point ") + kAxisLetters[a] + " " + number_text(p[a]) +
+                         unit + " is out of range (|value| <= " + number_text(kMaxCoordinateMm) +
+                         unit + ")");
         }
     }
 }
@@ -115,8 +109,8 @@ void Interpreter::feed_word(const Command& c) {
     }
     const double mm_per_min = f->value * scale();
     if (!(mm_per_min > 0) || mm_per_min > kMaxFeedMmPerMin) {
-        fail(f->at, "feed F" + f->text + " is out of range (0 < F <= " + number(kMaxFeedMmPerMin) +
-                        " mm/min)");
+        fail(f->at, "feed F" + f->text +
+                        " is out of range (0 < F <= " + number_text(kMaxFeedMmPerMin) + " mm/min)");
     }
     feed_ = f->value / 60.0;  // program units: scaled per move, rotary-only moves are not
 }
@@ -293,55 +287,6 @@ void Interpreter::check_words_used(const Command& c, Motion move, bool moving) c
     }
 }
 
-Axes Interpreter::targets(const Command& c, bool machine_coordinates) const {
-    Axes to = pos_;
-    for (std::size_t a = 0; a < kAxisCount; ++a) {
-        const Word* w = c.value(kAxisLetters[a]);
-        if (!w) continue;
-        if (!on_path(a) && a != kZ) {
-            fail(w->at, std::string("axis ") + w->letter + " is not one of this machine's axes (" +
-                            options_.axes + ")");
-        }
-        const double v = incremental_ ? pos_[a] + axis_value(*w, a)
-                                      : axis_value(*w, a) + (machine_coordinates ? 0 : offset(a));
-        if (std::fabs(v) > kMaxCoordinateMm) {
-            const char* unit = is_rotary(a) ? "" : " mm";
-            fail(w->at, std::string(1, w->letter) + " " + number(v) + unit +
-                            " is out of range (|value| <= " + number(kMaxCoordinateMm) + unit +
-                            ")");
-        }
-        to[a] = v;
-    }
-    if (c.polar_distance || c.polar_angle) {
-        // As LinuxCNC: polar about the program's XY origin; in G91 @ and ^ add to the current
-        // point's distance and angle.
-        const Word* at = c.polar_distance ? &*c.polar_distance : &*c.polar_angle;
-        if (c.value('X') || c.value('Y')) {
-            fail(at->at, "polar coordinates (@ ^) and X or Y in one block");
-        }
-        if (plane_.normal != kZ) fail(at->at, "polar coordinates need the XY plane (G17)");
-        if (machine_coordinates) fail(at->at, "polar coordinates with G53");
-        const double x0 = pos_[kX] - offset(kX), y0 = pos_[kY] - offset(kY);
-        const double r0 = std::hypot(x0, y0), a0 = std::atan2(y0, x0) * 180 / std::numbers::pi;
-        if (r0 == 0 && (incremental_ || !c.polar_angle)) {
-            fail(at->at, incremental_ ? "incremental polar coordinates at the origin: the angle "
-                                        "is undefined there"
-                                      : "polar coordinates at the origin need ^ (the angle)");
-        }
-        double r = r0, angle = a0;
-        if (c.polar_distance) r = (incremental_ ? r0 : 0) + length(*c.polar_distance);
-        if (c.polar_angle) angle = (incremental_ ? a0 : 0) + c.polar_angle->value;
-        const double rad = angle * std::numbers::pi / 180;
-        to[kX] = r * std::cos(rad) + offset(kX);
-        to[kY] = r * std::sin(rad) + offset(kY);
-        if (std::fabs(to[kX]) > kMaxCoordinateMm || std::fabs(to[kY]) > kMaxCoordinateMm) {
-            fail(at->at,
-                 "polar point is out of range (|value| <= " + number(kMaxCoordinateMm) + " mm)");
-        }
-    }
-    return to;
-}
-
 void Interpreter::move(const Command& c, Motion move, SourceLocation at) {
     if (is_cycle(move)) {
         canned_cycle(c, move, at);
@@ -396,7 +341,7 @@ Path Interpreter::finish(bool allow_empty) {
                 why = "moves (G0 travels)";
                 break;
             default:
-                why = "moves at Z <= " + number(options_.z_down_max) + " mm";
+                why = "moves at Z <= " + number_text(options_.z_down_max) + " mm";
         }
         throw InputError(
             main_file_, {},

@@ -24,12 +24,6 @@ ParameterRef numbered(long n) {
     return ParameterRef{n, {}};
 }
 
-std::string text(double v) {
-    std::ostringstream s;
-    s << v;
-    return s.str();
-}
-
 const char* system_name(std::size_t system) {
     static const char* const names[] = {"G54", "G55",   "G56",   "G57",  "G58",
                                         "G59", "G59.1", "G59.2", "G59.3"};
@@ -163,7 +157,7 @@ void Interpreter::non_modal(const Command& c) {
                 const long n = base + static_cast<long>(a);
                 const double v = *parameters_.get(numbered(n));
                 if (std::fabs(v) > 1e6) {
-                    fail(at, "#" + std::to_string(n) + " " + text(v) +
+                    fail(at, "#" + std::to_string(n) + " " + number_text(v) +
                                  " is out of range (|value| <= 1e+06)");
                 }
                 if (!on_path(a) && a != kZ && v != pos_[a]) {
