@@ -201,8 +201,8 @@ TEST_CASE("G-code: skipped codes warn once each", "[gcode]") {
     CHECK(info.warnings[2].rfind("t.ngc:4:7: M8 skipped", 0) == 0);
     CHECK(info.warnings[3].rfind("t.ngc:6:1: M300 skipped", 0) == 0);
     CHECK(last_point(p).first == 1);
-    CHECK(error_of("G1 Z-1 X1\nM123\n") ==
-          "t.ngc:2:1: unsupported M code M123 (skip it with --ignore-code M123 if it means nothing "
+    CHECK(error_of("G1 Z-1 X1\nM223\n") ==
+          "t.ngc:2:1: unsupported M code M223 (skip it with --ignore-code M223 if it means nothing "
           "here)");
     GcodeOptions o;
     o.ignore_codes = {"m0123", "G43"};

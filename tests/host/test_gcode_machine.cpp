@@ -385,3 +385,16 @@ TEST_CASE("G-code: subroutine files, labels from parameters, LinuxCNC's paramete
     CHECK(error_of("o#<s> sub\no#<s> endsub\n", o) ==
           "t.ngc:1:1: only a call may take its label from a parameter (O#... call)");
 }
+
+TEST_CASE("G-code machine: M60 pauses and user M codes are refused", "[gcode][machine]") {
+    const Path p = gcode("G1 X1 F60\nM60\nG1 X2\n");
+    REQUIRE(p.subpaths.size() == 2);
+    CHECK(p.subpaths[1].pause_before);
+    CHECK(p.subpaths[1].pause_note == "pallet change (M60), line 2");
+    CHECK(error_of("G1 X1 F60\nM101\n") ==
+          "t.ngc:2:1: user M code M101: LinuxCNC runs a program of that name, this reader runs "
+          "none (skip it with --ignore-code M101 if it means nothing here)");
+    GcodeOptions skip = router();
+    skip.ignore_codes = {"M101"};
+    CHECK(gcode("G1 X1 F60\nM101 P3\nG1 X2\n", skip).subpaths.size() == 1);
+}

@@ -314,9 +314,9 @@ void handle_pauses(InterruptOptions& interrupt, const JournalWriter& writer, Job
         const std::vector<std::string>& pauses = writer.journal().pauses;
         const std::string next = index < pauses.size() ? pauses[index] : "the rest of the job";
         // A G-code stop or tool change says so (its note); others are a plotter's pen change.
-        const bool noted = next.rfind("tool change", 0) == 0 ||
-                           next.rfind("program stop", 0) == 0 ||
-                           next.rfind("optional stop", 0) == 0;
+        const bool noted =
+            next.rfind("tool change", 0) == 0 || next.rfind("program stop", 0) == 0 ||
+            next.rfind("optional stop", 0) == 0 || next.rfind("pallet change", 0) == 0;
         const std::string what = noted ? next : "a pen change, " + next + " next";
         std::fprintf(stderr, "\npathstream: paused for %s: %s `pathstream ctl %s resume`\n",
                      what.c_str(), terminal ? "press Enter to go on, or" : "go on with",

@@ -333,6 +333,12 @@ private:
                 c.pause_at = w.at;
                 c.optional_stop = code == 1;
                 break;
+            case 60:
+                claim(kStopping, w, name);
+                c.pause = true;
+                c.pause_at = w.at;
+                c.pallet_change = true;
+                break;
             case 2:
             case 30:
                 claim(kStopping, w, name);
@@ -354,6 +360,12 @@ private:
                 c.pause_at = w.at;
                 break;
             default:
+                if (code >= 100 && code <= 199) {
+                    fail(w, "user M code " + name +
+                                ": LinuxCNC runs a program of that name, this reader runs none "
+                                "(skip it with --ignore-code " +
+                                name + " if it means nothing here)");
+                }
                 fail(w, "unsupported M code " + name + " (skip it with --ignore-code " + name +
                             " if it means nothing here)");
         }

@@ -91,6 +91,7 @@ struct Command {
     bool pause = false;                      ///< M0, M1
     SourceLocation pause_at;                 ///< where the M0, M1 or M6 is
     bool optional_stop = false;              ///< M1
+    bool pallet_change = false;              ///< M60
     bool tool_change = false;                ///< M6 (when not skipped)
     /// Codes skipped in this block; when `skip` the whole block is skipped (it held only
     /// skipped codes and their words).

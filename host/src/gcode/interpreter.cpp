@@ -224,7 +224,10 @@ bool Interpreter::execute(const Command& c) {
 std::string Interpreter::pause_note(const Command& c) const {
     const std::string line = ", line " + std::to_string(c.pause_at.line);
     if (!c.tool_change)
-        return std::string(c.optional_stop ? "optional stop (M1)" : "program stop (M0)") + line;
+        return std::string(c.pallet_change   ? "pallet change (M60)"
+                           : c.optional_stop ? "optional stop (M1)"
+                                             : "program stop (M0)") +
+               line;
     if (selected_tool_ < 0) return "tool change (M6, no T given)" + line;
     std::string note = "tool change to T" + std::to_string(selected_tool_);
     if (const ToolEntry* t = tools_.find(selected_tool_); t && !t->comment.empty())
