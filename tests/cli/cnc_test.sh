@@ -13,7 +13,7 @@ ok() { passed=$((passed + 1)); }
 machine=$src/examples/machines/router.json
 tools=(--tool-table "$src/examples/cnc/tools.tbl")
 
-for name in pocket drill finish; do
+for name in pocket drill profile finish; do
   program=$src/examples/cnc/$name.ngc
   out=$("$bin" plan "$program" -m "$machine" "${tools[@]}" 2>&1); rc=$?
   [ $rc -eq 0 ] && [[ "$out" == *"within limits"* && "$out" == *"pause for the operator"* ]] && ok ||
@@ -29,8 +29,8 @@ assert d["machine"]["axes"] == 3, d["machine"]
 done
 
 # Streams: the device starts at the machine's origin; the job leads in from there.
-scale=(pocket 20 drill 20 finish 30)
-for i in 0 2 4; do
+scale=(pocket 20 drill 20 profile 20 finish 30)
+for i in 0 2 4 6; do
   name=${scale[$i]}
   : > "$work/device.log"
   "$bin" device -m "$machine" --no-gpio --tcp 127.0.0.1:0 --time-scale "${scale[$((i + 1))]}" \

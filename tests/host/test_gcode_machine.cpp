@@ -398,3 +398,42 @@ TEST_CASE("G-code machine: M60 pauses and user M codes are refused", "[gcode][ma
     skip.ignore_codes = {"M101"};
     CHECK(gcode("G1 X1 F60\nM101 P3\nG1 X2\n", skip).subpaths.size() == 1);
 }
+
+TEST_CASE("G-code machine: cutter radius compensation in the reader", "[gcode][machine][cutter]") {
+    // A 40 x 30 rectangle counterclockwise with the tool (6 mm) on its left: inside, its
+    // center 3 mm in from every side; the exit move after G40 starts from the tool center.
+    const Path p = gcode(
+        "G0 X20 Y10\nG41.1 D6\nG1 X20 Y0 F600\nX40 Y0\nX40 Y30\nX0 Y30\nX0 Y0\nX20 Y0\nG40\n"
+        "G0 X20 Y10\n");
+    std::vector<std::vector<double>> corners;
+    for (const Waypoint& w : waypoints(p)) {
+        if (!w.travel) corners.push_back(w.at);
+    }
+    const std::vector<std::vector<double>> expected{{20, 3, 0}, {37, 3, 0}, {37, 27, 0},
+                                                    {3, 27, 0}, {3, 3, 0},  {20, 3, 0}};
+    REQUIRE(corners.size() >= expected.size());
+    for (const auto& e : expected) {
+        bool found = false;
+        for (const auto& c : corners) {
+            found = found || (std::fabs(c[0] - e[0]) < 1e-9 && std::fabs(c[1] - e[1]) < 1e-9);
+        }
+        INFO("corner " << e[0] << ", " << e[1]);
+        CHECK(found);
+    }
+    // Nothing of the tool path leaves the inside by less than the radius.
+    for (const Subpath& s : p.subpaths) {
+        for (std::size_t i = 0; i < s.points.size(); ++i) {
+            if (s.travel) continue;
+            CHECK(s.points[i][0] >= 3 - 1e-9);
+            CHECK(s.points[i][0] <= 37 + 1e-9);
+        }
+    }
+    CHECK(error_of("G41.1 D6\nG41.1 D6\n") ==
+          "t.ngc:2:1: cutter radius compensation is on already (give G40 first)");
+    CHECK(error_of("G41.1 D6\nG1 X10 F60\nG18\n") ==
+          "t.ngc:3:1: a plane change while cutter radius compensation is on (give G40 first; it "
+          "began at line 1)");
+    CHECK(error_of("G41 D1\n") == "t.ngc:1:1: G41/G42: no tool table (give one with --tool-table)");
+    CHECK(error_of("G1 X1 D3 F60\n") ==
+          "t.ngc:1:7: word D is not used by any command in this block");
+}

@@ -153,6 +153,11 @@ void Interpreter::arc(const Command& c, Motion move, const Axes& to3, SourceLoca
         fail(at, "arc center is out of range (|value| <= 1e+06 mm)");
     }
     Arc geometry{from, to, center, sweep};
+    if (comp_) {
+        if (turns > 1) fail(p->at, "P (turns) above 1 while cutter radius compensation is on");
+        comp_add(PlaneMove::kArc, &geometry, false, to3, at);
+        return;
+    }
     if (on_path(pl.normal)) geometry.rise = to3[pl.normal] - pos_[pl.normal];
     follow(lift(arc_to_cubics(geometry, options_.arc_tolerance_mm), to3),
            pen_down(pos_[kZ], to3[kZ]), to3, at);

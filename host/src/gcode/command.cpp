@@ -37,10 +37,9 @@ struct Seen {
     std::string name;
 };
 
-// LinuxCNC's letters but D (cutter radius compensation, not read here): axis words, I J K
-// offsets, F H L P Q R S T values.
-constexpr std::string_view kSupportedLetters = "ABCFHIJKLPQRSTUVWXYZ";
-constexpr const char* kSupportedLettersText = "A B C F H I J K L P Q R S T U V W X Y Z";
+// LinuxCNC's letters: axis words, I J K offsets, D F H L P Q R S T values.
+constexpr std::string_view kSupportedLetters = "ABCDFHIJKLPQRSTUVWXYZ";
+constexpr const char* kSupportedLettersText = "A B C D F H I J K L P Q R S T U V W X Y Z";
 
 class Decoder {
 public:
@@ -80,11 +79,9 @@ public:
             return c;
         }
         if (unsupported) {
-            fail(*unsupported,
-                 std::string("unsupported word letter '") + unsupported->letter + "'" +
-                     (unsupported->letter == 'D'
-                          ? " (D is the cutter radius compensation's tool; G41/G42 are not read)"
-                          : std::string(" (supported: G M N O ") + kSupportedLettersText + ")"));
+            fail(*unsupported, std::string("unsupported word letter '") + unsupported->letter +
+                                   "'" + std::string(" (supported: G M N O ") +
+                                   kSupportedLettersText + ")");
         }
         return c;
     }
@@ -248,14 +245,18 @@ private:
                 c.inch = false;
                 break;
             case 400:
-                claim(kCutterComp, w, name);
-                c.cutter_compensation_off = true;
-                break;
             case 410:
             case 411:
             case 420:
             case 421:
-                fail(w, "cutter radius compensation (" + name + ") is not supported");
+                claim(kCutterComp, w, name);
+                c.cutter_comp = tenths == 400   ? CutterComp::kOff
+                                : tenths == 410 ? CutterComp::kLeft
+                                : tenths == 420 ? CutterComp::kRight
+                                : tenths == 411 ? CutterComp::kLeftDiameter
+                                                : CutterComp::kRightDiameter;
+                c.cutter_comp_at = w.at;
+                break;
             case 430:
             case 431:
             case 490:

@@ -39,6 +39,10 @@ inline bool is_cycle(Motion m) {
     return m >= Motion::kPeckChipBreak;
 }
 
+/// Cutter radius compensation (group 7): G40 off; G41/G42 left/right with D the tool table's
+/// tool; G41.1/G42.1 with D the diameter.
+enum class CutterComp { kOff, kLeft, kRight, kLeftDiameter, kRightDiameter };
+
 /// G43 (H from the tool table), G43.1 (dynamic, from the block's axis words), G49 (none).
 enum class ToolLength { kTable, kDynamic, kCancel };
 
@@ -79,10 +83,11 @@ struct Command {
     SourceLocation coordinate_system_at;
     std::optional<ToolLength> tool_length;  ///< G43, G43.1, G49
     SourceLocation tool_length_at;
-    std::optional<bool> cutter_compensation_off;  ///< G40
-    NonModal non_modal = NonModal::kNone;         ///< G4, G28, G30, G53, G92...
-    SourceLocation non_modal_at;                  ///< where that G word is
-    bool nurbs_end = false;                       ///< G5.3
+    std::optional<CutterComp> cutter_comp;  ///< G40, G41, G42, G41.1, G42.1
+    SourceLocation cutter_comp_at;
+    NonModal non_modal = NonModal::kNone;    ///< G4, G28, G30, G53, G92...
+    SourceLocation non_modal_at;             ///< where that G word is
+    bool nurbs_end = false;                  ///< G5.3
     std::optional<CornerMode> path_control;  ///< G61 (exact path), G61.1 (exact stop), G64 (P, Q)
     SourceLocation path_control_at;          ///< where that G word is
     std::optional<bool> spindle_on;          ///< M3, M4 (true) / M5 (false)

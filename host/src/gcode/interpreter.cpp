@@ -122,6 +122,7 @@ bool Interpreter::execute(const Command& c) {
              "the G5.2 curve must end with G5.3 before other motion or G4, G10, G28, G30, G53, "
              "G92");
     }
+    comp_refuse(c);
     if (c.inch) inch_ = *c.inch;
     if (c.plane) plane_ = *c.plane;
     if (c.incremental) incremental_ = *c.incremental;
@@ -153,6 +154,7 @@ bool Interpreter::execute(const Command& c) {
         runs_.dwell_next(p->value, down);
     }
     offsets_modes(c);
+    cutter_mode(c);
     if (c.retract_to_r) retract_to_r_ = *c.retract_to_r;
     if (c.nurbs_end) {
         if (nurbs_.empty()) fail(c.start, "G5.3 without a G5.2 curve to end");
@@ -216,6 +218,7 @@ bool Interpreter::execute(const Command& c) {
     if (c.tool_change) load_tool();
     if (c.end_program) {
         if (!nurbs_.empty()) fail(c.start, "program ends inside a G5.2 curve (no G5.3)");
+        if (comp_) comp_flush();  // as LinuxCNC, the program's end turns compensation off
         return false;
     }
     return true;
@@ -275,6 +278,7 @@ void Interpreter::check_words_used(const Command& c, Motion move, bool moving) c
         {'Q', cubic || blending || peck},
         {'L', nurbs || cycle || g10},
         {'H', c.tool_length == ToolLength::kTable},
+        {'D', c.cutter_comp && *c.cutter_comp != CutterComp::kOff},
     };
     if (const Word* p = c.value('P');
         p && blending && (arc || cubic || nurbs || c.non_modal == NonModal::kDwell)) {
@@ -328,6 +332,7 @@ void Interpreter::move(const Command& c, Motion move, SourceLocation at) {
 }
 
 Path Interpreter::finish(bool allow_empty) {
+    if (comp_) comp_flush();
     Path path;
     path.axes = options_.axes.size();
     path.subpaths = runs_.finish();

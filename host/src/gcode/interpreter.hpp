@@ -8,8 +8,10 @@
 #include <string>
 #include <vector>
 
+#include "arc.hpp"
 #include "axes.hpp"
 #include "command.hpp"
+#include "cutter_comp.hpp"
 #include "parameters.hpp"
 #include "pathstream/host/gcode_path.hpp"
 #include "pathstream/host/path.hpp"
@@ -107,8 +109,19 @@ private:
     /// Plane pieces of a move from pos_ to `to` lifted into all axes: the plane's axes from
     /// the pieces, every other axis linear in the piece index (the arcs' equal angle steps).
     std::vector<Piece> lift(const std::vector<Cubic>& pieces, const Axes& to) const;
-    /// Draws (pen down) or travels along pieces ending at `to`, then moves there.
-    void follow(const std::vector<Piece>& pieces, bool down, const Axes& to, SourceLocation at);
+    /// Draws (pen down) or travels along pieces ending at `to`, then moves there. `feed`: the
+    /// feed when it was fixed before (compensated moves), else from move_feed.
+    void follow(const std::vector<Piece>& pieces, bool down, const Axes& to, SourceLocation at,
+                std::optional<double> feed = std::nullopt);
+    /// G40, G41, G42, G41.1, G42.1: starts collecting moves, or makes those collected.
+    void cutter_mode(const Command& c);
+    /// Throws when the block does what cannot happen while compensation is on.
+    void comp_refuse(const Command& c) const;
+    /// Collects a programmed move (pos_ -> to) while compensation is on.
+    void comp_add(PlaneMove::Kind kind, const Arc* arc, bool rapid, const Axes& to,
+                  SourceLocation at);
+    /// Makes the collected moves along the tool center's path; the compensation ends.
+    void comp_flush();
 
     const std::string* file_;
     const std::string& main_file_;
@@ -145,6 +158,23 @@ private:
     bool cycle_r_incremental_ = false, cycle_z_incremental_ = false;
     Motion last_cycle_ = Motion::kNone;    ///< the cycle of the series, kNone out of one
     std::optional<double> cycle_initial_;  ///< the series' initial level on the drill axis
+
+    /// A programmed move collected under G41/G42.
+    struct CompMove {
+        PlaneMove plane;  ///< in XY; source: its index
+        Axes from{}, to{};
+        bool rapid = false;
+        double feed = 0;  ///< mm/s along the path (feed moves)
+        SourceLocation at;
+    };
+    struct CompState {
+        CompSide side = CompSide::kLeft;
+        double radius = 0;  ///< mm
+        Axes start{};       ///< the tool center where compensation began
+        SourceLocation at;  ///< the G41/G42
+        std::vector<CompMove> moves;
+    };
+    std::optional<CompState> comp_;
 
     struct NurbsPoint {
         Vec2 at;

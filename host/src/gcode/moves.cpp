@@ -7,6 +7,10 @@
 namespace pathstream::host::gcode {
 
 void Interpreter::travel(const Axes& to, SourceLocation at) {
+    if (comp_) {
+        comp_add(PlaneMove::kLine, nullptr, true, to, at);
+        return;
+    }
     if (machine()) {
         follow({line_piece(pos_, to)}, false, to, at);
         return;
@@ -73,12 +77,12 @@ std::vector<Piece> Interpreter::lift(const std::vector<Cubic>& pieces, const Axe
 }
 
 void Interpreter::follow(const std::vector<Piece>& pieces, bool down, const Axes& to,
-                         SourceLocation at) {
+                         SourceLocation at, std::optional<double> fixed_feed) {
     for (const Piece& piece : pieces) {
         for (const Axes& p : piece.p) check_point(p, at);
     }
     if (down) {
-        const double feed = move_feed(pieces, at);
+        const double feed = fixed_feed ? *fixed_feed : move_feed(pieces, at);
         for (const Piece& piece : pieces) runs_.draw(piece, feed, at, *file_);
         runs_.end_block();
     } else if (machine()) {
@@ -91,6 +95,10 @@ void Interpreter::follow(const std::vector<Piece>& pieces, bool down, const Axes
 }
 
 void Interpreter::line(const Axes& to, SourceLocation at) {
+    if (comp_) {
+        comp_add(PlaneMove::kLine, nullptr, false, to, at);
+        return;
+    }
     follow({line_piece(pos_, to)}, pen_down(pos_[kZ], to[kZ]), to, at);
 }
 
