@@ -1,5 +1,5 @@
-// The G-code reader, pen on Z or on M3/M5 (the first byte picks): geometry or an InputError
-// naming the file.
+// The G-code reader, pen on Z or on M3/M5, or a router's X Y Z (A) machine with every move in
+// order (the first byte picks): geometry or an InputError naming the file.
 #include "fuzz_support.hpp"
 #include "pathstream/host/gcode_path.hpp"
 
@@ -7,7 +7,22 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     using namespace pathstream;
     if (size < 1) return 0;
     host::GcodeOptions options;
-    if ((data[0] & 1u) != 0) options.pen = host::PenControl::kSpindle;
+    switch (data[0] & 3u) {
+        case 1:
+            options.pen = host::PenControl::kSpindle;
+            break;
+        case 2:
+            options.pen = host::PenControl::kMachine;
+            options.axes = "XYZ";
+            options.rapid_feed = 150;
+            break;
+        case 3:
+            options.pen = host::PenControl::kMachine;
+            options.axes = "XYZA";
+            break;
+        default:
+            break;
+    }
     const std::string text = fuzz::text_of(data + 1, size - 1);
     fuzz::check_reader("f.ngc", [&] { return host::parse_gcode_path(text, "f.ngc", options); });
     return 0;
