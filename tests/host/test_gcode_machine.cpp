@@ -342,8 +342,10 @@ TEST_CASE("G-code machine: the loaded tool, G43.1 and units", "[gcode][machine]"
     // G43 without H: the tool M6 loaded; G43.1 X replaces X's offset and keeps Z's.
     check_waypoints(gcode("T3 M6\nG43\nG0 Z0\nG43.1 X1\nG0 X0\nG1 X1 F60\n", o),
                     {{T, {0, 0, 10}}, {T, {1, 0, 10}}, {D, {2, 0, 10}}});
-    CHECK(error_of("G43\nG1 X1 F60\n", o) ==
-          "t.ngc:1:1: G43 (no H): no tool loaded (give H, or T and M6 first)");
+    // No tool loaded is tool 0, whose offsets are 0 (LinuxCNC).
+    check_waypoints(gcode("G43\nG1 X1 F60\n", o), {{D, {1, 0, 0}}});
+    // M61 Q sets the tool in the spindle without a change: G43 takes its offsets.
+    check_waypoints(gcode("M61 Q3\nG43\nG1 X1 Z0 F60\n", o), {{D, {1, 0, 10}}});
     // G20: F is inches per minute along X, degrees per minute along A alone.
     const Path inch = gcode("G20 G1 X1 F60\nG1 A90\n", router("XYZA"));
     CHECK(inch.subpaths[0].feed == Approx(25.4));

@@ -533,8 +533,7 @@ TEST_CASE("G-code: code and word errors", "[host][gcode]") {
     CHECK(error_of("G20 G21") ==
           "t.ngc:1:5: G20 and G21 are in the same modal group (one per block)");
     CHECK(error_of("M3 M5") == "t.ngc:1:4: M3 and M5 are in the same modal group (one per block)");
-    CHECK(error_of("G41") ==
-          "t.ngc:1:1: G41/G42 without D and no tool loaded (give D, or T and M6)");
+    CHECK(error_of("G41 D2") == "t.ngc:1:1: G41/G42: no tool table (give one with --tool-table)");
     CHECK(error_of("G0 Z0\nG52 X0") == "t.ngc:2:1: unsupported G code G52");
     CHECK(error_of("G1.5") == "t.ngc:1:1: unsupported G code G1.5");
     CHECK(error_of("G1.25") == "t.ngc:1:1: unsupported G code G1.25");
@@ -557,10 +556,10 @@ TEST_CASE("G-code: code and word errors", "[host][gcode]") {
     CHECK(error_of("G1 X1\nI2") == "t.ngc:2:1: word I is not used by any command in this block");
     CHECK(error_of("G4") == "t.ngc:1:1: G4 needs P (the dwell time in seconds)");
     CHECK(error_of("G4 P-1") == "t.ngc:1:4: G4 dwell time P must not be negative");
-    CHECK(error_of("G1 X1 F0") == "t.ngc:1:7: feed F0 is out of range (0 < F <= 1e+06 mm/min)");
-    CHECK(error_of("G1 X1 F-5") == "t.ngc:1:7: feed F-5 is out of range (0 < F <= 1e+06 mm/min)");
-    CHECK(error_of("G20 G1 X1 F40000") ==
-          "t.ngc:1:11: feed F40000 is out of range (0 < F <= 1e+06 mm/min)");
+    CHECK(error_of("G1 X1 F0") == "t.ngc:1:7: feed F0 is out of range (0 < F <= 1e+09 mm/min)");
+    CHECK(error_of("G1 X1 F-5") == "t.ngc:1:7: feed F-5 is out of range (0 < F <= 1e+09 mm/min)");
+    CHECK(error_of("G20 G1 X1 F40000000") ==
+          "t.ngc:1:11: feed F40000000 is out of range (0 < F <= 1e+09 mm/min)");
 }
 
 TEST_CASE("G-code: out-of-range coordinates", "[host][gcode]") {

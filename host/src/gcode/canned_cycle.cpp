@@ -48,7 +48,6 @@ void Interpreter::canned_cycle(const Command& c, Motion cycle, SourceLocation at
         fail(at, std::string(name) + " drills along " + drill_letter +
                      ", which is not one of this machine's axes (" + options_.axes + ")");
     }
-    if (c.polar_distance || c.polar_angle) fail(at, "polar coordinates with a canned cycle");
     if (inverse_time_) fail(at, std::string(name) + " with inverse time feed (G93): give G94");
     for (std::size_t a = 3; a < kAxisCount; ++a) {
         // LinuxCNC: no rotary word in a cycle, and U V W only where they are the plane's.

@@ -29,6 +29,7 @@ enum Group {
     kSpindle,
     kRetract,
     kToolChange,
+    kSpindleSpeedMode,
     kGroupCount
 };
 
@@ -219,6 +220,26 @@ private:
                 fail(w, name +
                             " (tapping) needs a spindle whose turning the axes follow; this "
                             "machine's spindle is an output");
+            case 960:
+            case 970:
+                // Spindle speed mode (constant surface speed or RPM): S drives no output here,
+                // so neither changes anything; D (G96's speed cap) belongs to it.
+                claim(kSpindleSpeedMode, w, name);
+                c.spindle_speed_mode = true;
+                break;
+            case 382:
+            case 383:
+            case 384:
+            case 385:
+                fail(w, name + " (probing) needs a probe input, which this machine has not");
+            case 70:
+            case 80:
+            case 700:
+            case 710:
+            case 711:
+            case 720:
+            case 721:
+                fail(w, name + " is for lathes (diameter mode, turning cycles)");
             case 330:
             case 760:
                 fail(w, name + " (threading) needs a lathe spindle with an encoder");
@@ -355,6 +376,10 @@ private:
                 claim(kSpindle, w, name);
                 c.spindle_on = false;
                 break;
+            case 61:
+                claim(kToolChange, w, name);
+                c.set_tool = true;
+                break;
             case 6:
                 claim(kToolChange, w, name);
                 c.tool_change = true;
@@ -392,8 +417,10 @@ std::string g_code_name(long tenths) {
 }
 
 const std::set<std::string>& default_ignored_codes() {
-    static const std::set<std::string> codes{"M6",   "M7",   "M8",   "M9",   "M17",  "M18",  "M84",
-                                             "M106", "M107", "M117", "M300", "M888", "M2000"};
+    // M48-M53: LinuxCNC's override and adaptive feed switches (this machine has no overrides).
+    static const std::set<std::string> codes{"M6",   "M7",   "M8",   "M9",   "M17",  "M18", "M48",
+                                             "M49",  "M50",  "M51",  "M52",  "M53",  "M84", "M106",
+                                             "M107", "M117", "M300", "M888", "M2000"};
     return codes;
 }
 

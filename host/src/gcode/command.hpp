@@ -98,6 +98,8 @@ struct Command {
     bool optional_stop = false;              ///< M1
     bool pallet_change = false;              ///< M60
     bool tool_change = false;                ///< M6 (when not skipped)
+    bool set_tool = false;                   ///< M61 Q: the tool in the spindle, no change
+    bool spindle_speed_mode = false;         ///< G96, G97 (no effect: S drives no output)
     /// Codes skipped in this block; when `skip` the whole block is skipped (it held only
     /// skipped codes and their words).
     std::vector<IgnoredCode> ignored;
@@ -114,7 +116,8 @@ struct Command {
     }
 };
 
-/// Codes skipped when no --ignore-code is given: M6 (tool change), M7 M8 M9 (coolant),
+/// Codes skipped when no --ignore-code is given: M6 (tool change; not on a machine), M7 M8 M9
+/// (coolant), M48-M53 (LinuxCNC's override and adaptive feed switches),
 /// M17 M18 M84 (stepper power), M106 M107 (fan), M117 (display text), M300 (beep),
 /// M888 M2000 (DexArm modes).
 const std::set<std::string>& default_ignored_codes();

@@ -2,6 +2,7 @@
 // compensation"): G41/G42 collect the programmed XY moves up to G40, cutter_comp.cpp turns
 // them into the tool center's path, and the moves are made along it with every other axis
 // as programmed.
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -36,15 +37,17 @@ void Interpreter::cutter_mode(const Command& c) {
         if (d && (d->value != std::floor(d->value) || d->value < 0)) {
             fail(d->at, "D must be a whole tool number >= 0");
         }
-        const long tool = d && d->value > 0 ? static_cast<long>(d->value) : loaded_tool_;
-        if (tool < 0) fail(at, "G41/G42 without D and no tool loaded (give D, or T and M6)");
-        if (tools_.empty()) fail(at, "G41/G42: no tool table (give one with --tool-table)");
-        const ToolEntry* entry = tools_.find(tool);
-        if (!entry) {
-            fail(d ? d->at : at, "G41/G42: tool " + std::to_string(tool) +
-                                     " is not in the tool table " + tools_.source());
-        }
-        diameter = entry->diameter;
+        const long tool =
+            d && d->value > 0 ? static_cast<long>(d->value) : std::max(loaded_tool_, 0L);
+        if (tool > 0) {
+            if (tools_.empty()) fail(at, "G41/G42: no tool table (give one with --tool-table)");
+            const ToolEntry* entry = tools_.find(tool);
+            if (!entry) {
+                fail(d ? d->at : at, "G41/G42: tool " + std::to_string(tool) +
+                                         " is not in the tool table " + tools_.source());
+            }
+            diameter = entry->diameter;
+        }  // tool 0 (none loaded, D0): no tool, radius 0, as LinuxCNC
     }
     // As LinuxCNC, a negative diameter puts the tool on the other side.
     CompState state;

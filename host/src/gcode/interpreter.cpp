@@ -11,7 +11,8 @@ namespace pathstream::host::gcode {
 
 namespace {
 
-constexpr double kMaxFeedMmPerMin = 1e6;
+// LinuxCNC takes any F and the machine's limits govern; this bounds only nonsense.
+constexpr double kMaxFeedMmPerMin = 1e9;
 
 std::vector<std::size_t> axis_indices(const std::string& letters) {
     std::vector<std::size_t> indices;
@@ -216,6 +217,14 @@ bool Interpreter::execute(const Command& c) {
     if (pause || c.end_program) runs_.lift();
     if (pause) runs_.pause_next(pause_note(c));
     if (c.tool_change) load_tool();
+    if (c.set_tool) {
+        const Word* q = c.value('Q');
+        if (!q || q->value != std::floor(q->value) || q->value < 0) {
+            fail(q ? q->at : c.start, "M61 needs Q, a whole tool number >= 0");
+        }
+        selected_tool_ = static_cast<long>(q->value);
+        load_tool();
+    }
     if (c.end_program) {
         if (!nurbs_.empty()) fail(c.start, "program ends inside a G5.2 curve (no G5.3)");
         if (comp_) comp_flush();  // as LinuxCNC, the program's end turns compensation off
@@ -275,10 +284,10 @@ void Interpreter::check_words_used(const Command& c, Motion move, bool moving) c
         {'R', arc || cycle || g10},
         {'P', arc || cubic || nurbs || cycle_dwell || c.non_modal == NonModal::kDwell || blending ||
                   g10},
-        {'Q', cubic || blending || peck},
+        {'Q', cubic || blending || peck || c.set_tool},
         {'L', nurbs || cycle || g10},
         {'H', c.tool_length == ToolLength::kTable},
-        {'D', c.cutter_comp && *c.cutter_comp != CutterComp::kOff},
+        {'D', (c.cutter_comp && *c.cutter_comp != CutterComp::kOff) || c.spindle_speed_mode},
     };
     if (const Word* p = c.value('P');
         p && blending && (arc || cubic || nurbs || c.non_modal == NonModal::kDwell)) {

@@ -1,6 +1,7 @@
 // Program -> machine coordinates: coordinate systems G54..G59.3 and G10 L2/L20, the G92
 // offset, tool length offsets G43/G43.1/G49; G28/G30 homing moves (docs/formats-gcode.md,
 // "Offsets"). Positions and offsets live in LinuxCNC's numbered parameters, in mm.
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -75,11 +76,11 @@ void Interpreter::offsets_modes(const Command& c) {
             const SourceLocation h_at = h ? h->at : c.tool_length_at;
             const std::string h_text = h ? "H" + h->text : std::string("(no H)");
             long tool = h ? static_cast<long>(h->value) : 0;
+            if (tool == 0) tool = std::max(loaded_tool_, 0L);
             if (tool == 0) {
-                if (loaded_tool_ < 0) {
-                    fail(h_at, "G43 " + h_text + ": no tool loaded (give H, or T and M6 first)");
-                }
-                tool = loaded_tool_;
+                // As LinuxCNC: tool 0 is no tool, whose offsets are 0.
+                tool_offset_ = {};
+                break;
             }
             if (tools_.empty()) {
                 fail(h_at, "G43 " + h_text + ": no tool table (give one with --tool-table)");

@@ -115,9 +115,10 @@ private:
                 close(k, o, OKind::kSub);
                 break;
             case OKind::kReturn:
-                if (open_.empty() || open_line(0).kind != OKind::kSub ||
-                    open_line(0).label != o.label) {
-                    fail(o, oline_text(o) + " outside the subroutine of its label");
+                // As LinuxCNC: a return leaves the subroutine it is in, whatever its label (its
+                // demos write "o<test_return> return" inside "o<test_return> if").
+                if (open_.empty() || open_line(0).kind != OKind::kSub) {
+                    fail(o, oline_text(o) + " outside a subroutine");
                 }
                 break;
             case OKind::kCall:
