@@ -439,3 +439,23 @@ TEST_CASE("G-code machine: cutter radius compensation in the reader", "[gcode][m
     CHECK(error_of("G1 X1 D3 F60\n") ==
           "t.ngc:1:7: word D is not used by any command in this block");
 }
+
+TEST_CASE("G-code machine: a bolt circle with polar words in a cycle", "[gcode][machine][cycle]") {
+    // Four holes 10 mm from the origin, 90 degrees apart: G91 turns ^ on each L repeat.
+    const Path p = gcode("G0 Z5\nG90 G81 @10 ^0 Z-1 R1 F600\nG91 G81 ^90 Z-2 R-4 L3\n");
+    std::vector<std::vector<double>> bottoms;
+    for (const Waypoint& w : waypoints(p)) {
+        if (!w.travel) bottoms.push_back(w.at);
+    }
+    REQUIRE(bottoms.size() == 4);
+    const double expected[4][2] = {{10, 0}, {0, 10}, {-10, 0}, {0, -10}};
+    for (std::size_t k = 0; k < 4; ++k) {
+        CHECK(bottoms[k][0] == Approx(expected[k][0]).margin(1e-9));
+        CHECK(bottoms[k][1] == Approx(expected[k][1]).margin(1e-9));
+        CHECK(bottoms[k][2] == Approx(-1).margin(1e-9));
+    }
+    // A return under an if's label leaves the subroutine it is in, as LinuxCNC's demos do.
+    check_waypoints(gcode("o<s> sub\no<t> if [1]\no<t> return\no<t> endif\nG1 X9 F60\no<s> endsub\n"
+                          "o<s> call\nG1 X1 F60\n"),
+                    {{D, {1, 0, 0}}});
+}
