@@ -1,7 +1,7 @@
 // Cutter radius compensation in the reader (docs/formats-gcode.md, "Cutter radius
-// compensation"): G41/G42 collect the programmed XY moves up to G40, cutter_comp.cpp turns
-// them into the tool center's path, and the moves are made along it with every other axis
-// as programmed.
+// compensation"): G41/G42 collect the programmed moves in the plane (G17, G18) up to G40,
+// cutter_comp.cpp turns them into the tool center's path, and the moves are made along it with
+// every other axis as programmed.
 #include <algorithm>
 #include <cmath>
 #include <numbers>
@@ -20,7 +20,8 @@ void Interpreter::cutter_mode(const Command& c) {
     }
     const SourceLocation at = c.cutter_comp_at;
     if (comp_) fail(at, "cutter radius compensation is on already (give G40 first)");
-    if (plane_.normal != kZ) fail(at, "cutter radius compensation needs the XY plane (G17)");
+    // As LinuxCNC: G17 (a mill) and G18 (a lathe's XZ), the side seen from the plane's normal.
+    if (plane_.normal == kX) fail(at, "cutter radius compensation needs G17 or G18, not G19");
     if (inverse_time_) fail(at, "cutter radius compensation with inverse time feed (G93)");
     const bool left =
         *c.cutter_comp == CutterComp::kLeft || *c.cutter_comp == CutterComp::kLeftDiameter;
@@ -88,8 +89,8 @@ void Interpreter::comp_add(PlaneMove::Kind kind, const Arc* arc, bool rapid, con
                            SourceLocation at) {
     CompMove m;
     m.plane.kind = kind;
-    m.plane.start = in_plane(pos_, kPlaneXY);
-    m.plane.end = in_plane(to, kPlaneXY);
+    m.plane.start = in_plane(pos_, plane_);
+    m.plane.end = in_plane(to, plane_);
     if (arc) {
         m.plane.center = arc->center;
         m.plane.ccw = arc->sweep > 0;
@@ -116,7 +117,7 @@ void Interpreter::comp_flush() {
     if (programmed.empty()) return;
     CompResult result;
     try {
-        result = compensate(programmed, in_plane(state.start, kPlaneXY), state.side, state.radius,
+        result = compensate(programmed, in_plane(state.start, plane_), state.side, state.radius,
                             options_.arc_tolerance_mm);
     } catch (const CompError& e) {
         fail(state.moves.at(e.source).at, e.what());
@@ -144,13 +145,13 @@ void Interpreter::comp_flush() {
         }
         Axes to = m.to;
         if (!plane.empty()) {
-            to[kX] = plane.back().p[3].x;
-            to[kY] = plane.back().p[3].y;
+            to[plane_.first] = plane.back().p[3].x;
+            to[plane_.second] = plane.back().p[3].y;
         } else {
-            to[kX] = pos_[kX];
-            to[kY] = pos_[kY];
+            to[plane_.first] = pos_[plane_.first];
+            to[plane_.second] = pos_[plane_.second];
             if (to == pos_) continue;
-            plane.push_back(line_piece(in_plane(pos_, kPlaneXY), in_plane(pos_, kPlaneXY)));
+            plane.push_back(line_piece(in_plane(pos_, plane_), in_plane(pos_, plane_)));
         }
         // Every other axis moves linearly along the move's own length in the plane.
         std::vector<double> lengths;
@@ -171,8 +172,8 @@ void Interpreter::comp_flush() {
                                                  static_cast<double>(plane.size());
                 for (std::size_t a = 0; a < kAxisCount; ++a)
                     piece.p[j][a] = pos_[a] + f * (to[a] - pos_[a]);
-                piece.p[j][kX] = plane[i].p[j].x;
-                piece.p[j][kY] = plane[i].p[j].y;
+                piece.p[j][plane_.first] = plane[i].p[j].x;
+                piece.p[j][plane_.second] = plane[i].p[j].y;
             }
             if (i > 0) piece.p[0] = pieces.back().p[3];
             if (i == 0) piece.p[0] = pos_;
