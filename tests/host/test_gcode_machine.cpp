@@ -459,3 +459,18 @@ TEST_CASE("G-code machine: a bolt circle with polar words in a cycle", "[gcode][
                           "o<s> call\nG1 X1 F60\n"),
                     {{D, {1, 0, 0}}});
 }
+
+TEST_CASE("G-code machine: cutter compensation in G18, as on a lathe", "[gcode][machine][cutter]") {
+    // In G18 the plane is Z X and the tool's left is seen from +Y: going toward -Z at X10, a
+    // tool of radius 1 on the left runs at X9.
+    const Path p = gcode("G18 G0 X12 Z2\nG41.1 D2\nG1 X10 Z0 F60\nG1 Z-20\nG40\nG0 X12\n");
+    std::vector<Waypoint> feeds;
+    for (const Waypoint& w : waypoints(p)) {
+        if (!w.travel) feeds.push_back(w);
+    }
+    REQUIRE_FALSE(feeds.empty());
+    CHECK(feeds.back().at[0] == Approx(9).margin(1e-9));
+    CHECK(feeds.back().at[2] == Approx(-20).margin(1e-9));
+    CHECK(error_of("G19 G41.1 D2\n") ==
+          "t.ngc:1:5: cutter radius compensation needs G17 or G18, not G19");
+}
