@@ -474,3 +474,14 @@ TEST_CASE("G-code machine: cutter compensation in G18, as on a lathe", "[gcode][
     CHECK(error_of("G19 G41.1 D2\n") ==
           "t.ngc:1:5: cutter radius compensation needs G17 or G18, not G19");
 }
+
+TEST_CASE("G-code machine: M70-M73 save and restore the modes", "[gcode][machine]") {
+    // M70 saves G21 G90; the program switches to G20 G91, M72 brings back mm and absolute.
+    check_waypoints(gcode("G21 G90 F60\nM70\nG20 G91\nG1 X1\nM72\nG1 X5\n"),
+                    {{D, {25.4, 0, 0}}, {D, {5, 0, 0}}});
+    // M73 in a subroutine: its mode changes end with the call.
+    check_waypoints(gcode("o<s> sub\nM73\nG91\nG1 X1\no<s> endsub\nG90 F60\no<s> call\nG1 X5\n"),
+                    {{D, {1, 0, 0}}, {D, {5, 0, 0}}});
+    CHECK(error_of("M72\n") == "t.ngc:1:1: M72 without a state saved by M70");
+    CHECK(error_of("M73\n") == "t.ngc:1:1: M73 outside a subroutine");
+}

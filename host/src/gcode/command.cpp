@@ -30,6 +30,7 @@ enum Group {
     kRetract,
     kToolChange,
     kSpindleSpeedMode,
+    kModalState,
     kGroupCount
 };
 
@@ -375,6 +376,14 @@ private:
             case 5:
                 claim(kSpindle, w, name);
                 c.spindle_on = false;
+                break;
+            case 70:
+            case 71:
+            case 72:
+            case 73:
+                claim(kModalState, w, name);
+                c.modal_state = static_cast<int>(code);
+                c.modal_state_at = w.at;
                 break;
             case 61:
                 claim(kToolChange, w, name);

@@ -99,7 +99,10 @@ struct Command {
     bool pallet_change = false;              ///< M60
     bool tool_change = false;                ///< M6 (when not skipped)
     bool set_tool = false;                   ///< M61 Q: the tool in the spindle, no change
-    bool spindle_speed_mode = false;         ///< G96, G97 (no effect: S drives no output)
+    /// M70 save, M71 invalidate, M72 restore, M73 save until the subroutine returns; 0: none.
+    int modal_state = 0;
+    SourceLocation modal_state_at;
+    bool spindle_speed_mode = false;  ///< G96, G97 (no effect: S drives no output)
     /// Codes skipped in this block; when `skip` the whole block is skipped (it held only
     /// skipped codes and their words).
     std::vector<IgnoredCode> ignored;

@@ -124,6 +124,7 @@ bool Interpreter::execute(const Command& c) {
              "G92");
     }
     comp_refuse(c);
+    modal_state_code(c);
     if (c.inch) inch_ = *c.inch;
     if (c.plane) plane_ = *c.plane;
     if (c.incremental) incremental_ = *c.incremental;
@@ -231,6 +232,67 @@ bool Interpreter::execute(const Command& c) {
         return false;
     }
     return true;
+}
+
+Interpreter::ModalState Interpreter::modal_state() const {
+    return ModalState{inch_,
+                      incremental_,
+                      arc_incremental_,
+                      inverse_time_,
+                      plane_,
+                      feed_,
+                      system_,
+                      tool_offset_,
+                      retract_to_r_,
+                      spindle_,
+                      runs_.corner_mode(),
+                      runs_.blend_tolerance()};
+}
+
+void Interpreter::restore(const ModalState& s) {
+    inch_ = s.inch;
+    incremental_ = s.incremental;
+    arc_incremental_ = s.arc_incremental;
+    inverse_time_ = s.inverse_time;
+    plane_ = s.plane;
+    feed_ = s.feed;
+    system_ = s.system;
+    parameters_.set(ParameterRef{5220, {}}, static_cast<double>(system_ + 1));
+    tool_offset_ = s.tool_offset;
+    retract_to_r_ = s.retract_to_r;
+    spindle_ = s.spindle;
+    runs_.set_corners(s.corners, s.blend_tolerance);
+}
+
+// LinuxCNC's M70-M73, at the start of the block (LinuxCNC saves after the block's F, S, T
+// and spindle codes; a block that both saves and sets those is rare).
+void Interpreter::modal_state_code(const Command& c) {
+    switch (c.modal_state) {
+        case 70:
+            saved_state_ = modal_state();
+            break;
+        case 71:
+            saved_state_.reset();
+            break;
+        case 72:
+            if (!saved_state_) fail(c.modal_state_at, "M72 without a state saved by M70");
+            restore(*saved_state_);
+            break;
+        case 73:
+            if (call_depth_ == 0) fail(c.modal_state_at, "M73 outside a subroutine");
+            call_states_.emplace_back(call_depth_, modal_state());
+            break;
+        default:
+            break;
+    }
+}
+
+void Interpreter::leave_call() {
+    if (!call_states_.empty() && call_states_.back().first == call_depth_) {
+        restore(call_states_.back().second);
+        call_states_.pop_back();
+    }
+    if (call_depth_ > 0) --call_depth_;
 }
 
 std::string Interpreter::pause_note(const Command& c) const {

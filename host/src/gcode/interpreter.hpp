@@ -42,6 +42,10 @@ public:
     using Warn = std::function<void(const std::string&, SourceLocation, const std::string&)>;
     void set_warn(Warn warn) { warn_ = std::move(warn); }
 
+    /// The program runner's calls: M73 restores the state it saved when its call returns.
+    void enter_call() { ++call_depth_; }
+    void leave_call();
+
     /// Executes one block (in LinuxCNC's order: units, distance modes, F, spindle, dwell,
     /// offsets and homing, motion, then M0/M1 and program end). Returns false after M2 or
     /// M30: read no further. Throws InputError at the offending word.
@@ -158,6 +162,26 @@ private:
     bool cycle_r_incremental_ = false, cycle_z_incremental_ = false;
     Motion last_cycle_ = Motion::kNone;    ///< the cycle of the series, kNone out of one
     std::optional<double> cycle_initial_;  ///< the series' initial level on the drill axis
+
+    /// The modes M70 and M73 save and M72 restores (LinuxCNC's list, what this reader has).
+    struct ModalState {
+        bool inch = false, incremental = false, arc_incremental = true, inverse_time = false;
+        Plane plane = kPlaneXY;
+        double feed = 0;
+        std::size_t system = 0;
+        Axes tool_offset{};
+        bool retract_to_r = false, spindle = false;
+        CornerMode corners = CornerMode::kBlend;
+        double blend_tolerance = 0;
+    };
+    ModalState modal_state() const;
+    void restore(const ModalState& s);
+    /// M70, M71, M72, M73.
+    void modal_state_code(const Command& c);
+    std::optional<ModalState> saved_state_;  ///< M70's
+    std::size_t call_depth_ = 0;
+    /// M73's, by the call depth that saved it (restored when that call returns).
+    std::vector<std::pair<std::size_t, ModalState>> call_states_;
 
     /// A programmed move collected under G41/G42.
     struct CompMove {

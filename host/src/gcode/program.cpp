@@ -222,6 +222,7 @@ private:
                 const std::size_t back = frames_.back().return_to;
                 frames_.pop_back();
                 parameters_.leave_call();
+                interpreter_.leave_call();
                 return back;
             }
             case OKind::kCall: {
@@ -242,6 +243,7 @@ private:
                                    std::to_string(kMaxCallDepth) + " deep");
                 }
                 parameters_.enter_call(args);
+                interpreter_.enter_call();
                 frames_.push_back(Frame{pc + 1, {}});
                 return sub_line + 1;
             }
