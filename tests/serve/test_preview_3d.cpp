@@ -52,7 +52,7 @@ TEST_CASE("serve: a router's preview has x, y, z by name and the isometric view"
     const nlohmann::ordered_json p = preview_json(plan, path, m);
     REQUIRE(p.contains("view"));
     CHECK(p["view"]["projection"] == "isometric");
-    CHECK(p["view"]["axes"] == nlohmann::json::array({1, 2, 0}));
+    CHECK(p["view"]["axes"] == nlohmann::ordered_json::array({1, 2, 0}));
     CHECK(p["view"]["box"]["z_min"] == -60);
     CHECK(p["view"]["box"]["x_max"] == 600);
     const auto& x = p["path"]["x"];
