@@ -79,27 +79,6 @@ double nice_length(double target) {
     return m;
 }
 
-/// The executed path as pen-down (solid) and pen-up (dashed) runs, as path.svg's 2-D view
-/// draws them, each point through the view.
-void draw_executed(Canvas& c, const std::vector<TracePoint>& s, const std::string& colour,
-                   double width) {
-    const std::size_t n = s.size();
-    std::size_t k = 0;
-    while (k < n) {
-        const bool down = s[k].pen_down;
-        std::vector<Point> run;
-        std::size_t j = k;
-        for (; j < n && s[j].pen_down == down; ++j)
-            add_px(run, to_px(c, {s[j].x, s[j].y, s[j].z}), 0.75);
-        const std::size_t last = j < n ? j : n - 1;  // share the boundary point with the next run
-        const Point end = to_px(c, {s[last].x, s[last].y, s[last].z});
-        if (run.empty() || run.back().x != end.x || run.back().y != end.y) run.push_back(end);
-        c.polyline_px(run, colour, width, down ? "" : detail::kPenUpDash,
-                      down ? "pen-down" : "pen-up");
-        k = j;
-    }
-}
-
 /// An arrow from `from` to `to` (pixels) with its head, and `label` beyond its tip.
 void arrow(Canvas& c, Point from, Point to, const std::string& colour, const std::string& label) {
     const double len = std::max(1e-9, std::hypot(to.x - from.x, to.y - from.y));
@@ -223,11 +202,12 @@ std::string isometric_path_svg(SegmentSource& path, const RunRecord& r,
     c.end_group();
 
     c.begin_series("setpoints");
-    draw_executed(c, r.executed_path, detail::kSetpointColour, 1.6);
+    const auto view = [&c](const TracePoint& t) { return to_px(c, {t.x, t.y, t.z}); };
+    detail::draw_executed(c, r.executed_path, detail::kSetpointColour, 1.6, view);
     c.end_group();
     if (r.has_plant) {
         c.begin_series("plant");
-        draw_executed(c, r.plant_path, detail::kPlantColour, 1);
+        detail::draw_executed(c, r.plant_path, detail::kPlantColour, 1, view);
         c.end_group();
     }
 

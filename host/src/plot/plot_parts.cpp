@@ -78,6 +78,23 @@ void add_px(std::vector<Point>& run, Point p, double min_px) {
     run.push_back(p);
 }
 
+void draw_executed(Canvas& c, const std::vector<TracePoint>& s, const std::string& colour,
+                   double width, const std::function<Point(const TracePoint&)>& to_px) {
+    const std::size_t n = s.size();
+    std::size_t k = 0;
+    while (k < n) {
+        const bool down = s[k].pen_down;
+        std::vector<Point> run;
+        std::size_t j = k;
+        for (; j < n && s[j].pen_down == down; ++j) add_px(run, to_px(s[j]), 0.75);
+        const std::size_t last = j < n ? j : n - 1;  // share the boundary point with the next run
+        const Point end = to_px(s[last]);
+        if (run.empty() || run.back().x != end.x || run.back().y != end.y) run.push_back(end);
+        c.polyline_px(run, colour, width, down ? "" : kPenUpDash, down ? "pen-down" : "pen-up");
+        k = j;
+    }
+}
+
 LegendEntry pen_up_legend() {
     return {"pen up", kPenUpShade, "", 10};
 }

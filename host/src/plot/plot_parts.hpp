@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstddef>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -21,6 +22,12 @@ std::string axis_name(const MachineProfile& profile, std::size_t axis);
 
 /// Appends a pixel point unless it is within `min_px` of the last one kept.
 void add_px(std::vector<Point>& run, Point p, double min_px = 0.4);
+
+/// Draws an executed trace as pen-down (solid) and pen-up (dashed) runs, each point through
+/// `to_px` (the 2-D view or the isometric one), thinned to points at least 0.75 px apart, the
+/// boundary point shared with the next run.
+void draw_executed(Canvas& c, const std::vector<TracePoint>& s, const std::string& colour,
+                   double width, const std::function<Point(const TracePoint&)>& to_px);
 
 /// The legend's swatch of the pen-up shading.
 LegendEntry pen_up_legend();

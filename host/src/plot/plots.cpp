@@ -61,27 +61,6 @@ struct Bounds {
     bool empty() const { return !(x1 >= x0); }
 };
 
-/// Draws a path's points as pen-down (solid) and pen-up (dashed) runs, in pixels, thinned to
-/// points at least 0.75 px apart (the last point of every run kept).
-void draw_executed(Canvas& c, const std::vector<TracePoint>& s, const std::string& colour,
-                   double width) {
-    const std::size_t n = s.size();
-    std::size_t k = 0;
-    while (k < n) {
-        const bool down = s[k].pen_down;
-        std::vector<Point> run;
-        std::size_t j = k;
-        for (; j < n && s[j].pen_down == down; ++j) {
-            add_px(run, {c.px(s[j].x), c.py(s[j].y)}, 0.75);
-        }
-        const std::size_t last = j < n ? j : n - 1;  // share the boundary point with the next run
-        const Point end{c.px(s[last].x), c.py(s[last].y)};
-        if (run.empty() || run.back().x != end.x || run.back().y != end.y) run.push_back(end);
-        c.polyline_px(run, colour, width, down ? "" : kPenUpDash, down ? "pen-down" : "pen-up");
-        k = j;
-    }
-}
-
 /// One axis: position against time for the executed series (and plant).
 std::string position_time_svg(const RunRecord& r, const MachineProfile& profile,
                               const Options& options) {
@@ -280,7 +259,8 @@ std::string path_svg(SegmentSource& path, const RunRecord& r, const MachineProfi
     c.end_group();
 
     c.begin_series("setpoints");
-    draw_executed(c, r.executed_path, detail::kSetpointColour, 1.6);
+    const auto plane = [&c](const TracePoint& t) { return Point{c.px(t.x), c.py(t.y)}; };
+    detail::draw_executed(c, r.executed_path, detail::kSetpointColour, 1.6, plane);
     c.end_group();
     std::vector<LegendEntry> legend;
     if (any_segment && layered) {
@@ -295,7 +275,7 @@ std::string path_svg(SegmentSource& path, const RunRecord& r, const MachineProfi
                       detail::kSetpointColour, "", 1.6});
     if (r.has_plant) {
         c.begin_series("plant");
-        draw_executed(c, r.plant_path, detail::kPlantColour, 1);
+        detail::draw_executed(c, r.plant_path, detail::kPlantColour, 1, plane);
         c.end_group();
         legend.push_back(
             {r.plant_name.empty() ? "plant" : r.plant_name, detail::kPlantColour, "", 1});
