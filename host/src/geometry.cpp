@@ -215,8 +215,9 @@ bool PathSegmentSource::next(BezierSegment& out) {
                 out.p[3] = seg.p[0];
                 out.pen_down = false;
                 out.subpath = any_ ? s_ : 0;
-                if (!seg.pen_down && any_) {
-                    // Joins the travel subpath's run: the run's pause and dwell go first.
+                if (!seg.pen_down) {
+                    // Joins the travel subpath's run (the lead-in too): its pause and dwell go
+                    // first.
                     out.pause_before = seg.pause_before;
                     out.dwell_before = seg.dwell_before;
                     out.dwell_pen_down = seg.dwell_pen_down;

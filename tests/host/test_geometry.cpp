@@ -249,3 +249,28 @@ TEST_CASE("a path's segments made one at a time: the list's, a lead-in first, ag
     REQUIRE(at_start.next(first));
     CHECK(first.pen_down);
 }
+
+TEST_CASE("a routed travel's pause stays first behind a lead-in", "[geometry]") {
+    // A machine program that starts with M6 then G0: the travel subpath carries the pause, and
+    // the lead-in that joins its run must carry it, or the pause is lost.
+    Path path;
+    path.axes = 2;
+    Subpath rapid;
+    rapid.basis = PathBasis::kPolyline;
+    rapid.travel = true;
+    rapid.pause_before = true;
+    rapid.points = PointList({{10, 0}, {10, 10}});
+    path.subpaths.push_back(rapid);
+    Subpath cut;
+    cut.basis = PathBasis::kPolyline;
+    cut.points = PointList({{10, 10}, {20, 10}});
+    path.subpaths.push_back(cut);
+    PathSegmentSource source(path, PathPoint{0, 0});
+    BezierSegment first, second;
+    REQUIRE(source.next(first));
+    REQUIRE(source.next(second));
+    CHECK_FALSE(first.pen_down);
+    CHECK(first.pause_before);  // the lead-in, first of the run
+    CHECK(second.subpath == first.subpath);
+    CHECK_FALSE(second.pause_before);
+}
