@@ -52,7 +52,7 @@ public:
         only_keys(root, "",
                   {"axes", "mm_per_lsb", "tick_hz", "ticks_per_span", "feed", "travel_feed",
                    "pen_down_delay", "pen_up_delay", "chord_tolerance", "corner_stop_angle", "gpio",
-                   "layer_feeds"});
+                   "layer_feeds", "spindle"});
         MachineProfile p;
         if (!root.contains("axes")) fail("", "machine profile has no \"axes\"");
         const json& axes = root["axes"];
@@ -146,6 +146,7 @@ public:
         }
         check_plannable(root, p);
         if (root.contains("gpio")) p.gpio = gpio(root["gpio"], p);
+        if (root.contains("spindle")) p.spindle = spindle(root["spindle"]);
         if (root.contains("layer_feeds")) {
             const json& f = root["layer_feeds"];
             if (!f.is_object())
@@ -293,6 +294,16 @@ private:
             }
             c.bias = b.get<std::string>();
         }
+        return c;
+    }
+
+    SpindleConfig spindle(const json& v) const {
+        if (!v.is_object()) fail("/spindle", "spindle must be an object like {\"spin_up\": 2}");
+        only_keys(v, "/spindle", {"spin_up"});
+        SpindleConfig c;
+        c.present = true;
+        if (v.contains("spin_up"))
+            c.spin_up = number(v["spin_up"], "/spindle/spin_up", "spin_up", 0, 600, false, "s");
         return c;
     }
 

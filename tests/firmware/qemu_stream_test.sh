@@ -78,7 +78,7 @@ run() { timeout -k 5 120 "$@"; }
 
 # 1. Status and the start position, on both devices.
 for target in "$fw" "$linux"; do
-  if out=$(run "$bin" ctl "$target" status 2>&1) && grep -q "protocol 5, 2 axes" <<<"$out"; then
+  if out=$(run "$bin" ctl "$target" status 2>&1) && grep -q "protocol 6, 2 axes" <<<"$out"; then
     ok
   else
     fail "ctl status on $target: $out"

@@ -19,6 +19,7 @@
 #include "pathstream/device/can_protocol.hpp"
 #include "pathstream/device/device_state.hpp"
 #include "pathstream/device/jog.hpp"
+#include "pathstream/device/modbus_map.hpp"
 #include "pathstream/hal/modbus_server.hpp"
 #include "pathstream/host/can_stream.hpp"
 #include "pathstream/host/device_link.hpp"
@@ -514,7 +515,8 @@ TEST_CASE("ctl's link: status and every command over Modbus TCP, refusals by nam
     ModbusDeviceThread dt(start_of(job.plan), 1.0, &limits);
     const std::unique_ptr<host::DeviceLink> link = host::open_device_link(dt.target(), {});
     host::DeviceSnapshot s = link->status();
-    CHECK((s.magic == 0x5053 && s.version == 5 && s.axes == 2 && s.state == DeviceState::kIdle));
+    CHECK((s.magic == 0x5053 && s.version == device::modbus::kProtocolVersion && s.axes == 2 &&
+           s.state == DeviceState::kIdle));
     CHECK((s.position[0] == start_of(job.plan)[0] && s.position[1] == start_of(job.plan)[1]));
     CHECK(link->command(Command::kHold) == Status::kWrongState);  // idle: nothing to hold
     CHECK(link->command(Command::kResume) == Status::kWrongState);
@@ -570,7 +572,8 @@ TEST_CASE("ctl's link over native CAN: status, commands, a hold of a running str
     c.name = "can://loop?node=5";
     const std::unique_ptr<host::DeviceLink> link = host::open_can_link(ctl_bus, c);
     host::DeviceSnapshot s = link->status();
-    CHECK((s.version == 4 && s.axes == 2 && s.state == DeviceState::kIdle));
+    CHECK((s.version == device::can::kProtocolVersion && s.axes == 2 &&
+           s.state == DeviceState::kIdle));
     CHECK((s.position[0] == start_of(job.plan)[0] && s.position[1] == start_of(job.plan)[1]));
     CHECK(link->command(Command::kHold) == Status::kWrongState);
     CHECK(link->command_with_arguments(device::kCommandSetPosition, 2, 0, 0) ==

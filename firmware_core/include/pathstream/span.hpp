@@ -28,6 +28,21 @@ struct Span {
 /// Bits of Span::outputs. The device applies a span's outputs at its first tick, so a pen
 /// change happens exactly at a span boundary (the planner puts a dwell span there).
 inline constexpr std::uint8_t kOutputPenDown = 1u << 0;
+/// The spindle (or laser) runs: G-code M3 or M4 until M5.
+inline constexpr std::uint8_t kOutputSpindle = 1u << 1;
+/// With kOutputSpindle: it turns counter-clockwise (M4); without, clockwise (M3).
+inline constexpr std::uint8_t kOutputSpindleReverse = 1u << 2;
+/// Mist coolant (M7) and flood coolant (M8), until M9.
+inline constexpr std::uint8_t kOutputMist = 1u << 3;
+inline constexpr std::uint8_t kOutputFlood = 1u << 4;
+/// The machine functions among the outputs. Unlike the pen, the device keeps them as the last
+/// played span left them while the job is held, paused, underrun or stopping (a spindle is not
+/// stopped by a feed hold), and drops them only when the job ends or stops, a fault or the
+/// e-stop; the planner changes them only where the motion rests.
+inline constexpr std::uint8_t kOutputMachineMask =
+    kOutputSpindle | kOutputSpindleReverse | kOutputMist | kOutputFlood;
+/// Every defined bit: a span with any other bit set is refused.
+inline constexpr std::uint8_t kOutputKnownMask = kOutputPenDown | kOutputMachineMask;
 
 /// What a queue entry carries besides the motion, for whoever consumes the queue; the stream
 /// itself never reads it. A device stamps each span with the queue epoch it was accepted in,

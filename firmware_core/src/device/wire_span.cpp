@@ -56,7 +56,8 @@ Status decode_wire_span(const std::uint8_t* bytes, std::size_t available, unsign
     const std::uint32_t ticks = get_u16(p) + 1;
     const std::uint8_t flags = *p++;
     const std::uint8_t outputs = *p++;
-    if ((flags & ~kWireKnownFlags) != 0) return Status::kBadBatch;
+    if ((flags & ~kWireKnownFlags) != 0 || (outputs & ~kOutputKnownMask) != 0)
+        return Status::kBadBatch;
     const bool continues = (flags & kWireContinueTangent) != 0;
     const std::size_t size = wire_span_bytes(axes, continues);
     if (available < size) return Status::kBadBatch;

@@ -29,9 +29,11 @@ DeviceSnapshot snapshot_of(const pc::Status3& s) {
     d.fault_code = s.fault_code;
     d.free_slots = s.free_slots;
     d.queued = s.queued;
-    // Status A's flags agree with the snapshot's bits; its pen flag is the snapshot's output.
-    d.flags = s.flags & ~unsigned{pc::kFlagPenDown};
-    d.outputs = (s.flags & pc::kFlagPenDown) != 0 ? kOutputPenDown : 0u;
+    // Status A's flags agree with the snapshot's bits; its pen and spindle flags are the
+    // snapshot's outputs (CAN reports no coolant).
+    d.flags = s.flags & ~unsigned{pc::kFlagPenDown | pc::kFlagSpindle};
+    d.outputs = ((s.flags & pc::kFlagPenDown) != 0 ? kOutputPenDown : 0u) |
+                ((s.flags & pc::kFlagSpindle) != 0 ? kOutputSpindle : 0u);
     d.underruns = s.underruns;
     d.duplicates = s.duplicates;
     d.last_accepted = s.last_accepted;

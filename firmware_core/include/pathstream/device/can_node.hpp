@@ -82,6 +82,7 @@ public:
             (d.held_by_underrun() ? kFlagHeldByUnderrun : 0) | (d.own_move() ? kFlagOwnMove : 0) |
             (d.paused() ? kFlagPaused : 0) | (operator_.homing() ? kFlagHoming : 0) |
             ((d.outputs & kOutputPenDown) != 0 ? kFlagPenDown : 0) |
+            ((d.outputs & kOutputSpindle) != 0 ? kFlagSpindle : 0) |
             (bus_problem_ ? kFlagBusProblem : 0));
         s.free_slots = saturate8(device_.free_slots());
         s.queued = saturate8(device_.queued_spans());

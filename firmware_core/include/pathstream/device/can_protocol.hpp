@@ -19,7 +19,9 @@ namespace pathstream::device::can {
 /// 3: home and pen commands (CommandArgs 8, 9), the homing and pen flags (status A), each
 /// axis's homing state (status E).
 /// 4: programmed pauses (wire flag kWirePause) and the paused flag (status A bit 6).
-inline constexpr std::uint8_t kProtocolVersion = 4;
+/// 5: machine-function outputs in the spans (kOutputMachineMask, kept through holds; undefined
+/// output bits refused) and the spindle flag (status A bit 7).
+inline constexpr std::uint8_t kProtocolVersion = 5;
 inline constexpr std::uint8_t kMinNode = 1;
 inline constexpr std::uint8_t kMaxNode = 127;
 
@@ -88,6 +90,8 @@ inline constexpr std::uint8_t kFlagHoming = 1u << 4;
 inline constexpr std::uint8_t kFlagPenDown = 1u << 5;
 /// Holding at a programmed pause (a span with kWirePause ended); resume continues the job.
 inline constexpr std::uint8_t kFlagPaused = 1u << 6;
+/// The spindle output is on (kOutputSpindle in the status's outputs); coolant is not reported.
+inline constexpr std::uint8_t kFlagSpindle = 1u << 7;
 
 /// Configuration items: 0 tick rate, 1 + 2a axis a's max velocity, 2 + 2a its acceleration,
 /// 18 + 2a its travel min, 19 + 2a its travel max (LSB, signed; optional: without them the
@@ -203,7 +207,7 @@ inline constexpr Signal kStatusASignals[] = {
     {"Flags", 1, 1, false, "",
      "bit 0 configured, bit 1 held by underrun, bit 2 bus problem seen, bit 3 own stop or re-entry "
      "move, bit 4 homing, "
-     "bit 5 pen down, bit 6 paused at a programmed pause"},
+     "bit 5 pen down, bit 6 paused at a programmed pause, bit 7 spindle on"},
     {"FreeSlots", 2, 1, false, "span", "free span slots"},
     {"Queued", 3, 1, false, "span", "spans queued"},
     {"FaultCode", 4, 2, false, "",

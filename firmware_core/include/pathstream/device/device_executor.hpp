@@ -66,7 +66,7 @@ public:
                     path = true;
                 } else {
                     for (unsigned a = 0; a < Axes; ++a) out[a] = queue.resting_position(a);
-                    outputs_ = 0;
+                    outputs_ = held_machine_outputs();
                 }
                 break;
             case Motion::kGenerated:
@@ -74,16 +74,17 @@ public:
                 ++generated_ticks_;
                 // Only the pen, and only for the last pen-down delay of a re-entry onto a
                 // pen-down span: it lands as the axes reach the boundary.
-                outputs_ =
-                    generated_kind_ == Generated::kReentry && generated_left_ <= pen_lead_ticks_
-                        ? pen_lead_outputs_
-                        : std::uint8_t{0};
+                outputs_ = static_cast<std::uint8_t>(
+                    held_machine_outputs() |
+                    (generated_kind_ == Generated::kReentry && generated_left_ <= pen_lead_ticks_
+                         ? pen_lead_outputs_
+                         : std::uint8_t{0}));
                 --generated_left_;
                 break;
             case Motion::kRest:
             default:
                 for (unsigned a = 0; a < Axes; ++a) out[a] = rest_[a];
-                outputs_ = state_ == DeviceState::kIdle ? manual_pen_ : std::uint8_t{0};
+                outputs_ = state_ == DeviceState::kIdle ? manual_pen_ : held_machine_outputs();
                 break;
         }
         for (unsigned a = 0; a < Axes; ++a) position_[a] = out[a];
@@ -106,6 +107,16 @@ private:
     };
 
     const MotionLimits<Axes>& limits() const { return channel_.mailbox.limits; }
+
+    // Off the path, a job keeps the machine functions (spindle, coolant) of the span it last
+    // played while it runs, holds or stops (the stream keeps that span's outputs); idle, in a
+    // fault and in the e-stop there are none.
+    std::uint8_t held_machine_outputs() const {
+        const bool job = state_ == DeviceState::kRunning || state_ == DeviceState::kHolding ||
+                         state_ == DeviceState::kStopping;
+        return job ? static_cast<std::uint8_t>(channel_.queue.outputs() & kOutputMachineMask)
+                   : std::uint8_t{0};
+    }
 
     void set_state(DeviceState s) {
         state_ = s;

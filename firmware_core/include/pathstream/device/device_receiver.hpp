@@ -71,16 +71,15 @@ public:
     /// tick while the batch was being queued: its spans are then never executed);
     /// kBadSequence (a gap, a partial overlap, an older batch, or the last batch's numbers
     /// with other bytes); kBadBatch (count 0 or > kMaxBatchSpans,
-    /// length mismatch, bad flags); a span's own Status (its validation, kVelocityLimit,
-    /// kAccelerationLimit, kOutsideTravel, kVelocityStep, kJobEndMoving, kPauseMoving, and
-    /// under a jerk limit kJerkLimit and kAccelerationStep: the acceleration at every join,
-    /// a job's first span, after a pause and at a job end or pause too, where the other side
-    /// is rest); and only for a batch that is
-    /// otherwise acceptable, kQueueFull (not enough free slots: retry later).
-    /// `between` is called before each span is queued: a test hook that runs the tick there
-    /// (the interrupt could); the default does nothing. Cost: two decodes and one validation
-    /// per span, the push's own validation (~5,000 instructions per axis on M4), and one
-    /// CRC-32 of the payload (~8 steps per byte) for an accepted batch or a resend.
+    /// length mismatch, bad flags, an output bit outside kOutputKnownMask); a span's own Status
+    /// (its validation, kVelocityLimit, kAccelerationLimit, kOutsideTravel, kVelocityStep,
+    /// kJobEndMoving, kPauseMoving, and under a jerk limit kJerkLimit and kAccelerationStep: the
+    /// acceleration at every join, a job's first span, after a pause and at a job end or pause too,
+    /// where the other side is rest); and only for a batch that is otherwise acceptable, kQueueFull
+    /// (not enough free slots: retry later). `between` is called before each span is queued: a test
+    /// hook that runs the tick there (the interrupt could); the default does nothing. Cost: two
+    /// decodes and one validation per span, the push's own validation (~5,000 instructions per axis
+    /// on M4), and one CRC-32 of the payload (~8 steps per byte) for an accepted batch or a resend.
     template <typename Between = NoInterleave>
     [[nodiscard]] Status accept_batch(std::uint32_t first_sequence, std::uint16_t count,
                                       const std::uint8_t* payload, std::size_t length,

@@ -14,7 +14,9 @@ inline constexpr std::uint16_t kMagic = 0x5053;  ///< "PS"
 /// per-axis homing registers (42-49).
 /// 4: programmed pauses (wire flag kWirePause) and the paused flag (bit 6).
 /// 5: per-axis jerk limits at the end of the configuration block (config_jerk_register).
-inline constexpr std::uint16_t kProtocolVersion = 5;
+/// 6: machine-function outputs (spindle, direction, mist, flood: kOutputMachineMask), kept
+/// through holds; spans with an undefined output bit are refused.
+inline constexpr std::uint16_t kProtocolVersion = 6;
 
 /// Status block: input registers (FC4) from 0, mirrored read-only in holding registers
 /// (FC3/FC23) at the same addresses so one FC23 can write spans and read the status.

@@ -89,9 +89,10 @@ public:
     std::uint64_t generated_ticks() const { return status().generated_ticks(); }
     /// Setpoint output by the last tick, per axis.
     Lsb position(unsigned axis) const { return status().position[axis]; }
-    /// Discrete outputs the last tick drove: the playing span's on a path tick, none on any
-    /// other tick (except the pen-down lead at the end of a re-entry, and the operator's pen
-    /// at rest while idle, set_pen).
+    /// Discrete outputs the last tick drove: the playing span's on a path tick; on any other
+    /// tick the machine functions (kOutputMachineMask) of the span last played while a job runs,
+    /// holds or stops, and no pen (except the pen-down lead at the end of a re-entry, and the
+    /// operator's pen at rest while idle, set_pen).
     std::uint8_t outputs() const { return static_cast<std::uint8_t>(status().outputs); }
     std::uint32_t underruns() const { return status().underruns; }
     std::uint32_t duplicates() const { return receiver_.duplicates(); }

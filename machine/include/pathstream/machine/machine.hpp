@@ -56,6 +56,15 @@ struct GpioConfig {
     std::vector<HomingAxisConfig> home;  ///< in profile order
 };
 
+/// The profile's optional "spindle" object: a spindle (or laser) switched by G-code M3/M4/M5
+/// through the span outputs (kOutputSpindle, kOutputSpindleReverse).
+struct SpindleConfig {
+    bool present = false;
+    /// Seconds the machine rests with the spindle on before it moves after M3 or M4 turn it on
+    /// or reverse it, and before a resume re-enters a cut with it on (0..600).
+    double spin_up = 0;
+};
+
 /// Everything the planner and the simulated device need to know about the machine.
 struct MachineProfile {
     std::vector<AxisLimits> axes;      ///< one per path axis, in path order
@@ -70,7 +79,8 @@ struct MachineProfile {
     /// Optional "corner_stop_angle" (1..180 degrees in the file, radians here): a joint turning
     /// by more stops exactly; absent (< 0): the planner's PlanOptions::corner_stop_angle.
     double corner_stop_angle = -1;
-    GpioConfig gpio;  ///< optional "gpio" object
+    GpioConfig gpio;        ///< optional "gpio" object
+    SpindleConfig spindle;  ///< optional "spindle" object
     /// Optional "layer_feeds": pen-down speed (mm/s) per layer name (an Inkscape layer's label,
     /// a stroke colour such as "#ff0000"), for subpaths that set no feed of their own.
     std::vector<std::pair<std::string, double>> layer_feeds;
