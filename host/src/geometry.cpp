@@ -162,6 +162,8 @@ void PathSegmentSource::make_segment(BezierSegment& seg) {
     seg.pause_before = first && sp.pause_before;
     seg.dwell_before = first ? sp.dwell_before : 0;
     seg.dwell_pen_down = first && sp.dwell_pen_down;
+    seg.outputs = sp.outputs;
+    seg.pause_outputs = first ? sp.pause_outputs : sp.outputs;
     const bool stops = sp.corner_mode == CornerMode::kExactStop;
     while (stops && next_stop_ < sp.stops.size() && sp.stops[next_stop_] < k_) ++next_stop_;
     seg.stop_before = stops && !first && next_stop_ < sp.stops.size() && sp.stops[next_stop_] == k_;
@@ -215,12 +217,15 @@ bool PathSegmentSource::next(BezierSegment& out) {
                 out.p[3] = seg.p[0];
                 out.pen_down = false;
                 out.subpath = any_ ? s_ : 0;
+                out.outputs = seg.outputs;
+                out.pause_outputs = seg.outputs;
                 if (!seg.pen_down) {
                     // Joins the travel subpath's run (the lead-in too): its pause and dwell go
                     // first.
                     out.pause_before = seg.pause_before;
                     out.dwell_before = seg.dwell_before;
                     out.dwell_pen_down = seg.dwell_pen_down;
+                    out.pause_outputs = seg.pause_outputs;
                     seg.pause_before = false;
                     seg.dwell_before = 0;
                     seg.dwell_pen_down = false;

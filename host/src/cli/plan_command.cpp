@@ -62,6 +62,14 @@ void print_plan_summary(const PlannedJob& job, std::ostream& out) {
     std::snprintf(line, sizeof line, "  path: %.3f mm drawn, %.3f mm travel; planned in %.3f s\n",
                   job.plan.path_length, job.plan.travel_length, job.planning_seconds);
     out << line;
+    if (job.outputs.any()) {
+        std::snprintf(line, sizeof line,
+                      "  spindle: on %.3f s, %zu starts (spin-up %g s); coolant on %.3f s\n",
+                      static_cast<double>(job.outputs.spindle_ticks) / job.machine.tick_hz,
+                      job.outputs.spindle_starts, job.machine.spindle.spin_up,
+                      static_cast<double>(job.outputs.coolant_ticks) / job.machine.tick_hz);
+        out << line;
+    }
     std::snprintf(line, sizeof line,
                   "  max deviation from the path: %.2f um (tolerance %.2f um) at tick %llu\n",
                   c.max_deviation * 1000, job.machine.chord_tolerance * 1000,
@@ -150,6 +158,9 @@ nlohmann::ordered_json plan_summary_json(const PlanCommandOptions& o, const Plan
     j["spans"] = job.span_count;
     j["pen_changes"] = job.pen_count;
     j["pauses"] = job.pause_count;
+    j["spindle_s"] = static_cast<double>(job.outputs.spindle_ticks) / job.machine.tick_hz;
+    j["spindle_starts"] = job.outputs.spindle_starts;
+    j["coolant_s"] = static_cast<double>(job.outputs.coolant_ticks) / job.machine.tick_hz;
     j["layers"] = layers_json(job.path);
     j["drawn_length_mm"] = job.plan.path_length;
     j["travel_length_mm"] = job.plan.travel_length;
@@ -199,6 +210,7 @@ public:
     }
     void span(const CoreSpan& s) override {
         check_span_travel(s, spans_++, job_.path, job_.machine, file_);
+        job_.outputs.add(s);
         if (checker_) checker_->span(s);
     }
     void pen(const PenEvent& e) override {

@@ -29,6 +29,7 @@ enum Group {
     kSpindle,
     kRetract,
     kToolChange,
+    kCoolant,
     kSpindleSpeedMode,
     kModalState,
     kGroupCount
@@ -371,11 +372,23 @@ private:
             case 4:
                 claim(kSpindle, w, name);
                 c.spindle_on = true;
+                c.spindle_reverse = code == 4;
                 c.spindle_at = w.at;
                 break;
             case 5:
                 claim(kSpindle, w, name);
                 c.spindle_on = false;
+                c.spindle_at = w.at;
+                break;
+            case 7:
+            case 8:
+                if (c.coolant_off) claim(kCoolant, w, name);  // M9 with them
+                if (!groups_[kCoolant].given) groups_[kCoolant] = {true, name};
+                (code == 7 ? c.mist : c.flood) = true;
+                break;
+            case 9:
+                claim(kCoolant, w, name);
+                c.coolant_off = true;
                 break;
             case 70:
             case 71:

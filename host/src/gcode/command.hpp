@@ -91,14 +91,17 @@ struct Command {
     std::optional<CornerMode> path_control;  ///< G61 (exact path), G61.1 (exact stop), G64 (P, Q)
     SourceLocation path_control_at;          ///< where that G word is
     std::optional<bool> spindle_on;          ///< M3, M4 (true) / M5 (false)
+    bool spindle_reverse = false;            ///< M4
     SourceLocation spindle_at;               ///< where that M word is
-    bool end_program = false;                ///< M2, M30
-    bool pause = false;                      ///< M0, M1
-    SourceLocation pause_at;                 ///< where the M0, M1 or M6 is
-    bool optional_stop = false;              ///< M1
-    bool pallet_change = false;              ///< M60
-    bool tool_change = false;                ///< M6 (when not skipped)
-    bool set_tool = false;                   ///< M61 Q: the tool in the spindle, no change
+    /// M7 (mist), M8 (flood): on; M9: both off. M7 and M8 may share a block, as in LinuxCNC.
+    bool mist = false, flood = false, coolant_off = false;
+    bool end_program = false;    ///< M2, M30
+    bool pause = false;          ///< M0, M1
+    SourceLocation pause_at;     ///< where the M0, M1 or M6 is
+    bool optional_stop = false;  ///< M1
+    bool pallet_change = false;  ///< M60
+    bool tool_change = false;    ///< M6 (when not skipped)
+    bool set_tool = false;       ///< M61 Q: the tool in the spindle, no change
     /// M70 save, M71 invalidate, M72 restore, M73 save until the subroutine returns; 0: none.
     int modal_state = 0;
     SourceLocation modal_state_at;

@@ -136,7 +136,15 @@ Path parse_gcode_path(const std::string& text, const std::string& file, const Gc
     const bool m6_skip_asked =
         std::any_of(options.ignore_codes.begin(), options.ignore_codes.end(),
                     [](const std::string& c) { return gcode::normalise_code_name(c) == "M6"; });
-    if (!m6_skip_asked && (z_axis || options.pen == PenControl::kMachine)) ignored.erase("M6");
+    // And M7-M9 switch the coolant outputs, unless asked to skip them.
+    const bool machine_codes = z_axis || options.pen == PenControl::kMachine;
+    if (!m6_skip_asked && machine_codes) ignored.erase("M6");
+    for (const char* code : {"M7", "M8", "M9"}) {
+        const bool asked = std::any_of(
+            options.ignore_codes.begin(), options.ignore_codes.end(),
+            [&](const std::string& c) { return gcode::normalise_code_name(c) == code; });
+        if (!asked && machine_codes) ignored.erase(code);
+    }
     const std::vector<std::string_view> lines = split_lines(text);
     GcodeReadInfo local;
     GcodeReadInfo& out = info ? *info : local;

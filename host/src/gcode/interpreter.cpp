@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "pathstream/machine/input_error.hpp"
+#include "pathstream/span.hpp"
 
 namespace pathstream::host::gcode {
 
@@ -136,12 +137,10 @@ bool Interpreter::execute(const Command& c) {
         selected_tool_ = static_cast<long>(t->value);
     }
     if (c.path_control) path_control(c);
+    // LinuxCNC runs M6 before the spindle and coolant codes of its block: with a tool change
+    // they follow its pause.
+    if (machine() && !c.tool_change) machine_functions(c);
     if (c.spindle_on) {
-        if (*c.spindle_on && machine() && warn_) {
-            warn_("M3", c.spindle_at,
-                  "M3/M4 drive no spindle output yet (the moves run, the spindle must be started "
-                  "by hand)");
-        }
         spindle_ = *c.spindle_on;
         if (spindle_) evidence_.spindle = true;
         if (!spindle_ && options_.pen == PenControl::kSpindle) runs_.lift();
@@ -216,7 +215,13 @@ bool Interpreter::execute(const Command& c) {
     // where the program last left it, which is the same place when M6 has a block of its own).
     const bool pause = c.pause || c.tool_change;
     if (pause || c.end_program) runs_.lift();
+    if (c.tool_change && machine()) {
+        // As LinuxCNC, a tool change stops the spindle (the coolant stays as it was).
+        runs_.set_outputs(
+            static_cast<std::uint8_t>(runs_.outputs() & ~(kOutputSpindle | kOutputSpindleReverse)));
+    }
     if (pause) runs_.pause_next(pause_note(c));
+    if (c.tool_change && machine()) machine_functions(c);
     if (c.tool_change) load_tool();
     if (c.set_tool) {
         const Word* q = c.value('Q');
@@ -234,6 +239,19 @@ bool Interpreter::execute(const Command& c) {
     return true;
 }
 
+// M3/M4/M5 and M7/M8/M9 on a machine: the spindle's and the coolant's outputs from here on.
+void Interpreter::machine_functions(const Command& c) {
+    unsigned o = runs_.outputs();
+    if (c.spindle_on) {
+        o &= ~unsigned{kOutputSpindle | kOutputSpindleReverse};
+        if (*c.spindle_on) o |= kOutputSpindle | (c.spindle_reverse ? kOutputSpindleReverse : 0u);
+    }
+    if (c.coolant_off) o &= ~unsigned{kOutputMist | kOutputFlood};
+    if (c.mist) o |= kOutputMist;
+    if (c.flood) o |= kOutputFlood;
+    runs_.set_outputs(static_cast<std::uint8_t>(o));
+}
+
 Interpreter::ModalState Interpreter::modal_state() const {
     return ModalState{inch_,
                       incremental_,
@@ -245,6 +263,7 @@ Interpreter::ModalState Interpreter::modal_state() const {
                       tool_offset_,
                       retract_to_r_,
                       spindle_,
+                      runs_.outputs(),
                       runs_.corner_mode(),
                       runs_.blend_tolerance()};
 }
@@ -261,6 +280,7 @@ void Interpreter::restore(const ModalState& s) {
     tool_offset_ = s.tool_offset;
     retract_to_r_ = s.retract_to_r;
     spindle_ = s.spindle;
+    if (machine()) runs_.set_outputs(s.outputs);
     runs_.set_corners(s.corners, s.blend_tolerance);
 }
 

@@ -171,6 +171,7 @@ private:
         std::size_t system = 0;
         Axes tool_offset{};
         bool retract_to_r = false, spindle = false;
+        std::uint8_t outputs = 0;  ///< the spindle's and the coolant's (a machine's M3-M9)
         CornerMode corners = CornerMode::kBlend;
         double blend_tolerance = 0;
     };
@@ -178,6 +179,7 @@ private:
     void restore(const ModalState& s);
     /// M70, M71, M72, M73.
     void modal_state_code(const Command& c);
+    void machine_functions(const Command& c);
     std::optional<ModalState> saved_state_;  ///< M70's
     std::size_t call_depth_ = 0;
     /// M73's, by the call depth that saved it (restored when that call returns).

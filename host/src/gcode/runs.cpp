@@ -84,6 +84,8 @@ void RunBuilder::add(const Piece& piece, double feed_mm_s, bool travel, SourceLo
         sp.location = at;
         sp.pause_before = pause_next_;
         sp.pause_note = pause_next_ ? std::move(pause_note_) : std::string();
+        sp.outputs = outputs_;
+        sp.pause_outputs = pause_next_ ? pause_outputs_ : outputs_;
         sp.dwell_before = dwell_next_;
         sp.dwell_pen_down = dwell_pen_down_;
         sp.corner_mode = corner_mode_;

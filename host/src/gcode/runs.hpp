@@ -3,6 +3,7 @@
 // travel subpath), a polyline while the run has only line pieces, else a Bezier chain.
 #pragma once
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -43,11 +44,21 @@ public:
     /// A block's pieces are drawn: in exact stop mode (G61.1) the motion rests where it ended.
     void end_block();
 
-    /// The next subpath started gets Subpath::pause_before (M0, M1).
+    /// The next subpath started gets Subpath::pause_before (M0, M1), held with the machine
+    /// functions in force now (Subpath::pause_outputs).
     void pause_next(std::string note = {}) {
         pause_next_ = true;
         pause_note_ = std::move(note);
+        pause_outputs_ = outputs_;
     }
+    /// The machine functions (kOutputMachineMask bits) of what is drawn from here on: a change
+    /// ends the open run, so that the planner switches them where the motion rests.
+    void set_outputs(std::uint8_t outputs) {
+        if (outputs == outputs_) return;
+        close_run();
+        outputs_ = outputs;
+    }
+    std::uint8_t outputs() const { return outputs_; }
     /// The next subpath started rests `seconds` more at its start (G4), pen down or up.
     void dwell_next(double seconds, bool pen_down) {
         dwell_next_ += seconds;
@@ -70,6 +81,7 @@ private:
     bool open_ = false;
     bool pause_next_ = false;
     std::string pause_note_;
+    std::uint8_t outputs_ = 0, pause_outputs_ = 0;
     double dwell_next_ = 0;
     bool dwell_pen_down_ = false;
     std::size_t pieces_ = 0;

@@ -98,6 +98,7 @@ PlannedJob plan_job(const JobRequest& path_options, const std::string& machine_f
     job.check = check_plan(job.plan, job.segments, job.machine);
     check_plan_travel(job.plan, job.path, job.machine, path_options.file);
     job.span_count = job.plan.spans.size();
+    for (const CoreSpan& s : job.plan.spans) job.outputs.add(s);
     job.pen_count = job.plan.pen.size();
     job.pause_count = job.plan.pauses.size();
     return job;

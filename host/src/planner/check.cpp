@@ -140,7 +140,7 @@ public:
         span.basis = cs.basis;
         span.ticks = cs.ticks;
         span.tag = tag;
-        span.outputs = cs.pen_down ? kOutputPenDown : 0;
+        span.outputs = span_outputs(cs);
         for (unsigned a = 0; a < Axes; ++a) {
             for (unsigned k = 0; k < 4; ++k) span.control[a][k] = cs.control[a][k];
         }

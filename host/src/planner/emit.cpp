@@ -67,6 +67,7 @@ void SpanEmitter::span(const LsbVec& p1, const LsbVec& t0, const LsbVec& t1, std
     s.ticks = ticks;
     s.subpath = subpath;
     s.pen_down = pen_down;
+    s.machine = machine_;
     if (make_span_timing(s.basis, ticks, s.timing) != Status::kOk)
         fail(subpath, "span ticks out of range");
     if (check_jerk_) verify_jerk(p1, t0, t1, ticks, subpath);
@@ -132,11 +133,33 @@ void SpanEmitter::pen(bool down, std::size_t subpath, bool last) {
     pen_ = down;
 }
 
+// At rest: the machine functions change with a still span that carries them (the device
+// switches outputs at a span's first tick), lasting the spindle's spin-up when it starts or
+// reverses, so that no motion happens before it runs at speed.
+void SpanEmitter::set_machine(std::uint8_t machine, std::size_t subpath) {
+    if (machine == machine_) return;
+    const bool on = (machine & kOutputSpindle) != 0;
+    const bool starts = on && ((machine_ & kOutputSpindle) == 0 ||
+                               ((machine ^ machine_) & kOutputSpindleReverse) != 0);
+    machine_ = machine;
+    std::uint64_t ticks = 1;
+    if (starts) {
+        const std::uint64_t spin_up = delay_ticks(profile_.spindle.spin_up, profile_.tick_hz);
+        if (spin_up > 0) {
+            ticks = spin_up;
+            spin_up_ticks_ += spin_up;
+        }
+        ++spin_ups_;
+    }
+    dwell(ticks, subpath, pen_);
+}
+
 // Before a subpath's pen goes down (or a routed travel starts): its programmed pause (the
-// device holds at the end of the last span, which must be a still pen-up one) and its pen-up
-// rest.
+// device holds at the end of the last span, which must be a still pen-up one, carrying the
+// machine functions the pause holds with), its machine functions and its pen-up rest.
 void SpanEmitter::before_pen_down(const Run& run) {
     if (run.pause_before) {
+        set_machine(run.pause_outputs, run.subpath);
         // The pause follows a still pen-up span, held back so that it can be marked.
         if (!any_span_ || last_pen_down_ || !held_) dwell(1, run.subpath, false);
         events_.back().span.pause_after = true;
@@ -146,6 +169,7 @@ void SpanEmitter::before_pen_down(const Run& run) {
         ev.pause = {total_ticks_, run.subpath};
         events_.push_back(std::move(ev));
     }
+    set_machine(run.outputs, run.subpath);
     if (run.dwell_before > 0 && !run.dwell_pen_down) {
         dwell(delay_ticks(run.dwell_before, profile_.tick_hz), run.subpath, false);
     }
@@ -169,6 +193,7 @@ void SpanEmitter::begin_run(const Run& run) {
         return;
     }
     if (!pen_) before_pen_down(run);
+    set_machine(run.outputs, run.subpath);  // pen down already: it changes here, at rest
     if (!pen_) pen(true, run.subpath, false);
     if (run.pen_down && run.dwell_before > 0 && run.dwell_pen_down) {
         dwell(delay_ticks(run.dwell_before, profile_.tick_hz), run.subpath, true);

@@ -68,6 +68,9 @@ public:
     std::size_t motion_spans() const { return motion_spans_; }
     std::uint64_t motion_ticks() const { return motion_ticks_; }
     std::uint64_t dwell_ticks() const { return dwell_ticks_; }
+    /// Of the dwell ticks, those waiting for the spindle to spin up; and how often it did.
+    std::uint64_t spin_up_ticks() const { return spin_up_ticks_; }
+    std::size_t spin_ups() const { return spin_ups_; }
 
 private:
     LsbVec quantise(const Vec& mm) const;
@@ -77,6 +80,7 @@ private:
     void dwell(std::uint64_t ticks, std::size_t subpath, bool pen_down);
     void pen(bool down, std::size_t subpath, bool last);
     void before_pen_down(const Run& run);
+    void set_machine(std::uint8_t machine, std::size_t subpath);
     void release();
     void verify_jerk(const LsbVec& p1, const LsbVec& t0, const LsbVec& t1, std::uint32_t ticks,
                      std::size_t subpath);
@@ -95,12 +99,14 @@ private:
     bool any_span_ = false, last_pen_down_ = false;
     LsbVec pos_{};
     bool pen_ = false;
+    std::uint8_t machine_ = 0;  ///< the machine functions the spans carry now
     bool in_run_ = false;
     std::size_t run_subpath_ = 0;
     bool run_pen_down_ = false;
     std::uint64_t total_ticks_ = 0;
     std::size_t motion_spans_ = 0;
-    std::uint64_t motion_ticks_ = 0, dwell_ticks_ = 0;
+    std::uint64_t motion_ticks_ = 0, dwell_ticks_ = 0, spin_up_ticks_ = 0;
+    std::size_t spin_ups_ = 0;
 };
 
 }  // namespace pathstream::host::planner_detail

@@ -198,6 +198,8 @@ struct Builder {
         run.pause_before = segments[first_seg].pause_before;
         run.dwell_before = segments[first_seg].dwell_before;
         run.dwell_pen_down = segments[first_seg].dwell_pen_down;
+        run.outputs = segments[first_seg].outputs;
+        run.pause_outputs = segments[first_seg].pause_outputs;
         run.start = out.cubics[first_seg].p[0];
         run.end = out.cubics[last_seg].p[3];
         const double feed =

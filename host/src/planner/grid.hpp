@@ -89,6 +89,7 @@ struct Run {
     bool pause_before = false;  ///< the first segment's pause and rest (BezierSegment)
     double dwell_before = 0;
     bool dwell_pen_down = false;
+    std::uint8_t outputs = 0, pause_outputs = 0;  ///< the first segment's (BezierSegment)
     std::vector<std::size_t> pieces;
     Vec start{}, end{};  ///< mm
 };

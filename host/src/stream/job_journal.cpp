@@ -97,7 +97,8 @@ std::string job_span_line(const CoreSpan& s, std::int64_t origin, std::uint64_t 
     std::string line;
     std::snprintf(buffer, sizeof buffer, "%lld %llu %zu %d %u", static_cast<long long>(origin),
                   static_cast<unsigned long long>(drawing_tick), s.subpath,
-                  (s.pen_down ? 1 : 0) | (s.pause_after ? 2 : 0), static_cast<unsigned>(s.ticks));
+                  (s.pen_down ? 1 : 0) | (s.pause_after ? 2 : 0) | (s.machine << 1),
+                  static_cast<unsigned>(s.ticks));
     line = buffer;
     for (const auto& c : s.control) {
         std::snprintf(buffer, sizeof buffer, " %d %d %d %d", c[0], c[1], c[2], c[3]);
@@ -210,14 +211,17 @@ JobSpans parse_job_spans(const std::string& contents, const std::string& path,
         CoreSpan s;
         std::int64_t origin = 0;
         std::uint64_t tick = 0;
-        int marks = 0;  // bit 0: pen down, bit 1: a pause follows
+        // Bit 0: pen down, bit 1: a pause follows, bits 2-5: the machine functions (outputs
+        // bits 1-4).
+        int marks = 0;
         s.basis = Basis::kHermite;
         if (!(l >> origin >> tick >> s.subpath >> marks >> s.ticks) || s.ticks < 1 || marks < 0 ||
-            marks > 3) {
+            marks > 3 + (kOutputMachineMask << 1)) {
             fail("bad span line");
         }
         s.pen_down = (marks & 1) != 0;
         s.pause_after = (marks & 2) != 0;
+        s.machine = static_cast<std::uint8_t>((marks >> 1) & kOutputMachineMask);
         s.control.assign(axes, {});
         for (auto& c : s.control) {
             if (!(l >> c[0] >> c[1] >> c[2] >> c[3]))

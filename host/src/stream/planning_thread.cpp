@@ -69,6 +69,7 @@ void PlanningThread::push(const CoreSpan& s) {
     q.subpath = static_cast<std::uint32_t>(s.subpath);
     q.axes = static_cast<std::uint8_t>(s.control.size());
     q.pen_down = s.pen_down;
+    q.machine = s.machine;
     q.pause_after = s.pause_after;
     for (std::size_t a = 0; a < s.control.size(); ++a) {
         for (unsigned k = 0; k < 4; ++k) q.control[a][k] = s.control[a][k];
@@ -89,6 +90,7 @@ SpanSupply::Take PlanningThread::take(CoreSpan& out) {
     out.ticks = q.ticks;
     out.subpath = q.subpath;
     out.pen_down = q.pen_down;
+    out.machine = q.machine;
     out.pause_after = q.pause_after;
     out.control.resize(q.axes);
     for (std::size_t a = 0; a < q.axes; ++a) {

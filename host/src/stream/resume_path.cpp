@@ -44,7 +44,7 @@ Status reentry(const std::vector<Lsb>& from, const std::vector<std::int32_t>& to
         }
         Span<kAxes> span;
         const Status s = device::plan_reentry(f, t, g, ticks, motion_limits<kAxes>(l), span);
-        if (s == Status::kOk) out = from_core_span(span, out.subpath, out.pen_down);
+        if (s == Status::kOk) out = from_core_span(span, out.subpath, out.pen_down, out.machine);
         return s;
     });
 }

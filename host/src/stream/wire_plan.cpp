@@ -21,7 +21,7 @@ std::vector<std::uint8_t> WireEncoder::encode(const CoreSpan& c, bool last) {
     }
     device::WireSpan w;
     w.ticks = c.ticks;
-    w.outputs = c.pen_down ? kOutputPenDown : std::uint8_t{0};
+    w.outputs = span_outputs(c);
     bool continues = i > 0;
     for (unsigned a = 0; a < axes_; ++a) {
         if (i > 0 && c.control[a][0] != previous_end_[a]) {

@@ -24,6 +24,10 @@ struct BezierSegment {
     bool pause_before = false;
     double dwell_before = 0;
     bool dwell_pen_down = false;
+    /// Subpath::outputs (every segment of the subpath, and the travel leading to it) and, on
+    /// the first drawing segment, Subpath::pause_outputs.
+    std::uint8_t outputs = 0;
+    std::uint8_t pause_outputs = 0;
     /// The vertex at this segment's start, inside its subpath: < 0 may be rounded within the
     /// planner's own bound, > 0 within the smaller of that and this many mm (G64 P), 0 not at
     /// all (G61, G61.1). From Subpath::corner_mode and blend_tolerance.

@@ -63,6 +63,14 @@ struct Subpath {
     /// Why the machine pauses before this subpath when the file says (G-code: "tool change to
     /// T2 (3 mm drill), line 6", "program stop (M0), line 9"); empty: a pen change.
     std::string pause_note{};
+    /// The machine functions in force while the machine moves along it, from its start
+    /// (kOutputMachineMask bits: G-code M3/M4/M5, M7/M8/M9 on a machine); 0 from the other
+    /// readers. The planner changes them where the motion rests before the subpath, with a
+    /// still span of the profile's spindle spin_up when that turns the spindle on or reverses it.
+    std::uint8_t outputs = 0;
+    /// With pause_before: those in force while the machine holds at the pause (a program may
+    /// stop the spindle before it, M5 M0 or a tool change, or start it after, M0 then M3).
+    std::uint8_t pause_outputs = 0;
 };
 
 /// Curve segments of a polyline or Bezier chain: the joints Subpath::stops counts lie between

@@ -9,6 +9,7 @@
 
 #include "pathstream/host/geometry.hpp"
 #include "pathstream/host/job_request.hpp"
+#include "pathstream/host/output_figures.hpp"
 #include "pathstream/host/plan.hpp"
 #include "pathstream/machine/machine.hpp"
 
@@ -27,6 +28,7 @@ struct PlannedJob {
     PlanCheck check;
     double planning_seconds = 0;
     std::size_t span_count = 0, pen_count = 0, pause_count = 0;
+    OutputFigures outputs;  ///< the spindle's and the coolant's share of the plan
 };
 
 /// Loads both files, checks they agree (axis count) and makes the segments, the lead-in's

@@ -27,6 +27,7 @@ struct QueuedSpan {
     std::uint8_t axes = 0;
     bool pen_down = false;
     bool pause_after = false;
+    std::uint8_t machine = 0;  ///< CoreSpan::machine
     std::int32_t control[kMaxAxes][4] = {};
 };
 

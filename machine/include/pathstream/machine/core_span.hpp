@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "pathstream/basis.hpp"
+#include "pathstream/span.hpp"
 #include "pathstream/tick_cubic.hpp"
 #include "pathstream/units.hpp"
 
@@ -20,11 +21,18 @@ struct CoreSpan {
     std::vector<std::array<std::int32_t, 4>> control;  ///< per axis: P0..P3 (Hermite P0 P1 T0 T1)
     std::size_t subpath = 0;                           ///< index in Path::subpaths
     bool pen_down = true;                              ///< false for travel between subpaths
+    /// The machine functions while it plays (kOutputMachineMask bits: spindle, coolant).
+    std::uint8_t machine = 0;
     bool pause_after =
         false;          ///< a programmed pause follows: the device holds at its end (at rest)
     SpanTiming timing;  ///< the core's timing, once validated
     std::vector<TickCubic> cubic;  ///< the core's exact cubic per axis
 };
+
+/// The span's Span::outputs: the pen bit and its machine functions. O(1).
+inline std::uint8_t span_outputs(const CoreSpan& span) {
+    return static_cast<std::uint8_t>((span.pen_down ? kOutputPenDown : 0u) | span.machine);
+}
 
 /// The core's exact value of `span` on `axis` at tick k (0..ticks), via Horner. The span must
 /// have been validated (uniform_core_spans does); throws std::logic_error otherwise.

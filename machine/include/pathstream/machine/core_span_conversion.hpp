@@ -19,7 +19,7 @@ Span<Axes> to_core_span(const CoreSpan& in, std::uint32_t tag) {
     s.basis = in.basis;
     s.ticks = in.ticks;
     s.tag = tag;
-    s.outputs = in.pen_down ? kOutputPenDown : std::uint8_t{0};
+    s.outputs = span_outputs(in);
     for (unsigned a = 0; a < Axes; ++a) {
         for (unsigned i = 0; i < 4; ++i) s.control[a][i] = in.control[a][i];
     }
@@ -27,14 +27,17 @@ Span<Axes> to_core_span(const CoreSpan& in, std::uint32_t tag) {
 }
 
 /// The host's form of a span the core made (a device move: stop, re-entry), for `subpath`, pen
-/// down or up; its timing and cubics are left for the caller to fill.
+/// down or up, with the machine functions `machine`; its timing and cubics are left for the
+/// caller to fill.
 template <unsigned Axes>
-CoreSpan from_core_span(const Span<Axes>& in, std::size_t subpath, bool pen_down) {
+CoreSpan from_core_span(const Span<Axes>& in, std::size_t subpath, bool pen_down,
+                        std::uint8_t machine = 0) {
     CoreSpan c;
     c.basis = in.basis;
     c.ticks = in.ticks;
     c.subpath = subpath;
     c.pen_down = pen_down;
+    c.machine = machine;
     c.control.assign(Axes, {});
     for (unsigned a = 0; a < Axes; ++a) {
         for (unsigned i = 0; i < 4; ++i) c.control[a][i] = in.control[a][i];
