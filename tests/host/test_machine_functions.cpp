@@ -120,6 +120,20 @@ TEST_CASE("machine functions: a pause holds with what the program left on", "[gc
     }
 }
 
+TEST_CASE("machine functions: G86 stops the spindle at the hole's bottom", "[gcode][machine]") {
+    const Path p = gcode("M4\nG0 Z5\nG98 G86 X10 Y0 Z-2 R1 P0.5 F120\nG80\nG1 X20 F600\n");
+    // Rapid to Z5; the cycle rapids over the hole and down to R; feed to the bottom; out with the
+    // spindle stopped; then it runs again (counter-clockwise) for the next move.
+    std::vector<unsigned> outputs;
+    std::vector<bool> travel;
+    for (const Subpath& s : p.subpaths) {
+        outputs.push_back(s.outputs);
+        travel.push_back(s.travel);
+    }
+    CHECK(outputs == std::vector<unsigned>{kCcw, kCcw, kCcw, 0, kCcw});
+    CHECK(travel == std::vector<bool>{true, true, false, true, false});
+}
+
 TEST_CASE("machine functions: a plotter skips coolant and keeps M3 as its pen", "[gcode]") {
     GcodeReadInfo info;  // a pen plotter, Z as the pen
     const Path p =

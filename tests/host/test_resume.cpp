@@ -382,6 +382,42 @@ TEST_CASE("resume_from: the pen-down approach along the tangent, and errors", "[
                     std::invalid_argument);
 }
 
+TEST_CASE("resume_from: a running spindle spins up where the device rests, then re-enters",
+          "[resume]") {
+    const Job job = plan_example("wave.json");
+    host::JobSpans whole = host::job_from_plan(job.plan);
+    const host::DeviceLimitsLsb limits = host::device_limits(job.machine);
+    std::size_t drawing = 0;
+    while (!whole.plan.spans[drawing].pen_down || whole.plan.spans[drawing].control[0][2] == 0)
+        ++drawing;
+    const std::vector<Lsb> rest = {start_of(job.plan)[0] - 3000, start_of(job.plan)[1] + 2000};
+    const std::uint64_t spin_up = 70000;  // more than one span's 65,536 ticks
+    const host::JobSpans off = host::resume_from(whole, drawing, rest, limits, spin_up);
+    for (host::CoreSpan& s : whole.plan.spans) s.machine = kOutputSpindle | kOutputFlood;
+    const host::JobSpans on = host::resume_from(whole, drawing, rest, limits, spin_up);
+    // Without the spindle nothing is added; with it, two still spans of 70,000 ticks in all
+    // at the rest point carry the target's outputs, then the same re-entry and approach.
+    REQUIRE(on.plan.spans.size() == off.plan.spans.size() + 2);
+    std::uint64_t still = 0;
+    for (std::size_t i = 0; i < 2; ++i) {
+        const host::CoreSpan& s = on.plan.spans[i];
+        CHECK(on.origin[i] == -1);
+        CHECK(s.machine == (kOutputSpindle | kOutputFlood));
+        CHECK_FALSE(s.pen_down);
+        for (std::size_t a = 0; a < 2; ++a) {
+            CHECK((s.control[a][0] == rest[a] && s.control[a][1] == rest[a] &&
+                   s.control[a][2] == 0 && s.control[a][3] == 0));
+        }
+        still += s.ticks;
+    }
+    CHECK(still == spin_up);
+    for (std::size_t i = 2; i < on.plan.spans.size(); ++i) {
+        INFO("span " << i);
+        CHECK(on.plan.spans[i].machine == (kOutputSpindle | kOutputFlood));
+        CHECK(on.plan.spans[i].control == off.plan.spans[i - 2].control);
+    }
+}
+
 TEST_CASE(
     "resume_from under a jerk limit: the re-entry and the approach keep the acceleration "
     "continuous",

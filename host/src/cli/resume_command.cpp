@@ -197,7 +197,8 @@ int run_resume(StreamCommandOptions o, const EventChannel& channel) {
             journal.job, first);
     }
     std::vector<Lsb> rest(s.position, s.position + axes);
-    const JobSpans resumed = resume_from(job, first, rest, device_limits(machine));
+    const JobSpans resumed = resume_from(job, first, rest, device_limits(machine),
+                                         delay_ticks(machine.spindle.spin_up, machine.tick_hz));
     std::printf(
         "resume        from where the device rests, back onto the drawing at span %lld of %zu "
         "(tick %llu)\n",

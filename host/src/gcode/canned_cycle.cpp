@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "interpreter.hpp"
+#include "pathstream/span.hpp"
 
 namespace pathstream::host::gcode {
 
@@ -162,7 +163,16 @@ void Interpreter::canned_cycle(const Command& c, Motion cycle, SourceLocation at
                 dwell();
                 line(to(clear), at);
                 break;
-            default:  // G81, G82, G86 (the spindle's stop and restart are outputs)
+            case Motion::kBoreSpindleStop: {  // G86: the spindle stops at the bottom
+                line(to(bottom), at);
+                const std::uint8_t on = runs_.outputs();
+                runs_.set_outputs(
+                    static_cast<std::uint8_t>(on & ~(kOutputSpindle | kOutputSpindleReverse)));
+                travel(to(clear), at);
+                runs_.set_outputs(on);  // and starts again as it ran, after its spin-up
+                break;
+            }
+            default:  // G81, G82
                 line(to(bottom), at);
                 if (dwells) dwell();
                 travel(to(clear), at);

@@ -123,7 +123,7 @@ void complete_core_span(CoreSpan& c) {
 }  // namespace
 
 JobSpans resume_from(const JobSpans& job, std::size_t first, const std::vector<Lsb>& rest,
-                     const DeviceLimitsLsb& limits) {
+                     const DeviceLimitsLsb& limits, std::uint64_t spin_up_ticks) {
     while (first < job.origin.size() && job.origin[first] < 0) ++first;  // our own re-entry spans
     if (first >= job.plan.spans.size())
         throw std::invalid_argument("nothing left to draw: the job ran to its end");
@@ -148,6 +148,23 @@ JobSpans resume_from(const JobSpans& job, std::size_t first, const std::vector<L
     // The lead-in spans (re-entry, approach), then the job's own from `first` on.
     const auto complete = [&](std::vector<CoreSpan> lead) {
         const std::uint64_t tick = job.drawing_tick[first];
+        // The machine functions of the span re-entered are on from the start: a spindle that
+        // runs there first spins up where the device rests (it was off while the device idled).
+        for (CoreSpan& c : lead) c.machine = target.machine;
+        for (std::uint64_t left = (target.machine & kOutputSpindle) != 0 ? spin_up_ticks : 0;
+             left > 0;) {
+            CoreSpan still;
+            still.basis = Basis::kHermite;
+            still.ticks = static_cast<std::uint32_t>(std::min<std::uint64_t>(left, kMaxSpanTicks));
+            still.subpath = target.subpath;
+            still.pen_down = false;
+            still.machine = target.machine;
+            for (std::size_t a = 0; a < axes; ++a)
+                still.control.push_back({rest[a], rest[a], 0, 0});
+            left -= still.ticks;
+            complete_core_span(still);
+            add(std::move(still), -1, tick);
+        }
         for (CoreSpan& c : lead) {
             complete_core_span(c);
             add(std::move(c), -1, tick);

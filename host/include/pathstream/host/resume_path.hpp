@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <vector>
 
 #include "pathstream/host/job_journal.hpp"
@@ -21,9 +22,12 @@ namespace pathstream::host {
 /// re-entry is plan_jerk_reentry's three or four spans, and the approach a span of at least
 /// the delay that ends with the span's start velocity and acceleration and starts with about
 /// none (a ramp, slightly curved where that acceleration is not along the tangent). Re-entry
-/// spans of `job` itself are skipped. Throws std::invalid_argument when `first` is past the end
-/// and std::range_error when no re-entry fits the limits.
+/// spans of `job` itself are skipped. Every span before span `first` carries its machine
+/// functions (spindle, coolant); when its spindle runs, still spans at `rest` lasting
+/// `spin_up_ticks` (the profile's spindle spin-up) come first, so the tool meets the work at
+/// speed. Throws std::invalid_argument when `first` is past the end and std::range_error when
+/// no re-entry fits the limits.
 JobSpans resume_from(const JobSpans& job, std::size_t first, const std::vector<Lsb>& rest,
-                     const DeviceLimitsLsb& limits);
+                     const DeviceLimitsLsb& limits, std::uint64_t spin_up_ticks = 0);
 
 }  // namespace pathstream::host
