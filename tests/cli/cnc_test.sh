@@ -16,7 +16,8 @@ tools=(--tool-table "$src/examples/cnc/tools.tbl")
 for name in pocket drill profile finish; do
   program=$src/examples/cnc/$name.ngc
   out=$("$bin" plan "$program" -m "$machine" "${tools[@]}" 2>&1); rc=$?
-  [ $rc -eq 0 ] && [[ "$out" == *"within limits"* && "$out" == *"pause for the operator"* ]] && ok ||
+  [ $rc -eq 0 ] && [[ "$out" == *"within limits"* && "$out" == *"pause for the operator"* &&
+    "$out" == *"spindle: on"*"1 starts (spin-up 2 s)"* ]] && ok ||
     fail "plan $name: $rc $out"
   out=$("$bin" sim "$program" -m "$machine" "${tools[@]}" --plot "$work/$name" --json 2>/dev/null); rc=$?
   [ $rc -eq 0 ] && [ -s "$work/$name/path.svg" ] && [ -s "$work/$name/z.svg" ] && ok ||
@@ -50,10 +51,15 @@ for i in 0 2 4 6; do
   "$bin" stream "$src/examples/cnc/$name.ngc" -m "$machine" "${tools[@]}" -t "$target" --no-journal \
     < /dev/null > "$work/stream_$name.log" 2>&1 &
   stream_pid=$!
-  resumed=0
+  resumed=0 spindle=0 flood=0
   for _ in $(seq 2400); do
     kill -0 "$stream_pid" 2>/dev/null || break
-    if "$bin" ctl "$target" status --json 2>/dev/null | grep -q '"paused": true'; then
+    status=$("$bin" ctl "$target" status --json 2>/dev/null)
+    grep -q '"spindle": "clockwise"' <<<"$status" && spindle=$((spindle + 1))
+    grep -q '"flood": true' <<<"$status" && flood=$((flood + 1))
+    if grep -q '"paused": true' <<<"$status"; then
+      # A tool change stops the spindle before its pause.
+      grep -q '"spindle": "off"' <<<"$status" && ok || fail "stream $name: the spindle runs in a tool change"
       # The operator reads the message first (the stream notices the pause on its next poll).
       for _ in $(seq 100); do
         grep -q "paused for" "$work/stream_$name.log" && break
@@ -72,6 +78,12 @@ for i in 0 2 4 6; do
     ok || fail "stream $name: exit $rc: $(tail -n 8 "$work/stream_$name.log")"
   [ "$resumed" -ge 1 ] && grep -q "paused for tool change to T" "$work/stream_$name.log" && ok ||
     fail "stream $name: no tool-change pause resumed ($resumed): $(grep -i paus "$work/stream_$name.log")"
+  # M3 ran the spindle (and M8 the drill's flood coolant) on the device; the job's end stops them.
+  [ "$spindle" -ge 1 ] && ok || fail "stream $name: the device never showed the spindle on"
+  if [ "$name" = drill ]; then [ "$flood" -ge 1 ] && ok || fail "stream drill: no flood coolant seen"; fi
+  status=$("$bin" ctl "$target" status --json 2>/dev/null)
+  grep -q '"spindle": "off"' <<<"$status" && grep -q '"flood": false' <<<"$status" && ok ||
+    fail "stream $name: outputs still on after the job: $status"
   kill -INT "$device_pid" 2>/dev/null; wait "$device_pid" 2>/dev/null
   grep -q "(0 refused)" "$work/device.log" && ok || fail "the device refused requests ($name): $(tail -5 "$work/device.log")"
 done

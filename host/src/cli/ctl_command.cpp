@@ -16,9 +16,16 @@
 #include "pathstream/machine/device_setup.hpp"
 #include "pathstream/machine/machine.hpp"
 #include "pathstream/machine/position_argument.hpp"
+#include "pathstream/span.hpp"
 
 namespace pathstream::host {
 namespace {
+
+// The spindle output as the status reports it.
+const char* spindle_text(unsigned outputs) {
+    if ((outputs & kOutputSpindle) == 0) return "off";
+    return (outputs & kOutputSpindleReverse) != 0 ? "counter-clockwise" : "clockwise";
+}
 
 using Clock = std::chrono::steady_clock;
 
@@ -85,6 +92,9 @@ nlohmann::json to_json(const DeviceSnapshot& s, const Units& u, const std::strin
     j["homing"] = s.homing_runs();
     j["paused"] = s.paused();
     j["pen_down"] = s.pen_down();
+    j["spindle"] = spindle_text(s.outputs);
+    j["mist"] = (s.outputs & kOutputMist) != 0;
+    j["flood"] = (s.outputs & kOutputFlood) != 0;
     j["queued_spans"] = s.queued;
     j["free_slots"] = s.free_slots;
     j["ticks_executed"] = s.ticks_executed;
@@ -132,6 +142,11 @@ void print_status(const DeviceSnapshot& s, const Units& u, const std::string& ta
     std::printf("queue         %u spans queued, %u slots free\n", s.queued, s.free_slots);
     std::printf("position      %s\n", position_text(s, u).c_str());
     std::printf("pen           %s\n", s.pen_down() ? "down" : "up");
+    if ((s.outputs & kOutputMachineMask) != 0) {
+        std::printf("machine       spindle %s%s%s\n", spindle_text(s.outputs),
+                    (s.outputs & kOutputMist) != 0 ? ", mist" : "",
+                    (s.outputs & kOutputFlood) != 0 ? ", flood" : "");
+    }
     std::printf("homing        %s\n", homing_text(s, u).c_str());
     std::printf(
         "ticks         %u path ticks executed; spans: last accepted %u, last completed %u\n",
