@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <iostream>
 #include <nlohmann/json.hpp>
@@ -12,6 +13,7 @@
 #include "pathstream/host/events.hpp"
 #include "pathstream/host/job_estimate.hpp"
 #include "pathstream/host/layers.hpp"
+#include "pathstream/host/output_figures.hpp"
 #include "pathstream/host/planner.hpp"
 #include "pathstream/host/planning_thread.hpp"
 #include "pathstream/host/plot.hpp"
@@ -193,6 +195,10 @@ Json report_json(const SimCommandOptions& o, const SimRun& s, const plot::RunSum
     limits_json(s.job, f, j);
     j["layers"] = layers_json(s.job.path);
     j["pauses"] = s.job.pause_count;
+    const double tick_hz = s.job.machine.tick_hz;
+    j["spindle_s"] = static_cast<double>(s.job.outputs.spindle_ticks) / tick_hz;
+    j["spindle_starts"] = s.job.outputs.spindle_starts;
+    j["coolant_s"] = static_cast<double>(s.job.outputs.coolant_ticks) / tick_hz;
     return j;
 }
 
@@ -311,6 +317,7 @@ public:
     }
     void span(const CoreSpan& s) override {
         check_span_travel(s, spans_++, job_.path, job_.machine, file_);
+        outputs_.add(s);
     }
     void pen(const PenEvent& e) override {
         dwell_ticks_ += delay_ticks(
@@ -321,6 +328,7 @@ public:
     StreamCheck* stream_check() { return &check_; }
     const PlanCheck& check() const { return check_.result; }
     std::uint64_t dwell_ticks() const { return dwell_ticks_; }
+    const OutputFigures& outputs() const { return outputs_; }
 
 private:
     const PlannedJob& job_;
@@ -329,6 +337,7 @@ private:
     StreamCheck check_;
     std::size_t spans_ = 0;
     std::uint64_t dwell_ticks_ = 0;
+    OutputFigures outputs_;
 };
 
 /// The default: the plan made on a planning thread as the device runs it (the device fed span
@@ -419,6 +428,7 @@ SimRun run_streamed(const SimCommandOptions& o, const EventChannel& channel,
         job.span_count = totals->spans;
         job.pen_count = totals->pen_changes;
         job.pause_count = totals->pauses;
+        job.outputs = tap.outputs();
     } catch (const std::exception& e) {
         events->end("failed", e.what());
         throw;
@@ -473,6 +483,15 @@ int run_sim(const SimCommandOptions& o) {
         std::cout << report();
         if (const std::string layers = layers_text(job.path); !layers.empty())
             std::cout << "  " << layers << " (the operator's time is not in the durations)\n";
+        if (job.outputs.any()) {
+            char line[160];
+            std::snprintf(line, sizeof line,
+                          "  machine    spindle on %.3f s, %zu starts; coolant on %.3f s\n",
+                          static_cast<double>(job.outputs.spindle_ticks) / job.machine.tick_hz,
+                          job.outputs.spindle_starts,
+                          static_cast<double>(job.outputs.coolant_ticks) / job.machine.tick_hz);
+            std::cout << line;
+        }
     }
     if (o.json && failed) std::cerr << report();
     Json document;
