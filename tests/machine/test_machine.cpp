@@ -74,7 +74,13 @@ TEST_CASE("impossible profiles are refused with the place and the reason", "[hos
           "m.json:1:83: unknown key \"speed\" (expected one of: axes, chord_tolerance, "
           "corner_stop_angle, feed, gpio, "
           "layer_feeds, mm_per_lsb, "
-          "pen_down_delay, pen_up_delay, tick_hz, ticks_per_span, travel_feed)");
+          "pen_down_delay, pen_up_delay, spindle, tick_hz, ticks_per_span, travel_feed)");
+    CHECK(error_of(std::string("{") + kAxes + ", \"spindle\": {\"spin_up\": -1}}") ==
+          "m.json:1:97: spin_up -1 s is impossible (allowed: >= 0 and <= 600 s)");
+    CHECK(error_of(std::string("{") + kAxes + ", \"spindle\": {\"rpm\": 1}}") ==
+          "m.json:1:93: unknown key \"rpm\" (expected one of: spin_up)");
+    CHECK(error_of(std::string("{") + kAxes + ", \"spindle\": 2}") ==
+          "m.json:1:85: spindle must be an object like {\"spin_up\": 2}");
     CHECK(error_of(R"({"axes": [{"name": "x", "max_velocity": 1, "max_acceleration": 1},
                               {"name": "x", "max_velocity": 1, "max_acceleration": 1}]})") ==
           "m.json:2:40: axis name \"x\" is used twice");
