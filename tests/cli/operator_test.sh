@@ -70,7 +70,7 @@ start_device 2 || exit 1
 out=$("$bin" ctl "$target" status -m "$machine" 2>&1)
 [[ "$out" == *"state         idle"* && "$out" == *"x 139.3220 mm (139322 LSB)"* ]] && ok || fail "ctl status: $out"
 out=$("$bin" ctl "$target" status --json 2>&1)
-echo "$out" | /usr/bin/python3 -c 'import json,sys; d=json.load(sys.stdin); assert d["state"]=="idle" and d["position"][0]["position_lsb"]==139322 and d["protocol_version"]==5 and d["pen_down"] is False and d["position"][0]["homing"]=="not homed"' && ok || fail "ctl status --json: $out"
+echo "$out" | /usr/bin/python3 -c 'import json,sys; d=json.load(sys.stdin); assert d["state"]=="idle" and d["position"][0]["position_lsb"]==139322 and d["protocol_version"]==6 and d["pen_down"] is False and d["spindle"]=="off" and d["flood"] is False and d["position"][0]["homing"]=="not homed"' && ok || fail "ctl status --json: $out"
 out=$("$bin" ctl "$target" hold 2>&1); rc=$?
 [ $rc -eq 6 ] && [[ "$out" == *"device refused hold while idle: command not allowed in this state"* ]] && ok || fail "ctl hold idle: $rc $out"
 out=$("$bin" ctl "$target" jog x 5.5 --feed 20 -m "$machine" 2>&1)
