@@ -200,7 +200,8 @@ struct ModbusClient::Impl {
 
     bool broadcast() const { return framing == ModbusFraming::kRtu && target.unit == 0; }
 
-    void refuse_broadcast_read(const char* what) const {
+    // Reads, and the coil writes (an output must be confirmed), need an answer.
+    void refuse_broadcast(const char* what) const {
         if (broadcast()) {
             throw std::invalid_argument(name + ": " + what +
                                         " to the broadcast unit 0 (nobody answers)");
@@ -239,7 +240,7 @@ ModbusClient& ModbusClient::operator=(ModbusClient&&) noexcept = default;
 void ModbusClient::read_input_registers(std::uint16_t address, std::span<std::uint16_t> out) {
     check_count("read_input_registers", out.size(), 125);
     check_range("read_input_registers", address, out.size());
-    impl_->refuse_broadcast_read("read_input_registers");
+    impl_->refuse_broadcast("read_input_registers");
     const int n = static_cast<int>(out.size());
     impl_->transact(
         "FC4 read input registers " + std::to_string(address) + " x" + std::to_string(n),
@@ -250,7 +251,7 @@ void ModbusClient::read_input_registers(std::uint16_t address, std::span<std::ui
 void ModbusClient::read_holding_registers(std::uint16_t address, std::span<std::uint16_t> out) {
     check_count("read_holding_registers", out.size(), 125);
     check_range("read_holding_registers", address, out.size());
-    impl_->refuse_broadcast_read("read_holding_registers");
+    impl_->refuse_broadcast("read_holding_registers");
     const int n = static_cast<int>(out.size());
     impl_->transact(
         "FC3 read holding registers " + std::to_string(address) + " x" + std::to_string(n),
@@ -301,6 +302,34 @@ void ModbusClient::write_registers(std::uint16_t address, std::span<const std::u
                     });
 }
 
+void ModbusClient::write_coil(std::uint16_t address, bool on) {
+    impl_->refuse_broadcast("write_coil");
+    impl_->transact("FC5 write coil " + std::to_string(address) + (on ? " on" : " off"),
+                    modbus_write_single_pdu_bytes(), modbus_write_single_pdu_bytes(),
+                    [&](modbus_t* ctx) { return modbus_write_bit(ctx, address, on ? 1 : 0); });
+}
+
+void ModbusClient::write_coils(std::uint16_t address, std::span<const std::uint8_t> values) {
+    if (values.empty() || values.size() > 1968) {
+        throw std::invalid_argument("write_coils: " + std::to_string(values.size()) +
+                                    " coils is not in 1..1968");
+    }
+    if (address + values.size() > 0x10000u) {
+        throw std::invalid_argument("write_coils: coils " + std::to_string(address) + ".." +
+                                    std::to_string(address + values.size() - 1) +
+                                    " run past 65535");
+    }
+    impl_->refuse_broadcast("write_coils");
+    const int n = static_cast<int>(values.size());
+    // libmodbus takes one byte per coil (0 off, anything else on) and packs them itself.
+    std::uint8_t bits[1968];
+    for (std::size_t k = 0; k < values.size(); ++k) bits[k] = values[k] != 0 ? 1 : 0;
+    impl_->transact("FC15 write coils " + std::to_string(address) + " x" + std::to_string(n),
+                    modbus_write_coils_request_pdu_bytes(values.size()),
+                    modbus_write_multiple_response_pdu_bytes(),
+                    [&](modbus_t* ctx) { return modbus_write_bits(ctx, address, n, bits); });
+}
+
 void ModbusClient::write_read_registers(std::uint16_t write_address,
                                         std::span<const std::uint16_t> values,
                                         std::uint16_t read_address, std::span<std::uint16_t> out) {
@@ -308,7 +337,7 @@ void ModbusClient::write_read_registers(std::uint16_t write_address,
     check_count("write_read_registers (read)", out.size(), 125);
     check_range("write_read_registers (write)", write_address, values.size());
     check_range("write_read_registers (read)", read_address, out.size());
-    impl_->refuse_broadcast_read("write_read_registers");
+    impl_->refuse_broadcast("write_read_registers");
     const int nw = static_cast<int>(values.size());
     const int nr = static_cast<int>(out.size());
     impl_->transact("FC23 write " + std::to_string(write_address) + " x" + std::to_string(nw) +

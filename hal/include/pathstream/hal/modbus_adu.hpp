@@ -32,7 +32,7 @@ constexpr std::size_t modbus_read_request_pdu_bytes() {
 constexpr std::size_t modbus_read_response_pdu_bytes(std::size_t count) {
     return 2 + 2 * count;
 }
-/// FC6 request and its echoed response: fc, address, value.
+/// FC5 and FC6 request and their echoed response: fc, address, value.
 constexpr std::size_t modbus_write_single_pdu_bytes() {
     return 5;
 }
@@ -40,7 +40,11 @@ constexpr std::size_t modbus_write_single_pdu_bytes() {
 constexpr std::size_t modbus_write_multiple_request_pdu_bytes(std::size_t count) {
     return 6 + 2 * count;
 }
-/// FC16 response: fc, address, count.
+/// FC15 request: fc, address, count, byte count, one bit per coil.
+constexpr std::size_t modbus_write_coils_request_pdu_bytes(std::size_t count) {
+    return 6 + (count + 7) / 8;
+}
+/// FC15 and FC16 response: fc, address, count.
 constexpr std::size_t modbus_write_multiple_response_pdu_bytes() {
     return 5;
 }

@@ -87,6 +87,12 @@ public:
     void write_register(std::uint16_t address, std::uint16_t value);
     /// FC16: values.size() registers (1..123) from `address`.
     void write_registers(std::uint16_t address, std::span<const std::uint16_t> values);
+    /// FC5: coil `address` on or off. Not to the broadcast unit (std::invalid_argument):
+    /// an output write must be confirmed.
+    void write_coil(std::uint16_t address, bool on);
+    /// FC15: values.size() coils (1..1968) from `address`, coil address + k on when
+    /// values[k] != 0. Not to the broadcast unit (std::invalid_argument).
+    void write_coils(std::uint16_t address, std::span<const std::uint8_t> values);
     /// FC23: writes `values` (1..121) at write_address, then reads out.size() (1..125)
     /// registers from read_address, in one transaction (the device writes first).
     void write_read_registers(std::uint16_t write_address, std::span<const std::uint16_t> values,
