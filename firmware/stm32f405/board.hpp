@@ -67,6 +67,11 @@ inline constexpr unsigned kDirPin[4] = {1, 3, 5, 7};
 inline constexpr Pin kEnable = {stm32::kGpioD, 8};
 inline constexpr bool kEnableActiveLow = true;
 inline constexpr Pin kPen = {stm32::kGpioD, 9};
+/// The machine functions, high = on (relay or VFD inputs through a driver): spindle runs
+/// (PD10), spindle counter-clockwise (PD11), mist (PD12), flood (PD13), in the order of
+/// device::kMachineOutputBits. One port, so that one BSRR write switches them together.
+inline constexpr std::uintptr_t kMachineOutputPort = stm32::kGpioD;
+inline constexpr unsigned kMachineOutputPin[4] = {10, 11, 12, 13};
 /// E-stop (PE0) and limit switches x-, x+, y-, y+, ... (PE1..PE8), active low with pull-ups:
 /// a broken wire reads as pressed.
 inline constexpr Pin kEstop = {stm32::kGpioE, 0};

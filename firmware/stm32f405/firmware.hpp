@@ -5,8 +5,9 @@
 
 namespace firmware {
 
-/// Drives every output to its safe level at once: enable inactive, pen up, step pins low, step
-/// timer stopped. Any context (the fault handler calls it with interrupts off).
+/// Drives every output to its safe level at once: enable inactive, pen up, spindle and coolant
+/// off, step pins low, step timer stopped. Any context (the fault handler calls it with
+/// interrupts off).
 void halt_outputs();
 
 /// Bytes of the main stack ever used (the highest point not still painted at reset) and the

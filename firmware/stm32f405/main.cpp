@@ -1,7 +1,7 @@
 // pathstream on an STM32F405: the device of `pathstream device`, with its Modbus register map
-// served over RTU on USART1, ticked by a timer interrupt, driving step/dir, enable and pen
-// outputs. The split is the core's: the tick interrupt runs the device's tick side and the
-// outputs; the main loop is the task, serving the bus, feeding the device's own moves and
+// served over RTU on USART1, ticked by a timer interrupt, driving step/dir, enable, pen, spindle
+// and coolant outputs. The split is the core's: the tick interrupt runs the device's tick side
+// and the outputs; the main loop is the task, serving the bus, feeding the device's own moves and
 // writing the trace. Everything they share is written by one side only (docs/firmware.md,
 // "Contexts").
 #include <atomic>
@@ -91,6 +91,23 @@ void note_line_counters() {
 }
 #endif
 
+// The machine functions' pins from the tick's state and outputs (device::machine_output_on),
+// in one BSRR write. Tick interrupt, and halt_outputs (all off).
+void drive_machine_outputs(device::DeviceState state, std::uint8_t outputs) {
+    static_assert(device::kMachineOutputCount ==
+                  sizeof board::kMachineOutputPin / sizeof board::kMachineOutputPin[0]);
+    std::uint32_t on = 0, off = 0;
+    for (unsigned k = 0; k < device::kMachineOutputCount; ++k) {
+        const std::uint32_t pin = 1u << board::kMachineOutputPin[k];
+        if (device::machine_output_on(state, outputs, device::kMachineOutputBits[k])) {
+            on |= pin;
+        } else {
+            off |= pin;
+        }
+    }
+    firmware::pins::write(board::kMachineOutputPort, on, off);
+}
+
 void bump(std::atomic<std::uint32_t>& counter) {
     counter.store(counter.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
 }
@@ -106,6 +123,7 @@ void bump(std::atomic<std::uint32_t>& counter) {
     const auto outputs = static_cast<std::uint8_t>(status.outputs);
     kEnableLine.set(device::enable_asserted(state));
     kPenLine.set(device::pen_down(state, outputs));
+    drive_machine_outputs(state, outputs);
     // A position set at rest ("set zero", homing) moves the coordinates, not the axes: that
     // tick makes no steps.
     const bool moved_coordinates = status.position_applied != g_positions_set;
@@ -155,6 +173,8 @@ void init_pins() {
     }
     configure(board::kEnable.port, board::kEnable.number, stm32::kModeOutput);
     configure(board::kPen.port, board::kPen.number, stm32::kModeOutput);
+    for (const unsigned pin : board::kMachineOutputPin)
+        configure(board::kMachineOutputPort, pin, stm32::kModeOutput);
     if constexpr (board::kSwitchInputs) {
         configure(board::kEstop.port, board::kEstop.number, stm32::kModeInput, 0, stm32::kPullUp);
         for (unsigned k = 0; k < 2 * kAxes; ++k) {
@@ -193,6 +213,7 @@ void halt_outputs() {
     g_steps.halt();
     kEnableLine.set(false);
     kPenLine.set(false);
+    drive_machine_outputs(device::DeviceState::kIdle, 0);
 }
 
 }  // namespace firmware

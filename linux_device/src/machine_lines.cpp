@@ -2,9 +2,13 @@
 
 #include <stdexcept>
 
+#include "pathstream/device/gpio_logic.hpp"
 #include "pathstream/machine/device_setup.hpp"
 
 namespace pathstream::linux_device {
+
+static_assert(host::kMachineFunctionCount == device::kMachineOutputCount,
+              "the profile's machine functions are the device's machine outputs, in one order");
 
 hal::GpioLineSpec line_spec(const std::string& chip, const host::GpioLineConfig& line) {
     hal::GpioLineSpec s;
@@ -49,6 +53,14 @@ MachineLines MachineLines::open(const host::MachineProfile& profile) {
             hal::open_gpiod_output(line_spec(g.chip, g.pen), "pathstream-pen", false));
         m.wiring_.pen = m.outputs_.back().get();
         note("pen", g.pen);
+    }
+    for (unsigned k = 0; k < host::kMachineFunctionCount; ++k) {
+        if (!g.has_function[k]) continue;
+        const std::string function = host::kMachineFunctionKeys[k];
+        m.outputs_.push_back(hal::open_gpiod_output(line_spec(g.chip, g.function[k]),
+                                                    "pathstream-" + function, false));
+        m.wiring_.machine[k] = m.outputs_.back().get();
+        note(function, g.function[k]);
     }
     if (g.has_estop) {
         m.inputs_.push_back(hal::open_gpiod_input(line_spec(g.chip, g.estop), "pathstream-estop"));

@@ -309,7 +309,9 @@ private:
 
     GpioConfig gpio(const json& g, const MachineProfile& p) const {
         if (!g.is_object()) fail("/gpio", "gpio must be an object");
-        only_keys(g, "/gpio", {"chip", "enable", "estop", "pen", "limits", "home"});
+        only_keys(g, "/gpio",
+                  {"chip", "enable", "estop", "pen", "spindle", "spindle_reverse", "mist", "flood",
+                   "limits", "home"});
         GpioConfig c;
         c.present = true;
         if (!g.contains("chip")) fail("/gpio", "gpio has no \"chip\"");
@@ -323,6 +325,12 @@ private:
         if (g.contains("estop"))
             c.estop = line(g["estop"], "/gpio/estop", "estop"), c.has_estop = true;
         if (g.contains("pen")) c.pen = line(g["pen"], "/gpio/pen", "pen"), c.has_pen = true;
+        for (unsigned k = 0; k < kMachineFunctionCount; ++k) {
+            const char* key = kMachineFunctionKeys[k];
+            if (!g.contains(key)) continue;
+            c.function[k] = line(g[key], std::string("/gpio/") + key, key);
+            c.has_function[k] = true;
+        }
         std::set<std::string> switch_names;
         for (const auto& a : p.axes) {
             switch_names.insert(a.name + "-");

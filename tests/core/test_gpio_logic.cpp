@@ -1,5 +1,6 @@
-// GPIO device logic (gpio_logic.hpp): limit-switch fault codes and names, when enables and the
-// pen are asserted, and MotionDevice::set_position (homing's "set zero").
+// GPIO device logic (gpio_logic.hpp): limit-switch fault codes and names, when enables, the
+// pen and the machine functions (spindle, coolant) are asserted, and MotionDevice::set_position
+// (homing's "set zero").
 #include <catch2/catch.hpp>
 #include <string>
 
@@ -75,6 +76,33 @@ TEST_CASE("enables are asserted only while the device may move, the pen then or 
     for (DeviceState s : {DeviceState::kFault, DeviceState::kEstop}) {
         CHECK_FALSE(pen_down(s, kOutputPenDown));
     }
+}
+
+TEST_CASE("machine function outputs are on only with the drives enabled and their bit set",
+          "[device][gpio][outputs]") {
+    constexpr std::uint8_t kAll = kOutputMachineMask | kOutputPenDown;
+    static_assert(machine_output_on(DeviceState::kRunning, kOutputSpindle, kOutputSpindle));
+    for (DeviceState s : {DeviceState::kRunning, DeviceState::kHolding, DeviceState::kStopping}) {
+        for (const std::uint8_t bit : kMachineOutputBits) {
+            CHECK(machine_output_on(s, bit, bit));
+            CHECK(machine_output_on(s, kAll, bit));
+            CHECK_FALSE(machine_output_on(s, static_cast<std::uint8_t>(kAll & ~bit), bit));
+        }
+        CHECK(machine_outputs_on(s, kAll) == kOutputMachineMask);
+        CHECK(machine_outputs_on(s, kOutputSpindle | kOutputFlood | kOutputPenDown) ==
+              (kOutputSpindle | kOutputFlood));
+    }
+    // Idle, fault, e-stop: off whatever the byte says (the drives are off too).
+    for (DeviceState s : {DeviceState::kIdle, DeviceState::kFault, DeviceState::kEstop}) {
+        for (const std::uint8_t bit : kMachineOutputBits)
+            CHECK_FALSE(machine_output_on(s, kAll, bit));
+        CHECK(machine_outputs_on(s, kAll) == 0);
+    }
+    // The pen is not a machine function.
+    CHECK_FALSE(machine_output_on(DeviceState::kRunning, kOutputPenDown, kOutputPenDown));
+    std::uint8_t all = 0;
+    for (const std::uint8_t bit : kMachineOutputBits) all = static_cast<std::uint8_t>(all | bit);
+    CHECK(all == kOutputMachineMask);
 }
 
 TEST_CASE("set_position redefines the rest point while idle and hands it to the producer",

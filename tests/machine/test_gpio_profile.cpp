@@ -1,5 +1,6 @@
 // The machine profile's "gpio" object: chip, lines by offset or name, active-low, bias, limit
-// switches per axis and side, homing; each bad value with its file:line:col.
+// switches per axis and side, homing, the spindle and coolant lines; each bad value with its
+// file:line:col.
 #include <catch2/catch.hpp>
 #include <string>
 
@@ -75,8 +76,8 @@ TEST_CASE("gpio profile: bad values are refused with the place and the reason",
     CHECK(error_of(with_gpio(R"({"chip": ""})")) ==
           "m.json:3:18: chip must be a chip name, path, number or label (non-empty string)");
     CHECK(error_of(with_gpio(R"({"chip": "c", "beeper": {"line": 1}})")) ==
-          "m.json:3:33: unknown key \"beeper\" (expected one of: chip, enable, estop, home, "
-          "limits, pen)");
+          "m.json:3:33: unknown key \"beeper\" (expected one of: chip, enable, estop, flood, "
+          "home, limits, mist, pen, spindle, spindle_reverse)");
     CHECK(error_of(with_gpio(R"({"chip": "c", "enable": {"line": -1}})")) ==
           "m.json:3:42: line offset must be 0..65535");
     CHECK(error_of(with_gpio(R"({"chip": "c", "enable": {"line": 1.5}})")) ==
@@ -107,4 +108,27 @@ TEST_CASE("gpio profile: bad values are refused with the place and the reason",
     CHECK(error_of(with_gpio(R"({"chip": "c", "limits": {"x-": {"line": 2}},
         "home": {"x": {"switch": "x-", "search_velocity": 10, "latch_velocity": 1, "backoff": 0, "max_travel": 300}}})")) ==
           "m.json:4:95: backoff 0 mm is impossible (allowed: > 0 and <= 10000 mm)");
+}
+
+TEST_CASE("gpio profile: spindle, its direction, mist and flood lines", "[host][gpio][machine]") {
+    const MachineProfile p = parse_machine_profile(with_gpio(R"({
+        "chip": "gpiochip0", "pen": {"line": 0},
+        "spindle": {"line": 5}, "spindle_reverse": {"line": "vfd-rev", "active_low": true},
+        "flood": {"line": 7, "bias": "pull-down"}})"),
+                                                   "m.json");
+    const GpioConfig& g = p.gpio;
+    REQUIRE(g.present);
+    CHECK(std::string(kMachineFunctionKeys[0]) == "spindle");
+    CHECK(g.has_function[0]);
+    CHECK(g.function[0].line == "5");
+    CHECK(g.has_function[1]);
+    CHECK(g.function[1].line == "vfd-rev");
+    CHECK(g.function[1].active_low);
+    CHECK_FALSE(g.has_function[2]);  // mist: not fitted
+    CHECK(g.has_function[3]);
+    CHECK(g.function[3].bias == "pull-down");
+    CHECK(error_of(with_gpio(R"({"chip": "c", "mist": {"line": 70000}})")) ==
+          "m.json:3:40: line offset must be 0..65535");
+    CHECK(error_of(with_gpio(R"({"chip": "c", "flood": 3})")) ==
+          "m.json:3:32: flood must be an object like {\"line\": 3}");
 }

@@ -1,6 +1,7 @@
-// The GPIO glue on the simulated plotter (sim/gpio): enable follows the state, the e-stop input
-// stops motion within one tick and drops enable, limit switches fault naming axis and side,
-// homing against a simulated switch, and the simulated lines themselves.
+// The GPIO glue on the simulated plotter (sim/gpio): enable follows the state, the spindle and
+// coolant follow a job (kept through a hold, off at its end, a stop, a fault and the e-stop),
+// the e-stop input stops motion within one tick and drops enable, limit switches fault naming
+// axis and side, homing against a simulated switch, and the simulated lines themselves.
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <string>
@@ -26,8 +27,10 @@ MotionLimits<kAxes> limits() {
     return l;
 }
 
-// Queues a pen-down move of `distance` LSB on `axis` (AxisMove spans) and returns its ticks.
-std::uint64_t queue_move(Bench& b, unsigned axis, std::int64_t distance) {
+// Queues a move of `distance` LSB on `axis` (AxisMove spans) with `outputs` (pen down unless
+// told) and returns its ticks; `flags` go on its last span (kWireJobEnd: the job ends there).
+std::uint64_t queue_move(Bench& b, unsigned axis, std::int64_t distance,
+                         std::uint8_t outputs = kOutputPenDown, std::uint8_t flags = 0) {
     Lsb from[kAxes];
     for (unsigned a = 0; a < kAxes; ++a) from[a] = b.device.position(a);
     AxisMove<kAxes> m;
@@ -36,7 +39,8 @@ std::uint64_t queue_move(Bench& b, unsigned axis, std::int64_t distance) {
     while (m.pending()) {
         WireSpan w;
         REQUIRE(m.next(w));
-        w.outputs = kOutputPenDown;
+        w.outputs = outputs;
+        if (!m.pending()) w.flags = static_cast<std::uint8_t>(w.flags | flags);
         std::uint8_t bytes[4 + 12 * kAxes];
         const std::size_t n = encode_wire_span(w, kAxes, bytes, sizeof bytes);
         REQUIRE(b.device.accept_batch(b.device.last_accepted_sequence() + 1, 1, bytes, n) ==
@@ -86,6 +90,96 @@ TEST_CASE("gpio glue: enable follows the state: up while running, down when idle
     REQUIRE(b.device.command(Command::kStop) == Status::kOk);
     REQUIRE(b.run_until([&] { return b.device.state() == DeviceState::kIdle; }, 2000));
     CHECK_FALSE(b.enable.state());
+}
+
+TEST_CASE("gpio glue: spindle and flood follow a job, kept through a hold, off when it ends",
+          "[gpio][glue][outputs]") {
+    const Lsb start[kAxes] = {0, 0};
+    Bench b(start, limits());
+    constexpr std::uint8_t kCutting = kOutputSpindle | kOutputFlood;
+    const std::uint64_t ticks = queue_move(b, 0, 30000, kCutting, kWireJobEnd);
+    b.step();
+    CHECK_FALSE(b.spindle.state());  // idle with a job queued
+    REQUIRE(b.device.command(Command::kStart) == Status::kOk);
+    b.step();
+    // On right after the tick that started, with the enable; the pen, mist and the spindle's
+    // direction stay off (not in the spans).
+    CHECK(b.spindle.state());
+    CHECK(b.flood.state());
+    CHECK(b.spindle.switch_ticks() == std::vector<std::uint64_t>{2});
+    CHECK(b.flood.switch_ticks() == b.spindle.switch_ticks());
+    CHECK_FALSE(b.spindle_reverse.state());
+    CHECK_FALSE(b.mist.state());
+    CHECK_FALSE(b.pen.state());
+    for (int i = 0; i < 100; ++i) b.step();
+    // A hold decelerates and rests: the spindle and the coolant keep running.
+    REQUIRE(b.device.command(Command::kHold) == Status::kOk);
+    REQUIRE(b.run_until(
+        [&] { return b.device.state() == DeviceState::kHolding && b.ticks.size() > 600; }, 2000));
+    CHECK(b.spindle.state());
+    CHECK(b.flood.state());
+    CHECK(b.spindle.switch_ticks().size() == 1);
+    REQUIRE(b.device.command(Command::kResume) == Status::kOk);
+    // The job runs to its end mark: the tick that ends it (idle) switches both off, with the
+    // enable.
+    REQUIRE(b.run_until([&] { return b.device.state() == DeviceState::kIdle; }, ticks + 2000));
+    CHECK_FALSE(b.spindle.state());
+    CHECK_FALSE(b.flood.state());
+    REQUIRE(b.spindle.switch_ticks().size() == 2);
+    CHECK(b.spindle.switch_ticks()[1] == b.enable.switch_ticks().back());
+    CHECK(b.flood.switch_ticks() == b.spindle.switch_ticks());
+}
+
+TEST_CASE("gpio glue: a stop, a fault and the e-stop switch the spindle and coolant off",
+          "[gpio][glue][outputs]") {
+    const Lsb start[kAxes] = {0, 0};
+    Bench b(start, limits());
+    constexpr std::uint8_t kReverseMist = kOutputSpindle | kOutputSpindleReverse | kOutputMist;
+    const auto cutting = [&] {
+        return b.spindle.state() && b.spindle_reverse.state() && b.mist.state();
+    };
+    const auto all_off = [&] {
+        return !b.spindle.state() && !b.spindle_reverse.state() && !b.mist.state() &&
+               !b.flood.state() && !b.enable.state();
+    };
+    // A stop: the spindle keeps running while the axes decelerate (stopping), then off at rest.
+    queue_move(b, 0, 30000, kReverseMist);
+    REQUIRE(b.device.command(Command::kStart) == Status::kOk);
+    for (int i = 0; i < 150; ++i) b.step();
+    REQUIRE(cutting());
+    REQUIRE(b.device.command(Command::kStop) == Status::kOk);
+    b.step();
+    REQUIRE(b.device.state() == DeviceState::kStopping);
+    CHECK(cutting());
+    REQUIRE(b.run_until([&] { return b.device.state() == DeviceState::kIdle; }, 2000));
+    CHECK(all_off());
+    // A fault (a limit switch): off right after the tick that faults.
+    queue_move(b, 1, 30000, kReverseMist);
+    REQUIRE(b.device.command(Command::kStart) == Status::kOk);
+    for (int i = 0; i < 150; ++i) b.step();
+    REQUIRE(cutting());
+    b.limit[1][1].drive(true, 1);
+    b.step();
+    CHECK(b.device.state() == DeviceState::kFault);
+    CHECK(all_off());
+    b.limit[1][1].drive(false, 2);
+    b.step();
+    REQUIRE(b.device.command(Command::kReset) == Status::kOk);
+    b.step();
+    REQUIRE(b.device.state() == DeviceState::kIdle);
+    // The e-stop: off right after the tick that sees it.
+    queue_move(b, 1, -30000, kReverseMist);
+    REQUIRE(b.device.command(Command::kStart) == Status::kOk);
+    for (int i = 0; i < 150; ++i) b.step();
+    REQUIRE(cutting());
+    const std::size_t edge_at = b.ticks.size();
+    b.estop.drive(true, 3);
+    b.step();
+    CHECK(b.device.state() == DeviceState::kEstop);
+    CHECK(all_off());
+    CHECK(b.spindle.switch_ticks().back() == edge_at + 1);
+    for (int i = 0; i < 20; ++i) b.step();
+    CHECK(all_off());
 }
 
 TEST_CASE("gpio glue: the e-stop stops motion within one tick, drops enable, resets only released",

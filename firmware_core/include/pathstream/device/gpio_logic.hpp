@@ -1,7 +1,8 @@
 // What the device's discrete I/O means, as pure functions of the device state: when the drive
-// enables are asserted, when the pen is down, which fault a limit switch raises, and a fault
-// code's name. The I/O glue (sim/gpio, the libgpiod driver) applies them; keeping the rules
-// here makes them the same on every port and testable without any I/O.
+// enables are asserted, when the pen is down and the spindle and coolant are on, which fault a
+// limit switch raises, and a fault code's name. The I/O glue (sim/gpio, the libgpiod driver)
+// applies them; keeping the rules here makes them the same on every port and testable without any
+// I/O.
 #pragma once
 
 #include <cstddef>
@@ -52,6 +53,32 @@ constexpr bool enable_asserted(DeviceState state) {
 constexpr bool pen_down(DeviceState state, std::uint8_t outputs) {
     return (enable_asserted(state) || state == DeviceState::kIdle) &&
            (outputs & kOutputPenDown) != 0;
+}
+
+/// How many machine functions have an output of their own (spindle, its direction, mist,
+/// flood).
+inline constexpr unsigned kMachineOutputCount = 4;
+
+/// The machine functions' span output bits, in the order every wiring lists their outputs
+/// (a profile's gpio lines and output coils, the firmware's pins).
+inline constexpr std::uint8_t kMachineOutputBits[kMachineOutputCount] = {
+    kOutputSpindle, kOutputSpindleReverse, kOutputMist, kOutputFlood};
+
+/// A machine function's output (`bit`: kOutputSpindle, kOutputSpindleReverse, kOutputMist or
+/// kOutputFlood): on only while the drives are enabled (enable_asserted) and the outputs the
+/// device's last tick drove (MotionDevice::outputs) have the bit. The device already keeps
+/// these bits through a hold, an underrun, a stop within a span and a re-entry, and drops them
+/// when it goes idle, faults or sees the e-stop; the rule repeats the enable condition so that
+/// an output is never on while the drives are not, whatever a port does with the byte (the
+/// e-stop switches a spindle off with the drives). Pure, O(1), any context.
+constexpr bool machine_output_on(DeviceState state, std::uint8_t outputs, std::uint8_t bit) {
+    return enable_asserted(state) && (outputs & kOutputMachineMask & bit) != 0;
+}
+
+/// Every machine function's output at once: the bits of kOutputMachineMask that
+/// machine_output_on() turns on (what an output module is sent). Pure, O(1), any context.
+constexpr std::uint8_t machine_outputs_on(DeviceState state, std::uint8_t outputs) {
+    return enable_asserted(state) ? static_cast<std::uint8_t>(outputs & kOutputMachineMask) : 0;
 }
 
 /// Writes a NUL-terminated English name of `code` into out[0..capacity): "none", "external

@@ -1,8 +1,8 @@
 // The I/O glue between a MotionDevice and its discrete lines: e-stop and limit-switch inputs
-// in, enable and pen-lift outputs out. The rules are firmware_core's (gpio_logic.hpp,
-// switch_rules.hpp: the firmware applies the same ones); this
-// class only moves levels, edges and requests between the hal interfaces and the device. The
-// same code runs against the simulated lines (tests) and libgpiod (the VM test's driver).
+// in, enable, pen-lift, spindle and coolant outputs out. The rules are firmware_core's
+// (gpio_logic.hpp, switch_rules.hpp: the firmware applies the same ones); this class only moves
+// levels, edges and requests between the hal interfaces and the device. The same code runs against
+// the simulated lines (tests) and libgpiod (the VM test's driver).
 #pragma once
 
 #include <cstdint>
@@ -21,6 +21,8 @@ struct DeviceWiring {
     hal::DigitalInput* limit[Axes][2] = {};  ///< [axis][LimitSide]
     hal::DigitalOutput* enable = nullptr;
     hal::DigitalOutput* pen = nullptr;
+    /// Spindle, spindle direction, mist, flood: by device::kMachineOutputBits index.
+    hal::DigitalOutput* machine[device::kMachineOutputCount] = {};
 };
 
 /// Task-side glue. Call poll_inputs() before each tick (or whenever an input's event_fd is
@@ -70,12 +72,19 @@ public:
         }
     }
 
-    /// Drives enable and pen from the state the last tick left. Cheap: each output switches
-    /// only on a change (one ioctl with libgpiod).
+    /// Drives enable, pen and the machine functions (spindle, its direction, mist, flood)
+    /// from the state the last tick left. Cheap: each output switches only on a change (one
+    /// ioctl with libgpiod).
     void update_outputs() {
         const device::DeviceState s = device_.state();
+        const std::uint8_t outputs = device_.outputs();
         if (wiring_.enable != nullptr) wiring_.enable->set(device::enable_asserted(s));
-        if (wiring_.pen != nullptr) wiring_.pen->set(device::pen_down(s, device_.outputs()));
+        if (wiring_.pen != nullptr) wiring_.pen->set(device::pen_down(s, outputs));
+        for (unsigned k = 0; k < device::kMachineOutputCount; ++k) {
+            if (wiring_.machine[k] != nullptr)
+                wiring_.machine[k]->set(
+                    device::machine_output_on(s, outputs, device::kMachineOutputBits[k]));
+        }
     }
 
     /// Masks (or unmasks) one switch's fault: homing drives onto its own switch on purpose.

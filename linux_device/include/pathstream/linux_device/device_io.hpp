@@ -22,6 +22,8 @@ struct MachineWiring {
     hal::DigitalInput* limit[kMaxAxes][2] = {};  ///< [axis][LimitSide]
     hal::DigitalOutput* enable = nullptr;
     hal::DigitalOutput* pen = nullptr;
+    /// Spindle, spindle direction, mist, flood: by device::kMachineOutputBits index.
+    hal::DigitalOutput* machine[device::kMachineOutputCount] = {};
 };
 
 /// The I/O of one device. Task context, the thread that ticks the device.
@@ -30,7 +32,8 @@ public:
     virtual ~DeviceIo() = default;
     /// Drains the inputs' edges into the device (e-stop, limit faults). Before every tick.
     virtual void before_tick() = 0;
-    /// Drives enable and pen from the new state; advances homing. After every tick.
+    /// Drives enable, pen, spindle and coolant from the new state; advances homing. After
+    /// every tick.
     virtual void after_tick() = 0;
 
     /// Starts homing `config.axis` against its `side` switch (which must be wired: else
@@ -163,6 +166,7 @@ private:
         d.estop = w.estop;
         d.enable = w.enable;
         d.pen = w.pen;
+        for (unsigned k = 0; k < device::kMachineOutputCount; ++k) d.machine[k] = w.machine[k];
         for (unsigned a = 0; a < Axes; ++a) {
             d.limit[a][0] = w.limit[a][0];
             d.limit[a][1] = w.limit[a][1];

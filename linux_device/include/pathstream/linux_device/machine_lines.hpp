@@ -17,7 +17,8 @@ namespace pathstream::linux_device {
 /// The libgpiod request for one profile line (chip from the gpio object).
 hal::GpioLineSpec line_spec(const std::string& chip, const host::GpioLineConfig& line);
 
-/// Owns the requested lines. Outputs start inactive (drives disabled, pen up).
+/// Owns the requested lines. Outputs start inactive (drives disabled, pen up, spindle and
+/// coolant off).
 class MachineLines {
 public:
     /// Requests every line the profile's "gpio" object names, consumers "pathstream-<function>"
@@ -28,9 +29,9 @@ public:
 
     MachineLines(MachineLines&&) = default;
     MachineLines& operator=(MachineLines&&) = delete;
-    /// Drives every output inactive (drives disabled, pen up) before releasing the lines: a
-    /// released line may keep its last level, and a program that ends must not leave the
-    /// drives enabled.
+    /// Drives every output inactive (drives disabled, pen up, spindle and coolant off) before
+    /// releasing the lines: a released line may keep its last level, and a program that ends
+    /// must not leave the drives enabled or the spindle running.
     ~MachineLines();
 
     /// Pointers into the owned lines; valid while this object lives.

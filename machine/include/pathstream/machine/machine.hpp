@@ -43,6 +43,15 @@ struct HomingAxisConfig {
     double pull_off = 0;
 };
 
+/// How many machine functions a profile can wire to an output of their own.
+inline constexpr unsigned kMachineFunctionCount = 4;
+
+/// The machine functions' keys in a profile's "gpio" object, in the order
+/// of device::kMachineOutputBits (gpio_logic.hpp): spindle (on: M3/M4), spindle_reverse (on:
+/// counter-clockwise, M4), mist (M7), flood (M8).
+inline constexpr const char* kMachineFunctionKeys[kMachineFunctionCount] = {
+    "spindle", "spindle_reverse", "mist", "flood"};
+
 /// Which chip lines do what. Absent from the profile: present == false.
 struct GpioConfig {
     bool present = false;
@@ -51,6 +60,10 @@ struct GpioConfig {
     GpioLineConfig enable;  ///< drive enable output
     GpioLineConfig estop;   ///< e-stop input
     GpioLineConfig pen;     ///< pen-lift output (active = pen down)
+    /// Machine function outputs by kMachineFunctionKeys index (active = on, or counter-
+    /// clockwise for spindle_reverse); has_function[k] says whether line k is fitted.
+    bool has_function[kMachineFunctionCount] = {};
+    GpioLineConfig function[kMachineFunctionCount];
     /// Limit switch inputs by "<axis><side>": "x-", "x+", "y-", ... (side "-" or "+").
     std::vector<std::pair<std::string, GpioLineConfig>> limits;
     std::vector<HomingAxisConfig> home;  ///< in profile order

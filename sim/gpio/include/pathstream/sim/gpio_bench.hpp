@@ -1,6 +1,6 @@
 // A simulated plotter with its discrete lines: MotionDevice + DeviceGpio + simulated e-stop,
-// limit switches that trip at a position, and enable and pen outputs that record the tick of
-// every switch. Tests drive it tick by tick.
+// limit switches that trip at a position, and enable, pen, spindle and coolant outputs that
+// record the tick of every switch. Tests drive it tick by tick.
 #pragma once
 
 #include <array>
@@ -82,6 +82,10 @@ public:
     SimulatedInput limit[Axes][2];
     SimulatedOutput enable{clock};
     SimulatedOutput pen{clock};
+    SimulatedOutput spindle{clock};
+    SimulatedOutput spindle_reverse{clock};
+    SimulatedOutput mist{clock};
+    SimulatedOutput flood{clock};
     linux_device::DeviceGpio<Axes, Capacity> glue;
     MachineSwitches switches;  ///< the switches placed, on the machine's coordinates
     std::vector<std::array<Lsb, Axes>> ticks;  ///< every tick's setpoints
@@ -97,6 +101,9 @@ private:
         }
         w.enable = &enable;
         w.pen = &pen;
+        SimulatedOutput* machine[device::kMachineOutputCount] = {&spindle, &spindle_reverse, &mist,
+                                                                 &flood};
+        for (unsigned k = 0; k < device::kMachineOutputCount; ++k) w.machine[k] = machine[k];
         return w;
     }
 };
