@@ -142,9 +142,9 @@ void add_device_command(CLI::App& app, DeviceCommandOptions& o) {
         ->capture_default_str()
         ->check(CLI::Range(1, 127));
     cmd->add_option("--machine,-m", o.machine,
-                    "machine profile: configure the device from it (axes, tick rate, limits) and "
-                    "open its \"gpio\" "
-                    "lines: e-stop, limit switches, enable, pen (docs/gpio.md)")
+                    "machine profile: configure the device from it (axes, tick rate, limits), "
+                    "open its \"gpio\" lines (e-stop, limit switches, enable, pen, spindle, "
+                    "coolant) and its \"output_coils\" module (docs/gpio.md)")
         ->check(CLI::ExistingFile);
     cmd->add_flag("--no-gpio", o.run.no_gpio,
                   "with --machine: do not open the profile's GPIO lines");

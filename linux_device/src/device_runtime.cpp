@@ -4,18 +4,21 @@
 #include <chrono>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <stdexcept>
 #include <string>
 #include <thread>
 
 #include "device_watch.hpp"
+#include "pathstream/hal/modbus_error.hpp"
 #include "pathstream/hal/modbus_server.hpp"
 #include "pathstream/hal/socketcan_bus.hpp"
 #include "pathstream/linux_device/can_motion_device.hpp"
 #include "pathstream/linux_device/machine_homing.hpp"
 #include "pathstream/linux_device/machine_lines.hpp"
 #include "pathstream/linux_device/modbus_motion_device.hpp"
+#include "pathstream/linux_device/output_coils.hpp"
 #include "pathstream/linux_device/paced_loop.hpp"
 #include "pathstream/machine/atomic_file.hpp"
 #include "pathstream/machine/device_setup.hpp"
@@ -64,19 +67,48 @@ void home(AnyMotionDevice& device, DeviceIo& io, const host::MachineProfile& pro
     (void)home_axes(device, io, host::homing_setups(profile), profile.mm_per_lsb, run_until, phase);
 }
 
-// Configuration, GPIO and homing from the profile, shared by every transport.
+// Configuration, GPIO, output coils and homing from the profile, shared by every transport.
 struct Machine {
     std::optional<host::MachineProfile> profile;
     std::optional<MachineLines> lines;
     DeviceIo* io = nullptr;
-    std::optional<HomingRunLog> homing_log;  ///< homing runs a bus command starts
+    std::optional<HomingRunLog> homing_log;   ///< homing runs a bus command starts
+    std::unique_ptr<OutputCoilThread> coils;  ///< the profile's output_coils
 
-    // After every tick while serving: the log's lines of a homing run.
-    void after_tick(const DeviceLog& log) {
+    // After every tick while serving: the machine outputs to the coil writer (a failed write
+    // stops the machine), the log's lines of a homing run.
+    void after_tick(AnyMotionDevice& device, const DeviceLog& log) {
+        if (coils) {
+            const std::string failure = coils->after_tick(device);
+            if (!failure.empty()) log("outputs", failure + "; stopping the machine");
+        }
         if (homing_log)
             homing_log->after_tick([&log](const std::string& line) { log("homing", line); });
     }
+
+    // When the device stops serving: every coil off, said in the log.
+    void stop_outputs(const DeviceLog& log) {
+        if (!coils) return;
+        const std::string failure = coils->stop();
+        log("outputs", failure.empty() ? "output coils off" : failure);
+    }
 };
+
+// Connects to the profile's output module and writes every coil off: the machine's outputs
+// are known before anything is served. A module that cannot be reached or refuses the writes
+// stops the start (hal::ModbusError, naming the profile and the target).
+void open_output_coils(Machine& m, const host::MachineProfile& profile, const DeviceLog& log) {
+    const std::string where = profile.source + ": output_coils: ";
+    try {
+        m.coils = std::make_unique<OutputCoilThread>(CoilWriter(profile.output_coils));
+    } catch (const hal::ModbusError& e) {
+        throw hal::ModbusError(e.kind(), where + e.what(), e.exception_code(), e.os_error());
+    } catch (const std::invalid_argument& e) {
+        throw std::invalid_argument(where + e.what());
+    }
+    log("outputs",
+        "output coils at " + m.coils->target() + ": " + m.coils->mapping() + "; all off");
+}
 
 Machine prepare_machine(AnyMotionDevice& device, const DeviceRunOptions& o,
                         const std::optional<host::MachineProfile>& profile,
@@ -112,6 +144,7 @@ Machine prepare_machine(AnyMotionDevice& device, const DeviceRunOptions& o,
             throw std::invalid_argument(profile->source + ": " + e.what());
         }
     }
+    if (profile->output_coils.present) open_output_coils(m, *profile, log);
     if (attach) attach(device, log);
     if (o.home) {
         if (m.io == nullptr) {
@@ -151,7 +184,7 @@ void serve_until_stopped(AnyMotionDevice& device, DeviceWatch& watch, Machine& m
         [&] {
             device.tick();
             watch.after_tick(device);
-            machine.after_tick(log);
+            machine.after_tick(device, log);
         },
         [&] { return device.tick_hz(); }, serve, loop_options(o, device), stop);
 }
@@ -174,6 +207,7 @@ int run_can_device(const DeviceRunOptions& o, const std::vector<Lsb>& start,
     serve_until_stopped(
         *device, watch, machine, log, [&](std::chrono::microseconds w) { device->serve(bus, w); },
         o, stop);
+    machine.stop_outputs(log);
     const hal::SocketCanCounters& c = bus.counters();
     log("stopped",
         "stopped after " + std::to_string(device->ticks_run()) + " ticks, " +
@@ -231,6 +265,7 @@ int run_modbus_device(const DeviceRunOptions& o, const std::vector<Lsb>& start,
             watch.after_poll(server);
         },
         o, stop);
+    machine.stop_outputs(log);
     watch.after_poll(server, true);
     log("stopped",
         "stopped after " + std::to_string(device->ticks_run()) + " ticks, " +

@@ -10,6 +10,7 @@
 #include <utility>
 
 #include "pathstream/device/motion_limits.hpp"
+#include "pathstream/hal/modbus_target.hpp"
 #include "pathstream/machine/input_error.hpp"
 #include "pathstream/machine/json_document.hpp"
 #include "pathstream/units.hpp"
@@ -52,7 +53,7 @@ public:
         only_keys(root, "",
                   {"axes", "mm_per_lsb", "tick_hz", "ticks_per_span", "feed", "travel_feed",
                    "pen_down_delay", "pen_up_delay", "chord_tolerance", "corner_stop_angle", "gpio",
-                   "layer_feeds", "spindle"});
+                   "layer_feeds", "spindle", "output_coils"});
         MachineProfile p;
         if (!root.contains("axes")) fail("", "machine profile has no \"axes\"");
         const json& axes = root["axes"];
@@ -147,6 +148,7 @@ public:
         check_plannable(root, p);
         if (root.contains("gpio")) p.gpio = gpio(root["gpio"], p);
         if (root.contains("spindle")) p.spindle = spindle(root["spindle"]);
+        if (root.contains("output_coils")) p.output_coils = output_coils(root["output_coils"]);
         if (root.contains("layer_feeds")) {
             const json& f = root["layer_feeds"];
             if (!f.is_object())
@@ -304,6 +306,59 @@ private:
         c.present = true;
         if (v.contains("spin_up"))
             c.spin_up = number(v["spin_up"], "/spindle/spin_up", "spin_up", 0, 600, false, "s");
+        return c;
+    }
+
+    OutputCoilsConfig output_coils(const json& v) const {
+        if (!v.is_object()) {
+            fail("/output_coils",
+                 "output_coils must be an object like {\"target\": "
+                 "\"modbus-tcp://HOST:PORT?unit=1\", \"spindle\": 0}");
+        }
+        std::set<std::string> keys{"target"};
+        for (const char* key : kMachineFunctionKeys) keys.insert(key);
+        only_keys(v, "/output_coils", keys);
+        OutputCoilsConfig c;
+        c.present = true;
+        if (!v.contains("target")) fail("/output_coils", "output_coils has no \"target\"");
+        const json& t = v["target"];
+        if (!t.is_string())
+            fail("/output_coils/target",
+                 "target must be a Modbus URL string (modbus-tcp://HOST:PORT?unit=N or "
+                 "modbus-rtu://DEVICE?baud=B&unit=N)");
+        c.target = t.get<std::string>();
+        hal::ModbusTarget target;
+        try {
+            target = hal::parse_modbus_target(c.target);
+        } catch (const std::invalid_argument& e) {
+            fail("/output_coils/target", e.what());
+        }
+        // Unit 0 on a serial line is a broadcast: nobody answers, so no write is confirmed and
+        // a module that is gone would never stop the machine.
+        if (target.transport == hal::ModbusTarget::Transport::kRtu && target.unit == 0)
+            fail("/output_coils/target",
+                 "unit 0 is the broadcast address: no answer would confirm a write (give the "
+                 "module's unit, 1..247)");
+        bool any = false;
+        for (unsigned k = 0; k < kMachineFunctionCount; ++k) {
+            const char* key = kMachineFunctionKeys[k];
+            if (!v.contains(key)) continue;
+            const std::string ptr = std::string("/output_coils/") + key;
+            const json& a = v[key];
+            if (!a.is_number_integer() || a.get<long long>() < 0 || a.get<long long>() > 65535)
+                fail(ptr, std::string(key) + " coil address must be a whole number 0..65535");
+            c.coil[k] = static_cast<std::int32_t>(a.get<long long>());
+            for (unsigned j = 0; j < k; ++j) {
+                if (c.coil[j] == c.coil[k])
+                    fail(ptr, "coil " + std::to_string(c.coil[k]) + " is " +
+                                  kMachineFunctionKeys[j] + "'s already: one coil per function");
+            }
+            any = true;
+        }
+        if (!any)
+            fail("/output_coils",
+                 "output_coils switches no function: give a coil for one or more of spindle, "
+                 "spindle_reverse, mist, flood");
         return c;
     }
 

@@ -43,6 +43,8 @@ TEST_CASE("fault names say which switch, on which axis and side", "[device][gpio
     CHECK(name_of(FaultCode::kNone) == "none");
     CHECK(name_of(FaultCode::kExternal) == "external fault");
     CHECK(name_of(FaultCode::kStopFailed) == "no controlled stop fits in one span");
+    CHECK(name_of(FaultCode::kOutputFailed) == "a machine output could not be switched");
+    CHECK(static_cast<unsigned>(FaultCode::kOutputFailed) == 4);
     CHECK(name_of(limit_fault(0, LimitSide::kNegative)) ==
           "limit switch x- (axis 0, negative side)");
     CHECK(name_of(limit_fault(1, LimitSide::kPositive)) ==

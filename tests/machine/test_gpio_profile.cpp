@@ -1,6 +1,6 @@
 // The machine profile's "gpio" object: chip, lines by offset or name, active-low, bias, limit
-// switches per axis and side, homing, the spindle and coolant lines; each bad value with its
-// file:line:col.
+// switches per axis and side, homing, the spindle and coolant lines; the "output_coils" object
+// (a Modbus module's coils for the same functions); each bad value with its file:line:col.
 #include <catch2/catch.hpp>
 #include <string>
 
@@ -131,4 +131,64 @@ TEST_CASE("gpio profile: spindle, its direction, mist and flood lines", "[host][
           "m.json:3:40: line offset must be 0..65535");
     CHECK(error_of(with_gpio(R"({"chip": "c", "flood": 3})")) ==
           "m.json:3:32: flood must be an object like {\"line\": 3}");
+}
+
+namespace {
+// Line 3 of the document starts with `"output_coils": ` (16 columns) before the object.
+std::string with_coils(const std::string& coils) {
+    return std::string("{") + kAxes + ",\n\"output_coils\": " + coils + "}";
+}
+}  // namespace
+
+TEST_CASE("output coils profile: target and one coil per function", "[host][machine][coils]") {
+    const MachineProfile none = parse_machine_profile(std::string("{") + kAxes + "}", "m.json");
+    CHECK_FALSE(none.output_coils.present);
+    const MachineProfile p = parse_machine_profile(
+        with_coils(R"({"target": "modbus-tcp://10.0.0.7:502?unit=3", "spindle": 0,
+                        "spindle_reverse": 1, "flood": 65535})"),
+        "m.json");
+    const OutputCoilsConfig& c = p.output_coils;
+    REQUIRE(c.present);
+    CHECK(c.target == "modbus-tcp://10.0.0.7:502?unit=3");
+    CHECK(c.coil[0] == 0);
+    CHECK(c.coil[1] == 1);
+    CHECK(c.coil[2] == -1);  // mist: no coil
+    CHECK(c.coil[3] == 65535);
+    const MachineProfile rtu = parse_machine_profile(
+        with_coils(
+            R"({"target": "modbus-rtu:///dev/ttyUSB0?baud=9600&parity=E&unit=2", "mist": 4})"),
+        "m.json");
+    CHECK(rtu.output_coils.coil[2] == 4);
+}
+
+TEST_CASE("output coils profile: bad values are refused with the place and the reason",
+          "[host][machine][coils]") {
+    CHECK(error_of(with_coils("[]")) ==
+          "m.json:3:17: output_coils must be an object like {\"target\": "
+          "\"modbus-tcp://HOST:PORT?unit=1\", \"spindle\": 0}");
+    CHECK(error_of(with_coils(R"({"spindle": 0})")) ==
+          "m.json:3:17: output_coils has no \"target\"");
+    CHECK(error_of(with_coils(R"({"target": 5, "spindle": 0})")) ==
+          "m.json:3:28: target must be a Modbus URL string (modbus-tcp://HOST:PORT?unit=N or "
+          "modbus-rtu://DEVICE?baud=B&unit=N)");
+    CHECK(error_of(with_coils(R"({"target": "http://x", "spindle": 0})")) ==
+          "m.json:3:28: bad target URL 'http://x': unknown scheme (want modbus-tcp:// or "
+          "modbus-rtu://)");
+    CHECK(error_of(with_coils(R"({"target": "modbus-rtu:///dev/ttyS0?unit=0", "spindle": 0})")) ==
+          "m.json:3:28: unit 0 is the broadcast address: no answer would confirm a write (give "
+          "the module's unit, 1..247)");
+    CHECK(error_of(with_coils(R"({"target": "modbus-tcp://h:502"})")) ==
+          "m.json:3:17: output_coils switches no function: give a coil for one or more of "
+          "spindle, spindle_reverse, mist, flood");
+    CHECK(error_of(with_coils(R"({"target": "modbus-tcp://h:502", "spindle": -1})")) ==
+          "m.json:3:61: spindle coil address must be a whole number 0..65535");
+    CHECK(error_of(with_coils(R"({"target": "modbus-tcp://h:502", "mist": 65536})")) ==
+          "m.json:3:58: mist coil address must be a whole number 0..65535");
+    CHECK(error_of(with_coils(R"({"target": "modbus-tcp://h:502", "flood": 2.5})")) ==
+          "m.json:3:59: flood coil address must be a whole number 0..65535");
+    CHECK(error_of(with_coils(R"({"target": "modbus-tcp://h:502", "spindle": 2, "flood": 2})")) ==
+          "m.json:3:73: coil 2 is spindle's already: one coil per function");
+    CHECK(error_of(with_coils(R"({"target": "modbus-tcp://h:502", "fan": 2})")) ==
+          "m.json:3:57: unknown key \"fan\" (expected one of: flood, mist, spindle, "
+          "spindle_reverse, target)");
 }

@@ -52,6 +52,8 @@ std::size_t fault_name(FaultCode code, char* out, std::size_t capacity) {
         w.put("no controlled stop fits in one span");
     } else if (code == FaultCode::kReentryFailed) {
         w.put("no move back onto the path fits in one span");
+    } else if (code == FaultCode::kOutputFailed) {
+        w.put("a machine output could not be switched");
     } else if (limit_fault_switch(code, axis, side)) {
         const char* names = "xyzabcuv";
         const bool negative = side == LimitSide::kNegative;

@@ -159,7 +159,7 @@ inline constexpr const char* kResultValues =
     "25 \"acceleration step\" "
     "128 \"incomplete transfer\" 129 \"bad frame\" 130 \"too long\"";
 inline constexpr const char* kFaultValues =
-    "0 \"none\" 1 \"external\" 2 \"stop failed\" 3 \"re-entry failed\" "
+    "0 \"none\" 1 \"external\" 2 \"stop failed\" 3 \"re-entry failed\" 4 \"output failed\" "
     "256 \"limit axis 0 negative\" 257 \"limit axis 0 positive\" 258 \"limit axis 1 negative\" "
     "259 \"limit axis 1 positive\" 260 \"limit axis 2 negative\" 261 \"limit axis 2 positive\" "
     "262 \"limit axis 3 negative\" 263 \"limit axis 3 positive\" 264 \"limit axis 4 negative\" "
@@ -211,7 +211,9 @@ inline constexpr Signal kStatusASignals[] = {
     {"FreeSlots", 2, 1, false, "span", "free span slots"},
     {"Queued", 3, 1, false, "span", "spans queued"},
     {"FaultCode", 4, 2, false, "",
-     "0 none, 1 external, 2 stop failed, 3 re-entry failed, 0x01xx limit switch", -1, kFaultValues},
+     "0 none, 1 external, 2 stop failed, 3 re-entry failed, 4 output failed, 0x01xx limit "
+     "switch",
+     -1, kFaultValues},
     {"Underruns", 6, 2, false, "", "controlled stops because the queue ran dry"},
 };
 inline constexpr Signal kStatusBSignals[] = {

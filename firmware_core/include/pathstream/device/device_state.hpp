@@ -27,6 +27,10 @@ enum class FaultCode : std::uint16_t {
     kExternal = 1,       ///< raised by the integration (e.g. a drive fault input)
     kStopFailed = 2,     ///< no controlled stop fits in one span: stopped at once
     kReentryFailed = 3,  ///< resume: no move back onto the path fits in one span
+    /// A machine function's output (spindle, coolant) could not be switched: its output
+    /// module did not confirm a write (raised by the integration, e.g. `pathstream device`'s
+    /// output coils).
+    kOutputFailed = 4,
     kLimitSwitchBase = 0x100,
 };
 

@@ -82,7 +82,8 @@ constexpr std::uint8_t machine_outputs_on(DeviceState state, std::uint8_t output
 }
 
 /// Writes a NUL-terminated English name of `code` into out[0..capacity): "none", "external
-/// fault", "no controlled stop fits in one span", "limit switch x- (axis 0, negative side)"
+/// fault", "no controlled stop fits in one span", "a machine output could not be switched",
+/// "limit switch x- (axis 0, negative side)"
 /// (axes 0..7 named x y z a b c u v), or "fault 0x1234". Returns the length written (without
 /// the NUL), truncated to capacity - 1; nothing is written when capacity is 0. No heap.
 /// Any context.

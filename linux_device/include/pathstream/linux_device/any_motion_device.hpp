@@ -59,6 +59,11 @@ public:
     virtual std::uint32_t finished_job_ticks() const = 0;
     /// Raises an external fault (as a drive fault input would).
     virtual void raise_fault() = 0;
+    /// Raises `code` (e.g. kOutputFailed: an output module did not confirm a write); the next
+    /// tick stops the machine at once. The first code raised is kept until a reset.
+    virtual void raise_fault(device::FaultCode code) = 0;
+    /// The outputs the last tick drove (MotionDevice::outputs: pen, spindle, coolant).
+    virtual std::uint8_t outputs() const = 0;
     /// Configures the device as a host's configuration would (idle only). Returns the
     /// device's Status (kBadLimits for zero limits or a wrong axis count, kWrongState).
     [[nodiscard]] virtual Status configure(const host::DeviceLimitsLsb& limits) = 0;
@@ -142,6 +147,8 @@ public:
         return device_.status().finished_job_ticks;
     }
     void raise_fault() override { device_.raise_fault(device::FaultCode::kExternal); }
+    void raise_fault(device::FaultCode code) override { device_.raise_fault(code); }
+    std::uint8_t outputs() const override { return device_.outputs(); }
     Status configure(const host::DeviceLimitsLsb& l) override {
         if (l.max_velocity.size() != Axes || l.max_acceleration.size() != Axes)
             return Status::kBadLimits;

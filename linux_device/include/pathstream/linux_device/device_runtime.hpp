@@ -1,6 +1,6 @@
 // The device runtime as a program runs it: a Modbus (TCP, RTU) or native CAN device configured
-// from a machine profile, wired to its GPIO lines, homed when asked, then served and ticked on
-// the steady clock until stopped, its events logged (docs/cli.md, "device").
+// from a machine profile, wired to its GPIO lines and output coils, homed when asked, then served
+// and ticked on the steady clock until stopped, its events logged (docs/cli.md, "device").
 #pragma once
 
 #include <atomic>
@@ -41,9 +41,13 @@ using AttachMachine = std::function<void(AnyMotionDevice& device, const DeviceLo
 
 /// Runs the device from `start` (LSB, one per axis) until `stop` becomes true or
 /// options.exit_after passes, and returns 0. With `profile`: configured from it, its GPIO lines
-/// opened (unless no_gpio), homed (with home). Throws std::invalid_argument for options or a
-/// profile the device cannot use, HomingFailed when homing fails or is stopped, hal::ModbusError,
-/// hal::GpioError or std::system_error when a bus or line cannot be opened. Main thread; blocks.
+/// opened (unless no_gpio), its output_coils module connected and every coil written off (a
+/// writer thread then follows the machine outputs; a write the module does not confirm raises
+/// FaultCode::kOutputFailed; the coils are written off again when it stops), homed (with
+/// home). Throws std::invalid_argument for options or a profile the device cannot use,
+/// HomingFailed when homing fails or is stopped, hal::ModbusError, hal::GpioError or
+/// std::system_error when a bus, line or output module cannot be opened or written. Main
+/// thread; blocks.
 int run_device_runtime(const DeviceRunOptions& options, const std::vector<Lsb>& start,
                        const std::optional<host::MachineProfile>& profile,
                        const AttachMachine& attach, const std::atomic<bool>& stop);

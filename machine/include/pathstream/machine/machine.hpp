@@ -46,7 +46,7 @@ struct HomingAxisConfig {
 /// How many machine functions a profile can wire to an output of their own.
 inline constexpr unsigned kMachineFunctionCount = 4;
 
-/// The machine functions' keys in a profile's "gpio" object, in the order
+/// The machine functions' keys in a profile's "gpio" and "output_coils" objects, in the order
 /// of device::kMachineOutputBits (gpio_logic.hpp): spindle (on: M3/M4), spindle_reverse (on:
 /// counter-clockwise, M4), mist (M7), flood (M8).
 inline constexpr const char* kMachineFunctionKeys[kMachineFunctionCount] = {
@@ -78,6 +78,19 @@ struct SpindleConfig {
     double spin_up = 0;
 };
 
+/// The profile's optional "output_coils" object: the machine functions switched by the coils
+/// of a Modbus I/O module (a relay board, a VFD's run and direction inputs) that the device
+/// writes as a client (docs/gpio.md, "Output coils").
+struct OutputCoilsConfig {
+    bool present = false;
+    /// The module's URL, modbus-tcp://HOST:PORT?unit=N or modbus-rtu://DEVICE?...; it parses
+    /// with hal::parse_modbus_target and its unit is not the broadcast address 0.
+    std::string target;
+    /// Coil address (0..65535) by kMachineFunctionKeys index; -1: the function has no coil.
+    /// At least one is mapped, no two to the same coil.
+    std::int32_t coil[kMachineFunctionCount] = {-1, -1, -1, -1};
+};
+
 /// Everything the planner and the simulated device need to know about the machine.
 struct MachineProfile {
     std::vector<AxisLimits> axes;      ///< one per path axis, in path order
@@ -92,8 +105,9 @@ struct MachineProfile {
     /// Optional "corner_stop_angle" (1..180 degrees in the file, radians here): a joint turning
     /// by more stops exactly; absent (< 0): the planner's PlanOptions::corner_stop_angle.
     double corner_stop_angle = -1;
-    GpioConfig gpio;        ///< optional "gpio" object
-    SpindleConfig spindle;  ///< optional "spindle" object
+    GpioConfig gpio;                 ///< optional "gpio" object
+    SpindleConfig spindle;           ///< optional "spindle" object
+    OutputCoilsConfig output_coils;  ///< optional "output_coils" object
     /// Optional "layer_feeds": pen-down speed (mm/s) per layer name (an Inkscape layer's label,
     /// a stroke colour such as "#ff0000"), for subpaths that set no feed of their own.
     std::vector<std::pair<std::string, double>> layer_feeds;
