@@ -4,8 +4,8 @@
 # writes every coil off before it serves and again when it stops (the module counts both
 # writes and sees no change); a module that is not there, or that refuses a coil it does not
 # have, stops the start with exit 6 and a message naming the profile, the target and the coil.
-# (The coils following a job's spindle and coolant are tested in tests/device/
-# test_output_coils.cpp, on the same module.)
+# Then drill.ngc streamed to the device turns the spindle and flood coils on after its tool
+# change and off by its end (holds and faults: tests/device/test_output_coils.cpp).
 #   output_coils_test.sh PATHSTREAM_BINARY COIL_MODULE_BINARY SOURCE_DIR WORK_DIR
 set -u
 bin=$1 module_bin=$2 src=$3 work=$4
@@ -86,6 +86,56 @@ if [ -n "$port" ]; then
   kill -TERM "$module_pid" 2>/dev/null; wait "$module_pid" 2>/dev/null
 else
   fail "the second module did not start: $(cat "$work/module3.log")"
+fi
+
+# 4. A G-code job end to end: drill.ngc (T2 M6, S6000 M3 M8, ... M9 M5) streamed to the device
+# switches the module's spindle and flood coils on after the tool change and off by its end.
+start_module module4.log 16
+if [ -n "$port" ]; then
+  write_profile "$port"
+  "$bin" device -m "$work/router_coils.json" --tcp 127.0.0.1:0 --time-scale 20 --exit-after 300 \
+    > "$work/device4.log" 2>&1 &
+  device_pid=$!
+  target=
+  for _ in $(seq 200); do
+    target=$(sed -n 's/.*serving \(modbus-tcp:[^ ]*\).*/\1/p' "$work/device4.log")
+    [ -n "$target" ] && break
+    kill -0 "$device_pid" 2>/dev/null || break
+    sleep 0.05
+  done
+  if [ -n "$target" ]; then
+    "$bin" stream "$src/examples/cnc/drill.ngc" -m "$work/router_coils.json" \
+      --tool-table "$src/examples/cnc/tools.tbl" -t "$target" --no-journal \
+      < /dev/null > "$work/stream4.log" 2>&1 &
+    stream_pid=$!
+    for _ in $(seq 2400); do
+      kill -0 "$stream_pid" 2>/dev/null || break
+      if "$bin" ctl "$target" status --json 2>/dev/null | grep -q '"paused": true'; then
+        # In the tool change the spindle's coil has not been switched on yet.
+        grep -q "^coil 0 on" "$work/module4.log" && fail "spindle coil on before the tool change"
+        "$bin" ctl "$target" resume > /dev/null 2>&1
+      fi
+      sleep 0.05
+    done
+    kill -0 "$stream_pid" 2>/dev/null && { fail "stream did not end"; kill -KILL "$stream_pid"; }
+    wait "$stream_pid"; rc=$?
+    [ $rc -eq 0 ] && ok || fail "stream drill: $rc $(tail -5 "$work/stream4.log")"
+    kill -INT "$device_pid" 2>/dev/null; wait "$device_pid" 2>/dev/null
+  else
+    fail "device did not start: $(cat "$work/device4.log")"
+    kill "$device_pid" 2>/dev/null; wait "$device_pid" 2>/dev/null
+  fi
+  kill -TERM "$module_pid" 2>/dev/null; wait "$module_pid" 2>/dev/null
+  # Each coil went on once and off once, in that order.
+  changes=$(grep "^coil" "$work/module4.log" | tr '\n' ';')
+  [ "$(grep -c "^coil 0 on" "$work/module4.log")" -eq 1 ] &&
+    [ "$(grep -c "^coil 3 on" "$work/module4.log")" -eq 1 ] &&
+    [ "$(grep -c "^coil 0 off" "$work/module4.log")" -eq 1 ] &&
+    [ "$(grep -c "^coil 3 off" "$work/module4.log")" -eq 1 ] &&
+    [ "$(grep "^coil 0" "$work/module4.log" | head -1)" = "coil 0 on" ] && ok ||
+    fail "the module's coils during drill.ngc: $changes"
+else
+  fail "the fourth module did not start: $(cat "$work/module4.log")"
 fi
 
 echo "output coils: $passed passed, $failures failed"
