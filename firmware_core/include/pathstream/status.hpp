@@ -34,6 +34,7 @@ enum class [[nodiscard]] Status : std::uint8_t{
     kPauseMoving = 23,            ///< a span with a pause after it must end at rest
     kJerkLimit = 24,              ///< the span's exact cubic has more jerk than an axis may
     kAccelerationStep = 25,       ///< acceleration steps at a join by more than one tick of jerk
+    kBadShaper = 26,              ///< input shaper taps refused (check_shaper_taps)
 };
 
 /// Short stable name of a status, for logs and host messages. Never null.
@@ -91,6 +92,8 @@ constexpr const char* status_name(Status s) {
             return "span exceeds an axis jerk limit";
         case Status::kAccelerationStep:
             return "acceleration steps at a join by more than one tick of jerk";
+        case Status::kBadShaper:
+            return "input shaper taps out of range or not summing to one";
     }
     return "unknown status";
 }
