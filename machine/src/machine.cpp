@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 #include <set>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <utility>
 
@@ -53,7 +54,7 @@ public:
         only_keys(root, "",
                   {"axes", "mm_per_lsb", "tick_hz", "ticks_per_span", "feed", "travel_feed",
                    "pen_down_delay", "pen_up_delay", "chord_tolerance", "corner_stop_angle", "gpio",
-                   "layer_feeds", "spindle", "output_coils"});
+                   "layer_feeds", "spindle", "output_coils", "input_shaper"});
         MachineProfile p;
         if (!root.contains("axes")) fail("", "machine profile has no \"axes\"");
         const json& axes = root["axes"];
@@ -149,6 +150,8 @@ public:
         if (root.contains("gpio")) p.gpio = gpio(root["gpio"], p);
         if (root.contains("spindle")) p.spindle = spindle(root["spindle"]);
         if (root.contains("output_coils")) p.output_coils = output_coils(root["output_coils"]);
+        p.input_shaper.assign(p.axes.size(), std::nullopt);
+        if (root.contains("input_shaper")) input_shaper(root["input_shaper"], p);
         if (root.contains("layer_feeds")) {
             const json& f = root["layer_feeds"];
             if (!f.is_object())
@@ -297,6 +300,48 @@ private:
             c.bias = b.get<std::string>();
         }
         return c;
+    }
+
+    /// "input_shaper": {"x": {"type": "mzv", "frequency": 40, "damping": 0.1}, ...}, each
+    /// axis's shaper checked against the device's history at the profile's tick rate.
+    void input_shaper(const json& v, MachineProfile& p) const {
+        if (!v.is_object()) {
+            fail("/input_shaper",
+                 "input_shaper must be an object like {\"x\": {\"type\": "
+                 "\"mzv\", \"frequency\": 40}}");
+        }
+        for (const auto& [name, s] : v.items()) {
+            const std::string ptr = "/input_shaper/" + json_pointer_token(name);
+            std::size_t axis = p.axes.size();
+            for (std::size_t a = 0; a < p.axes.size(); ++a)
+                if (p.axes[a].name == name) axis = a;
+            if (axis == p.axes.size()) fail(ptr, "the profile has no axis \"" + name + "\"");
+            if (!s.is_object())
+                fail(ptr, "an axis's shaper must be an object with type and frequency");
+            only_keys(s, ptr, {"type", "frequency", "damping"});
+            if (!s.contains("type") || !s["type"].is_string())
+                fail(ptr, "the shaper needs a \"type\": one of " + shaper_type_names());
+            const auto type = shaper_type_from_name(s["type"].get<std::string>());
+            if (!type) {
+                fail(ptr + "/type", "unknown shaper type \"" + s["type"].get<std::string>() +
+                                        "\" (known: " + shaper_type_names() + ")");
+            }
+            if (!s.contains("frequency")) fail(ptr, "the shaper needs a \"frequency\" in Hz");
+            ShaperSpec spec;
+            spec.type = *type;
+            spec.frequency_hz =
+                number(s["frequency"], ptr + "/frequency", "frequency", 0, 1e4, true, "Hz");
+            if (s.contains("damping")) {
+                spec.damping =
+                    number(s["damping"], ptr + "/damping", "damping", 0, 0.99, false, "");
+            }
+            try {
+                (void)design_shaper_taps(spec, p.tick_hz, kDeviceShaperHistoryTicks);
+            } catch (const std::invalid_argument& e) {
+                fail(ptr + "/frequency", e.what());
+            }
+            p.input_shaper[axis] = spec;
+        }
     }
 
     SpindleConfig spindle(const json& v) const {

@@ -72,7 +72,7 @@ TEST_CASE("impossible profiles are refused with the place and the reason", "[hos
           "setpoints cannot meet it");
     CHECK(error_of(std::string("{") + kAxes + ", \"speed\": 3}") ==
           "m.json:1:83: unknown key \"speed\" (expected one of: axes, chord_tolerance, "
-          "corner_stop_angle, feed, gpio, "
+          "corner_stop_angle, feed, gpio, input_shaper, "
           "layer_feeds, mm_per_lsb, output_coils, "
           "pen_down_delay, pen_up_delay, spindle, tick_hz, ticks_per_span, travel_feed)");
     CHECK(error_of(std::string("{") + kAxes + ", \"spindle\": {\"spin_up\": -1}}") ==

@@ -2,9 +2,12 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
+
+#include "pathstream/machine/shaper_design.hpp"
 
 namespace pathstream::host {
 
@@ -108,6 +111,9 @@ struct MachineProfile {
     GpioConfig gpio;                 ///< optional "gpio" object
     SpindleConfig spindle;           ///< optional "spindle" object
     OutputCoilsConfig output_coils;  ///< optional "output_coils" object
+    /// Optional "input_shaper": per axis (path order, one entry per axis), the shaper the
+    /// device applies to its setpoints, or none (docs/input-shaping.md).
+    std::vector<std::optional<ShaperSpec>> input_shaper;
     /// Optional "layer_feeds": pen-down speed (mm/s) per layer name (an Inkscape layer's label,
     /// a stroke colour such as "#ff0000"), for subpaths that set no feed of their own.
     std::vector<std::pair<std::string, double>> layer_feeds;

@@ -12,6 +12,10 @@
 
 namespace pathstream::host {
 
+/// Setpoints each axis of the Linux device and the simulator remembers for its shaper: the
+/// longest tap delay is one less (0.41 s at 10 kHz, a 3-hump EI down to 5 Hz).
+inline constexpr std::uint32_t kDeviceShaperHistoryTicks = 4096;
+
 /// The shaper families with positive impulses.
 enum class ShaperType {
     kZv,           ///< zero vibration: 2 impulses over half a damped period
