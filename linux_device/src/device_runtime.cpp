@@ -6,9 +6,11 @@
 #include <functional>
 #include <memory>
 #include <optional>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include "device_watch.hpp"
 #include "pathstream/hal/modbus_error.hpp"
@@ -22,6 +24,7 @@
 #include "pathstream/linux_device/paced_loop.hpp"
 #include "pathstream/machine/atomic_file.hpp"
 #include "pathstream/machine/device_setup.hpp"
+#include "pathstream/machine/shaper_design.hpp"
 
 namespace pathstream::linux_device {
 namespace {
@@ -110,6 +113,29 @@ void open_output_coils(Machine& m, const host::MachineProfile& profile, const De
         "output coils at " + m.coils->target() + ": " + m.coils->mapping() + "; all off");
 }
 
+/// The profile's input shapers on the device, one log line naming each axis's taps.
+void configure_shaping(AnyMotionDevice& device, const host::MachineProfile& profile,
+                       std::uint32_t tick_hz, const DeviceLog& log) {
+    for (std::size_t a = 0; a < profile.input_shaper.size(); ++a) {
+        if (!profile.input_shaper[a]) continue;
+        const host::ShaperSpec& spec = *profile.input_shaper[a];
+        const std::vector<ShaperTap> taps =
+            host::design_shaper_taps(spec, tick_hz, host::kDeviceShaperHistoryTicks);
+        if (Status s = device.configure_shaper(static_cast<unsigned>(a), taps, tick_hz);
+            s != Status::kOk) {
+            throw std::invalid_argument(profile.source +
+                                        ": the device refused the input shaper of " +
+                                        profile.axes[a].name + ": " + status_name(s));
+        }
+        std::ostringstream text;
+        text << "input shaper on " << profile.axes[a].name << ": "
+             << host::shaper_type_name(spec.type) << " at " << spec.frequency_hz << " Hz, damping "
+             << spec.damping << ", " << taps.size() << " taps over " << taps.back().delay
+             << " ticks";
+        log("shaper", text.str(), {{"axis", profile.axes[a].name}, {"taps", taps.size()}});
+    }
+}
+
 Machine prepare_machine(AnyMotionDevice& device, const DeviceRunOptions& o,
                         const std::optional<host::MachineProfile>& profile,
                         const AttachMachine& attach, const DeviceLog& log, DeviceWatch& watch,
@@ -133,6 +159,7 @@ Machine prepare_machine(AnyMotionDevice& device, const DeviceRunOptions& o,
         }
     }
     log("configured", text, {{"tick_hz", limits.tick_hz}});
+    configure_shaping(device, *profile, limits.tick_hz, log);
     if (profile->gpio.present && !o.no_gpio) {
         m.lines.emplace(MachineLines::open(*profile));
         m.io = &device.attach_io(m.lines->wiring());

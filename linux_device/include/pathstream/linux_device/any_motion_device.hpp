@@ -10,8 +10,11 @@
 #include <vector>
 
 #include "pathstream/device/motion_device.hpp"
+#include "pathstream/input_shaper.hpp"
 #include "pathstream/linux_device/device_io.hpp"
 #include "pathstream/machine/device_setup.hpp"
+#include "pathstream/machine/shaper_design.hpp"
+#include "pathstream/shaper_taps.hpp"
 #include "pathstream/units.hpp"
 
 namespace pathstream::linux_device {
@@ -65,8 +68,19 @@ public:
     /// The outputs the last tick drove (MotionDevice::outputs: pen, spindle, coolant).
     virtual std::uint8_t outputs() const = 0;
     /// Configures the device as a host's configuration would (idle only). Returns the
-    /// device's Status (kBadLimits for zero limits or a wrong axis count, kWrongState).
+    /// device's Status (kBadLimits for zero limits or a wrong axis count, kWrongState;
+    /// kBadShaper for a tick rate other than the one an input shaper was set for).
     [[nodiscard]] virtual Status configure(const host::DeviceLimitsLsb& limits) = 0;
+    /// Shapes `axis`'s output from now on with `taps` (empty: unshaped), designed for
+    /// `tick_hz` ticks (docs/input-shaping.md): every tick's setpoints go through an
+    /// InputShaper<axes, host::kDeviceShaperHistoryTicks> before the observer and the
+    /// every-tick record see them; the status, the bus and the path-tick record keep the
+    /// unshaped command. A jump of the coordinates (set position, homing's zero) resets the
+    /// shaper instead of becoming a motion. kBadShaper for an axis out of range, taps
+    /// check_shaper_taps refuses or a tick rate other than the configured one; kWrongState
+    /// while the shaped output still moves. Task context, the ticking thread.
+    [[nodiscard]] virtual Status configure_shaper(unsigned axis, const std::vector<ShaperTap>& taps,
+                                                  std::uint32_t tick_hz) = 0;
     /// Wires the device to discrete lines; from now on every tick polls the inputs before
     /// it and drives the outputs after it. The lines must outlive the device. Init context.
     virtual DeviceIo& attach_io(const MachineWiring& wiring) = 0;
@@ -75,15 +89,20 @@ public:
     /// the device or be removed first. Init context.
     void observe_ticks(TickObserver* observer) { observer_ = observer; }
 
-    /// Records every path tick from now on: setpoints[k * axes + axis] is path tick k's.
+    /// Records every path tick from now on: setpoints[k * axes + axis] is path tick k's
+    /// command (before any input shaper).
     void record(bool on) { recording_ = on; }
     const std::vector<Lsb>& recorded_setpoints() const { return setpoints_; }
     const std::vector<DeviceTick>& recorded_ticks() const { return ticks_; }
     /// Records every tick from now on, path or not (stop and re-entry moves, rest): what the
-    /// axes were actually commanded, for checking the device's own moves against the limits.
-    /// every_tick_setpoints()[k * axes + axis] is tick k's (k counted from the call).
+    /// axes were actually commanded (after any input shaper), for checking the device's own
+    /// moves against the limits. every_tick_setpoints()[k * axes + axis] is tick k's (k
+    /// counted from the call).
     void record_every_tick(bool on) { recording_every_tick_ = on; }
     const std::vector<Lsb>& every_tick_setpoints() const { return every_tick_; }
+    /// With record_every_tick: every tick's command before the input shaper (the same as
+    /// every_tick_setpoints() without one).
+    const std::vector<Lsb>& every_tick_commands() const { return every_tick_command_; }
     std::uint64_t ticks_run() const { return ticks_run_; }
     /// Consecutive ticks, up to the last, that changed nothing in the device's status but its
     /// tick count: how long it has been at rest (a dwell or a wait for the host included).
@@ -95,6 +114,7 @@ protected:
     bool recording_every_tick_ = false;
     std::vector<Lsb> setpoints_;
     std::vector<Lsb> every_tick_;
+    std::vector<Lsb> every_tick_command_;
     std::vector<DeviceTick> ticks_;
     std::uint64_t ticks_run_ = 0;
     std::uint64_t unchanged_ticks_ = 0;
@@ -109,9 +129,11 @@ public:
 
     void tick() override {
         if (io_) io_->before_tick();
-        Lsb out[Axes];
+        Lsb command[Axes], out[Axes];
         const std::uint64_t before = device_.ticks_executed();
-        device_.tick(out);
+        device_.tick(command);
+        for (unsigned a = 0; a < Axes; ++a) out[a] = command[a];
+        if (shaper_) shape(out);
         if (io_) io_->after_tick();
         // The status but its tick count (the words after tick_count and before tick_check,
         // then every word after it), against the last tick's.
@@ -119,16 +141,21 @@ public:
                       "compared bytewise");
         device::DeviceStatus<Axes> now = device_.status();
         now.tick_count = now.tick_check = 0;
-        this->unchanged_ticks_ =
-            std::memcmp(&now, &last_status_, sizeof now) == 0 ? this->unchanged_ticks_ + 1 : 0;
+        // A shaped output still moving after the command rests is not at rest.
+        const bool same =
+            std::memcmp(&now, &last_status_, sizeof now) == 0 && (!shaper_ || shaper_->settled());
+        this->unchanged_ticks_ = same ? this->unchanged_ticks_ + 1 : 0;
         last_status_ = now;
         if (this->observer_ != nullptr)
             this->observer_->after_tick(out, Axes, device_.status().position_applied);
         ++this->ticks_run_;
-        if (this->recording_every_tick_)
+        if (this->recording_every_tick_) {
             this->every_tick_.insert(this->every_tick_.end(), out, out + Axes);
+            this->every_tick_command_.insert(this->every_tick_command_.end(), command,
+                                             command + Axes);
+        }
         if (this->recording_ && device_.ticks_executed() != before) {  // a path tick
-            this->setpoints_.insert(this->setpoints_.end(), out, out + Axes);
+            this->setpoints_.insert(this->setpoints_.end(), command, command + Axes);
             this->ticks_.push_back({static_cast<std::uint8_t>(device_.state()), device_.outputs()});
         }
     }
@@ -164,7 +191,24 @@ public:
             if (l.max_jerk.size() == Axes) m.axis[a].max_jerk = l.max_jerk[a];
         }
         m.pen_down_ticks = l.pen_down_ticks;
+        if (shaper_ && l.tick_hz != shaper_tick_hz_) return Status::kBadShaper;
         return device_.configure(m);
+    }
+    Status configure_shaper(unsigned axis, const std::vector<ShaperTap>& taps,
+                            std::uint32_t tick_hz) override {
+        if (axis >= Axes || tick_hz == 0 || (this->tick_hz() != 0 && tick_hz != this->tick_hz()))
+            return Status::kBadShaper;
+        if (shaper_tick_hz_ != 0 && tick_hz != shaper_tick_hz_) return Status::kBadShaper;
+        if (!shaper_) {
+            Lsb at[Axes];
+            for (unsigned a = 0; a < Axes; ++a) at[a] = device_.position(a);
+            shaper_ = std::make_unique<Shaper>(at);
+            positions_set_ = device_.status().position_applied;
+        }
+        const Status s =
+            shaper_->configure(axis, taps.data(), static_cast<std::uint32_t>(taps.size()));
+        if (s == Status::kOk) shaper_tick_hz_ = tick_hz;
+        return s;
     }
     DeviceIo& attach_io(const MachineWiring& wiring) override {
         io_ = std::make_unique<DeviceIoFor<Axes, Capacity>>(device_, wiring);
@@ -176,9 +220,25 @@ protected:
     /// Hands the I/O's homing to the bus protocol's commands (home over the bus).
     virtual void connect_homing(const device::HomingPort& port) = 0;
 
+    using Shaper = InputShaper<Axes, host::kDeviceShaperHistoryTicks>;
+    /// The tick's setpoints through the shaper; a new coordinate origin resets it first.
+    void shape(Lsb (&out)[Axes]) {
+        const std::uint32_t applied = device_.status().position_applied;
+        if (applied != positions_set_) {
+            positions_set_ = applied;
+            shaper_->reset(out);
+        }
+        Lsb shaped[Axes];
+        shaper_->shape(out, shaped);
+        for (unsigned a = 0; a < Axes; ++a) out[a] = shaped[a];
+    }
+
     device::MotionDevice<Axes, Capacity> device_;
     std::unique_ptr<DeviceIo> io_;
     device::DeviceStatus<Axes> last_status_{};
+    std::unique_ptr<Shaper> shaper_;  // 16 KB per axis: only with a shaper
+    std::uint32_t shaper_tick_hz_ = 0;
+    std::uint32_t positions_set_ = 0;
 };
 
 }  // namespace pathstream::linux_device
