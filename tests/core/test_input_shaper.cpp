@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <catch2/catch.hpp>
+#include <climits>
 #include <cstdint>
 #include <random>
 #include <vector>
@@ -129,11 +130,24 @@ TEST_CASE("shaped setpoints are the exact weighted sums of the command rounded o
         };
         std::vector<i128> sums[kAxes];
         std::vector<Lsb> shaped[kAxes], unshaped[kAxes];
+        // The test's own ring of the commands, for the two sums on their own.
+        Lsb ring[kAxes][kHistory];
+        for (unsigned a = 0; a < kAxes; ++a)
+            for (Lsb& r : ring[a]) r = origin[a];
         for (std::size_t k = 0; k < ticks; ++k) {
             Lsb in[kAxes], out[kAxes];
             for (unsigned a = 0; a < kAxes; ++a)
                 in[a] = static_cast<Lsb>(input(static_cast<std::int64_t>(k), a));
             shaper.shape(in, out);
+            const auto head = static_cast<std::uint32_t>(k % kHistory);
+            for (unsigned a = 0; a < kAxes; ++a) {
+                ring[a][head] = in[a];
+                const auto count = static_cast<std::uint32_t>(taps[a].size());
+                REQUIRE(shaped_sum_wide(taps[a].data(), count, ring[a], head, kHistory - 1) ==
+                        out[a]);
+                REQUIRE(shaped_sum_narrow(taps[a].data(), count, ring[a], head, kHistory - 1) ==
+                        out[a]);
+            }
             for (unsigned a = 0; a < kAxes; ++a) {
                 i128 sum = 0;
                 i128 lowest = input(static_cast<std::int64_t>(k), a), highest = lowest;
@@ -173,6 +187,30 @@ TEST_CASE("shaped setpoints are the exact weighted sums of the command rounded o
             CHECK(shaped[a].back() == command.back()[a]);
         }
         CHECK(shaper.settled());
+    }
+}
+
+TEST_CASE("the 64-bit and the 32-bit sums agree with the reference on any setpoints",
+          "[shaper][property]") {
+    std::mt19937_64 rng(test::property_seed() + 1);
+    std::uniform_int_distribution<std::int32_t> anywhere(INT32_MIN, INT32_MAX);
+    std::uniform_int_distribution<int> style(0, 2);
+    const std::uint64_t rounds = std::max<std::uint64_t>(test::g_spans_per_basis / 10, 1000);
+    Lsb ring[kHistory];
+    for (std::uint64_t round = 0; round < rounds; ++round) {
+        const std::vector<ShaperTap> taps = random_taps(rng);
+        // Anywhere in int32, or all at one extreme (the sums' worst cases), or mixed.
+        const int s = style(rng);
+        for (Lsb& r : ring)
+            r = s == 0 ? anywhere(rng) : s == 1 ? INT32_MIN : (anywhere(rng) < 0 ? INT32_MAX : -1);
+        const auto head = static_cast<std::uint32_t>(anywhere(rng)) % kHistory;
+        i128 sum = 0;
+        for (const ShaperTap& t : taps) sum += i128{t.weight} * ring[(head - t.delay) % kHistory];
+        const i128 reference =
+            test::floor_div(2 * sum + kShaperWeightOne, 2 * i128{kShaperWeightOne});
+        const auto count = static_cast<std::uint32_t>(taps.size());
+        REQUIRE(shaped_sum_wide(taps.data(), count, ring, head, kHistory - 1) == reference);
+        REQUIRE(shaped_sum_narrow(taps.data(), count, ring, head, kHistory - 1) == reference);
     }
 }
 

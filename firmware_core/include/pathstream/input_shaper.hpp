@@ -13,6 +13,44 @@
 
 namespace pathstream {
 
+/// round(sum of taps[i].weight * history[(head - taps[i].delay) & mask] / 2^16), halves up, in
+/// 64-bit arithmetic: |weight * setpoint| < 2^16 * 2^31, and the weights sum to 2^16. One
+/// signed multiply-accumulate per tap where the CPU has one (SMLAL on ARMv7-M). `count` >= 1.
+/// Any context.
+inline Lsb shaped_sum_wide(const ShaperTap* taps, std::uint32_t count, const Lsb* history,
+                           std::uint32_t head, std::uint32_t mask) {
+    std::int64_t sum = std::int64_t{1} << (kShaperWeightBits - 1);
+    for (std::uint32_t t = 0; t < count; ++t) {
+        // A weight is at most 2^16: signed, so that the product is one signed multiply-add.
+        sum += static_cast<std::int64_t>(static_cast<std::int32_t>(taps[t].weight)) *
+               history[(head - taps[t].delay) & mask];
+    }
+    // An arithmetic shift is floor division (C++20): the sum plus a half, floored.
+    return static_cast<Lsb>(sum >> kShaperWeightBits);
+}
+
+/// shaped_sum_wide's value in 32-bit arithmetic only, for CPUs without a 32x32->64 multiply
+/// (ARMv6-M calls a library routine for each). Each setpoint h splits into h = 2^16 hi + lo,
+/// hi = h >> 16 (signed) and lo = h & 0xFFFF, so sum w h = 2^16 A + B with A = sum w hi and
+/// B = sum w lo. B + 2^15 <= 2^16 (2^16 - 1) + 2^15 < 2^32 never overflows, and the result
+/// A + floor((B + 2^15) / 2^16) lies between the smallest and largest setpoint summed, so
+/// computing A modulo 2^32 gives it exactly for any int32 setpoints. `count` >= 1. Any
+/// context.
+inline Lsb shaped_sum_narrow(const ShaperTap* taps, std::uint32_t count, const Lsb* history,
+                             std::uint32_t head, std::uint32_t mask) {
+    std::uint32_t high = 0;  // two's complement of sum w hi: wraps only through the casts
+    std::uint32_t low = std::uint32_t{1} << (kShaperWeightBits - 1);
+    for (std::uint32_t t = 0; t < count; ++t) {
+        const auto h = static_cast<std::uint32_t>(history[(head - taps[t].delay) & mask]);
+        const std::uint32_t w = taps[t].weight;
+        // h >> 16 as a signed value, in unsigned arithmetic (sign bits replicated by hand).
+        const std::uint32_t hi = (h >> 16) | ((h & 0x80000000u) != 0 ? 0xFFFF0000u : 0u);
+        high += w * hi;
+        low += w * (h & 0xFFFFu);
+    }
+    return static_cast<Lsb>(high + (low >> kShaperWeightBits));
+}
+
 /// A shaper stage for `Axes` axes that remembers the last `HistoryTicks` setpoints of each
 /// (a power of two: the longest tap delay is HistoryTicks - 1). RAM: 4 * HistoryTicks bytes per
 /// axis plus 8 bytes per tap. Storage inline, no allocation. shape() runs in the tick
@@ -61,9 +99,9 @@ public:
 
     /// One tick: remembers `command` and writes each axis's shaped setpoint to `out`:
     /// round(sum of weight_i * command(now - delay_i) / kShaperWeightOne), halves rounded up,
-    /// computed exactly in 64 bits (|weight * setpoint| < 2^16 * 2^31). Cost per axis: one
-    /// store and, per tap, an index mask, a load and a 32x32->64 multiply-add. Tick interrupt
-    /// context.
+    /// exactly (shaped_sum_wide; on ARMv6-M shaped_sum_narrow, the same value). Cost per axis:
+    /// one store and per tap an index mask, two loads and a multiply-add (docs/cortex-m.md has
+    /// the counts). Tick interrupt context.
     void shape(const Lsb (&command)[Axes], Lsb (&out)[Axes]) {
         const std::uint32_t previous = head_;
         head_ = (head_ + 1) & kMask;
@@ -77,26 +115,34 @@ public:
                 out[a] = command[a];
                 continue;
             }
-            std::int64_t sum = std::int64_t{1} << (kShaperWeightBits - 1);
-            for (std::uint32_t t = 0; t < count; ++t) {
-                const ShaperTap& tap = taps_[a][t];
-                sum += static_cast<std::int64_t>(tap.weight) * history[(head_ - tap.delay) & kMask];
-            }
-            // An arithmetic shift is floor division (C++20): the sum plus a half, floored.
-            out[a] = static_cast<Lsb>(sum >> kShaperWeightBits);
+#if defined(__ARM_ARCH_6M__)
+            out[a] = shaped_sum_narrow(taps_[a], count, history, head_, kMask);
+#else
+            out[a] = shaped_sum_wide(taps_[a], count, history, head_, kMask);
+#endif
         }
         still_ticks_ = moved ? 0 : (still_ticks_ < HistoryTicks ? still_ticks_ + 1 : still_ticks_);
     }
 
     /// True when the output equals the command and stays so while the command rests: the
     /// command has not moved for the longest tap delay. Any context of the owner.
-    bool settled() const { return still_ticks_ >= longest_delay_; }
+    bool settled() const {
+        return still_ticks_ >= longest_delay_;
+    }
     /// Ticks the output lags its settled state after the command stops: the longest delay.
-    std::uint32_t longest_delay() const { return longest_delay_; }
+    std::uint32_t longest_delay() const {
+        return longest_delay_;
+    }
     /// The taps of `axis` (tap_count(axis) of them). Any context of the owner.
-    const ShaperTap* taps(unsigned axis) const { return taps_[axis]; }
-    std::uint32_t tap_count(unsigned axis) const { return tap_count_[axis]; }
-    static constexpr std::uint32_t history_ticks() { return HistoryTicks; }
+    const ShaperTap* taps(unsigned axis) const {
+        return taps_[axis];
+    }
+    std::uint32_t tap_count(unsigned axis) const {
+        return tap_count_[axis];
+    }
+    static constexpr std::uint32_t history_ticks() {
+        return HistoryTicks;
+    }
 
 private:
     static constexpr std::uint32_t kMask = HistoryTicks - 1;

@@ -7,6 +7,7 @@
 //                   --image budget.elf [--budget 20]
 //                   [--assert narrow:1=22,2=20,3=20,4=20,8=20] [--assert binary:...]
 //                   [--assert-marginal] [--assert-stop plain=4480,jerk=40355]
+//                   [--assert-shaper 3=MAX,5=MAX,9=MAX]
 //                   [--no-legend] [--timeout 60] [--keep DIR]
 //
 // --assert KIND:A=LIMIT,...: for spans of that kind (narrow, binary, wide) and each listed axis
@@ -16,6 +17,8 @@
 // plan_jerk_stop (jerk) may execute over the image's seeded states (the best figure reached,
 // like the tick limits: a regression fails).
 //
+// --assert-shaper TAPS=MAX,...: InputShaper::shape with that many taps on every axis may
+// execute at most MAX instructions per axis per tick, at every axis count measured.
 // Method (docs/cortex-m.md): the address ranges of budget_tick_<A> (SetpointStream::tick
 // inlined into an out-of-line function), SetpointStream<A,16>::tick_slow (span start, wide
 // spans and the empty queue, called from tick), start_span (called from tick_slow) and
@@ -55,7 +58,8 @@ struct Options {
     std::optional<double> budget;
     std::map<std::string, std::map<unsigned, double>> limits;  // kind -> axes -> max per axis
     bool assert_marginal = false;
-    std::map<std::string, double> stop_limits;  // plain_stop / jerk_stop -> max per call
+    std::map<std::string, double> stop_limits;      // plain_stop / jerk_stop -> max per call
+    std::map<std::uint64_t, double> shaper_limits;  // taps -> max per axis per tick
     bool legend = true;
     int timeout = 60;
 };
@@ -222,6 +226,14 @@ Options parse_options(int argc, char** argv) {
                 if (kind != "plain" && kind != "jerk")
                     die("--assert-stop wants plain=MAX,jerk=MAX: " + spec);
                 o.stop_limits[kind + "_stop"] = std::stod(item.substr(eq + 1));
+            }
+        } else if (arg == "--assert-shaper") {
+            const std::string spec = value();
+            std::istringstream in(spec);
+            for (std::string item; std::getline(in, item, ',');) {
+                const auto eq = item.find('=');
+                if (eq == std::string::npos) die("--assert-shaper wants TAPS=MAX,...: " + spec);
+                o.shaper_limits[std::stoull(item.substr(0, eq))] = std::stod(item.substr(eq + 1));
             }
         } else
             die("unknown argument " + arg);
@@ -535,6 +547,44 @@ int main(int argc, char** argv) {
                      " reads and SetpointStream::tick included); whole run with batches decoded"
                      " and checked: "
                   << fmt(whole) << " per tick\n";
+    }
+    // The input shaper: phases (taps, T ticks) and (taps, 2T ticks) per axis count; their
+    // difference is T steady calls of shape() plus the driver loop's ramp.
+    std::map<std::pair<std::uint64_t, unsigned>, std::vector<Phase>> shaper_phases;
+    for (const Phase& p : phases) {
+        if (p.kind != "shaper") continue;
+        if (!p.ok) fail("phase " + std::to_string(p.id) + " (shaper) not ok");
+        shaper_phases[{p.n, p.axes}].push_back(p);
+    }
+    if (!shaper_phases.empty()) {
+        std::cout << "\nInputShaper<A, 256>::shape, steady state (instructions):\n\n"
+                     "| taps | A | per tick | per axis per tick |\n|---|---|---|---|\n";
+    }
+    for (const auto& [key, list] : shaper_phases) {
+        const auto [taps, axes] = key;
+        if (list.size() != 2 || list[1].ticks != 2 * list[0].ticks) {
+            fail("shaper phases are not (taps, T) and (taps, 2T)");
+            continue;
+        }
+        const double per_tick =
+            (delta(list[1], 0) - delta(list[0], 0)) / static_cast<double>(list[0].ticks);
+        const double per_axis = per_tick / axes;
+        std::cout << "| " << taps << " | " << axes << " | " << fmt(per_tick) << " | "
+                  << fmt(per_axis) << " |\n";
+        if (const auto limit = o.shaper_limits.find(taps);
+            limit != o.shaper_limits.end() && per_axis > limit->second) {
+            fail("shaper, " + std::to_string(taps) + " taps, A = " + std::to_string(axes) + ": " +
+                 fmt(per_axis) + " per axis per tick, over " + fmt(limit->second));
+        }
+    }
+    if (!o.shaper_limits.empty()) {
+        std::cout << "Asserted: shaper per axis per tick <=";
+        bool first = true;
+        for (const auto& [taps, limit] : o.shaper_limits) {
+            std::cout << (first ? " " : ", ") << fmt(limit) << " with " << taps << " taps";
+            first = false;
+        }
+        std::cout << "\n";
     }
     if (o.legend)
         std::cout

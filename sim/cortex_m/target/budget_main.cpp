@@ -24,6 +24,7 @@
 #include "pathstream/device/jerk_moves.hpp"
 #include "pathstream/device/motion_device.hpp"
 #include "pathstream/device/wire_span.hpp"
+#include "pathstream/input_shaper.hpp"
 #include "pathstream/setpoint_stream.hpp"
 #include "pathstream/tick_cubic.hpp"
 #include "semihosting.hpp"
@@ -42,9 +43,18 @@ using Stream = pathstream::SetpointStream<A, kCapacity>;
 template <unsigned A>
 using Device = pathstream::device::MotionDevice<A, kCapacity>;
 
+// The input shaper's history in the budget image: 256 ticks (a 40 Hz 3-hump EI at 1 kHz needs
+// 51), so that four axes fit the micro:bit's RAM beside the stack.
+constexpr std::uint32_t kShaperHistory = 256;
+template <unsigned A>
+using Shaper = pathstream::InputShaper<A, kShaperHistory>;
+
 // One stream or device at a time lives here (the micro:bit has 16 KiB of RAM).
-constexpr std::size_t kArenaBytes = sizeof(Stream<8>) > sizeof(Device<2>) ? sizeof(Stream<8>)
-                                                                          : sizeof(Device<2>);
+constexpr std::size_t kLargest(std::size_t a, std::size_t b) {
+    return a > b ? a : b;
+}
+constexpr std::size_t kArenaBytes =
+    kLargest(kLargest(sizeof(Stream<8>), sizeof(Device<2>)), sizeof(Shaper<4>));
 alignas(8) unsigned char g_arena[kArenaBytes];
 Lsb g_out[8];
 bool g_failed = false;
@@ -78,6 +88,16 @@ PATHSTREAM_BUDGET_TICK(2)
 PATHSTREAM_BUDGET_TICK(3)
 PATHSTREAM_BUDGET_TICK(4)
 PATHSTREAM_BUDGET_TICK(8)
+
+// InputShaper::shape as an out-of-line function per axis count: budget_shape_<A>.
+#define PATHSTREAM_BUDGET_SHAPE(A)                                 \
+    extern "C" [[gnu::noinline, gnu::used]] void budget_shape_##A( \
+        Shaper<A>& s, const Lsb(&command)[A], Lsb(&out)[A]) {      \
+        s.shape(command, out);                                     \
+    }
+PATHSTREAM_BUDGET_SHAPE(1)
+PATHSTREAM_BUDGET_SHAPE(2)
+PATHSTREAM_BUDGET_SHAPE(4)
 
 namespace {
 
@@ -367,6 +387,60 @@ template <unsigned A>
                  s == Status::kOk);
 }
 
+template <unsigned A>
+void shape_of(Shaper<A>& s, const Lsb (&command)[A], Lsb (&out)[A]);
+template <>
+void shape_of<1>(Shaper<1>& s, const Lsb (&command)[1], Lsb (&out)[1]) {
+    budget_shape_1(s, command, out);
+}
+template <>
+void shape_of<2>(Shaper<2>& s, const Lsb (&command)[2], Lsb (&out)[2]) {
+    budget_shape_2(s, command, out);
+}
+template <>
+void shape_of<4>(Shaper<4>& s, const Lsb (&command)[4], Lsb (&out)[4]) {
+    budget_shape_4(s, command, out);
+}
+
+/// The input shaper in the tick: `ticks` calls of shape() with `taps` taps on every axis
+/// (delays spread over 0..50, weights summing to 2^16), the command a ramp that moves every
+/// tick. The report takes the difference of runs of `ticks` and 2 * `ticks`: the steady cost
+/// per tick with the driver loop's few instructions.
+template <unsigned A>
+[[gnu::noinline]] void shaper_phase(std::uint32_t taps, std::uint32_t ticks) {
+    const Lsb start[A] = {};
+    Shaper<A>& s = *new (g_arena) Shaper<A>(start);
+    pathstream::ShaperTap tap[pathstream::kMaxShaperTaps];
+    std::uint32_t left = pathstream::kShaperWeightOne;
+    for (std::uint32_t i = 0; i < taps; ++i) {
+        tap[i].delay = i * 50 / (taps - 1);
+        tap[i].weight = i + 1 == taps ? left : pathstream::kShaperWeightOne / taps;
+        left -= tap[i].weight;
+    }
+    bool ok = true;
+    for (unsigned a = 0; a < A; ++a) ok &= s.configure(a, tap, taps) == Status::kOk;
+    Lsb command[A] = {};
+    budget_mark(2 * g_phase);
+    for (std::uint32_t t = 0; t < ticks; ++t) {
+        for (unsigned a = 0; a < A; ++a) command[a] += static_cast<Lsb>(a + 1);
+        shape_of<A>(s, command, reinterpret_cast<Lsb(&)[A]>(g_out));
+    }
+    budget_mark(2 * g_phase + 1);
+    // After `ticks` ramp ticks past the longest delay the output lags the command by the
+    // taps' mean delay times the ramp's slope; it must have moved and stayed below it.
+    ok &= g_out[0] > 0 && g_out[0] <= command[0];
+    report_phase("shaper", A, taps, 1, ticks, 0, ok);
+}
+
+template <unsigned A>
+void shaper_phases() {
+    constexpr std::uint32_t kTapCounts[] = {3, 5, 9};
+    for (std::uint32_t taps : kTapCounts) {
+        shaper_phase<A>(taps, 200);
+        shaper_phase<A>(taps, 400);
+    }
+}
+
 [[gnu::noinline]] void calibration_phase(std::uint32_t iterations) {
     budget_mark(2 * g_phase);
     budget_calibrate(iterations);
@@ -391,6 +465,9 @@ int main() {
     device_phase<2>(120, 32);
     for (int i = 0; i < 8; ++i) stop_phase<2>(rng, true);
     for (int i = 0; i < 4; ++i) stop_phase<2>(rng, false);
+    shaper_phases<1>();
+    shaper_phases<2>();
+    shaper_phases<4>();
     cortex_m::Line line;
     line.text("budget done phases=").dec(g_phase).text(g_failed ? " FAILED" : " ok").end();
     return g_failed ? 1 : 0;
