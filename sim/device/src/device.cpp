@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <deque>
 #include <memory>
+#include <numbers>
 #include <optional>
 #include <sstream>
 #include <stdexcept>
@@ -71,6 +72,36 @@ std::size_t plan_axes(const CoreSpan& first, const host::MachineProfile& profile
     return axes;
 }
 
+/// The lowest natural frequency of the plant (Hz; 0: the ideal plant) and its lag behind a
+/// ramp (s): the servo's 2 zeta / omega (a mode, excited through spring and damper, adds none).
+struct PlantScales {
+    double lowest_hz = 0;
+    double lag_seconds = 0;
+};
+
+PlantScales plant_scales(const SimOptions& o) {
+    PlantScales s;
+    if (o.plant != PlantModel::kServo) return s;
+    const auto lag = [](double hz, double zeta) { return 2 * zeta / (2 * std::numbers::pi * hz); };
+    s.lowest_hz = o.servo.bandwidth_hz;
+    s.lag_seconds = lag(o.servo.bandwidth_hz, o.servo.damping);
+    for (const auto& axis : o.modes)
+        for (const ResonantMode& m : axis) s.lowest_hz = std::min(s.lowest_hz, m.frequency_hz);
+    return s;
+}
+
+/// Checks the modes against the axes and the plant.
+void check_modes(const SimOptions& o, std::size_t axes) {
+    if (o.modes.size() > axes) {
+        throw std::invalid_argument("resonant modes given for " + std::to_string(o.modes.size()) +
+                                    " axes; the plan has " + std::to_string(axes));
+    }
+    for (const auto& axis : o.modes) {
+        if (!axis.empty() && o.plant != PlantModel::kServo)
+            throw std::invalid_argument("resonant modes need the servo plant");
+    }
+}
+
 void check_span_axes(const CoreSpan& span, std::size_t index, std::size_t axes) {
     if (span.control.size() != axes) {
         throw std::invalid_argument("span " + std::to_string(index) + " has " +
@@ -106,13 +137,18 @@ public:
           progress_(progress),
           wall_start_(std::chrono::steady_clock::now()),
           pen_(device_time_),
+          residual_(Axes, residual_window_ticks(profile.tick_hz, plant_scales(options).lowest_hz),
+                    static_cast<std::uint64_t>(std::ceil(kMinStopSeconds * profile.tick_hz))),
+          contour_(Axes, contour_back_ticks(profile.tick_hz, plant_scales(options).lag_seconds)),
           interval_(std::max<std::uint32_t>(1, options.producer_interval_ticks)),
           rows_after_end_(1 + options.settle_ticks) {
+        check_modes(options, Axes);
         r_.axes = Axes;
         r_.tick_hz = profile.tick_hz;
         r_.mm_per_lsb = profile.mm_per_lsb;
         r_.plant = options.plant;
         r_.servo = options.servo;
+        r_.modes = options.modes;
         r_.paced = pacing != nullptr || options.realtime;
         Lsb start[Axes];
         start_point<Axes>(first, start);
@@ -121,6 +157,12 @@ public:
             for (unsigned a = 0; a < Axes; ++a) {
                 servo_.emplace_back(options.servo, profile.tick_seconds(),
                                     start[a] * profile.mm_per_lsb);
+                const bool rings = a < options.modes.size() && !options.modes[a].empty();
+                resonant_.push_back(rings
+                                        ? std::make_unique<ResonantAxis>(
+                                              options.servo, options.modes[a],
+                                              profile.tick_seconds(), start[a] * profile.mm_per_lsb)
+                                        : nullptr);
             }
         }
         expected_rows_ = expected_ticks + 1 + options.settle_ticks;
@@ -145,6 +187,8 @@ public:
         for (unsigned a = 0; a < Axes; ++a) {
             r_.following[a].rms_mm = std::sqrt(sum_sq_[a] / static_cast<double>(r_.ticks));
         }
+        r_.residual = residual_.finish();
+        r_.contour = contour_.finish();
         r_.stream.ticks_executed = stream_->ticks_executed();
         r_.stream.spans_completed = stream_->spans_completed();
         r_.stream.last_completed_tag = stream_->last_completed_tag();
@@ -230,10 +274,17 @@ private:
             const bool pen_down = pen_.state();
             if (options_.record_ticks) r_.pen.push_back(pen_down ? 1 : 0);
             double positions[Axes];
+            // The planned setpoints (the reference) and the command into the plant: the same
+            // today; a stage between the stream and the plant would make them differ.
+            double reference[Axes];
             for (unsigned a = 0; a < Axes; ++a) {
                 const double setpoint_mm = out_[a] * profile_.mm_per_lsb;
+                reference[a] = setpoint_mm;
                 double position = setpoint_mm;
-                if (!servo_.empty()) {
+                if (!servo_.empty() && resonant_[a]) {
+                    position = resonant_[a]->tool_position();  // at the tick's instant
+                    resonant_[a]->step(setpoint_mm);
+                } else if (!servo_.empty()) {
                     position = servo_[a].position();  // at this tick's instant, before its hold
                     servo_[a].step(setpoint_mm);
                 }
@@ -249,6 +300,8 @@ private:
                     r_.following[a].max_tick = k;
                 }
             }
+            residual_.add(reference, positions);
+            contour_.add(reference, positions);
             r_.ticks = k + 1;
             if (options_.tick_observer) {
                 options_.tick_observer({k, stream_->ticks_executed(), stream_->last_completed_tag(),
@@ -276,6 +329,9 @@ private:
     VirtualClock device_time_;  // the device's tick counter
     SimulatedOutput pen_;       // the pen lift, stamped in device ticks
     std::vector<ServoAxis> servo_;
+    std::vector<std::unique_ptr<ResonantAxis>> resonant_;  // per axis with servo_; null: none
+    ResidualVibrationMeter residual_;
+    ContourErrorMeter contour_;
     std::deque<CoreSpan> pending_;  // spans given, not yet taken by the device
     std::size_t next_ = 0;          // spans the device took
     std::uint64_t ticks_pushed_ = 0;

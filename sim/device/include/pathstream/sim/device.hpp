@@ -13,7 +13,10 @@
 #include "pathstream/hal/clock.hpp"
 #include "pathstream/machine/core_span.hpp"
 #include "pathstream/machine/machine.hpp"
+#include "pathstream/sim/contour_error.hpp"
 #include "pathstream/sim/plant.hpp"
+#include "pathstream/sim/residual_vibration.hpp"
+#include "pathstream/sim/resonant_axis.hpp"
 #include "pathstream/units.hpp"
 
 namespace pathstream::sim {
@@ -29,14 +32,18 @@ struct TickProbe {
     std::uint32_t queued_spans = 0;        ///< spans queued, the one in progress included
     std::uint64_t ticks_pushed = 0;        ///< ticks of every span the device accepted so far
     const Lsb* setpoints = nullptr;        ///< the tick's setpoints, one per axis
-    const double* positions = nullptr;     ///< mm per axis: the plant's position at the tick
+    const double* positions = nullptr;     ///< mm per axis: the plant's (tool's) position
     bool pen_down = false;                 ///< the pen output after the tick
 };
 
 /// How to run.
 struct SimOptions {
     PlantModel plant = PlantModel::kIdeal;
-    ServoParameters servo;           ///< used when plant == kServo
+    ServoParameters servo;  ///< used when plant == kServo
+    /// Resonant modes per axis, in axis order (docs/simulator.md): an axis with modes is a
+    /// ResonantAxis (the servo driving them; its position is the tool's). Shorter than the
+    /// axes: the rest have none. Only with kServo (std::invalid_argument with kIdeal).
+    std::vector<std::vector<ResonantMode>> modes;
     bool realtime = false;           ///< pace ticks with the Linux monotonic clock
     std::uint64_t settle_ticks = 0;  ///< idle ticks run after the end point (plant settling)
     /// The producer task runs before every `producer_interval_ticks`-th tick and pushes up to
@@ -51,7 +58,8 @@ struct SimOptions {
     bool record_ticks = true;
 };
 
-/// Following error of one axis, |setpoint - plant position| over every recorded tick.
+/// Following error of one axis, |setpoint - plant position| over every tick (the tool's
+/// position on an axis with resonant modes).
 struct FollowingError {
     double max_mm = 0;
     double rms_mm = 0;
@@ -77,6 +85,7 @@ struct SimulationResult {
     double mm_per_lsb = 0;
     PlantModel plant = PlantModel::kIdeal;
     ServoParameters servo;
+    std::vector<std::vector<ResonantMode>> modes;  ///< SimOptions::modes
 
     std::uint64_t ticks = 0;         ///< ticks run = rows recorded
     std::uint64_t plan_ticks = 0;    ///< sum of the plan's span ticks
@@ -93,6 +102,10 @@ struct SimulationResult {
     std::vector<double> positions;          ///< mm, the plant's position at the tick's instant
     std::vector<std::uint8_t> pen;          ///< pen output after the tick (1: down)
     std::vector<FollowingError> following;  ///< per axis
+    /// After the command into the plant came to rest, over every tick (docs/simulator.md).
+    ResidualVibration residual;
+    /// The tool's distance from the planned setpoints' polyline, over every tick.
+    ContourError contour;
 
     Lsb setpoint(std::uint64_t tick, std::size_t axis) const {
         return setpoints[tick * axes + axis];
@@ -157,8 +170,9 @@ private:
 /// tick, and the plant stepped with the tick's setpoint. Virtual time (as fast as possible)
 /// unless options.realtime (hal::LinuxClock at profile.tick_hz).
 /// Throws std::invalid_argument for an empty plan, spans whose axis count differs from the
-/// profile's, or bad servo parameters; std::runtime_error ("span I (tag T): the device
-/// refused it: <status name>") when push() answers anything but kOk or kQueueFull.
+/// profile's, bad servo parameters or resonant modes (more mode lists than axes, modes
+/// without the servo plant, a mode check_resonant_mode refuses); std::runtime_error ("span I (tag
+/// T): the device refused it: <status name>") when push() answers anything but kOk or kQueueFull.
 SimulationResult simulate(const std::vector<host::CoreSpan>& spans,
                           const host::MachineProfile& profile, const SimOptions& options,
                           const Progress& progress = {});
