@@ -1,5 +1,7 @@
 // Residual vibration and contour error: the meters on made-up ticks, then on the simulated
 // device with and without a ringing mode.
+#include <algorithm>
+#include <array>
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <cstdint>
@@ -166,4 +168,57 @@ TEST_CASE("resonant modes need the servo plant and one list per axis at most", "
                       "resonant modes given for 3 axes; the plan has 2");
     CHECK_THROWS_WITH(run(sim::PlantModel::kServo, {{{600, 0.05}}}),
                       Catch::Contains("mode frequency 600 Hz is impossible"));
+}
+
+TEST_CASE("contour error equals a brute-force search of the same window", "[sim][contour]") {
+    const std::uint64_t back = 20, ahead = 7;
+    ContourErrorMeter meter(3, back, ahead);
+    std::vector<std::array<double, 3>> reference, tool;
+    std::uint32_t seed = 12345;
+    const auto random = [&] {
+        seed = seed * 1664525u + 1013904223u;
+        return static_cast<double>(seed >> 8) / 16777216.0 - 0.5;
+    };
+    std::array<double, 3> r{0, 0, 0};
+    for (int k = 0; k < 3000; ++k) {
+        if (k % 50 >= 10) {  // moves with rests between them
+            for (double& v : r) v = std::round((v + random()) * 100) / 100;
+        }
+        reference.push_back(r);
+        std::array<double, 3> t = reference[k >= 5 ? k - 5 : 0];
+        for (double& v : t) v += 0.3 * random();
+        tool.push_back(t);
+        meter.add(reference.back().data(), tool.back().data());
+    }
+    const sim::ContourError c = meter.finish();
+    // Brute force: each tool tick against every vertex and segment of the setpoints in effect
+    // from tick j - back to tick j + ahead.
+    const auto distance = [](const std::array<double, 3>& p, const std::array<double, 3>& a,
+                             const std::array<double, 3>& b) {
+        double ab_ab = 0, ap_ab = 0;
+        for (int x = 0; x < 3; ++x) {
+            ab_ab += (b[x] - a[x]) * (b[x] - a[x]);
+            ap_ab += (p[x] - a[x]) * (b[x] - a[x]);
+        }
+        const double t = ab_ab > 0 ? std::clamp(ap_ab / ab_ab, 0.0, 1.0) : 0.0;
+        double s = 0;
+        for (int x = 0; x < 3; ++x) s += std::pow(p[x] - (a[x] + t * (b[x] - a[x])), 2);
+        return std::sqrt(s);
+    };
+    double max = 0, squares = 0;
+    std::size_t max_tick = 0;
+    const std::size_t n = reference.size();
+    for (std::size_t j = 0; j < n; ++j) {
+        const std::size_t from = j > back ? j - back : 0, to = std::min(n - 1, j + ahead);
+        double best = 1e300;
+        for (std::size_t k = from; k <= to; ++k) {
+            best = std::min(best, distance(tool[j], reference[k], reference[k]));
+            if (k < to) best = std::min(best, distance(tool[j], reference[k], reference[k + 1]));
+        }
+        squares += best * best;
+        if (best > max) max = best, max_tick = j;
+    }
+    CHECK(c.max_mm == Approx(max).epsilon(1e-12));
+    CHECK(c.max_tick == max_tick);
+    CHECK(c.rms_mm == Approx(std::sqrt(squares / static_cast<double>(n))).epsilon(1e-12));
 }

@@ -6,6 +6,11 @@
 #include <stdexcept>
 
 namespace pathstream::sim {
+namespace {
+
+constexpr std::uint64_t kBlock = 16;  // vertices per bounding box
+
+}  // namespace
 
 std::uint64_t contour_back_ticks(double tick_hz, double lag_seconds) {
     const double lag_ticks = std::ceil(4 * std::max(0.0, lag_seconds) * tick_hz);
@@ -24,7 +29,9 @@ ContourErrorMeter::ContourErrorMeter(std::size_t axes, std::uint64_t back_ticks,
     vertex_mm_.assign(vertex_capacity_ * axes, 0.0);
     vertex_ticks_.assign(vertex_capacity_, 0);
     tool_mm_.assign(tool_capacity_ * axes, 0.0);
-    nearest_.assign(axes, 0.0);
+    block_capacity_ = vertex_capacity_ / kBlock + 3;
+    block_lo_.assign(block_capacity_ * axes, 0.0);
+    block_hi_.assign(block_capacity_ * axes, 0.0);
     r_.back_ticks = back_;
     r_.ahead_ticks = ahead_;
     r_.window.axes = axes;
@@ -54,6 +61,18 @@ void ContourErrorMeter::add(const double* reference_mm, const double* tool_mm) {
                   vertex_mm_.begin() +
                       static_cast<std::ptrdiff_t>((vertices_ % vertex_capacity_) * axes_));
         vertex_ticks_[vertices_ % vertex_capacity_] = k;
+        // The vertex's block, and the block before when it is that one's closing vertex.
+        const std::uint64_t b = vertices_ / kBlock;
+        for (std::uint64_t block = b > 0 && vertices_ % kBlock == 0 ? b - 1 : b; block <= b;
+             ++block) {
+            double* lo = &block_lo_[(block % block_capacity_) * axes_];
+            double* hi = &block_hi_[(block % block_capacity_) * axes_];
+            const bool first = block == b && vertices_ % kBlock == 0;
+            for (std::size_t a = 0; a < axes_; ++a) {
+                lo[a] = first ? reference_mm[a] : std::min(lo[a], reference_mm[a]);
+                hi[a] = first ? reference_mm[a] : std::max(hi[a], reference_mm[a]);
+            }
+        }
         ++vertices_;
     }
     std::copy(tool_mm, tool_mm + axes_,
@@ -61,47 +80,70 @@ void ContourErrorMeter::add(const double* reference_mm, const double* tool_mm) {
     if (k >= ahead_) evaluate(k - ahead_);
 }
 
-void ContourErrorMeter::evaluate(std::uint64_t j) {
-    const double* p = tool(j);
-    double best = std::numeric_limits<double>::infinity();
-    const auto consider = [&](const double* a, const double* b) {
-        // The nearest point of segment a-b (b null: the point a).
-        double ab_ab = 0, ap_ab = 0;
-        if (b != nullptr) {
-            for (std::size_t x = 0; x < axes_; ++x) {
-                const double ab = b[x] - a[x];
-                ab_ab += ab * ab;
-                ap_ab += (p[x] - a[x]) * ab;
-            }
-        }
-        const double t = ab_ab > 0 ? std::clamp(ap_ab / ab_ab, 0.0, 1.0) : 0.0;
+void ContourErrorMeter::scan(std::uint64_t first, std::uint64_t last) {
+    const double* p = point_;
+    for (std::uint64_t i = first; i <= last; ++i) {
+        const double* a = vertex(i);
         double squares = 0;
-        double q[8];
+        for (std::size_t x = 0; x < axes_; ++x) squares += (p[x] - a[x]) * (p[x] - a[x]);
+        if (squares < best_) best_ = squares, best_vertex_ = i, best_t_ = 0;
+        if (i + 1 >= vertices_) continue;
+        const double* b = vertex(i + 1);
+        double ab_ab = 0, ap_ab = 0;
         for (std::size_t x = 0; x < axes_; ++x) {
-            q[x] = b != nullptr ? a[x] + t * (b[x] - a[x]) : a[x];
-            const double d = p[x] - q[x];
+            const double ab = b[x] - a[x];
+            ab_ab += ab * ab;
+            ap_ab += (p[x] - a[x]) * ab;
+        }
+        if (!(ap_ab > 0) || !(ab_ab > 0)) continue;  // the vertex is nearest: done above
+        const double t = std::min(1.0, ap_ab / ab_ab);
+        squares = 0;
+        for (std::size_t x = 0; x < axes_; ++x) {
+            const double d = p[x] - (a[x] + t * (b[x] - a[x]));
             squares += d * d;
         }
-        if (squares < best) {
-            best = squares;
-            std::copy(q, q + axes_, nearest_.begin());
-        }
-    };
-    const std::uint64_t from = j > back_ ? j - back_ : 0;
-    // From the newest vertex back to the one in effect at tick `from`: each vertex, and the
-    // segment to the next one.
-    for (std::uint64_t i = vertices_; i-- > 0;) {
-        consider(vertex(i), nullptr);
-        if (i + 1 < vertices_) consider(vertex(i), vertex(i + 1));
-        if (vertex_tick(i) <= from) break;
+        if (squares < best_) best_ = squares, best_vertex_ = i, best_t_ = t;
     }
-    const double distance = std::sqrt(best);
-    sum_squares_ += best;
+}
+
+void ContourErrorMeter::evaluate(std::uint64_t j) {
+    point_ = tool(j);
+    const std::uint64_t from = j > back_ ? j - back_ : 0;
+    const std::uint64_t newest = vertices_ - 1;
+    while (start_ < newest && vertex_tick(start_ + 1) <= from) ++start_;
+    while (own_ < newest && vertex_tick(own_ + 1) <= j) ++own_;
+    // The vertices from the one in effect at tick `from` to the newest: the block of the
+    // tool's own tick first (the nearest point is about there), then every block whose box is
+    // nearer than the best point yet.
+    best_ = std::numeric_limits<double>::infinity();
+    const auto scan_block = [&](std::uint64_t block) {
+        scan(std::max(start_, block * kBlock), std::min(newest, block * kBlock + kBlock - 1));
+    };
+    const std::uint64_t own_block = own_ / kBlock;
+    scan_block(own_block);
+    for (std::uint64_t block = start_ / kBlock; block <= newest / kBlock; ++block) {
+        if (block == own_block) continue;
+        const double* lo = &block_lo_[(block % block_capacity_) * axes_];
+        const double* hi = &block_hi_[(block % block_capacity_) * axes_];
+        double squares = 0;
+        for (std::size_t x = 0; x < axes_; ++x) {
+            const double d = std::max({lo[x] - point_[x], 0.0, point_[x] - hi[x]});
+            squares += d * d;
+        }
+        if (squares < best_) scan_block(block);
+    }
+    const double distance = std::sqrt(best_);
+    sum_squares_ += best_;
     if (r_.max_tool_mm.empty() || distance > r_.max_mm) {
         r_.max_mm = distance;
         r_.max_tick = j;
-        r_.max_tool_mm.assign(p, p + axes_);
-        r_.max_path_mm = nearest_;
+        r_.max_tool_mm.assign(point_, point_ + axes_);
+        const double* a = vertex(best_vertex_);
+        r_.max_path_mm.assign(a, a + axes_);
+        if (best_t_ > 0) {
+            const double* b = vertex(best_vertex_ + 1);
+            for (std::size_t x = 0; x < axes_; ++x) r_.max_path_mm[x] += best_t_ * (b[x] - a[x]);
+        }
         pending_ = true;
     }
     if (pending_ && j == r_.max_tick + back_) snapshot(j);

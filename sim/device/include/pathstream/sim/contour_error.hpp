@@ -54,6 +54,7 @@ public:
 
 private:
     void evaluate(std::uint64_t tick);
+    void scan(std::uint64_t first, std::uint64_t last);  // vertices first..last and segments
     void snapshot(std::uint64_t tick);
     const double* vertex(std::uint64_t index) const;  // by vertex number, must be kept
     std::uint64_t vertex_tick(std::uint64_t index) const;
@@ -67,7 +68,17 @@ private:
     std::vector<double> vertex_mm_;  // ring of vertices
     std::vector<std::uint64_t> vertex_ticks_;
     std::vector<double> tool_mm_;  // ring of tool points by tick
-    std::vector<double> nearest_;  // scratch: the nearest point found
+    // Blocks of 16 vertices (and the first of the next: their segments): bounding boxes, so
+    // that a block farther than the nearest point found so far is skipped whole.
+    std::uint64_t block_capacity_;
+    std::vector<double> block_lo_, block_hi_;
+    std::uint64_t start_ = 0;  // the vertex in effect at the window's first tick
+    std::uint64_t own_ = 0;    // the vertex in effect at the tool's tick
+    // The evaluation under way: its tool point, the best squared distance, where.
+    const double* point_ = nullptr;
+    double best_ = 0;
+    std::uint64_t best_vertex_ = 0;
+    double best_t_ = 0;  // along the segment from best_vertex_ (0: the vertex)
     double sum_squares_ = 0;
     bool pending_ = false;  // the window around max_tick is still to be taken
     ContourError r_;
