@@ -1,6 +1,7 @@
 // The machine profile: what the axes can do and how the device ticks (docs/formats.md).
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -94,6 +95,16 @@ struct OutputCoilsConfig {
     std::int32_t coil[kMachineFunctionCount] = {-1, -1, -1, -1};
 };
 
+/// One resonant mode of an axis's mechanics, from the profile's "resonance" object: what the
+/// simulator's servo plant rings with (docs/simulator.md, "Resonant modes").
+struct ResonanceMode {
+    double frequency_hz = 0;  ///< natural frequency, > 0 and below tick_hz / 2
+    double damping = 0;       ///< damping ratio, in (0, 1]
+};
+
+/// Most resonant modes one axis may have (profile or command line).
+inline constexpr std::size_t kMaxResonanceModes = 4;
+
 /// Everything the planner and the simulated device need to know about the machine.
 struct MachineProfile {
     std::vector<AxisLimits> axes;      ///< one per path axis, in path order
@@ -117,6 +128,9 @@ struct MachineProfile {
     /// Optional "layer_feeds": pen-down speed (mm/s) per layer name (an Inkscape layer's label,
     /// a stroke colour such as "#ff0000"), for subpaths that set no feed of their own.
     std::vector<std::pair<std::string, double>> layer_feeds;
+    /// Optional "resonance": resonant modes per axis, in axis order, for the simulator. Empty
+    /// without the key, else one list per axis (empty for an axis it does not name).
+    std::vector<std::vector<ResonanceMode>> resonance;
     std::string source;  ///< file it came from, for messages
 
     double tick_seconds() const { return 1.0 / tick_hz; }
