@@ -84,6 +84,35 @@ AxisFigures axis_figures(const PlanCheck* check, const MachineProfile& profile,
     return f;
 }
 
+/// "(20.012, 0.003)": a position in mm, three decimals.
+std::string position_text(const std::vector<double>& mm) {
+    std::string out = "(";
+    for (std::size_t a = 0; a < mm.size(); ++a) out += (a ? ", " : "") + fmt("%.3f", mm[a]);
+    return out + ")";
+}
+
+/// The residual vibration and contour error lines.
+void motion_lines(std::ostream& o, const RunSummary& run, double tick_hz) {
+    const ResidualFigures& v = run.residual;
+    const auto seconds = [&](std::uint64_t tick) {
+        return fmt("%.3f", static_cast<double>(tick) / tick_hz);
+    };
+    if (v.stops == 0) {
+        o << "  vibration  no stop after a motion: no residual vibration measured\n";
+    } else {
+        o << "  vibration  residual after " << v.stops << (v.stops == 1 ? " stop" : " stops")
+          << ": max " << fmt("%.1f", v.max_mm * 1000) << " um, rms " << fmt("%.1f", v.rms_mm * 1000)
+          << " um\n"
+          << "             worst " << seconds(v.max_tick) << " s, tool " << position_text(v.tool_mm)
+          << " mm, window " << v.window_ticks << " ticks\n";
+    }
+    const ContourFigures& c = run.contour;
+    o << "  contour    error max " << fmt("%.1f", c.max_mm * 1000) << " um, rms "
+      << fmt("%.1f", c.rms_mm * 1000) << " um\n"
+      << "             worst " << seconds(c.max_tick) << " s, tool " << position_text(c.tool_mm)
+      << " mm, window -" << c.back_ticks << "..+" << c.ahead_ticks << " ticks\n";
+}
+
 }  // namespace
 
 void pen_figures(const TickSeries& executed, ExecutedFigures& f) {
@@ -182,6 +211,7 @@ std::string text_report(const PlanFigures& plan, const PlanCheck* check,
     o << "  machine    " << axes << " axes (" << names << "), " << fmt("%.6g", profile.tick_hz)
       << " Hz tick, " << fmt("%.6g", profile.mm_per_lsb) << " mm/LSB\n";
     o << "  plant      " << run.plant << "\n";
+    if (!run.modes.empty()) o << "  modes      " << run.modes << "\n";
     o << "  duration   " << fmt("%.3f", f.duration) << " s planned; "
       << fmt("%.3f", run.simulated_seconds) << " s simulated in " << fmt("%.3f", run.wall_seconds)
       << " s wall";
@@ -273,6 +303,7 @@ std::string text_report(const PlanFigures& plan, const PlanCheck* check,
     } else {
         o << "  following error: 0 (ideal plant: position = setpoint)\n";
     }
+    if (run.motion_measured) motion_lines(o, run, profile.tick_hz);
     if (run.underruns > 0) {
         o << "  WARNING: the span queue ran dry " << run.underruns
           << " times before the end of the plan\n";

@@ -161,6 +161,10 @@ WrittenPlots write_plots(const std::string& directory, SegmentSource& path, cons
         names.push_back("z");
         svgs.push_back(z_svg(record, profile, options));
     }
+    if (record.corner) {
+        names.push_back("corner");
+        svgs.push_back(corner_svg(*record.corner, options));
+    }
     for (std::size_t i = 0; i < names.size(); ++i) {
         const std::string file = join(directory, names[i] + ".svg");
         write_text(file, svgs[i]);

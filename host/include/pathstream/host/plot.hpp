@@ -100,6 +100,18 @@ struct TracePoint {
     bool pen_down = false;
 };
 
+/// The path and the tool around a run's worst contour error, in the plane of two axes: what
+/// corner.svg zooms into (docs/simulator.md, "Contour error").
+struct CornerWindow {
+    std::string x_name, y_name;  ///< the axes plotted
+    std::vector<Point> path;     ///< the reference polyline (the planned setpoints), mm
+    std::vector<Point> tool;     ///< the tool's position, one point per tick, mm
+    Point worst_tool;            ///< the tool at the worst tick
+    Point worst_path;            ///< the path's point nearest to it (over all axes)
+    double error_mm = 0;         ///< the contour error there, over all axes
+    double time_s = 0;           ///< when
+};
+
 /// A run as the plots need it, of bounded size: its figures, each series' path thinned to
 /// at most 8 x `capacity` points at least a distance apart (that grows as needed; pen changes
 /// kept), the speed and the accelerations as the minimum and maximum of each of up to
@@ -132,6 +144,9 @@ struct RunRecord {
     /// Pen-up intervals in ticks, [first, end), in order.
     std::vector<std::pair<std::uint64_t, std::uint64_t>> pen_up;
     bool thinned = false;  ///< something was thinned or merged
+    /// Set by whoever knows the run's contour error (the simulator's caller): write_plots then
+    /// writes corner.svg too.
+    std::optional<CornerWindow> corner;
 };
 
 /// Builds a RunRecord from ticks seen once each, in order: memory O(capacity), whatever the
@@ -184,6 +199,13 @@ struct Options {
     std::vector<std::string> layers;
     std::vector<std::size_t> subpath_layers;
 };
+
+/// corner.svg as text: the window's path (group "path") and tool trace (group "tool") at equal
+/// scale, zoomed to a square around the worst point at least 10 times the error across
+/// (0.01 mm at least), the worst distance marked (group "worst"), a scale bar of one nice length
+/// (1, 2 or 5 x 10^n mm, at most a quarter of the view: group "scale"). +y down unless
+/// options.y_up.
+std::string corner_svg(const CornerWindow& corner, const Options& options);
 
 /// path.svg as text: the ideal path (Bezier segments sampled densely; pen-down solid, pen-up
 /// travel dashed, grey and wide underneath; with layers, each layer's pen-down path in its
@@ -241,7 +263,8 @@ struct WrittenPlots {
 };
 
 /// Writes DIRECTORY/path.svg, speed.svg, acceleration.svg (each atomically: whole or absent),
-/// with the machine's x, y and z axes (xyz_axes) path.svg in 3-D and a fourth, z.svg,
+/// with the machine's x, y and z axes (xyz_axes) path.svg in 3-D and a fourth, z.svg, with
+/// a record's corner window corner.svg last,
 /// and, when options.png and rsvg-convert is on PATH, a PNG of each. The directory must exist.
 /// Throws std::runtime_error naming the file when a file cannot be written or rsvg-convert
 /// fails; a missing rsvg-convert is not an error (see WrittenPlots::note).
@@ -262,6 +285,27 @@ std::optional<std::string> find_rsvg_convert();
 /// std::runtime_error with rsvg-convert's message on failure.
 void svg_to_png(const std::string& rsvg, const std::string& svg_file, const std::string& png_file);
 
+/// Residual vibration of a run: the tool's largest distance from its rest position after
+/// each stop of the command (docs/simulator.md, "Residual vibration").
+struct ResidualFigures {
+    std::uint64_t stops = 0;
+    std::uint64_t window_ticks = 0;  ///< ticks of a stop looked at, at most
+    double max_mm = 0;               ///< the largest stop's peak
+    double rms_mm = 0;               ///< RMS over the stops' peaks
+    std::uint64_t max_tick = 0;      ///< where: the tick, the tool and the rest position
+    std::vector<double> tool_mm, rest_mm;
+};
+
+/// Contour error of a run: the tool's distance from the planned setpoints' polyline
+/// (docs/simulator.md, "Contour error").
+struct ContourFigures {
+    double max_mm = 0;
+    double rms_mm = 0;                              ///< over every tick
+    std::uint64_t back_ticks = 0, ahead_ticks = 0;  ///< the window of setpoints compared with
+    std::uint64_t max_tick = 0;                     ///< where: the tick, the tool, the path's point
+    std::vector<double> tool_mm, path_mm;
+};
+
 /// What the executing target measured, for the report.
 struct RunSummary {
     std::string target = "simulated device";
@@ -276,6 +320,11 @@ struct RunSummary {
     double wall_seconds = 0;
     std::vector<double> max_following_error_mm;  ///< per axis; empty: not measured (ideal)
     std::vector<double> rms_following_error_mm;  ///< per axis
+    std::string modes;  ///< the report's modes line ("x: 40 Hz zeta 0.05 ..."); empty: none
+    /// Residual vibration and contour error (docs/simulator.md); not measured: not shown.
+    bool motion_measured = false;
+    ResidualFigures residual;
+    ContourFigures contour;
 };
 
 /// One axis of the report's table: peaks against the limits three ways, following error.
