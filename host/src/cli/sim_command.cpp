@@ -10,6 +10,7 @@
 #include <optional>
 #include <thread>
 
+#include "mode_option.hpp"
 #include "pathstream/host/events.hpp"
 #include "pathstream/host/job_estimate.hpp"
 #include "pathstream/host/layers.hpp"
@@ -51,6 +52,20 @@ void add_sim_command(CLI::App& app, SimCommandOptions& o) {
     cmd->add_option("--damping", o.damping, "servo damping ratio")
         ->capture_default_str()
         ->check(CLI::Range(0.05, 20.0));
+    cmd->add_option("--mode", o.modes,
+                    "a resonant mode of an axis, AXIS:FREQ_HZ:DAMPING (e.g. x:40:0.05; "
+                    "repeatable, up to 4 an axis; replaces the profile's \"resonance\" for that "
+                    "axis; servo plant only)")
+        ->check(CLI::Validator(
+            [](std::string& text) -> std::string {
+                try {
+                    parse_mode_option(text);
+                } catch (const std::invalid_argument& e) {
+                    return e.what();
+                }
+                return "";
+            },
+            "AXIS:FREQ_HZ:DAMPING"));
     cmd->add_flag("--y-up", o.y_up,
                   "draw path.svg with +y upwards (default: downwards, like SVG and most "
                   "plotters; the 3-D view has z up)");
@@ -67,6 +82,11 @@ void add_sim_command(CLI::App& app, SimCommandOptions& o) {
                   "plan the whole job before running it and keep every tick for the report and "
                   "plots (default: plan as the device runs, memory bounded; docs/cli.md)");
     cmd->callback([&o] {
+        if (o.plant == "ideal" && !o.modes.empty()) {
+            throw CLI::ValidationError("--mode",
+                                       "resonant modes need the servo plant: --plant ideal "
+                                       "follows the setpoints exactly");
+        }
         if (o.json && o.events == "-") {
             throw CLI::ValidationError("--events",
                                        "-: the standard output carries the --json document");
@@ -114,8 +134,9 @@ struct SimRun {
 };
 
 /// The machine and plant lines of the report.
-void machine_json(const SimCommandOptions& o, const PlannedJob& job, const plot::RunSummary& run,
+void machine_json(const SimCommandOptions& o, const SimRun& s, const plot::RunSummary& run,
                   Json& j) {
+    const PlannedJob& job = s.job;
     j["target"] = run.target;
     j["file"] = path_display_name(o.path.file);
     j["machine"] = {{"file", o.machine},
@@ -126,7 +147,52 @@ void machine_json(const SimCommandOptions& o, const PlannedJob& job, const plot:
     if (o.plant == "servo") {
         j["plant"]["bandwidth_hz"] = o.bandwidth_hz;
         j["plant"]["damping"] = o.damping;
+        Json modes = Json::object();
+        const auto& per_axis = s.result.modes;
+        for (std::size_t a = 0; a < per_axis.size() && a < job.machine.axes.size(); ++a) {
+            if (per_axis[a].empty()) continue;
+            Json list = Json::array();
+            for (const sim::ResonantMode& m : per_axis[a])
+                list.push_back({{"frequency_hz", m.frequency_hz}, {"damping", m.damping}});
+            modes[job.machine.axes[a].name] = list;
+        }
+        j["plant"]["modes"] = modes;
     }
+}
+
+/// A position by axis name.
+Json position_json(const std::vector<double>& mm, const MachineProfile& profile) {
+    Json j = Json::object();
+    for (std::size_t a = 0; a < mm.size() && a < profile.axes.size(); ++a)
+        j[profile.axes[a].name] = mm[a];
+    return j;
+}
+
+/// Residual vibration and contour error: max, RMS and where (docs/simulator.md).
+void motion_json(const plot::RunSummary& run, const MachineProfile& profile, Json& j) {
+    const plot::ResidualFigures& v = run.residual;
+    const auto where = [&](std::uint64_t tick) {
+        return Json{{"tick", tick}, {"time_s", static_cast<double>(tick) / profile.tick_hz}};
+    };
+    Json residual = {
+        {"max", v.max_mm}, {"rms", v.rms_mm}, {"stops", v.stops}, {"window_ticks", v.window_ticks}};
+    if (v.stops > 0) {
+        residual["where"] = where(v.max_tick);
+        residual["where"]["tool_mm"] = position_json(v.tool_mm, profile);
+        residual["where"]["rest_mm"] = position_json(v.rest_mm, profile);
+    } else {
+        residual["where"] = nullptr;
+    }
+    j["residual_vibration_mm"] = residual;
+    const plot::ContourFigures& c = run.contour;
+    Json contour = {{"max", c.max_mm},
+                    {"rms", c.rms_mm},
+                    {"back_ticks", c.back_ticks},
+                    {"ahead_ticks", c.ahead_ticks},
+                    {"where", where(c.max_tick)}};
+    contour["where"]["tool_mm"] = position_json(c.tool_mm, profile);
+    contour["where"]["path_mm"] = position_json(c.path_mm, profile);
+    j["contour_error_mm"] = contour;
 }
 
 /// The duration, path, pen and device lines of the report.
@@ -190,9 +256,10 @@ Json report_json(const SimCommandOptions& o, const SimRun& s, const plot::RunSum
     const plot::ReportFigures f =
         plot::report_figures(s.plan, &s.job.check, s.job.machine, s.record.figures, run);
     Json j;
-    machine_json(o, s.job, run, j);
+    machine_json(o, s, run, j);
     run_json(s, run, f, j);
     limits_json(s.job, f, j);
+    motion_json(run, s.job.machine, j);
     j["layers"] = layers_json(s.job.path);
     j["pauses"] = s.job.pause_count;
     const double tick_hz = s.job.machine.tick_hz;
@@ -249,14 +316,35 @@ JobSample sim_sample(const sim::TickProbe& p, std::size_t axes, double tick_hz) 
     return s;
 }
 
-/// The device's options from the command line's.
-sim::SimOptions device_options(const SimCommandOptions& o) {
+/// The device's options from the command line's and the profile's: the modes of both (the
+/// ideal plant ignores the profile's), and with modes a settling time after the end point as
+/// long as a stop's residual vibration window, so that the last stop is measured whole.
+sim::SimOptions device_options(const SimCommandOptions& o, const MachineProfile& profile) {
     sim::SimOptions options;
     options.plant = o.plant == "ideal" ? sim::PlantModel::kIdeal : sim::PlantModel::kServo;
     options.servo.bandwidth_hz = o.bandwidth_hz;
     options.servo.damping = o.damping;
     options.realtime = o.realtime;
+    if (options.plant == sim::PlantModel::kServo) options.modes = run_modes(o.modes, profile);
+    double lowest = 0;
+    for (const auto& axis : options.modes)
+        for (const sim::ResonantMode& m : axis)
+            if (lowest == 0 || m.frequency_hz < lowest) lowest = m.frequency_hz;
+    if (lowest > 0)
+        options.settle_ticks =
+            sim::residual_window_ticks(profile.tick_hz, std::min(lowest, o.bandwidth_hz));
     return options;
+}
+
+/// The report's modes line: the run's modes, or that the ideal plant ignores the profile's.
+std::string modes_line(const SimCommandOptions& o, const MachineProfile& profile,
+                       const sim::SimulationResult& result) {
+    bool profile_modes = false;
+    for (const auto& axis : profile.resonance) profile_modes = profile_modes || !axis.empty();
+    if (o.plant == "ideal")
+        return profile_modes ? "none: the ideal plant ignores the profile's resonance" : "";
+    const std::string modes = describe_modes(result.modes, profile);
+    return modes.empty() ? "" : modes + " (position = the tool's)";
 }
 
 /// --plan-first: the whole plan, then the device's run with every tick kept (the report and
@@ -269,7 +357,7 @@ SimRun run_plan_first(const SimCommandOptions& o, const EventChannel& channel,
     s.plan = plot::plan_figures(job.plan, job.machine);
     events.emplace(channel, job.plan, job.machine,
                    JobInfo{"sim", path_display_name(o.path.file), "sim", count_subpaths(job.plan)});
-    sim::SimOptions options = device_options(o);
+    sim::SimOptions options = device_options(o, job.machine);
     if (!o.events.empty()) {
         options.tick_observer = [&](const sim::TickProbe& p) {
             events->sample(sim_sample(p, job.machine.axes.size(), job.machine.tick_hz));
@@ -364,7 +452,7 @@ SimRun run_streamed(const SimCommandOptions& o, const EventChannel& channel,
     const bool servo = o.plant != "ideal";
     plot::RunRecorder recorder(job.machine, axes, job.machine.tick_hz, job.machine.mm_per_lsb,
                                servo, plot::RunRecorder::kDefaultCapacity, 0, !o.plot_dir.empty());
-    sim::SimOptions options = device_options(o);
+    sim::SimOptions options = device_options(o, job.machine);
     options.record_ticks = false;
     std::vector<double> setpoint_mm(axes);
     options.tick_observer = [&](const sim::TickProbe& p) {
@@ -466,11 +554,12 @@ int run_sim(const SimCommandOptions& o) {
     channel.progress_hz = o.events_rate;
     if (!o.events.empty()) channel.writer = NdjsonWriter::open(o.events);
     std::optional<JobEvents> events;
-    const SimRun s =
-        o.plan_first ? run_plan_first(o, channel, events) : run_streamed(o, channel, events);
+    SimRun s = o.plan_first ? run_plan_first(o, channel, events) : run_streamed(o, channel, events);
     const PlannedJob& job = s.job;
     const sim::SimulationResult& result = s.result;
-    const plot::RunSummary run = run_summary(result);
+    plot::RunSummary run = run_summary(result);
+    run.modes = modes_line(o, job.machine, result);
+    if (!o.plot_dir.empty()) s.record.corner = corner_window(result, job.machine);
     const bool failed =
         result.underruns != 0 || !job.check.within_limits || job.check.drawing_while_pen_moves;
     end_events(*events, result, failed);

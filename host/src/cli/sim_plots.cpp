@@ -60,7 +60,49 @@ plot::RunSummary run_summary(const sim::SimulationResult& r) {
             s.rms_following_error_mm.push_back(f.rms_mm);
         }
     }
+    s.motion_measured = true;
+    s.residual.stops = r.residual.stops;
+    s.residual.window_ticks = r.residual.window_ticks;
+    s.residual.max_mm = r.residual.max_mm;
+    s.residual.rms_mm = r.residual.rms_mm;
+    s.residual.max_tick = r.residual.max_tick;
+    s.residual.tool_mm = r.residual.max_tool_mm;
+    s.residual.rest_mm = r.residual.max_rest_mm;
+    s.contour.max_mm = r.contour.max_mm;
+    s.contour.rms_mm = r.contour.rms_mm;
+    s.contour.back_ticks = r.contour.back_ticks;
+    s.contour.ahead_ticks = r.contour.ahead_ticks;
+    s.contour.max_tick = r.contour.max_tick;
+    s.contour.tool_mm = r.contour.max_tool_mm;
+    s.contour.path_mm = r.contour.max_path_mm;
     return s;
+}
+
+std::optional<plot::CornerWindow> corner_window(const sim::SimulationResult& r,
+                                                const MachineProfile& profile) {
+    const sim::ContourError& c = r.contour;
+    const std::size_t axes = c.window.axes;
+    if (axes < 2 || !(c.max_mm > 0) || c.max_tool_mm.size() != axes) return std::nullopt;
+    std::size_t ax = 0, ay = 1;
+    if (const std::optional<XyzAxes> xyz = xyz_axes(profile); xyz && xyz->y < axes) {
+        ax = xyz->x;
+        ay = xyz->y;
+    }
+    const auto name = [&](std::size_t a) {
+        return a < profile.axes.size() ? profile.axes[a].name : "axis" + std::to_string(a);
+    };
+    plot::CornerWindow w;
+    w.x_name = name(ax);
+    w.y_name = name(ay);
+    for (std::size_t i = 0; i + axes <= c.window.path_mm.size(); i += axes)
+        w.path.push_back({c.window.path_mm[i + ax], c.window.path_mm[i + ay]});
+    for (std::size_t i = 0; i + axes <= c.window.tool_mm.size(); i += axes)
+        w.tool.push_back({c.window.tool_mm[i + ax], c.window.tool_mm[i + ay]});
+    w.worst_tool = {c.max_tool_mm[ax], c.max_tool_mm[ay]};
+    w.worst_path = {c.max_path_mm[ax], c.max_path_mm[ay]};
+    w.error_mm = c.max_mm;
+    w.time_s = static_cast<double>(c.max_tick) / r.tick_hz;
+    return w;
 }
 
 }  // namespace pathstream::host
