@@ -12,7 +12,9 @@
 #include <stdexcept>
 
 #include "pathstream/hal/linux_clock.hpp"
+#include "pathstream/input_shaper.hpp"
 #include "pathstream/machine/core_span_conversion.hpp"
+#include "pathstream/machine/shaper_design.hpp"
 #include "pathstream/setpoint_stream.hpp"
 #include "pathstream/sim/simulated_output.hpp"
 #include "pathstream/sim/virtual_clock.hpp"
@@ -143,6 +145,7 @@ public:
           interval_(std::max<std::uint32_t>(1, options.producer_interval_ticks)),
           rows_after_end_(1 + options.settle_ticks) {
         check_modes(options, Axes);
+        make_shaper(first);
         r_.axes = Axes;
         r_.tick_hz = profile.tick_hz;
         r_.mm_per_lsb = profile.mm_per_lsb;
@@ -165,7 +168,7 @@ public:
                                         : nullptr);
             }
         }
-        expected_rows_ = expected_ticks + 1 + options.settle_ticks;
+        expected_rows_ = expected_ticks + rows_after_end_;
         if (options.record_ticks && expected_ticks > 0) {
             r_.setpoints.reserve(expected_rows_ * Axes);
             r_.positions.reserve(expected_rows_ * Axes);
@@ -203,6 +206,32 @@ public:
     std::uint64_t ticks() const override { return r_.ticks; }
 
 private:
+    using Shaper = InputShaper<Axes, host::kDeviceShaperHistoryTicks>;
+
+    /// The device's input shaper when an axis has taps; the run gets its longest delay more.
+    void make_shaper(const CoreSpan& first) {
+        if (options_.shaper.size() > Axes) {
+            throw std::invalid_argument("input shapers given for " +
+                                        std::to_string(options_.shaper.size()) +
+                                        " axes, the run has " + std::to_string(Axes));
+        }
+        bool any = false;
+        for (const auto& taps : options_.shaper) any = any || !taps.empty();
+        if (!any) return;
+        Lsb start[Axes];
+        start_point<Axes>(first, start);
+        shaper_ = std::make_unique<Shaper>(start);
+        for (unsigned a = 0; a < options_.shaper.size(); ++a) {
+            const auto& taps = options_.shaper[a];
+            if (shaper_->configure(a, taps.data(), static_cast<std::uint32_t>(taps.size())) !=
+                Status::kOk) {
+                throw std::invalid_argument("axis " + std::to_string(a) +
+                                            ": the device refuses these input shaper taps");
+            }
+        }
+        rows_after_end_ += shaper_->longest_delay();
+    }
+
     /// The producer task: pushes waiting spans while the queue takes them.
     void produce() {
         std::uint32_t pushed = 0;
@@ -273,24 +302,30 @@ private:
             }
             const bool pen_down = pen_.state();
             if (options_.record_ticks) r_.pen.push_back(pen_down ? 1 : 0);
-            double positions[Axes];
-            // The planned setpoints (the reference) and the command into the plant: the same
-            // today; a stage between the stream and the plant would make them differ.
-            double reference[Axes];
+            double positions[Axes], carriage[Axes];
+            // The planned setpoints (the contour's reference) and the command into the plant:
+            // the input shaper's output when there is one.
+            double reference[Axes], command[Axes];
+            if (shaper_) shaper_->shape(out_, shaped_);
+            const Lsb* const device_out = shaper_ ? shaped_ : out_;
             for (unsigned a = 0; a < Axes; ++a) {
-                const double setpoint_mm = out_[a] * profile_.mm_per_lsb;
-                reference[a] = setpoint_mm;
+                reference[a] = out_[a] * profile_.mm_per_lsb;
+                const double setpoint_mm = device_out[a] * profile_.mm_per_lsb;
+                command[a] = setpoint_mm;
                 double position = setpoint_mm;
+                carriage[a] = setpoint_mm;
                 if (!servo_.empty() && resonant_[a]) {
                     position = resonant_[a]->tool_position();  // at the tick's instant
+                    carriage[a] = resonant_[a]->motor_position();
                     resonant_[a]->step(setpoint_mm);
                 } else if (!servo_.empty()) {
                     position = servo_[a].position();  // at this tick's instant, before its hold
+                    carriage[a] = position;
                     servo_[a].step(setpoint_mm);
                 }
                 positions[a] = position;
                 if (options_.record_ticks) {
-                    r_.setpoints.push_back(out_[a]);
+                    r_.setpoints.push_back(device_out[a]);
                     r_.positions.push_back(position);
                 }
                 const double e = std::fabs(setpoint_mm - position);
@@ -300,13 +335,13 @@ private:
                     r_.following[a].max_tick = k;
                 }
             }
-            residual_.add(reference, positions);
+            residual_.add(command, positions, carriage);
             contour_.add(reference, positions);
             r_.ticks = k + 1;
             if (options_.tick_observer) {
                 options_.tick_observer({k, stream_->ticks_executed(), stream_->last_completed_tag(),
-                                        stream_->queued_spans(), ticks_pushed_, out_, positions,
-                                        pen_down});
+                                        stream_->queued_spans(), ticks_pushed_, device_out,
+                                        positions, pen_down});
             }
             if (progress_ && progress_stride_ > 0 && r_.ticks % progress_stride_ == 0) {
                 progress_(std::min(
@@ -329,6 +364,8 @@ private:
     VirtualClock device_time_;  // the device's tick counter
     SimulatedOutput pen_;       // the pen lift, stamped in device ticks
     std::vector<ServoAxis> servo_;
+    std::unique_ptr<Shaper> shaper_;  // null: no axis shaped
+    Lsb shaped_[Axes] = {};
     std::vector<std::unique_ptr<ResonantAxis>> resonant_;  // per axis with servo_; null: none
     ResidualVibrationMeter residual_;
     ContourErrorMeter contour_;

@@ -18,10 +18,12 @@ ResidualVibrationMeter::ResidualVibrationMeter(std::size_t axes, std::uint64_t w
         throw std::invalid_argument("residual vibration needs an axis and a window of a tick");
     previous_.assign(axes, 0.0);
     peak_tool_.assign(axes, 0.0);
+    peak_carriage_.assign(axes, 0.0);
     r_.window_ticks = window_ticks;
 }
 
-void ResidualVibrationMeter::add(const double* command_mm, const double* tool_mm) {
+void ResidualVibrationMeter::add(const double* command_mm, const double* tool_mm,
+                                 const double* carriage_mm) {
     const std::uint64_t k = tick_++;
     bool moving = false;
     for (std::size_t a = 0; a < axes_; ++a) moving = moving || command_mm[a] != previous_[a];
@@ -38,7 +40,7 @@ void ResidualVibrationMeter::add(const double* command_mm, const double* tool_mm
     if (++held_ > window_) return;
     double squares = 0;
     for (std::size_t a = 0; a < axes_; ++a) {
-        const double d = tool_mm[a] - command_mm[a];
+        const double d = tool_mm[a] - carriage_mm[a];
         squares += d * d;
     }
     const double distance = std::sqrt(squares);
@@ -46,6 +48,7 @@ void ResidualVibrationMeter::add(const double* command_mm, const double* tool_mm
         peak_ = distance;
         peak_tick_ = k;
         std::copy(tool_mm, tool_mm + axes_, peak_tool_.begin());
+        std::copy(carriage_mm, carriage_mm + axes_, peak_carriage_.begin());
     }
 }
 
@@ -59,6 +62,7 @@ void ResidualVibrationMeter::close_stop(bool run_ended) {
         r_.max_mm = peak_;
         r_.max_tick = peak_tick_;
         r_.max_tool_mm = peak_tool_;
+        r_.max_carriage_mm = peak_carriage_;
         r_.max_rest_mm = previous_;
     }
 }

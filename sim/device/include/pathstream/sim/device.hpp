@@ -13,6 +13,7 @@
 #include "pathstream/hal/clock.hpp"
 #include "pathstream/machine/core_span.hpp"
 #include "pathstream/machine/machine.hpp"
+#include "pathstream/shaper_taps.hpp"
 #include "pathstream/sim/contour_error.hpp"
 #include "pathstream/sim/plant.hpp"
 #include "pathstream/sim/residual_vibration.hpp"
@@ -44,6 +45,13 @@ struct SimOptions {
     /// ResonantAxis (the servo driving them; its position is the tool's). Shorter than the
     /// axes: the rest have none. Only with kServo (std::invalid_argument with kIdeal).
     std::vector<std::vector<ResonantMode>> modes;
+    /// The device's input shaper per axis, in axis order (docs/input-shaping.md): taps as
+    /// check_shaper_taps takes them with a history of host::kDeviceShaperHistoryTicks, empty
+    /// for an unshaped axis; shorter than the axes: the rest are unshaped. The shaped
+    /// setpoints drive the plant and are what the run records; the planned ones stay the
+    /// contour error's reference. The run lasts the longest delay longer, so the shaped
+    /// output reaches the end point. std::invalid_argument for taps the device refuses.
+    std::vector<std::vector<ShaperTap>> shaper;
     bool realtime = false;           ///< pace ticks with the Linux monotonic clock
     std::uint64_t settle_ticks = 0;  ///< idle ticks run after the end point (plant settling)
     /// The producer task runs before every `producer_interval_ticks`-th tick and pushes up to

@@ -1,5 +1,5 @@
-// Residual vibration: how far the tool still moves about its rest position once the command
-// into the plant has come to rest (docs/simulator.md, "Residual vibration").
+// Residual vibration: how far the tool still rings about the carriage once the command into
+// the plant has come to rest (docs/simulator.md, "Residual vibration").
 #pragma once
 
 #include <cstddef>
@@ -14,13 +14,14 @@ inline constexpr double kMinStopSeconds = 0.01;
 
 /// The residual vibration over a run's stops.
 struct ResidualVibration {
-    std::uint64_t stops = 0;          ///< stops measured
-    std::uint64_t window_ticks = 0;   ///< ticks of each stop looked at, at most
-    double max_mm = 0;                ///< largest peak over the stops
-    double rms_mm = 0;                ///< RMS of the stops' peaks (0 without stops)
-    std::uint64_t max_tick = 0;       ///< tick of the largest peak
-    std::vector<double> max_tool_mm;  ///< tool position per axis at that tick (empty: none)
-    std::vector<double> max_rest_mm;  ///< that stop's rest position per axis
+    std::uint64_t stops = 0;              ///< stops measured
+    std::uint64_t window_ticks = 0;       ///< ticks of each stop looked at, at most
+    double max_mm = 0;                    ///< largest peak over the stops
+    double rms_mm = 0;                    ///< RMS of the stops' peaks (0 without stops)
+    std::uint64_t max_tick = 0;           ///< tick of the largest peak
+    std::vector<double> max_tool_mm;      ///< tool position per axis at that tick (empty: none)
+    std::vector<double> max_rest_mm;      ///< that stop's rest position per axis
+    std::vector<double> max_carriage_mm;  ///< the carriage per axis at that tick
 };
 
 /// Ticks a stop is looked at: 5 periods of the plant's lowest natural frequency (a servo's
@@ -31,18 +32,20 @@ std::uint64_t residual_window_ticks(double tick_hz, double lowest_hz);
 /// Measures residual vibration tick by tick in O(axes) memory. A stop begins at the first tick
 /// whose command equals the previous tick's after a tick where it changed (motion, then rest;
 /// the rest before the first motion is no stop) and lasts while the command stays equal. Its
-/// peak is the largest Euclidean distance over the axes between the tool and the rest position
-/// (the held command) over its first `window_ticks` ticks. A stop counts when it holds for
-/// min_stop_ticks or more, or when the run ends in it.
+/// peak is the largest Euclidean distance over the axes between the tool and the carriage
+/// (the servo's own position, which the modes ring about) over its first `window_ticks` ticks:
+/// the ringing, not the servo closing its lag without overshoot. A stop counts when it holds
+/// for min_stop_ticks or more, or when the run ends in it.
 class ResidualVibrationMeter {
 public:
     /// `axes` >= 1, `window_ticks` >= 1. Throws std::invalid_argument otherwise.
     ResidualVibrationMeter(std::size_t axes, std::uint64_t window_ticks,
                            std::uint64_t min_stop_ticks);
 
-    /// The next tick (ticks come in order, from 0): the command into the plant and the tool's
-    /// position at the tick, mm per axis.
-    void add(const double* command_mm, const double* tool_mm);
+    /// The next tick (ticks come in order, from 0): the command into the plant, the tool's
+    /// position and the carriage's (the servo's; the tool's without modes) at the tick, mm
+    /// per axis.
+    void add(const double* command_mm, const double* tool_mm, const double* carriage_mm);
     /// After the last tick: the figures. Call once.
     ResidualVibration finish();
 
@@ -59,6 +62,7 @@ private:
     std::uint64_t peak_tick_ = 0;
     std::vector<double> previous_;
     std::vector<double> peak_tool_;
+    std::vector<double> peak_carriage_;
     double sum_squares_ = 0;
     ResidualVibration r_;
 };
