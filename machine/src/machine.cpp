@@ -343,228 +343,225 @@ private:
             }
             p.input_shaper[axis] = spec;
         }
-        // "resonance": {"x": [{"frequency": 40, "damping": 0.05}, ...], ...} by axis name.
-        std::vector<std::vector<ResonanceMode>> resonance(const json& v, const MachineProfile& p)
-            const {
-            const char* example = "{\"x\": [{\"frequency\": 40, \"damping\": 0.05}]}";
-            if (!v.is_object())
-                fail("/resonance", std::string("resonance must be an object like ") + example);
-            std::set<std::string> names;
-            for (const auto& a : p.axes) names.insert(a.name);
-            only_keys(v, "/resonance", names);
-            std::vector<std::vector<ResonanceMode>> modes(p.axes.size());
-            for (std::size_t axis = 0; axis < p.axes.size(); ++axis) {
-                const std::string& name = p.axes[axis].name;
-                if (!v.contains(name)) continue;
-                const std::string ptr = "/resonance/" + json_pointer_token(name);
-                const json& list = v[name];
-                if (!list.is_array() || list.empty() || list.size() > kMaxResonanceModes) {
-                    fail(ptr, "axis " + name + "'s resonance must be an array of 1 to " +
-                                  std::to_string(kMaxResonanceModes) +
-                                  " modes like [{\"frequency\": 40, \"damping\": 0.05}]");
-                }
-                for (std::size_t i = 0; i < list.size(); ++i) {
-                    const std::string mode_ptr = ptr + "/" + std::to_string(i);
-                    modes[axis].push_back(resonance_mode(list[i], mode_ptr, p.tick_hz));
-                }
-            }
-            return modes;
-        }
+    }
 
-        ResonanceMode resonance_mode(const json& m, const std::string& ptr, double tick_hz) const {
-            if (!m.is_object())
-                fail(ptr, "a mode must be an object like {\"frequency\": 40, \"damping\": 0.05}");
-            only_keys(m, ptr, {"frequency", "damping"});
-            for (const char* key : {"frequency", "damping"})
-                if (!m.contains(key)) fail(ptr, std::string("mode has no \"") + key + "\"");
-            ResonanceMode mode;
-            // Below the Nyquist frequency: a faster mode cannot show in positions sampled per tick.
-            mode.frequency_hz =
-                number(m["frequency"], ptr + "/frequency", "frequency", 0, 1e6, true, "Hz");
-            if (mode.frequency_hz >= tick_hz / 2) {
-                fail(ptr + "/frequency", "frequency " + format(mode.frequency_hz) +
-                                             " Hz is impossible (allowed: > 0 and below half the "
-                                             "tick rate, " +
-                                             format(tick_hz / 2) + " Hz)");
+    // "resonance": {"x": [{"frequency": 40, "damping": 0.05}, ...], ...} by axis name.
+    std::vector<std::vector<ResonanceMode>> resonance(const json& v,
+                                                      const MachineProfile& p) const {
+        const char* example = "{\"x\": [{\"frequency\": 40, \"damping\": 0.05}]}";
+        if (!v.is_object())
+            fail("/resonance", std::string("resonance must be an object like ") + example);
+        std::set<std::string> names;
+        for (const auto& a : p.axes) names.insert(a.name);
+        only_keys(v, "/resonance", names);
+        std::vector<std::vector<ResonanceMode>> modes(p.axes.size());
+        for (std::size_t axis = 0; axis < p.axes.size(); ++axis) {
+            const std::string& name = p.axes[axis].name;
+            if (!v.contains(name)) continue;
+            const std::string ptr = "/resonance/" + json_pointer_token(name);
+            const json& list = v[name];
+            if (!list.is_array() || list.empty() || list.size() > kMaxResonanceModes) {
+                fail(ptr, "axis " + name + "'s resonance must be an array of 1 to " +
+                              std::to_string(kMaxResonanceModes) +
+                              " modes like [{\"frequency\": 40, \"damping\": 0.05}]");
             }
-            mode.damping = number(m["damping"], ptr + "/damping", "damping", 0, 1, true, "(ratio)");
-            return mode;
+            for (std::size_t i = 0; i < list.size(); ++i) {
+                const std::string mode_ptr = ptr + "/" + std::to_string(i);
+                modes[axis].push_back(resonance_mode(list[i], mode_ptr, p.tick_hz));
+            }
         }
+        return modes;
+    }
 
-        SpindleConfig spindle(const json& v) const {
-            if (!v.is_object()) fail("/spindle", "spindle must be an object like {\"spin_up\": 2}");
-            only_keys(v, "/spindle", {"spin_up"});
-            SpindleConfig c;
-            c.present = true;
-            if (v.contains("spin_up"))
-                c.spin_up = number(v["spin_up"], "/spindle/spin_up", "spin_up", 0, 600, false, "s");
-            return c;
+    ResonanceMode resonance_mode(const json& m, const std::string& ptr, double tick_hz) const {
+        if (!m.is_object())
+            fail(ptr, "a mode must be an object like {\"frequency\": 40, \"damping\": 0.05}");
+        only_keys(m, ptr, {"frequency", "damping"});
+        for (const char* key : {"frequency", "damping"})
+            if (!m.contains(key)) fail(ptr, std::string("mode has no \"") + key + "\"");
+        ResonanceMode mode;
+        // Below the Nyquist frequency: a faster mode cannot show in positions sampled per tick.
+        mode.frequency_hz =
+            number(m["frequency"], ptr + "/frequency", "frequency", 0, 1e6, true, "Hz");
+        if (mode.frequency_hz >= tick_hz / 2) {
+            fail(ptr + "/frequency", "frequency " + format(mode.frequency_hz) +
+                                         " Hz is impossible (allowed: > 0 and below half the "
+                                         "tick rate, " +
+                                         format(tick_hz / 2) + " Hz)");
         }
+        mode.damping = number(m["damping"], ptr + "/damping", "damping", 0, 1, true, "(ratio)");
+        return mode;
+    }
 
-        OutputCoilsConfig output_coils(const json& v) const {
-            if (!v.is_object()) {
-                fail("/output_coils",
-                     "output_coils must be an object like {\"target\": "
-                     "\"modbus-tcp://HOST:PORT?unit=1\", \"spindle\": 0}");
-            }
-            std::set<std::string> keys{"target"};
-            for (const char* key : kMachineFunctionKeys) keys.insert(key);
-            only_keys(v, "/output_coils", keys);
-            OutputCoilsConfig c;
-            c.present = true;
-            if (!v.contains("target")) fail("/output_coils", "output_coils has no \"target\"");
-            const json& t = v["target"];
-            if (!t.is_string())
-                fail("/output_coils/target",
-                     "target must be a Modbus URL string (modbus-tcp://HOST:PORT?unit=N or "
-                     "modbus-rtu://DEVICE?baud=B&unit=N)");
-            c.target = t.get<std::string>();
-            hal::ModbusTarget target;
-            try {
-                target = hal::parse_modbus_target(c.target);
-            } catch (const std::invalid_argument& e) {
-                fail("/output_coils/target", e.what());
-            }
-            // Unit 0 on a serial line is a broadcast: nobody answers, so no write is confirmed and
-            // a module that is gone would never stop the machine.
-            if (target.transport == hal::ModbusTarget::Transport::kRtu && target.unit == 0)
-                fail("/output_coils/target",
-                     "unit 0 is the broadcast address: no answer would confirm a write (give the "
-                     "module's unit, 1..247)");
-            bool any = false;
-            for (unsigned k = 0; k < kMachineFunctionCount; ++k) {
-                const char* key = kMachineFunctionKeys[k];
-                if (!v.contains(key)) continue;
-                const std::string ptr = std::string("/output_coils/") + key;
-                const json& a = v[key];
-                if (!a.is_number_integer() || a.get<long long>() < 0 || a.get<long long>() > 65535)
-                    fail(ptr, std::string(key) + " coil address must be a whole number 0..65535");
-                c.coil[k] = static_cast<std::int32_t>(a.get<long long>());
-                for (unsigned j = 0; j < k; ++j) {
-                    if (c.coil[j] == c.coil[k])
-                        fail(ptr, "coil " + std::to_string(c.coil[k]) + " is " +
-                                      kMachineFunctionKeys[j] +
-                                      "'s already: one coil per function");
-                }
-                any = true;
-            }
-            if (!any)
-                fail("/output_coils",
-                     "output_coils switches no function: give a coil for one or more of spindle, "
-                     "spindle_reverse, mist, flood");
-            return c;
-        }
+    SpindleConfig spindle(const json& v) const {
+        if (!v.is_object()) fail("/spindle", "spindle must be an object like {\"spin_up\": 2}");
+        only_keys(v, "/spindle", {"spin_up"});
+        SpindleConfig c;
+        c.present = true;
+        if (v.contains("spin_up"))
+            c.spin_up = number(v["spin_up"], "/spindle/spin_up", "spin_up", 0, 600, false, "s");
+        return c;
+    }
 
-        GpioConfig gpio(const json& g, const MachineProfile& p) const {
-            if (!g.is_object()) fail("/gpio", "gpio must be an object");
-            only_keys(g, "/gpio",
-                      {"chip", "enable", "estop", "pen", "spindle", "spindle_reverse", "mist",
-                       "flood", "limits", "home"});
-            GpioConfig c;
-            c.present = true;
-            if (!g.contains("chip")) fail("/gpio", "gpio has no \"chip\"");
-            if (!g["chip"].is_string() || g["chip"].get<std::string>().empty()) {
-                fail("/gpio/chip",
-                     "chip must be a chip name, path, number or label (non-empty string)");
-            }
-            c.chip = g["chip"].get<std::string>();
-            if (g.contains("enable"))
-                c.enable = line(g["enable"], "/gpio/enable", "enable"), c.has_enable = true;
-            if (g.contains("estop"))
-                c.estop = line(g["estop"], "/gpio/estop", "estop"), c.has_estop = true;
-            if (g.contains("pen")) c.pen = line(g["pen"], "/gpio/pen", "pen"), c.has_pen = true;
-            for (unsigned k = 0; k < kMachineFunctionCount; ++k) {
-                const char* key = kMachineFunctionKeys[k];
-                if (!g.contains(key)) continue;
-                c.function[k] = line(g[key], std::string("/gpio/") + key, key);
-                c.has_function[k] = true;
-            }
-            std::set<std::string> switch_names;
-            for (const auto& a : p.axes) {
-                switch_names.insert(a.name + "-");
-                switch_names.insert(a.name + "+");
-            }
-            if (g.contains("limits")) {
-                const json& lim = g["limits"];
-                if (!lim.is_object())
-                    fail("/gpio/limits", "limits must be an object like {\"x-\": {\"line\": 3}}");
-                only_keys(lim, "/gpio/limits", switch_names);
-                for (auto it = lim.begin(); it != lim.end(); ++it) {
-                    c.limits.emplace_back(
-                        it.key(), line(it.value(), "/gpio/limits/" + it.key(), "limit switch"));
-                }
-            }
-            if (g.contains("home")) {
-                const json& home = g["home"];
-                if (!home.is_object())
-                    fail("/gpio/home",
-                         "home must be an object like {\"x\": {\"switch\": \"x-\", ...}}");
-                std::set<std::string> axis_names;
-                for (const auto& a : p.axes) axis_names.insert(a.name);
-                only_keys(home, "/gpio/home", axis_names);
-                for (auto it = home.begin(); it != home.end(); ++it) {
-                    const std::string ptr = "/gpio/home/" + it.key();
-                    const json& h = it.value();
-                    if (!h.is_object())
-                        fail(ptr,
-                             "homing must be an object with switch, search_velocity, "
-                             "latch_velocity, "
-                             "backoff, max_travel");
-                    only_keys(h, ptr,
-                              {"switch", "search_velocity", "latch_velocity", "backoff",
-                               "max_travel", "position", "pull_off"});
-                    for (const char* key :
-                         {"switch", "search_velocity", "latch_velocity", "backoff", "max_travel"}) {
-                        if (!h.contains(key))
-                            fail(ptr, std::string("homing has no \"") + key + "\"");
-                    }
-                    HomingAxisConfig hc;
-                    hc.axis = it.key();
-                    const AxisLimits* axis = nullptr;
-                    for (const auto& a : p.axes) {
-                        if (a.name == hc.axis) axis = &a;
-                    }
-                    const json& sw = h["switch"];
-                    if (!sw.is_string() || (sw.get<std::string>() != hc.axis + "-" &&
-                                            sw.get<std::string>() != hc.axis + "+")) {
-                        fail(ptr + "/switch",
-                             "switch must be \"" + hc.axis + "-\" or \"" + hc.axis + "+\"");
-                    }
-                    hc.switch_name = sw.get<std::string>();
-                    bool fitted = false;
-                    for (const auto& l : c.limits) fitted = fitted || l.first == hc.switch_name;
-                    if (!fitted)
-                        fail(ptr + "/switch",
-                             "switch \"" + hc.switch_name + "\" is not in gpio.limits");
-                    hc.search_velocity =
-                        number(h["search_velocity"], ptr + "/search_velocity", "search_velocity", 0,
-                               axis->max_velocity, true, "mm/s");
-                    hc.latch_velocity =
-                        number(h["latch_velocity"], ptr + "/latch_velocity", "latch_velocity", 0,
-                               hc.search_velocity, true, "mm/s");
-                    hc.backoff =
-                        number(h["backoff"], ptr + "/backoff", "backoff", 0, 1e4, true, "mm");
-                    hc.max_travel = number(h["max_travel"], ptr + "/max_travel", "max_travel", 0,
-                                           1e5, true, "mm");
-                    hc.pull_off = h.contains("pull_off") ? number(h["pull_off"], ptr + "/pull_off",
-                                                                  "pull_off", 0, 1e4, false, "mm")
-                                                         : hc.backoff;
-                    if (h.contains("position"))
-                        hc.position = number(h["position"], ptr + "/position", "position", -1e5,
-                                             1e5, false, "mm");
-                    c.home.push_back(hc);
-                }
-            }
-            return c;
+    OutputCoilsConfig output_coils(const json& v) const {
+        if (!v.is_object()) {
+            fail("/output_coils",
+                 "output_coils must be an object like {\"target\": "
+                 "\"modbus-tcp://HOST:PORT?unit=1\", \"spindle\": 0}");
         }
-    };
+        std::set<std::string> keys{"target"};
+        for (const char* key : kMachineFunctionKeys) keys.insert(key);
+        only_keys(v, "/output_coils", keys);
+        OutputCoilsConfig c;
+        c.present = true;
+        if (!v.contains("target")) fail("/output_coils", "output_coils has no \"target\"");
+        const json& t = v["target"];
+        if (!t.is_string())
+            fail("/output_coils/target",
+                 "target must be a Modbus URL string (modbus-tcp://HOST:PORT?unit=N or "
+                 "modbus-rtu://DEVICE?baud=B&unit=N)");
+        c.target = t.get<std::string>();
+        hal::ModbusTarget target;
+        try {
+            target = hal::parse_modbus_target(c.target);
+        } catch (const std::invalid_argument& e) {
+            fail("/output_coils/target", e.what());
+        }
+        // Unit 0 on a serial line is a broadcast: nobody answers, so no write is confirmed and
+        // a module that is gone would never stop the machine.
+        if (target.transport == hal::ModbusTarget::Transport::kRtu && target.unit == 0)
+            fail("/output_coils/target",
+                 "unit 0 is the broadcast address: no answer would confirm a write (give the "
+                 "module's unit, 1..247)");
+        bool any = false;
+        for (unsigned k = 0; k < kMachineFunctionCount; ++k) {
+            const char* key = kMachineFunctionKeys[k];
+            if (!v.contains(key)) continue;
+            const std::string ptr = std::string("/output_coils/") + key;
+            const json& a = v[key];
+            if (!a.is_number_integer() || a.get<long long>() < 0 || a.get<long long>() > 65535)
+                fail(ptr, std::string(key) + " coil address must be a whole number 0..65535");
+            c.coil[k] = static_cast<std::int32_t>(a.get<long long>());
+            for (unsigned j = 0; j < k; ++j) {
+                if (c.coil[j] == c.coil[k])
+                    fail(ptr, "coil " + std::to_string(c.coil[k]) + " is " +
+                                  kMachineFunctionKeys[j] + "'s already: one coil per function");
+            }
+            any = true;
+        }
+        if (!any)
+            fail("/output_coils",
+                 "output_coils switches no function: give a coil for one or more of spindle, "
+                 "spindle_reverse, mist, flood");
+        return c;
+    }
+
+    GpioConfig gpio(const json& g, const MachineProfile& p) const {
+        if (!g.is_object()) fail("/gpio", "gpio must be an object");
+        only_keys(g, "/gpio",
+                  {"chip", "enable", "estop", "pen", "spindle", "spindle_reverse", "mist", "flood",
+                   "limits", "home"});
+        GpioConfig c;
+        c.present = true;
+        if (!g.contains("chip")) fail("/gpio", "gpio has no \"chip\"");
+        if (!g["chip"].is_string() || g["chip"].get<std::string>().empty()) {
+            fail("/gpio/chip",
+                 "chip must be a chip name, path, number or label (non-empty string)");
+        }
+        c.chip = g["chip"].get<std::string>();
+        if (g.contains("enable"))
+            c.enable = line(g["enable"], "/gpio/enable", "enable"), c.has_enable = true;
+        if (g.contains("estop"))
+            c.estop = line(g["estop"], "/gpio/estop", "estop"), c.has_estop = true;
+        if (g.contains("pen")) c.pen = line(g["pen"], "/gpio/pen", "pen"), c.has_pen = true;
+        for (unsigned k = 0; k < kMachineFunctionCount; ++k) {
+            const char* key = kMachineFunctionKeys[k];
+            if (!g.contains(key)) continue;
+            c.function[k] = line(g[key], std::string("/gpio/") + key, key);
+            c.has_function[k] = true;
+        }
+        std::set<std::string> switch_names;
+        for (const auto& a : p.axes) {
+            switch_names.insert(a.name + "-");
+            switch_names.insert(a.name + "+");
+        }
+        if (g.contains("limits")) {
+            const json& lim = g["limits"];
+            if (!lim.is_object())
+                fail("/gpio/limits", "limits must be an object like {\"x-\": {\"line\": 3}}");
+            only_keys(lim, "/gpio/limits", switch_names);
+            for (auto it = lim.begin(); it != lim.end(); ++it) {
+                c.limits.emplace_back(it.key(),
+                                      line(it.value(), "/gpio/limits/" + it.key(), "limit switch"));
+            }
+        }
+        if (g.contains("home")) {
+            const json& home = g["home"];
+            if (!home.is_object())
+                fail("/gpio/home",
+                     "home must be an object like {\"x\": {\"switch\": \"x-\", ...}}");
+            std::set<std::string> axis_names;
+            for (const auto& a : p.axes) axis_names.insert(a.name);
+            only_keys(home, "/gpio/home", axis_names);
+            for (auto it = home.begin(); it != home.end(); ++it) {
+                const std::string ptr = "/gpio/home/" + it.key();
+                const json& h = it.value();
+                if (!h.is_object())
+                    fail(ptr,
+                         "homing must be an object with switch, search_velocity, "
+                         "latch_velocity, "
+                         "backoff, max_travel");
+                only_keys(h, ptr,
+                          {"switch", "search_velocity", "latch_velocity", "backoff", "max_travel",
+                           "position", "pull_off"});
+                for (const char* key :
+                     {"switch", "search_velocity", "latch_velocity", "backoff", "max_travel"}) {
+                    if (!h.contains(key)) fail(ptr, std::string("homing has no \"") + key + "\"");
+                }
+                HomingAxisConfig hc;
+                hc.axis = it.key();
+                const AxisLimits* axis = nullptr;
+                for (const auto& a : p.axes) {
+                    if (a.name == hc.axis) axis = &a;
+                }
+                const json& sw = h["switch"];
+                if (!sw.is_string() || (sw.get<std::string>() != hc.axis + "-" &&
+                                        sw.get<std::string>() != hc.axis + "+")) {
+                    fail(ptr + "/switch",
+                         "switch must be \"" + hc.axis + "-\" or \"" + hc.axis + "+\"");
+                }
+                hc.switch_name = sw.get<std::string>();
+                bool fitted = false;
+                for (const auto& l : c.limits) fitted = fitted || l.first == hc.switch_name;
+                if (!fitted)
+                    fail(ptr + "/switch",
+                         "switch \"" + hc.switch_name + "\" is not in gpio.limits");
+                hc.search_velocity = number(h["search_velocity"], ptr + "/search_velocity",
+                                            "search_velocity", 0, axis->max_velocity, true, "mm/s");
+                hc.latch_velocity = number(h["latch_velocity"], ptr + "/latch_velocity",
+                                           "latch_velocity", 0, hc.search_velocity, true, "mm/s");
+                hc.backoff = number(h["backoff"], ptr + "/backoff", "backoff", 0, 1e4, true, "mm");
+                hc.max_travel =
+                    number(h["max_travel"], ptr + "/max_travel", "max_travel", 0, 1e5, true, "mm");
+                hc.pull_off = h.contains("pull_off") ? number(h["pull_off"], ptr + "/pull_off",
+                                                              "pull_off", 0, 1e4, false, "mm")
+                                                     : hc.backoff;
+                if (h.contains("position"))
+                    hc.position = number(h["position"], ptr + "/position", "position", -1e5, 1e5,
+                                         false, "mm");
+                c.home.push_back(hc);
+            }
+        }
+        return c;
+    }
+};
 
 }  // namespace
 
 namespace {
-    double grid_velocity(const MachineProfile& p) {
-        return p.mm_per_lsb * p.tick_hz / p.ticks_per_span;
-    }
+double grid_velocity(const MachineProfile& p) {
+    return p.mm_per_lsb * p.tick_hz / p.ticks_per_span;
+}
 
 }  // namespace
 
