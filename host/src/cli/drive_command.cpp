@@ -62,6 +62,11 @@ void add_drive_command(CLI::App& app, DriveCommandOptions& o) {
     cmd->add_option("--following-window", o.following_window,
                     "following error window (0x6065), LSB")
         ->capture_default_str();
+    cmd->add_option("--inertia", o.inertia,
+                    "torque offset (0x60B2, per mille of rated torque) per LSB/s^2 of "
+                    "acceleration; 0: the drive has no torque model and refuses to map 0x60B2")
+        ->capture_default_str()
+        ->check(CLI::Range(0.0, 1e6));
     cmd->add_option("--exit-after", o.exit_after,
                     "stop after this many seconds (default: at SIGINT/SIGTERM)")
         ->check(CLI::Range(0.0, 1e6));
@@ -75,6 +80,7 @@ int run_drive(const DriveCommandOptions& o) {
     d.start_position = o.position;
     d.servo.bandwidth_hz = o.bandwidth_hz;
     d.following_error_window = o.following_window;
+    d.torque_per_acceleration = o.inertia;
     sim::SimulatedCia402Drive drive(bus, d);
     std::signal(SIGINT, on_drive_signal);
     std::signal(SIGTERM, on_drive_signal);

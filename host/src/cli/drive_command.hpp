@@ -13,7 +13,8 @@ struct DriveCommandOptions {
     std::int32_t position = 0;              ///< LSB at power-up
     double bandwidth_hz = 100;              ///< servo plant
     std::uint32_t following_window = 5000;  ///< LSB (0x6065 default)
-    double exit_after = 0;                  ///< seconds of wall time; 0 = until SIGINT/SIGTERM
+    double inertia = 0;     ///< torque offset per mille per LSB/s^2; 0: 0x60B2 not mappable
+    double exit_after = 0;  ///< seconds of wall time; 0 = until SIGINT/SIGTERM
 };
 
 void add_drive_command(CLI::App& app, DriveCommandOptions& options);

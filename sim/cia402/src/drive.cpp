@@ -35,6 +35,9 @@ SimulatedCia402Drive::SimulatedCia402Drive(hal::CanBus& bus, const Cia402DriveOp
     : s_(std::make_unique<State>(bus, options)) {
     if (options.node < 1 || options.node > 127)
         throw std::invalid_argument("CiA 402 drive: node outside 1..127");
+    if (!std::isfinite(options.torque_per_acceleration) || options.torque_per_acceleration < 0)
+        throw std::invalid_argument(
+            "CiA 402 drive: torque per acceleration must be a finite number >= 0");
     s_->fe_window = options.following_error_window;
     s_->qs_decel = options.quick_stop_deceleration;
     s_->position = s_->demand = options.start_position;
@@ -49,6 +52,8 @@ void SimulatedCia402Drive::State::reset_communication() {
     const std::uint8_t n = options.node;
     rpdo1 = DrivePdo{};
     rpdo1.cob_id = kPdoInvalid | (kRpdo1Base + n);
+    rpdo2 = DrivePdo{};
+    rpdo2.cob_id = kPdoInvalid | (kRpdo2Base + n);
     tpdo1 = DrivePdo{};
     tpdo1.cob_id = kPdoInvalid | (kTpdo1Base + n);
     tpdo2 = DrivePdo{};
@@ -56,6 +61,7 @@ void SimulatedCia402Drive::State::reset_communication() {
     nmt = NmtState::kBootUp;
     boot_pending = true;
     pending = have_pending_cw = have_pending_target = false;
+    have_pending_velocity_offset = have_pending_torque_offset = false;
 }
 
 double SimulatedCia402Drive::State::period_seconds() const {
@@ -136,7 +142,9 @@ void SimulatedCia402Drive::State::handle(const hal::CanFrame& f) {
     if (f.id == kSyncId) {
         on_sync();
     } else if (rpdo1.valid() && f.id == (rpdo1.cob_id & 0x7FF)) {
-        on_rpdo(f);
+        on_rpdo(rpdo1, f);
+    } else if (rpdo2.valid() && f.id == (rpdo2.cob_id & 0x7FF)) {
+        on_rpdo(rpdo2, f);
     }
 }
 
@@ -158,6 +166,8 @@ void SimulatedCia402Drive::State::on_nmt(std::uint8_t command) {
             ip_index = -3;
             fe_window = options.following_error_window;
             qs_decel = options.quick_stop_deceleration;
+            velocity_offset = 0;
+            torque_offset = 0;
             reset_communication();
             break;
         case NmtCommand::kResetCommunication:
@@ -172,16 +182,16 @@ void SimulatedCia402Drive::State::on_nmt(std::uint8_t command) {
     }
 }
 
-void SimulatedCia402Drive::State::on_rpdo(const hal::CanFrame& f) {
-    if (f.length != rpdo1.bytes()) {
+void SimulatedCia402Drive::State::on_rpdo(const DrivePdo& p, const hal::CanFrame& f) {
+    if (f.length != p.bytes()) {
         if (!length_emcy_sent) emcy(kEmcyPdoLength);  // once: not a fault, the frame is dropped
         length_emcy_sent = true;
         return;
     }
     unsigned at = 0;
-    for (unsigned i = 0; i < rpdo1.count; ++i) {
-        const std::uint16_t index = static_cast<std::uint16_t>(rpdo1.map[i] >> 16);
-        const unsigned bytes = (rpdo1.map[i] & 0xFF) / 8;
+    for (unsigned i = 0; i < p.count; ++i) {
+        const std::uint16_t index = static_cast<std::uint16_t>(p.map[i] >> 16);
+        const unsigned bytes = (p.map[i] & 0xFF) / 8;
         const std::uint32_t v = get(f, at, bytes);
         at += bytes;
         if (index == kControlword) {
@@ -190,15 +200,26 @@ void SimulatedCia402Drive::State::on_rpdo(const hal::CanFrame& f) {
         } else if (index == kTargetPosition) {
             pending_target = static_cast<std::int32_t>(v);
             have_pending_target = true;
+        } else if (index == kVelocityOffset) {
+            pending_velocity_offset = static_cast<std::int32_t>(v);
+            have_pending_velocity_offset = true;
+        } else if (index == kTorqueOffset) {
+            pending_torque_offset = static_cast<std::int16_t>(v);
+            have_pending_torque_offset = true;
         }
     }
     ++rpdos;
-    pending = true;
-    if (rpdo1.type >= 254) {  // asynchronous: applied at once
-        if (have_pending_target) target = pending_target;
-        if (have_pending_cw) apply_controlword(pending_cw);
-        have_pending_cw = have_pending_target = false;
-    }
+    if (&p == &rpdo1) pending = true;
+    if (p.type >= 254) apply_pending();  // asynchronous: applied at once
+}
+
+void SimulatedCia402Drive::State::apply_pending() {
+    if (have_pending_target) target = pending_target;
+    if (have_pending_velocity_offset) velocity_offset = pending_velocity_offset;
+    if (have_pending_torque_offset) torque_offset = pending_torque_offset;
+    if (have_pending_cw) apply_controlword(pending_cw);
+    have_pending_cw = have_pending_target = false;
+    have_pending_velocity_offset = have_pending_torque_offset = false;
 }
 
 void SimulatedCia402Drive::State::on_sync() {
@@ -210,18 +231,20 @@ void SimulatedCia402Drive::State::on_sync() {
     // A drive that becomes enabled at this SYNC starts from where it is; targets count from
     // the next SYNC on.
     const bool was_enabled = ds == DriveState::kOperationEnabled;
-    if (have_pending_target) target = pending_target;
-    if (have_pending_cw) apply_controlword(pending_cw);
-    have_pending_cw = have_pending_target = false;
+    apply_pending();
 
     const double period = period_seconds() > 0 ? period_seconds() : 0.001;
     const double before = demand;
+    FeedForward ff;  // only while following targets in CSP
     switch (ds) {
         case DriveState::kOperationEnabled:
             if (mode == kModeCsp && was_enabled) {
                 if (!fresh) ++stale;
                 demand = target;
                 applied.push_back(target);
+                ff.velocity = velocity_offset;
+                if (options.torque_per_acceleration > 0)
+                    ff.acceleration = torque_offset / options.torque_per_acceleration;
             }
             break;
         case DriveState::kQuickStopActive: {
@@ -246,7 +269,10 @@ void SimulatedCia402Drive::State::on_sync() {
             plant = std::make_unique<ServoAxis>(options.servo, period, position);
             plant_period = period;
         }
-        plant->step(demand);
+        // The demand moves linearly from the last target to this one over the cycle, as a
+        // drive interpolating between cycle targets runs it: the target is reached at the
+        // cycle's end, and the velocity offset is the slope of that line.
+        plant->step_interpolated(before, demand, ff);
         position = plant->position();
     } else {
         plant.reset();  // unpowered or jammed: the axis stands still
@@ -320,6 +346,12 @@ std::uint64_t SimulatedCia402Drive::syncs() const {
 }
 std::uint64_t SimulatedCia402Drive::stale_syncs() const {
     return s_->stale;
+}
+std::int32_t SimulatedCia402Drive::velocity_offset() const {
+    return s_->velocity_offset;
+}
+std::int16_t SimulatedCia402Drive::torque_offset() const {
+    return s_->torque_offset;
 }
 std::uint64_t SimulatedCia402Drive::rpdos() const {
     return s_->rpdos;

@@ -40,7 +40,7 @@ struct SimulatedCia402Drive::State {
     std::uint16_t heartbeat_ms = 0;
     std::uint64_t next_heartbeat = 0;
     bool heartbeat_enabled = true;
-    DrivePdo rpdo1, tpdo1, tpdo2;
+    DrivePdo rpdo1, rpdo2, tpdo1, tpdo2;
     std::uint32_t sync_count = 0;  // for TPDO transmission types 2..240
 
     // Application (reset by NMT reset node or power-up).
@@ -50,11 +50,18 @@ struct SimulatedCia402Drive::State {
     std::uint8_t ip_value = 0;
     std::int8_t ip_index = -3;
     std::int32_t target = 0;
+    std::int32_t velocity_offset = 0;  // 0x60B1, LSB/s
+    std::int16_t torque_offset = 0;    // 0x60B2, per mille
+    // What synchronous RPDOs carried since the last SYNC, applied at the next one.
     std::uint16_t pending_cw = 0;
     std::int32_t pending_target = 0;
-    bool pending = false;  // an RPDO arrived since the last SYNC
+    std::int32_t pending_velocity_offset = 0;
+    std::int16_t pending_torque_offset = 0;
+    bool pending = false;  // an RPDO1 (the target's PDO) arrived since the last SYNC
     bool have_pending_cw = false;
     bool have_pending_target = false;
+    bool have_pending_velocity_offset = false;
+    bool have_pending_torque_offset = false;
     std::uint32_t fe_window;
     std::uint32_t qs_decel;
     std::uint16_t error_code = 0;
@@ -79,7 +86,8 @@ struct SimulatedCia402Drive::State {
     void handle(const hal::CanFrame& f);
     void on_nmt(std::uint8_t command);
     void on_sync();
-    void on_rpdo(const hal::CanFrame& f);
+    void on_rpdo(const DrivePdo& p, const hal::CanFrame& f);
+    void apply_pending();
     void send_tpdo(const DrivePdo& p);
     void emcy(std::uint16_t code);
     void fault(std::uint16_t code);

@@ -10,10 +10,14 @@ using namespace host::cia402;
 
 namespace {
 
-// Objects a PDO may carry, with their length in bits.
-bool rpdo_mappable(std::uint32_t entry) {
+// Objects a PDO may carry, with their length in bits. The torque offset only with a torque
+// model (Cia402DriveOptions::torque_per_acceleration): a drive that cannot act on it says so
+// at configuration rather than ignoring it.
+bool rpdo_mappable(std::uint32_t entry, bool torque_model) {
     return entry == pdo_mapping(kControlword, 0, 16) ||
-           entry == pdo_mapping(kTargetPosition, 0, 32);
+           entry == pdo_mapping(kTargetPosition, 0, 32) ||
+           entry == pdo_mapping(kVelocityOffset, 0, 32) ||
+           (torque_model && entry == pdo_mapping(kTorqueOffset, 0, 16));
 }
 bool tpdo_mappable(std::uint32_t entry) {
     return entry == pdo_mapping(kStatusword, 0, 16) ||
@@ -114,12 +118,16 @@ std::uint32_t SimulatedCia402Drive::State::od_read(std::uint16_t index, std::uin
             return one(heartbeat_ms, 2);
         case kRpdo1Communication:
             return pdo_comm(rpdo1);
+        case kRpdo2Communication:
+            return pdo_comm(rpdo2);
         case kTpdo1Communication:
             return pdo_comm(tpdo1);
         case kTpdo2Communication:
             return pdo_comm(tpdo2);
         case kRpdo1Mapping:
             return pdo_map(rpdo1);
+        case kRpdo2Mapping:
+            return pdo_map(rpdo2);
         case kTpdo1Mapping:
             return pdo_map(tpdo1);
         case kTpdo2Mapping:
@@ -145,6 +153,10 @@ std::uint32_t SimulatedCia402Drive::State::od_read(std::uint16_t index, std::uin
             return one(static_cast<std::uint32_t>(target), 4);
         case kQuickStopDeceleration:
             return one(qs_decel, 4);
+        case kVelocityOffset:
+            return one(static_cast<std::uint32_t>(velocity_offset), 4);
+        case kTorqueOffset:
+            return one(static_cast<std::uint16_t>(torque_offset), 2);
         case kInterpolationPeriod:
             switch (sub) {
                 case 0:
@@ -201,7 +213,9 @@ std::uint32_t SimulatedCia402Drive::State::od_write(std::uint16_t index, std::ui
             return 0;
         }
         if (p.count != 0) return kAbortDeviceState;
-        if (!(receive ? rpdo_mappable(v) : tpdo_mappable(v))) return kAbortNotMappable;
+        const bool torque_model = options.torque_per_acceleration > 0;
+        if (!(receive ? rpdo_mappable(v, torque_model) : tpdo_mappable(v)))
+            return kAbortNotMappable;
         p.map[sub - 1] = v;
         return 0;
     };
@@ -212,12 +226,16 @@ std::uint32_t SimulatedCia402Drive::State::od_write(std::uint16_t index, std::ui
             return 0;
         case kRpdo1Communication:
             return pdo_comm(rpdo1);
+        case kRpdo2Communication:
+            return pdo_comm(rpdo2);
         case kTpdo1Communication:
             return pdo_comm(tpdo1);
         case kTpdo2Communication:
             return pdo_comm(tpdo2);
         case kRpdo1Mapping:
             return pdo_map(rpdo1, true);
+        case kRpdo2Mapping:
+            return pdo_map(rpdo2, true);
         case kTpdo1Mapping:
             return pdo_map(tpdo1, false);
         case kTpdo2Mapping:
@@ -237,6 +255,12 @@ std::uint32_t SimulatedCia402Drive::State::od_write(std::uint16_t index, std::ui
             return 0;
         case kTargetPosition:
             target = static_cast<std::int32_t>(v);
+            return 0;
+        case kVelocityOffset:
+            velocity_offset = static_cast<std::int32_t>(v);
+            return 0;
+        case kTorqueOffset:
+            torque_offset = static_cast<std::int16_t>(v);
             return 0;
         case kQuickStopDeceleration:
             if (v == 0) return kAbortValueRange;

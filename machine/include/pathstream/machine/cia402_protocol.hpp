@@ -15,6 +15,7 @@ inline constexpr std::uint32_t kEmcyBase = 0x080;
 inline constexpr std::uint32_t kTpdo1Base = 0x180;
 inline constexpr std::uint32_t kRpdo1Base = 0x200;
 inline constexpr std::uint32_t kTpdo2Base = 0x280;
+inline constexpr std::uint32_t kRpdo2Base = 0x300;
 inline constexpr std::uint32_t kSdoResponseBase = 0x580;  ///< server (drive) -> client
 inline constexpr std::uint32_t kSdoRequestBase = 0x600;   ///< client (master) -> server
 inline constexpr std::uint32_t kHeartbeatBase = 0x700;
@@ -70,7 +71,9 @@ inline constexpr std::uint16_t kDeviceType = 0x1000;          ///< u32, low 16 b
 inline constexpr std::uint16_t kErrorRegister = 0x1001;       ///< u8
 inline constexpr std::uint16_t kHeartbeatProducer = 0x1017;   ///< u16 ms, 0 = off
 inline constexpr std::uint16_t kRpdo1Communication = 0x1400;  ///< sub 1 COB-ID u32, sub 2 type u8
-inline constexpr std::uint16_t kRpdo1Mapping = 0x1600;        ///< sub 0 count u8, sub 1..8 u32
+inline constexpr std::uint16_t kRpdo2Communication = 0x1401;
+inline constexpr std::uint16_t kRpdo1Mapping = 0x1600;  ///< sub 0 count u8, sub 1..8 u32
+inline constexpr std::uint16_t kRpdo2Mapping = 0x1601;
 inline constexpr std::uint16_t kTpdo1Communication = 0x1800;
 inline constexpr std::uint16_t kTpdo2Communication = 0x1801;
 inline constexpr std::uint16_t kTpdo1Mapping = 0x1A00;
@@ -85,6 +88,10 @@ inline constexpr std::uint16_t kPositionActual = 0x6064;         ///< i32
 inline constexpr std::uint16_t kFollowingErrorWindow = 0x6065;   ///< u32 (inc)
 inline constexpr std::uint16_t kTargetPosition = 0x607A;         ///< i32
 inline constexpr std::uint16_t kQuickStopDeceleration = 0x6085;  ///< u32 (inc/s^2)
+/// i32, velocity units (here position units per second), added to the velocity loop in CSP.
+inline constexpr std::uint16_t kVelocityOffset = 0x60B1;
+/// i16, per mille of the rated torque, added to the torque loop in CSP.
+inline constexpr std::uint16_t kTorqueOffset = 0x60B2;
 inline constexpr std::uint16_t kInterpolationPeriod =
     0x60C2;  ///< sub 1 u8 value, sub 2 i8 index (10^index s)
 

@@ -1,6 +1,7 @@
 // A simulated CiA 402 servo drive on a hal::CanBus: NMT, an expedited SDO server, PDO mapping
 // as configured, the power state machine, cyclic synchronous position through a second-order
-// servo plant, heartbeat and EMCY, and injectable faults (docs/cia402.md).
+// servo plant (targets interpolated linearly over the cycle, velocity and torque offsets as
+// feed-forward), heartbeat and EMCY, and injectable faults (docs/cia402.md).
 #pragma once
 
 #include <cstdint>
@@ -20,13 +21,19 @@ struct Cia402DriveOptions {
     ServoParameters servo{100, 1.0};                  ///< the axis, in LSB (the plant is linear)
     std::uint32_t following_error_window = 5000;      ///< 0x6065 default, LSB
     std::uint32_t quick_stop_deceleration = 5000000;  ///< 0x6085 default, LSB/s^2
+    /// The axis's inertia as the torque offset (0x60B2, per mille of rated torque) that one
+    /// LSB/s^2 of acceleration takes: the drive turns a torque offset t into the acceleration
+    /// feed-forward t / torque_per_acceleration. 0 (default): no torque model, and 0x60B2
+    /// cannot be mapped into an RPDO.
+    double torque_per_acceleration = 0;
 };
 
 /// One drive. Not thread-safe: one task calls poll(). Time is the caller's, in microseconds.
 class SimulatedCia402Drive {
 public:
     /// Powers up: NMT initialisation, then its boot-up message at the first poll().
-    /// Throws std::invalid_argument for a node outside 1..127.
+    /// Throws std::invalid_argument for a node outside 1..127 or a torque_per_acceleration
+    /// that is negative or not finite.
     SimulatedCia402Drive(hal::CanBus& bus, const Cia402DriveOptions& options);
     ~SimulatedCia402Drive();
     SimulatedCia402Drive(const SimulatedCia402Drive&) = delete;
@@ -57,12 +64,14 @@ public:
     std::uint32_t interpolation_period_ms() const;  ///< 0x60C2 as milliseconds (0 if not set)
     /// The target applied at each SYNC while operation enabled in CSP, in order.
     const std::vector<std::int32_t>& applied_targets() const;
+    std::int32_t velocity_offset() const;  ///< 0x60B1 in effect, LSB/s
+    std::int16_t torque_offset() const;    ///< 0x60B2 in effect, per mille of rated torque
     /// Largest |demand - actual| while operation enabled, LSB.
     double max_following_error() const;
     std::uint64_t syncs() const;  ///< SYNCs processed while NMT operational
     std::uint64_t stale_syncs()
         const;                    ///< of which, operation enabled with no new RPDO since the last
-    std::uint64_t rpdos() const;  ///< RPDO1 frames accepted
+    std::uint64_t rpdos() const;  ///< RPDO1 and RPDO2 frames accepted
     std::uint16_t last_emcy() const;  ///< last EMCY code sent (0 after a reset)
 
 private:
