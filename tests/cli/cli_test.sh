@@ -170,6 +170,8 @@ expect check-machine-travel 1 "wide.ngc:5:1: subpath 1 leaves the work area: it 
 expect margin-without-fit 2 "--margin requires --fit" -- "$bin" check "$src/examples/landscape.svg" --margin 10
 expect stream-lead-in-twice 2 "--lead-in excludes --no-lead-in" -- "$bin" stream "$src/examples/rose.json" -m "$machine" -t "modbus-tcp://127.0.0.1:1" --lead-in --no-lead-in
 expect stream-lead-in-cia402 2 "--lead-in: CiA 402 drives must stand at the drawing's first point" -- "$bin" stream "$src/examples/rose.json" -m "$machine" -t "can://vcan0?node=1&protocol=cia402" --lead-in
+expect stream-cia402-bad-ff 2 "ff 'fast' is not none, velocity or torque" -- "$bin" stream "$src/examples/rose.json" -m "$machine" -t "can://vcan0?node=1&protocol=cia402&ff=fast"
+expect stream-cia402-torque-no-inertia 2 "ff=torque needs inertia=X" -- "$bin" stream "$src/examples/rose.json" -m "$machine" -t "can://vcan0?node=1&protocol=cia402&ff=torque"
 expect drive-bad-inertia 2 "--inertia" -- "$bin" drive --can vcan0 --inertia -1
 expect stream-resume-lead-in 2 "--resume: --no-lead-in does not apply" -- "$bin" stream --resume "$src/examples/rose.json" --no-lead-in
 expect device-axes-and-machine 2 "the axis count comes from --machine" -- "$bin" device -m "$machine" --axes 3

@@ -45,13 +45,18 @@ int run_cia402_stream(const Plan& plan, const MachineProfile& profile, const std
         r = stream_cia402(plan, profile, t.options, bus, clock, [&](double f) { bar.update(f); });
     }
     const std::size_t axes = profile.axes.size();
-    // Per cycle: an RPDO1 (6 bytes) per drive, one SYNC, a TPDO1 (6) per drive [+ TPDO2 (4)].
+    // Per cycle: an RPDO1 (6 bytes) per drive [+ RPDO2: 4, 6 with the torque offset], one
+    // SYNC, a TPDO1 (6) per drive [+ TPDO2 (4)].
+    const Cia402FeedForward ff = t.options.feed_forward;
+    const unsigned rpdo2 = ff == Cia402FeedForward::kNone       ? 0
+                           : ff == Cia402FeedForward::kVelocity ? worst_case_bits(4)
+                                                                : worst_case_bits(6);
     const unsigned bits =
         worst_case_bits(0) +
         static_cast<unsigned>(axes) *
-            (2 * worst_case_bits(6) + (t.options.demand_echo ? worst_case_bits(4) : 0));
-    std::printf("streamed      %s (CiA 402 CSP, %u ms cycle, nodes", target.c_str(),
-                t.options.cycle_ms);
+            (2 * worst_case_bits(6) + rpdo2 + (t.options.demand_echo ? worst_case_bits(4) : 0));
+    std::printf("streamed      %s (CiA 402 CSP, %u ms cycle, feed-forward %s, nodes",
+                target.c_str(), t.options.cycle_ms, cia402_feed_forward_name(ff));
     for (const auto n : t.options.nodes) std::printf(" %u", unsigned(n));
     std::printf(")\n");
     std::printf("executed      %llu motion cycles (%llu path ticks), %llu cycles in all\n",
@@ -73,8 +78,9 @@ int run_cia402_stream(const Plan& plan, const MachineProfile& profile, const std
         static_cast<unsigned long long>(r.demand_mismatches), bits,
         bits / (t.options.cycle_ms * 10.0));
     std::printf(
-        "drives        largest step %d LSB per cycle, largest lag %d LSB; wall time %.2f s\n",
-        r.max_step, r.max_lag, r.wall_seconds);
+        "drives        largest step %d LSB per cycle, largest lag (following error) %d LSB = "
+        "%.4f mm; wall time %.2f s\n",
+        r.max_step, r.max_lag, r.max_lag * profile.mm_per_lsb, r.wall_seconds);
     return 0;
 }
 

@@ -105,6 +105,13 @@ void Cia402Master::configure_node(std::uint8_t n) {
                     kRpdo1Base + n,
                     {pdo_mapping(kControlword, 0, 16), pdo_mapping(kTargetPosition, 0, 32)},
                     2};
+    // Feed-forward in a PDO of its own: controlword + target fill 6 of RPDO1's 8 bytes.
+    const bool torque = options_.feed_forward == Cia402FeedForward::kTorque;
+    const Pdo rpdo2{kRpdo2Communication,
+                    kRpdo2Mapping,
+                    kRpdo2Base + n,
+                    {pdo_mapping(kVelocityOffset, 0, 32), pdo_mapping(kTorqueOffset, 0, 16)},
+                    static_cast<std::uint8_t>(torque ? 2 : 1)};
     const Pdo tpdo1{kTpdo1Communication,
                     kTpdo1Mapping,
                     kTpdo1Base + n,
@@ -133,17 +140,25 @@ void Cia402Master::configure_node(std::uint8_t n) {
             }
         }
     };
+    // Keep a PDO the drive may map by default out of the way; a drive without one is fine.
+    auto disable = [&](const Pdo& p) {
+        try {
+            sdo_download(n, p.communication, 1, kPdoInvalid | p.cob_id, 4);
+        } catch (const SdoError& e) {
+            if (e.code() != kAbortNoObject) throw;
+        }
+    };
     map(rpdo1);
+    if (options_.feed_forward != Cia402FeedForward::kNone) {
+        map(rpdo2);
+    } else {
+        disable(rpdo2);
+    }
     map(tpdo1);
     if (options_.demand_echo) {
         map(tpdo2);
     } else {
-        // Keep a TPDO2 the drive may map by default off the bus; a drive without one is fine.
-        try {
-            sdo_download(n, kTpdo2Communication, 1, kPdoInvalid | tpdo2.cob_id, 4);
-        } catch (const SdoError& e) {
-            if (e.code() != kAbortNoObject) throw;
-        }
+        disable(tpdo2);
     }
     sdo_download(n, kHeartbeatProducer, 0, options_.heartbeat_ms, 2);
     const std::uint32_t mode = sdo_upload(n, kModesOfOperation, 0);

@@ -1,6 +1,7 @@
 // The master's plumbing: frames in and out, the cycle exchange (RPDO1 per drive, then SYNC),
 // the consumers (heartbeat, EMCY, TPDOs) and the health check every cycle runs.
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <set>
 #include <stdexcept>
@@ -35,6 +36,18 @@ const char* cia402_stop_name(Cia402Stop stop) {
     return "unknown";
 }
 
+const char* cia402_feed_forward_name(Cia402FeedForward feed_forward) {
+    switch (feed_forward) {
+        case Cia402FeedForward::kNone:
+            return "none";
+        case Cia402FeedForward::kVelocity:
+            return "velocity";
+        case Cia402FeedForward::kTorque:
+            return "torque";
+    }
+    return "unknown";
+}
+
 Cia402Master::Cia402Master(hal::CanBus& bus, hal::Clock& clock_us, Cia402Options options)
     : bus_(bus), clock_(clock_us), options_(std::move(options)) {
     if (options_.nodes.empty()) throw std::invalid_argument("CiA 402: no drive nodes given");
@@ -53,6 +66,14 @@ Cia402Master::Cia402Master(hal::CanBus& bus, hal::Clock& clock_us, Cia402Options
         throw std::invalid_argument("CiA 402: cycle 1..255 ms");
     if (options_.sdo_attempts == 0)
         throw std::invalid_argument("CiA 402: sdo_attempts must be >= 1");
+    const double k = options_.torque_per_acceleration;
+    if (!std::isfinite(k) || k < 0)
+        throw std::invalid_argument("CiA 402: torque per acceleration must be a number >= 0");
+    if (options_.feed_forward == Cia402FeedForward::kTorque && k == 0) {
+        throw std::invalid_argument(
+            "CiA 402: torque feed-forward needs the axes' inertia (per mille of rated torque per "
+            "LSB/s^2)");
+    }
 }
 
 Cia402DriveView& Cia402Master::view(std::uint8_t node) {
@@ -155,7 +176,7 @@ void Cia402Master::wait_until(std::uint64_t deadline_us) {
 }
 
 void Cia402Master::exchange(const std::vector<std::uint16_t>& controlwords,
-                            const std::vector<std::int32_t>& targets) {
+                            const std::vector<std::int32_t>& targets, const Offsets* offsets) {
     cycling_ = true;
     const std::uint64_t now = clock_.now();
     const std::uint64_t period = std::uint64_t{options_.cycle_ms} * 1000;
@@ -164,11 +185,19 @@ void Cia402Master::exchange(const std::vector<std::uint16_t>& controlwords,
     if (next_deadline_ + period < now || next_deadline_ == 0) next_deadline_ = now;
     // RPDOs first: a synchronous RPDO is applied at the next SYNC, so the drive takes this
     // cycle's target at this cycle's SYNC.
+    const bool torque = options_.feed_forward == Cia402FeedForward::kTorque;
     for (std::size_t i = 0; i < drives_.size(); ++i) {
         hal::CanFrame f = make_frame(kRpdo1Base + drives_[i].node, 6);
         put_le(f, 0, 2, controlwords[i]);
         put_le(f, 2, 4, static_cast<std::uint32_t>(targets[i]));
         send(f);
+        if (options_.feed_forward == Cia402FeedForward::kNone) continue;
+        // Zero offsets while enabling, holding or stopping: a drive keeps an offset until
+        // told otherwise.
+        hal::CanFrame o = make_frame(kRpdo2Base + drives_[i].node, torque ? 6 : 4);
+        put_le(o, 0, 4, static_cast<std::uint32_t>(offsets ? offsets->velocity[i] : 0));
+        if (torque) put_le(o, 4, 2, static_cast<std::uint16_t>(offsets ? offsets->torque[i] : 0));
+        send(o);
     }
     send(make_frame(kSyncId, 0));
     ++cycle_;

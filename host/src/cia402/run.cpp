@@ -1,5 +1,6 @@
 // The cyclic synchronous position job: enable at the plan's start, one core setpoint per
-// cycle with the step check before each send, settle at the end point, disable.
+// cycle (with its velocity and acceleration as feed-forward) and the step check before each
+// send, settle at the end point, disable.
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
@@ -7,6 +8,7 @@
 #include <string>
 
 #include "cycle_setpoints.hpp"
+#include "feed_forward.hpp"
 #include "pathstream/host/cia402_master.hpp"
 
 namespace pathstream::host {
@@ -48,20 +50,65 @@ Cia402Report Cia402Master::run(const Plan& plan, const MachineProfile& profile,
         const double acc = profile.axes[a].max_acceleration / profile.mm_per_lsb;
         max_step[a] = static_cast<std::int64_t>(std::floor(v * cycle_s)) + 1;
         max_second[a] = static_cast<std::int64_t>(std::floor(acc * cycle_s * cycle_s)) + 2;
+        const double torque = acc * options_.torque_per_acceleration;
+        if (options_.feed_forward == Cia402FeedForward::kTorque && torque > 32767) {
+            throw std::invalid_argument(
+                "CiA 402: axis " + profile.axes[a].name + " would need a torque offset of " +
+                std::to_string(std::llround(torque)) +
+                " per mille at a_max, beyond 0x60B2's 32767: check the inertia");
+        }
     }
     const std::uint64_t t0 = clock_.now();
     report_.total_motion_cycles = (plan.total_ticks + c - 1) / c + 1;
     auto source = make_cycle_setpoints(plan.spans, axes, c);
-    std::vector<std::int32_t> target(axes), prev(axes), prev2(axes), next(axes);
+    // p_(k-2), p_(k-1), the target p_k and, read one cycle ahead for the central acceleration,
+    // p_(k+1). Before the start and after the end the axes rest: repeated points.
+    std::vector<std::int32_t> target(axes), prev(axes), prev2(axes), ahead(axes);
     source->next(target.data());
+    std::uint64_t target_ticks = source->ticks();
     prev = prev2 = target;
+    bool have_ahead = source->next(ahead.data());
+    std::uint64_t ahead_ticks = source->ticks();
+    Offsets offsets{std::vector<std::int32_t>(axes), std::vector<std::int16_t>(axes)};
+    // The step check of p_(k+1), before p_k is sent: a refused p_(k+1) is never sent, and
+    // the feed-forward sent with p_k takes the axes as stopping there.
+    std::string refused;
+    auto check_ahead = [&]() {
+        refused.clear();
+        for (std::size_t a = 0; a < axes && have_ahead; ++a) {
+            const std::int64_t step = std::int64_t{ahead[a]} - target[a];
+            const std::int64_t second = step - (std::int64_t{target[a]} - prev[a]);
+            if (std::llabs(step) <= max_step[a] && std::llabs(second) <= max_second[a]) continue;
+            const bool v = std::llabs(step) > max_step[a];
+            refused =
+                "axis " + profile.axes[a].name + " (node " + std::to_string(drives_[a].node) +
+                "): the next target would " +
+                (v ? "step " + std::to_string(step) +
+                         " LSB in one cycle, more than v_max x cycle = " +
+                         std::to_string(max_step[a]) + " LSB"
+                   : "change its step by " + std::to_string(second) +
+                         " LSB, more than a_max x cycle^2 = " + std::to_string(max_second[a]) +
+                         " LSB") +
+                "; not sent";
+        }
+    };
+    auto set_offsets = [&]() {
+        for (std::size_t a = 0; a < axes; ++a) {
+            const bool next = have_ahead && refused.empty();
+            const CycleFeedForward f =
+                cycle_feed_forward(prev2[a], prev[a], target[a], next ? ahead[a] : target[a],
+                                   cycle_s, options_.torque_per_acceleration);
+            offsets.velocity[a] = f.velocity;
+            offsets.torque[a] = f.torque;
+        }
+    };
 
     auto finish = [&](bool completed) {
         report_.completed = completed;
         report_.final_target = target;
         report_.final_position.clear();
         for (const auto& d : drives_) report_.final_position.push_back(d.position);
-        report_.path_ticks = source->ticks();
+        report_.path_ticks = target_ticks;
         report_.wall_seconds = static_cast<double>(clock_.now() - t0) / 1e6;
         cycling_ = false;
         return report_;
@@ -109,7 +156,9 @@ Cia402Report Cia402Master::run(const Plan& plan, const MachineProfile& profile,
     const std::vector<std::uint16_t> enabled(axes, kCwEnableOperation);
     bool more = true;
     while (more) {
-        exchange(enabled, target);
+        check_ahead();
+        set_offsets();
+        exchange(enabled, target, &offsets);
         ++report_.motion_cycles;
         for (std::size_t a = 0; a < axes; ++a) {
             const auto& d = drives_[a];
@@ -124,34 +173,28 @@ Cia402Report Cia402Master::run(const Plan& plan, const MachineProfile& profile,
         if (progress)
             progress(static_cast<double>(report_.motion_cycles) /
                      static_cast<double>(report_.total_motion_cycles));
-        more = source->next(next.data());
+        more = have_ahead;
         if (!more) break;
+        if (!refused.empty()) {
+            stop_with(Cia402Stop::kStepLimit, refused);
+            return stop();
+        }
         for (std::size_t a = 0; a < axes; ++a) {
-            const std::int64_t step = std::int64_t{next[a]} - prev[a];
-            const std::int64_t second = step - (std::int64_t{prev[a]} - prev2[a]);
-            if (std::llabs(step) > max_step[a] || std::llabs(second) > max_second[a]) {
-                const bool v = std::llabs(step) > max_step[a];
-                stop_with(Cia402Stop::kStepLimit,
-                          "axis " + profile.axes[a].name + " (node " +
-                              std::to_string(drives_[a].node) + "): the next target would " +
-                              (v ? "step " + std::to_string(step) +
-                                       " LSB in one cycle, more than v_max x cycle = " +
-                                       std::to_string(max_step[a]) + " LSB"
-                                 : "change its step by " + std::to_string(second) +
-                                       " LSB, more than a_max x cycle^2 = " +
-                                       std::to_string(max_second[a]) + " LSB") +
-                              "; not sent");
-                return stop();
-            }
-            if (std::llabs(step) > report_.max_step)
-                report_.max_step = static_cast<std::int32_t>(std::llabs(step));
+            const std::int64_t step = std::llabs(std::int64_t{ahead[a]} - target[a]);
+            if (step > report_.max_step) report_.max_step = static_cast<std::int32_t>(step);
         }
         prev2 = prev;
-        prev = next;
-        target = next;
+        prev = target;
+        target = ahead;
+        target_ticks = ahead_ticks;
+        have_ahead = source->next(ahead.data());
+        ahead_ticks = source->ticks();
     }
 
-    // Hold the end point until every axis has arrived (fresh feedback within the window).
+    // Hold the end point until every axis has arrived (fresh feedback within the window). The
+    // window slides on: the feed-forward winds down with the demand's last velocity change.
+    prev2 = prev;
+    prev = target;
     const std::uint64_t settle_deadline =
         clock_.now() + std::uint64_t{options_.settle_timeout_ms} * 1000;
     for (;;) {
@@ -168,7 +211,10 @@ Cia402Report Cia402Master::run(const Plan& plan, const MachineProfile& profile,
                                                       " ms");
             return stop();
         }
-        exchange(enabled, target);
+        set_offsets();
+        exchange(enabled, target, &offsets);
+        prev2 = prev;
+        prev = target;
         if (check_health(true) != Cia402Stop::kNone) return stop();
     }
     if (options_.disable_at_end) {

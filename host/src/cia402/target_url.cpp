@@ -1,4 +1,5 @@
 // can://IFACE?node=N&protocol=cia402&cycle=2ms
+#include <cmath>
 #include <stdexcept>
 #include <string>
 
@@ -17,6 +18,19 @@ unsigned long number(const std::string& text, const std::string& key, const std:
     }
     if (used == 0 || used != text.size())
         throw std::invalid_argument(url + ": " + key + " wants a number, not '" + text + "'");
+    return v;
+}
+
+double positive_number(const std::string& text, const std::string& key, const std::string& url) {
+    std::size_t used = 0;
+    double v = 0;
+    try {
+        v = std::stod(text, &used);
+    } catch (const std::exception&) {
+        used = 0;
+    }
+    if (used == 0 || used != text.size() || !std::isfinite(v) || v <= 0)
+        throw std::invalid_argument(url + ": " + key + " wants a number > 0, not '" + text + "'");
     return v;
 }
 
@@ -83,15 +97,35 @@ Cia402Target parse_cia402_target(const std::string& url, std::size_t axes) {
             t.options.heartbeat_timeout_ms = hb * 3 + 50;
         } else if (key == "echo") {
             t.options.demand_echo = value == "1" || value == "true";
+        } else if (key == "ff") {
+            if (value == "none") {
+                t.options.feed_forward = Cia402FeedForward::kNone;
+            } else if (value == "velocity") {
+                t.options.feed_forward = Cia402FeedForward::kVelocity;
+            } else if (value == "torque") {
+                t.options.feed_forward = Cia402FeedForward::kTorque;
+            } else {
+                throw std::invalid_argument(url + ": ff '" + value +
+                                            "' is not none, velocity or torque");
+            }
+        } else if (key == "inertia") {
+            t.options.torque_per_acceleration = positive_number(value, key, url);
         } else {
-            throw std::invalid_argument(url + ": unknown key '" + key +
-                                        "' (node, nodes, protocol, cycle, heartbeat, echo)");
+            throw std::invalid_argument(
+                url + ": unknown key '" + key +
+                "' (node, nodes, protocol, cycle, heartbeat, echo, ff, inertia)");
         }
     }
     if (!cia402) throw std::invalid_argument(url + ": protocol=cia402 missing");
     if (t.options.nodes.empty()) {
         for (std::size_t a = 0; a < axes; ++a)
             t.options.nodes.push_back(static_cast<std::uint8_t>(1 + a));
+    }
+    if (t.options.feed_forward == Cia402FeedForward::kTorque &&
+        t.options.torque_per_acceleration == 0) {
+        throw std::invalid_argument(url +
+                                    ": ff=torque needs inertia=X (per mille of rated torque per "
+                                    "LSB/s^2)");
     }
     if (t.options.nodes.size() != axes) {
         throw std::invalid_argument(url + ": " + std::to_string(t.options.nodes.size()) +

@@ -2,8 +2,9 @@
 # two `pathstream drive --can vcan0 --node 1|2` in the background, `pathstream stream ...
 # --target can://vcan0?node=1&protocol=cia402&cycle=10ms` in the foreground, candump -L
 # capturing the bus. A 10 ms cycle because TCG timing is not a real-time one (docs/vm.md).
-# Checks: the stream completed, the capture holds NMT, SDO, SYNC, RPDO1, TPDO1 and heartbeat
-# frames of both nodes, and each drive ended where the plan ends, disabled.
+# Checks: the stream completed, the capture holds NMT, SDO, SYNC, RPDO1, RPDO2 (the velocity
+# feed-forward, on by default), TPDO1 and heartbeat frames of both nodes, and each drive ended
+# where the plan ends, disabled.
 iface=vcan0
 data=/pathstream/data
 rx_ready() { [ "$(grep -c "^ *$iface " /proc/net/can/rcvlist_all)" -ge "$1" ]; }
@@ -32,7 +33,7 @@ kill "$dump" 2>/dev/null
 wait "$dump" 2>/dev/null
 
 # candump -L lines: "(time) vcan0 ID#DATA".
-for id in 000 080 181 182 201 202 581 582 601 602 701 702; do
+for id in 000 080 181 182 201 202 301 302 581 582 601 602 701 702; do
   n=$(grep -c " $iface $id#" capture.log)
   vm_log "frames 0x$id: $n"
   [ "$n" -gt 0 ] || vm_fail "capture holds no 0x$id frame"

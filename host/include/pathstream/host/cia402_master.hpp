@@ -1,5 +1,6 @@
 // A CANopen CiA 402 cyclic synchronous position (CSP) master for third-party drives on a
-// hal::CanBus: NMT, expedited SDO configuration, RPDO1/TPDO1 (+ optional TPDO2) mapping, SYNC
+// hal::CanBus: NMT, expedited SDO configuration, RPDO1/TPDO1 (+ RPDO2 feed-forward, + optional
+// TPDO2) mapping, SYNC
 // at the cycle, heartbeat consumer, EMCY, the enable state machine, and the plan played through
 // the firmware core with one setpoint per cycle (docs/cia402.md).
 #pragma once
@@ -36,6 +37,16 @@ private:
     std::uint32_t code_;
 };
 
+/// What the master sends each cycle besides the target (docs/cia402.md "Feed-forward").
+enum class Cia402FeedForward : std::uint8_t {
+    kNone,      ///< the target only: the drive's position loop lags by 2 zeta v / omega
+    kVelocity,  ///< + velocity offset 0x60B1 (RPDO2): the exact velocity of each cycle's target
+    kTorque,    ///< + torque offset 0x60B2 from the exact acceleration (needs the inertia)
+};
+
+/// "none", "velocity", "torque".
+const char* cia402_feed_forward_name(Cia402FeedForward feed_forward);
+
 /// How the master runs the drives. Times are in milliseconds of the master's clock.
 struct Cia402Options {
     std::vector<std::uint8_t> nodes{1};  ///< node id (1..127) of the drive of each axis, path order
@@ -56,6 +67,12 @@ struct Cia402Options {
     /// which target the drive applied, and counts lost RPDOs exactly (4 more bytes per axis
     /// per cycle on the bus).
     bool demand_echo = false;
+    /// Feed-forward sent with each target: velocity (default) removes the position loop's lag
+    /// on every drive that adds 0x60B1 to its velocity loop; kNone is the target alone.
+    Cia402FeedForward feed_forward = Cia402FeedForward::kVelocity;
+    /// kTorque: the torque offset (per mille of rated torque) one LSB/s^2 of acceleration
+    /// takes, i.e. the axis's inertia over the motor's rated torque (x 1000, per LSB/s^2).
+    double torque_per_acceleration = 0;
     bool disable_at_end = true;       ///< shutdown (0x06) after the settle phase
     bool reset_communication = true;  ///< NMT reset communication before configuring
 };
@@ -124,12 +141,13 @@ struct Cia402DriveView {
 class Cia402Master {
 public:
     /// Throws std::invalid_argument for bad options (no nodes, node outside 1..127, repeated
-    /// node, zero cycle).
+    /// node, zero cycle, torque feed-forward without a finite torque_per_acceleration > 0).
     Cia402Master(hal::CanBus& bus, hal::Clock& clock_us, Cia402Options options);
 
     /// NMT reset communication (if configured) and boot-up of every node, device type check
     /// (profile 402), then over SDO: mode 8 (CSP), interpolation period (cycle_ms, index -3),
-    /// RPDO1 = controlword + target position on 0x200+n (synchronous), TPDO1 = statusword +
+    /// RPDO1 = controlword + target position on 0x200+n (synchronous), RPDO2 = velocity offset
+    /// (+ torque offset) on 0x300+n with feed-forward (else disabled), TPDO1 = statusword +
     /// position actual on 0x180+n (every SYNC), TPDO2 = position demand on 0x280+n when
     /// demand_echo, heartbeat producer time; every mapping read back; then NMT start and the
     /// operational heartbeat. Throws SdoError / Cia402Error naming node and object.
@@ -162,8 +180,11 @@ public:
     /// then disables them (disable_at_end). Checks each target against the previous ones
     /// before sending (|step| <= v_max x cycle + 1 LSB, |second difference| <= a_max x cycle^2
     /// + 2 LSB) and every cycle's feedback; on any failure it stops commanding motion (quick
-    /// stop with the last target held) and returns the report with the reason.
-    /// Throws std::invalid_argument if the plan does not fit (axes, cycle vs tick rate).
+    /// stop with the last target held) and returns the report with the reason. With
+    /// feed-forward each target goes with the velocity of the cycle it ends (its backward
+    /// difference) and, kTorque, the acceleration around that cycle (central, one cycle ahead).
+    /// Throws std::invalid_argument if the plan does not fit (axes, cycle vs tick rate, a
+    /// torque offset at a_max beyond 32767 per mille).
     Cia402Report run(const Plan& plan, const MachineProfile& profile,
                      const Cia402Progress& progress = {});
 
@@ -175,8 +196,15 @@ private:
     void send(const hal::CanFrame& frame);
     void handle(const hal::CanFrame& frame);
     void wait_until(std::uint64_t deadline_us);
+    /// Per axis: velocity offset (LSB/s) and torque offset (per mille) of one cycle.
+    struct Offsets {
+        std::vector<std::int32_t> velocity;
+        std::vector<std::int16_t> torque;
+    };
+    /// One cycle: RPDO1 (and RPDO2 with feed-forward: `offsets`, zero when null) per drive,
+    /// then SYNC, then the answers until the cycle's deadline.
     void exchange(const std::vector<std::uint16_t>& controlwords,
-                  const std::vector<std::int32_t>& targets);
+                  const std::vector<std::int32_t>& targets, const Offsets* offsets = nullptr);
     Cia402Stop check_health(bool moving);
     Cia402Stop stop_with(Cia402Stop why, const std::string& message);
     void quick_stop(const std::vector<std::int32_t>& hold);
@@ -207,7 +235,9 @@ struct Cia402Target {
 
 /// Parses a CiA 402 target for `axes` axes. Query keys: node=N (axis a on node N + a) or
 /// nodes=N1,N2,... (one per axis), protocol=cia402 (required), cycle=Kms (default 2ms),
-/// heartbeat=Kms, echo=1 (demand_echo). Throws std::invalid_argument with what is wrong.
+/// heartbeat=Kms, echo=1 (demand_echo), ff=none|velocity|torque (default velocity),
+/// inertia=X (torque_per_acceleration, required by ff=torque). Throws std::invalid_argument
+/// with what is wrong.
 Cia402Target parse_cia402_target(const std::string& url, std::size_t axes);
 
 /// The whole job on an open bus: configure(), run(). Throws Cia402Error when run() stops
