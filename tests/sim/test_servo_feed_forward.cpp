@@ -6,6 +6,7 @@
 #include <functional>
 #include <numbers>
 
+#include "pathstream/sim/matrix_exponential.hpp"
 #include "pathstream/sim/plant.hpp"
 
 using pathstream::sim::FeedForward;
@@ -131,16 +132,23 @@ TEST_CASE("servo without feed-forward: a held and an interpolated constant agree
 }
 
 TEST_CASE("matrix exponential of a rotation and of a nilpotent matrix", "[sim][servo]") {
+    using pathstream::sim::SquareMatrix;
     // exp([[0 -a] [a 0]]) is the rotation by a; a large a exercises the scaling and squaring.
     for (const double a : {0.25, 3.0, 40.0}) {
-        const auto e = pathstream::sim::matrix_exponential<2>({{{0, -a}, {a, 0}}});
-        CHECK(e[0][0] == Approx(std::cos(a)).margin(1e-12));
-        CHECK(e[0][1] == Approx(-std::sin(a)).margin(1e-12));
-        CHECK(e[1][0] == Approx(std::sin(a)).margin(1e-12));
+        SquareMatrix m(2);
+        m(0, 1) = -a;
+        m(1, 0) = a;
+        const SquareMatrix e = pathstream::sim::matrix_exponential(m);
+        CHECK(e(0, 0) == Approx(std::cos(a)).margin(1e-12));
+        CHECK(e(0, 1) == Approx(-std::sin(a)).margin(1e-12));
+        CHECK(e(1, 0) == Approx(std::sin(a)).margin(1e-12));
     }
     // A strictly upper triangular 3x3: the series ends, exp = I + N + N^2 / 2.
-    const auto e = pathstream::sim::matrix_exponential<3>({{{0, 2, 0}, {0, 0, 3}, {0, 0, 0}}});
-    CHECK(e[0][2] == Approx(3.0));
-    CHECK(e[0][1] == Approx(2.0));
-    CHECK(e[2][2] == Approx(1.0));
+    SquareMatrix n(3);
+    n(0, 1) = 2;
+    n(1, 2) = 3;
+    const SquareMatrix e = pathstream::sim::matrix_exponential(n);
+    CHECK(e(0, 2) == Approx(3.0));
+    CHECK(e(0, 1) == Approx(2.0));
+    CHECK(e(2, 2) == Approx(1.0));
 }

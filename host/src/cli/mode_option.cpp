@@ -1,10 +1,11 @@
 #include "mode_option.hpp"
 
-#include <cerrno>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
+#include <optional>
 #include <stdexcept>
+
+#include "decimal_text.hpp"
 
 namespace pathstream::host {
 namespace {
@@ -15,13 +16,9 @@ namespace {
 
 /// `part` as a whole finite decimal number, else the error names it as `what`.
 double number(const std::string& text, const std::string& part, const char* what) {
-    const char* begin = part.c_str();
-    char* end = nullptr;
-    errno = 0;
-    const double v = std::strtod(begin, &end);
-    if (part.empty() || end != begin + part.size() || errno == ERANGE || !std::isfinite(v))
-        bad(text, std::string(what) + " \"" + part + "\" is not a number");
-    return v;
+    const std::optional<double> v = decimal_text(part);
+    if (!v) bad(text, std::string(what) + " \"" + part + "\" is not a number");
+    return *v;
 }
 
 }  // namespace

@@ -24,6 +24,7 @@
 #include "pathstream/machine/exit_codes.hpp"
 #include "pathstream/sim/device.hpp"
 #include "plan_command.hpp"
+#include "shaper_option.hpp"
 #include "sim_plots.hpp"
 
 namespace pathstream::host {
@@ -66,6 +67,21 @@ void add_sim_command(CLI::App& app, SimCommandOptions& o) {
                 return "";
             },
             "AXIS:FREQ_HZ:DAMPING"));
+    cmd->add_option("--shaper", o.shapers,
+                    "the device's input shaper on an axis, AXIS:TYPE:FREQ_HZ[:DAMPING] (e.g. "
+                    "x:mzv:40; types zv, zvd, mzv, ei, 2hump_ei, 3hump_ei; damping 0.1 if not "
+                    "given), AXIS:none, or none for every axis; repeatable, in order, over the "
+                    "profile's \"input_shaper\" (docs/input-shaping.md)")
+        ->check(CLI::Validator(
+            [](std::string& text) -> std::string {
+                try {
+                    parse_shaper_option(text);
+                } catch (const std::invalid_argument& e) {
+                    return e.what();
+                }
+                return "";
+            },
+            "AXIS:TYPE:FREQ_HZ[:DAMPING]"));
     cmd->add_flag("--y-up", o.y_up,
                   "draw path.svg with +y upwards (default: downwards, like SVG and most "
                   "plotters; the 3-D view has z up)");
@@ -158,6 +174,22 @@ void machine_json(const SimCommandOptions& o, const SimRun& s, const plot::RunSu
         }
         j["plant"]["modes"] = modes;
     }
+    // The device's input shapers by axis name (docs/input-shaping.md); {} without one.
+    Json shapers = Json::object();
+    const auto specs = run_shapers(o.shapers, job.machine);
+    const auto taps = shaper_taps(specs, job.machine);
+    for (std::size_t a = 0; a < specs.size() && a < job.machine.axes.size(); ++a) {
+        if (!specs[a]) continue;
+        shapers[job.machine.axes[a].name] = {
+            {"type", shaper_type_name(specs[a]->type)},
+            {"frequency_hz", specs[a]->frequency_hz},
+            {"damping", specs[a]->damping},
+            {"taps", taps[a].size()},
+            {"duration_s", shaper_duration(taps[a], job.machine.tick_hz)}};
+    }
+    j["input_shaper"] = shapers;
+    // What the shapers cut off corners: the shaped command's distance from the planned path.
+    j["shaped_command_deviation_mm"] = s.result.shaped_command.max_mm;
 }
 
 /// A position by axis name.
@@ -326,13 +358,15 @@ sim::SimOptions device_options(const SimCommandOptions& o, const MachineProfile&
     options.servo.damping = o.damping;
     options.realtime = o.realtime;
     if (options.plant == sim::PlantModel::kServo) options.modes = run_modes(o.modes, profile);
+    options.shaper = shaper_taps(run_shapers(o.shapers, profile), profile);
     double lowest = 0;
     for (const auto& axis : options.modes)
         for (const sim::ResonantMode& m : axis)
             if (lowest == 0 || m.frequency_hz < lowest) lowest = m.frequency_hz;
     if (lowest > 0)
         options.settle_ticks =
-            sim::residual_window_ticks(profile.tick_hz, std::min(lowest, o.bandwidth_hz));
+            sim::residual_window_ticks(profile.tick_hz, std::min(lowest, o.bandwidth_hz)) +
+            sim::servo_settle_ticks(profile.tick_hz, o.bandwidth_hz, o.damping);
     return options;
 }
 
@@ -559,6 +593,15 @@ int run_sim(const SimCommandOptions& o) {
     const sim::SimulationResult& result = s.result;
     plot::RunSummary run = run_summary(result);
     run.modes = modes_line(o, job.machine, result);
+    const auto shapers = run_shapers(o.shapers, job.machine);
+    run.shaper = describe_shapers(shapers, shaper_taps(shapers, job.machine), job.machine);
+    if (!run.shaper.empty()) {
+        char deviation[96];
+        std::snprintf(deviation, sizeof deviation,
+                      "; the shaped command is up to %.1f um off the path",
+                      result.shaped_command.max_mm * 1000);
+        run.shaper += deviation;
+    }
     if (!o.plot_dir.empty()) s.record.corner = corner_window(result, job.machine);
     const bool failed =
         result.underruns != 0 || !job.check.within_limits || job.check.drawing_while_pen_moves;

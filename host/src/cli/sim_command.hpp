@@ -19,7 +19,8 @@ struct SimCommandOptions {
     std::string plant = "servo";
     double bandwidth_hz = 50;
     double damping = 1.0;
-    std::vector<std::string> modes;  ///< --mode AXIS:FREQ_HZ:DAMPING, repeatable
+    std::vector<std::string> modes;    ///< --mode AXIS:FREQ_HZ:DAMPING, repeatable
+    std::vector<std::string> shapers;  ///< --shaper AXIS:TYPE:FREQ_HZ[:DAMPING], repeatable
     bool y_up = false;
     bool json = false;        ///< --json: one JSON document on standard output instead of text
     std::string events;       ///< --events: NDJSON events to this file ("-": stdout)

@@ -212,6 +212,7 @@ std::string text_report(const PlanFigures& plan, const PlanCheck* check,
       << " Hz tick, " << fmt("%.6g", profile.mm_per_lsb) << " mm/LSB\n";
     o << "  plant      " << run.plant << "\n";
     if (!run.modes.empty()) o << "  modes      " << run.modes << "\n";
+    if (!run.shaper.empty()) o << "  shaper     " << run.shaper << "\n";
     o << "  duration   " << fmt("%.3f", f.duration) << " s planned; "
       << fmt("%.3f", run.simulated_seconds) << " s simulated in " << fmt("%.3f", run.wall_seconds)
       << " s wall";

@@ -140,7 +140,11 @@ public:
           wall_start_(std::chrono::steady_clock::now()),
           pen_(device_time_),
           residual_(Axes, residual_window_ticks(profile.tick_hz, plant_scales(options).lowest_hz),
-                    static_cast<std::uint64_t>(std::ceil(kMinStopSeconds * profile.tick_hz))),
+                    static_cast<std::uint64_t>(std::ceil(kMinStopSeconds * profile.tick_hz)),
+                    options.plant == PlantModel::kServo
+                        ? servo_settle_ticks(profile.tick_hz, options.servo.bandwidth_hz,
+                                             options.servo.damping)
+                        : 0),
           contour_(Axes, contour_back_ticks(profile.tick_hz, plant_scales(options).lag_seconds)),
           interval_(std::max<std::uint32_t>(1, options.producer_interval_ticks)),
           rows_after_end_(1 + options.settle_ticks) {
@@ -192,6 +196,7 @@ public:
         }
         r_.residual = residual_.finish();
         r_.contour = contour_.finish();
+        if (command_contour_) r_.shaped_command = command_contour_->finish();
         r_.stream.ticks_executed = stream_->ticks_executed();
         r_.stream.spans_completed = stream_->spans_completed();
         r_.stream.last_completed_tag = stream_->last_completed_tag();
@@ -230,6 +235,8 @@ private:
             }
         }
         rows_after_end_ += shaper_->longest_delay();
+        command_contour_.emplace(
+            Axes, contour_back_ticks(profile_.tick_hz, 0) + shaper_->longest_delay());
     }
 
     /// The producer task: pushes waiting spans while the queue takes them.
@@ -337,6 +344,7 @@ private:
             }
             residual_.add(command, positions, carriage);
             contour_.add(reference, positions);
+            if (command_contour_) command_contour_->add(reference, command);
             r_.ticks = k + 1;
             if (options_.tick_observer) {
                 options_.tick_observer({k, stream_->ticks_executed(), stream_->last_completed_tag(),
@@ -369,8 +377,9 @@ private:
     std::vector<std::unique_ptr<ResonantAxis>> resonant_;  // per axis with servo_; null: none
     ResidualVibrationMeter residual_;
     ContourErrorMeter contour_;
-    std::deque<CoreSpan> pending_;  // spans given, not yet taken by the device
-    std::size_t next_ = 0;          // spans the device took
+    std::optional<ContourErrorMeter> command_contour_;  // with a shaper
+    std::deque<CoreSpan> pending_;                      // spans given, not yet taken by the device
+    std::size_t next_ = 0;                              // spans the device took
     std::uint64_t ticks_pushed_ = 0;
     std::uint32_t interval_;
     std::uint64_t rows_after_end_;  // end point + settling

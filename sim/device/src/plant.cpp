@@ -4,6 +4,8 @@
 #include <numbers>
 #include <stdexcept>
 
+#include "pathstream/sim/matrix_exponential.hpp"
+
 namespace pathstream::sim {
 
 const char* plant_name(PlantModel model) {
@@ -28,19 +30,19 @@ ServoAxis::ServoAxis(const ServoParameters& p, double tick_seconds, double start
     // tick, 0 for a hold), the inputs constant. exp(M T) = [[Phi Gamma] [0 exp(N T)]]; its
     // first two rows are all a step needs.
     constexpr std::size_t n = 2 + kInputs;
-    SquareMatrix<n> m{};
+    SquareMatrix m(n);
     const double t = tick_seconds;
-    m[0][1] = t;
-    m[1][0] = -omega * omega * t;
-    m[1][1] = -2 * p.damping * omega * t;
-    m[1][2] = omega * omega * t;
-    m[1][4] = 2 * p.damping * omega * t;
-    m[1][5] = t;
-    m[2][3] = t;
-    const SquareMatrix<n> e = matrix_exponential(m);
+    m(0, 1) = t;
+    m(1, 0) = -omega * omega * t;
+    m(1, 1) = -2 * p.damping * omega * t;
+    m(1, 2) = omega * omega * t;
+    m(1, 4) = 2 * p.damping * omega * t;
+    m(1, 5) = t;
+    m(2, 3) = t;
+    const SquareMatrix e = matrix_exponential(m);
     for (std::size_t i = 0; i < 2; ++i) {
-        for (std::size_t j = 0; j < 2; ++j) phi_[i][j] = e[i][j];
-        for (std::size_t j = 0; j < kInputs; ++j) gamma_[i][j] = e[i][2 + j];
+        for (std::size_t j = 0; j < 2; ++j) phi_[i][j] = e(i, j);
+        for (std::size_t j = 0; j < kInputs; ++j) gamma_[i][j] = e(i, 2 + j);
     }
 }
 

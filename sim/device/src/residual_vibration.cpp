@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <stdexcept>
 
 namespace pathstream::sim {
@@ -11,15 +12,23 @@ std::uint64_t residual_window_ticks(double tick_hz, double lowest_hz) {
     return std::max<std::uint64_t>(1, static_cast<std::uint64_t>(std::ceil(seconds * tick_hz)));
 }
 
+std::uint64_t servo_settle_ticks(double tick_hz, double servo_hz, double servo_damping) {
+    if (!(servo_hz > 0) || !(servo_damping > 0)) return 0;
+    const double seconds = 6.64 / (std::min(1.0, servo_damping) * 2 * std::numbers::pi * servo_hz);
+    return static_cast<std::uint64_t>(std::ceil(seconds * tick_hz));
+}
+
 ResidualVibrationMeter::ResidualVibrationMeter(std::size_t axes, std::uint64_t window_ticks,
-                                               std::uint64_t min_stop_ticks)
-    : axes_(axes), window_(window_ticks), min_stop_(min_stop_ticks) {
+                                               std::uint64_t min_stop_ticks,
+                                               std::uint64_t settle_ticks)
+    : axes_(axes), window_(window_ticks), min_stop_(min_stop_ticks), settle_(settle_ticks) {
     if (axes == 0 || window_ticks == 0)
         throw std::invalid_argument("residual vibration needs an axis and a window of a tick");
     previous_.assign(axes, 0.0);
     peak_tool_.assign(axes, 0.0);
     peak_carriage_.assign(axes, 0.0);
     r_.window_ticks = window_ticks;
+    r_.settle_ticks = settle_ticks;
 }
 
 void ResidualVibrationMeter::add(const double* command_mm, const double* tool_mm,
@@ -37,7 +46,7 @@ void ResidualVibrationMeter::add(const double* command_mm, const double* tool_mm
     }
     if (!moved_) return;
     if (held_ == 0) peak_ = -1;
-    if (++held_ > window_) return;
+    if (++held_ <= settle_ || held_ > settle_ + window_) return;
     double squares = 0;
     for (std::size_t a = 0; a < axes_; ++a) {
         const double d = tool_mm[a] - carriage_mm[a];
@@ -55,7 +64,7 @@ void ResidualVibrationMeter::add(const double* command_mm, const double* tool_mm
 void ResidualVibrationMeter::close_stop(bool run_ended) {
     const std::uint64_t held = held_;
     held_ = 0;
-    if (held == 0 || (held < min_stop_ && !run_ended)) return;
+    if (held <= settle_ || (held < min_stop_ && !run_ended)) return;
     ++r_.stops;
     sum_squares_ += peak_ * peak_;
     if (r_.max_tool_mm.empty() || peak_ > r_.max_mm) {

@@ -321,6 +321,8 @@ struct RunSummary {
     std::vector<double> max_following_error_mm;  ///< per axis; empty: not measured (ideal)
     std::vector<double> rms_following_error_mm;  ///< per axis
     std::string modes;  ///< the report's modes line ("x: 40 Hz zeta 0.05 ..."); empty: none
+    /// The report's shaper line ("x: mzv 40 Hz zeta 0.1, 5 taps over 19 ms ..."); empty: none.
+    std::string shaper;
     /// Residual vibration and contour error (docs/simulator.md); not measured: not shown.
     bool motion_measured = false;
     ResidualFigures residual;

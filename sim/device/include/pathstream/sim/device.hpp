@@ -114,6 +114,10 @@ struct SimulationResult {
     ResidualVibration residual;
     /// The tool's distance from the planned setpoints' polyline, over every tick.
     ContourError contour;
+    /// With an input shaper: the shaped command's own distance from the planned setpoints'
+    /// polyline (the contour error of an ideal plant, from the exact integer setpoints): what
+    /// the shaper cuts off corners. Zero without one.
+    ContourError shaped_command;
 
     Lsb setpoint(std::uint64_t tick, std::size_t axis) const {
         return setpoints[tick * axes + axis];

@@ -16,50 +16,6 @@ enum class PlantModel {
 /// Name for reports: "ideal", "servo".
 const char* plant_name(PlantModel model);
 
-/// A square matrix of N rows, row-major.
-template <std::size_t N>
-using SquareMatrix = std::array<std::array<double, N>, N>;
-
-/// exp(m) by scaling and squaring with a Taylor series: m is halved until its infinity norm is
-/// at most 1/2, 20 terms are summed (truncation below 1e-25 relative), and the sum is squared
-/// back. Exact to rounding for the small, well-scaled systems the plants build (a linear ODE
-/// x' = A x with constant inputs held as extra states: exp(A T) is its solution over T).
-template <std::size_t N>
-SquareMatrix<N> matrix_exponential(SquareMatrix<N> m) {
-    const auto multiply = [](const SquareMatrix<N>& a, const SquareMatrix<N>& b) {
-        SquareMatrix<N> c{};
-        for (std::size_t i = 0; i < N; ++i)
-            for (std::size_t k = 0; k < N; ++k)
-                for (std::size_t j = 0; j < N; ++j) c[i][j] += a[i][k] * b[k][j];
-        return c;
-    };
-    double norm = 0;
-    for (const auto& row : m) {
-        double s = 0;
-        for (double v : row) s += std::fabs(v);
-        norm = std::fmax(norm, s);
-    }
-    int squarings = 0;
-    while (norm > 0.5) {
-        norm /= 2;
-        ++squarings;
-    }
-    const double scale = std::ldexp(1.0, -squarings);
-    for (auto& row : m)
-        for (double& v : row) v *= scale;
-    SquareMatrix<N> sum{}, term{};
-    for (std::size_t i = 0; i < N; ++i) sum[i][i] = term[i][i] = 1;
-    for (int n = 1; n <= 20; ++n) {
-        term = multiply(term, m);
-        for (auto& row : term)
-            for (double& v : row) v /= n;
-        for (std::size_t i = 0; i < N; ++i)
-            for (std::size_t j = 0; j < N; ++j) sum[i][j] += term[i][j];
-    }
-    for (int i = 0; i < squarings; ++i) sum = multiply(sum, sum);
-    return sum;
-}
-
 /// A position-controlled axis as a second-order system from setpoint u to position x, with
 /// the velocity and acceleration feed-forward a servo drive adds to its inner loops:
 ///   x'' = omega^2 (u - x) + 2 zeta omega (v_ff - x') + a_ff,   omega = 2 pi bandwidth_hz.
