@@ -8,6 +8,7 @@
 #include <stdexcept>
 #include <system_error>
 
+#include "cli/calibrate_command.hpp"
 #include "cli/check_command.hpp"
 #include "cli/ctl_command.hpp"
 #include "cli/drive_command.hpp"
@@ -51,6 +52,8 @@ int main(int argc, char** argv) {
     pathstream::host::add_ctl_command(app, ctl);
     pathstream::host::ServeCommandOptions serve;
     pathstream::host::add_serve_command(app, serve);
+    pathstream::host::CalibrateOptions calibrate;
+    pathstream::host::add_calibrate_command(app, calibrate);
 
     return pathstream::device_cli::parse_and_run(app, argc, argv, [&]() -> int {
         try {
@@ -64,6 +67,7 @@ int main(int argc, char** argv) {
             if (app.got_subcommand("drive")) return pathstream::host::run_drive(drive);
             if (app.got_subcommand("ctl")) return pathstream::host::run_ctl(ctl);
             if (app.got_subcommand("serve")) return pathstream::host::run_serve(serve);
+            if (app.got_subcommand("calibrate")) return pathstream::host::run_calibrate(calibrate);
         } catch (const pathstream::host::PlanError& e) {
             std::cerr << "pathstream: planning failed: " << e.what() << '\n';
             return kExitPlanning;

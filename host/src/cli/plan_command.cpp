@@ -2,10 +2,13 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <iostream>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <stdexcept>
+#include <string>
+#include <vector>
 
 #include "pathstream/host/core_playback.hpp"
 #include "pathstream/host/job_estimate.hpp"
@@ -16,6 +19,8 @@
 #include "pathstream/host/work_area.hpp"
 #include "pathstream/machine/atomic_file.hpp"
 #include "pathstream/machine/input_error.hpp"
+#include "pathstream/sim/device.hpp"
+#include "shaper_option.hpp"
 
 namespace pathstream::host {
 
@@ -199,6 +204,18 @@ class StreamedPlan : public PlanSink {
 public:
     StreamedPlan(PlannedJob& job, const std::string& file, std::ostream* csv)
         : job_(job), file_(file), checked_path_(job.path) {
+        // With an input shaper in the profile, the device's shaped command is played too (an
+        // ideal plant: the setpoints themselves) to measure how far it leaves the path.
+        shapers_ = run_shapers({}, job.machine);
+        taps_ = shaper_taps(shapers_, job.machine);
+        bool any = false;
+        for (const auto& t : taps_) any = any || !t.empty();
+        if (any) {
+            sim::SimOptions so;
+            so.record_ticks = false;
+            so.shaper = taps_;
+            shaped_.emplace(job.machine, so);
+        }
         if (csv != nullptr) {
             checker_.emplace(checked_path_, job.machine);
             write_plan_header(job.path.axes, *csv);
@@ -212,6 +229,7 @@ public:
         check_span_travel(s, spans_++, job_.path, job_.machine, file_);
         job_.outputs.add(s);
         if (checker_) checker_->span(s);
+        if (shaped_) shaped_->push(s);
     }
     void pen(const PenEvent& e) override {
         if (checker_) checker_->pen(e);
@@ -242,7 +260,23 @@ public:
         job_.span_count = totals.spans;
         job_.pen_count = totals.pen_changes;
         job_.pause_count = totals.pauses;
+        if (shaped_ && totals.spans > 0)
+            shaped_deviation_ = shaped_->finish().shaped_command.max_mm;
     }
+
+    /// The input shaper line of the summary ("" without one): each axis's shaper and how far
+    /// the shaped command leaves the path, against the chord tolerance.
+    std::string shaper_line() const {
+        if (!shaped_deviation_) return "";
+        char tail[160];
+        std::snprintf(tail, sizeof tail,
+                      "; the shaped command is up to %.2f um off the path (chord tolerance "
+                      "%.2f um)",
+                      *shaped_deviation_ * 1000, job_.machine.chord_tolerance * 1000);
+        return "  input shaper: " + describe_shapers(shapers_, taps_, job_.machine) + tail + "\n";
+    }
+    /// The shaped command's largest distance from the path, mm; nothing without a shaper.
+    std::optional<double> shaped_deviation() const { return shaped_deviation_; }
 
 private:
     PlannedJob& job_;
@@ -250,6 +284,10 @@ private:
     PathSegmentSource checked_path_;  ///< the check's own pass over the path
     std::optional<PlanChecker> checker_;
     std::size_t spans_ = 0;
+    std::vector<std::optional<ShaperSpec>> shapers_;
+    std::vector<std::vector<ShaperTap>> taps_;
+    std::optional<sim::Simulator> shaped_;
+    std::optional<double> shaped_deviation_;
 };
 
 }  // namespace
@@ -263,11 +301,18 @@ int run_plan(const PlanCommandOptions& o) {
     if (o.preview) return run_plan_preview(o);
     PlannedJob job = prepare_streamed_job(o.path, o.machine);
     refuse_long_motion(job, o.max_motion);
+    std::string shaper_line;
+    std::optional<double> shaped_deviation;
+    const auto plan = [&](std::ostream* csv) {
+        StreamedPlan streamed(job, o.path.file, csv);
+        streamed.run();
+        shaper_line = streamed.shaper_line();
+        shaped_deviation = streamed.shaped_deviation();
+    };
     if (o.output.empty()) {
-        StreamedPlan(job, o.path.file, nullptr).run();
+        plan(nullptr);
     } else {
-        write_output(o.output,
-                     [&](std::ostream& csv) { StreamedPlan(job, o.path.file, &csv).run(); });
+        write_output(o.output, [&](std::ostream& csv) { plan(&csv); });
     }
     const bool failed = !job.check.within_limits || job.check.drawing_while_pen_moves;
     // With --json, standard output holds the document or, on failure, nothing: the text
@@ -277,6 +322,7 @@ int run_plan(const PlanCommandOptions& o) {
         text << "pathstream plan: " << path_display_name(o.path.file) << " on " << o.machine
              << (o.output.empty() ? "" : " -> " + o.output) << '\n';
         print_plan_summary(job, text);
+        text << shaper_line;
     }
     if (failed) {
         // Name the rule the plan broke: the jerk limit is checked with the others.
@@ -289,7 +335,13 @@ int run_plan(const PlanCommandOptions& o) {
         throw PlanError(
             "the plan failed its per-tick check (a planner bug): see the summary above");
     }
-    if (o.json) std::cout << plan_summary_json(o, job).dump(2) << '\n';
+    if (o.json) {
+        auto j = plan_summary_json(o, job);
+        // The device's input shaper (docs/input-shaping.md): null without one.
+        j["shaped_command_deviation_mm"] =
+            shaped_deviation ? nlohmann::ordered_json(*shaped_deviation) : nullptr;
+        std::cout << j.dump(2) << '\n';
+    }
     return 0;
 }
 
