@@ -7,12 +7,12 @@
 // own distance from the path (the ideal plant: what the shaper cuts off corners, from the
 // exact integer setpoints), and the limit check of every shaped tick against the unshaped.
 //   bench_shaping [--quick] [--markdown] [--help]
-// Targets (independent of the machine's speed): with the mode at the tuned frequency MZV and
-// EI cut the residual vibration at least 20x; with the mode 20 % off the EI family at least
-// 5x; no shaped tick moves faster than the fastest unshaped tick or accelerates harder than
-// the hardest unshaped one plus the one LSB/tick^2 of rounding (docs/input-shaping.md).
-// Exit status (also printed by --help): 0 targets met, 1 a target missed, 2 usage error, 3 a
-// drawing could not be planned or run.
+// Targets (independent of the machine's speed): with the mode at the tuned frequency MZV cuts
+// the residual vibration at least 20x (EI is designed to leave its 5 % tolerance there: 20x at
+// best, printed, not held); with the mode 20 % off the EI family at least 5x; no shaped tick moves
+// faster than the fastest unshaped tick or accelerates harder than the hardest unshaped one plus
+// the one LSB/tick^2 of rounding (docs/input-shaping.md). Exit status (also printed by --help): 0
+// targets met, 1 a target missed, 2 usage error, 3 a drawing could not be planned or run.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -50,8 +50,8 @@ constexpr const char* kUsageText =
     "  distance from the path and the limit check.\n"
     "  --quick     examples/wave.json and the zigzag, one mode (the ctest smoke run)\n"
     "  --markdown  the tables in Markdown\n"
-    "targets (independent of the machine's speed): MZV and EI cut the residual vibration at\n"
-    "least 20x at the tuned frequency; the EI family at least 5x with the mode 20 % off; no\n"
+    "targets (independent of the machine's speed): MZV cuts the residual vibration at least\n"
+    "20x at the tuned frequency; the EI family at least 5x with the mode 20 % off; no\n"
     "shaped tick exceeds the unshaped run's velocity, nor its acceleration by more than the\n"
     "one LSB/tick^2 of rounding.\n"
     "exit status: 0 targets met; 1 a target missed; 2 usage error; 3 a drawing could not be\n"
@@ -215,7 +215,9 @@ int main(int argc, char** argv) {
                     r.limits_ok = command.peak_step <= plain.peak_step &&
                                   command.peak_second <= plain.peak_second + 1;
                     rows.push_back(r);
-                    const bool tuned_class = type == ShaperType::kMzv || type == ShaperType::kEi;
+                    // 20x at the tuned frequency is MZV's goal: EI is designed to leave its 5 %
+                    // tolerance there (a 20x cut at best), and is held to the off-tune goal.
+                    const bool tuned_class = type == ShaperType::kMzv;
                     const bool ei_class = type == ShaperType::kEi ||
                                           type == ShaperType::kTwoHumpEi ||
                                           type == ShaperType::kThreeHumpEi;
@@ -245,7 +247,7 @@ int main(int argc, char** argv) {
         }
     }
     std::printf(
-        "\ntargets: MZV and EI cut >= 20x tuned, EI family >= 5x 20 %% off (one mode); "
+        "\ntargets: MZV cuts >= 20x tuned, the EI family >= 5x 20 %% off (one mode); "
         "limits on every shaped tick: %s\n",
         met ? "met" : "MISSED");
     return met ? 0 : kExitTargetMissed;
