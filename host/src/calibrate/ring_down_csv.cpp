@@ -1,6 +1,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -38,8 +39,15 @@ std::vector<Cell> cells(const std::string& line) {
 }  // namespace
 
 RingDownSamples load_ring_down_csv(const std::string& file) {
-    std::ifstream in(file);
+    std::ifstream in(file, std::ios::binary);
     if (!in) throw InputError(file, {}, "cannot open the ring-down file");
+    std::ostringstream text;
+    text << in.rdbuf();
+    return parse_ring_down_csv(text.str(), file);
+}
+
+RingDownSamples parse_ring_down_csv(const std::string& text, const std::string& file) {
+    std::istringstream in(text);
     RingDownSamples s;
     std::size_t time_column = 0, value_column = 0, columns = 0, line_number = 0;
     bool header = false;
