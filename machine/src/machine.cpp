@@ -54,7 +54,8 @@ public:
         only_keys(root, "",
                   {"axes", "mm_per_lsb", "tick_hz", "ticks_per_span", "feed", "travel_feed",
                    "pen_down_delay", "pen_up_delay", "chord_tolerance", "corner_stop_angle", "gpio",
-                   "layer_feeds", "spindle", "output_coils", "input_shaper", "resonance"});
+                   "layer_feeds", "spindle", "output_coils", "input_shaper", "resonance",
+                   "plan_for_shaper"});
         MachineProfile p;
         if (!root.contains("axes")) fail("", "machine profile has no \"axes\"");
         const json& axes = root["axes"];
@@ -152,6 +153,15 @@ public:
         if (root.contains("output_coils")) p.output_coils = output_coils(root["output_coils"]);
         p.input_shaper.assign(p.axes.size(), std::nullopt);
         if (root.contains("input_shaper")) input_shaper(root["input_shaper"], p);
+        if (root.contains("plan_for_shaper")) {
+            if (!root["plan_for_shaper"].is_boolean())
+                fail("/plan_for_shaper", "plan_for_shaper must be true or false");
+            p.plan_for_shaper = root["plan_for_shaper"].get<bool>();
+            bool any = false;
+            for (const auto& s : p.input_shaper) any = any || s.has_value();
+            if (p.plan_for_shaper && !any)
+                fail("/plan_for_shaper", "plan_for_shaper needs an \"input_shaper\" to plan for");
+        }
         if (root.contains("resonance")) p.resonance = resonance(root["resonance"], p);
         if (root.contains("layer_feeds")) {
             const json& f = root["layer_feeds"];

@@ -8,6 +8,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "pathstream/machine/machine.hpp"
+
 namespace pathstream::host {
 namespace {
 
@@ -170,6 +172,35 @@ double residual_vibration_ratio(const std::vector<ShaperTap>& taps, double tick_
                std::complex<double>(std::cos(omega_d * t), std::sin(omega_d * t));
     }
     return std::abs(sum);
+}
+
+ShaperSpread shaper_spread(const std::vector<ShaperTap>& taps, double tick_hz) {
+    ShaperSpread s;
+    if (taps.empty()) return s;
+    double mean = 0;
+    for (const ShaperTap& t : taps)
+        mean += static_cast<double>(t.weight) / kShaperWeightOne * t.delay / tick_hz;
+    for (const ShaperTap& t : taps) {
+        const double w = static_cast<double>(t.weight) / kShaperWeightOne;
+        const double d = t.delay / tick_hz - mean;
+        s.variance += w * d * d;
+        s.spread += w * std::fabs(d);
+    }
+    s.longest_delay = taps.back().delay;
+    return s;
+}
+
+ShaperSpread profile_shaper_spread(const MachineProfile& profile) {
+    ShaperSpread most;
+    for (const auto& spec : profile.input_shaper) {
+        if (!spec) continue;
+        const ShaperSpread s = shaper_spread(
+            design_shaper_taps(*spec, profile.tick_hz, kDeviceShaperHistoryTicks), profile.tick_hz);
+        most.variance = std::max(most.variance, s.variance);
+        most.spread = std::max(most.spread, s.spread);
+        most.longest_delay = std::max(most.longest_delay, s.longest_delay);
+    }
+    return most;
 }
 
 double shaper_duration(const std::vector<ShaperTap>& taps, double tick_hz) {

@@ -74,7 +74,8 @@ TEST_CASE("impossible profiles are refused with the place and the reason", "[hos
           "m.json:1:83: unknown key \"speed\" (expected one of: axes, chord_tolerance, "
           "corner_stop_angle, feed, gpio, input_shaper, "
           "layer_feeds, mm_per_lsb, output_coils, "
-          "pen_down_delay, pen_up_delay, resonance, spindle, tick_hz, ticks_per_span, "
+          "pen_down_delay, pen_up_delay, plan_for_shaper, resonance, spindle, tick_hz, "
+          "ticks_per_span, "
           "travel_feed)");
     CHECK(error_of(std::string("{") + kAxes + ", \"spindle\": {\"spin_up\": -1}}") ==
           "m.json:1:97: spin_up -1 s is impossible (allowed: >= 0 and <= 600 s)");

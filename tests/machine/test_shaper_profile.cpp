@@ -67,3 +67,17 @@ TEST_CASE("shaper profile: bad values are refused with the place and the reason"
     CHECK(error_of(with_shaper(R"({"x": {"type": "ei", "frequency": 40, "damping": 1}})"))
               .find("damping 1") != std::string::npos);
 }
+
+TEST_CASE("shaper profile: plan_for_shaper is a boolean and needs a shaper",
+          "[host][machine][shaper]") {
+    const MachineProfile p = parse_machine_profile(
+        std::string("{") + kAxes +
+            ",\n\"input_shaper\": {\"x\": {\"type\": \"zv\", \"frequency\": 40}},\n"
+            "\"plan_for_shaper\": true}",
+        "m.json");
+    CHECK(p.plan_for_shaper);
+    CHECK(error_of(std::string("{") + kAxes + ",\n\"plan_for_shaper\": true}") ==
+          "m.json:3:20: plan_for_shaper needs an \"input_shaper\" to plan for");
+    CHECK(error_of(std::string("{") + kAxes + ",\n\"plan_for_shaper\": 1}") ==
+          "m.json:3:20: plan_for_shaper must be true or false");
+}

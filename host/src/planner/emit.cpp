@@ -33,6 +33,7 @@ namespace pathstream::host::planner_detail {
 SpanEmitter::SpanEmitter(const MachineProfile& profile, std::size_t axes, const Vec& start_mm)
     : profile_(profile), axes_(axes) {
     pos_ = quantise(start_mm);
+    if (profile.plan_for_shaper) shaper_rest_ticks_ = profile_shaper_spread(profile).longest_delay;
 }
 
 SpanEmitter::LsbVec SpanEmitter::quantise(const Vec& mm) const {
@@ -54,6 +55,15 @@ void SpanEmitter::release() {
 
 void SpanEmitter::span(const LsbVec& p1, const LsbVec& t0, const LsbVec& t1, std::uint32_t ticks,
                        std::size_t subpath, bool pen_down) {
+    // With plan_for_shaper, motion that stopped rests the shapers' longest delay before it moves
+    // again: no window of the shaped command then holds points of both legs of a corner, so it
+    // turns the corner exactly instead of cutting it.
+    const bool moves = p1 != pos_ || t0 != LsbVec{} || t1 != LsbVec{};
+    if (moves && t0 == LsbVec{} && rested_ticks_ < shaper_rest_ticks_)
+        dwell(shaper_rest_ticks_ - rested_ticks_, subpath, last_pen_down_);
+    // Still ticks at the end of the plan so far: 0 after a span that moves (one that ends at
+    // rest starts the count).
+    rested_ticks_ = moves ? 0 : rested_ticks_ + ticks;
     PlanEvent ev;
     CoreSpan& s = ev.span;
     if (!spare_.empty()) {  // a span taken back: its vectors' storage, emptied

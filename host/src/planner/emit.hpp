@@ -5,6 +5,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -107,6 +108,9 @@ private:
     std::size_t motion_spans_ = 0;
     std::uint64_t motion_ticks_ = 0, dwell_ticks_ = 0, spin_up_ticks_ = 0;
     std::size_t spin_ups_ = 0;
+    std::uint32_t shaper_rest_ticks_ = 0;  ///< plan_for_shaper: the rest before moving again
+    /// Still ticks since the last span that moved (the start counts as a long rest).
+    std::uint64_t rested_ticks_ = std::numeric_limits<std::uint32_t>::max();
 };
 
 }  // namespace pathstream::host::planner_detail

@@ -64,6 +64,8 @@ std::vector<double> speed_caps(const PathGrid& pg, const Limits& limits,
     const Grid& g = pg.grid;
     const double tick = 1.0 / profile.tick_hz;
     const double delta = profile.chord_tolerance;
+    const ShaperSpread shaper =
+        profile.plan_for_shaper ? profile_shaper_spread(profile) : ShaperSpread{};
     std::vector<double> caps(g.size(), kNoCap);
     for (std::size_t k = 0; k < g.size(); ++k) {
         // The node's regular span: longer where its feed is far below an LSB per span.
@@ -102,6 +104,13 @@ std::vector<double> speed_caps(const PathGrid& pg, const Limits& limits,
                 if (j > 0) s = std::min(s, limits.acceleration[i] * window / j);
             }
             s = std::min(s, 0.45 * delta / (0.1407 * span * jump));
+        }
+        // Input shaping (docs/input-shaping.md): the device's shaped command runs inside a bend
+        // by about s^2 kappa variance / 2 and cuts a corner crossed at speed s by about
+        // s |J| spread / 2; with plan_for_shaper keep each within half the tolerance.
+        if (shaper.variance > 0) {
+            if (kappa > 0) s = std::min(s, std::sqrt(delta / (kappa * shaper.variance)));
+            if (jump > 0) s = std::min(s, delta / (jump * shaper.spread));
         }
         caps[k] = std::min(kNoCap, s * s);
     }

@@ -125,6 +125,11 @@ struct MachineProfile {
     /// Optional "input_shaper": per axis (path order, one entry per axis), the shaper the
     /// device applies to its setpoints, or none (docs/input-shaping.md).
     std::vector<std::optional<ShaperSpec>> input_shaper;
+    /// Optional "plan_for_shaper": the planner slows bends and corners and rests at stops for
+    /// the shapers' longest delay so that the device's shaped command stays on the path within
+    /// the chord tolerance (docs/input-shaping.md); false: the plan is unshaped's, and plan and
+    /// sim report how far the shaped command leaves the path.
+    bool plan_for_shaper = false;
     /// Optional "layer_feeds": pen-down speed (mm/s) per layer name (an Inkscape layer's label,
     /// a stroke colour such as "#ff0000"), for subpaths that set no feed of their own.
     std::vector<std::pair<std::string, double>> layer_feeds;

@@ -12,6 +12,8 @@
 
 namespace pathstream::host {
 
+struct MachineProfile;  // machine.hpp, which includes this header
+
 /// Setpoints each axis of the Linux device and the simulator remembers for its shaper: the
 /// longest tap delay is one less (0.41 s at 10 kHz, a 3-hump EI down to 5 Hz).
 inline constexpr std::uint32_t kDeviceShaperHistoryTicks = 4096;
@@ -71,5 +73,22 @@ double residual_vibration_ratio(const std::vector<ShaperTap>& taps, double tick_
 /// Seconds from the first tap to the last: the time the shaped motion needs to settle after the
 /// command stops.
 double shaper_duration(const std::vector<ShaperTap>& taps, double tick_hz);
+
+/// The spread of a shaper's delays, which sets how much it smooths the path: on a bend of
+/// curvature k crossed at speed s the shaped command runs about s^2 k variance / 2 inside it;
+/// through a corner whose unit tangent jumps by J at speed s, about s |J| spread / 2 off it.
+struct ShaperSpread {
+    double variance = 0;              ///< s^2: sum w_i (t_i - mean)^2 of the taps' delays
+    double spread = 0;                ///< s: sum w_i |t_i - mean|, the mean absolute deviation
+    std::uint32_t longest_delay = 0;  ///< ticks
+};
+
+/// The spread of `taps` at `tick_hz` (zeros for none). O(taps).
+ShaperSpread shaper_spread(const std::vector<ShaperTap>& taps, double tick_hz);
+
+/// The largest spread over a profile's axes' shapers at its tick rate (each designed for
+/// kDeviceShaperHistoryTicks), what the planner allows for: variance, spread and longest
+/// delay each the largest of any axis. Zeros without a shaper. O(axes taps).
+ShaperSpread profile_shaper_spread(const MachineProfile& profile);
 
 }  // namespace pathstream::host
