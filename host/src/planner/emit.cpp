@@ -131,6 +131,10 @@ void SpanEmitter::dwell(std::uint64_t ticks, std::size_t subpath, bool pen_down)
 }
 
 void SpanEmitter::pen(bool down, std::size_t subpath, bool last) {
+    // Planned for the shaper, the pen changes once the shaped axes have arrived too: a stroke's
+    // end is drawn before the pen lifts, and the pen lands where the shaped travel ends.
+    if (rested_ticks_ < shaper_rest_ticks_ && any_span_)
+        dwell(shaper_rest_ticks_ - rested_ticks_, subpath, pen_);
     release();
     PlanEvent ev;
     ev.kind = PlanEvent::Kind::kPen;
