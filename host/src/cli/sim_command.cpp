@@ -596,10 +596,11 @@ int run_sim(const SimCommandOptions& o) {
     const auto shapers = run_shapers(o.shapers, job.machine);
     run.shaper = describe_shapers(shapers, shaper_taps(shapers, job.machine), job.machine);
     if (!run.shaper.empty()) {
-        char deviation[96];
+        char deviation[160];
         std::snprintf(deviation, sizeof deviation,
-                      "; the shaped command is up to %.1f um off the path",
-                      result.shaped_command.max_mm * 1000);
+                      "; the shaped command is up to %.1f um off the path (tolerance %.1f um%s)",
+                      result.shaped_command.max_mm * 1000, job.machine.chord_tolerance * 1000,
+                      job.machine.plan_for_shaper ? ", planned for it" : "");
         run.shaper += deviation;
     }
     if (!o.plot_dir.empty()) s.record.corner = corner_window(result, job.machine);
