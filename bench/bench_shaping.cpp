@@ -19,7 +19,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <cstring>
 #include <exception>
 #include <filesystem>
 #include <fstream>
@@ -27,6 +26,7 @@
 #include <string>
 #include <vector>
 
+#include "bench_args.hpp"
 #include "pathstream/host/csv_path.hpp"
 #include "pathstream/host/gcode_path.hpp"
 #include "pathstream/host/geometry.hpp"
@@ -41,7 +41,7 @@ using host::ShaperType;
 
 namespace {
 
-constexpr int kExitTargetMissed = 1, kExitUsage = 2, kExitRunFailed = 3;
+constexpr int kExitTargetMissed = 1, kExitRunFailed = 3;  // 2, a usage error: bench_args.hpp
 constexpr double kModeHz = 40, kModeDamping = 0.05;
 
 constexpr const char* kUsageText =
@@ -145,20 +145,9 @@ struct Row {
 }  // namespace
 
 int main(int argc, char** argv) {
-    bool quick = false, markdown = false;
-    for (int i = 1; i < argc; ++i) {
-        if (std::strcmp(argv[i], "--quick") == 0) {
-            quick = true;
-        } else if (std::strcmp(argv[i], "--markdown") == 0) {
-            markdown = true;
-        } else if (std::strcmp(argv[i], "--help") == 0) {
-            std::fputs(kUsageText, stdout);
-            return 0;
-        } else {
-            std::fputs(kUsageText, stderr);
-            return kExitUsage;
-        }
-    }
+    bench::BenchArgs args;
+    if (const auto exit = bench::parse_bench_args(argc, argv, kUsageText, args)) return *exit;
+    const bool quick = args.quick, markdown = args.markdown;
     std::vector<std::string> names{"wave.json", "zigzag"};
     if (!quick) names.insert(names.end(), {"rose.json", "star.csv", "leaf.ngc", "spikes"});
     const host::MachineProfile machine = host::load_machine_profile(

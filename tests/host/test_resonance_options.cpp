@@ -5,28 +5,23 @@
 #include <string>
 
 #include "mode_option.hpp"
-#include "pathstream/machine/input_error.hpp"
 #include "pathstream/machine/machine.hpp"
+#include "profile_text.hpp"
 
+using namespace pathstream;
 using namespace pathstream::host;
 
 namespace {
 
-const char* kAxes = R"("axes": [{"name": "x", "max_velocity": 100, "max_acceleration": 1000},
-                                {"name": "y", "max_velocity": 100, "max_acceleration": 1000}])";
+using test::kTwoAxes;
 
 // Line 3 of the document starts with `"resonance": ` (13 columns) before the object.
 std::string with_resonance(const std::string& resonance) {
-    return std::string("{") + kAxes + ",\n\"resonance\": " + resonance + "}";
+    return test::with_key("resonance", resonance);
 }
 
 std::string error_of(const std::string& text) {
-    try {
-        parse_machine_profile(text, "m.json");
-    } catch (const InputError& e) {
-        return e.what();
-    }
-    return "no error";
+    return test::profile_error(text);
 }
 
 std::string mode_error(const std::vector<std::string>& options, const MachineProfile& p) {
@@ -41,7 +36,7 @@ std::string mode_error(const std::vector<std::string>& options, const MachinePro
 }  // namespace
 
 TEST_CASE("resonance profile: modes by axis name, in axis order", "[machine][resonance]") {
-    const MachineProfile none = parse_machine_profile(std::string("{") + kAxes + "}", "m.json");
+    const MachineProfile none = parse_machine_profile(std::string("{") + kTwoAxes + "}", "m.json");
     CHECK(none.resonance.empty());
     const MachineProfile p =
         parse_machine_profile(with_resonance(R"({"y": [{"frequency": 40, "damping": 0.05},
@@ -121,7 +116,7 @@ TEST_CASE("sim --mode replaces the profile's modes of its axis", "[host][resonan
     CHECK(merged[1][0].frequency_hz == 30);
     CHECK(merged[1][1].damping == 0.2);
     CHECK(describe_modes(merged, p) == "x: 40 Hz zeta 0.05; y: 30 Hz zeta 0.02, 90 Hz zeta 0.2");
-    const MachineProfile bare = parse_machine_profile(std::string("{") + kAxes + "}", "m.json");
+    const MachineProfile bare = parse_machine_profile(std::string("{") + kTwoAxes + "}", "m.json");
     CHECK(run_modes({}, bare).empty());
     CHECK(mode_error({"q:40:0.1"}, bare) ==
           "--mode q:40:0.1: axis \"q\" is not in the machine profile (axes: x, y)");

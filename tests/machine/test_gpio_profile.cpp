@@ -4,27 +4,21 @@
 #include <catch2/catch.hpp>
 #include <string>
 
-#include "pathstream/machine/input_error.hpp"
 #include "pathstream/machine/machine.hpp"
+#include "profile_text.hpp"
 
 using namespace pathstream::host;
 
 namespace {
-const char* kAxes = R"("axes": [{"name": "x", "max_velocity": 100, "max_acceleration": 1000},
-                                {"name": "y", "max_velocity": 100, "max_acceleration": 1000}])";
+const char* kAxes = pathstream::test::kTwoAxes;
 
 // Line 3 of the document starts with `"gpio": ` (8 columns) before the object.
 std::string with_gpio(const std::string& gpio) {
-    return std::string("{") + kAxes + ",\n\"gpio\": " + gpio + "}";
+    return pathstream::test::with_key("gpio", gpio);
 }
 
 std::string error_of(const std::string& text) {
-    try {
-        parse_machine_profile(text, "m.json");
-    } catch (const InputError& e) {
-        return e.what();
-    }
-    return "no error";
+    return pathstream::test::profile_error(text);
 }
 }  // namespace
 
@@ -136,7 +130,7 @@ TEST_CASE("gpio profile: spindle, its direction, mist and flood lines", "[host][
 namespace {
 // Line 3 of the document starts with `"output_coils": ` (16 columns) before the object.
 std::string with_coils(const std::string& coils) {
-    return std::string("{") + kAxes + ",\n\"output_coils\": " + coils + "}";
+    return pathstream::test::with_key("output_coils", coils);
 }
 }  // namespace
 

@@ -3,32 +3,25 @@
 #include <catch2/catch.hpp>
 #include <string>
 
-#include "pathstream/machine/input_error.hpp"
 #include "pathstream/machine/machine.hpp"
+#include "profile_text.hpp"
 
+using namespace pathstream;
 using namespace pathstream::host;
 
 namespace {
-const char* kAxes = R"("axes": [{"name": "x", "max_velocity": 100, "max_acceleration": 1000},
-                                {"name": "y", "max_velocity": 100, "max_acceleration": 1000}])";
-
+using test::kTwoAxes;
 // Line 3 of the document starts with `"input_shaper": ` (16 columns) before the object.
 std::string with_shaper(const std::string& shaper) {
-    return std::string("{") + kAxes + ",\n\"input_shaper\": " + shaper + "}";
+    return test::with_key("input_shaper", shaper);
 }
-
 std::string error_of(const std::string& text) {
-    try {
-        parse_machine_profile(text, "m.json");
-    } catch (const InputError& e) {
-        return e.what();
-    }
-    return "no error";
+    return test::profile_error(text);
 }
 }  // namespace
 
 TEST_CASE("shaper profile: one shaper per named axis", "[host][machine][shaper]") {
-    const MachineProfile none = parse_machine_profile(std::string("{") + kAxes + "}", "m.json");
+    const MachineProfile none = parse_machine_profile(std::string("{") + kTwoAxes + "}", "m.json");
     REQUIRE(none.input_shaper.size() == 2);
     CHECK_FALSE(none.input_shaper[0]);
     const MachineProfile p = parse_machine_profile(
@@ -71,13 +64,13 @@ TEST_CASE("shaper profile: bad values are refused with the place and the reason"
 TEST_CASE("shaper profile: plan_for_shaper is a boolean and needs a shaper",
           "[host][machine][shaper]") {
     const MachineProfile p = parse_machine_profile(
-        std::string("{") + kAxes +
+        std::string("{") + kTwoAxes +
             ",\n\"input_shaper\": {\"x\": {\"type\": \"zv\", \"frequency\": 40}},\n"
             "\"plan_for_shaper\": true}",
         "m.json");
     CHECK(p.plan_for_shaper);
-    CHECK(error_of(std::string("{") + kAxes + ",\n\"plan_for_shaper\": true}") ==
+    CHECK(error_of(std::string("{") + kTwoAxes + ",\n\"plan_for_shaper\": true}") ==
           "m.json:3:20: plan_for_shaper needs an \"input_shaper\" to plan for");
-    CHECK(error_of(std::string("{") + kAxes + ",\n\"plan_for_shaper\": 1}") ==
+    CHECK(error_of(std::string("{") + kTwoAxes + ",\n\"plan_for_shaper\": 1}") ==
           "m.json:3:20: plan_for_shaper must be true or false");
 }

@@ -5,7 +5,7 @@
 #include <optional>
 #include <stdexcept>
 
-#include "decimal_text.hpp"
+#include "option_parts.hpp"
 
 namespace pathstream::host {
 namespace {
@@ -53,12 +53,10 @@ std::vector<std::vector<sim::ResonantMode>> run_modes(const std::vector<std::str
     for (const std::string& text : options) {
         const ModeOption o = parse_mode_option(text);
         std::size_t a = 0;
-        while (a < axes && profile.axes[a].name != o.axis) ++a;
-        if (a == axes) {
-            std::string names;
-            for (const AxisLimits& x : profile.axes) names += (names.empty() ? "" : ", ") + x.name;
-            bad(text,
-                "axis \"" + o.axis + "\" is not in the machine profile (axes: " + names + ")");
+        try {
+            a = profile_axis(profile, o.axis);
+        } catch (const std::invalid_argument& e) {
+            bad(text, e.what());
         }
         try {
             sim::check_resonant_mode(o.mode, profile.tick_hz);

@@ -3,7 +3,7 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "decimal_text.hpp"
+#include "option_parts.hpp"
 
 namespace pathstream::host {
 namespace {
@@ -68,12 +68,10 @@ std::vector<std::optional<ShaperSpec>> run_shapers(const std::vector<std::string
             continue;
         }
         std::size_t a = 0;
-        while (a < axes && profile.axes[a].name != o.axis) ++a;
-        if (a == axes) {
-            std::string names;
-            for (const AxisLimits& x : profile.axes) names += (names.empty() ? "" : ", ") + x.name;
-            bad(text,
-                "axis \"" + o.axis + "\" is not in the machine profile (axes: " + names + ")");
+        try {
+            a = profile_axis(profile, o.axis);
+        } catch (const std::invalid_argument& e) {
+            bad(text, e.what());
         }
         specs[a] = o.spec;
     }
