@@ -56,6 +56,21 @@ if not (rb * 10 < ra): print("residual", ra, rb); sys.exit(1)
 if set(b["input_shaper"]) != {"x"} or b["shaped_command_deviation_mm"] <= 0: print(b["input_shaper"]); sys.exit(1)
 PY
 
+# The device shapes with the profile's shapers and logs each one (docs/events.schema.json).
+"$bin" device -m "$src/examples/machines/shaped_plotter.json" --no-gpio --tcp 127.0.0.1:0 \
+    --exit-after 0.1 --log-json > "$work/device.ndjson" 2>&1 && ok || fail "shaped device exits $?"
+/usr/bin/python3 - "$src/docs/events.schema.json" "$work/device.ndjson" <<'PY' && ok || fail "shaped device log (above)"
+import json, sys
+import jsonschema
+schema = json.load(open(sys.argv[1]))
+v = jsonschema.Draft202012Validator({"$defs": schema["$defs"], "$ref": "#/$defs/device_log_line"})
+lines = [json.loads(l) for l in open(sys.argv[2])]
+for e in lines: v.validate(e)
+shapers = [e for e in lines if e["event"] == "shaper"]
+if [e["axis"] for e in shapers] != ["x", "y"] or any(e["taps"] != 5 for e in shapers):
+    print(shapers); sys.exit(1)
+PY
+
 out=$("$bin" calibrate -m "$machine" 2>&1); rc=$?
 [[ $rc == 2 && "$out" == *"no resonant modes to measure"* ]] && ok || fail "no modes: rc $rc: $out"
 out=$("$bin" calibrate -m "$machine" --csv "$work/ring.csv" 2>&1); rc=$?
