@@ -147,6 +147,9 @@ struct SimRun {
     plot::PlanFigures plan;        ///< the plan's totals and dwells
     sim::SimulationResult result;  ///< the device's counters (every tick: --plan-first)
     plot::RunRecord record;        ///< the executed ticks' figures, and the plots' record
+    /// The device's input shapers per axis and their taps, for the text and JSON reports.
+    std::vector<std::optional<ShaperSpec>> shapers;
+    std::vector<std::vector<ShaperTap>> shaper_taps;
 };
 
 /// The machine and plant lines of the report.
@@ -176,8 +179,8 @@ void machine_json(const SimCommandOptions& o, const SimRun& s, const plot::RunSu
     }
     // The device's input shapers by axis name (docs/input-shaping.md); {} without one.
     Json shapers = Json::object();
-    const auto specs = run_shapers(o.shapers, job.machine);
-    const auto taps = shaper_taps(specs, job.machine);
+    const auto& specs = s.shapers;
+    const auto& taps = s.shaper_taps;
     for (std::size_t a = 0; a < specs.size() && a < job.machine.axes.size(); ++a) {
         if (!specs[a]) continue;
         shapers[job.machine.axes[a].name] = {
@@ -593,8 +596,9 @@ int run_sim(const SimCommandOptions& o) {
     const sim::SimulationResult& result = s.result;
     plot::RunSummary run = run_summary(result);
     run.modes = modes_line(o, job.machine, result);
-    const auto shapers = run_shapers(o.shapers, job.machine);
-    run.shaper = describe_shapers(shapers, shaper_taps(shapers, job.machine), job.machine);
+    s.shapers = run_shapers(o.shapers, job.machine);
+    s.shaper_taps = shaper_taps(s.shapers, job.machine);
+    run.shaper = describe_shapers(s.shapers, s.shaper_taps, job.machine);
     if (!run.shaper.empty()) {
         char deviation[160];
         std::snprintf(deviation, sizeof deviation,
