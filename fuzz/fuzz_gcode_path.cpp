@@ -7,6 +7,13 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     using namespace pathstream;
     if (size < 1) return 0;
     host::GcodeOptions options;
+    // A hundredth of the reader's budgets: a program that spends one (a loop that never ends)
+    // is read to its limit well within the fuzzer's per-input timeout, also instrumented on a
+    // loaded machine. Per-line costs that grow with the input are still found.
+    options.budget.blocks = 100'000;
+    options.budget.characters = 5'000'000;
+    options.budget.loop_passes = 10'000;
+    options.budget.pieces = 20'000;
     switch (data[0] & 3u) {
         case 1:
             options.pen = host::PenControl::kSpindle;

@@ -262,6 +262,27 @@ TEST_CASE("G-code: loop and piece budgets", "[gcode]") {
           "t.ngc:3:1: more than 2000000 curve pieces drawn (the reader's limit)");
 }
 
+TEST_CASE("G-code: budgets smaller than the reader's", "[gcode]") {
+    GcodeOptions options;
+    options.budget.loop_passes = 10;
+    CHECK(error_of("G1 Z-1\no1 repeat [11]\no1 endrepeat\n", options) ==
+          "t.ngc:2:1: O1 repeat: more than 10 loop passes in all (the reader's limit; a loop "
+          "that never ends?)");
+    CHECK(run("G1 Z-1\no1 repeat [10]\nG91 G1 X1\no1 endrepeat\n", options).subpaths.size() == 1);
+    options = {};
+    options.budget.blocks = 3;
+    CHECK(error_of("G1 Z-1\nG1 X1\nG1 X2\nG1 X3\n", options) ==
+          "t.ngc:4:1: more than 3 lines or 500000000 characters run (the reader's limit; a loop "
+          "that never ends?)");
+    options = {};
+    options.budget.pieces = 2;
+    CHECK(error_of("G1 Z-1\nG1 X1\nX2\nX3\n", options) ==
+          "t.ngc:4:1: more than 2 curve pieces drawn (the reader's limit)");
+    options = {};
+    options.budget.characters = 0;
+    CHECK_THROWS_AS(run("G1 Z-1 X1\n", options), std::invalid_argument);
+}
+
 TEST_CASE("G-code: a setting's own line reads the old value", "[gcode]") {
     const Path p = run("#1=10\n#1=20 G1 Z-1 Y#1\nG1 X#1\n");
     REQUIRE(p.subpaths.size() == 1);

@@ -62,7 +62,7 @@ Path run(const std::vector<std::string_view>& lines, const std::string& file,
          const gcode::ToolTable& tools) {
     gcode::Parameters parameters;
     gcode::Interpreter interpreter(file, options, parameters, tools);
-    gcode::run_program(lines, file, ignored, interpreter, parameters, warnings,
+    gcode::run_program(lines, file, ignored, interpreter, parameters, warnings, options.budget,
                        options.subroutine_path);
     if (evidence) *evidence = interpreter.evidence();
     return interpreter.finish(allow_empty);
@@ -111,6 +111,10 @@ Path parse_gcode_path(const std::string& text, const std::string& file, const Gc
     check_axes(options.axes);
     if (!(options.rapid_feed >= 0) || !std::isfinite(options.rapid_feed)) {
         throw std::invalid_argument("GcodeOptions::rapid_feed must be finite and >= 0");
+    }
+    const GcodeBudget& b = options.budget;
+    if (b.blocks == 0 || b.characters == 0 || b.loop_passes == 0 || b.pieces == 0) {
+        throw std::invalid_argument("GcodeOptions::budget values must be >= 1");
     }
     const bool z_axis = options.axes.find('Z') != std::string::npos;
     if (z_axis && options.pen != PenControl::kMachine && options.pen != PenControl::kAuto) {

@@ -30,7 +30,7 @@ Interpreter::Interpreter(const std::string& file, const GcodeOptions& options,
       options_(options),
       parameters_(parameters),
       tools_(tools),
-      runs_(axis_indices(options.axes)) {
+      runs_(axis_indices(options.axes), options.budget.pieces) {
     for (const char c : options.axes) path_axis_[axis_index(c)] = true;
     parameters_.set(ParameterRef{5220, {}}, 1);  // G54
 }

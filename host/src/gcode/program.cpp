@@ -21,8 +21,10 @@ class Runner {
 public:
     Runner(const std::vector<std::string_view>& lines, const std::string& file,
            const std::set<std::string>& ignored, Interpreter& interpreter, Parameters& parameters,
-           std::vector<std::string>& warnings, const std::vector<std::string>& search_path)
+           std::vector<std::string>& warnings, const GcodeBudget& budget,
+           const std::vector<std::string>& search_path)
         : lines_(lines),
+          budget_(budget),
           file_(file),
           search_path_(search_path),
           ignored_(ignored),
@@ -39,10 +41,10 @@ public:
         std::size_t pc = 0;
         while (pc < lines_.size()) {
             characters_ += lines_[pc].size();
-            if (++blocks_ > kMaxBlocksRun || characters_ > kMaxCharactersRun) {
+            if (++blocks_ > budget_.blocks || characters_ > budget_.characters) {
                 throw InputError(file_of(pc), SourceLocation{line_of(pc), 1},
-                                 "more than " + std::to_string(kMaxBlocksRun) + " lines or " +
-                                     std::to_string(kMaxCharactersRun) +
+                                 "more than " + std::to_string(budget_.blocks) + " lines or " +
+                                     std::to_string(budget_.characters) +
                                      " characters run (the reader's limit; a loop that never "
                                      "ends?)");
             }
@@ -198,9 +200,9 @@ private:
     }
 
     void loop_pass(std::size_t loop_line) {
-        if (++loop_passes_ > kMaxLoopPasses) {
+        if (++loop_passes_ > budget_.loop_passes) {
             fail(o(loop_line), oline_text(o(loop_line)) + ": more than " +
-                                   std::to_string(kMaxLoopPasses) +
+                                   std::to_string(budget_.loop_passes) +
                                    " loop passes in all (the reader's limit; a loop that never "
                                    "ends?)");
         }
@@ -272,8 +274,8 @@ private:
                 // As LinuxCNC: the count is rounded to the nearest whole number.
                 const double n = std::nearbyint(condition(pc));
                 if (n < 1) return partner + 1;
-                frames_.back().repeats_left[pc] = n > static_cast<double>(kMaxLoopPasses)
-                                                      ? static_cast<long>(kMaxLoopPasses) + 1
+                frames_.back().repeats_left[pc] = n > static_cast<double>(budget_.loop_passes)
+                                                      ? static_cast<long>(budget_.loop_passes) + 1
                                                       : static_cast<long>(n) - 1;
                 return pc + 1;
             }
@@ -313,6 +315,7 @@ private:
     }
 
     std::vector<std::string_view> lines_;
+    GcodeBudget budget_;
     const std::string& file_;
     const std::vector<std::string>& search_path_;
     std::size_t main_lines_ = lines_.size();
@@ -335,8 +338,8 @@ private:
 void run_program(const std::vector<std::string_view>& lines, const std::string& file,
                  const std::set<std::string>& ignored, Interpreter& interpreter,
                  Parameters& parameters, std::vector<std::string>& warnings,
-                 const std::vector<std::string>& search_path) {
-    Runner(lines, file, ignored, interpreter, parameters, warnings, search_path).run();
+                 const GcodeBudget& budget, const std::vector<std::string>& search_path) {
+    Runner(lines, file, ignored, interpreter, parameters, warnings, budget, search_path).run();
 }
 
 }  // namespace pathstream::host::gcode

@@ -13,10 +13,6 @@
 
 namespace pathstream::host::gcode {
 
-/// Budgets that keep a hostile program's cost bounded (docs/formats-gcode.md, "Budgets").
-constexpr std::size_t kMaxBlocksRun = 10'000'000;       ///< lines run, loops counted each pass
-constexpr std::size_t kMaxCharactersRun = 500'000'000;  ///< characters of the lines run
-constexpr std::size_t kMaxLoopPasses = 1'000'000;       ///< loop passes in all
 /// Calls nested at most: LinuxCNC's INTERP_SUB_ROUTINE_LEVELS (10) counts the main program.
 constexpr std::size_t kMaxCallDepth = 9;
 /// Subroutine files loaded at most (each once, its characters counted in the budget).
@@ -25,12 +21,13 @@ constexpr std::size_t kMaxSubroutineFiles = 100;
 /// Runs `lines` (the program's lines, without line breaks) through `interpreter`. Codes in
 /// `ignored` are skipped; the first time each is met, a warning "file:line:col: ..." is
 /// appended to `warnings` (also for grbl '$' lines). Throws InputError as the stages do and
-/// for O-word errors (an unknown subroutine, a missing condition) and spent budgets. A call of
+/// for O-word errors (an unknown subroutine, a missing condition) and when `budget`'s blocks,
+/// characters or loop passes are spent. A call of
 /// a subroutine the program does not define loads NAME.ngc from the first directory of
 /// `search_path` that has it (LinuxCNC's subroutine files); errors there name that file.
 void run_program(const std::vector<std::string_view>& lines, const std::string& file,
                  const std::set<std::string>& ignored, Interpreter& interpreter,
                  Parameters& parameters, std::vector<std::string>& warnings,
-                 const std::vector<std::string>& search_path = {});
+                 const GcodeBudget& budget, const std::vector<std::string>& search_path = {});
 
 }  // namespace pathstream::host::gcode

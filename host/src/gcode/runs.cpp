@@ -64,10 +64,10 @@ void RunBuilder::add(const Piece& piece, double feed_mm_s, bool travel, SourceLo
     const PathPoint p0 = point(piece.p[0]), p1 = point(piece.p[1]), p2 = point(piece.p[2]),
                     p3 = point(piece.p[3]);
     if (p1 == p0 && p2 == p0 && p3 == p0) return;  // zero length on the path's axes
-    if (++pieces_ > kMaxPieces) {
-        throw InputError(
-            file, at,
-            "more than " + std::to_string(kMaxPieces) + " curve pieces drawn (the reader's limit)");
+    if (++pieces_ > max_pieces_) {
+        throw InputError(file, at,
+                         "more than " + std::to_string(max_pieces_) +
+                             " curve pieces drawn (the reader's limit)");
     }
     if (open_ && (done_.back().travel != travel || done_.back().feed != feed_mm_s ||
                   done_.back().corner_mode != corner_mode_ ||

@@ -15,16 +15,15 @@ namespace pathstream::host::gcode {
 class RunBuilder {
 public:
     /// `path_axes`: the G-code axis index of each path axis, in path order ({kX, kY} for a
-    /// plotter, {kX, kY, kZ} for a router).
-    explicit RunBuilder(std::vector<std::size_t> path_axes) : path_axes_(std::move(path_axes)) {}
-
-    /// At most this many pieces in all: bounds the memory a hostile program can take.
-    static constexpr std::size_t kMaxPieces = 2'000'000;
+    /// plotter, {kX, kY, kZ} for a router). `max_pieces`: at most this many pieces in all,
+    /// which bounds the memory a hostile program can take.
+    RunBuilder(std::vector<std::size_t> path_axes, std::size_t max_pieces)
+        : path_axes_(std::move(path_axes)), max_pieces_(max_pieces) {}
 
     /// Appends a pen-down piece drawn at `feed_mm_s` (0: the machine's feed). A piece whose
     /// four points are all equal is dropped. The piece starts a new subpath (located at `at`)
     /// when no run is open or when the open run has a different feed; otherwise it must start
-    /// where the run ends. Throws InputError at `at` (naming `file`) past kMaxPieces.
+    /// where the run ends. Throws InputError at `at` (naming `file`) past max_pieces.
     void draw(const Piece& piece, double feed_mm_s, SourceLocation at, const std::string& file);
     /// As draw, for a rapid: the piece joins (or starts) a travel run (Subpath::travel).
     void travel(const Piece& piece, double feed_mm_s, SourceLocation at, const std::string& file);
@@ -77,6 +76,7 @@ private:
     PathPoint point(const Axes& a) const;
 
     std::vector<std::size_t> path_axes_;
+    std::size_t max_pieces_;
     std::vector<Subpath> done_;
     bool open_ = false;
     bool pause_next_ = false;

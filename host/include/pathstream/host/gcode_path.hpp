@@ -26,6 +26,16 @@ enum class PenControl {
 const char* pen_control_name(PenControl pen);
 
 /// How to read a G-code program.
+/// What a program may cost before the read fails naming the line (docs/formats-gcode.md,
+/// "Budgets"): bounds the time and memory of a hostile program. The defaults are the reader's;
+/// smaller ones suit a fuzzer or a service that reads untrusted programs.
+struct GcodeBudget {
+    std::size_t blocks = 10'000'000;       ///< lines run, loops counted each pass
+    std::size_t characters = 500'000'000;  ///< characters of the lines run
+    std::size_t loop_passes = 1'000'000;   ///< loop passes in all
+    std::size_t pieces = 2'000'000;        ///< curve pieces drawn (about 170 bytes each)
+};
+
 struct GcodeOptions {
     PenControl pen = PenControl::kZ;  ///< what lowers the pen
     double z_down_max = 0.0;          ///< kZ: highest Z (mm) at which the pen is down; finite
@@ -46,6 +56,7 @@ struct GcodeOptions {
     /// Directories searched, in order, for NAME.ngc when the program calls a subroutine it
     /// does not define (LinuxCNC's SUBROUTINE_PATH); empty: such a call is an error.
     std::vector<std::string> subroutine_path;
+    GcodeBudget budget;  ///< what the program may cost; each value >= 1
 };
 
 /// What a read found beside the path.
