@@ -10,6 +10,7 @@
 #include "nurbs/nurbs.hpp"
 #include "pathstream/machine/input_error.hpp"
 #include "pathstream/machine/json_document.hpp"
+#include "surface/surface_json.hpp"
 
 namespace pathstream::host {
 
@@ -207,7 +208,7 @@ public:
 
     Path path(const json& root) const {
         if (!root.is_object()) fail("", "a path file must be a JSON object");
-        only_keys(root, "", {"units", "basis", "closed", "subpaths", "points"});
+        only_keys(root, "", {"units", "basis", "closed", "subpaths", "points", "view", "surfaces"});
         double scale = 1.0;
         if (root.contains("units")) {
             const json& u = root["units"];
@@ -226,7 +227,8 @@ public:
         Path path;
         std::size_t axes = 0;
         const bool has_points = root.contains("points"), has_subpaths = root.contains("subpaths");
-        if (has_points == has_subpaths) {
+        const bool has_surfaces = root.contains("surfaces");
+        if (has_points == has_subpaths && !(has_surfaces && !has_points)) {
             fail("", "give either \"points\" (one subpath) or \"subpaths\", not both or neither");
         }
         // Located from here on without an error: "/points" or "/subpaths/N", not the points.
@@ -239,7 +241,7 @@ public:
             sp.points = points(root["points"], "/points", scale, axes);
             check_count(sp, "/points");
             path.subpaths.push_back(std::move(sp));
-        } else {
+        } else if (has_subpaths) {
             const json& list = root["subpaths"];
             if (!list.is_array() || list.empty())
                 fail("/subpaths", "subpaths must be a non-empty array");
@@ -249,6 +251,7 @@ public:
             }
         }
         path.axes = axes;
+        if (root.contains("view") || has_surfaces) project(root, scale, path);
         if (scale != 1.0) {
             path.units = "in";
             path.mm_per_unit = scale;
@@ -257,6 +260,36 @@ public:
     }
 
 private:
+    // Under a view the drawing is the page: 3-D subpaths are projected onto it, 2-D ones (a
+    // frame, a title) drawn as they are, and the surfaces' wireframes added after them.
+    void project(const json& root, double scale, Path& path) const {
+        const ViewFrame frame = root.contains("view")
+                                    ? surface::read_view(*this, root["view"], "/view")
+                                    : view_frame(SurfaceView{});
+        if (path.axes == 3) {
+            for (Subpath& sp : path.subpaths) {
+                try {
+                    sp = surface::project_subpath(sp, frame, nurbs_tolerance_mm_);
+                } catch (const std::domain_error& e) {
+                    fail("/view", e.what());
+                }
+            }
+        } else if (path.axes != 2 && !path.subpaths.empty()) {
+            fail("/subpaths",
+                 "under a view, points have 3 coordinates (projected) or 2 (drawn "
+                 "on the page as they are)");
+        }
+        if (root.contains("surfaces")) {
+            WireframeFigures figures;
+            for (Subpath& sp : surface::read_surfaces(*this, root["surfaces"], scale, frame,
+                                                      nurbs_tolerance_mm_, figures)) {
+                path.subpaths.push_back(std::move(sp));
+            }
+            if (path.subpaths.empty()) fail("/surfaces", "the surfaces draw no curve");
+        }
+        path.axes = 2;
+    }
+
     double nurbs_tolerance_mm_;
     FlatNumberArrays& flat_;
 };

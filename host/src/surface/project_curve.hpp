@@ -1,0 +1,23 @@
+// One model-space Bezier curve (polynomial or rational, degree 1 to 3) onto the drawing: the
+// exact projected cubic where the view keeps it polynomial, else a fitted chain.
+#pragma once
+
+#include <vector>
+
+#include "pathstream/host/surface.hpp"
+
+namespace pathstream::host::surface {
+
+/// The drawing's open Bezier chain (2 axes, P0 C C P1 ...) for the curve with control points
+/// `q` and, when not empty, positive `weights` (a rational curve). Exact (degree raised to 3)
+/// when the view is orthographic and the curve polynomial, or when it is a line; otherwise the
+/// projected rational curve fitted within `tolerance_mm` (`exact` says which). Throws
+/// std::domain_error when a control point is not in front of the eye.
+std::vector<PathPoint> project_curve(const std::vector<Point3>& q,
+                                     const std::vector<double>& weights, const ViewFrame& frame,
+                                     double tolerance_mm, bool& exact);
+
+/// `q` (degree 1 to 3) raised to degree 3: the same curve, four control points. O(1).
+std::vector<Point3> raise_to_cubic(const std::vector<Point3>& q);
+
+}  // namespace pathstream::host::surface
