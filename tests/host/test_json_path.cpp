@@ -45,7 +45,7 @@ TEST_CASE("broken documents name file, line, column and the problem", "[host][js
           "t.json:3:9: coordinate must be a number");
     CHECK(error_of("{\"points\": [[0, 0], [1, 2]], \"colour\": 1}") ==
           "t.json:1:40: unknown key \"colour\" (expected one of: basis, closed, points, subpaths, "
-          "units)");
+          "surfaces, units, view)");
     CHECK(error_of("{\"points\": [[0, 0], [1, 2]]\n,}")
               .rfind("t.json:2:2: invalid JSON: syntax error", 0) == 0);
     CHECK(error_of("{\"points\": [[0, 0], [1e400, 2]]}") ==
