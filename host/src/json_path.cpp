@@ -263,8 +263,9 @@ private:
     // Under a view the drawing is the page: 3-D subpaths are projected onto it, 2-D ones (a
     // frame, a title) drawn as they are, and the surfaces' wireframes added after them.
     void project(const json& root, double scale, Path& path) const {
+        bool hidden_lines = false;
         const ViewFrame frame = root.contains("view")
-                                    ? surface::read_view(*this, root["view"], "/view")
+                                    ? surface::read_view(*this, root["view"], "/view", hidden_lines)
                                     : view_frame(SurfaceView{});
         if (path.axes == 3) {
             for (Subpath& sp : path.subpaths) {
@@ -282,7 +283,7 @@ private:
         if (root.contains("surfaces")) {
             WireframeFigures figures;
             for (Subpath& sp : surface::read_surfaces(*this, root["surfaces"], scale, frame,
-                                                      nurbs_tolerance_mm_, figures)) {
+                                                      hidden_lines, nurbs_tolerance_mm_, figures)) {
                 path.subpaths.push_back(std::move(sp));
             }
             if (path.subpaths.empty()) fail("/surfaces", "the surfaces draw no curve");

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <string>
 
+#include "pathstream/host/hidden_lines.hpp"
 #include "pathstream/host/surface.hpp"
 #include "project_curve.hpp"
 #include "seam_set.hpp"
@@ -55,9 +56,18 @@ Point3 patch_point(const BezierPatch& patch, double u, double v) {
     return casteljau(iso_curve(patch, true, v), u);
 }
 
+std::vector<SurfaceSheet> sheets_of(const std::vector<BezierPatch>& patches) {
+    std::vector<SurfaceSheet> out;
+    for (const BezierPatch& p : patches) {
+        out.push_back([p](double u, double v) { return patch_point(p, u, v); });
+    }
+    return out;
+}
+
 std::vector<Subpath> patch_wireframe(const std::vector<BezierPatch>& patches,
                                      const IsoCounts& counts, const ViewFrame& frame,
-                                     double tolerance_mm, WireframeFigures* figures) {
+                                     double tolerance_mm, WireframeFigures* figures,
+                                     const Occluder* occluder) {
     WireframeFigures f;
     const double resolution = 1e-9 * extent(patches);
     surface::SeamSet drawn(resolution);
@@ -77,18 +87,14 @@ std::vector<Subpath> patch_wireframe(const std::vector<BezierPatch>& patches,
                     ++f.seams_merged;
                     continue;
                 }
-                bool exact = false;
-                Subpath sp;
-                sp.basis = PathBasis::kBezier;
-                sp.location = patch.location;
-                for (const PathPoint& point :
-                     surface::project_curve(q, {}, frame, tolerance_mm, exact)) {
-                    sp.points.push_back(point);
+                for (const auto& chain :
+                     surface::draw_curve(q, {}, frame, tolerance_mm, occluder, f)) {
+                    Subpath sp;
+                    sp.basis = PathBasis::kBezier;
+                    sp.location = patch.location;
+                    for (const PathPoint& point : chain) sp.points.push_back(point);
+                    out.push_back(std::move(sp));
                 }
-                if (sp.points.size() < 4) continue;  // fitted to nothing: a point on the page
-                ++f.curves;
-                if (exact) ++f.exact_curves;
-                out.push_back(std::move(sp));
             }
         }
     }

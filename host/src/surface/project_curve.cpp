@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "../nurbs/nurbs.hpp"
+#include "pathstream/host/hidden_lines.hpp"
 
 namespace pathstream::host::surface {
 
@@ -55,6 +56,38 @@ std::vector<PathPoint> project_curve(const std::vector<Point3>& q,
     curve.knots.assign(q.size(), 0.0);
     curve.knots.insert(curve.knots.end(), q.size(), 1.0);
     return nurbs::nurbs_to_bezier(curve, tolerance_mm);
+}
+
+std::vector<std::vector<PathPoint>> draw_curve(const std::vector<Point3>& q,
+                                               const std::vector<double>& weights,
+                                               const ViewFrame& frame, double tolerance_mm,
+                                               const Occluder* occluder,
+                                               WireframeFigures& figures) {
+    std::vector<std::vector<PathPoint>> out;
+    auto add = [&](const std::vector<Point3>& piece, const std::vector<double>& w) {
+        bool exact = false;
+        std::vector<PathPoint> chain = project_curve(piece, w, frame, tolerance_mm, exact);
+        if (chain.size() < 4) return;  // fitted to nothing: a point on the page
+        ++figures.curves;
+        if (exact) ++figures.exact_curves;
+        out.push_back(std::move(chain));
+    };
+    if (!occluder) {
+        add(q, weights);
+        return out;
+    }
+    const auto intervals = visible_intervals(q, weights, frame, *occluder, tolerance_mm);
+    if (intervals.empty()) {
+        ++figures.hidden;
+        return out;
+    }
+    if (intervals.size() > 1 || intervals[0][0] > 0 || intervals[0][1] < 1) ++figures.split;
+    for (const auto& iv : intervals) {
+        std::vector<double> w = weights;
+        const std::vector<Point3> piece = bezier_piece(q, w, iv[0], iv[1]);
+        add(piece, w);
+    }
+    return out;
 }
 
 }  // namespace pathstream::host::surface

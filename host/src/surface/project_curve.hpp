@@ -17,6 +17,14 @@ std::vector<PathPoint> project_curve(const std::vector<Point3>& q,
                                      const std::vector<double>& weights, const ViewFrame& frame,
                                      double tolerance_mm, bool& exact);
 
+/// The drawing's chains of the curve `q` (with `weights` as in project_curve): the whole
+/// curve, or with `occluder` each part it does not hide. Adds to figures' curves, exact
+/// curves, hidden and split counts.
+std::vector<std::vector<PathPoint>> draw_curve(const std::vector<Point3>& q,
+                                               const std::vector<double>& weights,
+                                               const ViewFrame& frame, double tolerance_mm,
+                                               const Occluder* occluder, WireframeFigures& figures);
+
 /// `q` (degree 1 to 3) raised to degree 3: the same curve, four control points. O(1).
 std::vector<Point3> raise_to_cubic(const std::vector<Point3>& q);
 

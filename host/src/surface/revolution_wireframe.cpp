@@ -5,6 +5,7 @@
 #include <numbers>
 #include <stdexcept>
 
+#include "pathstream/host/hidden_lines.hpp"
 #include "pathstream/host/surface.hpp"
 #include "project_curve.hpp"
 #include "seam_set.hpp"
@@ -51,9 +52,21 @@ Point3 place(const AxisFrame& f, double r, double h, double theta) {
     return p;
 }
 
-void append_chain(Subpath& sp, const std::vector<PathPoint>& chain) {
-    for (std::size_t i = sp.points.size() == 0 ? 0 : 1; i < chain.size(); ++i) {
-        sp.points.push_back(chain[i]);
+// Chains drawn one after another become one subpath while each starts where the last ended.
+void add_chains(std::vector<Subpath>& out, const std::vector<std::vector<PathPoint>>& chains,
+                const SourceLocation& at) {
+    bool joined = false;
+    for (const std::vector<PathPoint>& chain : chains) {
+        if (joined && out.back().points.back() == chain.front()) {
+            for (std::size_t i = 1; i < chain.size(); ++i) out.back().points.push_back(chain[i]);
+            continue;
+        }
+        Subpath sp;
+        sp.basis = PathBasis::kBezier;
+        sp.location = at;
+        for (const PathPoint& p : chain) sp.points.push_back(p);
+        out.push_back(std::move(sp));
+        joined = true;
     }
 }
 
@@ -61,7 +74,7 @@ void append_chain(Subpath& sp, const std::vector<PathPoint>& chain) {
 
 std::vector<Subpath> revolution_wireframe(const RevolutionSurface& surface, const IsoCounts& counts,
                                           const ViewFrame& frame, double tolerance_mm,
-                                          WireframeFigures* figures) {
+                                          WireframeFigures* figures, const Occluder* occluder) {
     if (!(surface.angle_deg > 0 && surface.angle_deg <= 360)) {
         throw std::invalid_argument("the angle of revolution must be in (0, 360] degrees");
     }
@@ -76,18 +89,9 @@ std::vector<Subpath> revolution_wireframe(const RevolutionSurface& surface, cons
     surface::SeamSet drawn(resolution);
     WireframeFigures f;
     std::vector<Subpath> out;
-    auto emit = [&](Subpath&& sp, bool exact) {
-        if (sp.points.size() < 4) return;
-        ++f.curves;
-        if (exact) ++f.exact_curves;
-        sp.basis = PathBasis::kBezier;
-        sp.location = surface.location;
-        out.push_back(std::move(sp));
-    };
     for (std::size_t k = 0; counts.u > 0 && k <= counts.u; ++k) {  // meridians
         const double theta = angle * static_cast<double>(k) / static_cast<double>(counts.u);
-        Subpath sp;
-        bool all_exact = true;
+        std::vector<std::vector<PathPoint>> chains;
         for (const BezierSegment& s : surface.profile) {
             std::vector<Point3> q;
             for (const PathPoint& p : s.p) q.push_back(place(axis, p[0], p[1], theta));
@@ -96,11 +100,11 @@ std::vector<Subpath> revolution_wireframe(const RevolutionSurface& surface, cons
                 ++f.seams_merged;
                 continue;
             }
-            bool exact = false;
-            append_chain(sp, surface::project_curve(q, {}, frame, tolerance_mm, exact));
-            all_exact = all_exact && exact;
+            for (auto& chain : surface::draw_curve(q, {}, frame, tolerance_mm, occluder, f)) {
+                chains.push_back(std::move(chain));
+            }
         }
-        emit(std::move(sp), all_exact);
+        add_chains(out, chains, surface.location);
     }
     const std::size_t arcs = static_cast<std::size_t>(std::ceil(angle / (std::numbers::pi / 2)));
     const double step = angle / static_cast<double>(arcs);
@@ -120,20 +124,37 @@ std::vector<Subpath> revolution_wireframe(const RevolutionSurface& surface, cons
                 ++f.seams_merged;
                 continue;
             }
-            Subpath sp;
+            std::vector<std::vector<PathPoint>> chains;
             for (std::size_t a = 0; a < arcs; ++a) {
                 const double t0 = step * static_cast<double>(a), half = step / 2;
                 const std::vector<Point3> q{place(axis, rh[0], rh[1], t0),
                                             place(axis, rh[0] / std::cos(half), rh[1], t0 + half),
                                             place(axis, rh[0], rh[1], t0 + step)};
-                bool exact = false;
-                append_chain(sp, surface::project_curve(q, {1.0, std::cos(half), 1.0}, frame,
-                                                        tolerance_mm, exact));
+                for (auto& chain : surface::draw_curve(q, {1.0, std::cos(half), 1.0}, frame,
+                                                       tolerance_mm, occluder, f)) {
+                    chains.push_back(std::move(chain));
+                }
             }
-            emit(std::move(sp), false);
+            add_chains(out, chains, surface.location);
         }
     }
     if (figures) *figures = f;
+    return out;
+}
+
+std::vector<SurfaceSheet> sheets_of(const RevolutionSurface& surface) {
+    if (!(surface.angle_deg > 0 && surface.angle_deg <= 360)) {
+        throw std::invalid_argument("the angle of revolution must be in (0, 360] degrees");
+    }
+    const AxisFrame axis = axis_frame(surface);
+    const double angle = surface.angle_deg * std::numbers::pi / 180.0;
+    std::vector<SurfaceSheet> out;
+    for (const BezierSegment& s : surface.profile) {
+        out.push_back([axis, angle, s](double u, double v) {
+            const PathPoint rh = bezier_point(s, v);
+            return place(axis, rh[0], rh[1], angle * u);
+        });
+    }
     return out;
 }
 

@@ -3,7 +3,10 @@
 #include "surface_json.hpp"
 
 #include <cmath>
+#include <memory>
+#include <optional>
 
+#include "pathstream/host/hidden_lines.hpp"
 #include "pathstream/machine/input_error.hpp"
 #include "project_curve.hpp"
 
@@ -166,10 +169,21 @@ std::vector<BezierSegment> read_profile(const JsonChecker& c, const json& s,
 
 }  // namespace
 
-ViewFrame read_view(const JsonChecker& c, const json& v, const std::string& pointer) {
+ViewFrame read_view(const JsonChecker& c, const json& v, const std::string& pointer,
+                    bool& hidden_lines) {
     if (!v.is_object()) c.fail(pointer, "view must be an object");
-    c.only_keys(v, pointer,
-                {"projection", "azimuth", "elevation", "roll", "scale", "eye_distance"});
+    c.only_keys(
+        v, pointer,
+        {"projection", "azimuth", "elevation", "roll", "scale", "eye_distance", "hidden_lines"});
+    hidden_lines = false;
+    if (v.contains("hidden_lines")) {
+        const json& h = v["hidden_lines"];
+        if (h == "remove") {
+            hidden_lines = true;
+        } else if (h != "draw") {
+            c.fail(pointer + "/hidden_lines", "hidden_lines must be \"draw\" or \"remove\"");
+        }
+    }
     SurfaceView view;
     if (v.contains("projection")) {
         const json& p = v["projection"];
@@ -208,77 +222,104 @@ ViewFrame read_view(const JsonChecker& c, const json& v, const std::string& poin
 }
 
 std::vector<Subpath> read_surfaces(const JsonChecker& c, const json& surfaces, double scale,
-                                   const ViewFrame& frame, double tolerance_mm,
+                                   const ViewFrame& frame, bool hidden_lines, double tolerance_mm,
                                    WireframeFigures& figures, std::size_t max_curves) {
     if (!surfaces.is_array() || surfaces.empty()) {
         c.fail("/surfaces", "surfaces must be a non-empty array");
     }
-    std::vector<Subpath> out;
+    struct Parsed {
+        std::string at;
+        IsoCounts counts;
+        std::vector<BezierPatch> patches;
+        std::optional<RevolutionSurface> revolution;
+    };
+    // All surfaces first: each hides the others' lines as well as its own.
+    std::vector<Parsed> parsed;
+    double estimate = 0;
     for (std::size_t i = 0; i < surfaces.size(); ++i) {
-        const std::string at = "/surfaces/" + std::to_string(i);
+        Parsed item;
+        item.at = "/surfaces/" + std::to_string(i);
+        const std::string& at = item.at;
         const json& s = surfaces[i];
         if (!s.is_object() || !s.contains("type")) {
             c.fail(at, "a surface is an object with \"type\": \"bezier\" or \"revolution\"");
         }
-        const IsoCounts counts = iso(c, s, at);
-        WireframeFigures f;
-        std::vector<Subpath> curves;
-        try {
-            if (s["type"] == "bezier") {
-                c.only_keys(s, at, {"type", "degree", "patches", "vertices", "iso"});
-                const std::vector<BezierPatch> list = patches(c, s, at, scale);
-                const double per_patch = static_cast<double>(counts.u + counts.v + 2);
-                if (static_cast<double>(list.size()) * per_patch >
-                    static_cast<double>(max_curves)) {
-                    c.fail(at, "more than " + std::to_string(max_curves) +
-                                   " iso-curves (the reader's limit): fewer patches or iso lines");
+        item.counts = iso(c, s, at);
+        const double per_line = static_cast<double>(item.counts.u + item.counts.v + 2);
+        if (s["type"] == "bezier") {
+            c.only_keys(s, at, {"type", "degree", "patches", "vertices", "iso"});
+            item.patches = patches(c, s, at, scale);
+            estimate += static_cast<double>(item.patches.size()) * per_line;
+        } else if (s["type"] == "revolution") {
+            c.only_keys(s, at, {"type", "profile", "axis", "angle", "iso"});
+            RevolutionSurface r;
+            r.location = c.locate(at);
+            r.profile = read_profile(c, s, at, scale);
+            if (s.contains("axis")) {
+                const json& a = s["axis"];
+                if (!a.is_array() || a.size() != 2) {
+                    c.fail(at + "/axis",
+                           "axis is [[x, y, z] of a point, [x, y, z] of its direction]");
                 }
-                curves = patch_wireframe(list, counts, frame, tolerance_mm, &f);
-            } else if (s["type"] == "revolution") {
-                c.only_keys(s, at, {"type", "profile", "axis", "angle", "iso"});
-                RevolutionSurface r;
-                r.location = c.locate(at);
-                r.profile = read_profile(c, s, at, scale);
-                if (s.contains("axis")) {
-                    const json& a = s["axis"];
-                    if (!a.is_array() || a.size() != 2) {
-                        c.fail(at + "/axis",
-                               "axis is [[x, y, z] of a point, [x, y, z] of its direction]");
-                    }
-                    r.axis_point = point3(c, a[0], at + "/axis/0", scale);
-                    r.axis_direction = point3(c, a[1], at + "/axis/1", 1.0);
-                }
-                if (s.contains("angle")) {
-                    r.angle_deg = number(c, s["angle"], at + "/angle", "angle");
-                    if (!(r.angle_deg > 0 && r.angle_deg <= 360)) {
-                        c.fail(at + "/angle", "angle must be in (0, 360] degrees");
-                    }
-                }
-                const double estimate =
-                    static_cast<double>(counts.u + 1) +
-                    static_cast<double>(r.profile.size()) * static_cast<double>(counts.v + 1);
-                if (estimate > static_cast<double>(max_curves)) {
-                    c.fail(at, "more than " + std::to_string(max_curves) +
-                                   " iso-curves (the reader's limit): fewer iso lines");
-                }
-                curves = revolution_wireframe(r, counts, frame, tolerance_mm, &f);
-            } else {
-                c.fail(at + "/type", "type must be \"bezier\" or \"revolution\"");
+                r.axis_point = point3(c, a[0], at + "/axis/0", scale);
+                r.axis_direction = point3(c, a[1], at + "/axis/1", 1.0);
             }
-        } catch (const std::domain_error& e) {
-            c.fail(at, e.what());
-        } catch (const std::invalid_argument& e) {
-            c.fail(at, e.what());
-        } catch (const std::length_error& e) {
-            c.fail(at, e.what());
+            if (s.contains("angle")) {
+                r.angle_deg = number(c, s["angle"], at + "/angle", "angle");
+                if (!(r.angle_deg > 0 && r.angle_deg <= 360)) {
+                    c.fail(at + "/angle", "angle must be in (0, 360] degrees");
+                }
+            }
+            estimate += static_cast<double>(r.profile.size()) * per_line * 4;
+            item.revolution = std::move(r);
+        } else {
+            c.fail(at + "/type", "type must be \"bezier\" or \"revolution\"");
         }
-        figures.curves += f.curves;
-        figures.exact_curves += f.exact_curves;
-        figures.seams_merged += f.seams_merged;
-        figures.degenerate += f.degenerate;
-        for (Subpath& sp : curves) out.push_back(std::move(sp));
+        if (estimate > static_cast<double>(max_curves)) {
+            c.fail(at, "more than " + std::to_string(max_curves) +
+                           " iso-curves (the reader's limit): fewer surfaces or iso lines");
+        }
+        parsed.push_back(std::move(item));
     }
-    return out;
+    std::unique_ptr<Occluder> occluder;
+    std::string at = "/view";
+    try {
+        if (hidden_lines) {
+            std::vector<SurfaceSheet> sheets;
+            for (const Parsed& item : parsed) {
+                at = item.at;
+                for (SurfaceSheet& sheet :
+                     item.revolution ? sheets_of(*item.revolution) : sheets_of(item.patches)) {
+                    sheets.push_back(std::move(sheet));
+                }
+            }
+            occluder = std::make_unique<Occluder>(std::move(sheets), frame);
+        }
+        std::vector<Subpath> out;
+        for (const Parsed& item : parsed) {
+            at = item.at;
+            WireframeFigures f;
+            std::vector<Subpath> curves =
+                item.revolution ? revolution_wireframe(*item.revolution, item.counts, frame,
+                                                       tolerance_mm, &f, occluder.get())
+                                : patch_wireframe(item.patches, item.counts, frame, tolerance_mm,
+                                                  &f, occluder.get());
+            figures.curves += f.curves;
+            figures.exact_curves += f.exact_curves;
+            figures.seams_merged += f.seams_merged;
+            figures.degenerate += f.degenerate;
+            figures.hidden += f.hidden;
+            figures.split += f.split;
+            for (Subpath& sp : curves) out.push_back(std::move(sp));
+        }
+        return out;
+    } catch (const std::domain_error& e) {
+        c.fail(at, e.what());
+    } catch (const std::invalid_argument& e) {
+        c.fail(at, e.what());
+    } catch (const std::length_error& e) {
+        c.fail(at, e.what());
+    }
 }
 
 Subpath project_subpath(const Subpath& sp, const ViewFrame& frame, double tolerance_mm) {

@@ -71,30 +71,38 @@ struct IsoCounts {
     std::size_t v = 6;
 };
 
+class Occluder;
+
 /// The wireframe's figures.
 struct WireframeFigures {
     std::size_t curves = 0;        ///< iso-curves drawn
     std::size_t exact_curves = 0;  ///< of them, projected exactly (no fitting)
     std::size_t seams_merged = 0;  ///< boundary curves a neighbouring patch had drawn already
     std::size_t degenerate = 0;    ///< iso-curves that are a single point, not drawn
+    std::size_t hidden = 0;        ///< iso-curves hidden whole by the surfaces
+    std::size_t split = 0;         ///< iso-curves drawn in parts, the rest hidden
 };
 
 /// The iso-curves of `patches` seen through `frame`, as open Bezier subpaths (2 axes, mm),
 /// in patch order. Under an orthographic view each curve is the exact projection of the
 /// surface's iso-curve (degree raised to 3); under perspective it is the projected rational
 /// curve fitted within `tolerance_mm`. A boundary curve equal to one drawn already (either
-/// direction, within 1e-9 of the drawing's extent) is drawn once. Cost O(patches x counts).
-/// Throws std::domain_error when a point is behind the eye.
+/// direction, within 1e-9 of the drawing's extent) is drawn once. With `occluder`, only the
+/// parts it does not hide are drawn, each an exact piece of the curve (visible_intervals).
+/// Cost O(patches x counts), times the samples' questions with an occluder. Throws
+/// std::domain_error when a point is behind the eye.
 std::vector<Subpath> patch_wireframe(const std::vector<BezierPatch>& patches,
                                      const IsoCounts& counts, const ViewFrame& frame,
-                                     double tolerance_mm, WireframeFigures* figures = nullptr);
+                                     double tolerance_mm, WireframeFigures* figures = nullptr,
+                                     const Occluder* occluder = nullptr);
 
 /// The meridians and parallels of `surface` through `frame`: meridians are exact under an
 /// orthographic view, parallels (circles) are fitted within `tolerance_mm`. Throws as
 /// patch_wireframe, and std::invalid_argument for a zero axis or an angle out of range.
 std::vector<Subpath> revolution_wireframe(const RevolutionSurface& surface, const IsoCounts& counts,
                                           const ViewFrame& frame, double tolerance_mm,
-                                          WireframeFigures* figures = nullptr);
+                                          WireframeFigures* figures = nullptr,
+                                          const Occluder* occluder = nullptr);
 
 /// The point of `patch` at (u, v) in [0, 1]^2 (de Casteljau in u, then in v). O(degree^2).
 Point3 patch_point(const BezierPatch& patch, double u, double v);
