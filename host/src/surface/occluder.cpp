@@ -154,13 +154,22 @@ bool Occluder::hidden(const Point3& p) const {
         const double l1 = ((b.y - c.y) * (xy[0] - c.x) + (c.x - b.x) * (xy[1] - c.y)) / det;
         const double l2 = ((c.y - a.y) * (xy[0] - c.x) + (a.x - c.x) * (xy[1] - c.y)) / det;
         const double l3 = 1 - l1 - l2;
-        const double slack = -1e-6;
+        const double slack = -0.25;
         if (l1 < slack || l2 < slack || l3 < slack) continue;
-        if (l1 * a.depth + l2 * b.depth + l3 * c.depth < depth - m.near_depth) continue;
+        const double mesh_depth = l1 * a.depth + l2 * b.depth + l3 * c.depth;
+        if (mesh_depth < depth - m.near_depth) continue;
         double u = l1 * a.u + l2 * b.u + l3 * c.u, v = l1 * a.v + l2 * b.v + l3 * c.v;
         Point3 at;
-        if (!m.solve(m.sheets[tr.sheet], xy[0], xy[1], u, v, at)) continue;
-        if (view_depth(m.frame, at) > depth + m.same_depth) return true;
+        if (m.solve(m.sheets[tr.sheet], xy[0], xy[1], u, v, at) &&
+            view_depth(m.frame, at) > depth + m.same_depth) {
+            return true;
+        }
+        // Near an outline the sheet folds: the point under xy on the near side and the point
+        // itself on the far side are close in (u, v), and Newton may find the latter. A mesh
+        // triangle well inside the point's place and nearer by more than the mesh's own depth
+        // error then decides.
+        const bool inside = l1 >= 0 && l2 >= 0 && l3 >= 0;
+        if (inside && mesh_depth > depth + m.near_depth) return true;
     }
     return false;
 }

@@ -293,7 +293,7 @@ std::vector<Subpath> read_surfaces(const JsonChecker& c, const json& surfaces, d
                     sheets.push_back(std::move(sheet));
                 }
             }
-            occluder = std::make_unique<Occluder>(std::move(sheets), frame);
+            occluder = std::make_unique<Occluder>(std::move(sheets), frame, 16);
         }
         std::vector<Subpath> out;
         for (const Parsed& item : parsed) {
