@@ -5,6 +5,13 @@
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
     using namespace pathstream;
     const std::string text = fuzz::text_of(data, size);
-    fuzz::check_reader("f.json", [&] { return host::parse_json_path(text, "f.json"); });
+    // Surfaces at a small fraction of the reader's budgets: any input is read to its limit
+    // well within the per-input timeout under the sanitizers.
+    host::JsonPathBudget budget;
+    budget.surface_curves = 2'000;
+    budget.surface_points = 100'000;
+    budget.hidden_line_questions = 100'000;
+    fuzz::check_reader("f.json",
+                       [&] { return host::parse_json_path(text, "f.json", 0.01, budget); });
     return 0;
 }

@@ -24,8 +24,11 @@ constexpr double kMaxCoordinateMm = 1e6;  // 1 km: beyond any plotter; catches u
 class Reader : public JsonChecker {
 public:
     Reader(const std::string& text, const std::string& file, double nurbs_tolerance_mm,
-           FlatNumberArrays& flat)
-        : JsonChecker(text, file), nurbs_tolerance_mm_(nurbs_tolerance_mm), flat_(flat) {}
+           const JsonPathBudget& budget, FlatNumberArrays& flat)
+        : JsonChecker(text, file),
+          nurbs_tolerance_mm_(nurbs_tolerance_mm),
+          budget_(budget),
+          flat_(flat) {}
 
     PathBasis basis(const json& v, const std::string& pointer) const {
         if (!v.is_string()) fail(pointer, "basis must be a string");
@@ -282,8 +285,9 @@ private:
         }
         if (root.contains("surfaces")) {
             WireframeFigures figures;
-            for (Subpath& sp : surface::read_surfaces(*this, root["surfaces"], scale, frame,
-                                                      hidden_lines, nurbs_tolerance_mm_, figures)) {
+            for (Subpath& sp :
+                 surface::read_surfaces(*this, root["surfaces"], scale, frame, hidden_lines,
+                                        nurbs_tolerance_mm_, budget_, figures)) {
                 path.subpaths.push_back(std::move(sp));
             }
             if (path.subpaths.empty()) fail("/surfaces", "the surfaces draw no curve");
@@ -292,12 +296,14 @@ private:
     }
 
     double nurbs_tolerance_mm_;
+    JsonPathBudget budget_;
     FlatNumberArrays& flat_;
 };
 
 }  // namespace
 
-Path parse_json_path(const std::string& text, const std::string& file, double nurbs_tolerance_mm) {
+Path parse_json_path(const std::string& text, const std::string& file, double nurbs_tolerance_mm,
+                     const JsonPathBudget& budget) {
     if (!(nurbs_tolerance_mm > 0) || !std::isfinite(nurbs_tolerance_mm)) {
         throw std::invalid_argument(
             "parse_json_path: the NURBS tolerance must be positive and finite");
@@ -306,7 +312,7 @@ Path parse_json_path(const std::string& text, const std::string& file, double nu
     FlatNumberArrays flat;
     flat.where = {"/points", "/subpaths/*/points"};
     const nlohmann::json document = parse_json_document(text, file, &flat);
-    return Reader(text, file, nurbs_tolerance_mm, flat).path(document);
+    return Reader(text, file, nurbs_tolerance_mm, budget, flat).path(document);
 }
 
 Path load_json_path(const std::string& file, double nurbs_tolerance_mm) {

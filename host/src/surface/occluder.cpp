@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <string>
 
 #include "pathstream/host/hidden_lines.hpp"
 
@@ -26,6 +27,7 @@ struct Occluder::Mesh {
     double same_depth = 0;  // exact depths closer than this are the same point
     double converged = 0;   // Newton's residual on the drawing that counts as a solution
     mutable std::size_t questions = 0, solves = 0;
+    std::size_t max_questions = 0;
 
     const std::vector<std::uint32_t>* bin(double x, double y) const {
         const double i = std::floor((x - x0) / bin_w), j = std::floor((y - y0) / bin_h);
@@ -66,12 +68,14 @@ struct Occluder::Mesh {
     }
 };
 
-Occluder::Occluder(std::vector<SurfaceSheet> sheets, const ViewFrame& frame, std::size_t cells)
+Occluder::Occluder(std::vector<SurfaceSheet> sheets, const ViewFrame& frame, std::size_t cells,
+                   std::size_t max_questions)
     : mesh_(std::make_unique<Mesh>()) {
     if (cells < 2 || cells > 256) throw std::invalid_argument("occluder cells must be 2 to 256");
     if (sheets.empty()) throw std::invalid_argument("an occluder needs at least one sheet");
     Mesh& m = *mesh_;
     m.sheets = std::move(sheets);
+    m.max_questions = max_questions;
     m.frame = frame;
     const std::size_t n = cells, row = n + 1;
     double extent = 1e-300, chord = 0;
@@ -141,7 +145,11 @@ Occluder::~Occluder() = default;
 
 bool Occluder::hidden(const Point3& p) const {
     const Mesh& m = *mesh_;
-    ++m.questions;
+    if (++m.questions > m.max_questions) {
+        throw std::length_error("hidden-line removal needs more than " +
+                                std::to_string(m.max_questions) +
+                                " points judged (the reader's limit): fewer iso lines");
+    }
     const auto xy = project_point(m.frame, p);
     const double depth = view_depth(m.frame, p);
     const std::vector<std::uint32_t>* list = m.bin(xy[0], xy[1]);

@@ -55,7 +55,9 @@ std::vector<PathPoint> project_curve(const std::vector<Point3>& q,
     }
     curve.knots.assign(q.size(), 0.0);
     curve.knots.insert(curve.knots.end(), q.size(), 1.0);
-    return nurbs::nurbs_to_bezier(curve, tolerance_mm);
+    // No projected iso-curve of a real drawing needs this many cubics; the cap bounds what a
+    // curve grazing the eye can cost.
+    return nurbs::nurbs_to_bezier(curve, tolerance_mm, 100'000);
 }
 
 std::vector<std::vector<PathPoint>> draw_curve(const std::vector<Point3>& q,

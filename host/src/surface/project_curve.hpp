@@ -12,7 +12,8 @@ namespace pathstream::host::surface {
 /// `q` and, when not empty, positive `weights` (a rational curve). Exact (degree raised to 3)
 /// when the view is orthographic and the curve polynomial, or when it is a line; otherwise the
 /// projected rational curve fitted within `tolerance_mm` (`exact` says which). Throws
-/// std::domain_error when a control point is not in front of the eye.
+/// std::domain_error when a control point is not in front of the eye, std::length_error when
+/// the fit needs more than 100,000 cubics.
 std::vector<PathPoint> project_curve(const std::vector<Point3>& q,
                                      const std::vector<double>& weights, const ViewFrame& frame,
                                      double tolerance_mm, bool& exact);

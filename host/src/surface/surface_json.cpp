@@ -223,7 +223,8 @@ ViewFrame read_view(const JsonChecker& c, const json& v, const std::string& poin
 
 std::vector<Subpath> read_surfaces(const JsonChecker& c, const json& surfaces, double scale,
                                    const ViewFrame& frame, bool hidden_lines, double tolerance_mm,
-                                   WireframeFigures& figures, std::size_t max_curves) {
+                                   const JsonPathBudget& budget, WireframeFigures& figures) {
+    const std::size_t max_curves = budget.surface_curves;
     if (!surfaces.is_array() || surfaces.empty()) {
         c.fail("/surfaces", "surfaces must be a non-empty array");
     }
@@ -293,9 +294,11 @@ std::vector<Subpath> read_surfaces(const JsonChecker& c, const json& surfaces, d
                     sheets.push_back(std::move(sheet));
                 }
             }
-            occluder = std::make_unique<Occluder>(std::move(sheets), frame, 16);
+            occluder = std::make_unique<Occluder>(std::move(sheets), frame, 16,
+                                                  budget.hidden_line_questions);
         }
         std::vector<Subpath> out;
+        std::size_t points = 0;
         for (const Parsed& item : parsed) {
             at = item.at;
             WireframeFigures f;
@@ -310,7 +313,15 @@ std::vector<Subpath> read_surfaces(const JsonChecker& c, const json& surfaces, d
             figures.degenerate += f.degenerate;
             figures.hidden += f.hidden;
             figures.split += f.split;
-            for (Subpath& sp : curves) out.push_back(std::move(sp));
+            for (Subpath& sp : curves) {
+                points += sp.points.size();
+                out.push_back(std::move(sp));
+            }
+            if (points > budget.surface_points) {
+                c.fail(at, "the wireframes have more than " +
+                               std::to_string(budget.surface_points) +
+                               " control points (the reader's limit): fewer iso lines");
+            }
         }
         return out;
     } catch (const std::domain_error& e) {

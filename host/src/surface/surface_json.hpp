@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "pathstream/host/json_path.hpp"
 #include "pathstream/host/surface.hpp"
 #include "pathstream/machine/json_document.hpp"
 
@@ -18,12 +19,12 @@ ViewFrame read_view(const JsonChecker& c, const nlohmann::json& v, const std::st
 
 /// The wireframes of the surfaces in the array at "/surfaces", through `frame`, with the
 /// parts any of them hides removed when `hidden_lines`; model coordinates are multiplied by
-/// `scale` (the document's units in mm). Throws InputError at the offending value; also when
-/// the wireframes would exceed about `max_curves` curves in all.
+/// `scale` (the document's units in mm). Throws InputError at the offending value; also past
+/// any of `budget`'s limits.
 std::vector<Subpath> read_surfaces(const JsonChecker& c, const nlohmann::json& surfaces,
                                    double scale, const ViewFrame& frame, bool hidden_lines,
-                                   double tolerance_mm, WireframeFigures& figures,
-                                   std::size_t max_curves = 200'000);
+                                   double tolerance_mm, const JsonPathBudget& budget,
+                                   WireframeFigures& figures);
 
 /// `sp` (3 axes, model mm) projected through `frame` onto the drawing: a Bezier subpath of 2
 /// axes, exact under an orthographic view, fitted within `tolerance_mm` under perspective.

@@ -28,15 +28,17 @@ std::vector<SurfaceSheet> sheets_of(const RevolutionSurface& surface);
 class Occluder {
 public:
     /// Throws std::invalid_argument for `cells` outside 2..256 or no sheets; std::domain_error
-    /// when a sheet's point is behind the eye.
-    Occluder(std::vector<SurfaceSheet> sheets, const ViewFrame& frame, std::size_t cells = 16);
+    /// when a sheet's point is behind the eye. `max_questions` bounds the work of hidden().
+    Occluder(std::vector<SurfaceSheet> sheets, const ViewFrame& frame, std::size_t cells = 16,
+             std::size_t max_questions = 20'000'000);
     ~Occluder();
     Occluder(const Occluder&) = delete;
     Occluder& operator=(const Occluder&) = delete;
 
     /// True when some sheet lies between `p` (a point on or near the surfaces) and the eye,
     /// by more than 1e-7 of the model's extent. Cost: the triangles over p's bin, a Newton
-    /// solve (at most 20 steps) for each in front.
+    /// solve (at most 20 steps) for each in front. Throws std::length_error once asked more
+    /// than max_questions times.
     bool hidden(const Point3& p) const;
 
     /// Questions asked and Newton solves run so far (figures, not needed for answers).

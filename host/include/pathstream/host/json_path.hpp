@@ -7,14 +7,24 @@
 
 namespace pathstream::host {
 
+/// What the surfaces of a JSON path may cost before the read fails (the reader's limits;
+/// smaller ones suit a fuzzer or a service reading untrusted files).
+struct JsonPathBudget {
+    std::size_t surface_curves = 200'000;            ///< iso-curves, estimated before drawing
+    std::size_t surface_points = 5'000'000;          ///< control points of the wireframes
+    std::size_t hidden_line_questions = 20'000'000;  ///< points judged for hidden lines
+};
+
 /// Parses a JSON path document. `file` names the source in error messages. Subpaths with
 /// basis "nurbs" become open Bezier chains (kBezier): exact for non-rational curves of degree
 /// 1 to 3, else within `nurbs_tolerance_mm` (> 0).
 /// Throws InputError ("file:line:col: what is wrong") on malformed JSON, unknown keys,
 /// wrong types, non-finite or out-of-range numbers, too few points, unknown bases and
-/// unusable NURBS (degree, knots, weights). Throws std::invalid_argument for a bad tolerance.
+/// unusable NURBS (degree, knots, weights), and surfaces past `budget`. "surfaces" and "view"
+/// draw wireframes of surfaces (docs/formats-surfaces.md), fitted where they must be within
+/// `nurbs_tolerance_mm` too. Throws std::invalid_argument for a bad tolerance.
 Path parse_json_path(const std::string& text, const std::string& file,
-                     double nurbs_tolerance_mm = 0.01);
+                     double nurbs_tolerance_mm = 0.01, const JsonPathBudget& budget = {});
 
 /// Reads and parses a JSON path file. Throws InputError, also when it cannot be read.
 Path load_json_path(const std::string& file, double nurbs_tolerance_mm = 0.01);
