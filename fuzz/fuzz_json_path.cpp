@@ -8,9 +8,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     // Surfaces at a small fraction of the reader's budgets: any input is read to its limit
     // well within the per-input timeout under the sanitizers.
     host::JsonPathBudget budget;
-    budget.surface_curves = 2'000;
-    budget.surface_points = 100'000;
-    budget.hidden_line_questions = 100'000;
+    budget.surfaces.curves = 2'000;
+    budget.surfaces.points = 100'000;
+    budget.surfaces.hidden_line_questions = 100'000;
     fuzz::check_reader("f.json",
                        [&] { return host::parse_json_path(text, "f.json", 0.01, budget); });
     return 0;

@@ -287,7 +287,7 @@ private:
             WireframeFigures figures;
             for (Subpath& sp :
                  surface::read_surfaces(*this, root["surfaces"], scale, frame, hidden_lines,
-                                        nurbs_tolerance_mm_, budget_, figures)) {
+                                        nurbs_tolerance_mm_, budget_.surfaces, figures)) {
                 path.subpaths.push_back(std::move(sp));
             }
             if (path.subpaths.empty()) fail("/surfaces", "the surfaces draw no curve");

@@ -3,10 +3,7 @@
 #include "surface_json.hpp"
 
 #include <cmath>
-#include <memory>
-#include <optional>
 
-#include "pathstream/host/hidden_lines.hpp"
 #include "pathstream/machine/input_error.hpp"
 #include "project_curve.hpp"
 
@@ -223,34 +220,23 @@ ViewFrame read_view(const JsonChecker& c, const json& v, const std::string& poin
 
 std::vector<Subpath> read_surfaces(const JsonChecker& c, const json& surfaces, double scale,
                                    const ViewFrame& frame, bool hidden_lines, double tolerance_mm,
-                                   const JsonPathBudget& budget, WireframeFigures& figures) {
-    const std::size_t max_curves = budget.surface_curves;
+                                   const SurfaceBudget& budget, WireframeFigures& figures) {
     if (!surfaces.is_array() || surfaces.empty()) {
         c.fail("/surfaces", "surfaces must be a non-empty array");
     }
-    struct Parsed {
-        std::string at;
-        IsoCounts counts;
-        std::vector<BezierPatch> patches;
-        std::optional<RevolutionSurface> revolution;
-    };
-    // All surfaces first: each hides the others' lines as well as its own.
-    std::vector<Parsed> parsed;
+    std::vector<SurfaceInput> parsed;
     double estimate = 0;
     for (std::size_t i = 0; i < surfaces.size(); ++i) {
-        Parsed item;
-        item.at = "/surfaces/" + std::to_string(i);
-        const std::string& at = item.at;
+        SurfaceInput item;
+        const std::string at = "/surfaces/" + std::to_string(i);
         const json& s = surfaces[i];
         if (!s.is_object() || !s.contains("type")) {
             c.fail(at, "a surface is an object with \"type\": \"bezier\" or \"revolution\"");
         }
         item.counts = iso(c, s, at);
-        const double per_line = static_cast<double>(item.counts.u + item.counts.v + 2);
         if (s["type"] == "bezier") {
             c.only_keys(s, at, {"type", "degree", "patches", "vertices", "iso"});
             item.patches = patches(c, s, at, scale);
-            estimate += static_cast<double>(item.patches.size()) * per_line;
         } else if (s["type"] == "revolution") {
             c.only_keys(s, at, {"type", "profile", "axis", "angle", "iso"});
             RevolutionSurface r;
@@ -271,65 +257,22 @@ std::vector<Subpath> read_surfaces(const JsonChecker& c, const json& surfaces, d
                     c.fail(at + "/angle", "angle must be in (0, 360] degrees");
                 }
             }
-            estimate += static_cast<double>(r.profile.size()) * per_line * 4;
             item.revolution = std::move(r);
         } else {
             c.fail(at + "/type", "type must be \"bezier\" or \"revolution\"");
         }
-        if (estimate > static_cast<double>(max_curves)) {
-            c.fail(at, "more than " + std::to_string(max_curves) +
+        // Checked while reading, so that a huge file stops at the surface that spends it.
+        estimate += estimated_curves(item);
+        if (estimate > static_cast<double>(budget.curves)) {
+            c.fail(at, "more than " + std::to_string(budget.curves) +
                            " iso-curves (the reader's limit): fewer surfaces or iso lines");
         }
         parsed.push_back(std::move(item));
     }
-    std::unique_ptr<Occluder> occluder;
-    std::string at = "/view";
     try {
-        if (hidden_lines) {
-            std::vector<SurfaceSheet> sheets;
-            for (const Parsed& item : parsed) {
-                at = item.at;
-                for (SurfaceSheet& sheet :
-                     item.revolution ? sheets_of(*item.revolution) : sheets_of(item.patches)) {
-                    sheets.push_back(std::move(sheet));
-                }
-            }
-            occluder = std::make_unique<Occluder>(std::move(sheets), frame, 16,
-                                                  budget.hidden_line_questions);
-        }
-        std::vector<Subpath> out;
-        std::size_t points = 0;
-        for (const Parsed& item : parsed) {
-            at = item.at;
-            WireframeFigures f;
-            std::vector<Subpath> curves =
-                item.revolution ? revolution_wireframe(*item.revolution, item.counts, frame,
-                                                       tolerance_mm, &f, occluder.get())
-                                : patch_wireframe(item.patches, item.counts, frame, tolerance_mm,
-                                                  &f, occluder.get());
-            figures.curves += f.curves;
-            figures.exact_curves += f.exact_curves;
-            figures.seams_merged += f.seams_merged;
-            figures.degenerate += f.degenerate;
-            figures.hidden += f.hidden;
-            figures.split += f.split;
-            for (Subpath& sp : curves) {
-                points += sp.points.size();
-                out.push_back(std::move(sp));
-            }
-            if (points > budget.surface_points) {
-                c.fail(at, "the wireframes have more than " +
-                               std::to_string(budget.surface_points) +
-                               " control points (the reader's limit): fewer iso lines");
-            }
-        }
-        return out;
-    } catch (const std::domain_error& e) {
-        c.fail(at, e.what());
-    } catch (const std::invalid_argument& e) {
-        c.fail(at, e.what());
-    } catch (const std::length_error& e) {
-        c.fail(at, e.what());
+        return draw_surfaces(parsed, frame, hidden_lines, tolerance_mm, budget, figures);
+    } catch (const SurfaceError& e) {
+        c.fail("/surfaces/" + std::to_string(e.surface), e.what());
     }
 }
 

@@ -6,7 +6,6 @@
 #include <string>
 #include <vector>
 
-#include "pathstream/host/json_path.hpp"
 #include "pathstream/host/surface.hpp"
 #include "pathstream/machine/json_document.hpp"
 
@@ -23,7 +22,7 @@ ViewFrame read_view(const JsonChecker& c, const nlohmann::json& v, const std::st
 /// any of `budget`'s limits.
 std::vector<Subpath> read_surfaces(const JsonChecker& c, const nlohmann::json& surfaces,
                                    double scale, const ViewFrame& frame, bool hidden_lines,
-                                   double tolerance_mm, const JsonPathBudget& budget,
+                                   double tolerance_mm, const SurfaceBudget& budget,
                                    WireframeFigures& figures);
 
 /// `sp` (3 axes, model mm) projected through `frame` onto the drawing: a Bezier subpath of 2

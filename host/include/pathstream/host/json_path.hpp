@@ -4,15 +4,13 @@
 #include <string>
 
 #include "pathstream/host/path.hpp"
+#include "pathstream/host/surface.hpp"
 
 namespace pathstream::host {
 
-/// What the surfaces of a JSON path may cost before the read fails (the reader's limits;
-/// smaller ones suit a fuzzer or a service reading untrusted files).
+/// What a JSON path may cost before the read fails (the reader's limits).
 struct JsonPathBudget {
-    std::size_t surface_curves = 200'000;            ///< iso-curves, estimated before drawing
-    std::size_t surface_points = 5'000'000;          ///< control points of the wireframes
-    std::size_t hidden_line_questions = 20'000'000;  ///< points judged for hidden lines
+    SurfaceBudget surfaces;  ///< its "surfaces"
 };
 
 /// Parses a JSON path document. `file` names the source in error messages. Subpaths with

@@ -4,6 +4,9 @@
 
 #include <array>
 #include <cstddef>
+#include <optional>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "pathstream/host/geometry.hpp"
@@ -103,6 +106,39 @@ std::vector<Subpath> revolution_wireframe(const RevolutionSurface& surface, cons
                                           const ViewFrame& frame, double tolerance_mm,
                                           WireframeFigures* figures = nullptr,
                                           const Occluder* occluder = nullptr);
+
+/// One surface of a drawing: Bezier patches, or a surface of revolution, and its iso lines.
+struct SurfaceInput {
+    std::vector<BezierPatch> patches;
+    std::optional<RevolutionSurface> revolution;  ///< set: this, not patches
+    IsoCounts counts;
+};
+
+/// What the surfaces of one drawing may cost (the readers' limits; smaller ones suit a fuzzer
+/// or a service reading untrusted files).
+struct SurfaceBudget {
+    std::size_t curves = 200'000;                    ///< iso-curves, estimated before drawing
+    std::size_t points = 5'000'000;                  ///< control points of the wireframes
+    std::size_t hidden_line_questions = 20'000'000;  ///< points judged for hidden lines
+};
+
+/// Why draw_surfaces failed, and on which surface (an index into its input).
+class SurfaceError : public std::runtime_error {
+public:
+    SurfaceError(std::size_t surface_index, const std::string& message)
+        : std::runtime_error(message), surface(surface_index) {}
+    std::size_t surface;
+};
+
+/// An estimate of the iso-curves `surface` draws, for the budget before any is drawn.
+double estimated_curves(const SurfaceInput& surface);
+
+/// The wireframes of `surfaces` through `frame`, in order, each with the parts any of them
+/// hides removed when `hidden_lines`; `figures` summed over all. Throws SurfaceError for a
+/// point behind the eye, an axis or angle out of range, and past `budget`.
+std::vector<Subpath> draw_surfaces(const std::vector<SurfaceInput>& surfaces,
+                                   const ViewFrame& frame, bool hidden_lines, double tolerance_mm,
+                                   const SurfaceBudget& budget, WireframeFigures& figures);
 
 /// The point of `patch` at (u, v) in [0, 1]^2 (de Casteljau in u, then in v). O(degree^2).
 Point3 patch_point(const BezierPatch& patch, double u, double v);
