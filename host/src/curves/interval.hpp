@@ -1,0 +1,92 @@
+// Interval arithmetic with outward rounding: every result contains the exact result of the
+// operation on every pair of reals drawn from the operands. This is what lets the curve fitter
+// prove an error bound with floating-point arithmetic.
+#pragma once
+
+#include <cmath>
+#include <limits>
+
+namespace pathstream::host::curves {
+
+/// A closed interval [lo, hi] of reals. Three kinds of value:
+///  - bounded: both ends finite (lo <= hi);
+///  - unbounded: an end is infinite (the whole line when nothing better is known, e.g. after a
+///    division by an interval containing 0);
+///  - undefined: an end is NaN (the function is not defined on part of the operand: sqrt or
+///    ln of a negative part, asin outside [-1, 1]).
+/// Callers that need a bound treat the last two alike: "cannot prove anything here".
+struct Interval {
+    double lo = 0;
+    double hi = 0;
+
+    Interval() = default;
+    /// The point interval [x, x] (x is exact: a double converts without rounding).
+    Interval(double x) : lo(x), hi(x) {}  // NOLINT: implicit, as a number is a point interval
+    Interval(double low, double high) : lo(low), hi(high) {}
+
+    /// Both ends finite (and not NaN).
+    bool bounded() const { return std::isfinite(lo) && std::isfinite(hi); }
+    bool undefined() const { return std::isnan(lo) || std::isnan(hi); }
+    bool contains(double x) const { return lo <= x && x <= hi; }
+    double width() const { return hi - lo; }
+    /// The largest |x| over the interval (infinite when unbounded, NaN when undefined).
+    double magnitude() const { return std::fmax(std::fabs(lo), std::fabs(hi)) + (lo - lo); }
+};
+
+/// The whole real line.
+Interval whole();
+/// The undefined interval (NaN ends).
+Interval undefined();
+/// The smallest interval holding both.
+Interval hull(const Interval& a, const Interval& b);
+/// An interval known to contain pi.
+Interval pi_interval();
+/// An interval known to contain e.
+Interval e_interval();
+
+// Arithmetic: each end rounded outward by one ulp after the nearest-rounded operation, which
+// covers IEEE 754's correctly rounded + - * / and sqrt. O(1), never throws.
+Interval operator+(const Interval& a, const Interval& b);
+Interval operator-(const Interval& a, const Interval& b);
+Interval operator-(const Interval& a);
+Interval operator*(const Interval& a, const Interval& b);
+/// Whole line when b contains 0 (unless a is undefined).
+Interval operator/(const Interval& a, const Interval& b);
+/// x², tighter than x * x when x contains 0 ([0, ...], never negative).
+Interval sqr(const Interval& x);
+/// x^n for an integer n (even n: never negative; negative n: whole line when x contains 0).
+Interval integer_power(const Interval& x, int n);
+
+// Elementary functions over an interval. The library's functions are assumed accurate to a
+// few ulps (glibc documents at most 2 to 4 for these); results are widened by kLibmUlps ulps
+// at each end. O(1), never throw; undefined() outside the domain, as the class comment says.
+inline constexpr int kLibmUlps = 4;
+Interval sin(const Interval& x);
+Interval cos(const Interval& x);
+/// Whole line when x may contain a pole (pi/2 + k pi) or is wider than pi.
+Interval tan(const Interval& x);
+Interval asin(const Interval& x);
+Interval acos(const Interval& x);
+Interval atan(const Interval& x);
+/// The angle of the points of the box y × x; [-pi, pi] when the box touches the origin or the
+/// negative x axis (the branch cut).
+Interval atan2(const Interval& y, const Interval& x);
+Interval sqrt(const Interval& x);
+Interval exp(const Interval& x);
+/// Natural logarithm; undefined when x has a negative part, -inf at the lower end for 0.
+Interval log(const Interval& x);
+Interval log10(const Interval& x);
+Interval fabs(const Interval& x);
+Interval sinh(const Interval& x);
+Interval cosh(const Interval& x);
+Interval tanh(const Interval& x);
+Interval fmin(const Interval& a, const Interval& b);
+Interval fmax(const Interval& a, const Interval& b);
+Interval hypot(const Interval& a, const Interval& b);
+/// a^b: integer_power when b is one integer point, else exp(b ln a) for a > 0 (undefined
+/// where a has a negative part).
+Interval pow(const Interval& a, const Interval& b);
+/// The sign of x's points: [-1, 1] when x contains 0 (the slopes of |x| there).
+Interval sign(const Interval& x);
+
+}  // namespace pathstream::host::curves
