@@ -47,6 +47,17 @@ Interval ln10_of(const Interval&) {
     return log(Interval(10.0));
 }
 
+double minus_one(double x) {
+    return x - 1;
+}
+
+// An integer exponent stays a point (outward rounding would make x^(n-1) a real power, undefined
+// for negative x).
+Interval minus_one(const Interval& x) {
+    if (x.lo == x.hi && std::trunc(x.lo) == x.lo && std::fabs(x.lo) < 0x1p52) return x.lo - 1;
+    return x - Interval(1.0);
+}
+
 double sign(double x) {
     return (x > 0) - (x < 0);
 }
@@ -79,7 +90,7 @@ Dual<N> power(const Dual<N>& a, const Dual<N>& b) {
     using std::pow;
     const N v = pow(a.v, b.v);
     if (is_zero(b.v) && is_zero(b.d)) return {v, N(0.0)};
-    N d = b.v * pow(a.v, b.v - N(1.0)) * a.d;
+    N d = b.v * pow(a.v, minus_one(b.v)) * a.d;
     if (!is_zero(b.d)) d = d + v * log(a.v) * b.d;
     return {v, d};
 }

@@ -20,6 +20,9 @@ constexpr double kSampleShare = 0.7;
 constexpr int kSamples = 8;
 // Halvings of the whole range before a piece counts as too short to split further.
 constexpr int kMaxDepth = 60;
+// Beyond this a coordinate is no drawing (1000 km); refusing it early also keeps a pole, where
+// the curve runs off to infinity, from costing the whole piece budget first.
+constexpr double kMaxCoordinate = 1e9;
 
 std::string number(double v) {
     std::ostringstream s;
@@ -30,6 +33,14 @@ std::string number(double v) {
 std::string axis_name(std::size_t k) {
     static const char* const kNames[] = {"x", "y", "z"};
     return k < 3 ? kNames[k] : "coordinate " + std::to_string(k + 1);
+}
+
+void check_value(std::size_t k, double t, double v) {
+    if (!std::isfinite(v))
+        throw FitError(axis_name(k) + " is not finite at t=" + number(t) + " (" + number(v) + ")");
+    if (std::fabs(v) > kMaxCoordinate)
+        throw FitError(axis_name(k) + " is " + number(v) + " mm at t=" + number(t) +
+                       ", beyond the " + number(kMaxCoordinate) + " mm a curve may reach");
 }
 
 struct End {
@@ -78,9 +89,7 @@ double sampled_error(const FunctionCurve& curve, const BezierPiece& piece) {
         double sum = 0;
         for (std::size_t k = 0; k < curve.coordinates.size(); ++k) {
             const double c = evaluate(curve.coordinates[k], t);
-            if (!std::isfinite(c))
-                throw FitError(axis_name(k) + " is not finite at t=" + number(t) + " (" +
-                               number(c) + ")");
+            check_value(k, t, c);
             const double e = c - bezier_at(piece.control[k], u);
             sum += e * e;
         }
@@ -169,9 +178,8 @@ FittedCurve fit_function_curve_pieces(const FunctionCurve& curve, double toleran
                 throw FitError("the curve's derivative is unbounded or undefined near t=" +
                                number(proof.failed_at) + ": its error cannot be bounded there");
             throw FitError("the curve cannot be fitted within " + number(tolerance_mm) +
-                           " mm near t=" + number(m) + " (error " + number(sampled) +
-                           " mm over a t interval of " + number(span.b - span.a) +
-                           "): is it discontinuous there?");
+                           " mm near t=" + number(m) + " (not even by pieces " +
+                           number(span.b - span.a) + " long in t): is it discontinuous there?");
         }
         spans.push_back({m, span.b, span.depth + 1});
         spans.push_back({span.a, m, span.depth + 1});

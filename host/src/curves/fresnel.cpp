@@ -77,8 +77,10 @@ void series(double x, double& c, double& s) {
 void phase(double x, double& sine, double& cosine) {
     const DD w = two_prod(x, x);
     const DD half{w.hi / 2, w.lo / 2};
-    const double even = 2 * std::nearbyint(half.hi / 2);
-    const DD r = two_sum(half.hi - even, half.lo);
+    // fmod is exact; both parts need it, as for large x the low part is a huge integer too.
+    DD r = two_sum(std::fmod(half.hi, 2.0), std::fmod(half.lo, 2.0));
+    const double even = 2 * std::nearbyint(r.hi / 2);
+    r = two_sum(r.hi - even, r.lo);
     const DD theta = mul(kPiDD, r);
     sine = std::sin(theta.hi) + theta.lo * std::cos(theta.hi);
     cosine = std::cos(theta.hi) - theta.lo * std::sin(theta.hi);
