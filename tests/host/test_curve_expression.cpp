@@ -4,6 +4,7 @@
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <cstdlib>
+#include <limits>
 #include <random>
 #include <string>
 
@@ -153,6 +154,13 @@ TEST_CASE("interval functions handle their hard cases", "[function]") {
     CHECK(atan2(Interval(1, 2), Interval(1, 2)).contains(M_PI / 4));
     CHECK(fresnel_c(Interval(0.9, 1.1)).contains(0.7798934003768228));
     CHECK(fresnel_s(Interval(-1e3, 1e3)).hi < 0.8);
+    // Outward rounding: the exact sum 1 + 1e-30 lies strictly between the ends.
+    const Interval sum = Interval(1) + Interval(1e-30);
+    CHECK(sum.lo < 1);
+    CHECK(sum.hi > 1);
+    CHECK(sum.hi == std::nextafter(1.0, 2.0));
+    CHECK((Interval(0) - Interval(0)).lo == -std::numeric_limits<double>::denorm_min());
+    CHECK((Interval(-INFINITY, 0) + Interval(1)).lo == -INFINITY);
     const Interval pi = pi_interval();
     CHECK(pi.lo < M_PI);
     CHECK(pi.hi > M_PI);

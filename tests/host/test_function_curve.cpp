@@ -130,6 +130,19 @@ TEST_CASE("a circle takes few pieces", "[function]") {
     CHECK(finer.pieces <= 64);
 }
 
+TEST_CASE("a curve that stays at one point is one piece", "[function]") {
+    // Its error bounds are sums of zeros whose lower ends round below 0: they must still prove.
+    for (const auto& coordinates :
+         {std::vector<std::string>{"0*cos(t)", "0*t"}, std::vector<std::string>{"5", "-7", "pi"}}) {
+        FitFigures figures;
+        const auto points = fit_function_curve(curve_of(coordinates, 0, kTwoPi), 0.1, &figures);
+        CHECK(figures.pieces == 1);
+        CHECK(figures.cells == 1);
+        REQUIRE(points.size() == 4);
+        CHECK(points[0] == points[3]);
+    }
+}
+
 TEST_CASE("the piece proof refuses a piece off by a known amount", "[function]") {
     // The line (t, 0) against a piece whose y bulges by 3d u(1 - u): its largest error is
     // exactly 0.75 d, at u = 1/2.

@@ -1,9 +1,11 @@
-// Outward rounding by nextafter: simpler than switching the rounding mode, and safe under any
-// optimisation level (the compiler may not reorder across a changed rounding mode otherwise).
+// Outward rounding by stepping to the next double: simpler than switching the rounding mode,
+// and safe under any optimisation level (which may move operations across a mode switch).
 #include "interval.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <initializer_list>
 
 namespace pathstream::host::curves {
@@ -15,15 +17,31 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kPi = 3.141592653589793;
 // Past this the argument reduction of sin/cos/tan in k units is too coarse to trust.
 constexpr double kPeriodicLimit = 1e9;
+constexpr std::uint64_t kInfBits = 0x7ff0000000000000;
+
+// The next double toward -infinity: std::nextafter's result without its call (a fit makes
+// tens of millions of these), by stepping the bit pattern.
+double next_down(double x) {
+    if (std::isnan(x) || x == -kInf) return x;
+    if (x == 0) return -std::numeric_limits<double>::denorm_min();
+    const auto bits = std::bit_cast<std::uint64_t>(x);
+    return std::bit_cast<double>(x > 0 ? bits - 1 : bits + 1);
+}
 
 double down(double x, int ulps = 1) {
-    for (int i = 0; i < ulps; ++i) x = std::nextafter(x, -kInf);
+    // Finite and at least `ulps` steps away from 0 and infinity: one integer step.
+    const auto bits = std::bit_cast<std::uint64_t>(x);
+    const auto magnitude = bits & ~(std::uint64_t{1} << 63);
+    const auto steps = static_cast<std::uint64_t>(ulps);
+    if (x > 0 && magnitude < kInfBits && magnitude > steps)
+        return std::bit_cast<double>(bits - steps);
+    if (x < 0 && magnitude + steps < kInfBits) return std::bit_cast<double>(bits + steps);
+    for (int i = 0; i < ulps; ++i) x = next_down(x);
     return x;
 }
 
 double up(double x, int ulps = 1) {
-    for (int i = 0; i < ulps; ++i) x = std::nextafter(x, kInf);
-    return x;
+    return -down(-x, ulps);
 }
 
 // [lo, hi] widened; a NaN end from inf - inf or 0 * inf means "anything": the whole line.

@@ -64,7 +64,9 @@ double cell_bound(const std::vector<Expression>& curve, const BezierPiece& piece
         }
         sum = sum + sqr(Interval(e_mid) + Interval(e_slope) * Interval(radius));
     }
-    return sqrt(sum).hi;
+    // Only the upper end counts: the lower one may dip below 0 by rounding, where sqrt is
+    // undefined.
+    return sqrt(Interval(sum.hi)).hi;
 }
 
 }  // namespace
