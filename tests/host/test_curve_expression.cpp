@@ -154,13 +154,22 @@ TEST_CASE("interval functions handle their hard cases", "[function]") {
     CHECK(atan2(Interval(1, 2), Interval(1, 2)).contains(M_PI / 4));
     CHECK(fresnel_c(Interval(0.9, 1.1)).contains(0.7798934003768228));
     CHECK(fresnel_s(Interval(-1e3, 1e3)).hi < 0.8);
-    // Outward rounding: the exact sum 1 + 1e-30 lies strictly between the ends.
+    // Directed rounding: the exact sum 1 + 1e-30 lies between 1 and the next double up; exact
+    // results stay points.
     const Interval sum = Interval(1) + Interval(1e-30);
-    CHECK(sum.lo < 1);
-    CHECK(sum.hi > 1);
+    CHECK(sum.lo == 1);
     CHECK(sum.hi == std::nextafter(1.0, 2.0));
-    CHECK((Interval(0) - Interval(0)).lo == -std::numeric_limits<double>::denorm_min());
+    CHECK((Interval(1) - Interval(1e-30)).lo == std::nextafter(1.0, 0.0));
+    const Interval third = Interval(1) / Interval(3);
+    CHECK(third.lo < 1.0 / 3);
+    CHECK(third.hi > 1.0 / 3);
+    CHECK((Interval(0.1) * Interval(3)).contains(0.1 * 3));
+    CHECK((Interval(0) * Interval(3)).hi == 0);
+    CHECK((Interval(-1) * Interval(3)).lo == -3);
+    CHECK((Interval(0) - Interval(0)).hi == 0);
+    CHECK((Interval(1e-200) * Interval(1e-200)).lo < 0);  // underflowed to 0: still stepped
     CHECK((Interval(-INFINITY, 0) + Interval(1)).lo == -INFINITY);
+    CHECK(!(Interval(0, INFINITY) * Interval(0)).bounded());
     const Interval pi = pi_interval();
     CHECK(pi.lo < M_PI);
     CHECK(pi.hi > M_PI);

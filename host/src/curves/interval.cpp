@@ -50,6 +50,45 @@ Interval outward(double lo, double hi, int ulps = 1) {
     return {down(lo, ulps), up(hi, ulps)};
 }
 
+// Bounds of the exact a + b: the rounded sum, stepped outward only on the side where the exact
+// error (two-sum, exact for every finite pair) says the exact sum lies. Exact sums stay points,
+// which also keeps sums with 0 from stepping into subnormals (slow on most CPUs).
+Interval sum_bounds(double a, double b) {
+    const double s = a + b;
+    if (!std::isfinite(s)) return {down(s), up(s)};
+    const double bb = s - a;
+    const double error = (a - (s - bb)) + (b - bb);
+    return {error < 0 ? down(s) : s, error > 0 ? up(s) : s};
+}
+
+// Bounds of the exact a · b: one step each way, except where the product is exact (a factor 0
+// or ±1). The step on both sides costs less than finding the error's sign by fma, which is a
+// library call on CPUs without it.
+Interval product_bounds(double a, double b) {
+    const double p = a * b;
+    if (a == 0 || b == 0 || std::fabs(a) == 1 || std::fabs(b) == 1) return {p, p};
+    return {down(p), up(p)};
+}
+
+// Bounds of the exact a / b (b != 0), as product_bounds.
+Interval quotient_bounds(double a, double b) {
+    const double q = a / b;
+    if (a == 0 || std::fabs(b) == 1) return {q, q};
+    return {down(q), up(q)};
+}
+
+// [lo, hi] from bounds already rounded outward; NaN (inf - inf, 0 · inf among `parts`) means
+// "anything": the whole line.
+Interval checked(double lo, double hi, const Interval* parts = nullptr) {
+    if (parts != nullptr) {
+        for (int i = 0; i < 4; ++i) {
+            if (std::isnan(parts[i].lo) || std::isnan(parts[i].hi)) return whole();
+        }
+    }
+    if (std::isnan(lo) || std::isnan(hi)) return whole();
+    return {lo, hi};
+}
+
 Interval libm(double lo, double hi) {
     return outward(lo, hi, kLibmUlps);
 }
@@ -109,12 +148,11 @@ Interval e_interval() {
 
 Interval operator+(const Interval& a, const Interval& b) {
     if (a.undefined() || b.undefined()) return undefined();
-    return outward(a.lo + b.lo, a.hi + b.hi);
+    return checked(sum_bounds(a.lo, b.lo).lo, sum_bounds(a.hi, b.hi).hi);
 }
 
 Interval operator-(const Interval& a, const Interval& b) {
-    if (a.undefined() || b.undefined()) return undefined();
-    return outward(a.lo - b.hi, a.hi - b.lo);
+    return a + -b;
 }
 
 Interval operator-(const Interval& a) {
@@ -123,33 +161,25 @@ Interval operator-(const Interval& a) {
 
 Interval operator*(const Interval& a, const Interval& b) {
     if (a.undefined() || b.undefined()) return undefined();
-    const double p[] = {a.lo * b.lo, a.lo * b.hi, a.hi * b.lo, a.hi * b.hi};
-    double lo = p[0], hi = p[0];
-    for (const double v : p) {
-        if (std::isnan(v)) return whole();
-        lo = std::min(lo, v);
-        hi = std::max(hi, v);
-    }
-    return outward(lo, hi);
+    const Interval p[] = {product_bounds(a.lo, b.lo), product_bounds(a.lo, b.hi),
+                          product_bounds(a.hi, b.lo), product_bounds(a.hi, b.hi)};
+    return checked(std::min({p[0].lo, p[1].lo, p[2].lo, p[3].lo}),
+                   std::max({p[0].hi, p[1].hi, p[2].hi, p[3].hi}), p);
 }
 
 Interval operator/(const Interval& a, const Interval& b) {
     if (a.undefined() || b.undefined()) return undefined();
     if (b.contains(0)) return whole();
-    const double q[] = {a.lo / b.lo, a.lo / b.hi, a.hi / b.lo, a.hi / b.hi};
-    double lo = q[0], hi = q[0];
-    for (const double v : q) {
-        if (std::isnan(v)) return whole();
-        lo = std::min(lo, v);
-        hi = std::max(hi, v);
-    }
-    return outward(lo, hi);
+    const Interval q[] = {quotient_bounds(a.lo, b.lo), quotient_bounds(a.lo, b.hi),
+                          quotient_bounds(a.hi, b.lo), quotient_bounds(a.hi, b.hi)};
+    return checked(std::min({q[0].lo, q[1].lo, q[2].lo, q[3].lo}),
+                   std::max({q[0].hi, q[1].hi, q[2].hi, q[3].hi}), q);
 }
 
 Interval sqr(const Interval& x) {
     if (x.undefined()) return undefined();
     const double small = mig(x), big = x.magnitude();
-    return {std::max(0.0, down(small * small)), up(big * big)};
+    return {std::max(0.0, product_bounds(small, small).lo), product_bounds(big, big).hi};
 }
 
 Interval integer_power(const Interval& x, int n) {

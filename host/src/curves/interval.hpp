@@ -44,8 +44,10 @@ Interval pi_interval();
 /// An interval known to contain e.
 Interval e_interval();
 
-// Arithmetic: each end rounded outward by one ulp after the nearest-rounded operation, which
-// covers IEEE 754's correctly rounded + - * / and sqrt. O(1), never throws.
+// Arithmetic: each end is the nearest-rounded result stepped one ulp outward, which covers
+// IEEE 754's correctly rounded operations. Results known exact stay exact: sums whose rounding
+// error (two-sum) is 0 or of one sign step on that side only; products and quotients with a
+// factor 0 or ±1 do not step. O(1), never throws.
 Interval operator+(const Interval& a, const Interval& b);
 Interval operator-(const Interval& a, const Interval& b);
 Interval operator-(const Interval& a);
