@@ -119,7 +119,7 @@ TEST_CASE("a circle takes few pieces", "[function]") {
     FitFigures figures;
     const FunctionCurve c = curve_of({"40*cos(t)", "40*sin(t)"}, 0, kTwoPi);
     const auto points = fit_function_curve(c, 0.005, &figures);
-    // Upper bounds, not exact counts: halving gives 16 today; a better split may give fewer.
+    // Upper bounds taken from measured counts, not exact counts: a better split may need fewer.
     CHECK(figures.pieces <= 16);
     CHECK(points.size() == 3 * figures.pieces + 1);
     CHECK(std::fabs(points.front()[0] - 40) < 1e-12);

@@ -7,7 +7,7 @@
 namespace pathstream::host::curves {
 
 /// The largest error fresnel_c and fresnel_s are trusted to have (the tests check them against
-/// reference values at far smaller errors); fresnel_*_enclosure widen by it.
+/// reference values at far smaller errors); the interval overloads widen by it.
 inline constexpr double kFresnelMargin = 1e-14;
 
 /// C(x), accurate to about 1e-16 absolute: a power series summed in double-double arithmetic
