@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <catch2/catch.hpp>
 #include <cmath>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -112,6 +113,32 @@ TEST_CASE("fitted function curves stay within the tolerance", "[function]") {
             CHECK(fit.figures.largest_sampled_error <= fit.figures.largest_bound);
             CHECK(fit.figures.cells >= pieces);
         }
+    }
+}
+
+TEST_CASE("random smooth curves stay within their proven bounds", "[function]") {
+    // Seed: Catch's --rng-seed (a fixed default without it).
+    const unsigned seed = Catch::rngSeed() != 0 ? Catch::rngSeed() : 20261129u;
+    std::mt19937_64 rng(seed);
+    std::uniform_real_distribution<double> amplitude(-30, 30), rate(-4, 4), phase(-3, 3);
+    const auto number = [](double v) { return "(" + std::to_string(v) + ")"; };
+    for (int c = 0; c < 20; ++c) {
+        std::vector<std::string> coordinates;
+        for (int axis = 0; axis < 2 + c % 2; ++axis) {
+            coordinates.push_back(number(amplitude(rng)) + "*sin(" + number(rate(rng)) + "*t + " +
+                                  number(phase(rng)) + ") + " + number(amplitude(rng)) + "*atan(" +
+                                  number(rate(rng)) + "*t) + " + number(amplitude(rng) / 10) +
+                                  "*t^2");
+        }
+        const double t0 = phase(rng);
+        const FunctionCurve curve = curve_of(coordinates, t0, t0 + 0.5 + std::fabs(phase(rng)));
+        const double tolerance = std::pow(10.0, -1 - c % 3);
+        INFO("seed " << seed << " curve " << c << ": " << coordinates[0] << " at " << tolerance);
+        const FittedCurve fit = fit_function_curve_pieces(curve, tolerance);
+        std::vector<double> per_piece;
+        CHECK(dense_error(curve, fit, 5'000, per_piece) <= tolerance + 1e-9);
+        for (std::size_t k = 0; k < per_piece.size(); ++k)
+            REQUIRE(per_piece[k] <= fit.bounds[k] + 1e-9);
     }
 }
 
