@@ -7,6 +7,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "curves/function_json.hpp"
 #include "nurbs/nurbs.hpp"
 #include "pathstream/machine/input_error.hpp"
 #include "pathstream/machine/json_document.hpp"
@@ -28,6 +29,7 @@ public:
         : JsonChecker(text, file),
           nurbs_tolerance_mm_(nurbs_tolerance_mm),
           budget_(budget),
+          function_cells_left_(budget.function_cells),
           flat_(flat) {}
 
     PathBasis basis(const json& v, const std::string& pointer) const {
@@ -40,8 +42,12 @@ public:
         if (s == "nurbs") {
             fail(pointer, "basis nurbs is given per subpath, with its degree and knots");
         }
+        if (s == "function") {
+            fail(pointer, "basis function is given per subpath, with its x, y (z) and t");
+        }
         fail(pointer, "unknown basis \"" + s +
-                          "\" (expected bspline, catmull-rom, bezier, polyline or nurbs)");
+                          "\" (expected bspline, catmull-rom, bezier, polyline, nurbs or "
+                          "function)");
     }
 
     bool boolean(const json& v, const std::string& pointer, const char* what) const {
@@ -78,6 +84,10 @@ public:
         if (!v.is_object()) fail(pointer, "subpath must be an object with \"points\"");
         if (v.contains("basis") && v["basis"] == "nurbs")
             return nurbs_subpath(v, pointer, sp, scale, axes);
+        if (v.contains("basis") && v["basis"] == "function") {
+            return curves::read_function_subpath(*this, v, pointer, sp, scale, nurbs_tolerance_mm_,
+                                                 axes, function_cells_left_);
+        }
         only_keys(v, pointer, {"basis", "closed", "points"});
         if (v.contains("basis")) sp.basis = basis(v["basis"], pointer + "/basis");
         if (v.contains("closed")) sp.closed = boolean(v["closed"], pointer + "/closed", "closed");
@@ -297,6 +307,7 @@ private:
 
     double nurbs_tolerance_mm_;
     JsonPathBudget budget_;
+    mutable std::size_t function_cells_left_;  // over every function subpath of the file
     FlatNumberArrays& flat_;
 };
 

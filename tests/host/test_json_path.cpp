@@ -61,8 +61,14 @@ TEST_CASE("broken documents name file, line, column and the problem", "[host][js
     CHECK(error_of("{\"basis\": \"nurbs\", \"points\": [[0,0],[1,1]]}") ==
           "t.json:1:11: basis nurbs is given per subpath, with its degree and knots");
     CHECK(error_of("{\"basis\": \"spline\", \"points\": [[0,0],[1,1]]}") ==
-          "t.json:1:11: unknown basis \"spline\" (expected bspline, catmull-rom, bezier, polyline "
-          "or nurbs)");
+          "t.json:1:11: unknown basis \"spline\" (expected bspline, catmull-rom, bezier, polyline, "
+          "nurbs or function)");
+    CHECK(error_of("{\"basis\": \"function\", \"points\": [[0,0],[1,1]]}") ==
+          "t.json:1:11: basis function is given per subpath, with its x, y (z) and t");
+    CHECK(error_of(
+              "{\"subpaths\": [{\"basis\": \"function\", \"x\": \"t\", \"y\": \"t\", \"z\": \"t\", "
+              "\"t\": [0, 1]}, {\"points\": [[0,0],[1,1]]}]}") ==
+          "t.json:1:93: point has 2 coordinates, expected 3");
     CHECK(error_of("{\"points\": [[0,0],[1,1,1]]}") ==
           "t.json:1:19: point has 3 coordinates, expected 2");
     CHECK(error_of("{\"points\": [[0,0],[1,1]], \"subpaths\": []}") ==

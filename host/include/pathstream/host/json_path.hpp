@@ -11,6 +11,8 @@ namespace pathstream::host {
 /// What a JSON path may cost before the read fails (the reader's limits).
 struct JsonPathBudget {
     SurfaceBudget surfaces;  ///< its "surfaces"
+    /// Interval cells the proofs of all its function subpaths may evaluate (about 10 us each).
+    std::size_t function_cells = 50'000'000;
 };
 
 /// Parses a JSON path document. `file` names the source in error messages. Subpaths with
