@@ -11,6 +11,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     budget.surfaces.curves = 2'000;
     budget.surfaces.points = 100'000;
     budget.surfaces.hidden_line_questions = 100'000;
+    budget.surfaces.fit_cells = 100'000;
     budget.function_cells = 100'000;
     fuzz::check_reader("f.json",
                        [&] { return host::parse_json_path(text, "f.json", 0.01, budget); });

@@ -44,14 +44,15 @@ std::vector<Subpath> draw_surfaces(const std::vector<SurfaceInput>& surfaces,
         }
         std::vector<Subpath> out;
         std::size_t points = 0;
+        std::size_t fit_cells_left = budget.fit_cells;
         for (at = 0; at < surfaces.size(); ++at) {
             const SurfaceInput& s = surfaces[at];
             WireframeFigures f;
             std::vector<Subpath> curves =
-                s.revolution
-                    ? revolution_wireframe(*s.revolution, s.counts, frame, tolerance_mm, &f,
-                                           occluder.get())
-                    : patch_wireframe(s.patches, s.counts, frame, tolerance_mm, &f, occluder.get());
+                s.revolution ? revolution_wireframe(*s.revolution, s.counts, frame, tolerance_mm,
+                                                    &f, occluder.get(), &fit_cells_left)
+                             : patch_wireframe(s.patches, s.counts, frame, tolerance_mm, &f,
+                                               occluder.get(), &fit_cells_left);
             figures.curves += f.curves;
             figures.exact_curves += f.exact_curves;
             figures.seams_merged += f.seams_merged;

@@ -67,7 +67,7 @@ std::vector<SurfaceSheet> sheets_of(const std::vector<BezierPatch>& patches) {
 std::vector<Subpath> patch_wireframe(const std::vector<BezierPatch>& patches,
                                      const IsoCounts& counts, const ViewFrame& frame,
                                      double tolerance_mm, WireframeFigures* figures,
-                                     const Occluder* occluder) {
+                                     const Occluder* occluder, std::size_t* fit_cells_left) {
     WireframeFigures f;
     const double resolution = 1e-9 * extent(patches);
     surface::SeamSet drawn(resolution);
@@ -88,7 +88,7 @@ std::vector<Subpath> patch_wireframe(const std::vector<BezierPatch>& patches,
                     continue;
                 }
                 for (const auto& chain :
-                     surface::draw_curve(q, {}, frame, tolerance_mm, occluder, f)) {
+                     surface::draw_curve(q, {}, frame, tolerance_mm, occluder, f, fit_cells_left)) {
                     Subpath sp;
                     sp.basis = PathBasis::kBezier;
                     sp.location = patch.location;

@@ -2,12 +2,36 @@
 // view makes them rational (weight: the eye's distance ahead), which the NURBS fitter takes.
 #include "project_curve.hpp"
 
+#include <algorithm>
+#include <cstdio>
 #include <stdexcept>
+#include <string>
 
-#include "../nurbs/nurbs.hpp"
+#include "../curves/fit_function.hpp"
 #include "pathstream/host/hidden_lines.hpp"
 
 namespace pathstream::host::surface {
+namespace {
+
+// sum_i c[i] B_i(t), the Bernstein basis of degree c.size() - 1, as an expression in t with
+// every coefficient printed so that it reads back as the same double.
+std::string bernstein_sum(const std::vector<double>& c) {
+    static const char* const basis[4][4] = {
+        {"1", "", "", ""},
+        {"(1-t)", "t", "", ""},
+        {"(1-t)^2", "2*t*(1-t)", "t^2", ""},
+        {"(1-t)^3", "3*t*(1-t)^2", "3*t^2*(1-t)", "t^3"},
+    };
+    std::string out;
+    char number[40];
+    for (std::size_t i = 0; i < c.size(); ++i) {
+        std::snprintf(number, sizeof number, "%.17g", c[i]);
+        out += (i ? " + (" : "(") + std::string(number) + ")*" + basis[c.size() - 1][i];
+    }
+    return out;
+}
+
+}  // namespace
 
 std::vector<Point3> raise_to_cubic(const std::vector<Point3>& q) {
     auto mix = [](const Point3& a, double wa, const Point3& b, double wb) {
@@ -28,7 +52,8 @@ std::vector<Point3> raise_to_cubic(const std::vector<Point3>& q) {
 
 std::vector<PathPoint> project_curve(const std::vector<Point3>& q,
                                      const std::vector<double>& weights, const ViewFrame& frame,
-                                     double tolerance_mm, bool& exact) {
+                                     double tolerance_mm, bool& exact,
+                                     std::size_t* fit_cells_left) {
     const bool ortho = frame.view.projection == SurfaceView::Projection::kOrthographic;
     // A straight line stays straight under any projection: its end points say it all.
     const bool line = q.size() == 2 && weights.empty();
@@ -42,33 +67,53 @@ std::vector<PathPoint> project_curve(const std::vector<Point3>& q,
         return out;
     }
     exact = false;
-    nurbs::Nurbs curve;
-    curve.degree = static_cast<int>(q.size()) - 1;
-    for (std::size_t i = 0; i < q.size(); ++i) {
+    // The projected curve is rational: each coordinate is a ratio of Bernstein sums, which
+    // the function-curve fitter takes as an expression and fits with a proven bound.
+    const std::size_t n = q.size() - 1;
+    std::vector<double> w(q.size()), wx(q.size()), wy(q.size());
+    for (std::size_t i = 0; i <= n; ++i) {
         const auto xy = project_point(frame, q[i]);
-        curve.points.push_back({xy[0], xy[1]});
-        double w = weights.empty() ? 1.0 : weights[i];
+        w[i] = weights.empty() ? 1.0 : weights[i];
         if (!ortho) {
-            w *= (frame.view.eye_distance - view_depth(frame, q[i])) / frame.view.eye_distance;
+            w[i] *= (frame.view.eye_distance - view_depth(frame, q[i])) / frame.view.eye_distance;
         }
-        curve.weights.push_back(w);
+        wx[i] = w[i] * xy[0];
+        wy[i] = w[i] * xy[1];
     }
-    curve.knots.assign(q.size(), 0.0);
-    curve.knots.insert(curve.knots.end(), q.size(), 1.0);
-    // No projected iso-curve of a real drawing needs this many cubics; the cap bounds what a
+    const std::string denominator = bernstein_sum(w);
+    curves::FunctionCurve curve;
+    curve.coordinates.push_back(
+        curves::parse_expression("(" + bernstein_sum(wx) + ")/(" + denominator + ")"));
+    curve.coordinates.push_back(
+        curves::parse_expression("(" + bernstein_sum(wy) + ")/(" + denominator + ")"));
+    curve.t0 = 0;
+    curve.t1 = 1;
+    curves::FitLimits limits;
+    // No projected iso-curve of a real drawing needs this many cubics; the caps bound what a
     // curve grazing the eye can cost.
-    return nurbs::nurbs_to_bezier(curve, tolerance_mm, 100'000);
+    limits.max_pieces = 100'000;
+    if (fit_cells_left) limits.max_cells = *fit_cells_left;
+    curves::FitFigures figures;
+    try {
+        std::vector<PathPoint> out =
+            curves::fit_function_curve(curve, tolerance_mm, &figures, limits);
+        if (fit_cells_left) *fit_cells_left -= std::min(*fit_cells_left, figures.cells);
+        return out;
+    } catch (const curves::FitError& e) {
+        throw std::length_error(std::string("a projected curve cannot be fitted: ") + e.what());
+    }
 }
 
 std::vector<std::vector<PathPoint>> draw_curve(const std::vector<Point3>& q,
                                                const std::vector<double>& weights,
                                                const ViewFrame& frame, double tolerance_mm,
-                                               const Occluder* occluder,
-                                               WireframeFigures& figures) {
+                                               const Occluder* occluder, WireframeFigures& figures,
+                                               std::size_t* fit_cells_left) {
     std::vector<std::vector<PathPoint>> out;
     auto add = [&](const std::vector<Point3>& piece, const std::vector<double>& w) {
         bool exact = false;
-        std::vector<PathPoint> chain = project_curve(piece, w, frame, tolerance_mm, exact);
+        std::vector<PathPoint> chain =
+            project_curve(piece, w, frame, tolerance_mm, exact, fit_cells_left);
         if (chain.size() < 4) return;  // fitted to nothing: a point on the page
         ++figures.curves;
         if (exact) ++figures.exact_curves;

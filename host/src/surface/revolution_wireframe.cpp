@@ -74,7 +74,8 @@ void add_chains(std::vector<Subpath>& out, const std::vector<std::vector<PathPoi
 
 std::vector<Subpath> revolution_wireframe(const RevolutionSurface& surface, const IsoCounts& counts,
                                           const ViewFrame& frame, double tolerance_mm,
-                                          WireframeFigures* figures, const Occluder* occluder) {
+                                          WireframeFigures* figures, const Occluder* occluder,
+                                          std::size_t* fit_cells_left) {
     if (!(surface.angle_deg > 0 && surface.angle_deg <= 360)) {
         throw std::invalid_argument("the angle of revolution must be in (0, 360] degrees");
     }
@@ -100,7 +101,8 @@ std::vector<Subpath> revolution_wireframe(const RevolutionSurface& surface, cons
                 ++f.seams_merged;
                 continue;
             }
-            for (auto& chain : surface::draw_curve(q, {}, frame, tolerance_mm, occluder, f)) {
+            for (auto& chain :
+                 surface::draw_curve(q, {}, frame, tolerance_mm, occluder, f, fit_cells_left)) {
                 chains.push_back(std::move(chain));
             }
         }
@@ -131,7 +133,7 @@ std::vector<Subpath> revolution_wireframe(const RevolutionSurface& surface, cons
                                             place(axis, rh[0] / std::cos(half), rh[1], t0 + half),
                                             place(axis, rh[0], rh[1], t0 + step)};
                 for (auto& chain : surface::draw_curve(q, {1.0, std::cos(half), 1.0}, frame,
-                                                       tolerance_mm, occluder, f)) {
+                                                       tolerance_mm, occluder, f, fit_cells_left)) {
                     chains.push_back(std::move(chain));
                 }
             }

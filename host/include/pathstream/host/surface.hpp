@@ -90,22 +90,27 @@ struct WireframeFigures {
 /// in patch order. Under an orthographic view each curve is the exact projection of the
 /// surface's iso-curve (degree raised to 3); under perspective it is the projected rational
 /// curve fitted within `tolerance_mm`. A boundary curve equal to one drawn already (either
-/// direction, within 1e-9 of the drawing's extent) is drawn once. With `occluder`, only the
+/// direction, within 1e-9 of the drawing's extent) is drawn once. Fitted curves carry a proven
+/// bound and evaluate at most `*fit_cells_left` interval cells in all (nullptr: the fitter's
+/// limit per curve), which they lower. With `occluder`, only the
 /// parts it does not hide are drawn, each an exact piece of the curve (visible_intervals).
 /// Cost O(patches x counts), times the samples' questions with an occluder. Throws
 /// std::domain_error when a point is behind the eye.
 std::vector<Subpath> patch_wireframe(const std::vector<BezierPatch>& patches,
                                      const IsoCounts& counts, const ViewFrame& frame,
                                      double tolerance_mm, WireframeFigures* figures = nullptr,
-                                     const Occluder* occluder = nullptr);
+                                     const Occluder* occluder = nullptr,
+                                     std::size_t* fit_cells_left = nullptr);
 
 /// The meridians and parallels of `surface` through `frame`: meridians are exact under an
-/// orthographic view, parallels (circles) are fitted within `tolerance_mm`. Throws as
+/// orthographic view, parallels (circles) are fitted within `tolerance_mm` with a proven
+/// bound. Throws as
 /// patch_wireframe, and std::invalid_argument for a zero axis or an angle out of range.
 std::vector<Subpath> revolution_wireframe(const RevolutionSurface& surface, const IsoCounts& counts,
                                           const ViewFrame& frame, double tolerance_mm,
                                           WireframeFigures* figures = nullptr,
-                                          const Occluder* occluder = nullptr);
+                                          const Occluder* occluder = nullptr,
+                                          std::size_t* fit_cells_left = nullptr);
 
 /// One surface of a drawing: Bezier patches, or a surface of revolution, and its iso lines.
 struct SurfaceInput {
@@ -120,6 +125,7 @@ struct SurfaceBudget {
     std::size_t curves = 200'000;                    ///< iso-curves, estimated before drawing
     std::size_t points = 5'000'000;                  ///< control points of the wireframes
     std::size_t hidden_line_questions = 20'000'000;  ///< points judged for hidden lines
+    std::size_t fit_cells = 20'000'000;  ///< interval cells the fitted curves' proofs evaluate
 };
 
 /// Why draw_surfaces failed, and on which surface (an index into its input).
