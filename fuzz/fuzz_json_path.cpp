@@ -10,7 +10,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     host::JsonPathBudget budget;
     budget.surfaces.curves = 2'000;
     budget.surfaces.points = 100'000;
-    budget.surfaces.hidden_line_questions = 100'000;
+    budget.surfaces.hidden_line_questions = 5'000;
     budget.surfaces.fit_cells = 100'000;
     budget.function_cells = 100'000;
     fuzz::check_reader("f.json",

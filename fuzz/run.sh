@@ -13,7 +13,7 @@ set -u
 here=$(cd "$(dirname "$0")" && pwd)
 seconds=${1:-${PATHSTREAM_FUZZ_SECONDS:-5}}
 build=${2:-$here/../build/asan}
-targets=${FUZZ_TARGETS:-"json_path csv_path svg_path gcode_path machine_profile target_url modbus_map modbus_rtu_slave wire_spans can_node cia402_drive job_journal http_request tool_table function_curve"}
+targets=${FUZZ_TARGETS:-"json_path csv_path svg_path gcode_path machine_profile target_url modbus_map modbus_rtu_slave wire_spans can_node cia402_drive job_journal http_request tool_table function_curve bpt_path"}
 work=${FUZZ_WORK:-$(mktemp -d)}
 failed=""
 for t in $targets; do

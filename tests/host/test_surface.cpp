@@ -4,8 +4,11 @@
 #include <boost/multiprecision/cpp_int.hpp>
 #include <catch2/catch.hpp>
 #include <cmath>
+#include <fstream>
 #include <random>
+#include <sstream>
 
+#include "pathstream/host/bpt_path.hpp"
 #include "pathstream/host/json_path.hpp"
 #include "pathstream/host/surface.hpp"
 #include "pathstream/machine/input_error.hpp"
@@ -349,4 +352,47 @@ TEST_CASE("surface: a 3-D path under a view is projected exactly", "[surface]") 
     // Looking along -x: y runs right, z up (drawn as -y).
     CHECK(p.subpaths[0].points.back()[0] == Approx(20));
     CHECK(p.subpaths[0].points.back()[1] == Approx(-10));
+}
+
+TEST_CASE("surface: the teapot's text form draws as its JSON form", "[surface]") {
+    std::ifstream in(std::string(PATHSTREAM_SOURCE_DIR) + "/examples/teapot.bpt");
+    std::stringstream text;
+    text << in.rdbuf();
+    BptOptions options;
+    options.view.azimuth_deg = -70;  // the view examples/teapot.json gives
+    options.view.elevation_deg = 25;
+    options.view.scale = 30;
+    const Path bpt = parse_bpt_path(text.str(), "teapot.bpt", options);
+    const Path json = load_json_path(std::string(PATHSTREAM_SOURCE_DIR) + "/examples/teapot.json");
+    REQUIRE(bpt.subpaths.size() == json.subpaths.size());
+    for (std::size_t i = 0; i < bpt.subpaths.size(); ++i) {
+        REQUIRE(bpt.subpaths[i].points.size() == json.subpaths[i].points.size());
+        for (std::size_t k = 0; k < bpt.subpaths[i].points.size(); ++k) {
+            CHECK(bpt.subpaths[i].points[k] == json.subpaths[i].points[k]);
+        }
+    }
+}
+
+TEST_CASE("surface: the text form's errors name the place", "[surface]") {
+    auto error_of = [](const std::string& text) {
+        try {
+            parse_bpt_path(text, "t.bpt");
+        } catch (const pathstream::host::InputError& e) {
+            return std::string(e.what());
+        }
+        return std::string("no error");
+    };
+    CHECK(error_of("") == "t.bpt:1:1: missing the patch count");
+    CHECK(error_of("0\n") == "t.bpt:1:1: the patch count must be a whole number from 1 to 100000");
+    CHECK(error_of("1\n3 4\n") ==
+          "t.bpt:2:3: a patch's v degree must be a whole number from 1 to 3");
+    CHECK(error_of("1\n1 1\n0 0 0\n1 0 0\n0 1 0\n1 1 x\n") ==
+          "t.bpt:6:5: a coordinate must be a finite number, got \"x\"");
+    CHECK(error_of("1\n1 1\n0 0 0\n1 0 0\n0 1 0\n1 1 1e7\n") ==
+          "t.bpt:6:5: coordinate is out of range (|value| <= 1e6 mm)");
+    CHECK(error_of("1\n1 1\n0 0 0\n1 0 0\n0 1 0\n1 1 1\n5\n") ==
+          "t.bpt:7:1: data after the 1 patches the file announces");
+    CHECK(error_of("2\n1 1\n0 0 0\n1 0 0\n0 1 0\n1 1 1\n") ==
+          "t.bpt:7:1: missing a patch's u degree");
+    CHECK(error_of("1\n1 1\n0 0 0\n0 0 0\n0 0 0\n0 0 0\n") == "t.bpt: the patches draw no curve");
 }

@@ -9,6 +9,7 @@
 #include <iostream>
 #include <system_error>
 
+#include "pathstream/host/bpt_path.hpp"
 #include "pathstream/host/csv_path.hpp"
 #include "pathstream/host/gcode_path.hpp"
 #include "pathstream/host/json_path.hpp"
@@ -79,6 +80,12 @@ Path read_csv(const std::string& text, const std::string& name, const JobRequest
     return parse_csv_path(text, name, basis_from_name(o.csv_basis), o.csv_closed);
 }
 
+Path read_bpt(const std::string& text, const std::string& name, const JobRequest& o, std::string&) {
+    BptOptions options;
+    options.tolerance_mm = o.tolerance;
+    return parse_bpt_path(text, name, options);
+}
+
 // Everything `in` holds, appended in blocks to a string reserved for `size_hint` bytes: no
 // second copy of the text (a string stream's buffer and then its str() held two or three).
 std::string read_all(std::istream& in, std::size_t size_hint) {
@@ -98,6 +105,10 @@ const std::vector<PathFormat>& path_formats() {
         {"csv", {"csv"}, "CSV points with a basis (docs/formats.md)", read_csv},
         {"svg", {"svg"}, "SVG drawings with layers (docs/formats-svg.md)", read_svg},
         {"gcode", {"gcode", "ngc", "nc", "gc"}, "RS274NGC G-code (docs/formats.md)", read_gcode},
+        {"bpt",
+         {"bpt"},
+         "Bezier patches, the teapot's text form (docs/formats-surfaces.md)",
+         read_bpt},
     };
     return formats;
 }

@@ -53,7 +53,34 @@ double extent(const std::vector<BezierPatch>& patches) {
 }  // namespace
 
 Point3 patch_point(const BezierPatch& patch, double u, double v) {
-    return casteljau(iso_curve(patch, true, v), u);
+    // The hidden-line search asks this millions of times: de Casteljau on fixed arrays, the
+    // columns at v first, then the row they make at u.
+    std::array<Point3, 4> row{};
+    for (int i = 0; i <= patch.degree_u; ++i) {
+        std::array<Point3, 4> column{};
+        for (int j = 0; j <= patch.degree_v; ++j)
+            column[static_cast<std::size_t>(j)] = at(patch, i, j);
+        for (int r = patch.degree_v; r > 0; --r) {
+            for (int k = 0; k < r; ++k) {
+                for (std::size_t c = 0; c < 3; ++c) {
+                    column[static_cast<std::size_t>(k)][c] =
+                        (1 - v) * column[static_cast<std::size_t>(k)][c] +
+                        v * column[static_cast<std::size_t>(k + 1)][c];
+                }
+            }
+        }
+        row[static_cast<std::size_t>(i)] = column[0];
+    }
+    for (int r = patch.degree_u; r > 0; --r) {
+        for (int k = 0; k < r; ++k) {
+            for (std::size_t c = 0; c < 3; ++c) {
+                row[static_cast<std::size_t>(k)][c] =
+                    (1 - u) * row[static_cast<std::size_t>(k)][c] +
+                    u * row[static_cast<std::size_t>(k + 1)][c];
+            }
+        }
+    }
+    return row[0];
 }
 
 std::vector<SurfaceSheet> sheets_of(const std::vector<BezierPatch>& patches) {
