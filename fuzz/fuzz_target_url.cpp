@@ -1,4 +1,5 @@
-// The target URL parsers (Modbus, native CAN, CiA 402): a target, or std::invalid_argument;
+// The target URL parsers (Modbus, native CAN, CiA 402, MQTT brokers): a target, or
+// std::invalid_argument;
 // a parsed Modbus target's canonical URL parses back to the same target.
 #include <stdexcept>
 
@@ -6,6 +7,7 @@
 #include "pathstream/hal/modbus_target.hpp"
 #include "pathstream/host/can_stream.hpp"
 #include "pathstream/host/cia402_master.hpp"
+#include "pathstream/host/mqtt_client.hpp"
 
 namespace {
 
@@ -39,5 +41,10 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         if (t.node < 1 || t.node > 127) fuzz::violated("CAN node out of range");
     });
     refused_only_as_invalid([&] { (void)host::parse_cia402_target(url, axes); });
+    refused_only_as_invalid([&] {
+        const host::MqttUrl t = host::parse_mqtt_url(url);
+        if (t.host.empty() || t.port < 1 || t.port > 65535) fuzz::violated("MQTT host or port");
+        if (t.password.size() > 4096 + url.size()) fuzz::violated("an unbounded password");
+    });
     return 0;
 }

@@ -3,6 +3,8 @@
 // passwords, and a shared subscription that hands each message to exactly one subscriber.
 #include <catch2/catch.hpp>
 #include <condition_variable>
+#include <cstdio>
+#include <fstream>
 #include <map>
 #include <mutex>
 #include <set>
@@ -174,4 +176,16 @@ TEST_CASE("mqtt: a shared subscription hands each job to exactly one machine", "
     CHECK(got.size() == 20);
     for (int j = 0; j < 20; ++j) CHECK(got.count("job-" + std::to_string(j)) == 1);
     CHECK(busy >= 2);  // the broker spreads them: not everything to one machine
+}
+
+TEST_CASE("mqtt: a password file gives its first line, bounded", "[mqtt]") {
+    const std::string file = "/tmp/pathstream_mqtt_pw_" + std::to_string(getpid());
+    std::ofstream(file) << "s3cret\r\nsecond line\n";
+    CHECK(parse_mqtt_url("mqtt://ann@h?password_file=" + file).password == "s3cret");
+    std::ofstream(file) << std::string(5000, 'x');
+    CHECK_THROWS_WITH(parse_mqtt_url("mqtt://ann@h?password_file=" + file),
+                      Catch::Contains("first line is longer than 4096 bytes"));
+    CHECK_THROWS_WITH(parse_mqtt_url("mqtt://ann@h?password_file=/dev/zero"),
+                      Catch::Contains("first line is longer than 4096 bytes"));
+    std::remove(file.c_str());
 }

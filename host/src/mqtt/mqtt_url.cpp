@@ -11,6 +11,25 @@ namespace {
     throw std::invalid_argument("mqtt URL \"" + url + "\": " + why);
 }
 
+// The password file's first line, read at most 4 KiB: a file that is no password file (a
+// device, a log) costs no more.
+std::string first_line(const std::string& url, const std::string& path) {
+    constexpr std::size_t kMax = 4096;
+    std::ifstream in(path, std::ios::binary);
+    if (!in) bad(url, "cannot read the password file " + path);
+    std::string line;
+    char c = 0;
+    while (in.get(c) && c != '\n') {
+        if (line.size() == kMax)
+            bad(url, "the password file's first line is longer than 4096 bytes");
+        line += c;
+    }
+    if (in.bad()) bad(url, "cannot read the password file " + path);
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (line.empty()) bad(url, "the password file " + path + " has no password on its first line");
+    return line;
+}
+
 }  // namespace
 
 std::string MqttUrl::text() const {
@@ -69,10 +88,7 @@ MqttUrl parse_mqtt_url(const std::string& url) {
             if (!u.tls) bad(url, "cafile needs mqtts://");
             u.ca_file = value;
         } else if (key == "password_file") {
-            std::ifstream in(value);
-            if (!in || !std::getline(in, u.password))
-                bad(url, "cannot read the password file " + value);
-            if (!u.password.empty() && u.password.back() == '\r') u.password.pop_back();
+            u.password = first_line(url, value);
             if (u.username.empty()) bad(url, "a password file needs a user name (mqtt://USER@...)");
         } else {
             bad(url, "unknown option \"" + key + "\" (cafile, password_file)");
