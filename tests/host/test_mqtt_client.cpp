@@ -79,7 +79,7 @@ TEST_CASE("mqtt: URLs", "[mqtt]") {
           "/nonexistent");
 }
 
-TEST_CASE("mqtt: publish, subscribe and retained state", "[mqtt]") {
+TEST_CASE("mqtt: publish, subscribe and retained state", "[mqtt][threads]") {
     MosquittoBroker broker;
     Inbox inbox;
     MqttClient machine(parse_mqtt_url(broker.url()), "machine-1");
@@ -101,7 +101,7 @@ TEST_CASE("mqtt: publish, subscribe and retained state", "[mqtt]") {
     CHECK(inbox.size() == 3);
 }
 
-TEST_CASE("mqtt: a dropped connection publishes the last will", "[mqtt]") {
+TEST_CASE("mqtt: a dropped connection publishes the last will", "[mqtt][threads]") {
     MosquittoBroker broker;
     Inbox inbox;
     MqttClient watcher(parse_mqtt_url(broker.url()), "watcher", {}, inbox.sink());
@@ -144,7 +144,7 @@ TEST_CASE("mqtt: a broker with passwords refuses a client without one", "[mqtt]"
     ann.publish("pathstream/m1/state", "idle", 1, true);
 }
 
-TEST_CASE("mqtt: a shared subscription hands each job to exactly one machine", "[mqtt]") {
+TEST_CASE("mqtt: a shared subscription hands each job to exactly one machine", "[mqtt][threads]") {
     MosquittoBroker broker;
     std::vector<std::unique_ptr<Inbox>> inboxes;
     std::vector<std::unique_ptr<MqttClient>> machines;
