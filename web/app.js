@@ -1,6 +1,7 @@
 // The page of `pathstream serve`: load a drawing, place it, preview it, stream or simulate it,
 // and watch and steer the machine through the server's API (docs/serve.md).
 import { PreviewView, drawSpeed, layerColours } from './preview.js';
+import { ViewPanel, surfaceDocument } from './view_panel.js';
 
 const $ = id => document.getElementById(id);
 const view = new PreviewView($('preview'));
@@ -15,6 +16,7 @@ const page = {
   shown: 0,            // the fraction shown for the job (never goes back within a job)
   jobRunning: false,
   device: null,
+  surface: null,       // a JSON drawing with surfaces: { name, doc }, its document parsed once
 };
 
 // The token came once in the address (?token=); the server keeps it as a cookie, so it is
@@ -213,23 +215,66 @@ function failed(message) {
   clearPreview();
 }
 
-async function load(file) {
-  showError('');
-  $('drawing-name').textContent = `${file.name}: planning…`;
-  const o = options();
-  delete o.layers;  // another drawing: its own layers
-  const r = await api(`/api/drawing?name=${encodeURIComponent(file.name)}&options=${encodeURIComponent(JSON.stringify(o))}`, file, true);
-  $('layers').replaceChildren();
+let previewSerial = 0;  // the latest upload or preview asked for: older answers are dropped
+
+// Stores the drawing (a file, or a surface drawing's text with another view) on the server
+// and plans it with the page's placement.
+async function upload(name, body, o) {
+  const serial = ++previewSerial;
+  const r = await api(`/api/drawing?name=${encodeURIComponent(name)}&options=${encodeURIComponent(JSON.stringify(o))}`, body, true);
+  if (serial !== previewSerial) return;
   if (!r.ok) {
     $('drawing-name').textContent = r.drawing || '';
     page.drawing = r.drawing || '';  // stored but not planned: other options may place it
     failed(r.error);
     return;
   }
+  showError('');
   showPreview(r);
 }
 
-let previewSerial = 0;
+async function load(file) {
+  showError('');
+  $('drawing-name').textContent = `${file.name}: planning…`;
+  // A JSON drawing with surfaces gets the View panel; the file itself goes up unchanged, so
+  // the reader's messages name its own lines.
+  clearTimeout(viewUpload.timer);
+  viewUpload.again = false;
+  const doc = surfaceDocument(file.name, await file.text().catch(() => ''));
+  page.surface = doc ? { name: file.name, doc } : null;
+  if (doc) viewPanel.show(doc); else viewPanel.hide();
+  const o = options();
+  delete o.layers;  // another drawing: its own layers
+  $('layers').replaceChildren();
+  viewUpload.loading = upload(file.name, file, o);
+  await viewUpload.loading;
+}
+
+// A view changed in the panel: 250 ms after the last change the document goes up again with
+// its new view, under the same name and with the same placement. One upload at a time (a
+// newer one would only stop the older's plan); a change while one is on its way goes up
+// when it answers, as the latest view.
+const viewUpload = { timer: 0, busy: false, again: false, loading: Promise.resolve() };
+const viewPanel = new ViewPanel($('surface-view'), () => {
+  clearTimeout(viewUpload.timer);
+  viewUpload.timer = setTimeout(uploadView, 250);
+});
+
+async function uploadView() {
+  if (viewUpload.busy) { viewUpload.again = true; return; }
+  viewUpload.busy = true;
+  await viewUpload.loading;  // the file's own upload answers first
+  do {
+    viewUpload.again = false;
+    const s = page.surface;
+    if (!s) break;
+    s.doc.view = viewPanel.view(s.doc.view);
+    $('drawing-name').textContent = `${s.name}: planning the new view…`;
+    await upload(s.name, JSON.stringify(s.doc), options());
+  } while (viewUpload.again);
+  viewUpload.busy = false;
+}
+
 async function refreshPreview() {
   if (!page.drawing) return;
   const serial = ++previewSerial;
