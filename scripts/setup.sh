@@ -28,7 +28,7 @@ packages=(
   # pathstream serve: the HTTP server library; its page's tests drive Debian's Chromium
   libboost-dev chromium
   # many machines: the MQTT client library and the broker the tests start on loopback
-  libmosquitto-dev mosquitto
+  libmosquitto-dev mosquitto mosquitto-clients
 )
 # Node.js and npm for the browser tests, from Debian unless a node is installed already.
 command -v node > /dev/null && command -v npm > /dev/null || packages+=(nodejs npm)

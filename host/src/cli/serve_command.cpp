@@ -67,6 +67,13 @@ void add_serve_command(CLI::App& app, ServeCommandOptions& o) {
                     "open connections per client address")
         ->capture_default_str()
         ->check(CLI::Range(4, 100000));
+    cmd->add_option("--mqtt", o.mqtt,
+                    "report to this MQTT broker and take commands from it: "
+                    "mqtt[s]://[USER[:PASSWORD]@]HOST[:PORT][?cafile=..&password_file=..] "
+                    "(docs/mqtt.md)");
+    cmd->add_option("--name", o.name,
+                    "the machine's name on the broker (topics pathstream/NAME/...)")
+        ->needs(cmd->get_option("--mqtt"));
 }
 
 namespace {
@@ -119,6 +126,11 @@ int run_serve(const ServeCommandOptions& o) {
     c.max_motion_s = o.max_motion_hours * 3600;
     c.limits.connections = o.max_connections;
     c.limits.connections_per_client = o.max_connections_per_client;
+    if (!o.mqtt.empty()) {
+        if (o.name.empty()) throw std::invalid_argument("serve: --mqtt needs --name NAME");
+        serve::check_machine_name(o.name);
+        c.mqtt = serve::MqttLink{parse_mqtt_url(o.mqtt), o.name};
+    }
     bool temporary = false;
     if (o.state_dir.empty()) {
         std::string pattern = (fs::temp_directory_path() / "pathstream-serve-XXXXXX").string();
@@ -136,6 +148,7 @@ int run_serve(const ServeCommandOptions& o) {
         serve::Server server(c, machine);
         try {
             server.bind();
+            server.start_mqtt();
         } catch (...) {
             if (temporary) {
                 std::error_code ignored;
@@ -149,6 +162,10 @@ int run_serve(const ServeCommandOptions& o) {
                     server.bound_port(), c.access.token.empty() ? "" : "?token=...",
                     o.target.c_str(), o.machine.c_str());
         std::printf("state         %s\n", c.state_dir.c_str());
+        if (c.mqtt) {
+            std::printf("mqtt          %s as pathstream/%s/\n", c.mqtt->url.text().c_str(),
+                        c.mqtt->name.c_str());
+        }
         std::fflush(stdout);
         ::signal(SIGINT, on_serve_signal);
         ::signal(SIGTERM, on_serve_signal);

@@ -21,6 +21,8 @@ struct ServeCommandOptions {
     double max_motion_hours = 24;  ///< a longer job (estimated) is refused before planning
     std::size_t max_connections = 512;
     std::size_t max_connections_per_client = 256;
+    std::string mqtt;  ///< --mqtt: the broker's URL ("": no broker)
+    std::string name;  ///< --name: the machine's name on the broker
 };
 
 /// Adds the `serve` subcommand and its options, parsed into `options` (which must outlive

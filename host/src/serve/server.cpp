@@ -105,6 +105,24 @@ void Server::bind() {
     config_.access.port = bound_port_;
 }
 
+void Server::start_mqtt() {
+    if (!config_.mqtt) return;
+    Json axes = Json::array();
+    for (const AxisLimits& a : machine_.axes) axes.push_back(a.name);
+    const Json identity{{"name", config_.mqtt->name},
+                        {"machine", fs::path(config_.machine_file).filename().string()},
+                        {"axes", axes},
+                        {"target", config_.target}};
+    mqtt_ = std::make_unique<MqttBridge>(
+        *config_.mqtt, hub_,
+        [this](const Json& request) {
+            const Reply r = control(request);
+            return std::make_pair(r.status, r.body);
+        },
+        identity);
+    mqtt_->start();
+}
+
 void Server::run() {
     poller_ = std::thread([this] { poll_device(); });
     http_->run();
@@ -118,6 +136,7 @@ void Server::stop() {
         const std::lock_guard<std::mutex> lock(job_mutex_);
         if (job_ && job_running_.load() && job_kind_ == "stream") job_->signal(SIGTERM);
     }
+    if (mqtt_) mqtt_->stop();
     hub_.close();
     http_->stop();
 }

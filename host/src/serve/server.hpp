@@ -8,6 +8,7 @@
 #include <memory>
 #include <mutex>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
@@ -16,6 +17,7 @@
 #include "child_process.hpp"
 #include "event_hub.hpp"
 #include "http_types.hpp"
+#include "mqtt_bridge.hpp"
 #include "pathstream/machine/machine.hpp"
 
 namespace pathstream::host::serve {
@@ -34,9 +36,10 @@ struct ServerConfig {
     double events_rate = 10;   ///< stream --events-rate: progress updates per second
     double status_hz = 10;     ///< device status reads per second
     std::size_t max_upload_bytes = 16u << 20;
-    HttpLimits limits;            ///< body_bytes comes from max_upload_bytes
-    double plan_timeout_s = 60;   ///< a preview's or run's planning is stopped after this
-    double max_motion_s = 86400;  ///< a job estimated to move longer is refused before planning
+    HttpLimits limits;             ///< body_bytes comes from max_upload_bytes
+    double plan_timeout_s = 60;    ///< a preview's or run's planning is stopped after this
+    double max_motion_s = 86400;   ///< a job estimated to move longer is refused before planning
+    std::optional<MqttLink> mqtt;  ///< serve --mqtt: report to and take commands from a broker
 };
 
 /// The HTTP server and what runs behind it: a device status poller thread, at most one job
@@ -52,6 +55,9 @@ public:
     void bind();
     /// The port bound (after bind()).
     unsigned bound_port() const { return bound_port_; }
+    /// With ServerConfig::mqtt: connects to the broker and starts the bridge (after bind(),
+    /// before run()). Throws MqttError when the broker cannot be reached or refuses.
+    void start_mqtt();
     /// Serves until stop(); starts the status poller. Blocks; call once.
     void run();
     /// Ends run(): a job still streaming is asked to hold (its journal can resume it), the
@@ -96,6 +102,7 @@ private:
     std::unique_ptr<HttpServer> http_;
     unsigned bound_port_ = 0;
     EventHub hub_;
+    std::unique_ptr<MqttBridge> mqtt_;
     std::atomic<bool> stopping_{false};
     std::thread poller_;
 
