@@ -162,6 +162,8 @@ bool Occluder::hidden(const Point3& p) const {
         const double l1 = ((b.y - c.y) * (xy[0] - c.x) + (c.x - b.x) * (xy[1] - c.y)) / det;
         const double l2 = ((c.y - a.y) * (xy[0] - c.x) + (a.x - c.x) * (xy[1] - c.y)) / det;
         const double l3 = 1 - l1 - l2;
+        // A quarter of the triangle beyond its edges counts too: the mesh's outline lies inside
+        // the surface's by its chord error, and Newton from there still finds the sheet.
         const double slack = -0.25;
         if (l1 < slack || l2 < slack || l3 < slack) continue;
         const double mesh_depth = l1 * a.depth + l2 * b.depth + l3 * c.depth;
