@@ -10,41 +10,13 @@
 #include <set>
 
 #include "mosquitto_broker.hpp"
+#include "mqtt_inbox.hpp"
 #include "pathstream/host/mqtt_client.hpp"
 
 using namespace pathstream::host;
 using pathstream::test::MosquittoBroker;
 
-namespace {
-
-// Messages a client received, waited for by count.
-struct Inbox {
-    std::mutex mutex;
-    std::condition_variable changed;
-    std::vector<std::pair<std::string, std::string>> messages;
-
-    MqttClient::OnMessage sink() {
-        return [this](const std::string& topic, const std::string& payload) {
-            {
-                std::lock_guard lock(mutex);
-                messages.emplace_back(topic, payload);
-            }
-            changed.notify_all();
-        };
-    }
-    // Waits (at most 10 s: a bound, not a measurement) until `n` messages are here.
-    bool wait_for(std::size_t n) {
-        std::unique_lock lock(mutex);
-        return changed.wait_for(lock, std::chrono::seconds(10),
-                                [&] { return messages.size() >= n; });
-    }
-    std::size_t size() {
-        std::lock_guard lock(mutex);
-        return messages.size();
-    }
-};
-
-}  // namespace
+using Inbox = pathstream::test::MqttInbox;
 
 TEST_CASE("mqtt: URLs", "[mqtt]") {
     const MqttUrl a = parse_mqtt_url("mqtt://broker.local");

@@ -9,6 +9,7 @@
 #include <thread>
 
 #include "../host/mosquitto_broker.hpp"
+#include "../host/mqtt_inbox.hpp"
 #include "serve/mqtt_bridge.hpp"
 
 using namespace pathstream::host;
@@ -17,26 +18,7 @@ using Json = nlohmann::json;
 
 namespace {
 
-struct Inbox {
-    std::mutex mutex;
-    std::condition_variable changed;
-    std::vector<std::pair<std::string, std::string>> messages;
-    MqttClient::OnMessage sink() {
-        return [this](const std::string& t, const std::string& p) {
-            {
-                std::lock_guard lock(mutex);
-                messages.emplace_back(t, p);
-            }
-            changed.notify_all();
-        };
-    }
-    // Waits (at most 20 s: a bound, not a measurement) until `pred` holds.
-    template <class Pred>
-    bool wait(Pred pred) {
-        std::unique_lock lock(mutex);
-        return changed.wait_for(lock, std::chrono::seconds(20), [&] { return pred(messages); });
-    }
-};
+using Inbox = pathstream::test::MqttInbox;
 
 std::size_t count_on(const std::vector<std::pair<std::string, std::string>>& m,
                      const std::string& topic) {
