@@ -74,6 +74,10 @@ void add_serve_command(CLI::App& app, ServeCommandOptions& o) {
     cmd->add_option("--name", o.name,
                     "the machine's name on the broker (topics pathstream/NAME/...)")
         ->needs(cmd->get_option("--mqtt"));
+    cmd->add_option("--kind", o.kind,
+                    "with --mqtt: the job queue it takes jobs from besides \"any\" "
+                    "(pathstream/queue/KIND; default: the profile's file name without .json)")
+        ->needs(cmd->get_option("--mqtt"));
 }
 
 namespace {
@@ -129,7 +133,16 @@ int run_serve(const ServeCommandOptions& o) {
     if (!o.mqtt.empty()) {
         if (o.name.empty()) throw std::invalid_argument("serve: --mqtt needs --name NAME");
         serve::check_machine_name(o.name);
-        c.mqtt = serve::MqttLink{parse_mqtt_url(o.mqtt), o.name};
+        std::string kind = o.kind.empty() ? fs::path(o.machine).stem().string() : o.kind;
+        // The profile's name may hold characters a topic level must not: the kind is checked
+        // as a name is, and a stem that fails asks for --kind.
+        try {
+            serve::check_machine_name(kind);
+        } catch (const std::invalid_argument&) {
+            throw std::invalid_argument("serve: --kind \"" + kind +
+                                        "\": only letters, digits, _ and - (it is part of topics)");
+        }
+        c.mqtt = serve::MqttLink{parse_mqtt_url(o.mqtt), o.name, kind};
     }
     bool temporary = false;
     if (o.state_dir.empty()) {
@@ -163,8 +176,8 @@ int run_serve(const ServeCommandOptions& o) {
                     o.target.c_str(), o.machine.c_str());
         std::printf("state         %s\n", c.state_dir.c_str());
         if (c.mqtt) {
-            std::printf("mqtt          %s as pathstream/%s/\n", c.mqtt->url.text().c_str(),
-                        c.mqtt->name.c_str());
+            std::printf("mqtt          %s as pathstream/%s/, jobs from pathstream/queue/%s\n",
+                        c.mqtt->url.text().c_str(), c.mqtt->name.c_str(), c.mqtt->kind.c_str());
         }
         std::fflush(stdout);
         ::signal(SIGINT, on_serve_signal);

@@ -23,6 +23,7 @@ struct ServeCommandOptions {
     std::size_t max_connections_per_client = 256;
     std::string mqtt;  ///< --mqtt: the broker's URL ("": no broker)
     std::string name;  ///< --name: the machine's name on the broker
+    std::string kind;  ///< --kind: its job queue (default: the profile's file name stem)
 };
 
 /// Adds the `serve` subcommand and its options, parsed into `options` (which must outlive

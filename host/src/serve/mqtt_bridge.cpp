@@ -40,11 +40,12 @@ void check_machine_name(const std::string& name) {
 }
 
 MqttBridge::MqttBridge(MqttLink link, EventHub& hub, ControlFunction control,
-                       nlohmann::json identity)
+                       nlohmann::json identity, JobDesk* desk)
     : link_(std::move(link)),
       hub_(hub),
       control_(std::move(control)),
-      identity_(std::move(identity)) {}
+      identity_(std::move(identity)),
+      desk_(desk) {}
 
 MqttBridge::~MqttBridge() {
     stop();
@@ -53,16 +54,25 @@ MqttBridge::~MqttBridge() {
 void MqttBridge::start() {
     nlohmann::json offline = identity_;
     offline["online"] = false;
-    client_ =
-        std::make_unique<MqttClient>(link_.url, "pathstream-" + link_.name,
-                                     MqttClient::Will{topic("online"), offline.dump(), 1, true},
-                                     [this](const std::string& t, const std::string& payload) {
-                                         // Only the command topic is subscribed; anything else is
-                                         // not ours to act on.
-                                         if (t == topic("command")) on_command(payload);
-                                     });
+    client_ = std::make_unique<MqttClient>(
+        link_.url, "pathstream-" + link_.name,
+        MqttClient::Will{topic("online"), offline.dump(), 1, true},
+        [this](const std::string& t, const std::string& payload) {
+            // Only the command and the job topics are subscribed;
+            // anything else is not ours to act on.
+            if (t == topic("command")) {
+                on_command(payload);
+            } else if (desk_ && (t == topic("jobs") || t.rfind("pathstream/queue/", 0) == 0)) {
+                desk_->on_message(t, payload);
+            }
+        });
     client_->connect();
     client_->subscribe(topic("command"), 1);
+    if (desk_) {
+        // The job left by a host that died is announced before any other job can come.
+        desk_->start();
+        for (const std::string& f : desk_->filters()) client_->subscribe(f, 1);
+    }
     nlohmann::json online = identity_;
     online["online"] = true;
     client_->publish(topic("online"), online.dump(), 1, true);
@@ -79,6 +89,7 @@ void MqttBridge::stop() {
     changed_.notify_all();
     if (forwarder_.joinable()) forwarder_.join();
     if (worker_.joinable()) worker_.join();
+    if (desk_) desk_->stop();
     try {
         nlohmann::json offline = identity_;
         offline["online"] = false;
@@ -87,6 +98,10 @@ void MqttBridge::stop() {
         // The broker is gone: the will says the same once it is back.
     }
     client_->disconnect();
+}
+
+void MqttBridge::publish(const std::string& t, const std::string& payload, int qos, bool retain) {
+    client_->publish(t, payload, qos, retain);
 }
 
 void MqttBridge::forward() {
@@ -110,6 +125,12 @@ void MqttBridge::forward() {
                 const std::string leaf = retained_leaf(e.json);
                 if (!leaf.empty()) client_->publish(topic(leaf), e.json, 0, true);
                 client_->publish(topic("events"), e.json, 0, false);
+                // The job's own progress, for whoever follows the job rather than the machine.
+                if (leaf == "progress" && desk_) {
+                    const std::string id = desk_->current();
+                    if (!id.empty())
+                        client_->publish("pathstream/jobs/" + id + "/progress", e.json, 0, true);
+                }
             } catch (const MqttError&) {
                 // Disconnected for a moment: libmosquitto reconnects; the retained topics
                 // catch up with the next event of each kind.
@@ -167,7 +188,10 @@ void MqttBridge::answer() {
             const nlohmann::json request = nlohmann::json::parse(payload);
             if (!request.is_object()) throw std::invalid_argument("a command is a JSON object");
             if (request.contains("id")) reply["id"] = request["id"];
-            auto [code, body] = control_(request);
+            const nlohmann::json verb = request.value("verb", nlohmann::json());
+            auto [code, body] = desk_ && verb == "resume_job" ? desk_->resume_job()
+                                : desk_ && verb == "drop_job" ? desk_->drop_job()
+                                                              : control_(request);
             status = code;
             for (auto& [k, v] : body.items()) reply[k] = v;
         } catch (const nlohmann::json::exception&) {

@@ -13,6 +13,7 @@
 #include <utility>
 
 #include "event_hub.hpp"
+#include "job_desk.hpp"
 #include "pathstream/host/mqtt_client.hpp"
 
 namespace pathstream::host::serve {
@@ -21,6 +22,7 @@ namespace pathstream::host::serve {
 struct MqttLink {
     MqttUrl url;
     std::string name;
+    std::string kind = "any";  ///< the queue it takes jobs from besides "any" (docs/mqtt.md)
 };
 
 /// Throws std::invalid_argument unless `name` is 1 to 64 of A-Z a-z 0-9 _ - (no MQTT
@@ -33,7 +35,9 @@ using ControlFunction = std::function<std::pair<int, nlohmann::json>(const nlohm
 /// Forwards `hub`'s events to the broker on its own thread and answers commands on another.
 class MqttBridge {
 public:
-    MqttBridge(MqttLink link, EventHub& hub, ControlFunction control, nlohmann::json identity);
+    /// `desk` (optional, outliving the bridge) takes jobs from the broker's queues.
+    MqttBridge(MqttLink link, EventHub& hub, ControlFunction control, nlohmann::json identity,
+               JobDesk* desk = nullptr);
     ~MqttBridge();
     MqttBridge(const MqttBridge&) = delete;
     MqttBridge& operator=(const MqttBridge&) = delete;
@@ -44,6 +48,8 @@ public:
     void start();
     /// Announces the machine offline, stops the threads and disconnects. Idempotent.
     void stop();
+    /// Publishes on the broker (after start()). Throws MqttError. Not on the network thread.
+    void publish(const std::string& topic, const std::string& payload, int qos, bool retain);
 
 private:
     void forward();
@@ -57,6 +63,7 @@ private:
     EventHub& hub_;
     ControlFunction control_;
     nlohmann::json identity_;
+    JobDesk* desk_;
     std::unique_ptr<MqttClient> client_;
     std::thread forwarder_, worker_;
     std::mutex mutex_;

@@ -110,16 +110,40 @@ void Server::start_mqtt() {
     Json axes = Json::array();
     for (const AxisLimits& a : machine_.axes) axes.push_back(a.name);
     const Json identity{{"name", config_.mqtt->name},
+                        {"kind", config_.mqtt->kind},
                         {"machine", fs::path(config_.machine_file).filename().string()},
                         {"axes", axes},
                         {"target", config_.target}};
+    const auto plain = [](const Reply& r) {
+        return std::make_pair(r.status, nlohmann::json::parse(r.body.dump()));
+    };
+    JobDeskHooks hooks;
+    hooks.start = [this, plain](const JobMessage& job) {
+        // A token each: the run's claim on planning cancels the newest plan before it, the
+        // upload's.
+        const CancelToken stored_plan, run_plan;
+        const Reply stored = upload(job.file, job.drawing, job.options, stored_plan);
+        if (stored.status != 200) return plain(stored);
+        try {
+            return plain(run_job(job.options, "", run_plan));
+        } catch (const std::exception& e) {
+            return std::make_pair(
+                422, nlohmann::json{{"ok", false}, {"error", clean_message(e.what())}});
+        }
+    };
+    hooks.resume = [this, plain] { return plain(resume()); };
+    hooks.busy = [this] { return job_running(); };
+    hooks.publish = [this](const std::string& topic, const std::string& payload, int qos,
+                           bool retain) { mqtt_->publish(topic, payload, qos, retain); };
+    desk_ = std::make_unique<JobDesk>(config_.mqtt->name, config_.mqtt->kind, config_.state_dir,
+                                      config_.max_upload_bytes, std::move(hooks));
     mqtt_ = std::make_unique<MqttBridge>(
         *config_.mqtt, hub_,
         [this](const Json& request) {
             const Reply r = control(request);
             return std::make_pair(r.status, r.body);
         },
-        identity);
+        identity, desk_.get());
     mqtt_->start();
 }
 
@@ -391,6 +415,7 @@ bool Server::start_child(const std::string& kind, std::vector<std::string> argv,
         if (exit_code != 0) end["error"] = clean_message(last_lines(errors, 1));
         hub_.publish(end.dump(), "process");
         job_running_.store(false);
+        if (desk_) desk_->job_ended(outcome, exit_code, end.value("error", std::string()));
     });
     return true;
 }

@@ -17,6 +17,7 @@
 #include "child_process.hpp"
 #include "event_hub.hpp"
 #include "http_types.hpp"
+#include "job_desk.hpp"
 #include "mqtt_bridge.hpp"
 #include "pathstream/machine/machine.hpp"
 
@@ -102,6 +103,7 @@ private:
     std::unique_ptr<HttpServer> http_;
     unsigned bound_port_ = 0;
     EventHub hub_;
+    std::unique_ptr<JobDesk> desk_;  ///< before mqtt_: the bridge uses it until destroyed
     std::unique_ptr<MqttBridge> mqtt_;
     std::atomic<bool> stopping_{false};
     std::thread poller_;
