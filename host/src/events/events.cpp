@@ -119,6 +119,7 @@ EventJson JobEvents::event(const char* type) const {
 
 void JobEvents::emit(const EventJson& e) const {
     if (channel_.writer) channel_.writer->write(e);
+    if (channel_.tap) channel_.tap(e.dump());
 }
 
 void JobEvents::start(std::optional<std::uint32_t> job) {

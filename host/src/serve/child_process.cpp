@@ -7,6 +7,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <filesystem>
 #include <system_error>
@@ -156,6 +157,25 @@ ChildOutput run_child(const std::vector<std::string>& argv, const std::string& c
 
 std::string self_executable() {
     return std::filesystem::read_symlink("/proc/self/exe").string();
+}
+
+std::string last_lines(const std::string& text, std::size_t count) {
+    std::vector<std::string> lines;
+    std::size_t at = 0;
+    while (at < text.size()) {
+        const std::size_t end = std::min(text.find('\n', at), text.size());
+        std::string line = text.substr(at, end - at);
+        // A progress bar redraws with carriage returns: its last state is what was seen.
+        if (const std::size_t cr = line.rfind('\r'); cr != std::string::npos)
+            line = line.substr(cr + 1);
+        if (!line.empty()) lines.push_back(line);
+        at = end + 1;
+    }
+    std::string out;
+    for (std::size_t i = lines.size() > count ? lines.size() - count : 0; i < lines.size(); ++i) {
+        out += (out.empty() ? "" : "\n") + lines[i];
+    }
+    return out;
 }
 
 }  // namespace pathstream::host::serve

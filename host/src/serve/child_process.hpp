@@ -53,6 +53,10 @@ struct ChildOutput {
 ChildOutput run_child(const std::vector<std::string>& argv, const std::string& cwd,
                       const std::function<bool()>& abandon = {});
 
+/// The last `count` lines of a command's output that say something (a progress bar's last
+/// state after its carriage returns): its error message. Linear in the text.
+std::string last_lines(const std::string& text, std::size_t count);
+
 /// The path of the running executable (/proc/self/exe), to start its other commands.
 std::string self_executable();
 

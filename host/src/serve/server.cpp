@@ -10,6 +10,7 @@
 
 #include "drawing_request.hpp"
 #include "http_server.hpp"
+#include "operator_command.hpp"
 #include "pathstream/host/device_link.hpp"
 #include "pathstream/host/job_journal.hpp"
 #include "pathstream/host/placement.hpp"
@@ -60,26 +61,6 @@ std::string number_text(double v) {
     char text[64];
     std::snprintf(text, sizeof text, "%.6f", v);
     return text;
-}
-
-// The last lines of a command's standard error that say something (its error message).
-std::string last_lines(const std::string& text, std::size_t count) {
-    std::vector<std::string> lines;
-    std::size_t at = 0;
-    while (at < text.size()) {
-        const std::size_t end = std::min(text.find('\n', at), text.size());
-        std::string line = text.substr(at, end - at);
-        // A progress bar redraws with carriage returns: its last state is what was seen.
-        if (const std::size_t cr = line.rfind('\r'); cr != std::string::npos)
-            line = line.substr(cr + 1);
-        if (!line.empty()) lines.push_back(line);
-        at = end + 1;
-    }
-    std::string out;
-    for (std::size_t i = lines.size() > count ? lines.size() - count : 0; i < lines.size(); ++i) {
-        out += (out.empty() ? "" : "\n") + lines[i];
-    }
-    return out;
 }
 
 }  // namespace
@@ -508,59 +489,17 @@ Server::Reply Server::control(const nlohmann::json& request) {
         }
         return {200, Json{{"ok", true}, {"message", "stopping the job"}}};
     }
-    // Options first, then `--`: no value from the page can become an option.
-    std::vector<std::string> argv = {config_.executable, "ctl", "--machine=" + config_.machine_file,
-                                     "--json", "--wait=60"};
-    std::vector<std::string> positional = {"--", config_.target, verb};
-    const auto axis_name = [&](const nlohmann::json& v) {
-        if (!v.is_string()) throw std::invalid_argument("axis: want an axis name");
-        for (const AxisLimits& a : machine_.axes) {
-            if (a.name == v.get<std::string>()) return a.name;
-        }
-        throw std::invalid_argument("axis: the machine has no axis '" + v.get<std::string>() + "'");
-    };
-    if (verb == "hold" || verb == "resume" || verb == "stop" || verb == "reset") {
-    } else if (verb == "home") {
-    } else if (verb == "pen") {
-        if (!request.contains("down") || !request["down"].is_boolean())
-            throw std::invalid_argument("pen: want down true or false");
-        positional.push_back(request["down"].get<bool>() ? "down" : "up");
-    } else if (verb == "jog") {
-        positional.push_back(axis_name(request.value("axis", nlohmann::json())));
-        const nlohmann::json d = request.value("distance_mm", nlohmann::json());
-        if (!d.is_number() || !std::isfinite(d.get<double>()) || d.get<double>() == 0 ||
-            std::fabs(d.get<double>()) > 10000) {
-            throw std::invalid_argument("jog: want distance_mm, not 0, at most 10000 either way");
-        }
-        positional.push_back(number_text(d.get<double>()));
-        if (request.contains("feed")) {
-            const nlohmann::json f = request["feed"];
-            if (!f.is_number() || !(f.get<double>() > 0) || f.get<double>() > 1e6)
-                throw std::invalid_argument("jog: feed in mm/s, > 0");
-            argv.push_back("--feed=" + number_text(f.get<double>()));
-        }
-    } else {
-        return {400, error_body("unknown verb '" + verb + "'")};
-    }
-    argv.insert(argv.end(), positional.begin(), positional.end());
-    // A command waits for the device (home: up to a minute); the server's stop does not wait
-    // for it (the device goes on, as it does when `ctl` at a terminal is interrupted).
-    const ChildOutput r = run_child(argv, config_.state_dir, [this] { return stopping_.load(); });
-    Json body{{"ok", r.exit_code == 0}, {"verb", verb}};
-    if (!r.out.empty()) {
-        try {
-            body["result"] = Json::parse(r.out);
-        } catch (const std::exception&) {
-            body["result"] = r.out;
-        }
-    }
-    if (r.exit_code != 0) body["error"] = clean_message(last_lines(r.err, 1));
-    hub_.publish(Json{{"event", "command"},
-                      {"verb", verb},
-                      {"ok", r.exit_code == 0},
-                      {"error", r.exit_code == 0 ? "" : clean_message(last_lines(r.err, 1))}}
-                     .dump());
-    return {r.exit_code == 0 ? 200 : 422, body};
+    const auto [status, answer] = run_operator_command(
+        {config_.executable, config_.machine_file, config_.target, config_.state_dir}, machine_,
+        request, [this] { return stopping_.load(); });
+    if (status == 400) return {400, error_body(answer.value("error", std::string()))};
+    const bool ok = status == 200;
+    const std::string error = ok ? "" : clean_message(answer.value("error", std::string()));
+    Json body{{"ok", ok}, {"verb", verb}};
+    if (answer.contains("result")) body["result"] = Json::parse(answer["result"].dump());
+    if (!ok) body["error"] = error;
+    hub_.publish(Json{{"event", "command"}, {"verb", verb}, {"ok", ok}, {"error", error}}.dump());
+    return {status, body};
 }
 
 Json Server::state() const {

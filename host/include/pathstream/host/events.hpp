@@ -51,6 +51,8 @@ struct EventChannel {
     std::unique_ptr<NdjsonWriter> writer;  ///< null: no --events (events only kept, not written)
     std::chrono::steady_clock::time_point start = std::chrono::steady_clock::now();
     double progress_hz = 5;  ///< at most this many progress events per second
+    /// Also given every event's line (stream --mqtt); called on the thread that emits.
+    std::function<void(const std::string& line)> tap;
 };
 
 /// What job_start says about a job.
