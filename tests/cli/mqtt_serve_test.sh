@@ -96,6 +96,31 @@ kill -9 "$serve_pid"; wait "$serve_pid" 2> /dev/null
 # The retained "true" may come first, until the broker notices the closed connection.
 until_retained '"online":false' -t pathstream/plotter-1/online &&
   ok || fail "no will (online false) after kill -9"
+
+# A headless machine: stream --mqtt publishes the job's events on its own topics and answers
+# commands while it streams; offline once the job has ended.
+"$bin" ctl -m "$machine" -- "$target" pen up > /dev/null 2>&1
+sub -t pathstream/plotter-h/events -C 400 -W 60 > "$work/stream_events.txt" &
+events_reader=$!
+sub -t pathstream/plotter-h/reply -C 1 -W 30 > "$work/stream_reply.txt" &
+reply_reader=$!
+sleep 0.5
+"$bin" stream "$src/examples/wave.json" -m "$machine" -t "$target" --no-journal \
+  --mqtt "mqtt://127.0.0.1:$port" --name plotter-h > "$work/stream.log" 2>&1 &
+stream_pid=$!
+until_retained '"online":true' -t pathstream/plotter-h/online && ok || fail "stream online: $(cat "$work/stream.log")"
+mosquitto_pub -p "$port" -t pathstream/plotter-h/command -m '{"id": "s1", "verb": "jog", "axis": "q", "distance_mm": 1}'
+wait "$stream_pid"; rc=$?
+[ $rc -eq 0 ] && ok || fail "stream --mqtt: exit $rc $(cat "$work/stream.log")"
+wait "$reply_reader"
+reply=$(cat "$work/stream_reply.txt")
+[[ "$reply" == *'"id":"s1"'* && "$reply" == *"the machine has no axis 'q'"* && "$reply" == *'"status":400'* ]] && ok ||
+  fail "a command to the streaming machine: $(cat "$work/stream_reply.txt")"
+until_retained '"outcome":"finished"' -t pathstream/plotter-h/job && ok || fail "the job's end on the job topic"
+until_retained '"online":false' -t pathstream/plotter-h/online && ok || fail "stream offline after its job"
+kill "$events_reader" 2> /dev/null; wait "$events_reader" 2> /dev/null
+grep -q '"event":"job_start"' "$work/stream_events.txt" && grep -q '"event":"progress"' "$work/stream_events.txt" &&
+  ok || fail "stream events on the broker: $(head -3 "$work/stream_events.txt")"
 kill -9 "$broker_pid"; wait "$broker_pid" 2> /dev/null
 
 # A broker with passwords: a server without one is refused, one with a password file let in.

@@ -27,6 +27,7 @@
 #include "pathstream/host/events.hpp"
 #include "pathstream/host/job_estimate.hpp"
 #include "pathstream/host/job_journal.hpp"
+#include "pathstream/host/mqtt_client.hpp"
 #include "pathstream/host/planning_thread.hpp"
 #include "pathstream/host/progress.hpp"
 #include "pathstream/host/resume_decision.hpp"
@@ -35,6 +36,8 @@
 #include "pathstream/machine/device_setup.hpp"
 #include "pathstream/machine/input_error.hpp"
 #include "plan_command.hpp"
+#include "serve/child_process.hpp"
+#include "serve/stream_reporter.hpp"
 #include "stream_job.hpp"
 #include "stream_plan_tap.hpp"
 
@@ -113,6 +116,13 @@ void add_stream_command(CLI::App& app, StreamCommandOptions& o) {
                     "progress events per second, at most (with --events)")
         ->capture_default_str()
         ->check(CLI::Range(0.1, 1000.0));
+    cmd->add_option("--mqtt", o.mqtt,
+                    "report the job to this MQTT broker and take operator commands from it, as "
+                    "serve --mqtt does: mqtt[s]://[USER[:PASSWORD]@]HOST[:PORT][?...] "
+                    "(docs/mqtt.md)");
+    cmd->add_option("--name", o.name,
+                    "the machine's name on the broker (topics pathstream/NAME/...)")
+        ->needs(cmd->get_option("--mqtt"));
 }
 
 namespace {
@@ -522,18 +532,44 @@ int stream_while_planning(const PlannedJob& job, const StreamCommandOptions& o,
                       job.machine, o, journal, journal_path, nullptr, channel);
 }
 
-// The events' file, opened before anything is planned or sent (so a bad path costs nothing).
-EventChannel open_events(const StreamCommandOptions& o) {
+// The events' file, opened before anything is planned or sent (so a bad path costs nothing),
+// and with --mqtt the broker, reached before anything is planned too (exit 3 when it cannot
+// be): the events also go there.
+EventChannel open_events(const StreamCommandOptions& o,
+                         std::unique_ptr<serve::StreamReporter>& reporter) {
     EventChannel channel;
     channel.progress_hz = o.events_rate;
     if (!o.events.empty()) channel.writer = NdjsonWriter::open(o.events);
+    if (!o.mqtt.empty()) {
+        if (o.name.empty()) throw std::invalid_argument("stream: --mqtt needs --name NAME");
+        serve::check_machine_name(o.name);
+        const MqttUrl url = parse_mqtt_url(o.mqtt);
+        // A resumed job names its machine and device in its journal.
+        std::string machine_file = o.machine, target = o.stream.target;
+        if (!o.resume.empty()) {
+            const JobJournal j = read_journal(o.resume);
+            machine_file = j.machine;
+            target = j.target;
+        }
+        if (machine_file.empty())
+            throw std::invalid_argument("stream: --mqtt needs --machine (or --resume JOURNAL)");
+        const std::string absolute = std::filesystem::absolute(machine_file).string();
+        reporter = std::make_unique<serve::StreamReporter>(
+            serve::MqttLink{url, o.name, "any"}, load_machine_profile(absolute),
+            serve::OperatorTarget{serve::self_executable(), absolute, target,
+                                  std::filesystem::current_path().string()},
+            absolute);
+        reporter->start();
+        channel.tap = [r = reporter.get()](const std::string& line) { r->event(line); };
+    }
     return channel;
 }
 
 }  // namespace
 
 int run_stream(const StreamCommandOptions& o) {
-    const EventChannel channel = open_events(o);
+    std::unique_ptr<serve::StreamReporter> reporter;
+    const EventChannel channel = open_events(o, reporter);
     if (!o.resume.empty()) {
         if (o.lead_in || o.no_lead_in)
             throw std::invalid_argument(std::string("--resume: ") +

@@ -31,6 +31,8 @@ struct StreamCommandOptions {
     /// --plan-first: plan the whole job before anything is sent (the events' totals known
     /// from job_start; memory grows with the job), instead of streaming while planning.
     bool plan_first = false;
+    std::string mqtt;  ///< --mqtt: report to this broker and take operator commands from it
+    std::string name;  ///< --name: the machine's name on the broker
 };
 
 void add_stream_command(CLI::App& app, StreamCommandOptions& options);

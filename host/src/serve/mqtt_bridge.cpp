@@ -114,11 +114,15 @@ void MqttBridge::forward() {
         }
     }
     for (;;) {
+        bool last = false;
         {
             std::lock_guard lock(mutex_);
-            if (stopping_) return;
+            last = stopping_;
         }
-        for (const HubEvent& e : hub_.wait_after(after, std::chrono::milliseconds(200))) {
+        // Once stopping, what the hub still holds goes out without waiting (a stream's
+        // job_end comes just before its bridge stops).
+        for (const HubEvent& e :
+             hub_.wait_after(after, std::chrono::milliseconds(last ? 0 : 200))) {
             after = e.sequence;
             // QoS 0: a status at 10 Hz needs no acknowledgement; the next one replaces it.
             try {
@@ -136,6 +140,7 @@ void MqttBridge::forward() {
                 // catch up with the next event of each kind.
             }
         }
+        if (last) return;
     }
 }
 
