@@ -69,6 +69,8 @@ public:
     MosquittoBroker& operator=(const MosquittoBroker&) = delete;
 
     int port() const { return port_; }
+    /// The broker's process (its CPU time is in /proc/PID/stat).
+    pid_t pid() const { return pid_; }
     std::string url(const std::string& user = "", const std::string& password = "") const {
         std::string auth =
             user.empty() ? "" : user + (password.empty() ? "" : ":" + password) + "@";
