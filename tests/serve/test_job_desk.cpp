@@ -7,6 +7,7 @@
 #include <condition_variable>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <mutex>
 #include <string>
 #include <thread>
@@ -32,12 +33,14 @@ struct Fake {
     std::vector<std::string> started;
     std::atomic<bool> busy{false};
     int start_status = 200;
+    std::function<void()> during_start;  ///< runs inside the start hook
 
     JobDeskHooks hooks() {
         JobDeskHooks h;
         h.start = [this](const JobMessage& j) {
             const std::lock_guard lock(mutex);
             started.push_back(j.id);
+            if (during_start) during_start();
             return std::make_pair(start_status, nlohmann::json{{"error", "no such pen"}});
         };
         h.resume = [] { return std::make_pair(200, nlohmann::json{{"ok", true}}); };
@@ -194,4 +197,24 @@ TEST_CASE("a host that died: its job is interrupted, its unread jobs are read",
     CHECK(states == std::vector<std::string>{"running", "interrupted", "running", "done"});
     CHECK(desk.resume_job().first == 409);
     CHECK(desk.drop_job().first == 409);
+}
+
+TEST_CASE("a stream that ends before its start is answered still ends the job",
+          "[mqtt][jobs][threads]") {
+    TempDir dir;
+    Fake fake;
+    JobDesk desk("m1", "any", dir.path.string(), 1000, fake.hooks());
+    // The server's job thread reports the end while the desk still waits for the start's
+    // answer (a stream that fails at once).
+    fake.during_start = [&] {
+        std::thread([&] { desk.job_ended("failed", 6, "device: no answer"); }).join();
+    };
+    desk.start();
+    desk.on_message("pathstream/queue/any", job("j1"));
+    const auto p = fake.wait_for(2);
+    REQUIRE(p.size() == 2);
+    CHECK(state_of(p[0])["state"] == "running");
+    CHECK(state_of(p[1])["state"] == "failed");
+    CHECK(state_of(p[1])["error"] == "device: no answer");
+    CHECK(desk.current().empty());
 }

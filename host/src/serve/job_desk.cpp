@@ -284,10 +284,8 @@ bool JobDesk::handle(const Received& r) {
         return pass_back(r.topic, job);
     }
     save();
-    const auto [status, body] = hooks_.start(job);
-    if (status == 200) {
-        set_state("running", "");
-    } else {
+    const auto [status, body] = run_started([&] { return hooks_.start(job); });
+    if (status != 200) {
         const std::string error =
             body.is_object() && body.contains("error") && body["error"].is_string()
                 ? body["error"].get<std::string>()
@@ -320,19 +318,49 @@ bool JobDesk::pass_back(const std::string& topic, JobMessage job) {
 void JobDesk::job_ended(const std::string& outcome, int exit_code, const std::string& error) {
     {
         const std::lock_guard lock(mutex_);
+        // A stream that ends before its start was answered: the end waits for the answer.
+        if (starting_) {
+            early_end_ = End{outcome, exit_code, error};
+            return;
+        }
         if (job_.is_null() || job_.value("state", "") != "running") return;  // a page's job
     }
-    if (outcome == "finished" && exit_code == 0) {
+    finish(End{outcome, exit_code, error});
+}
+
+void JobDesk::finish(const End& end) {
+    if (end.outcome == "finished" && end.exit_code == 0) {
         set_state("done", "");
-    } else if (outcome == "held") {
+    } else if (end.outcome == "held") {
         set_state("held", "held by the operator: resume_job continues it, drop_job gives it up");
-    } else if (outcome == "stopped") {
-        set_state("stopped", error);
+    } else if (end.outcome == "stopped") {
+        set_state("stopped", end.error);
     } else {
-        set_state("failed", error.empty()
-                                ? "the stream ended with exit code " + std::to_string(exit_code)
-                                : error);
+        set_state("failed", end.error.empty()
+                                ? "the stream ended with exit code " + std::to_string(end.exit_code)
+                                : end.error);
     }
+}
+
+std::pair<int, nlohmann::json> JobDesk::run_started(
+    const std::function<std::pair<int, nlohmann::json>()>& start) {
+    {
+        const std::lock_guard lock(mutex_);
+        starting_ = true;
+        early_end_.reset();
+    }
+    auto answer = start();
+    std::optional<End> ended;
+    {
+        const std::lock_guard lock(mutex_);
+        starting_ = false;
+        ended.swap(early_end_);
+    }
+    if (answer.first == 200) {
+        set_state("running", "");
+        if (ended) finish(*ended);
+    }
+    return answer;
 }
 
 std::pair<int, nlohmann::json> JobDesk::resume_job() {
@@ -344,9 +372,7 @@ std::pair<int, nlohmann::json> JobDesk::resume_job() {
     if (state != "held" && state != "interrupted") {
         return {409, {{"ok", false}, {"error", "no held or interrupted job on this machine"}}};
     }
-    auto [status, body] = hooks_.resume();
-    if (status == 200) set_state("running", "");
-    return {status, body};
+    return run_started(hooks_.resume);
 }
 
 std::pair<int, nlohmann::json> JobDesk::drop_job() {

@@ -9,6 +9,7 @@
 #include <functional>
 #include <mutex>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <set>
 #include <string>
 #include <thread>
@@ -73,6 +74,18 @@ public:
     std::uint64_t dropped() const;
 
 private:
+    /// How a job's stream ended.
+    struct End {
+        std::string outcome;
+        int exit_code = 0;
+        std::string error;
+    };
+    /// The state a job's end leads to (done, held, stopped, failed).
+    void finish(const End& end);
+    /// Runs `start` (a job's stream starting or resuming) and marks the job running when it
+    /// does; an end reported while `start` ran is applied after.
+    std::pair<int, nlohmann::json> run_started(
+        const std::function<std::pair<int, nlohmann::json>()>& start);
     struct Received {
         std::string topic, payload;
         std::string file;  ///< its copy in the inbox directory; removed once handled
@@ -101,6 +114,8 @@ private:
     nlohmann::json job_;  ///< the job in hand's state record; null: none
     std::uint64_t passed_back_ = 0, dropped_ = 0;
     bool stopping_ = false;
+    bool starting_ = false;         ///< a stream is being started: its end waits
+    std::optional<End> early_end_;  ///< the end of a stream that ended while starting_
     std::thread thread_;
 };
 
