@@ -29,6 +29,7 @@ struct MqttClient::State {
     std::string id;
     std::optional<Will> will;
     OnMessage on_message;
+    std::uint32_t session_expiry_s = 0;
     mosquitto* mosq = nullptr;
     bool loop_running = false;
 
@@ -48,7 +49,7 @@ struct MqttClient::State {
 };
 
 MqttClient::MqttClient(MqttUrl url, std::string client_id, std::optional<Will> will,
-                       OnMessage on_message)
+                       OnMessage on_message, std::uint32_t session_expiry_s)
     : state_(std::make_unique<State>()) {
     init_library_once();
     State& s = *state_;
@@ -56,7 +57,8 @@ MqttClient::MqttClient(MqttUrl url, std::string client_id, std::optional<Will> w
     s.id = std::move(client_id);
     s.will = std::move(will);
     s.on_message = std::move(on_message);
-    s.mosq = mosquitto_new(s.id.c_str(), true, &s);
+    s.session_expiry_s = session_expiry_s;
+    s.mosq = mosquitto_new(s.id.c_str(), session_expiry_s == 0, &s);
     if (!s.mosq) throw MqttError("cannot create an MQTT client (out of memory?)");
     mosquitto_int_option(s.mosq, MOSQ_OPT_PROTOCOL_VERSION, MQTT_PROTOCOL_V5);
     mosquitto_connect_v5_callback_set(
@@ -157,8 +159,13 @@ void MqttClient::connect(std::chrono::milliseconds timeout, int keepalive_s) {
         std::lock_guard lock(s.mutex);
         s.connect_result.reset();
     }
+    mosquitto_property* properties = nullptr;
+    if (s.session_expiry_s != 0)
+        mosquitto_property_add_int32(&properties, MQTT_PROP_SESSION_EXPIRY_INTERVAL,
+                                     s.session_expiry_s);
     int rc = mosquitto_connect_bind_v5(s.mosq, s.url.host.c_str(), s.url.port, keepalive_s, nullptr,
-                                       nullptr);
+                                       properties);
+    mosquitto_property_free_all(&properties);
     if (rc != MOSQ_ERR_SUCCESS) {
         throw MqttError(
             "cannot reach the broker " + s.url.text() + ": " +
@@ -239,7 +246,12 @@ void MqttClient::unsubscribe(const std::string& filter, std::chrono::millisecond
 void MqttClient::disconnect() {
     State& s = *state_;
     if (!s.mosq) return;
-    mosquitto_disconnect_v5(s.mosq, MQTT_RC_NORMAL_DISCONNECTION, nullptr);
+    // A proper disconnect ends a kept session too: nothing more is queued for this client.
+    mosquitto_property* properties = nullptr;
+    if (s.session_expiry_s != 0)
+        mosquitto_property_add_int32(&properties, MQTT_PROP_SESSION_EXPIRY_INTERVAL, 0);
+    mosquitto_disconnect_v5(s.mosq, MQTT_RC_NORMAL_DISCONNECTION, properties);
+    mosquitto_property_free_all(&properties);
     if (s.loop_running) {
         mosquitto_loop_stop(s.mosq, false);
         s.loop_running = false;

@@ -65,7 +65,26 @@ JobDesk::JobDesk(std::string name, std::string kind, std::string state_dir,
       inbox_dir_((fs::path(state_dir) / "mqtt_inbox").string()),
       max_drawing_bytes_(max_drawing_bytes),
       hooks_(std::move(hooks)),
-      job_(nullptr) {}
+      job_(nullptr) {
+    // Ready before the connection: a resumed session delivers at once, before start().
+    std::error_code error;
+    fs::create_directories(inbox_dir_, error);
+    for (const auto& [number, path] : inbox_files()) next_file_ = std::max(next_file_, number + 1);
+}
+
+std::vector<std::pair<std::uint64_t, std::string>> JobDesk::inbox_files() const {
+    std::vector<std::pair<std::uint64_t, std::string>> files;
+    std::error_code error;
+    for (const auto& entry : fs::directory_iterator(inbox_dir_, error)) {
+        const std::string stem = entry.path().stem().string();
+        if (entry.path().extension() != ".msg" || stem.empty() ||
+            stem.find_first_not_of("0123456789") != std::string::npos || stem.size() > 18)
+            continue;
+        files.emplace_back(std::stoull(stem), entry.path().string());
+    }
+    std::sort(files.begin(), files.end());
+    return files;
+}
 
 JobDesk::~JobDesk() {
     stop();
@@ -114,28 +133,27 @@ void JobDesk::start() {
     } else if (held) {
         set_state("held", "");  // announced again: a watcher that came later sees it
     }
-    // Jobs the broker delivered to the host that died, in the order they came.
-    std::error_code error;
-    fs::create_directories(inbox_dir_, error);
-    std::vector<std::pair<std::uint64_t, fs::path>> left;
-    for (const auto& entry : fs::directory_iterator(inbox_dir_, error)) {
-        const std::string stem = entry.path().stem().string();
-        if (entry.path().extension() != ".msg" || stem.empty() ||
-            stem.find_first_not_of("0123456789") != std::string::npos || stem.size() > 18)
-            continue;
-        left.emplace_back(std::stoull(stem), entry.path());
-    }
-    std::sort(left.begin(), left.end());
-    for (const auto& [number, path] : left) {
+    // Jobs the broker delivered to the host that died, oldest first, before those that came
+    // since the connection (queued already, their files among these).
+    std::deque<Received> left;
+    for (const auto& [number, path] : inbox_files()) {
+        {
+            const std::lock_guard lock(mutex_);
+            const bool queued = std::any_of(inbox_.begin(), inbox_.end(),
+                                            [&](const Received& r) { return r.file == path; });
+            if (queued) continue;
+        }
         std::ifstream message(path, std::ios::binary);
         std::string topic;
         std::getline(message, topic);
         std::stringstream payload;
         payload << message.rdbuf();
+        left.push_back({topic, payload.str(), path});
+    }
+    {
         const std::lock_guard lock(mutex_);
-        next_file_ = std::max(next_file_, number + 1);
-        inbox_bytes_ += payload.str().size();
-        inbox_.push_back({topic, payload.str(), path.string()});
+        for (const Received& r : left) inbox_bytes_ += r.payload.size();
+        inbox_.insert(inbox_.begin(), left.begin(), left.end());
     }
     thread_ = std::thread([this] { work(); });
 }

@@ -100,6 +100,8 @@ private:
     void publish_state(const nlohmann::json& record);
     void save() const;
     bool is_queue(const std::string& topic) const;
+    /// The inbox directory's message files (number, path), oldest first.
+    std::vector<std::pair<std::uint64_t, std::string>> inbox_files() const;
 
     std::string name_, kind_, state_file_, inbox_dir_;
     std::uint64_t next_file_ = 0;

@@ -9,6 +9,7 @@ namespace pathstream::host::serve {
 namespace {
 
 constexpr std::size_t kMaxQueued = 8;
+constexpr std::uint32_t kJobSessionExpiry_s = 24 * 3600;
 
 // The retained topic a hub event's kind updates ("" for none).
 std::string retained_leaf(const std::string& json) {
@@ -65,7 +66,10 @@ void MqttBridge::start() {
             } else if (desk_ && (t == topic("jobs") || t.rfind("pathstream/queue/", 0) == 0)) {
                 desk_->on_message(t, payload);
             }
-        });
+        },
+        // A machine that takes jobs keeps its session: jobs on their way to it when its host
+        // dies wait for its return instead of being dropped (as for a clean session).
+        desk_ ? kJobSessionExpiry_s : 0);
     client_->connect();
     client_->subscribe(topic("command"), 1);
     if (desk_) {
@@ -89,7 +93,18 @@ void MqttBridge::stop() {
     changed_.notify_all();
     if (forwarder_.joinable()) forwarder_.join();
     if (worker_.joinable()) worker_.join();
-    if (desk_) desk_->stop();
+    if (desk_) {
+        // Out of the queues first, so that no job comes after the desk has passed back what
+        // it holds.
+        for (const std::string& f : desk_->filters()) {
+            if (f.rfind("$share/", 0) != 0) continue;
+            try {
+                client_->unsubscribe(f);
+            } catch (const MqttError&) {
+            }
+        }
+        desk_->stop();
+    }
     try {
         nlohmann::json offline = identity_;
         offline["online"] = false;

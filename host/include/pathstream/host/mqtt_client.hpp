@@ -56,8 +56,11 @@ public:
     using OnMessage = std::function<void(const std::string& topic, const std::string& payload)>;
 
     /// Creates the client (no connection yet). `client_id` must be unique on the broker.
+    /// `session_expiry_s` 0: a clean session, forgotten at disconnect. Otherwise the broker
+    /// keeps the session (its subscriptions and the QoS 1 messages for it) that long after the
+    /// connection ends, and a client with the same id resumes it.
     MqttClient(MqttUrl url, std::string client_id, std::optional<Will> will = {},
-               OnMessage on_message = {});
+               OnMessage on_message = {}, std::uint32_t session_expiry_s = 0);
     ~MqttClient();
     MqttClient(const MqttClient&) = delete;
     MqttClient& operator=(const MqttClient&) = delete;
@@ -78,7 +81,7 @@ public:
     void unsubscribe(const std::string& filter,
                      std::chrono::milliseconds timeout = std::chrono::seconds(5));
 
-    /// Ends the connection properly: the broker drops the will.
+    /// Ends the connection properly: the broker drops the will and ends a kept session.
     void disconnect();
     /// Ends the connection without telling the broker, as a crash would: the broker then
     /// publishes the will. For tests and for a machine that must appear dead.
