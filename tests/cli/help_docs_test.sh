@@ -26,6 +26,35 @@ names_with() {
   grep -E -- "(^|[^-A-Za-z0-9_])$opt([^-A-Za-z0-9_]|$)" | grep -Eq -- "(^|[^-A-Za-z0-9_.])$value([^-A-Za-z0-9_.]|$)"
 }
 
+# Checks the options `pathstream WORDS... --help` lists against $text (the section); adds their
+# names to $help_names and leaves the help in $help.
+check_options() {
+  help=$("$bin" "$@" --help) || { fail "$bin $* --help exited $?"; return 1; }
+  local cmd="$*" line spec flags rest type default name list
+  # Option lines: "  -m,--machine TEXT:FILE REQUIRED", "  --lead FLOAT:FLOAT in [0.01 - 60]=0.25"
+  # (the type, up to two spaces or the end of the line, carries the default after "=").
+  while IFS= read -r line; do
+    spec=${line#  }
+    flags=${spec%% *}
+    rest=${spec#"$flags"}
+    type=$(printf '%s' "$rest" | sed -E 's/^ //; s/  .*$//')
+    default=""
+    case $type in *=*) default=${type##*=} ;; esac
+    IFS=, read -ra list <<< "$flags"
+    for name in "${list[@]}"; do
+      help_names="$help_names $name"
+      case $name in -h | --help) continue ;; esac
+      checks=$((checks + 1))
+      printf '%s\n' "$text" | names "$name" || fail "'$cmd' option $name is not documented in its section of $doc"
+      if [ -n "$default" ] && [ "${name#--}" != "$name" ]; then
+        checks=$((checks + 1))
+        printf '%s\n' "$text" | names_with "$name" "$default" ||
+          fail "'$cmd' option $name: no line of its section of $doc names it with its default $default"
+      fi
+    done
+  done < <(printf '%s\n' "$help" | awk '/^Options:/ { on = 1; next } /^[^ ]/ { on = 0 } on && /^  -/')
+}
+
 top=$("$bin" --help) || { echo "FAIL: $bin --help exited $?"; exit 1; }
 commands=$(printf '%s\n' "$top" | awk '/^Subcommands:/ { on = 1; next } /^[^ ]/ { on = 0 } on && /^  [a-z]/ { print $1 }')
 [ -n "$commands" ] || { echo "FAIL: no commands found in $bin --help"; exit 1; }
@@ -52,30 +81,13 @@ for cmd in $commands; do
     printf '%s\n' "$own" | grep -q "$word" || fail "section of '$cmd' does not state '$word'"
   done
 
-  help=$("$bin" "$cmd" --help) || { fail "$bin $cmd --help exited $?"; continue; }
-  # Option lines: "  -m,--machine TEXT:FILE REQUIRED", "  --lead FLOAT:FLOAT in [0.01 - 60]=0.25"
-  # (the type, up to two spaces or the end of the line, carries the default after "=").
   help_names=""
-  while IFS= read -r line; do
-    spec=${line#  }
-    flags=${spec%% *}
-    rest=${spec#"$flags"}
-    type=$(printf '%s' "$rest" | sed -E 's/^ //; s/  .*$//')
-    default=""
-    case $type in *=*) default=${type##*=} ;; esac
-    IFS=, read -ra list <<< "$flags"
-    for name in "${list[@]}"; do
-      help_names="$help_names $name"
-      case $name in -h | --help) continue ;; esac
-      checks=$((checks + 1))
-      printf '%s\n' "$text" | names "$name" || fail "'$cmd' option $name is not documented in its section of $doc"
-      if [ -n "$default" ] && [ "${name#--}" != "$name" ]; then
-        checks=$((checks + 1))
-        printf '%s\n' "$text" | names_with "$name" "$default" ||
-          fail "'$cmd' option $name: no line of its section of $doc names it with its default $default"
-      fi
-    done
-  done < <(printf '%s\n' "$help" | awk '/^Options:/ { on = 1; next } /^[^ ]/ { on = 0 } on && /^  -/')
+  check_options "$cmd" || continue
+  # A command with subcommands of its own (fleet status, fleet submit, ...): theirs too, in
+  # the same section.
+  for sub in $(printf '%s\n' "$help" | awk '/^Subcommands:/ { on = 1; next } /^[^ ]/ { on = 0 } on && /^  [a-z]/ { print $1 }'); do
+    check_options "$cmd" "$sub"
+  done
 
   # The other way round: an option in a table row of the section must exist.
   for name in $(printf '%s\n' "$own" | grep -E '^\| `-' | grep -oE -- '(^|[^-A-Za-z0-9_])--?[A-Za-z][-A-Za-z0-9]*' |
