@@ -13,6 +13,7 @@
 #include "cli/ctl_command.hpp"
 #include "cli/drive_command.hpp"
 #include "cli/eval_command.hpp"
+#include "cli/fleet_command.hpp"
 #include "cli/plan_command.hpp"
 #include "cli/serve_command.hpp"
 #include "cli/setpoints_command.hpp"
@@ -54,6 +55,8 @@ int main(int argc, char** argv) {
     pathstream::host::add_serve_command(app, serve);
     pathstream::host::CalibrateOptions calibrate;
     pathstream::host::add_calibrate_command(app, calibrate);
+    pathstream::host::FleetCommandOptions fleet;
+    pathstream::host::add_fleet_command(app, fleet);
 
     return pathstream::device_cli::parse_and_run(app, argc, argv, [&]() -> int {
         try {
@@ -68,6 +71,7 @@ int main(int argc, char** argv) {
             if (app.got_subcommand("ctl")) return pathstream::host::run_ctl(ctl);
             if (app.got_subcommand("serve")) return pathstream::host::run_serve(serve);
             if (app.got_subcommand("calibrate")) return pathstream::host::run_calibrate(calibrate);
+            if (app.got_subcommand("fleet")) return pathstream::host::run_fleet(fleet);
         } catch (const pathstream::host::PlanError& e) {
             std::cerr << "pathstream: planning failed: " << e.what() << '\n';
             return kExitPlanning;

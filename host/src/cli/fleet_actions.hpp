@@ -1,0 +1,24 @@
+// The subcommands of `pathstream fleet` that act: submit, command and the page's server.
+#pragma once
+
+#include "fleet_command.hpp"
+#include "fleet_link.hpp"
+
+namespace pathstream::host {
+
+/// `fleet submit`: publishes the job (its queued state first); with --wait, follows it to a
+/// final state. Returns 0, or 1 when the job ended other than done.
+int run_fleet_submit(FleetLink& link, const FleetCommandOptions& options);
+
+/// `fleet command`: one command to one machine, its reply printed. Returns 0 for status
+/// 200, else 6.
+int run_fleet_command(FleetLink& link, const FleetCommandOptions& options);
+
+/// `fleet serve`: the fleet page and its API until SIGINT or SIGTERM. Returns 0.
+int run_fleet_serve(FleetLink& link, const FleetCommandOptions& options);
+
+/// The file's text for a job. Throws std::invalid_argument when it cannot be read or is
+/// larger than `max_bytes` (read no further than that).
+std::string read_job_file(const std::string& path, std::size_t max_bytes);
+
+}  // namespace pathstream::host
