@@ -113,6 +113,7 @@ void print_table(const std::vector<std::vector<std::string>>& rows) {
             line += r[i];
             if (i + 1 < r.size()) line += std::string(width[i] - r[i].size() + 2, ' ');
         }
+        while (!line.empty() && line.back() == ' ') line.pop_back();  // an empty last cell
         std::cout << line << '\n';
     }
 }
