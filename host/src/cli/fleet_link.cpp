@@ -30,7 +30,9 @@ FleetLink::FleetLink(MqttUrl url) : url_(std::move(url)) {
 }
 
 FleetLink::~FleetLink() {
+    // The client first: its network thread calls on_message, which uses the members below.
     disconnect();
+    client_.reset();
 }
 
 void FleetLink::connect() {
@@ -39,7 +41,8 @@ void FleetLink::connect() {
 }
 
 void FleetLink::disconnect() {
-    if (client_ && client_->connected()) client_->disconnect();
+    // Also while reconnecting after a lost connection: this stops the network thread.
+    if (client_) client_->disconnect();
 }
 
 void FleetLink::on_message(const std::string& topic, const std::string& payload) {
