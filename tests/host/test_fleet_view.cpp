@@ -175,7 +175,7 @@ TEST_CASE("fleet job: the message and its queued state", "[fleet]") {
     s.machine.clear();
     s.kind = "pen_plotter";
     CHECK(build_fleet_job(s, 0, random).topic == "pathstream/queue/pen_plotter");
-    for (const char* ext : {"a.csv", "a.SVG", "a.ngc", "a.gcode", "a.nc", "a.bpt"}) {
+    for (const char* ext : {"a.csv", "a.svg", "a.ngc", "a.gcode", "a.nc", "a.bpt"}) {
         s.file_name = ext;
         CHECK_NOTHROW(build_fleet_job(s, 0, random));
     }
@@ -198,6 +198,13 @@ TEST_CASE("fleet job: bad submissions say why", "[fleet]") {
     b = s;
     b.file_name = "rose.docx";
     refused(b, "no reader knows its extension (.json");
+    // As the machines check it: lower case, and no .gc (a machine would refuse the job).
+    b.file_name = "rose.SVG";
+    refused(b, "no reader knows its extension");
+    b.file_name = "rose.gc";
+    refused(b, "no reader knows its extension");
+    b.file_name = ".json";
+    refused(b, "no leading .");
     b = s;
     b.drawing.assign(b.max_bytes + 1, 'x');
     refused(b, "a job may carry");

@@ -35,7 +35,7 @@ void add_fleet_command(CLI::App& app, FleetCommandOptions& o) {
     jobs->add_flag("--json", o.json, "print JSON instead of a table");
 
     CLI::App* submit = fleet->add_subcommand("submit", "publish a job; print its id");
-    submit->add_option("file", o.file, "the drawing (.json .csv .svg .ngc .gcode .nc .gc .bpt)")
+    submit->add_option("file", o.file, "the drawing (.json .csv .svg .ngc .gcode .nc .bpt)")
         ->required()
         ->check(CLI::ExistingFile);
     auto* kind = submit->add_option("--kind", o.kind,

@@ -8,11 +8,24 @@
 #include <stdexcept>
 
 #include "pathstream/host/fleet_view.hpp"
-#include "pathstream/host/path_formats.hpp"
 
 namespace pathstream::host {
 
 using Json = nlohmann::json;
+
+namespace {
+
+// The extensions the machines take (docs/mqtt.md), exactly as they check them: a job they would
+// refuse is refused here, before it is published.
+bool machine_takes(const std::string& file) {
+    for (const std::string e : {".json", ".csv", ".svg", ".ngc", ".gcode", ".nc", ".bpt"}) {
+        if (file.size() > e.size() && file.compare(file.size() - e.size(), e.size(), e) == 0)
+            return true;
+    }
+    return false;
+}
+
+}  // namespace
 
 std::string generate_job_id(double unix_seconds, std::mt19937_64& random) {
     const std::time_t t = static_cast<std::time_t>(std::floor(unix_seconds));
@@ -41,11 +54,12 @@ FleetJobMessages build_fleet_job(const FleetJobSpec& spec, double now, std::mt19
                                     "\": 1 to 64 of A-Z a-z 0-9 _ -");
     }
     const std::string base = spec.file_name.substr(spec.file_name.find_last_of("/\\") + 1);
-    if (base.empty() || base.size() > 255)
-        throw std::invalid_argument("a job needs a file name (1 to 255 characters)");
-    if (format_of_file_name(base).empty()) {
-        throw std::invalid_argument("file \"" + base + "\": no reader knows its extension (" +
-                                    path_extension_list() + ")");
+    if (base.empty() || base.size() > 255 || base.front() == '.')
+        throw std::invalid_argument("a job needs a file name (1 to 255 characters, no leading .)");
+    if (!machine_takes(base)) {
+        throw std::invalid_argument("file \"" + base +
+                                    "\": no reader knows its extension (.json .csv .svg .ngc "
+                                    ".gcode .nc .bpt)");
     }
     if (spec.drawing.size() > spec.max_bytes) {
         throw std::invalid_argument(
