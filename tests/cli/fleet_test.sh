@@ -5,7 +5,8 @@
 # and the job message on the right topic, submit --wait exiting as the final state says,
 # command getting its reply (a responder answers it), bad values refused (exit 2), a machine
 # that does not answer (exit 6), and a broker with passwords refusing a client without one
-# (exit 3) while a password file lets it in.
+# (exit 3) while a password file lets it in; end to end, a real serve --mqtt machine (the
+# simulated device) taking a job fleet submits and drawing it.
 #   fleet_test.sh PATHSTREAM_BINARY SOURCE_DIR WORK_DIR
 set -u
 bin=$1 src=$2 work=$3
@@ -195,6 +196,30 @@ expect 3 "refused the connection" "no password" -- fleet status
 printf 's3cret\n' > "$work/pw"
 out=$(timeout -s KILL 30 "$bin" fleet --mqtt "mqtt://ann@127.0.0.1:$port?password_file=$work/pw" status 2>&1); rc=$?
 [ $rc -eq 0 ] && [[ "$out" == *"0 machines"* ]] && ok || fail "with the password file: $rc $out"
+
+# End to end with a real machine on the same broker: the simulated device and serve --mqtt of
+# its own kind take the job fleet submits, draw it and report it done.
+url="mqtt://ann@127.0.0.1:$port?password_file=$work/pw"
+real() { timeout -s KILL 60 "$bin" fleet --mqtt "$url" "$@" < /dev/null; }
+machine="$src/examples/machines/pen_plotter.json"
+"$bin" device -m "$machine" --no-gpio --tcp 127.0.0.1:0 --time-scale 10 --exit-after 110 > "$work/device.log" 2>&1 &
+pids+=($!)
+for _ in $(seq 200); do
+  target=$(sed -n 's/.*serving \(modbus-tcp:[^ ]*\).*/\1/p' "$work/device.log"); [ -n "$target" ] && break; sleep 0.05
+done
+"$bin" serve -m "$machine" -t "$target" --listen 127.0.0.1:0 --state-dir "$work/state" --mqtt "$url" \
+  --name real-1 --kind fleet-e2e > "$work/serve.log" 2>&1 < /dev/null &
+pids+=($!)
+until_retained '"state":"idle"' -u ann -P s3cret -t pathstream/real-1/status && ok || fail "real-1 never idle: $(cat "$work/serve.log")"
+out=$(real status); [[ "$out" =~ real-1\ +yes\ +idle ]] && ok || fail "status of a real machine: $out"
+out=$(real submit "$src/examples/wave.json" --kind fleet-e2e --id e2e-1 --wait 2>&1); rc=$?
+[ $rc -eq 0 ] && [[ "$out" == *"e2e-1 done on real-1"* ]] && ok || fail "a real machine's job: $rc $out $(tail -5 "$work/serve.log")"
+real jobs --json > "$work/e2e.json"
+check_json '[h["state"] for j in d["jobs"] if j["id"] == "e2e-1" for h in j["history"]] == ["queued", "running", "done"]' \
+  < "$work/e2e.json" && ok || fail "e2e-1's history: $(cat "$work/e2e.json")"
+out=$(real command real-1 pen --pen down); rc=$?
+[ $rc -eq 0 ] && [[ "$out" == *'"status":200'* ]] && ok || fail "pen down on real-1: $rc $out"
+expect 6 "machine real-1 answered 409" "resume_job with no job" -- real command real-1 resume_job
 kill -9 "$broker_pid"; wait "$broker_pid" 2> /dev/null
 # No broker at all: exit 3.
 expect 3 "pathstream: " "no broker" -- fleet status
