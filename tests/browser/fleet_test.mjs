@@ -190,7 +190,10 @@ async function main() {
     await within(5000, 'the page shows the reply', async () =>
       (await page.textContent('#command-result')) === 'plotter-1: hold ok');
 
-    // The API refuses what cannot be a job, with the reason.
+    // The API refuses what cannot be a job, with the reason. A machine that went offline first.
+    pub('pathstream/plotter-9/online', { name: 'plotter-9', machine: 'pen_plotter.json', axes: ['x', 'y'], online: false });
+    await within(5000, 'the offline plotter-9 in the table', async () =>
+      (await page.getAttribute('#machines tr[data-machine="plotter-9"]', 'data-state').catch(() => null)) === 'offline');
     const api = await page.evaluate(async () => {
       const post = async body => {
         const r = await fetch('/api/submit', { method: 'POST', body: JSON.stringify(body) });
@@ -200,6 +203,7 @@ async function main() {
         id: await post({ file: 'a.json', drawing: '{}', id: 'a/b' }),
         ext: await post({ file: 'a.docx', drawing: 'x' }),
         machine: await post({ file: 'a.json', drawing: '{}', machine: 'nobody' }),
+        offline: await post({ file: 'a.json', drawing: '{}', machine: 'plotter-9' }),
         large: await post({ file: 'a.json', drawing: 'x'.repeat(6000) }),
         json: await post('not an object'),
         verb: await (await fetch('/api/command', { method: 'POST', body: '{"machine":"plotter-1","verb":"explode"}' })).status,
@@ -208,12 +212,16 @@ async function main() {
     check(api.id[0] === 400 && api.id[1].includes('1 to 64 of A-Z a-z 0-9 _ -'), `a bad id: ${api.id}`);
     check(api.ext[0] === 400 && api.ext[1].includes('no reader knows its extension'), `an unknown extension: ${api.ext}`);
     check(api.machine[0] === 404 && api.machine[1] === 'no machine named nobody on the broker', `an unknown machine: ${api.machine}`);
+    check(api.offline[0] === 409 && api.offline[1] === 'machine plotter-9 is offline: a job sent to it now would be lost',
+      `an offline machine: ${api.offline}`);
     check(api.large[0] === 413 && api.large[1].includes('more than 5242'), `too large: ${api.large}`);
     check(api.json[0] === 400, `not an object: ${api.json}`);
     check(api.verb === 400, `an unknown verb: ${api.verb}`);
     await page.screenshot({ path: path.join(outDir, 'fleet-phone.png'), fullPage: true });
 
-    // The picture for the docs: three machines drawing, on a laptop.
+    // The picture for the docs: three machines drawing, on a laptop (plotter-9 forgotten).
+    execFileSync('mosquitto_pub', ['-p', String(port), '-q', '1', '-r', '-t', 'pathstream/plotter-9/online', '-n']);
+    await within(5000, 'plotter-9 forgotten', async () => (await page.locator('#machines tbody tr').count()) === 3);
     await page.setViewportSize({ width: 1366, height: 768 });
     await page.click('#jobs tr[data-job="print-0002"]');
     await page.evaluate(() => window.scrollTo(0, 0));

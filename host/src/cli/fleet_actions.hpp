@@ -17,6 +17,10 @@ int run_fleet_command(FleetLink& link, const FleetCommandOptions& options);
 /// `fleet serve`: the fleet page and its API until SIGINT or SIGTERM. Returns 0.
 int run_fleet_serve(FleetLink& link, const FleetCommandOptions& options);
 
+/// Why a job cannot go to machine `name` ("no machine named NAME on the broker", "machine
+/// NAME is offline: ..."), or "" when it can.
+std::string machine_refusal(const FleetLink& link, const std::string& name);
+
 /// The file's text for a job. Throws std::invalid_argument when it cannot be read or is
 /// larger than `max_bytes` (read no further than that).
 std::string read_job_file(const std::string& path, std::size_t max_bytes);

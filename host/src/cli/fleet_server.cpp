@@ -56,7 +56,7 @@ std::string text_field(const Json& j, const char* key) {
 
 bool known_machine(const FleetLink& link, const std::string& name) {
     bool known = false;
-    link.read([&](const FleetView& v) { known = v.has_machine(name); });
+    link.read([&](const FleetView& v) { known = v.machine(name) != nullptr; });
     return known;
 }
 
@@ -85,9 +85,11 @@ HttpResponse submit(FleetLink& link, const HttpRequest& req, std::size_t max_byt
         return refuse(413, "the drawing has " + std::to_string(spec.drawing.size()) +
                                " bytes, more than " + std::to_string(max_bytes));
     }
-    if (!spec.machine.empty() && is_fleet_name(spec.machine) &&
-        !known_machine(link, spec.machine)) {
-        return refuse(404, "no machine named " + spec.machine + " on the broker");
+    if (!spec.machine.empty() && is_fleet_name(spec.machine)) {
+        if (!known_machine(link, spec.machine))
+            return refuse(404, "no machine named " + spec.machine + " on the broker");
+        if (const std::string why = machine_refusal(link, spec.machine); !why.empty())
+            return refuse(409, why);
     }
     thread_local std::mt19937_64 random(std::random_device{}());
     FleetJobMessages job;

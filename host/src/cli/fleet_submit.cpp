@@ -23,6 +23,21 @@ double unix_now() {
 
 }  // namespace
 
+std::string machine_refusal(const FleetLink& link, const std::string& name) {
+    bool known = false, online = false;
+    link.read([&](const FleetView& v) {
+        if (const FleetMachine* m = v.machine(name)) {
+            known = true;
+            online = m->online;
+        }
+    });
+    if (!known) return "no machine named " + name + " on the broker";
+    // Sessions are clean: an offline machine's jobs topic has no subscriber, and the broker
+    // drops what nobody is subscribed to.
+    if (!online) return "machine " + name + " is offline: a job sent to it now would be lost";
+    return "";
+}
+
 std::string read_job_file(const std::string& path, std::size_t max_bytes) {
     std::ifstream in(path, std::ios::binary);
     if (!in) throw std::invalid_argument("cannot read " + path);
@@ -52,9 +67,8 @@ int run_fleet_submit(FleetLink& link, const FleetCommandOptions& o) {
     if (!o.machine.empty()) {
         // A job on the topic of a machine nobody runs would wait for nobody: refuse it.
         std::this_thread::sleep_for(std::chrono::milliseconds(static_cast<long>(o.settle * 1000)));
-        bool known = false;
-        link.read([&](const FleetView& v) { known = v.has_machine(o.machine); });
-        if (!known) throw std::invalid_argument("no machine named " + o.machine + " on the broker");
+        const std::string why = machine_refusal(link, o.machine);
+        if (!why.empty()) throw std::invalid_argument(why);
     }
     // The state first: a watcher sees the job queued before any machine can take it.
     link.publish(job.state_topic, job.state.dump(), 1, true);

@@ -75,10 +75,6 @@ bool is_active(const std::string& state) {
     return state == "running" || state == "held" || state == "interrupted";
 }
 
-Json number_or_null(double v) {
-    return v < 0 ? Json(nullptr) : Json(v);
-}
-
 }  // namespace
 
 bool is_final_job_state(const std::string& s) {
@@ -278,51 +274,14 @@ std::vector<FleetJob> FleetView::jobs() const {
     return out;
 }
 
+const FleetMachine* FleetView::machine(const std::string& name) const {
+    const auto it = machines_.find(name);
+    return it == machines_.end() ? nullptr : &it->second;
+}
+
 const FleetJob* FleetView::job(const std::string& id) const {
     const auto it = jobs_.find(id);
     return it == jobs_.end() ? nullptr : &it->second;
-}
-
-Json to_json(const FleetMachine& m) {
-    Json position = Json::object();
-    for (const auto& [axis, v] : m.position_mm) position[axis] = v;
-    return Json{{"name", m.name},
-                {"online", m.online},
-                {"machine", m.machine_file},
-                {"axes", m.axes},
-                {"kind", m.kind},
-                {"state", m.state},
-                {"error", m.error},
-                {"position_mm", position},
-                {"fraction", number_or_null(m.fraction)},
-                {"eta_s", number_or_null(m.eta_s)},
-                {"job", m.job.empty() ? Json(nullptr) : Json(m.job)}};
-}
-
-Json to_json(const FleetJob& j) {
-    Json history = Json::array();
-    for (const FleetJobStep& s : j.history) {
-        history.push_back(Json{{"state", s.state},
-                               {"machine", s.machine.empty() ? Json(nullptr) : Json(s.machine)},
-                               {"at", s.at}});
-    }
-    return Json{{"id", j.id},
-                {"state", j.state},
-                {"machine", j.machine.empty() ? Json(nullptr) : Json(j.machine)},
-                {"file", j.file},
-                {"at", j.at},
-                {"error", j.error},
-                {"history", history},
-                {"fraction", number_or_null(j.fraction)},
-                {"eta_s", number_or_null(j.eta_s)}};
-}
-
-Json FleetView::to_json() const {
-    Json machines = Json::array();
-    for (const FleetMachine& m : this->machines()) machines.push_back(host::to_json(m));
-    Json jobs = Json::array();
-    for (const FleetJob& j : this->jobs()) jobs.push_back(host::to_json(j));
-    return Json{{"machines", machines}, {"jobs", jobs}, {"ignored", ignored_}};
 }
 
 }  // namespace pathstream::host

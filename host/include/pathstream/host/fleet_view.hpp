@@ -79,8 +79,8 @@ public:
     std::vector<FleetJob> jobs() const;
     /// The job `id`, or null.
     const FleetJob* job(const std::string& id) const;
-    /// True when a machine of this name has been seen (online or not).
-    bool has_machine(const std::string& name) const { return machines_.count(name) != 0; }
+    /// The machine `name` as last seen (online or not; its `job` not filled in), or null.
+    const FleetMachine* machine(const std::string& name) const;
 
     /// Messages ignored as malformed or past a cap, since construction.
     std::uint64_t ignored() const { return ignored_; }
