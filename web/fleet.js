@@ -81,7 +81,7 @@ function render(view) {
   $('no-jobs').hidden = view.jobs.length > 0;
   showHistory(view.jobs);
   const online = view.machines.filter(m => m.online).length;
-  $('counts').textContent = `${online} of ${view.machines.length} online, ${view.jobs.length} jobs` +
+  $('counts').textContent = `${online} of ${view.machines.length} online, ${view.jobs_total ?? view.jobs.length} jobs` +
     (view.ignored ? `, ${view.ignored} malformed messages ignored` : '');
   const kinds = [...new Set(view.machines.map(m => m.kind).filter(Boolean))].sort();
   fillSelect($('target'), [['kind:any', 'any idle machine'],

@@ -207,6 +207,7 @@ async function main() {
         large: await post({ file: 'a.json', drawing: 'x'.repeat(6000) }),
         json: await post('not an object'),
         verb: await (await fetch('/api/command', { method: 'POST', body: '{"machine":"plotter-1","verb":"explode"}' })).status,
+        view: await (await fetch('/api/fleet')).json(),
       };
     });
     check(api.id[0] === 400 && api.id[1].includes('1 to 64 of A-Z a-z 0-9 _ -'), `a bad id: ${api.id}`);
@@ -217,6 +218,8 @@ async function main() {
     check(api.large[0] === 413 && api.large[1].includes('more than 5242'), `too large: ${api.large}`);
     check(api.json[0] === 400, `not an object: ${api.json}`);
     check(api.verb === 400, `an unknown verb: ${api.verb}`);
+    check(api.view.jobs_total === 6 && api.view.jobs.length === 6 && api.view.ignored === 0,
+      `GET /api/fleet: ${api.view.jobs.length} of ${api.view.jobs_total} jobs, ${api.view.ignored} ignored`);
     await page.screenshot({ path: path.join(outDir, 'fleet-phone.png'), fullPage: true });
 
     // The picture for the docs: three machines drawing, on a laptop (plotter-9 forgotten).

@@ -27,6 +27,8 @@ using Json = nlohmann::json;
 using serve::HttpRequest;
 using serve::HttpResponse;
 
+constexpr std::size_t kPageJobs = 200;  // the newest jobs GET /api/fleet lists
+
 std::atomic<bool> g_stop{false};
 extern "C" void on_fleet_signal(int) {
     g_stop.store(true);
@@ -202,6 +204,12 @@ int run_fleet_serve(FleetLink& link, const FleetCommandOptions& o) {
                [&link](const HttpRequest&, const serve::CancelToken&) {
                    Json view = link.view_json();
                    view["broker"] = link.url().text();
+                   // The page polls once a second: the newest jobs only, not 4096 histories.
+                   Json& jobs = view["jobs"];
+                   view["jobs_total"] = jobs.size();
+                   if (jobs.size() > kPageJobs)
+                       jobs.erase(jobs.begin() + static_cast<std::ptrdiff_t>(kPageJobs),
+                                  jobs.end());
                    return reply(200, view);
                });
     http.route("POST", "/api/submit", serve::Lane::work,
