@@ -223,7 +223,9 @@ out=$(real command real-1 pen --pen down); rc=$?
 expect 6 "machine real-1 answered 409" "resume_job with no job" -- real command real-1 resume_job
 kill -9 "$broker_pid"; wait "$broker_pid" 2> /dev/null
 # No broker at all: exit 3.
-expect 3 "pathstream: " "no broker" -- fleet status
+expect 3 "cannot reach the broker mqtt://127.0.0.1:$port" "no broker" -- fleet status
+# A bad value is exit 2 even then: values are checked before connecting.
+expect 2 "1 to 64 of A-Z a-z 0-9 _ -" "a bad id, no broker" -- fleet submit "$src/examples/rose.json" --id 'a/b'
 
 echo "fleet_test: $passed passed, $failures failed"
 [ "$failures" -eq 0 ]

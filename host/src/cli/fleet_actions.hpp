@@ -3,12 +3,21 @@
 
 #include "fleet_command.hpp"
 #include "fleet_link.hpp"
+#include "pathstream/host/fleet_job.hpp"
 
 namespace pathstream::host {
 
-/// `fleet submit`: publishes the job (its queued state first); with --wait, follows it to a
+/// `fleet submit`'s job from its file and options, checked: before connecting, so that a bad
+/// value is exit 2 whether the broker is reachable or not. Throws std::invalid_argument.
+FleetJobMessages prepare_fleet_job(const FleetCommandOptions& options);
+
+/// `fleet submit`: publishes `job` (its queued state first); with --wait, follows it to a
 /// final state. Returns 0, or 1 when the job ended other than done.
-int run_fleet_submit(FleetLink& link, const FleetCommandOptions& options);
+int run_fleet_submit(FleetLink& link, const FleetCommandOptions& options,
+                     const FleetJobMessages& job);
+
+/// Checks `fleet command`'s machine name (before connecting). Throws std::invalid_argument.
+void check_command(const FleetCommandOptions& options);
 
 /// `fleet command`: one command to one machine, its reply printed. Returns 0 for status
 /// 200, else 6.

@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <ctime>
 #include <iostream>
+#include <optional>
 #include <stdexcept>
 #include <thread>
 
@@ -176,18 +177,22 @@ int print_jobs(const FleetLink& link, bool json) {
 }  // namespace
 
 int run_fleet(const FleetCommandOptions& o) {
+    const CLI::App& f = *o.command;
+    // Every value is checked before connecting: a bad one is exit 2 whatever the broker does.
     FleetLink link(parse_mqtt_url(o.mqtt));
+    std::optional<FleetJobMessages> job;
+    if (f.got_subcommand("submit")) job = prepare_fleet_job(o);
+    if (f.got_subcommand("command")) check_command(o);
     link.connect();
     const auto settle = std::chrono::milliseconds(static_cast<long>(o.settle * 1000));
-    const CLI::App& f = *o.command;
     int status = 0;
     if (f.got_subcommand("status") || f.got_subcommand("jobs")) {
         // The broker sends the retained topics right after each grant: a short wait has them
         // all (a quiet moment would never come from machines that report 10 times a second).
         std::this_thread::sleep_for(settle);
         status = f.got_subcommand("status") ? print_status(link, o.json) : print_jobs(link, o.json);
-    } else if (f.got_subcommand("submit")) {
-        status = run_fleet_submit(link, o);
+    } else if (job) {
+        status = run_fleet_submit(link, o, *job);
     } else if (f.got_subcommand("command")) {
         status = run_fleet_command(link, o);
     } else if (f.got_subcommand("serve")) {

@@ -51,7 +51,7 @@ std::string read_job_file(const std::string& path, std::size_t max_bytes) {
     return text;
 }
 
-int run_fleet_submit(FleetLink& link, const FleetCommandOptions& o) {
+FleetJobMessages prepare_fleet_job(const FleetCommandOptions& o) {
     FleetJobSpec spec;
     spec.file_name = o.file;
     spec.max_bytes = static_cast<std::size_t>(o.max_upload_mb * 1024 * 1024);
@@ -63,7 +63,17 @@ int run_fleet_submit(FleetLink& link, const FleetCommandOptions& o) {
     if (o.margin >= 0) spec.options["margin"] = o.margin;
     std::random_device entropy;
     std::mt19937_64 random(entropy());
-    const FleetJobMessages job = build_fleet_job(spec, unix_now(), random);
+    return build_fleet_job(spec, unix_now(), random);
+}
+
+void check_command(const FleetCommandOptions& o) {
+    if (!is_fleet_name(o.name)) {
+        throw std::invalid_argument("machine \"" + o.name +
+                                    "\": 1 to 64 of A-Z a-z 0-9 _ - (it is part of topics)");
+    }
+}
+
+int run_fleet_submit(FleetLink& link, const FleetCommandOptions& o, const FleetJobMessages& job) {
     if (!o.machine.empty()) {
         // A job on the topic of a machine nobody runs would wait for nobody: refuse it.
         std::this_thread::sleep_for(std::chrono::milliseconds(static_cast<long>(o.settle * 1000)));
@@ -115,10 +125,6 @@ int run_fleet_submit(FleetLink& link, const FleetCommandOptions& o) {
 }
 
 int run_fleet_command(FleetLink& link, const FleetCommandOptions& o) {
-    if (!is_fleet_name(o.name)) {
-        throw std::invalid_argument("machine \"" + o.name +
-                                    "\": 1 to 64 of A-Z a-z 0-9 _ - (it is part of topics)");
-    }
     nlohmann::json request{{"verb", o.verb}};
     if (!o.axis.empty()) request["axis"] = o.axis;
     if (o.distance != 0) request["distance_mm"] = o.distance;
