@@ -213,7 +213,7 @@ async function main() {
     check(api.id[0] === 400 && api.id[1].includes('1 to 64 of A-Z a-z 0-9 _ -'), `a bad id: ${api.id}`);
     check(api.ext[0] === 400 && api.ext[1].includes('no reader knows its extension'), `an unknown extension: ${api.ext}`);
     check(api.machine[0] === 404 && api.machine[1] === 'no machine named nobody on the broker', `an unknown machine: ${api.machine}`);
-    check(api.offline[0] === 409 && api.offline[1] === 'machine plotter-9 is offline: a job sent to it now would be lost',
+    check(api.offline[0] === 409 && api.offline[1] === 'machine plotter-9 is offline: a job sent to it now would not be drawn',
       `an offline machine: ${api.offline}`);
     check(api.large[0] === 413 && api.large[1].includes('more than 5242'), `too large: ${api.large}`);
     check(api.json[0] === 400, `not an object: ${api.json}`);

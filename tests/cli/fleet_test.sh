@@ -136,7 +136,7 @@ printf 'hello' > "$work/drawing.docx"
 expect 2 "1 to 64 of A-Z a-z 0-9 _ -" "a bad id" -- fleet submit "$src/examples/rose.json" --id 'a/b'
 expect 2 "no reader knows its extension (.json" "an unknown extension" -- fleet submit "$work/drawing.docx"
 expect 2 "no machine named nobody on the broker" "an unknown machine" -- fleet submit "$src/examples/rose.json" --machine nobody
-expect 2 "machine p3 is offline: a job sent to it now would be lost" "an offline machine" -- fleet submit "$src/examples/rose.json" --machine p3
+expect 2 "machine p3 is offline: a job sent to it now would not be drawn" "an offline machine" -- fleet submit "$src/examples/rose.json" --machine p3
 expect 2 "larger than --max-upload-mb" "too large" -- fleet submit "$src/examples/rose.json" --max-upload-mb 0.001
 expect 2 "excludes" "--kind and --machine" -- fleet submit "$src/examples/rose.json" --kind a --machine p1
 expect 2 "the scheme must be mqtt or mqtts" "a bad URL" -- "$bin" fleet --mqtt http://x status

@@ -32,9 +32,9 @@ std::string machine_refusal(const FleetLink& link, const std::string& name) {
         }
     });
     if (!known) return "no machine named " + name + " on the broker";
-    // Sessions are clean: an offline machine's jobs topic has no subscriber, and the broker
-    // drops what nobody is subscribed to.
-    if (!online) return "machine " + name + " is offline: a job sent to it now would be lost";
+    // A machine stopped properly has ended its broker session, which drops what is sent to it;
+    // one whose host died gets it only when it comes back. Neither is a job drawn now.
+    if (!online) return "machine " + name + " is offline: a job sent to it now would not be drawn";
     return "";
 }
 
