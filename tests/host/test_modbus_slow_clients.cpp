@@ -174,6 +174,13 @@ TEST_CASE("a slow client and a connection flood do not disturb a stream",
     host::StreamOptions o;
     o.target = "modbus-tcp://127.0.0.1:" + std::to_string(port) + "?unit=1";
     const host::StreamReport report = host::stream_modbus(job.plan, job.machine, o);
+    // The dribbler's second reply takes about a second of 90 ms gaps, as long as the stream:
+    // on a loaded machine its thread wakes late, so it is waited for (bounded) while the flood
+    // goes on, rather than expected by the stream's end.
+    const auto dribble_deadline = Clock::now() + std::chrono::seconds(15);
+    while (slow.replies < 2 && !slow.closed && Clock::now() < dribble_deadline) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
     // A connect returns once the kernel has queued it, before the server's accept: stop the
     // flood, then give the still-serving device a bounded time to accept what was queued.
     flood.finish();
