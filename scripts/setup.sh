@@ -29,6 +29,8 @@ packages=(
   libboost-dev chromium
   # many machines: the MQTT client library and the broker the tests start on loopback
   libmosquitto-dev mosquitto mosquitto-clients
+  # the TLS broker test makes its own certificate authority
+  openssl
 )
 # Node.js and npm for the browser tests, from Debian unless a node is installed already.
 command -v node > /dev/null && command -v npm > /dev/null || packages+=(nodejs npm)

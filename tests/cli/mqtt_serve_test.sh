@@ -138,6 +138,35 @@ online=$(sub -u ann -P s3cret -t pathstream/p1/online -C 1 -W 10)
 kill -INT "${pids[-1]}"; wait "${pids[-1]}" 2> /dev/null
 until_retained '"online":false' -u ann -P s3cret -t pathstream/p1/online &&
   ok || fail "not offline after a clean stop"
+kill -9 "$broker_pid"; wait "$broker_pid" 2> /dev/null
+
+# TLS: a broker with a certificate from a CA of the test's own; mqtts:// with that CA as cafile
+# connects, with the system's CAs (which never signed it) it is refused, exit 3.
+(cd "$work" &&
+  openssl req -x509 -newkey rsa:2048 -nodes -days 2 -subj /CN=test-ca -keyout ca.key -out ca.pem &&
+  openssl req -newkey rsa:2048 -nodes -subj /CN=127.0.0.1 -keyout broker.key -out broker.csr &&
+  printf 'subjectAltName=IP:127.0.0.1\n' > san.txt &&
+  openssl x509 -req -in broker.csr -CA ca.pem -CAkey ca.key -CAcreateserial -days 2 \
+    -extfile san.txt -out broker.pem && chmod 644 ca.pem broker.pem broker.key) > "$work/openssl.log" 2>&1 ||
+  fail "openssl: $(tail -3 "$work/openssl.log")"
+start_broker "allow_anonymous true
+cafile $work/ca.pem
+certfile $work/broker.pem
+keyfile $work/broker.key" || exit 1
+"$bin" serve -m "$machine" -t "$target" --listen 127.0.0.1:0 \
+  --mqtt "mqtts://127.0.0.1:$port?cafile=$work/ca.pem" --name tls-1 > "$work/serve_tls.log" 2>&1 &
+pids+=($!)
+online=$(timeout -s KILL 12 mosquitto_sub -h 127.0.0.1 -p "$port" --cafile "$work/ca.pem" -t pathstream/tls-1/online -C 1 -W 10 < /dev/null)
+[[ "$online" == *'"online":true'* ]] && ok || fail "over TLS with the CA: $online $(cat "$work/serve_tls.log")"
+kill -INT "${pids[-1]}"; wait "${pids[-1]}" 2> /dev/null
+out=$("$bin" serve -m "$machine" -t "$target" --listen 127.0.0.1:0 --mqtt "mqtts://127.0.0.1:$port" \
+  --name tls-2 2>&1 < /dev/null); rc=$?
+[ $rc -eq 3 ] && [[ "$out" == *"certificate verify failed"* ]] && ok || fail "TLS with a CA that did not sign the broker: $rc $out"
+# Plain MQTT to the TLS listener is not spoken either.
+out=$(timeout -s KILL 20 "$bin" serve -m "$machine" -t "$target" --listen 127.0.0.1:0 --mqtt "mqtt://127.0.0.1:$port" \
+  --name tls-3 2>&1 < /dev/null); rc=$?
+[ $rc -eq 3 ] && ok || fail "plain MQTT to a TLS broker: $rc $out"
+
 # Bad options: a name with a topic wildcard, --name without --mqtt.
 out=$("$bin" serve -m "$machine" -t "$target" --mqtt "mqtt://127.0.0.1:$port" --name 'a/#' 2>&1); rc=$?
 [ $rc -eq 2 ] && [[ "$out" == *"only letters, digits, _ and -"* ]] && ok || fail "bad name: $rc $out"

@@ -37,6 +37,7 @@ struct MqttClient::State {
     std::condition_variable changed;
     bool connected = false;
     std::optional<int> connect_result;  // the broker's reason code for the last CONNECT
+    std::string last_error;             // libmosquitto's last error log line (a TLS failure)
     std::set<int> acked;                // message ids acknowledged (PUBACK, SUBACK, UNSUBACK)
     std::vector<int> refused;           // SUBACK with a failure code, by message id
     std::vector<std::pair<std::string, int>> subscriptions;  // renewed after a reconnect
@@ -61,6 +62,14 @@ MqttClient::MqttClient(MqttUrl url, std::string client_id, std::optional<Will> w
     s.mosq = mosquitto_new(s.id.c_str(), session_expiry_s == 0, &s);
     if (!s.mosq) throw MqttError("cannot create an MQTT client (out of memory?)");
     mosquitto_int_option(s.mosq, MOSQ_OPT_PROTOCOL_VERSION, MQTT_PROTOCOL_V5);
+    // A TLS handshake that fails ends the connection without a CONNACK: what went wrong is only
+    // in libmosquitto's log, kept for the error message.
+    mosquitto_log_callback_set(s.mosq, [](mosquitto*, void* obj, int level, const char* text) {
+        if (level != MOSQ_LOG_ERR || text == nullptr) return;
+        auto& st = *static_cast<State*>(obj);
+        std::lock_guard lock(st.mutex);
+        st.last_error = std::string(text).substr(0, 300);
+    });
     mosquitto_connect_v5_callback_set(
         s.mosq, [](mosquitto* m, void* obj, int rc, int, const mosquitto_property*) {
             auto& st = *static_cast<State*>(obj);
@@ -167,9 +176,15 @@ void MqttClient::connect(std::chrono::milliseconds timeout, int keepalive_s) {
                                        properties);
     mosquitto_property_free_all(&properties);
     if (rc != MOSQ_ERR_SUCCESS) {
-        throw MqttError(
-            "cannot reach the broker " + s.url.text() + ": " +
-            (rc == MOSQ_ERR_ERRNO ? std::string(std::strerror(errno)) : mosquitto_strerror(rc)));
+        const std::string reason =
+            rc == MOSQ_ERR_ERRNO ? std::string(std::strerror(errno)) : mosquitto_strerror(rc);
+        std::string detail;
+        {
+            std::lock_guard lock(s.mutex);
+            detail = s.last_error;
+        }
+        throw MqttError("cannot reach the broker " + s.url.text() + ": " + reason +
+                        (detail.empty() ? "" : " (" + detail + ")"));
     }
     if (!s.loop_running) {
         rc = mosquitto_loop_start(s.mosq);
@@ -182,7 +197,8 @@ void MqttClient::connect(std::chrono::milliseconds timeout, int keepalive_s) {
         std::unique_lock lock(s.mutex);
         if (!s.wait(lock, timeout, [&] { return s.connect_result.has_value(); })) {
             failure = "no answer from the broker " + s.url.text() + " within " +
-                      std::to_string(timeout.count()) + " ms";
+                      std::to_string(timeout.count()) + " ms" +
+                      (s.last_error.empty() ? "" : " (" + s.last_error + ")");
         } else if (*s.connect_result != 0) {
             failure = "the broker " + s.url.text() +
                       " refused the connection: " + mosquitto_reason_string(*s.connect_result);
