@@ -9,90 +9,33 @@
 // and to one machine, arriving on the broker as published by the server (id, file, drawing);
 // a command button answered by a stand-in machine; the API's 4xx with a reason for a bad id,
 // an unknown extension, an unknown machine, a drawing too large. Screenshots go to OUT_DIR
-// (fleet.png, fleet-phone.png); with PATHSTREAM_UPDATE_IMAGES=1 fleet.png is also copied to
-// docs/images/.
-import { spawn, execFileSync } from 'node:child_process';
-import { mkdtempSync, writeFileSync, readFileSync, rmSync, mkdirSync, copyFileSync } from 'node:fs';
-import { tmpdir } from 'node:os';
-import net from 'node:net';
+// (fleet-stand-ins.png, fleet-stand-ins-phone.png); docs/images/fleet.png comes from
+// fleet_machines_test.mjs, where real machines draw.
+import { execFileSync } from 'node:child_process';
+import { readFileSync } from 'node:fs';
 import path from 'node:path';
-import { chromium } from 'playwright-core';
+import { harness } from './fleet_support.mjs';
 
 const [bin, source, outDir] = process.argv.slice(2);
 if (!bin || !source || !outDir) {
   console.error('usage: node fleet_test.mjs PATHSTREAM SOURCE_DIR OUT_DIR');
   process.exit(2);
 }
-const work = mkdtempSync(path.join(tmpdir(), 'pathstream-fleet-'));
-mkdirSync(outDir, { recursive: true });
-const children = [];
-let failures = 0;
-
-function check(ok, what) {
-  console.log(`${ok ? 'ok  ' : 'FAIL'} ${what}`);
-  if (!ok) failures++;
-}
-
-async function within(ms, what, condition) {
-  const end = Date.now() + ms;
-  while (Date.now() < end) {
-    if (await condition()) {
-      console.log(`ok   ${what}`);
-      return true;
-    }
-    await new Promise(r => setTimeout(r, 50));
-  }
-  check(false, `${what} (within ${ms} ms)`);
-  return false;
-}
-
-const freePort = () => new Promise(resolve => {
-  const s = net.createServer();
-  s.listen(0, '127.0.0.1', () => { const p = s.address().port; s.close(() => resolve(p)); });
-});
-
-async function startBroker() {
-  const port = await freePort();
-  const conf = path.join(work, 'mosquitto.conf');
-  writeFileSync(conf, `listener ${port} 127.0.0.1\npersistence false\nallow_anonymous true\n`);
-  children.push(spawn('/usr/sbin/mosquitto', ['-c', conf], { stdio: 'ignore' }));
-  await within(5000, 'mosquitto listens', () => new Promise(resolve => {
-    const c = net.connect(port, '127.0.0.1', () => { c.end(); resolve(true); });
-    c.on('error', () => resolve(false));
-  }));
-  return port;
-}
+const h = harness('fleet', outDir);
+const { check, within, startBroker } = h;
 
 // Resolves, once subscribed, with { messages }: a promise of the first `count` messages on
 // `topic` (one per line). Wrapped in an object: a promise resolved with a promise would wait
 // for it.
 function subscribe(port, topic, count) {
-  const child = spawn('mosquitto_sub', ['-p', String(port), '-t', topic, '-C', String(count), '-W', '20'],
+  const child = h.spawn('mosquitto_sub', ['-p', String(port), '-t', topic, '-C', String(count), '-W', '20'],
     { stdio: ['ignore', 'pipe', 'pipe'] });
-  children.push(child);
   let text = '';
   child.stdout.on('data', c => { text += c; });
   // 'close', not 'exit': the output is read to its end.
   const done = new Promise(resolve => child.on('close', () => resolve(text.split('\n').filter(Boolean))));
   // Subscribed once mosquitto_sub has had a moment to connect: give it one.
   return new Promise(r => setTimeout(() => r({ messages: done }), 500));
-}
-
-function startAndRead(args, pattern, name) {
-  const child = spawn(bin, args, { stdio: ['ignore', 'pipe', 'pipe'] });
-  children.push(child);
-  let text = '';
-  return new Promise((resolve, reject) => {
-    const timer = setTimeout(() => reject(new Error(`${name}: no ${pattern} in 10 s: ${text}`)), 10000);
-    const look = chunk => {
-      text += chunk;
-      const m = text.match(pattern);
-      if (m) { clearTimeout(timer); resolve({ child, match: m }); }
-    };
-    child.stdout.on('data', look);
-    child.stderr.on('data', chunk => { text += chunk; });
-    child.on('exit', code => reject(new Error(`${name} exited ${code}: ${text}`)));
-  });
 }
 
 async function main() {
@@ -118,17 +61,11 @@ async function main() {
       { state: 'done', machine: 'plotter-1', at: now - 30 }],
   });
 
-  const server = await startAndRead(['fleet', '--mqtt', `mqtt://127.0.0.1:${port}`, 'serve', '--listen', '127.0.0.1:0',
+  const server = await h.startAndRead(bin, ['fleet', '--mqtt', `mqtt://127.0.0.1:${port}`, 'serve', '--listen', '127.0.0.1:0',
     '--max-upload-mb', '0.005'], /(http:\/\/127\.0\.0\.1:\d+\/)/, 'fleet serve');
   const url = server.match[1];
 
-  const browser = await chromium.launchPersistentContext(path.join(work, 'chromium'), {
-    executablePath: '/usr/bin/chromium',
-    headless: true,
-    args: ['--headless', '--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run',
-      '--disable-background-networking', '--disable-component-update', '--disable-sync'],
-    viewport: { width: 390, height: 844 },
-  });
+  const browser = await h.launchBrowser();
   try {
     const page = await browser.newPage();
     page.on('pageerror', e => check(false, `no script error on the page: ${e.message}`));
@@ -145,8 +82,7 @@ async function main() {
     `the machines: ${JSON.stringify(rows.map(r => [r.name, r.online, r.state, r.job]))}`);
     check(rows.map(r => r.progress).join(' ') === '0.25 0.5 0.75' && rows[1].text.includes('50 %'),
       `the progress bars: ${rows.map(r => r.progress)}`);
-    const width = await page.evaluate(() => ({ scroll: document.documentElement.scrollWidth, w: window.innerWidth }));
-    check(width.scroll <= width.w, `no horizontal overflow at 390 px: the page is ${width.scroll} px wide`);
+    await h.noOverflow(page, 'with three stand-ins drawing');
 
     // A click on a job shows its history.
     await page.click('#jobs tr[data-job="print-0000"]');
@@ -220,9 +156,10 @@ async function main() {
     check(api.verb === 400, `an unknown verb: ${api.verb}`);
     check(api.view.jobs_total === 6 && api.view.jobs.length === 6 && api.view.ignored === 0,
       `GET /api/fleet: ${api.view.jobs.length} of ${api.view.jobs_total} jobs, ${api.view.ignored} ignored`);
-    await page.screenshot({ path: path.join(outDir, 'fleet-phone.png'), fullPage: true });
+    await page.screenshot({ path: path.join(outDir, 'fleet-stand-ins-phone.png'), fullPage: true });
 
-    // The picture for the docs: three machines drawing, on a laptop (plotter-9 forgotten).
+    // Three stand-ins drawing, on a laptop (plotter-9 forgotten). Not the docs' picture:
+    // fleet_machines_test.mjs takes that one with real machines drawing.
     execFileSync('mosquitto_pub', ['-p', String(port), '-q', '1', '-r', '-t', 'pathstream/plotter-9/online', '-n']);
     await within(5000, 'plotter-9 forgotten', async () => (await page.locator('#machines tbody tr').count()) === 3);
     await page.setViewportSize({ width: 1366, height: 768 });
@@ -230,27 +167,10 @@ async function main() {
     await page.evaluate(() => window.scrollTo(0, 0));
     await within(3000, 'the history of print-0002 shown', async () =>
       (await page.textContent('#history')).startsWith('print-0002'));
-    await page.screenshot({ path: path.join(outDir, 'fleet.png'), fullPage: true });
-    if (process.env.PATHSTREAM_UPDATE_IMAGES === '1') {
-      copyFileSync(path.join(outDir, 'fleet.png'), path.join(source, 'docs/images/fleet.png'));
-      console.log('copied fleet.png to docs/images/');
-    }
+    await page.screenshot({ path: path.join(outDir, 'fleet-stand-ins.png'), fullPage: true });
   } finally {
     await browser.close();
   }
 }
 
-let status = 0;
-try {
-  await main();
-} catch (e) {
-  console.log(`FAIL ${e.stack || e}`);
-  failures++;
-} finally {
-  for (const c of children) c.kill('SIGKILL');
-  await new Promise(r => setTimeout(r, 300));
-  rmSync(work, { recursive: true, force: true });
-}
-status = failures === 0 ? 0 : 1;
-console.log(failures === 0 ? 'fleet browser test: all passed' : `fleet browser test: ${failures} failed`);
-process.exit(status);
+await h.run(main, 'fleet browser test');
