@@ -159,6 +159,11 @@ int run_serve(const ServeCommandOptions& o) {
     int status = 0;
     {
         serve::Server server(c, machine);
+        // Before anything is announced (the broker's online state, the address printed): a
+        // signal sent as soon as the server shows up must stop it, not be lost (a background
+        // job of a script starts with SIGINT ignored until this handler replaces that).
+        ::signal(SIGINT, on_serve_signal);
+        ::signal(SIGTERM, on_serve_signal);
         try {
             server.bind();
             server.start_mqtt();
@@ -180,8 +185,6 @@ int run_serve(const ServeCommandOptions& o) {
                         c.mqtt->url.text().c_str(), c.mqtt->name.c_str(), c.mqtt->kind.c_str());
         }
         std::fflush(stdout);
-        ::signal(SIGINT, on_serve_signal);
-        ::signal(SIGTERM, on_serve_signal);
         ::signal(SIGPIPE, SIG_IGN);
         std::thread watcher([&] {
             while (!g_stop.load()) std::this_thread::sleep_for(std::chrono::milliseconds(100));
