@@ -4,6 +4,8 @@
 
 #include <stdexcept>
 
+#include "pathstream/host/fleet_view.hpp"
+
 namespace pathstream::host::serve {
 namespace {
 
@@ -31,13 +33,9 @@ std::string string_field(const nlohmann::json& j, const char* key) {
 void check_job_id(const std::string& id) {
     if (id.empty() || id.size() > 64)
         throw std::invalid_argument("job: \"id\" must have 1 to 64 characters");
-    for (const char c : id) {
-        const bool ok = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') ||
-                        (c >= '0' && c <= '9') || c == '_' || c == '-';
-        if (!ok) {
-            throw std::invalid_argument("job: \"id\" \"" + id +
-                                        "\": only letters, digits, _ and - (it is a topic level)");
-        }
+    if (!is_fleet_name(id)) {
+        throw std::invalid_argument("job: \"id\" \"" + id +
+                                    "\": only letters, digits, _ and - (it is a topic level)");
     }
 }
 

@@ -5,6 +5,8 @@
 #include <chrono>
 #include <stdexcept>
 
+#include "pathstream/host/fleet_view.hpp"
+
 namespace pathstream::host::serve {
 namespace {
 
@@ -30,13 +32,9 @@ void check_machine_name(const std::string& name) {
     if (name.empty() || name.size() > 64) {
         throw std::invalid_argument("serve: --name must have 1 to 64 characters");
     }
-    for (const char c : name) {
-        const bool ok = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') ||
-                        (c >= '0' && c <= '9') || c == '_' || c == '-';
-        if (!ok) {
-            throw std::invalid_argument("serve: --name \"" + name +
-                                        "\": only letters, digits, _ and - (it is part of topics)");
-        }
+    if (!is_fleet_name(name)) {
+        throw std::invalid_argument("serve: --name \"" + name +
+                                    "\": only letters, digits, _ and - (it is part of topics)");
     }
 }
 
