@@ -554,6 +554,11 @@ EventChannel open_events(const StreamCommandOptions& o,
         if (machine_file.empty())
             throw std::invalid_argument("stream: --mqtt needs --machine (or --resume JOURNAL)");
         const std::string absolute = std::filesystem::absolute(machine_file).string();
+        // Ours before the machine shows online: a signal sent on seeing it must not be lost (a
+        // script's background job starts with SIGINT ignored). The job then acts on it as on
+        // any Ctrl-C.
+        std::signal(SIGINT, on_stream_signal);
+        std::signal(SIGTERM, on_stream_signal);
         reporter = std::make_unique<serve::StreamReporter>(
             serve::MqttLink{url, o.name, "any"}, load_machine_profile(absolute),
             serve::OperatorTarget{serve::self_executable(), absolute, target,
