@@ -69,7 +69,7 @@ JobDesk::JobDesk(std::string name, std::string kind, std::string state_dir,
     // Ready before the connection: a resumed session delivers at once, before start().
     std::error_code error;
     fs::create_directories(inbox_dir_, error);
-    for (const auto& [number, path] : inbox_files()) next_file_ = std::max(next_file_, number + 1);
+    for (const auto& file : inbox_files()) next_file_ = std::max(next_file_, file.first + 1);
 }
 
 std::vector<std::pair<std::uint64_t, std::string>> JobDesk::inbox_files() const {
@@ -136,7 +136,8 @@ void JobDesk::start() {
     // Jobs the broker delivered to the host that died, oldest first, before those that came
     // since the connection (queued already, their files among these).
     std::deque<Received> left;
-    for (const auto& [number, path] : inbox_files()) {
+    for (const auto& file : inbox_files()) {
+        const std::string& path = file.second;
         {
             const std::lock_guard lock(mutex_);
             const bool queued = std::any_of(inbox_.begin(), inbox_.end(),
