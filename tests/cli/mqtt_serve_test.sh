@@ -104,18 +104,28 @@ sub -t pathstream/plotter-h/events -C 400 -W 60 > "$work/stream_events.txt" &
 events_reader=$!
 sub -t pathstream/plotter-h/reply -C 1 -W 30 > "$work/stream_reply.txt" &
 reply_reader=$!
+# Every online state as it comes: the stream may be over before a look at the retained one.
+sub -t pathstream/plotter-h/online -C 2 -W 30 > "$work/stream_online.txt" &
+online_reader=$!
 sleep 0.5
-"$bin" stream "$src/examples/wave.json" -m "$machine" -t "$target" --no-journal \
+"$bin" stream "$src/examples/rose.json" -m "$machine" -t "$target" --no-journal \
   --mqtt "mqtt://127.0.0.1:$port" --name plotter-h > "$work/stream.log" 2>&1 &
 stream_pid=$!
-until_retained '"online":true' -t pathstream/plotter-h/online && ok || fail "stream online: $(cat "$work/stream.log")"
-mosquitto_pub -p "$port" -t pathstream/plotter-h/command -m '{"id": "s1", "verb": "jog", "axis": "q", "distance_mm": 1}'
+# The command goes out until it is answered: those sent before the stream subscribed are
+# nobody's, and how soon that is depends on the machine's load.
+while kill -0 "$stream_pid" 2> /dev/null && [ ! -s "$work/stream_reply.txt" ]; do
+  mosquitto_pub -p "$port" -t pathstream/plotter-h/command -m '{"id": "s1", "verb": "jog", "axis": "q", "distance_mm": 1}'
+  sleep 0.1
+done
 wait "$stream_pid"; rc=$?
 [ $rc -eq 0 ] && ok || fail "stream --mqtt: exit $rc $(cat "$work/stream.log")"
 wait "$reply_reader"
 reply=$(cat "$work/stream_reply.txt")
 [[ "$reply" == *'"id":"s1"'* && "$reply" == *"the machine has no axis 'q'"* && "$reply" == *'"status":400'* ]] && ok ||
   fail "a command to the streaming machine: $(cat "$work/stream_reply.txt")"
+wait "$online_reader"
+[[ "$(head -1 "$work/stream_online.txt")" == *'"online":true'* ]] && ok ||
+  fail "stream online: $(cat "$work/stream_online.txt") $(cat "$work/stream.log")"
 until_retained '"outcome":"finished"' -t pathstream/plotter-h/job && ok || fail "the job's end on the job topic"
 until_retained '"online":false' -t pathstream/plotter-h/online && ok || fail "stream offline after its job"
 kill "$events_reader" 2> /dev/null; wait "$events_reader" 2> /dev/null
