@@ -26,25 +26,12 @@ cleanup() {
 }
 trap cleanup EXIT
 
-free_port() { $py -c 'import socket; s=socket.socket(); s.bind(("127.0.0.1",0)); print(s.getsockname()[1])'; }
+. "$src/tests/cli/mosquitto_broker.sh"
 mosquitto_passwd -c -b "$work/passwords" fleet 's3cret pass' > /dev/null 2>&1 || { fail "mosquitto_passwd"; exit 1; }
 chmod 644 "$work/passwords"
 printf 's3cret pass\n' > "$work/password.txt"
-for _ in 1 2 3 4 5; do
-  port=$(free_port)
-  printf 'listener %s 127.0.0.1\npersistence false\nlog_dest stderr\nallow_anonymous false\npassword_file %s\n' \
-    "$port" "$work/passwords" > "$work/mosquitto.conf"
-  /usr/sbin/mosquitto -c "$work/mosquitto.conf" 2>> "$work/mosquitto.log" &
-  broker_pid=$!
-  up=0
-  for _ in $(seq 100); do
-    kill -0 "$broker_pid" 2> /dev/null || break
-    (echo > "/dev/tcp/127.0.0.1/$port") 2> /dev/null && { up=1; break; }
-    sleep 0.05
-  done
-  [ $up = 1 ] && { pids+=("$broker_pid"); break; }
-done
-[ "${up:-0}" = 1 ] || { fail "mosquitto did not start: $(tail -3 "$work/mosquitto.log")"; exit 1; }
+start_broker "allow_anonymous false
+password_file $work/passwords" || exit 1
 url="mqtt://fleet@127.0.0.1:$port?password_file=$work/password.txt"
 auth=(-p "$port" -u fleet -P 's3cret pass')
 sub() { timeout -s KILL 12 mosquitto_sub "${auth[@]}" "$@" < /dev/null; }
