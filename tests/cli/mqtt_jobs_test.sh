@@ -36,6 +36,14 @@ url="mqtt://fleet@127.0.0.1:$port?password_file=$work/password.txt"
 auth=(-p "$port" -u fleet -P 's3cret pass')
 sub() { timeout -s KILL 12 mosquitto_sub "${auth[@]}" "$@" < /dev/null; }
 pub() { mosquitto_pub "${auth[@]}" -q 1 "$@"; }
+# Sends a command to machine $1 and writes its reply to $3: the reply's reader subscribes first.
+send_command() {
+  sub -t "pathstream/$1/reply" -C 1 -W 20 > "$3" &
+  local reader=$!
+  sleep 0.5
+  pub -t "pathstream/$1/command" -m "$2"
+  wait $reader
+}
 # Every job's retained state, one JSON object a line.
 states() { timeout -s KILL 5 mosquitto_sub "${auth[@]}" -t 'pathstream/jobs/+/state' -W 1 < /dev/null 2> /dev/null; }
 # Waits (up to $2 s) until the python condition $1 over `s` (job id -> state) holds.
@@ -157,11 +165,7 @@ sleep 2
 start_serve 2
 until_states 's.get("job-00", {}).get("state") == "interrupted" and s["job-00"]["machine"] == "plotter-2"' 20 &&
   ok || fail "job-00 interrupted: $(grep job-00 "$work/states.txt") $(cat "$work/serve2.log")"
-sub -t pathstream/plotter-2/reply -C 1 -W 20 > "$work/resume_reply.txt" &
-reader=$!
-sleep 0.5
-pub -t pathstream/plotter-2/command -m '{"id": "r1", "verb": "resume_job"}'
-wait $reader
+send_command plotter-2 '{"id": "r1", "verb": "resume_job"}' "$work/resume_reply.txt"
 grep -q '"status":200' "$work/resume_reply.txt" && ok || fail "resume_job: $(cat "$work/resume_reply.txt")"
 until_states 'all(s.get(f"job-{k:02d}", {}).get("state") == "done" for k in range(20))' 120 &&
   ok || fail "every job done: $(cat "$work/states.txt")"
@@ -174,11 +178,7 @@ sys.exit(0 if h[0] == "queued" and "interrupted" in h and h[-1] == "done" else 1
 PY
 
 # A command reaches only the machine it names: plotter-3's pen goes down, the others' not.
-sub -t pathstream/plotter-3/reply -C 1 -W 20 > "$work/pen_reply.txt" &
-reader=$!
-sleep 0.5
-pub -t pathstream/plotter-3/command -m '{"id": "c1", "verb": "pen", "down": true}'
-wait $reader
+send_command plotter-3 '{"id": "c1", "verb": "pen", "down": true}' "$work/pen_reply.txt"
 grep -q '"status":200' "$work/pen_reply.txt" && ok || fail "pen down on plotter-3: $(cat "$work/pen_reply.txt")"
 sleep 0.5
 for k in 1 2 3; do
