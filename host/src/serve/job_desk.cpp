@@ -40,16 +40,6 @@ std::string id_of(const std::string& payload) {
     return "";
 }
 
-double submitted_of(const std::string& payload) {
-    try {
-        const nlohmann::json j = nlohmann::json::parse(payload);
-        if (j.is_object() && j.contains("submitted") && j["submitted"].is_number())
-            return j["submitted"].get<double>();
-    } catch (const std::exception&) {
-    }
-    return -1;
-}
-
 }  // namespace
 
 double unix_seconds() {
@@ -265,9 +255,9 @@ bool JobDesk::handle(const Received& r) {
         free = job_.is_null() && !hooks_.busy();
         if (free) {
             nlohmann::json history = nlohmann::json::array();
-            const double submitted = submitted_of(r.payload);
-            if (submitted >= 0)
-                history.push_back({{"state", "queued"}, {"machine", nullptr}, {"at", submitted}});
+            if (job.submitted >= 0)
+                history.push_back(
+                    {{"state", "queued"}, {"machine", nullptr}, {"at", job.submitted}});
             job_ = nlohmann::json{{"id", job.id},      {"state", "taken"},     {"machine", name_},
                                   {"file", job.file},  {"at", unix_seconds()}, {"error", ""},
                                   {"history", history}};

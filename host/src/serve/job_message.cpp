@@ -73,16 +73,20 @@ JobMessage parse_job_message(const std::string& payload, std::size_t max_drawing
             throw std::invalid_argument("job: \"bounces\" must be a count");
         job.bounces = j["bounces"].get<unsigned>();
     }
+    if (j.contains("submitted") && j["submitted"].is_number())
+        job.submitted = j["submitted"].get<double>();
     return job;
 }
 
 std::string job_message_text(const JobMessage& job) {
-    return nlohmann::json{{"id", job.id},
-                          {"file", job.file},
-                          {"drawing", job.drawing},
-                          {"options", job.options},
-                          {"bounces", job.bounces}}
-        .dump();
+    nlohmann::json text{{"id", job.id},
+                        {"file", job.file},
+                        {"drawing", job.drawing},
+                        {"options", job.options},
+                        {"bounces", job.bounces}};
+    // The submission time goes along: the job's history starts there on whichever machine.
+    if (job.submitted >= 0) text["submitted"] = job.submitted;
+    return text.dump();
 }
 
 }  // namespace pathstream::host::serve

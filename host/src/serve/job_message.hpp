@@ -15,6 +15,7 @@ struct JobMessage {
     std::string drawing;     ///< the file's bytes
     nlohmann::json options;  ///< placement and order options, as POST /api/run takes them
     unsigned bounces = 0;    ///< times a busy machine passed it back to its queue
+    double submitted = -1;   ///< when it was submitted (s since the epoch); < 0: not said
 };
 
 /// Throws std::invalid_argument unless `id` is 1 to 64 of A-Z a-z 0-9 _ -. Cost: O(size).
