@@ -62,4 +62,12 @@ std::uint64_t EventHub::published() const {
     return next_ - 1;
 }
 
+std::string job_sticky_kind(const std::string& line) {
+    std::string sticky;
+    for (const char* k : {"job_start", "progress", "job_end", "pause", "state"}) {
+        if (line.find(std::string("\"event\":\"") + k + "\"") != std::string::npos) sticky = k;
+    }
+    return sticky;
+}
+
 }  // namespace pathstream::host::serve

@@ -19,6 +19,10 @@ struct HubEvent {
     std::string json;  ///< one JSON object, no newline
 };
 
+/// The sticky kind of a job's event line (the kinds a page joining late must see): job_start,
+/// progress, job_end, pause or state; "" for any other. Linear in the line.
+std::string job_sticky_kind(const std::string& line);
+
 /// A bounded log of the latest events that any number of threads publish to and any number
 /// of listeners read from, each at its own pace. A listener that falls more than `capacity`
 /// events behind misses the oldest (its next read says how many). Every member locks one

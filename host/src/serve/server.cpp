@@ -357,11 +357,7 @@ bool Server::start_child(const std::string& kind, std::vector<std::string> argv,
         std::string errors, outcome;
         const int exit_code = child->wait(
             [&](const std::string& line) {
-                std::string sticky;
-                for (const char* k : {"job_start", "progress", "job_end", "pause", "state"}) {
-                    if (line.find(std::string("\"event\":\"") + k + "\"") != std::string::npos)
-                        sticky = k;
-                }
+                const std::string sticky = job_sticky_kind(line);
                 if (sticky == "job_end") {
                     for (const char* o : {"finished", "held", "stopped", "failed"}) {
                         if (line.find(std::string("\"outcome\":\"") + o + "\"") !=

@@ -34,11 +34,7 @@ void StreamReporter::start() {
 }
 
 void StreamReporter::event(const std::string& line) {
-    std::string sticky;
-    for (const char* k : {"job_start", "progress", "job_end", "pause", "state"}) {
-        if (line.find(std::string("\"event\":\"") + k + "\"") != std::string::npos) sticky = k;
-    }
-    hub_.publish(line, sticky);
+    hub_.publish(line, job_sticky_kind(line));
 }
 
 void StreamReporter::stop() {
